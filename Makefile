@@ -1,0 +1,34 @@
+# The two commands a newcomer needs: `make report` and `make test`.
+# Both create .venv when missing and install the package with the pinned
+# versions of constraints.txt (so reports are reproduced byte for byte).
+PYTHON ?= python3
+VENV   ?= .venv
+PY     := $(VENV)/bin/python
+WB     := $(VENV)/bin/workbench
+STAMP  := $(VENV)/.installed
+
+.PHONY: install report test bench clean
+
+$(STAMP): pyproject.toml constraints.txt
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -c constraints.txt -e '.[test]'
+	touch $(STAMP)
+
+install: $(STAMP)
+
+## main job: every shipped design -> reports/<design>.md, figures, index
+report: install
+	$(WB) report --all
+
+## tests, then every claim (designs and proofs), then report freshness
+test: install
+	$(PY) -m pytest
+	$(WB) verify
+	$(WB) report --all --check
+
+bench: install
+	for b in benchmarks/*.py; do $(PY) $$b || exit 1; done
+
+clean:
+	rm -rf $(VENV) .pytest_cache

@@ -1,0 +1,175 @@
+"""Claims: machine-checkable statements in design files, and their verdicts.
+
+A claim in a design file::
+
+    [[claims]]
+    id = "table3-eps0.35-h"
+    description = "Table 3: h_m = 0.0433 s at eps = 0.35"
+    quantity = "synthesis.rows[eps=0.35].h_certified"
+    compare = "=="            # ">=", "<=", "==", "within"
+    value = 0.0433            # a number, "inf", or a word (e.g. "certified")
+    digits = 4                # "==" on numbers: compare at the printed digits
+    rounding = "truncate"     # how the source printed them: "round" | "truncate"
+    tolerance = 0.0           # "within": |got - value| <= tolerance
+    source = "paper 003, Table 3"
+    allow_inconclusive = false
+    expect = "pass"           # or "fail" with `reason`: a known, documented
+    reason = "..."            #   discrepancy (like pytest's strict xfail)
+
+Verdicts form a closed set: PASS, FAIL, INCONCLUSIVE. A claim is *ok* when it
+passes, is inconclusive and allows it, or fails and was expected to fail; a
+claim expected to fail that passes is not ok (the discrepancy went away, so
+the design must be updated).
+"""
+from __future__ import annotations
+
+import enum
+import math
+import re
+from dataclasses import dataclass
+from decimal import ROUND_DOWN, ROUND_HALF_EVEN, Decimal
+from typing import Any
+
+from .design import Reader
+
+COMPARES = (">=", "<=", "==", "within")
+
+
+class Verdict(str, enum.Enum):
+    PASS = "PASS"
+    FAIL = "FAIL"
+    INCONCLUSIVE = "INCONCLUSIVE"
+
+
+@dataclass(frozen=True)
+class Claim:
+    """One claim of a design (see module docstring)."""
+
+    id: str
+    description: str
+    quantity: str
+    compare: str
+    value: float | str
+    tolerance: float
+    digits: int | None
+    rounding: str
+    source: str
+    allow_inconclusive: bool
+    expect: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class ClaimResult:
+    """A claim with what was measured and its verdict."""
+
+    claim: Claim
+    got: float | str | None
+    verdict: Verdict
+    note: str = ""
+
+    @property
+    def ok(self) -> bool:
+        c = self.claim
+        if c.expect == "fail":
+            return self.verdict is Verdict.FAIL
+        return self.verdict is Verdict.PASS or (
+            self.verdict is Verdict.INCONCLUSIVE and c.allow_inconclusive)
+
+    def to_json(self) -> dict:
+        c = self.claim
+        return {"id": c.id, "quantity": c.quantity, "compare": c.compare,
+                "expected": _json_value(c.value), "tolerance": c.tolerance,
+                "got": _json_value(self.got), "verdict": self.verdict.value,
+                "ok": self.ok, "expect": c.expect, "source": c.source, "note": self.note}
+
+
+def _json_value(v):
+    if isinstance(v, float) and math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    return v
+
+
+_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.=+-]*$")
+
+
+def parse_claims(root: Reader, study, spec) -> list[Claim]:
+    """Validate the ``[[claims]]`` of a design against the study's quantities."""
+    names = study.quantity_names(spec)
+    out, seen = [], set()
+    for r in root.tables("claims", default=[]):
+        cid = r.string("id")
+        if not _ID.match(cid):
+            raise r.fail("id", cid, "letters, digits and _ . = + - only")
+        if cid in seen:
+            raise r.fail("id", cid, "an id not used by another claim")
+        seen.add(cid)
+        desc = r.string("description")
+        q = r.string("quantity")
+        if q not in names:
+            near = sorted(names)[:8]
+            raise r.fail("quantity", q, "a quantity this design computes, e.g. "
+                         + ", ".join(near) + (" ..." if len(names) > 8 else ""))
+        cmp_ = r.string("compare", choices=COMPARES)
+        raw = r.raw("value")
+        if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
+            raise r.fail("value", raw, 'a number, "inf" or a word')
+        value: float | str
+        if isinstance(raw, str):
+            value = math.inf if raw == "inf" else raw
+            if isinstance(value, str) and cmp_ != "==":
+                raise r.fail("compare", cmp_, '"==" for a word value')
+        else:
+            value = float(raw)
+            if not math.isfinite(value):
+                raise r.fail("value", raw, "a finite number (or the string \"inf\")")
+        tol = r.number("tolerance", default=0.0, nonneg=True)
+        if cmp_ == "within" and not r.has("tolerance"):
+            raise r.fail("tolerance", "<missing>", 'a tolerance for compare = "within"')
+        digits = r.number("digits", default=None, integer=True, lo=0, hi=12,
+                          what="integer number of printed decimals")
+        rounding = r.string("rounding", default="round", choices=("round", "truncate"))
+        src = r.string("source")
+        allow = r.boolean("allow_inconclusive", default=False)
+        expect = r.string("expect", default="pass", choices=("pass", "fail"))
+        reason = r.string("reason", default="")
+        if expect == "fail" and not reason:
+            raise r.fail("reason", "<missing>", 'a reason when expect = "fail"')
+        r.finish()
+        out.append(Claim(cid, desc, q, cmp_, value, tol, digits, rounding, src, allow,
+                         expect, reason))
+    return out
+
+
+def _printed(x: float, digits: int, rounding: str) -> Decimal:
+    mode = ROUND_DOWN if rounding == "truncate" else ROUND_HALF_EVEN
+    return Decimal(repr(x)).quantize(Decimal(1).scaleb(-digits), rounding=mode)
+
+
+def check_claim(claim: Claim, got: Any) -> ClaimResult:
+    """Compare a measured value with a claim.
+
+    ``got`` is a number, ``inf``, a word, or ``None`` (not determined:
+    INCONCLUSIVE).
+    """
+    if got is None or (isinstance(got, float) and math.isnan(got)):
+        return ClaimResult(claim, None, Verdict.INCONCLUSIVE, "not determined")
+    v = claim.value
+    if isinstance(v, str) or isinstance(got, str):
+        ok = str(got) == str(v)
+        return ClaimResult(claim, got, Verdict.PASS if ok else Verdict.FAIL)
+    got = float(got)
+    if claim.compare == ">=":
+        ok = got >= v - claim.tolerance
+    elif claim.compare == "<=":
+        ok = got <= v + claim.tolerance
+    elif claim.compare == "within":
+        ok = abs(got - v) <= claim.tolerance if math.isfinite(got) else got == v
+    else:  # "=="
+        if math.isinf(v) or math.isinf(got):
+            ok = got == v
+        elif claim.digits is not None:
+            ok = _printed(got, claim.digits, claim.rounding) == _printed(v, claim.digits, "round")
+        else:
+            ok = abs(got - v) <= claim.tolerance
+    return ClaimResult(claim, got, Verdict.PASS if ok else Verdict.FAIL)

@@ -1,0 +1,184 @@
+"""The ``workbench`` command: one table of verbs, each calling one API function.
+
+Exit codes (all verbs): 0 ok, 1 a claim / certificate failed or is
+inconclusive, 2 bad input (design file or arguments) — one message, no
+traceback, nothing half-written.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from dataclasses import replace
+from pathlib import Path
+from typing import Callable
+
+from .errors import DesignError, ModelError
+
+DESIGNS_DIR = Path("designs")
+REPORTS_DIR = Path("reports")
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # usage + message, exit 2 (no traceback)
+        self.print_usage(sys.stderr)
+        raise _BadArgs(f"{self.prog}: error: {message}")
+
+
+class _BadArgs(Exception):
+    pass
+
+
+def _designs(paths: list[str]) -> list:
+    from .design import load_design
+    if not paths:
+        paths = [str(p) for p in sorted(DESIGNS_DIR.glob("*.toml"))]
+        if not paths:
+            raise DesignError("<cli>", "DESIGN", str(DESIGNS_DIR), "a folder with design files")
+    return [load_design(p) for p in paths]
+
+
+# -- verbs ------------------------------------------------------------------------
+def cmd_synthesize(args) -> int:
+    from .design import load_design
+    from .report.markdown import fmt, md_table
+    from .synthesis import synthesize_delay_bound
+    from .studies import antiskid_cruise
+
+    design = load_design(args.design)
+    if design.kind != antiskid_cruise.STUDY.kind:
+        raise DesignError(design.path, "design.kind", design.kind,
+                          f'a design with a delay-bound synthesis ("{antiskid_cruise.STUDY.kind}")')
+    spec = design.spec
+    eps = spec.eps
+    if args.eps:
+        for e in args.eps:
+            if not (math.isfinite(e) and e > 0):
+                raise DesignError("<cli>", "--eps", e, "a positive number")
+        eps = tuple(args.eps)
+    from .plants.adhesion import NumericAdhesion
+    from .symbolic.linearise import linearise_cruise
+    plant = NumericAdhesion.from_dict({k: q.value for k, q in spec.params.items()})
+    lam_solved = plant.cruise_lambda(spec.v_d.value)
+    lam = spec.lambda_d_pinned.value if spec.lambda_d_pinned else lam_solved
+    lin = linearise_cruise(plant, spec.v_d.value, lam)
+    rows = synthesize_delay_bound(lin.A, lin.B, eps, spec.settings)
+    ok = all(r.status.value == "certified" for r in rows)
+    if args.json:
+        print(json.dumps({"design": design.name, "lambda_d_solved": lam_solved,
+                          "lambda_d_used": lam, "rows": [r.to_json() for r in rows]}, indent=2))
+        return 0 if ok else 1
+    print(f"{design.name}: problem (60) of paper 003 at v_d = {fmt(spec.v_d.value)} m/s, "
+          f"lambda_d = {fmt(lam, 5)} ({'pinned' if spec.lambda_d_pinned else 'solved'}; "
+          f"solved {fmt(lam_solved, 6)})")
+    table = [[fmt(r.eps), fmt(r.h_certified, 5), fmt(r.h_refuted, 5),
+              "—" if r.K is None else "[" + ", ".join(fmt(k, 5) for k in r.K) + "]",
+              fmt(r.exact.h if r.exact else None, 5),
+              fmt(r.exact_siso.h if r.exact_siso else None, 5),
+              fmt(r.ratio, 3), r.status.value, r.solves, f"{r.seconds:.3f}"] for r in rows]
+    print(md_table(["eps", "h_certified", "h_refuted", "K", "h* (eig)", "h* (pyctrl)",
+                    "ratio", "status", "solves", "s"], table, "rrrlrrrlrr"))
+    if any(r.exact and math.isinf(r.exact.h) for r in rows):
+        print("h* = inf: no characteristic root reaches the imaginary axis for any delay — the "
+              "loop is stable for every constant delay; h_certified is the limit of the LMI "
+              "criterion, not of the loop.")
+    return 0 if ok else 1
+
+
+def cmd_verify(args) -> int:
+    from .report.markdown import fmt, md_table
+    from .verify import evaluate_design
+
+    evs = [evaluate_design(d) for d in _designs(args.designs)]
+    extra = _extra_verifications(args)
+    if args.json:
+        out = {"designs": [{"design": e.design.name, "path": e.design.path, "ok": e.ok,
+                            "claims": [c.to_json() for c in e.claims]} for e in evs]}
+        out.update(extra.get("json", {}))
+        print(json.dumps(out, indent=2))
+    else:
+        rows = []
+        for e in evs:
+            for c in e.claims:
+                v = c.verdict.value + (" (expected)" if c.claim.expect == "fail" and c.ok else "")
+                rows.append([e.design.name, c.claim.id, f"{c.claim.compare} {fmt(c.claim.value, 6)}",
+                             fmt(c.got, 6), v if c.ok else v + " ✗", c.claim.source])
+        rows += extra.get("rows", [])
+        print(md_table(["design", "claim", "expected", "got", "verdict", "source"], rows))
+        n_bad = sum(not c.ok for e in evs for c in e.claims) + extra.get("bad", 0)
+        n = sum(len(e.claims) for e in evs) + len(extra.get("rows", []))
+        print(f"\n{n - n_bad} of {n} claims ok" + ("" if not n_bad else f"; {n_bad} not ok"))
+    ok = all(e.ok for e in evs) and not extra.get("bad", 0)
+    return 0 if ok else 1
+
+
+def _extra_verifications(args) -> dict:
+    """Hook for other claim sources (e.g. proofs/); none yet."""
+    return {}
+
+
+def cmd_report(args) -> int:
+    from .report.writer import build, check_reports, write_reports
+    from .verify import evaluate_design
+
+    designs = _designs([] if args.all else args.designs)
+    files = [build(evaluate_design(d)) for d in designs]
+    index = args.all or not args.designs
+    out = Path(args.out)
+    if args.check:
+        problems = check_reports(files, out, index=index)
+        for p in problems:
+            print(p)
+        if not problems:
+            print(f"{len(files)} report(s) fresh in {out}/")
+        return 1 if problems else 0
+    for p in write_reports(files, out, index=index):
+        print(f"wrote {p}")
+    return 0
+
+
+COMMANDS: dict[str, tuple[str, Callable]] = {
+    "synthesize": ("certified LMI synthesis (synthesize delay-bound DESIGN)", cmd_synthesize),
+    "verify": ("evaluate every claim; exit 1 if any is not ok", cmd_verify),
+    "report": ("write reports/<design>.md and figures (--check: fail if stale)", cmd_report),
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = _Parser(prog="workbench", description="Robust-control design and verification "
+                 "workbench for train control.")
+    sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    p = sub.add_parser("synthesize", help=COMMANDS["synthesize"][0])
+    ssub = p.add_subparsers(dest="what", required=True, parser_class=_Parser)
+    q = ssub.add_parser("delay-bound", help="problem (60) of paper 003 over eps, with exact margins")
+    q.add_argument("design")
+    q.add_argument("--eps", type=float, nargs="+", help="eps values (override the design's)")
+    q.add_argument("--json", action="store_true")
+    p = sub.add_parser("verify", help=COMMANDS["verify"][0])
+    p.add_argument("designs", nargs="*", help="design files (default: all of designs/)")
+    p.add_argument("--json", action="store_true")
+    p = sub.add_parser("report", help=COMMANDS["report"][0])
+    p.add_argument("designs", nargs="*", help="design files (default: all of designs/)")
+    p.add_argument("--all", action="store_true", help="every design in designs/ and the index")
+    p.add_argument("--check", action="store_true", help="exit 1 if a committed report is stale")
+    p.add_argument("--out", default=str(REPORTS_DIR), help="output folder (default: reports)")
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point; returns the exit code (tests call ``main([...])``)."""
+    try:
+        args = build_parser().parse_args(argv)
+    except _BadArgs as exc:
+        print(exc, file=sys.stderr)
+        return 2
+    try:
+        return COMMANDS[args.command][1](args)
+    except (DesignError, ModelError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

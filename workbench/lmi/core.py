@@ -1,0 +1,304 @@
+"""Certified LMI feasibility in the delay h, and the bracketed bisection.
+
+Every criterion of the workbench is a :class:`MarginLMI`: its blocks are
+written once, as a function of the decision variables, and evaluated twice —
+as cvxpy expressions for the solver and as numpy arrays for the independent
+re-check of the returned point.
+
+How a delay value is decided (a closed set of outcomes, cf. cvxpy's status
+groups):
+
+* the problem is solved as **maximise t** subject to every negative block
+  ``F(x) <= -t I`` and every positive block ``G(x) >= t I``, with the
+  normalisation ``trace(X_norm) <= 1`` (all criteria are homogeneous, so
+  this only fixes the scale) and ``|x| <= bound`` on the other variables;
+* **CERTIFIED** when the solver reports ``optimal``, ``t* >= margin`` and the
+  numpy re-check finds every block's eigenvalue margin ``>= margin`` (no
+  strict LMIs: ``margin`` is the named definiteness margin);
+* **REFUTED** when the solver reports ``optimal`` with ``t* < margin``: no
+  point of the criterion (at this normalisation) holds with that margin;
+* **INCONCLUSIVE** otherwise (inaccurate, solver error, or a point that
+  fails its re-check) — never certified.
+
+The maximise-t form always has a feasible point (x = 0, t = 0), so Clarabel
+answers ``optimal`` on both sides of the boundary instead of relying on
+infeasibility detection, which is fragile near a GEVP optimum where the
+Lyapunov matrix becomes singular.
+"""
+from __future__ import annotations
+
+import enum
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+from typing import Callable, Mapping, Sequence
+
+import cvxpy as cp
+import numpy as np
+
+#: Named definiteness margin of every LMI (absolute, at trace(X_norm) <= 1).
+DEFAULT_MARGIN = 1e-7
+#: Bound on the decision variables other than the normalised one.
+DEFAULT_BOUND = 1e3
+#: Clarabel settings: tighter than its defaults (1e-8) because the optimum
+#: of these GEVPs is degenerate.
+CLARABEL_SETTINGS: dict = {}
+
+
+class Outcome(str, enum.Enum):
+    """Closed set of outcomes of a certificate or a claim about one."""
+
+    CERTIFIED = "certified"
+    REFUTED = "refuted"
+    INCONCLUSIVE = "inconclusive"
+
+
+@dataclass(frozen=True)
+class Block:
+    """One LMI block: ``matrix <= -margin I`` (``sense='nsd'``) or ``>= margin I``."""
+
+    name: str
+    matrix: object
+    sense: str  # "nsd" | "psd"
+
+
+@dataclass(frozen=True)
+class Step:
+    """The decision at one delay value.
+
+    Attributes
+    ----------
+    h : float
+        Delay tested (s).
+    outcome : Outcome
+    solver_status : str
+        cvxpy status string, or ``"error: ..."``.
+    t_opt : float or None
+        Optimal definiteness margin found by the solver.
+    recheck : dict[str, float]
+        Smallest eigenvalue margin of each block, recomputed with numpy from
+        the returned values (positive = satisfied); empty when not solved.
+    certificate : dict[str, numpy.ndarray] or None
+        Decision variables (only for CERTIFIED steps).
+    seconds : float
+    """
+
+    h: float
+    outcome: Outcome
+    solver_status: str
+    t_opt: float | None
+    recheck: Mapping[str, float]
+    certificate: Mapping[str, np.ndarray] | None
+    seconds: float
+
+
+@dataclass(frozen=True)
+class Bracket:
+    """Result of a certified bisection on the delay.
+
+    ``h_certified`` is the largest delay whose LMI was certified (0 when
+    none was) and ``h_refuted`` the smallest delay refuted by the solver
+    (``inf`` when none was). Inconclusive steps are kept in ``steps`` and
+    never move ``h_certified``.
+    """
+
+    h_certified: float
+    h_refuted: float
+    outcome: Outcome
+    certificate: Step | None
+    steps: tuple[Step, ...] = field(repr=False)
+
+    @property
+    def solves(self) -> int:
+        return len(self.steps)
+
+    @property
+    def seconds(self) -> float:
+        return sum(s.seconds for s in self.steps)
+
+
+class MarginLMI:
+    """An LMI criterion in a scalar delay parameter, built once (DPP).
+
+    Subclasses declare variables in :meth:`variables` and write the blocks
+    once in :meth:`blocks`, which must work both on cvxpy expressions and on
+    numpy arrays (``bmat`` is ``cvxpy.bmat`` or ``numpy.block``).
+
+    Parameters
+    ----------
+    margin : float
+        Definiteness margin (see module docstring).
+    bound : float
+        Bound on every non-normalised decision variable.
+    """
+
+    #: Name of the variable whose trace is normalised to <= 1.
+    normaliser: str = "L"
+
+    def __init__(self, *, margin: float = DEFAULT_MARGIN, bound: float = DEFAULT_BOUND):
+        if not margin > 0:
+            raise ValueError(f"margin = {margin!r}; expected a positive number")
+        self.margin, self.bound = float(margin), float(bound)
+        self._params = {k: cp.Parameter(nonneg=True, name=k)
+                        for k in ("h", "iota") + tuple(self.parameters())}
+        self._vars = self.variables()
+        self._t = cp.Variable(name="t")
+        self._problem = self._build()
+
+    # -- to be written by each criterion -----------------------------------
+    def variables(self) -> dict[str, cp.Variable]:
+        raise NotImplementedError
+
+    def parameters(self) -> tuple[str, ...]:
+        """Names of scalar parameters besides ``h`` and ``iota`` (set with
+        :meth:`set_parameters`; the problem is not rebuilt)."""
+        return ()
+
+    def blocks(self, x: Mapping[str, object], p: Mapping[str, object],
+               bmat: Callable) -> list[Block]:
+        """The LMI blocks; ``p["h"]`` is the delay, ``p["iota"] = 1/h``."""
+        raise NotImplementedError
+
+    def set_parameters(self, **values: float) -> None:
+        """Set scalar parameters declared by :meth:`parameters`."""
+        for k, v in values.items():
+            if k in ("h", "iota") or k not in self._params:
+                raise KeyError(k)
+            self._params[k].value = float(v)
+
+    # -- machinery ----------------------------------------------------------
+    def _build(self) -> cp.Problem:
+        t, cons = self._t, []
+        for blk in self.blocks(self._vars, self._params, cp.bmat):
+            m = blk.matrix
+            sym = (m + m.T) / 2
+            eye = np.eye(sym.shape[0])
+            cons.append(sym << -t * eye if blk.sense == "nsd" else sym >> t * eye)
+        for name, var in self._vars.items():
+            if name == self.normaliser:
+                cons.append(cp.trace(var) <= 1)
+            else:
+                cons.append(cp.abs(var) <= self.bound)
+        cons.append(t <= 1.0)
+        return cp.Problem(cp.Maximize(t), cons)
+
+    def evaluate_blocks(self, values: Mapping[str, np.ndarray], h: float) -> list[Block]:
+        """The blocks as numpy arrays at ``values`` (the re-check path)."""
+        p = {k: float(v.value) for k, v in self._params.items() if k not in ("h", "iota")}
+        p.update(h=float(h), iota=1.0 / float(h))
+        return self.blocks(values, p, np.block)
+
+    def recheck(self, values: Mapping[str, np.ndarray], h: float) -> dict[str, float]:
+        """Smallest eigenvalue margin of every block, recomputed with numpy.
+
+        A positive entry means the block satisfies its inequality with that
+        much room; a block that is not symmetric to 1e-9 (relative) gets
+        ``-inf``.
+        """
+        out: dict[str, float] = {}
+        for blk in self.evaluate_blocks(values, h):
+            m = np.asarray(blk.matrix, dtype=float)
+            scale = max(1.0, float(np.max(np.abs(m))))
+            if np.max(np.abs(m - m.T)) > 1e-9 * scale:
+                out[blk.name] = -math.inf
+                continue
+            eig = np.linalg.eigvalsh((m + m.T) / 2)
+            out[blk.name] = float(-eig[-1]) if blk.sense == "nsd" else float(eig[0])
+        return out
+
+    def solve_at(self, h: float) -> Step:
+        """Decide the criterion at delay ``h`` (s); see the module docstring."""
+        self._params["h"].value, self._params["iota"].value = float(h), 1.0 / float(h)
+        t0 = time.perf_counter()
+        try:
+            with warnings.catch_warnings():   # "inaccurate" is an outcome, not a warning
+                warnings.simplefilter("ignore", UserWarning)
+                self._problem.solve(solver=cp.CLARABEL, **CLARABEL_SETTINGS)
+            status = str(self._problem.status)
+        except cp.error.SolverError as exc:  # an answer, not a crash
+            status = f"error: {exc}".splitlines()[0]
+        seconds = time.perf_counter() - t0
+        t_opt = self._t.value if status == cp.OPTIMAL else None
+        if t_opt is None:
+            return Step(h, Outcome.INCONCLUSIVE, status, None, {}, None, seconds)
+        t_opt = float(t_opt)
+        if t_opt < self.margin:
+            return Step(h, Outcome.REFUTED, status, t_opt, {}, None, seconds)
+        values = {k: np.array(v.value, dtype=float) for k, v in self._vars.items()}
+        margins = self.recheck(values, h)
+        ok = all(m >= self.margin for m in margins.values())
+        return Step(h, Outcome.CERTIFIED if ok else Outcome.INCONCLUSIVE, status, t_opt,
+                    margins, values if ok else None, seconds)
+
+
+def bisect_delay(decide: Callable[[float], Step], *, h_lo: float = 1e-4, h_hi: float = 100.0,
+                 rel_tol: float = 1e-4, max_solves: int = 60, guess: float | None = None
+                 ) -> Bracket:
+    """Bracketed bisection of a delay criterion (cf. cvxpy's ``bisection.py``).
+
+    The search first brackets the boundary geometrically from ``guess`` (or
+    from the geometric mean of ``[h_lo, h_hi]``), then bisects (geometric
+    mean) until ``h_refuted / h_certified <= 1 + rel_tol``. Inconclusive steps
+    shrink the search interval like refuted ones but never count as refuted.
+
+    Parameters
+    ----------
+    decide : callable
+        ``decide(h) -> Step``, e.g. :meth:`MarginLMI.solve_at`.
+    h_lo, h_hi : float
+        Search range (s); ``h_hi`` certified means the bound is at least
+        ``h_hi`` (reported as the bracket ``[h_hi, inf]``).
+    rel_tol : float
+        Relative width of the final bracket.
+    max_solves : int
+        Budget of solver calls.
+    guess : float, optional
+        Expected location of the boundary (s), e.g. from a neighbouring row.
+
+    Returns
+    -------
+    Bracket
+    """
+    steps: list[Step] = []
+    cert: Step | None = None
+    lo, hi = 0.0, math.inf          # certified / first not-certified (for search)
+    refuted = math.inf
+
+    def run(h: float) -> Step:
+        nonlocal cert, lo, hi, refuted
+        s = decide(h)
+        steps.append(s)
+        if s.outcome is Outcome.CERTIFIED:
+            if h > lo:
+                lo, cert = h, s
+        else:
+            hi = min(hi, h)
+            if s.outcome is Outcome.REFUTED:
+                refuted = min(refuted, h)
+        return s
+
+    h = min(max(guess if guess else math.sqrt(h_lo * h_hi), h_lo), h_hi)
+    run(h)
+    factor = 2.0 if guess else 10.0
+    while len(steps) < max_solves:      # geometric bracketing
+        if lo == 0.0:
+            if h <= h_lo:
+                break
+            h = max(h / factor, h_lo)
+        elif hi == math.inf:
+            if h >= h_hi:
+                break
+            h = min(h * factor, h_hi)
+        else:
+            break
+        run(h)
+    while len(steps) < max_solves and lo > 0 and hi < math.inf and hi / lo > 1 + rel_tol:
+        run(math.sqrt(lo * hi))
+    if lo > 0:
+        outcome = Outcome.CERTIFIED
+    elif refuted < math.inf and all(s.outcome is Outcome.REFUTED for s in steps):
+        outcome = Outcome.REFUTED
+    else:
+        outcome = Outcome.INCONCLUSIVE
+    return Bracket(lo, refuted, outcome, cert, tuple(steps))

@@ -1,0 +1,1 @@
+"""Physical models, each written once as sympy expressions."""

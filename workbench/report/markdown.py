@@ -1,0 +1,88 @@
+"""Pure Markdown helpers: numbers with their meaningful digits, tables, LaTeX.
+
+Everything here is a pure function of its inputs, so the same results give
+byte-identical Markdown.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+
+@dataclass(frozen=True)
+class Figure:
+    """A figure to draw: ``draw(fig)`` fills a matplotlib Figure.
+
+    Attributes
+    ----------
+    name : str
+        File name (``<name>.png`` in the design's figure folder).
+    caption : str
+    draw : callable
+        Pure function of the results it closes over.
+    size : tuple[float, float]
+        Inches.
+    """
+
+    name: str
+    caption: str
+    draw: Callable = field(compare=False, repr=False)
+    size: tuple[float, float] = (6.4, 4.0)
+
+
+@dataclass(frozen=True)
+class Rendered:
+    """Markdown sections (each starting with a ``## `` heading) and figures."""
+
+    sections: tuple[str, ...]
+    figures: tuple[Figure, ...] = ()
+
+
+def fmt(x, sig: int = 4) -> str:
+    """A number with ``sig`` significant digits (solver noise below them does
+    not change the text); ``inf``, ``nan``, ``None`` and words pass through."""
+    if x is None:
+        return "—"
+    if isinstance(x, str):
+        return x
+    if isinstance(x, bool):
+        return str(x).lower()
+    x = float(x)
+    if math.isnan(x):
+        return "nan"
+    if math.isinf(x):
+        return "∞" if x > 0 else "−∞"
+    if x == 0:
+        return "0"
+    s = f"{x:.{sig}g}"
+    if "e" in s:
+        m, e = s.split("e")
+        return f"{m}e{int(e)}"
+    return s
+
+
+def md_table(header: Sequence[str], rows: Sequence[Sequence[object]],
+             align: str | None = None) -> str:
+    """A GitHub Markdown table; ``align`` is a string of l/r/c per column."""
+    align = align or "l" * len(header)
+    marks = {"l": ":---", "r": "---:", "c": ":---:"}
+    esc = lambda c: str(c).replace("|", "\\|").replace("\n", " ")
+    lines = ["| " + " | ".join(esc(h) for h in header) + " |",
+             "| " + " | ".join(marks[a] for a in align) + " |"]
+    lines += ["| " + " | ".join(esc(c) for c in r) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def latex_matrix(M, sig: int = 4) -> str:
+    """``\\begin{bmatrix}...`` of a numeric matrix."""
+    rows = [" & ".join(_tex_num(v, sig) for v in row) for row in M]
+    return r"\begin{bmatrix} " + r" \\ ".join(rows) + r" \end{bmatrix}"
+
+
+def _tex_num(v, sig):
+    s = fmt(v, sig)
+    if "e" in s:
+        m, e = s.split("e")
+        return rf"{m}\times 10^{{{int(e)}}}"
+    return s.replace("−", "-")

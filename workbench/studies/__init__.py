@@ -1,0 +1,25 @@
+"""Studies: what a design of a given ``kind`` computes, claims and reports.
+
+Each study module provides an object with
+
+``load(root: Reader) -> spec``
+    Validate the study's tables of a design file into a frozen spec.
+``quantity_names(spec) -> set[str]``
+    Every quantity a claim may name (known before running, so an unknown
+    quantity is a design error, exit 2).
+``run(design) -> result``
+    Compute (a frozen dataclass with ``to_json()``).
+``quantities(result) -> dict[str, float | str | None]``
+    Values of the named quantities (``None``: not determined).
+``render(design, result) -> workbench.report.Rendered``
+    Markdown sections and figures (pure).
+
+New capabilities add a module here and one line to :data:`REGISTRY`.
+"""
+from __future__ import annotations
+
+from . import antiskid_cruise
+
+REGISTRY = {
+    antiskid_cruise.STUDY.kind: antiskid_cruise.STUDY,
+}

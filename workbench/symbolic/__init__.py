@@ -1,0 +1,1 @@
+"""Symbolic steps: linearisation and the proof/claim engine."""

@@ -1,0 +1,31 @@
+"""Claims -> verdicts: run a design's study and check every claim."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from . import studies
+from .claims import ClaimResult, check_claim
+from .design import Design
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """A design, its study result and its claims' verdicts."""
+
+    design: Design
+    result: Any
+    claims: tuple[ClaimResult, ...]
+
+    @property
+    def ok(self) -> bool:
+        return all(c.ok for c in self.claims)
+
+
+def evaluate_design(design: Design) -> Evaluation:
+    """Run the design's study and check each of its claims."""
+    study = studies.REGISTRY[design.kind]
+    result = study.run(design)
+    q = study.quantities(result)
+    return Evaluation(design, result, tuple(check_claim(c, q.get(c.quantity))
+                                            for c in design.claims))
