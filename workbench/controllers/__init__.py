@@ -1,0 +1,1 @@
+"""Controllers: PID, SMC, SMARC, NTSM, MFAC, predictor-based antiskid, fuzzy."""

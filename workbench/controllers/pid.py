@@ -1,0 +1,60 @@
+"""Sampled PID with output limits and conditional-integration anti-windup.
+
+Shared by every study that compares against PID (papers 000, 002, 004).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass
+class PID:
+    """Discrete PID u = kp e + ki sum(e) dt + kd (e - e_prev)/dt.
+
+    Parameters
+    ----------
+    kp, ki, kd : float
+        Gains (units of output per unit error, per unit error-second, per
+        unit error/second).
+    dt : float
+        Sampling period (s), > 0.
+    u_min, u_max : float
+        Output limits; the integrator is frozen while the output saturates in
+        the direction of the error (conditional integration).
+    derivative_on_measurement : bool
+        Differentiate -y instead of e (no derivative kick on set-point
+        steps); then :meth:`step` needs ``measurement``.
+    """
+
+    kp: float
+    ki: float = 0.0
+    kd: float = 0.0
+    dt: float = 0.1
+    u_min: float = float("-inf")
+    u_max: float = float("inf")
+    derivative_on_measurement: bool = False
+    _integral: float = field(default=0.0, init=False, repr=False)
+    _prev: float | None = field(default=None, init=False, repr=False)
+
+    def __post_init__(self):
+        if not self.dt > 0:
+            raise ValueError(f"dt = {self.dt!r}; expected a positive sampling period (s)")
+        if not self.u_min < self.u_max:
+            raise ValueError(f"u_min = {self.u_min!r}, u_max = {self.u_max!r}; expected u_min < u_max")
+
+    def reset(self) -> None:
+        self._integral, self._prev = 0.0, None
+
+    def step(self, error: float, measurement: float | None = None) -> float:
+        """One sample: the saturated output for this error."""
+        d_src = -measurement if self.derivative_on_measurement else error
+        if self.derivative_on_measurement and measurement is None:
+            raise ValueError("measurement is required with derivative_on_measurement")
+        deriv = 0.0 if self._prev is None else (d_src - self._prev) / self.dt
+        self._prev = d_src
+        u_free = self.kp * error + self.ki * (self._integral + error * self.dt) + self.kd * deriv
+        u = min(max(u_free, self.u_min), self.u_max)
+        saturating = (u_free > self.u_max and error > 0) or (u_free < self.u_min and error < 0)
+        if not saturating:
+            self._integral += error * self.dt
+        return u

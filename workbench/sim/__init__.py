@@ -1,0 +1,1 @@
+"""Time-domain simulation: delay-differential stepping, scenarios, metrics."""
