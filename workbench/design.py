@@ -78,14 +78,15 @@ class Reader:
 
     def number(self, name: str, *, default: Any = _MISSING, positive: bool = False,
                nonneg: bool = False, lo: float | None = None, hi: float | None = None,
-               what: str = "a number", integer: bool = False) -> float:
-        """A finite real number, optionally range-checked."""
+               what: str = "number", integer: bool = False) -> float:
+        """A finite real number, optionally range-checked (``what``: a noun
+        phrase for messages, e.g. ``"number (kg)"``)."""
         val = self.raw(name, default)
         if val is default and default is not _MISSING:
             return val
         ok_type = isinstance(val, int) if integer else isinstance(val, (int, float))
         if isinstance(val, bool) or not ok_type:
-            raise self.fail(name, val, what)
+            raise self.fail(name, val, f"a {what}")
         x = int(val) if integer else float(val)
         if not math.isfinite(x):
             raise self.fail(name, val, f"a finite {what}")
@@ -94,7 +95,7 @@ class Reader:
         if nonneg and not x >= 0:
             raise self.fail(name, val, f"a non-negative {what}")
         if lo is not None and not x >= lo or hi is not None and not x <= hi:
-            raise self.fail(name, val, f"{what} in [{lo}, {hi}]")
+            raise self.fail(name, val, f"a {what} in [{lo}, {hi}]")
         return x
 
     def string(self, name: str, *, default: Any = _MISSING,

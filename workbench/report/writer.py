@@ -37,7 +37,7 @@ def claims_table(results: tuple[ClaimResult, ...]) -> str:
         elif r.verdict is Verdict.INCONCLUSIVE and c.allow_inconclusive:
             verdict += " (allowed)"
         note = c.description + (f" — known discrepancy: {c.reason}" if c.expect == "fail" else "")
-        rows.append([f"`{c.id}`", note, f"`{c.quantity}`", exp, fmt(r.got, 6),
+        rows.append([f"`{c.id}`", note, f"`{c.quantity}`", exp, fmt(r.got, 5),
                      f"**{verdict}**", c.source])
     return md_table(["claim", "statement", "quantity", "expected", "got", "verdict", "source"],
                     rows, "lllrrll")

@@ -18,8 +18,9 @@ New capabilities add a module here and one line to :data:`REGISTRY`.
 """
 from __future__ import annotations
 
-from . import antiskid_cruise
+from . import antiskid_cruise, tracking002
 
 REGISTRY = {
     antiskid_cruise.STUDY.kind: antiskid_cruise.STUDY,
+    tracking002.STUDY.kind: tracking002.STUDY,
 }

@@ -64,7 +64,8 @@ def render(design, res) -> Rendered:
         ["lambda_d (solved)", fmt(res.lambda_d_solved, 5), "root of y1(v_d, lambda) = 0 in (0, lambda_opt)"],
         ["lambda_d (used)", fmt(res.lambda_d_used, 5),
          "pinned by the design" if spec.lambda_d_pinned else "the solved value"],
-        ["y1(v_d, lambda_d used)", fmt(lin.y1_residual, 3) + " m/s²",
+        ["y1(v_d, lambda_d used)", (fmt(lin.y1_residual, 3) if abs(lin.y1_residual) > 1e-12
+                                    else "0 (below 1e-12)") + " m/s²",
          "eq (25) holds exactly only when this is 0"],
     ], "lrl")
     co = md_table(["coefficient", "value"],
@@ -80,7 +81,7 @@ def render(design, res) -> Rendered:
     rows = []
     for r in res.rows:
         K = "—" if r.K is None else "[" + ", ".join(fmt(k, 4) for k in r.K) + "]"
-        rows.append([fmt(r.eps), fmt(r.h_certified, 4), fmt(r.h_refuted, 4), K,
+        rows.append([fmt(r.eps), fmt(r.h_certified, 5), fmt(r.h_refuted, 5), K,
                      _margin_text(r.exact), _margin_text(r.exact_siso), fmt(r.ratio, 3),
                      r.status.value, r.solves])
     st = spec.settings
@@ -160,6 +161,9 @@ def _plot_bounds(fig, res):
     if res.published:
         ax.plot([c.row.eps for c in res.published], [c.row.h_m for c in res.published], "x",
                 color="C3", ms=8, label="printed h_m")
+    if _all_inf(res):
+        ax.text(0.98, 0.04, "exact margin h* = ∞ for every row", transform=ax.transAxes,
+                ha="right", va="bottom", color="C2")
     ax.set_xlabel("eps (R = eps L)")
     ax.set_ylabel("delay bound (s)")
     ax.set_title("Problem (60): certified delay bound vs eps")

@@ -1,0 +1,190 @@
+"""Fixed-step simulation of speed-profile tracking (paper 002).
+
+The plants here are discrete-time / non-stiff: the 002 train is stepped at a
+fine plant step ``dt`` (the lag integrated exactly for a demand held over the
+step, the pure delay as a FIFO of whole steps) and the controller runs every
+``Ts = n_sub dt`` with zero-order hold. Every state is an array over a batch
+of independent runs (controllers, parameter sets, stations), so a whole
+parameter study is one loop over time.
+
+A run ends, per batch element, at the first sample after the profile's
+braking has begun where the speed is 0: the train is then held by its parking
+brake (the ATO stop), and that time and position define the quality indices.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..plants.train002 import Train002
+
+
+@dataclass(frozen=True)
+class Route:
+    """A station-to-station route: distance (m) and a piecewise-constant gradient.
+
+    Attributes
+    ----------
+    distance : float
+        Stopping point (m).
+    grade_from : tuple[float, ...]
+        Positions (m) where each gradient section begins (first is 0).
+    grade : tuple[float, ...]
+        Gradient of each section (rise over run, up-hill positive).
+    """
+
+    distance: float
+    grade_from: tuple[float, ...] = (0.0,)
+    grade: tuple[float, ...] = (0.0,)
+
+    def gradient_at(self, s: np.ndarray) -> np.ndarray:
+        idx = np.searchsorted(np.asarray(self.grade_from), s, side="right") - 1
+        return np.asarray(self.grade)[np.clip(idx, 0, len(self.grade) - 1)]
+
+
+@dataclass(frozen=True)
+class TrackingRun:
+    """Sampled histories of a batch of tracking runs (rows = batch elements).
+
+    Attributes
+    ----------
+    t : numpy.ndarray
+        Sample times (s), shape (K,).
+    v, s, a, u, target : numpy.ndarray
+        Speed (m/s), position (m), net acceleration over the next sample
+        (m/s^2), command, target speed (m/s); shape (N, K).
+    stop_time, stop_pos : numpy.ndarray
+        Time (s) and position (m) of the stop; nan when the train did not stop
+        within the horizon. Shape (N,).
+    traction_work : numpy.ndarray
+        Integral of max(a_applied, 0) v dt up to the stop (J/kg), shape (N,).
+    """
+
+    t: np.ndarray
+    v: np.ndarray
+    s: np.ndarray
+    a: np.ndarray
+    u: np.ndarray
+    target: np.ndarray
+    stop_time: np.ndarray
+    stop_pos: np.ndarray
+    traction_work: np.ndarray
+
+
+Controller = Callable[[int, np.ndarray, np.ndarray], np.ndarray]
+"""``control(k, y, y_target_next) -> u`` for a batch (arrays of shape (N,))."""
+
+
+def simulate_tracking(train: Train002, route: Route, target: Callable[[np.ndarray], np.ndarray],
+                      control: Controller, n: int, *, Ts: float, dt: float,
+                      horizon: float, brake_start: float) -> TrackingRun:
+    """Track ``target(t)`` with ``control`` on a batch of ``n`` identical trains.
+
+    Parameters
+    ----------
+    train : Train002
+    route : Route
+    target : callable
+        Target speed (m/s) as a function of time (s), vectorised.
+    control : callable
+        Batch controller, called every ``Ts`` with the sample index, the
+        measured speeds y(k) and the target y*(k+1).
+    n : int
+        Batch size.
+    Ts, dt : float
+        Control sample and plant step (s); ``Ts`` must be a multiple of ``dt``
+        and ``train.delay`` a multiple of ``dt``.
+    horizon : float
+        Longest simulated time (s).
+    brake_start : float
+        Time (s) after which a standstill counts as the stop.
+    """
+    n_sub = int(round(Ts / dt))
+    n_delay = int(round(train.delay / dt))
+    if not math.isclose(n_sub * dt, Ts) or not math.isclose(n_delay * dt, train.delay,
+                                                            abs_tol=1e-12):
+        raise ValueError(f"Ts = {Ts} and delay = {train.delay} must be multiples of dt = {dt}")
+    K = int(math.ceil(horizon / Ts))
+    decay = math.exp(-dt / train.lag)
+    gain_int = train.lag * (1.0 - decay)          # integral of (1 - e^{-t/T}) weight
+    fifo = np.zeros((n_delay + 1, n))              # demands of the last n_delay steps
+    head = 0
+    v = np.zeros(n); s = np.zeros(n); a = np.zeros(n)
+    work = np.zeros(n)
+    stopped = np.zeros(n, bool)
+    stop_time = np.full(n, np.nan); stop_pos = np.full(n, np.nan)
+    t_hist = np.arange(K) * Ts
+    H = {k: np.zeros((n, K)) for k in ("v", "s", "u", "target")}
+    for k in range(K):
+        t = k * Ts
+        y_next = np.broadcast_to(target(np.array(t + Ts)), (n,))
+        u = np.where(stopped, 0.0, control(k, v.copy(), y_next))
+        H["v"][:, k], H["s"][:, k], H["u"][:, k] = v, s, u
+        H["target"][:, k] = target(np.array(t))
+        demand = train.demand(u)
+        for _ in range(n_sub):
+            fifo[head] = demand
+            head = (head + 1) % (n_delay + 1)
+            A = fifo[head]                          # demand of n_delay steps ago
+            # exact lag over the step with A held: a(t+dt) and its integral
+            a_int = A * dt + (a - A) * gain_int
+            a = A + (a - A) * decay
+            acc_ext = train.resistance(v) + train.grade(route.gradient_at(s))
+            dv = a_int - acc_ext * dt
+            v_new = np.maximum(v + dv, 0.0)         # no rolling back (holding brake)
+            work += np.where(stopped, 0.0, np.maximum(a_int, 0.0) * v)
+            s = s + np.where(stopped, 0.0, 0.5 * (v + v_new) * dt)
+            v = np.where(stopped, 0.0, v_new)
+        now_stopped = ~stopped & (v <= 0.0) & (t + Ts >= brake_start)
+        stop_time = np.where(now_stopped, t + Ts, stop_time)
+        stop_pos = np.where(now_stopped, s, stop_pos)
+        stopped |= now_stopped
+        if stopped.all():
+            K = k + 1
+            break
+    v_hist = H["v"][:, :K]
+    acc = np.diff(np.concatenate([v_hist, v[:, None]], axis=1), axis=1) / Ts
+    return TrackingRun(t_hist[:K], v_hist, H["s"][:, :K], acc, H["u"][:, :K],
+                       H["target"][:, :K], stop_time, stop_pos, work)
+
+
+@dataclass(frozen=True)
+class QualityIndices:
+    """ATO quality indices of paper 002 (eqs 10-13, reconstructed); arrays over the batch.
+
+    Attributes
+    ----------
+    stop_error : numpy.ndarray
+        K_s = |s_t - s_o| (m).
+    punctuality : numpy.ndarray
+        K_t = |T_t - T_o| / T_o (-).
+    comfort : numpy.ndarray
+        K_c = (1 / T_t) sum_k |a(k+1) - a(k)| (m/s^3): mean absolute jerk.
+    energy : numpy.ndarray
+        K_e = (1 / S) integral max(a_applied, 0) v dt (J/(kg m) = m/s^2):
+        traction work per unit mass and metre.
+    rms_speed_error : numpy.ndarray
+        sqrt(mean (v - v*)^2) over the planned run time (m/s); the tuning criterion.
+    """
+
+    stop_error: np.ndarray
+    punctuality: np.ndarray
+    comfort: np.ndarray
+    energy: np.ndarray
+    rms_speed_error: np.ndarray
+
+    NAMES = ("stop_error", "punctuality", "comfort", "energy")
+
+
+def quality_indices(run: TrackingRun, distance: float, run_time: float) -> QualityIndices:
+    """The four indices (and the RMS speed error) of every run of a batch."""
+    t_stop = run.stop_time
+    jerk_sum = np.array([np.abs(np.diff(a[run.t < ts])).sum() if np.isfinite(ts) else np.nan
+                         for a, ts in zip(run.a, t_stop)])
+    planned = run.t <= run_time
+    rms = np.sqrt(np.mean((run.v[:, planned] - run.target[:, planned]) ** 2, axis=1))
+    return QualityIndices(np.abs(run.stop_pos - distance), np.abs(t_stop - run_time) / run_time,
+                          jerk_sum / t_stop, run.traction_work / distance, rms)

@@ -1,0 +1,538 @@
+"""Mechanical checking of the derivation steps of papers: three-valued proofs.
+
+A :class:`Claim` is built from sympy objects by a module of ``proofs/`` (never
+from text: nothing here calls ``eval`` or ``sympify`` on strings). It asserts
+one of four things:
+
+``identity``
+    ``lhs == rhs`` (scalars or matrices), possibly under equalities ``given``
+    (substitutions ``symbol := expression``).
+``inequality``
+    ``lhs <= rhs`` under hypotheses ``symbol op bound``. Checked the way papers
+    argue: ``rhs - lhs`` is written as a sum of ``terms`` (identity checked),
+    and every term is shown sign-definite (``>= 0``) after replacing each
+    hypothesis by a slack variable (``eta = D + s``, ``s >= 0``) and splitting
+    into cases on the signs of the symbols inside ``Abs`` / ``sign``.
+``minimiser``
+    ``law = argmin_u J(u)``: the stationary point is *derived* (solved from
+    dJ/du = 0, it must be unique), compared with the law, and convexity
+    (d2J/du2 > 0) is shown as for inequalities.
+``solution``
+    ``x(t)`` (closed form) solves ``x' = f(x, t)`` with ``x(t0) = x0`` and,
+    optionally, reaches ``x(T) = x_T`` (e.g. a reaching time).
+``value``
+    a worked number: an exact expression equals a printed value at its
+    printed decimals.
+
+Every claim also gets a second, independent check: a seeded falsification
+search that samples the symbols in a box, keeps the points satisfying the
+hypotheses, and evaluates the claim numerically (for ``solution``: integrates
+the ODE with scipy). A failure found is re-evaluated with 30-digit arithmetic
+at rounded values before it is reported as a counterexample.
+
+Verdicts form a closed set (like sympy's ``is_stable``: True / False / None):
+PROVED, REFUTED (with a counterexample), INCONCLUSIVE (with what remains to
+be shown).
+"""
+from __future__ import annotations
+
+import enum
+import itertools
+from decimal import Decimal
+from dataclasses import dataclass, field
+from typing import Literal, Sequence
+
+import numpy as np
+import sympy as sp
+
+KINDS = ("identity", "inequality", "minimiser", "solution", "value")
+OPS = (">=", ">", "<=", "<")
+#: Seed of the falsification search (fixed: same claims, same counterexamples).
+SEED = 20260
+N_SAMPLES = 1000
+LATEX_LIMIT = 700
+
+
+class Verdict(str, enum.Enum):
+    PROVED = "PROVED"
+    REFUTED = "REFUTED"
+    INCONCLUSIVE = "INCONCLUSIVE"
+
+
+@dataclass(frozen=True)
+class Hypothesis:
+    """``symbol op bound`` (op in ``>=, >, <=, <``): an assumption a proof may use.
+
+    The sign prover replaces ``symbol`` by ``bound + s`` (or ``bound - s``)
+    with a fresh slack ``s >= 0``; the falsification search keeps only the
+    sample points where the relation holds.
+    """
+
+    symbol: sp.Symbol
+    op: str
+    bound: sp.Expr
+
+    def __post_init__(self):
+        if self.op not in OPS:
+            raise ValueError(f"hypothesis op = {self.op!r}; expected one of {OPS}")
+
+    @property
+    def relational(self) -> sp.Basic:
+        return {">=": sp.Ge, ">": sp.Gt, "<=": sp.Le, "<": sp.Lt}[self.op](
+            self.symbol, self.bound, evaluate=False)
+
+    def latex(self) -> str:
+        return sp.latex(self.relational)
+
+
+def hyp(symbol: sp.Symbol, op: str, bound) -> Hypothesis:
+    """Shorthand for :class:`Hypothesis`."""
+    return Hypothesis(symbol, op, sp.sympify(bound) if isinstance(bound, (int, float)) else bound)
+
+
+def time_derivative(expr, flows: dict) -> sp.Expr:
+    """d/dt of ``expr`` along x' = flows[x] (chain rule over the flow's symbols)."""
+    return sp.Add(*(sp.diff(expr, x) * f for x, f in flows.items()))
+
+
+def sig(x: sp.Expr, p: sp.Expr) -> sp.Expr:
+    """Sign-preserving power sign(x) |x|^p (odd-ratio powers of papers 001)."""
+    return sp.sign(x) * sp.Abs(x) ** p
+
+
+@dataclass(frozen=True)
+class Claim:
+    """One checkable step of a paper (see the module docstring for ``kind``).
+
+    Attributes
+    ----------
+    id, paper, equations, statement : str
+        Identifier, paper number ("000".."004"), equation numbers, plain words.
+    kind : str
+        One of :data:`KINDS`.
+    lhs, rhs : sympy expression or Matrix
+        Both sides (``minimiser``: lhs = criterion J, rhs = the law;
+        ``solution``: lhs = x(t), rhs = f(x, t) with ``state`` standing for x;
+        ``value``: lhs = exact expression, rhs = printed value).
+    variable : sympy.Symbol, optional
+        ``minimiser``: decision variable; ``solution``: time.
+    state : sympy.Symbol, optional
+        ``solution``: symbol standing for x in ``rhs``.
+    initial, terminal : (time, value), optional
+        ``solution``: x(t0) = x0 and x(T) = x_T.
+    hypotheses : tuple of Hypothesis
+    given : tuple of (Symbol, Expr)
+        Equalities used as substitutions (applied in order).
+    terms : tuple of Expr
+        ``inequality``: decomposition of ``rhs - lhs`` into terms to show >= 0.
+    sample : tuple of (Symbol, lo, hi)
+        Falsification box; other symbols use [0.1, 3] (positive) or [-3, 3].
+    digits : int
+        ``value``: printed decimals.
+    expect : "proved" | "refuted"
+        "refuted" marks the as-printed half of an erratum pair.
+    display : str
+        LaTeX shown for the claim instead of ``lhs = rhs`` (for large
+        matrices; display only, never parsed).
+    note : str
+        Erratum / remark shown in the report.
+    """
+
+    id: str
+    paper: str
+    equations: str
+    statement: str
+    kind: Literal["identity", "inequality", "minimiser", "solution", "value"]
+    lhs: object
+    rhs: object
+    variable: sp.Symbol | None = None
+    state: sp.Symbol | None = None
+    initial: tuple | None = None
+    terminal: tuple | None = None
+    hypotheses: tuple[Hypothesis, ...] = ()
+    given: tuple[tuple[sp.Symbol, sp.Expr], ...] = ()
+    terms: tuple[sp.Expr, ...] = ()
+    sample: tuple[tuple[sp.Symbol, float, float], ...] = ()
+    digits: int | None = None
+    display: str = ""
+    expect: Literal["proved", "refuted"] = "proved"
+    note: str = ""
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise ValueError(f"claim {self.id}: kind = {self.kind!r}; expected one of {KINDS}")
+        if self.expect not in ("proved", "refuted"):
+            raise ValueError(f"claim {self.id}: expect = {self.expect!r}")
+
+
+@dataclass(frozen=True)
+class Step:
+    """One checked step: what, its LaTeX, and whether it went through."""
+
+    what: str
+    latex: str
+    ok: bool | None
+
+
+@dataclass(frozen=True)
+class ProofResult:
+    """Outcome of :func:`check_claim`.
+
+    Attributes
+    ----------
+    verdict : Verdict
+    steps : tuple of Step
+    counterexample : tuple of (name, float), optional
+        Symbol values where the claim fails (REFUTED only), re-checked with
+        30-digit arithmetic; ``violation`` is the amount it fails by there.
+    remaining : str
+        What is left to show (INCONCLUSIVE only).
+    samples : int
+        Points of the falsification search that satisfied the hypotheses.
+    """
+
+    claim: Claim
+    verdict: Verdict
+    steps: tuple[Step, ...]
+    counterexample: tuple[tuple[str, float], ...] | None = None
+    violation: float | None = None
+    remaining: str = ""
+    samples: int = 0
+    sign_proof: bool = field(default=False, compare=False)
+
+    @property
+    def ok(self) -> bool:
+        """PROVED, or REFUTED for a claim declared expected-refuted."""
+        want = Verdict.REFUTED if self.claim.expect == "refuted" else Verdict.PROVED
+        return self.verdict is want
+
+    def to_json(self) -> dict:
+        c = self.claim
+        return {"id": c.id, "paper": c.paper, "equations": c.equations,
+                "statement": c.statement, "kind": c.kind, "expect": c.expect,
+                "verdict": self.verdict.value, "ok": self.ok,
+                "counterexample": dict(self.counterexample) if self.counterexample else None,
+                "violation": self.violation, "remaining": self.remaining,
+                "samples": self.samples,
+                "steps": [{"what": s.what, "latex": s.latex, "ok": s.ok} for s in self.steps]}
+
+
+# -- symbolic helpers ---------------------------------------------------------------
+def tex(expr) -> str:
+    """LaTeX of an expression, or a size note when it is too long to read."""
+    s = sp.latex(expr)
+    if len(s) > LATEX_LIMIT:
+        return rf"\text{{(expression of {sp.count_ops(expr)} operations, not shown)}}"
+    return s
+
+
+def _elements(x) -> list:
+    return list(x) if isinstance(x, sp.MatrixBase) else [x]
+
+
+def _apply_given(expr, given):
+    for s, e in given:
+        expr = expr.subs(s, e)
+    return expr
+
+
+def _sign_atoms(expr) -> list[sp.Symbol]:
+    """Real symbols of unknown sign that appear inside Abs / sign."""
+    out = set()
+    for f in expr.atoms(sp.Abs, sp.sign):
+        for s in f.args[0].free_symbols:
+            if s.is_positive is None and s.is_negative is None:
+                out.add(s)
+    return sorted(out, key=lambda s: s.name)
+
+
+def _cases(expr):
+    """Yield (description, expression) over the sign cases of ``_sign_atoms``."""
+    atoms = _sign_atoms(expr)
+    if not atoms:
+        yield "", expr
+        return
+    pos = {s: sp.Symbol(s.name + "_+", positive=True) for s in atoms}
+    for signs in itertools.product((1, -1, 0), repeat=len(atoms)):
+        sub = {s: sg * pos[s] for s, sg in zip(atoms, signs)}
+        desc = ", ".join(f"{sp.latex(s)} {'>' if sg > 0 else '<' if sg < 0 else '='} 0"
+                         for s, sg in zip(atoms, signs))
+        yield desc, expr.subs(sub)
+
+
+def _is_zero(e) -> bool:
+    if e == 0:
+        return True
+    for f in (sp.expand, sp.cancel, sp.simplify):
+        try:
+            r = f(e)
+        except Exception:  # pragma: no cover - sympy internals
+            continue
+        if r == 0:
+            return True
+        e = r
+    return False
+
+
+def is_identically_zero(expr) -> tuple[bool, str]:
+    """(True, "") when ``expr`` simplifies to 0 in every sign case, else
+    (False, LaTeX of the first case that did not)."""
+    for e in _elements(expr):
+        for desc, ce in _cases(sp.sympify(e)):
+            if not _is_zero(ce):
+                return False, (desc + ": " if desc else "") + tex(sp.simplify(ce)) + r" \overset{?}{=} 0"
+    return True, ""
+
+
+def _slack(expr, hypotheses):
+    """Replace each hypothesis ``x op b`` by ``x = b +/- s`` with slack s >= 0."""
+    slacks = []
+    for i, h in enumerate(hypotheses):
+        s = sp.Symbol(f"s_{i + 1}", nonnegative=True) if h.op in (">=", "<=") else \
+            sp.Symbol(f"s_{i + 1}", positive=True)
+        expr = expr.subs(h.symbol, h.bound + s if h.op in (">=", ">") else h.bound - s)
+        slacks.append(s)
+    return expr
+
+
+def _nonneg(e) -> bool:
+    if e.is_nonnegative:
+        return True
+    for f in (sp.expand, sp.factor, sp.simplify, lambda x: sp.powsimp(sp.expand(x), force=False)):
+        try:
+            if f(e).is_nonnegative:
+                return True
+        except Exception:  # pragma: no cover
+            continue
+    return False
+
+
+def prove_nonnegative(expr, hypotheses: Sequence[Hypothesis] = (), *, strict=False
+                      ) -> tuple[bool, str]:
+    """Show ``expr >= 0`` (``> 0`` if strict) from symbol assumptions and hypotheses.
+
+    Returns (True, "") or (False, LaTeX of what remains to be shown).
+    """
+    e = _slack(sp.sympify(expr), hypotheses)
+    for desc, ce in _cases(e):
+        ok = (ce.is_positive or bool(sp.simplify(ce).is_positive)) if strict else _nonneg(ce)
+        if not ok:
+            rel = ">" if strict else r"\geq"
+            return False, (desc + ": " if desc else "") + f"{tex(sp.simplify(ce))} {rel} 0"
+    return True, ""
+
+
+# -- falsification ---------------------------------------------------------------------
+def _box(claim: Claim, symbols) -> dict:
+    box = {s: (lo, hi) for s, lo, hi in claim.sample}
+    out = {}
+    for s in symbols:
+        if s in box:
+            out[s] = box[s]
+        elif s.is_positive or s.is_nonnegative:
+            out[s] = (0.1, 3.0)
+        else:
+            out[s] = (-3.0, 3.0)
+    return out
+
+
+def _holds(h: Hypothesis, vals: dict, prec: int | None = None) -> bool:
+    lhs, rhs = h.symbol.subs(vals), h.bound.subs(vals)
+    if prec:
+        lhs, rhs = sp.N(lhs, prec), sp.N(rhs, prec)
+    return bool(h.relational.func(float(lhs), float(rhs)))
+
+
+def _round(x: float) -> float:
+    return float(f"{x:.4g}")
+
+
+def falsify(claim: Claim, residual, *, kind: Literal["zero", "nonneg"],
+            n: int = N_SAMPLES) -> tuple[tuple | None, float | None, int]:
+    """Seeded search for a point where ``residual`` is nonzero / negative.
+
+    ``residual`` is evaluated after ``claim.given``; the hypotheses filter the
+    samples. Returns (counterexample or None, violation, points used).
+    """
+    residual = [_apply_given(sp.sympify(r), claim.given) for r in _elements(residual)]
+    hyps = [Hypothesis(h.symbol, h.op, _apply_given(h.bound, claim.given)) for h in claim.hypotheses]
+    free = set().union(*(r.free_symbols for r in residual), *(h.bound.free_symbols | {h.symbol}
+                                                               for h in hyps))
+    symbols = sorted(free, key=lambda s: s.name)
+    if not symbols:
+        return None, None, 0
+    box = _box(claim, symbols)
+    rng = np.random.default_rng(np.random.SeedSequence([SEED, sum(map(ord, claim.id))]))
+    X = {s: rng.uniform(*box[s], n) for s in symbols}
+    keep = np.ones(n, bool)
+    for h in hyps:
+        f = sp.lambdify(symbols, sp.Add(h.symbol, -h.bound), "numpy")
+        d = np.broadcast_to(np.asarray(f(*[X[s] for s in symbols]), float), (n,))
+        keep &= {">=": d >= 0, ">": d > 0, "<=": d <= 0, "<": d < 0}[h.op]
+    used = int(keep.sum())
+    if not used:
+        return None, None, 0
+    worst, worst_i, worst_r = 0.0, None, None
+    for r in residual:
+        f = sp.lambdify(symbols, r, "numpy")
+        with np.errstate(all="ignore"):
+            val = np.broadcast_to(np.asarray(f(*[X[s] for s in symbols]), complex), (n,))
+        bad = np.where(np.isfinite(val) & keep, np.abs(val.imag) +
+                       (np.abs(val.real) if kind == "zero" else np.maximum(-val.real, 0)), 0)
+        scale = 1e-9 * (1 + np.abs(val))
+        bad = np.where(bad > scale, bad, 0)
+        i = int(np.argmax(bad))
+        if bad[i] > worst:
+            worst, worst_i, worst_r = bad[i], i, r
+    if worst_i is None:
+        return None, None, used
+    point = {s: float(X[s][worst_i]) for s in symbols}
+    for candidate in ({s: _round(v) for s, v in point.items()}, point):
+        vals = {s: sp.Float(v, 30) for s, v in candidate.items()}
+        if not all(_holds(h, vals, 30) for h in hyps):
+            continue
+        v = complex(sp.N(worst_r.subs(vals), 30))
+        viol = abs(v.imag) + (abs(v.real) if kind == "zero" else max(-v.real, 0.0))
+        if viol > 1e-12 * (1 + abs(v)):
+            cex = tuple((s.name, candidate[s]) for s in symbols)
+            derived = tuple((s.name, float(sp.N(_apply_given(s, claim.given).subs(vals), 15)))
+                            for s, _ in claim.given if s not in candidate)
+            return cex + derived, float(viol), used
+    return None, None, used
+
+
+# -- the checks ---------------------------------------------------------------------------
+def _verdict(claim, steps, symbolic_ok: bool, remaining: str, residual, kind) -> ProofResult:
+    """Combine the symbolic argument and the falsification search."""
+    cex, viol, used = falsify(claim, residual, kind=kind)
+    if cex is not None:
+        steps = steps + (Step("falsification search: counterexample found, re-checked with "
+                              "30 digits", ", ".join(f"{n} = {v:.6g}" for n, v in cex), False),)
+        if symbolic_ok:  # both cannot be right: never claim a proof then
+            return ProofResult(claim, Verdict.INCONCLUSIVE, steps, cex, viol,
+                               "the symbolic argument and a numeric counterexample disagree",
+                               used)
+        return ProofResult(claim, Verdict.REFUTED, steps, cex, viol, "", used)
+    steps = steps + (Step(f"falsification search: no counterexample in {used} seeded points "
+                          "satisfying the hypotheses", "", True if used else None),)
+    if symbolic_ok:
+        return ProofResult(claim, Verdict.PROVED, steps, samples=used, sign_proof=True)
+    return ProofResult(claim, Verdict.INCONCLUSIVE, steps, remaining=remaining, samples=used)
+
+
+def _hyp_step(claim) -> tuple[Step, ...]:
+    if not claim.hypotheses and not claim.given:
+        return ()
+    parts = [h.latex() for h in claim.hypotheses] + [
+        f"{sp.latex(s)} = {tex(e)}" for s, e in claim.given]
+    return (Step("hypotheses", r",\quad ".join(parts), None),)
+
+
+def _check_identity(c: Claim) -> ProofResult:
+    diff = sp.Matrix(c.lhs) - sp.Matrix(c.rhs) if isinstance(c.lhs, sp.MatrixBase) else \
+        sp.sympify(c.lhs) - sp.sympify(c.rhs)
+    d = _slack(_apply_given(diff, c.given), c.hypotheses)
+    ok, rest = is_identically_zero(d)
+    steps = _hyp_step(c) + (Step("identity (both sides simplified, sign cases split)",
+                                 c.display or f"{tex(c.lhs)} = {tex(c.rhs)}", ok),)
+    return _verdict(c, steps, ok, "show " + rest if rest else "", diff, "zero")
+
+
+def _check_inequality(c: Claim) -> ProofResult:
+    margin = _apply_given(sp.sympify(c.rhs) - sp.sympify(c.lhs), c.given)
+    terms = c.terms or (margin,)
+    steps = _hyp_step(c) + (Step("claim", rf"{tex(c.lhs)} \leq {tex(c.rhs)}", None),)
+    ok, remaining = True, ""
+    if c.terms:
+        same, rest = is_identically_zero(sp.Add(*terms) - margin)
+        steps += (Step("decomposition of the margin into terms",
+                       rf"{tex(c.rhs)} - \left({tex(c.lhs)}\right) = "
+                       + " + ".join(rf"\left({tex(t)}\right)" for t in terms), same),)
+        if not same:
+            ok, remaining = False, "the terms do not add up to the margin: " + rest
+    for t in terms:
+        t_ok, rest = prove_nonnegative(t, c.hypotheses)
+        steps += (Step("term is nonnegative (hypotheses as slacks, sign cases split)",
+                       rf"{tex(t)} \geq 0", t_ok),)
+        if not t_ok and ok:
+            ok, remaining = False, "show " + rest
+    return _verdict(c, steps, ok, remaining, sp.sympify(c.rhs) - sp.sympify(c.lhs), "nonneg")
+
+
+def _check_minimiser(c: Claim) -> ProofResult:
+    J, law, u = sp.sympify(c.lhs), sp.sympify(c.rhs), c.variable
+    dJ = sp.diff(J, u)
+    sols = sp.solve(dJ, u)
+    steps = _hyp_step(c) + (Step("criterion", f"J({sp.latex(u)}) = {tex(J)}", None),
+                            Step(f"stationarity dJ/d{u} = 0, solved for {u}",
+                                 r",\; ".join(f"{sp.latex(u)} = {tex(s)}" for s in sols) or
+                                 r"\text{no solution}", len(sols) == 1))
+    if len(sols) != 1:
+        return _verdict(c, steps, False, f"dJ/d{u} = 0 has {len(sols)} solutions",
+                        sp.Integer(0), "zero")
+    same, rest = is_identically_zero(sols[0] - law)
+    steps += (Step("the derived minimiser is the stated law",
+                   f"{tex(sols[0])} = {tex(law)}", same),)
+    d2 = sp.simplify(sp.diff(J, u, 2))
+    convex, rest2 = prove_nonnegative(d2, c.hypotheses, strict=True)
+    steps += (Step("strict convexity", rf"\frac{{d^2J}}{{d{sp.latex(u)}^2}} = {tex(d2)} > 0",
+                   convex),)
+    remaining = ("show " + rest) if not same else ("show " + rest2 if not convex else "")
+    # falsification: J(law) <= J(law + delta) for a few perturbations delta
+    residual = [J.subs(u, law + dl) - J.subs(u, law) for dl in (-1, sp.Rational(-1, 10),
+                                                                sp.Rational(1, 10), 1)]
+    return _verdict(c, steps, same and convex, remaining, sp.Matrix(residual), "nonneg")
+
+
+def _check_solution(c: Claim) -> ProofResult:
+    x, t, f = sp.sympify(c.lhs), c.variable, sp.sympify(c.rhs)
+    ode = sp.diff(x, t) - f.subs(c.state, x)
+    parts = [("solves the ODE", ode, rf"\frac{{d}}{{d{sp.latex(t)}}}\left({tex(x)}\right) = "
+              + tex(f.subs(c.state, x)))]
+    for label, tv in (("initial value", c.initial), ("reaches the target", c.terminal)):
+        if tv:
+            parts.append((label, x.subs(t, tv[0]) - tv[1],
+                          f"x({tex(tv[0])}) = {tex(x.subs(t, tv[0]))} = {tex(tv[1])}"))
+    steps, ok, remaining = _hyp_step(c), True, ""
+    for label, resid, latex in parts:
+        r = _apply_given(resid, c.given)
+        r_ok, rest = is_identically_zero(_slack(r, c.hypotheses))
+        steps += (Step(label, latex, r_ok),)
+        if not r_ok and ok:
+            ok, remaining = False, f"{label}: show {rest}"
+    return _verdict(c, steps, ok, remaining, sp.Matrix([p[1] for p in parts]), "zero")
+
+
+def _check_value(c: Claim) -> ProofResult:
+    exact = sp.sympify(c.lhs)
+    got = sp.N(exact, 30)
+    num, den = Decimal(repr(float(c.rhs))).as_integer_ratio()  # the printed decimal
+    printed = sp.Rational(num, den)
+    half = sp.Rational(1, 2) * sp.Rational(10) ** (-c.digits)
+    ok = bool(abs(got - printed) <= half)
+    steps = (Step(f"exact value, compared at the printed {c.digits} decimals",
+                  f"{tex(exact)} = {sp.N(exact, 10)} \\approx {c.rhs}", ok),)
+    if ok:
+        return ProofResult(c, Verdict.PROVED, steps, sign_proof=True)
+    return ProofResult(c, Verdict.REFUTED, steps, (("computed", float(got)),),
+                       float(abs(got - printed)))
+
+
+_CHECKS = {"identity": _check_identity, "inequality": _check_inequality,
+           "minimiser": _check_minimiser, "solution": _check_solution, "value": _check_value}
+
+
+def check_claim(claim: Claim) -> ProofResult:
+    """PROVED / REFUTED / INCONCLUSIVE for one claim (see the module docstring).
+
+    Parameters
+    ----------
+    claim : Claim
+
+    Returns
+    -------
+    ProofResult
+        With the LaTeX of every checked step, the counterexample of a
+        refuted claim and what remains of an inconclusive one.
+    """
+    return _CHECKS[claim.kind](claim)
