@@ -107,6 +107,14 @@ def balancing(A: np.ndarray) -> np.ndarray:
     return np.diag(scale)
 
 
+def _balanced(A, B):
+    """(A~, B~, T, T^{-1}) with A~ = T^{-1} A T, B~ = T^{-1} B (see module docstring)."""
+    A, B = np.asarray(A, float), np.asarray(B, float).reshape(np.shape(A)[0], -1)
+    T = balancing(A)
+    Tinv = np.diag(1.0 / np.diag(T))
+    return Tinv @ A @ T, Tinv @ B, T, Tinv
+
+
 def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, Tinv) -> SynthesisRow:
     K = exact = exact_siso = rmin = None
     if br.certificate is not None:
@@ -140,10 +148,9 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
     tuple of SynthesisRow
         In the order of ``eps_values``.
     """
-    A, B = np.asarray(A, float), np.asarray(B, float).reshape(A.shape[0], -1)
-    T = balancing(A)
-    Tinv = np.diag(1.0 / np.diag(T))
-    crit = FreeWeighting003(Tinv @ A @ T, Tinv @ B, eps_values[0], margin=settings.margin)
+    A, B = np.asarray(A, float), np.asarray(B, float).reshape(np.shape(A)[0], -1)
+    At, Bt, _, Tinv = _balanced(A, B)
+    crit = FreeWeighting003(At, Bt, eps_values[0], margin=settings.margin)
     rows, guess = [], None
     for eps in eps_values:
         crit.set_eps(eps)
@@ -159,11 +166,8 @@ def certify_given_gain(A, B, K, eps: float, settings: SynthesisSettings = Synthe
                        ) -> Bracket:
     """Largest delay the criterion of problem (60) certifies for a *given* K
     (V = K L fixed), e.g. a gain printed in a paper."""
-    A, B = np.asarray(A, float), np.asarray(B, float).reshape(A.shape[0], -1)
-    T = balancing(A)
-    Tinv = np.diag(1.0 / np.diag(T))
-    crit = FreeWeighting003FixedK(Tinv @ A @ T, Tinv @ B, np.atleast_2d(K) @ T, eps,
-                                  margin=settings.margin)
+    At, Bt, T, _ = _balanced(A, B)
+    crit = FreeWeighting003FixedK(At, Bt, np.atleast_2d(K) @ T, eps, margin=settings.margin)
     return bisect_delay(crit.solve_at, h_lo=settings.h_min, h_hi=settings.h_max,
                         rel_tol=settings.rel_tol, max_solves=settings.max_solves)
 
@@ -176,10 +180,8 @@ def eps_for_bound(A, B, h_target: float, eps_lo: float, eps_hi: float, *,
     Bisection on eps in [eps_lo, eps_hi], assuming the bound grows with eps
     there (checked at the ends; ``None`` when ``h_target`` is not bracketed).
     """
-    A, B = np.asarray(A, float), np.asarray(B, float).reshape(A.shape[0], -1)
-    T = balancing(A)
-    Tinv = np.diag(1.0 / np.diag(T))
-    crit = FreeWeighting003(Tinv @ A @ T, Tinv @ B, eps_lo, margin=settings.margin)
+    At, Bt, _, _ = _balanced(A, B)
+    crit = FreeWeighting003(At, Bt, eps_lo, margin=settings.margin)
 
     def h_of(eps):
         crit.set_eps(eps)
