@@ -71,6 +71,11 @@ class SynthesisRow:
     seconds : float
     statuses : tuple[str, ...]
         Outcome letter per solve (c / r / i), in order.
+    recheck : dict[str, float]
+        Re-check eigenvalue margin of every LMI block at ``h_certified``.
+    certificate : dict[str, numpy.ndarray]
+        Decision variables at ``h_certified`` (balanced coordinates, see
+        module docstring).
     """
 
     eps: float
@@ -84,6 +89,8 @@ class SynthesisRow:
     solves: int
     seconds: float
     statuses: tuple[str, ...] = field(repr=False)
+    recheck: dict = field(default_factory=dict, repr=False)
+    certificate: dict = field(default_factory=dict, repr=False)
 
     @property
     def ratio(self) -> float | None:
@@ -117,7 +124,9 @@ def _balanced(A, B):
 
 def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, Tinv) -> SynthesisRow:
     K = exact = exact_siso = rmin = None
+    recheck, cert = {}, {}
     if br.certificate is not None:
+        recheck, cert = dict(br.certificate.recheck), dict(br.certificate.certificate)
         Kmat = crit.gain(br.certificate.certificate) @ Tinv
         K = tuple(float(k) for k in Kmat.ravel())
         exact = delay_margin_eig(A, B @ Kmat)
@@ -126,7 +135,7 @@ def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, Tinv) -> SynthesisRow:
         rmin = min(br.certificate.recheck.values())
     return SynthesisRow(float(eps), br.h_certified, br.h_refuted, K, br.outcome, exact,
                         exact_siso, rmin, br.solves, br.seconds,
-                        tuple(s.outcome.value[0] for s in br.steps))
+                        tuple(s.outcome.value[0] for s in br.steps), recheck, cert)
 
 
 def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = SynthesisSettings()
