@@ -1,4 +1,4 @@
-"""Paper 000, SMARC (eqs 13-27): the Lyapunov argument, as printed and corrected.
+"""Paper 000: brake model (eq 1) and SMARC Lyapunov argument (eqs 13-27).
 
 Plant (eq 14): theta x2' = u + Delta, theta = m in [theta_min, theta_max],
 |Delta| <= D. Error e = x1 - x_d, sliding variable z = c e + e' (eq 18), used
@@ -91,14 +91,16 @@ def claims() -> list[Claim]:
             f"smarc-eq27-upper-{tag}", PAPER, "26-27",
             f"Proj with '{rel}': at theta_hat = theta_max the rate Proj(tau) is <= 0 "
             "(theta_hat stays <= theta_max)", "inequality", _projection(tau, strict), 0,
-            given=((th_hat, th_max),), sample=box, expect=exp,
+            given=((th_hat, th_max),), hypotheses=(hyp(th_max, ">", th_min),),
+            sample=box, expect=exp,
             note="" if not strict else "Eq 27's strict inequalities let the rate point "
             "outwards on the boundary itself; with >= / <= the interval is invariant."))
         out.append(Claim(
             f"smarc-eq27-lower-{tag}", PAPER, "26-27",
             f"Proj with '{rel.replace('>', '<')}': at theta_hat = theta_min the rate "
             "Proj(tau) is >= 0", "inequality", 0, _projection(tau, strict),
-            given=((th_hat, th_min),), sample=box, expect=exp))
+            given=((th_hat, th_min),), hypotheses=(hyp(th_max, ">", th_min),),
+            sample=box, expect=exp))
     # eq (27) keeps eq (25): the extra term theta_tilde (Proj(tau) - tau)/lambda <= 0
     proj = _projection(tau, False)
     extra = th_tilde * (proj - tau) / lam
@@ -121,4 +123,15 @@ def claims() -> list[Claim]:
         "Inside the bounds Proj(tau) = tau: the extra term vanishes", "identity",
         extra, 0, given=((th_hat, (th_min + th_max) / 2),), sample=box,
         hypotheses=(hyp(th_max, ">", th_min),)))
+    # eq (1): the electric-brake lag starts after the delay T1 ("t > T2" printed)
+    T1, T2, t = sp.symbols("T_1 T_2 t", positive=True)
+    lag = 1 - sp.exp(-(t - T1) / T2)          # a_real / a_bra on the second branch
+    for tag, start, exp in (("printed", T2, "refuted"), ("corrected", T1, "proved")):
+        out.append(Claim(
+            f"brake-model-eq1-{tag}", PAPER, "1",
+            f"on the branch t > {start} of eq 1, a_real = a_bra (1 - exp(-(t - T1)/T2)) "
+            "has the sign of a_bra (a_real / a_bra >= 0)", "inequality", 0, lag,
+            hypotheses=(hyp(t, ">", start),), expect=exp,
+            note="" if exp == "proved" else "Eq 1 writes t > T2 for the branch that starts "
+            "after the delay T1: for T2 < t < T1 the response has the wrong sign."))
     return out

@@ -66,8 +66,7 @@ def cmd_synthesize(args) -> int:
     rows = synthesize_delay_bound(lin.A, lin.B, eps, spec.settings)
     ok = all(r.status.value == "certified" for r in rows)
     if args.json:
-        print(json.dumps({"design": design.name, "lambda_d_solved": lam_solved,
-                          "lambda_d_used": lam, "rows": [r.to_json() for r in rows]}, indent=2))
+        print(json.dumps({"design": design.name, "rows": [r.to_json() for r in rows]}, indent=2))
         return 0 if ok else 1
     print(f"{design.name}: problem (60) of paper 003 at v_d = {fmt(spec.v_d.value)} m/s, "
           f"lambda_d = {fmt(lam, 5)} ({'pinned' if spec.lambda_d_pinned else 'solved'}; "
@@ -114,8 +113,12 @@ def cmd_verify(args) -> int:
 
 
 def _extra_verifications(args) -> dict:
-    """Hook for other claim sources (e.g. proofs/); none yet."""
-    return {}
+    """Other claim sources: every claim of proofs/ (workbench.prove), when
+    verify runs on everything (no design named)."""
+    if getattr(args, "designs", None):
+        return {}
+    from .prove import verification_rows
+    return verification_rows()
 
 
 def cmd_report(args) -> int:
@@ -125,6 +128,9 @@ def cmd_report(args) -> int:
     designs = _designs([] if args.all else args.designs)
     files = [build(evaluate_design(d)) for d in designs]
     index = args.all or not args.designs
+    if index:
+        from .prove import report_files
+        files += report_files()
     out = Path(args.out)
     if args.check:
         problems = check_reports(files, out, index=index)
@@ -138,10 +144,43 @@ def cmd_report(args) -> int:
     return 0
 
 
+def _cmd_prove(args) -> int:
+    from .prove import cmd_prove
+    return cmd_prove(args)
+
+
+def _cmd_fit(args) -> int:
+    from .fit import fit_design
+    return fit_design(args.design, as_json=args.json)
+
+
+def cmd_benchmark(args) -> int:
+    from .benchmark import benchmark_delay
+    return benchmark_delay(args.design, as_json=args.json, exact_check=args.exact_check)
+
+
+def cmd_simulate(args) -> int:
+    from .studies.antiskid_run import simulate_command
+    return simulate_command(args.design, case=args.case, dt=args.dt, as_json=args.json)
+
+
+def cmd_sweep(args) -> int:
+    from .sim.montecarlo import sweep_command
+    return sweep_command(args.design, samples=args.samples, seed=args.seed,
+                         workers=args.workers, figure=args.figure, as_json=args.json)
+
+
 COMMANDS: dict[str, tuple[str, Callable]] = {
+    "simulate": ("simulate one case of an antiskid-run design (simulate DESIGN [--case C])",
+                 cmd_simulate),
+    "sweep": ("Monte Carlo robustness sweep (sweep DESIGN --samples N --seed S)", cmd_sweep),
+    "benchmark": ("delay LMIs vs exact margins (benchmark delay [DESIGN] [--json])",
+                  cmd_benchmark),
     "synthesize": ("certified LMI synthesis (synthesize delay-bound DESIGN)", cmd_synthesize),
     "verify": ("evaluate every claim; exit 1 if any is not ok", cmd_verify),
+    "fit": ("fit paper 000's brake model to a brake-fit design's synthetic logs", _cmd_fit),
     "report": ("write reports/<design>.md and figures (--check: fail if stale)", cmd_report),
+    "prove": ("check the claims of proofs/: PROVED / REFUTED / INCONCLUSIVE", _cmd_prove),
 }
 
 
@@ -155,6 +194,29 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("design")
     q.add_argument("--eps", type=float, nargs="+", help="eps values (override the design's)")
     q.add_argument("--json", action="store_true")
+    p = sub.add_parser("fit", help=COMMANDS["fit"][0])
+    p.add_argument("design")
+    p.add_argument("--json", action="store_true")
+    p = sub.add_parser("benchmark", help=COMMANDS["benchmark"][0])
+    bsub = p.add_subparsers(dest="what", required=True, parser_class=_Parser)
+    q = bsub.add_parser("delay", help="every delay LMI on the benchmark examples")
+    q.add_argument("design", nargs="?", default=str(DESIGNS_DIR / "delay-benchmarks.toml"),
+                   help="a delay-benchmark design (default: designs/delay-benchmarks.toml)")
+    q.add_argument("--json", action="store_true")
+    q.add_argument("--exact-check", action="store_true",
+                   help="re-check every certificate in exact rational arithmetic")
+    p = sub.add_parser("simulate", help=COMMANDS["simulate"][0])
+    p.add_argument("design")
+    p.add_argument("--case", help="case name (default: the design's first)")
+    p.add_argument("--dt", type=float, help="step (s; default: the design's dt)")
+    p.add_argument("--json", action="store_true")
+    p = sub.add_parser("sweep", help=COMMANDS["sweep"][0])
+    p.add_argument("design")
+    p.add_argument("--samples", type=int, required=True)
+    p.add_argument("--seed", type=int, required=True)
+    p.add_argument("--workers", type=int, help="processes (default: CPU count)")
+    p.add_argument("--figure", help="write the histogram PNG here")
+    p.add_argument("--json", action="store_true")
     p = sub.add_parser("verify", help=COMMANDS["verify"][0])
     p.add_argument("designs", nargs="*", help="design files (default: all of designs/)")
     p.add_argument("--json", action="store_true")
@@ -163,6 +225,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--all", action="store_true", help="every design in designs/ and the index")
     p.add_argument("--check", action="store_true", help="exit 1 if a committed report is stale")
     p.add_argument("--out", default=str(REPORTS_DIR), help="output folder (default: reports)")
+    p = sub.add_parser("prove", help=COMMANDS["prove"][0])
+    p.add_argument("proofs", nargs="*", metavar="PROOF",
+                   help="paper (e.g. 003), module of proofs/ or claim id (default: all)")
+    p.add_argument("--json", action="store_true")
     return ap
 
 

@@ -163,3 +163,16 @@ def build_profile(spec: ProfileSpec, dt: float = 0.01) -> Profile:
     ss = np.concatenate([[0.0], np.cumsum(vv[:-1] * h + h * h * (2 * a[:-1] + a[1:]) / 6)])
     vv[-1] = 0.0 if abs(vv[-1]) < 1e-9 else vv[-1]
     return Profile(spec, v, t, ss, np.maximum(vv, 0.0), a)
+
+
+def spec_for_cruise(v_cruise: float, cruise_time: float, accel: float, brake: float,
+                    jerk: float) -> ProfileSpec:
+    """The profile spec whose run cruises at ``v_cruise`` (m/s) for ``cruise_time`` (s).
+
+    Used for a leader that "accelerates, cruises at 86 km/h for about 120 s and
+    brakes to the next station" (paper 001 §4): distance and planned time follow.
+    """
+    ta, tb = phase_time(v_cruise, accel, jerk), phase_time(v_cruise, brake, jerk)
+    return ProfileSpec(distance=v_cruise * ((ta + tb) / 2.0 + cruise_time),
+                       v_limit=1.2 * v_cruise, accel=accel, brake=brake, jerk=jerk,
+                       run_time=ta + tb + cruise_time)

@@ -16,12 +16,20 @@ Controllers (paper 003, section 3):
 * phases, eq (75): acceleration until the measured speed reaches v_d, cruise
   until t_brake, braking until v <= v_stop (end of the run).
 
-P = X(t + h) is the predictor of Lemma 1, eq (2), computed numerically:
+P = X(t + h) is the predictor of Lemma 1, eq (2), computed numerically with
+the model of the active phase (eq 65 traction form, eq 62 linear error
+model, eq 70 braking form). Default ("rollout"): the model is run from x(t)
+through the controller's own inputs of the last h seconds (u on [-h, 0) =
+u_init), with the plant's stiff step. Literal form ("recursive"):
 P_n = x_n + (integral over the last h seconds of f(P(s), u(s)) ds), the
-integrand stored per step in a :class:`~workbench.sim.history.DelayLine`
-(model f of the active phase: eq 65 traction form, eq 62 linear error model,
-eq 70 braking form). The initial window follows eq (66): the model is run
-from x(0) over [0, h] with the initial input u(theta) = u_init.
+integrand of past predictions stored per step in a
+:class:`~workbench.sim.history.DelayLine`, its initial window from eq (66);
+its error obeys a neutral-type equation and fails where the creep dynamics
+are stiff (see the antiskid-run-dry report).
+
+Sampling: laws run every step; ``sampling = "stiff"`` holds the torque that
+moves the exponential-Euler creep ratio by dt times the rate the continuous
+law asks for (see :class:`ControllerSettings`).
 
 Guards (as in the paper): below omega = omega_switch (3 rad/s, eq 76) the
 desired creep speed is 0 (creep speed, not creep ratio, is tracked in
@@ -34,12 +42,13 @@ at low speed (d lambda'/d lambda ~ -m g r^2 mu'(lambda) / (J v), a time
 constant of about v / 4000 s on dry rail), by the exponential Euler step
 lambda+ = lambda + dt phi1(dt J) lambda', J = d lambda'/d lambda from the
 sympy Jacobian, phi1(z) = (e^z - 1)/z: exact for the linear part, stable for
-any dt J < 0.
+any dt J < 0; a step that would move lambda by more than MAX_DLAMBDA is
+halved (adaptive sub-stepping, :func:`stiff_step`).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import lru_cache
 from typing import Literal
 
@@ -48,10 +57,11 @@ import sympy as sp
 
 from ..plants.adhesion import PARAMETER_UNITS, adhesion_model
 from ..sim.delay import SimResult, simulate_closed_loop
-from ..sim.history import DelayLine
+from ..sim.history import BatchDelayLine, DelayLine
 
-ACCEL, HANDOVER, CRUISE, BRAKE, STOPPED, DIVERGED = 0, 1, 2, 3, 4, 5
-PHASE_NAMES = ("acceleration", "handover", "cruise", "braking", "stopped", "diverged")
+ACCEL, HANDOVER, CRUISE, BRAKE_IN, BRAKE, STOPPED, DIVERGED = range(7)
+PHASE_NAMES = ("acceleration", "handover to cruise", "cruise", "handover to braking",
+               "braking", "stopped", "diverged")
 PARAM_ORDER = tuple(PARAMETER_UNITS)
 
 
@@ -133,11 +143,30 @@ class ControllerSettings:
     profile : CreepSpeedProfile
     compensate : bool
         False: the same laws fed the current state (no predictor).
-    handover : {"speed", "creep"}
+    sampling : {"stiff", "zoh"}
+        How a continuous law is held over a sample. "zoh": the printed value.
+        "stiff": the creep ratio reacts to a held torque within a fraction of
+        a sample at low speed (time constant ~ v/4000 s), so the printed
+        value held for dt realises the continuous law's rate only when
+        dt |J| << 1; "stiff" holds u with f20 + f2u u = g / phi1(dt J),
+        g = f20 + f2u u_printed, which moves the creep ratio of the
+        exponential step by dt g (the continuous law's rate) for any dt J.
+    predictor : {"rollout", "recursive"}
+        How eq (2) is evaluated: "rollout" runs the phase's model from x(t)
+        through the inputs of the last h seconds; "recursive" sums the stored
+        f(P(s), u(s)) of past predictions (the literal form of eq 2).
+        The recursive form's error obeys e(t) = int_{t-h}^t J e(s) ds, a
+        neutral-type equation, and is not robust when J (the creep-ratio
+        Jacobian) is stiff, i.e. at low speed.
+    cruise_entry : {"speed", "creep"}
         "speed" (eq 75 as printed): cruise law from the moment v >= v_d.
         "creep" (workbench variant): at v >= v_d, first eq (64) with target
         lambda_d instead of lambda_opt; the cruise law takes over once
         |lambda - lambda_d| <= ``handover_band``.
+    brake_entry : {"time", "creep"}
+        "time" (as printed): braking law (69) from t_brake. "creep"
+        (variant): eq (64) with target -``handover_band`` until lambda <= 0,
+        where the braking form (eq 15) that eq (69) is built on applies.
     v_stop, v_floor : float
         End of run and speed floor in denominators (m/s).
     lam_diverged : float
@@ -156,7 +185,10 @@ class ControllerSettings:
     h_model: float
     profile: CreepSpeedProfile
     compensate: bool = True
-    handover: str = "speed"
+    sampling: str = "stiff"
+    predictor: str = "rollout"
+    cruise_entry: str = "speed"
+    brake_entry: str = "time"
     handover_band: float = 0.002
     v_stop: float = 0.05
     v_floor: float = 0.01
@@ -184,18 +216,38 @@ def creep_speed(v, lam, xp):
     return xp.where(lam >= 0, lam * v / (1.0 - xp.minimum(lam, 0.999)), lam * v)
 
 
-def plant_step(x, u, p, dt, fns, xp, v_floor=1e-3):
-    """One step of the adhesion plant: explicit Euler in v, exponential Euler
-    in the stiff creep ratio (module docstring)."""
-    v, lam = x
-    vg = xp.maximum(v, v_floor)
-    f1, f20, f2u, j0, ju = _forms(vg, lam, p, fns, xp)
-    f2 = f20 + f2u * u
-    z = (j0 + ju * u) * dt
+def _exp_euler(v, lam, f1, f2, z, dt, xp):
+    """(v + dt f1, lambda + dt phi1(z) f2), z = dt d lambda'/d lambda."""
     big = xp.abs(z) > 1e-8
     zs = xp.where(big, z, 1.0)
     phi = xp.where(big, xp.expm1(zs) / zs, 1.0 + 0.5 * z)
-    return (v + dt * f1, lam + dt * phi * f2)
+    return v + dt * f1, lam + dt * phi * f2
+
+
+#: Largest creep-ratio change of one exponential-Euler step; larger steps are
+#: halved (the adhesion curve is far from linear over such a change).
+MAX_DLAMBDA = 0.02
+
+
+def stiff_step(v, lam, u, dt, evalf, xp, mask=True, depth=0):
+    """Explicit Euler in v, exponential Euler in the stiff creep ratio, with
+    ``evalf(v, lam) -> (v', lambda'_0, lambda'_u, J_0, J_u)``; halved
+    recursively (up to 8 times) while the creep ratio would move by more than
+    MAX_DLAMBDA (in a batch: in a run where ``mask`` is true)."""
+    f1, f20, f2u, j0, ju = evalf(v, lam)
+    out = _exp_euler(v, lam, f1, f20 + f2u * u, (j0 + ju * u) * dt, dt, xp)
+    if depth < 8 and xp.any(~(xp.abs(out[1] - lam) <= MAX_DLAMBDA) & mask if xp.batch
+                            else not abs(out[1] - lam) <= MAX_DLAMBDA):
+        hv, hl = stiff_step(v, lam, u, dt / 2, evalf, xp, mask, depth + 1)
+        return stiff_step(hv, hl, u, dt / 2, evalf, xp, mask, depth + 1)
+    return out
+
+
+def plant_step(x, u, p, dt, fns, xp, v_floor=1e-3, mask=True):
+    """One step of the adhesion plant (module docstring), the form (eq 12 or
+    15) chosen by the sign of lambda."""
+    return stiff_step(x[0], x[1], u, dt,
+                      lambda v, lam: _forms(xp.maximum(v, v_floor), lam, p, fns, xp), xp, mask)
 
 
 @dataclass
@@ -215,10 +267,12 @@ class RunMetrics:
     t_omega3: object = math.nan
     t_stop: object = math.nan
     t_handover_done: object = math.nan
+    v_at_handover: object = math.nan
+    lam_at_handover: object = math.nan
     t_diverged: object = math.nan
     phase_diverged: object = math.nan
-    evs_ema: object = 0.0
-    evs_max_late: object = 0.0
+    evs_last: object = math.nan
+    evs_max_tracking: object = 0.0
 
 
 class Antiskid003:
@@ -238,18 +292,21 @@ class Antiskid003:
         None: floats; else the number of runs stepped together.
     plant_r : float or array
         Wheel radius of the plant (for the measured wheel speed).
-    evs_window : float
-        Averaging time of the creep-speed-error metric (s).
+    evs_settle : float
+        The creep-speed error is tracked from t_brake + evs_settle (s) while
+        omega > omega_switch (``evs_max_tracking``); ``evs_last`` is its
+        value at the last braking sample.
     """
 
     def __init__(self, s: ControllerSettings, x0, u_init: float, dt: float, batch=None,
-                 plant_r=None, evs_window: float = 1.0):
+                 plant_r=None, evs_settle: float = 5.0):
         self.s, self.dt = s, dt
         self.xp = _Scalar if batch is None else _Array
         self.fns = model_functions("math" if batch is None else "numpy")
         self.r_c = s.params[PARAM_ORDER.index("r")]
         self.r_p = self.r_c if plant_r is None else plant_r
-        self.evs_window = evs_window
+        self.evs_settle = evs_settle
+        self._v_prev = x0[0] + (0.0 if batch is None else np.zeros(batch))
         zero = 0.0 if batch is None else np.zeros(batch)
         self.phase = ACCEL if batch is None else np.full(batch, ACCEL)
         self.m = RunMetrics()
@@ -268,12 +325,62 @@ class Antiskid003:
             v, lam = nv, nl
         self.fv = DelayLine(s.h_model, dt, zero, history=hist_v)
         self.fl = DelayLine(s.h_model, dt, zero, history=hist_l)
+        self.uline = DelayLine(s.h_model, dt, u_init + zero)
+
+    # -- predictors ----------------------------------------------------------------
+    def _model_step(self, v, lam, u, dt, ph):
+        """One step of the phase's prediction model: traction form (eq 65) in
+        acceleration and handovers, linear error model (eq 62) in cruise,
+        braking form (eq 70) in braking; exponential Euler in lambda."""
+        s, xp, p, c = self.s, self.xp, self.s.params, self.s.lin
+        out_v, out_l = v, lam
+        for forms, sel in (("traction", (ph != CRUISE) & (ph < BRAKE) if xp.batch
+                            else ph not in (CRUISE, BRAKE)),
+                           ("braking", ph == BRAKE)):
+            if xp.any(sel):
+                fn = self.fns[forms]
+                nv, nl = stiff_step(v, lam, u, dt, lambda vv, ll: fn(
+                    xp.maximum(vv, s.v_floor), ll, *p), xp, sel)
+                out_v, out_l = xp.where(sel, nv, out_v), xp.where(sel, nl, out_l)
+        sel = ph == CRUISE
+        if xp.any(sel):
+            ve, le = v - s.v_d, lam - s.lambda_d
+            den = c["d4"] * ve + c["d5"] * le + c["d6"]
+            f2 = c["d1"] * ve + c["d2"] * le + c["d3"] + den * u
+            nv, nl = _exp_euler(v, lam, c["a1"] * ve + c["a2"] * le, f2,
+                                (c["d2"] + c["d5"] * u) * dt, dt, xp)
+            out_v, out_l = xp.where(sel, nv, out_v), xp.where(sel, nl, out_l)
+        return out_v, out_l
+
+    def _rollout(self, v, lam, ph):
+        """X(t + h) of eq (2) by running the phase's model from x(t) through
+        the inputs of the last h seconds (exact ZOH weights of the window)."""
+        line, dt = self.uline, self.dt
+        n = line._n
+        if line.f > 0:
+            v, lam = self._model_step(v, lam, line._get(n - line.N - 1), line.f * dt, ph)
+        for k in range(n - line.N, n):
+            v, lam = self._model_step(v, lam, line._get(k), dt, ph)
+        return v, lam
 
     # -- the three laws -------------------------------------------------------------
+    def _sampled(self, u, f20, f2u, j0, ju):
+        """The input to hold over one sample so that the stiff creep ratio
+        moves by dt times the rate the continuous law asks for (see
+        ``ControllerSettings.sampling``); the printed law when dt J -> 0."""
+        if self.s.sampling == "zoh":
+            return u
+        xp = self.xp
+        z = (j0 + ju * u) * self.dt
+        big = xp.abs(z) > 1e-8
+        zs = xp.where(big, z, 1.0)
+        phi = xp.where(big, xp.expm1(zs) / zs, 1.0 + 0.5 * z)
+        return ((f20 + f2u * u) / phi - f20) / f2u
+
     def _accel(self, Pv, Pl, target):
         s, p = self.s, self.s.params
-        y1, y2, y3, *_ = self.fns["traction"](self.xp.maximum(Pv, s.v_floor), Pl, *p)
-        u = (-y2 - s.k_ac * (Pl - target)) / y3
+        y1, y2, y3, dy2, dy3 = self.fns["traction"](self.xp.maximum(Pv, s.v_floor), Pl, *p)
+        u = self._sampled((-y2 - s.k_ac * (Pl - target)) / y3, y2, y3, dy2, dy3)
         return u, y1, y2 + y3 * u
 
     def _cruise(self, v, lam, Pv, Pl):
@@ -281,72 +388,101 @@ class Antiskid003:
         ve, le = Pv - s.v_d, Pl - s.lambda_d
         den = c["d4"] * ve + c["d5"] * le + c["d6"]
         u = (-c["d3"] + s.K[0] * (v - s.v_d) + s.K[1] * (lam - s.lambda_d)) / den
+        u = self._sampled(u, c["d1"] * ve + c["d2"] * le + c["d3"], den, c["d2"], c["d5"])
         return u, c["a1"] * ve + c["a2"] * le, c["d1"] * ve + c["d2"] * le + c["d3"] + den * u
 
     def _brake(self, t, Pv, Pl):
         s, p, xp = self.s, self.s.params, self.xp
         vg = xp.maximum(Pv, s.v_floor)
-        z1, z2, z3, *_ = self.fns["braking"](vg, Pl, *p)
+        z1, z2, z3, dz2, dz3 = self.fns["braking"](vg, Pl, *p)
         omega = wheel_speed(vg, Pl, self.r_c, xp)
         vs, dvs = s.profile(t + s.h_model, vg, z1, omega, xp)
         u = ((-s.k_de * (vg * Pl - vs) + z1 + dvs) / vg - (1.0 + Pl) / vg * z1 - z2) / z3
+        u = self._sampled(u, z2, z3, dz2, dz3)
         return u, z1, z2 + z3 * u
 
     # -- one sample -----------------------------------------------------------------
     def __call__(self, t, x, inputs):
         s, xp, m = self.s, self.xp, self.m
         v, lam = x
-        if s.compensate:
-            Pv, Pl = v + self.fv.window_integral(), lam + self.fl.window_integral()
-        else:
-            Pv, Pl = v, lam
         ph, B = self.phase, xp.batch
-        after = HANDOVER if s.handover == "creep" else CRUISE
+        after = HANDOVER if s.cruise_entry == "creep" else CRUISE
         to_cruise = (ph == ACCEL) & (v >= s.v_d) if B else (ph == ACCEL and v >= s.v_d)
         ph = xp.where(to_cruise, after, ph)
         near = xp.abs(lam - s.lambda_d) <= s.handover_band
         handed = (ph == HANDOVER) & near if B else (ph == HANDOVER and near)
         ph = xp.where(handed, CRUISE, ph)
-        to_brake = (ph < BRAKE) & (t >= s.profile.t_brake) if B else (
-            ph < BRAKE and t >= s.profile.t_brake)
-        ph = xp.where(to_brake, BRAKE, ph)
-        to_stop = (ph == BRAKE) & (v <= s.v_stop) if B else (ph == BRAKE and v <= s.v_stop)
+        to_brake = (ph < BRAKE_IN) & (t >= s.profile.t_brake) if B else (
+            ph < BRAKE_IN and t >= s.profile.t_brake)
+        ph = xp.where(to_brake, BRAKE_IN if s.brake_entry == "creep" else BRAKE, ph)
+        braked = (ph == BRAKE_IN) & (lam <= 0) if B else (ph == BRAKE_IN and lam <= 0)
+        ph = xp.where(braked, BRAKE, ph)
+        in_brake = (ph == BRAKE_IN) | (ph == BRAKE) if B else ph in (BRAKE_IN, BRAKE)
+        to_stop = in_brake & (v <= s.v_stop) if B else (in_brake and v <= s.v_stop)
         ph = xp.where(to_stop, STOPPED, ph)
         bad = ~(xp.abs(lam) < s.lam_diverged) & (ph < STOPPED) if B else (
             not abs(lam) < s.lam_diverged and ph < STOPPED)
         self.m.t_diverged = xp.where(bad, t, self.m.t_diverged)
         self.m.phase_diverged = xp.where(bad, ph, self.m.phase_diverged)
         self.m.t_handover_done = xp.where(handed, t, self.m.t_handover_done)
+        self.m.v_at_handover = xp.where(handed, v, self.m.v_at_handover)
+        self.m.lam_at_handover = xp.where(handed, lam, self.m.lam_at_handover)
         ph = xp.where(bad, DIVERGED, ph)
         self.phase = ph
+        try:
+            u, fv, fl = self._laws(t, v, lam, ph)
+        except (OverflowError, ZeroDivisionError, ValueError):
+            if xp.batch:   # numpy gives inf/nan instead; never reached
+                raise
+            # floats: a model evaluation overflowed (e.g. a predicted creep ratio
+            # far outside (-1, 1)): the run has diverged
+            self.m.t_diverged, self.m.phase_diverged = t, ph
+            self.phase = ph = DIVERGED
+            u = fv = fl = 0.0
+        self.fv.push(fv)
+        self.fl.push(fl)
+        self.uline.push(u)
+        self._metrics(t, v, lam, ph, to_cruise, to_brake, to_stop)
+        return u, ph
+
+    def _laws(self, t, v, lam, ph):
+        """(u, predicted v', predicted lambda') of the active laws."""
+        s, xp = self.s, self.xp
+        if not s.compensate:
+            Pv, Pl = v, lam
+        elif s.predictor == "rollout":
+            Pv, Pl = self._rollout(v, lam, ph)
+        else:
+            Pv, Pl = v + self.fv.window_integral(), lam + self.fl.window_integral()
         u = fv = fl = 0.0 * v
         for code, law in ((ACCEL, lambda: self._accel(Pv, Pl, s.lambda_opt)),
                           (HANDOVER, lambda: self._accel(Pv, Pl, s.lambda_d)),
                           (CRUISE, lambda: self._cruise(v, lam, Pv, Pl)),
+                          (BRAKE_IN, lambda: self._accel(Pv, Pl, -s.handover_band)),
                           (BRAKE, lambda: self._brake(t, Pv, Pl))):
             sel = ph == code
             if xp.any(sel):
                 uc, fvc, flc = law()
                 u, fv, fl = xp.where(sel, uc, u), xp.where(sel, fvc, fv), xp.where(sel, flc, fl)
-        self.fv.push(fv)
-        self.fl.push(fl)
-        self._metrics(t, v, lam, ph, to_cruise, to_brake, to_stop)
-        return u, ph
+        return u, fv, fl
 
     def _metrics(self, t, v, lam, ph, to_cruise, to_brake, to_stop):
         s, xp, m = self.s, self.xp, self.m
         w = xp.where
-        m.t_cruise = w(to_cruise, t, m.t_cruise)
+        # crossing time of v = v_d, interpolated between the last two samples
+        frac = (v - s.v_d) / xp.maximum(v - self._v_prev, 1e-12)
+        m.t_cruise = w(to_cruise, t - self.dt * xp.minimum(frac, 1.0), m.t_cruise)
+        self._v_prev = v
         m.v_at_cruise = w(to_cruise, v, m.v_at_cruise)
         m.lam_at_cruise = w(to_cruise, lam, m.lam_at_cruise)
-        trac = ph < BRAKE
+        trac = ph < BRAKE_IN
         m.lam_max_traction = w(trac, xp.maximum(m.lam_max_traction, lam), m.lam_max_traction)
         m.v_max = w(trac, xp.maximum(m.v_max, v), m.v_max)
         m.lam_at_brake = w(to_brake, lam, m.lam_at_brake)
         m.v_err_at_brake = w(to_brake, v - s.v_d, m.v_err_at_brake)
         m.lam_err_at_brake = w(to_brake, lam - s.lambda_d, m.lam_err_at_brake)
         m.t_stop = w(to_stop, t, m.t_stop)
-        brk = ph == BRAKE
+        brk = (ph == BRAKE_IN) | (ph == BRAKE) if xp.batch else ph in (BRAKE_IN, BRAKE)
         if not xp.any(brk):
             return
         first_neg = brk & (lam < 0) & (m.t_lam_negative != m.t_lam_negative) if xp.batch else (
@@ -360,11 +496,11 @@ class Antiskid003:
         # creep-speed error of Theorem 3, e_vs = v_s - v_s*(t) (measured)
         vs_star, _ = s.profile(t, v, 0.0 * v, omega, xp)
         e = xp.abs(creep_speed(v, lam, xp) - vs_star)
-        a = self.dt / self.evs_window
-        m.evs_ema = w(brk, m.evs_ema + a * (e - m.evs_ema), m.evs_ema)
-        late = brk & (t >= s.profile.t_brake + 5.0) if xp.batch else (
-            brk and t >= s.profile.t_brake + 5.0)
-        m.evs_max_late = w(late, xp.maximum(m.evs_max_late, e), m.evs_max_late)
+        m.evs_last = w(brk, e, m.evs_last)
+        hi = omega > s.profile.omega_switch
+        late = brk & hi & (t >= s.profile.t_brake + self.evs_settle) if xp.batch else (
+            brk and hi and t >= s.profile.t_brake + self.evs_settle)
+        m.evs_max_tracking = w(late, xp.maximum(m.evs_max_tracking, e), m.evs_max_tracking)
 
 
 @dataclass(frozen=True)
@@ -388,8 +524,8 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     Parameters
     ----------
     run : RunSettings
-        For a batch, ``plant_params`` entries and ``h`` may be arrays... ``h``
-        must be one float (a batch shares the delay grid).
+        For a batch, ``plant_params`` entries and ``h`` may be (B,) arrays
+        (one value per run).
     dt : float
         Step and sampling period (s).
     record_dt : float or None
@@ -408,10 +544,10 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     zero = 0.0 if batch is None else np.zeros(batch)
 
     def step(x, u, t, dt_):
-        nx = plant_step(x, u, p, dt_, fns, xp)
         if batch is None:
-            return nx
+            return plant_step(x, u, p, dt_, fns, xp)
         stop = ctrl.phase >= STOPPED
+        nx = plant_step(x, u, p, dt_, fns, xp, mask=~stop)
         return (np.where(stop, x[0], nx[0]), np.where(stop, x[1], nx[1]))
 
     def done(t, x, ph):
@@ -419,9 +555,12 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
 
     every = 10**12 if record_dt is None else max(int(round(record_dt / dt)), 1)
     x0 = (run.x0[0] + zero, run.x0[1] + zero)
+    line = None if batch is None else BatchDelayLine(np.broadcast_to(run.h, (batch,)), dt,
+                                                      run.u_init)
     with np.errstate(all="ignore"):
-        res = simulate_closed_loop(step, ctrl, x0, h=run.h, dt=dt, t_end=run.t_end,
-                                   u_init=run.u_init + zero, record_every=every, done=done)
+        res = simulate_closed_loop(step, ctrl, x0, h=float(np.max(run.h)), dt=dt,
+                                   t_end=run.t_end, u_init=run.u_init + zero,
+                                   record_every=every, done=done, line=line)
     if record_dt is None:
         res = None
     else:

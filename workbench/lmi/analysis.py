@@ -4,7 +4,8 @@ Each criterion is a :class:`~workbench.lmi.core.MarginLMI`: blocks written
 once, solved as "maximise t" by Clarabel, re-checked with numpy; the largest
 certified h comes from the shared bracketed bisection
 (:func:`~workbench.lmi.core.bisect_delay`) through :func:`certified_delay`.
-Every criterion normalises the Lyapunov matrix ``P`` (trace(P) <= 1).
+Every criterion normalises the Lyapunov matrix ``P`` (trace(P) <= 1; for the
+Bessel-Legendre hierarchy its positive lower bound Theta, see the class).
 
 Notation (block selectors on the augmented vector xi):
 ``x = x(t)``, ``x_d = x(t - h)``, and for the Bessel-Legendre hierarchy the
@@ -22,8 +23,11 @@ Criteria (weakest to tightest on the classic example):
 What a CERTIFIED step proves: at the delay tested, the Lyapunov-Krasovskii
 functional of the criterion is positive definite and strictly decreasing
 along solutions, so the system is asymptotically stable for that constant
-delay (for the free-weighting criterion: for every constant delay in
-[0, h]).
+delay (for the free-weighting criterion, whose LMI is affine in h with a
+positive semidefinite slope: for every constant delay in [0, h]). The
+bisection treats the certified set as an interval [0, h], as the literature
+does; the benchmark and the soundness suite compare every bound with the
+exact margin of :mod:`workbench.margins`.
 
 References
 ----------
@@ -51,6 +55,17 @@ import numpy as np
 
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, bisect_delay
 
+#: Clarabel settings of the retries after an ``optimal_inaccurate`` answer,
+#: tried in order (near the bound the higher Bessel-Legendre orders are
+#: degenerate enough for the default refinement to stop short). The looser
+#: tolerances of the second retry cannot make a step CERTIFIED on their own:
+#: every certified point is re-checked with numpy against the margin.
+RETRY_SETTINGS = (
+    {"iterative_refinement_reltol": 1e-14, "iterative_refinement_abstol": 1e-14,
+     "iterative_refinement_max_iter": 50},
+    {"tol_gap_abs": 1e-7, "tol_gap_rel": 1e-7, "tol_feas": 1e-7, "tol_ktratio": 1e-5},
+)
+
 MethodName = Literal["delay-independent", "jensen", "free-weighting", "wirtinger",
                      "bessel-legendre"]
 METHODS: tuple[str, ...] = ("delay-independent", "jensen", "free-weighting", "wirtinger",
@@ -66,6 +81,7 @@ class _DelayAnalysis(MarginLMI):
 
     normaliser = "P"
     method: str = ""
+    retry_settings = RETRY_SETTINGS
 
     def __init__(self, A, Ad, **kw):
         self.A = np.atleast_2d(np.asarray(A, float))
@@ -79,7 +95,6 @@ class _DelayAnalysis(MarginLMI):
     def N(self) -> int | None:
         """Bessel-Legendre order (None for the other criteria)."""
         return None
-
 
 class DelayIndependentLMI(_DelayAnalysis):
     """Delay-independent test: stable for every constant h >= 0.
@@ -155,7 +170,7 @@ class FreeWeightingLMI(_DelayAnalysis):
     def blocks(self, x, p, bmat):
         P, Q, Zm, N1, N2, A, Ad, h = x["P"], x["Q"], x["Z"], x["N1"], x["N2"], self.A, \
             self.Ad, p["h"]
-        O = np.zeros((self.n, self.n))
+        O = np.zeros((self.n, self.n), dtype=int)
         p11 = P @ A + A.T @ P + N1 + N1.T + Q
         p12 = P @ Ad - N1 + N2.T
         p22 = -N2 - N2.T - Q
@@ -171,7 +186,7 @@ def legendre_derivative_coefficients(N: int) -> np.ndarray:
 
     For l_k(u) = P_k(2u - 1): c[k, j] = (2j + 1)(1 - (-1)^(k+j)) (SG15, eq. 4).
     """
-    c = np.zeros((N + 1, N + 1))
+    c = np.zeros((N + 1, N + 1), dtype=int)
     for k in range(N + 1):
         for j in range(k):
             c[k, j] = (2 * j + 1) * (1 - (-1) ** (k + j))
@@ -200,12 +215,15 @@ class BesselLegendreLMI(_DelayAnalysis):
         Theta_N(h) = P + (1/h) diag(0, S, 3S, ..., (2N-1)S) >= 0,  S, R >= 0
 
     (Theta from int x'Sx >= (1/h) sum (2k+1) (h Omega_k)' S (h Omega_k)).
-    Decision variables: P ((N+1) n symmetric), S, R (n x n symmetric).
+    Decision variables: Theta ((N+1) n symmetric, the normalised one, with
+    P = Theta - (1/h) diag(0, S, ..., (2N-1) S) substituted), S, R (n x n
+    symmetric).
     N = 0 is the Jensen criterion, N = 1 the Wirtinger one of SG13; the bound
     is non-decreasing in N (SG15 Theorem 4: the hierarchy).
     """
 
     method = "bessel-legendre"
+    normaliser = "Theta"
 
     def __init__(self, A, Ad, N: int, **kw):
         if not (isinstance(N, (int, np.integer)) and N >= 0):
@@ -219,16 +237,18 @@ class BesselLegendreLMI(_DelayAnalysis):
 
     def variables(self):
         n, N = self.n, self._N
-        return {"P": _sym((N + 1) * n, "P"), "S": _sym(n, "S"), "R": _sym(n, "R")}
+        # Theta (not P) is the variable: P = Theta - (1/h) D(S), so the
+        # normalisation trace(Theta) <= 1 bounds a positive semidefinite matrix.
+        return {"Theta": _sym((N + 1) * n, "Theta"), "S": _sym(n, "S"), "R": _sym(n, "R")}
 
     def selectors(self):
         """(G0, G1, H, F, [Gamma_0..Gamma_N]) as numpy arrays (see class doc)."""
         n, N = self.n, self._N
-        I = np.eye(n)
+        I = np.eye(n, dtype=int)      # integer selectors keep exact re-checks exact
         m = (N + 2) * n
 
         def e(i):               # block selector of xi's i-th block
-            E = np.zeros((n, m))
+            E = np.zeros((n, m), dtype=int)
             E[:, i * n:(i + 1) * n] = I
             return E
         c = legendre_derivative_coefficients(N)
@@ -239,32 +259,37 @@ class BesselLegendreLMI(_DelayAnalysis):
                 g = g - c[k, j] * e(2 + j)
             gam.append(g)
         F = self.A @ e(0) + self.Ad @ e(1)
-        G0 = np.vstack([e(0)] + [np.zeros((n, m))] * N)
-        G1 = np.vstack([np.zeros((n, m))] + [e(2 + k) for k in range(N)])
+        G0 = np.vstack([e(0)] + [np.zeros((n, m), dtype=int)] * N)
+        G1 = np.vstack([np.zeros((n, m), dtype=int)] + [e(2 + k) for k in range(N)])
         H = np.vstack([F] + gam[:N])
         return G0, G1, H, F, gam
 
     def blocks(self, x, p, bmat):
-        P, S, R = x["P"], x["S"], x["R"]
+        Th, S, R = x["Theta"], x["S"], x["R"]
         n, N = self.n, self._N
         G0, G1, H, F, gam = self.selectors()
         h, iota = p["h"], p["iota"]
-        e0, e1 = G0[:n], np.eye(n, (N + 2) * n, n)
-        he0, he1 = G0.T @ P @ H, G1.T @ P @ H
+        e0, e1 = G0[:n], np.eye(n, (N + 2) * n, n, dtype=int)
+        # G0' D(S) = 0, so (1/h) He(G0' P H) = (1/h) He(G0' Theta H): affine in the
+        # parameters (DPP); He(G1' P H) = He(G1' Theta H) - (1/h) He(G1' D(S) H).
+        he0 = G0.T @ Th @ H
+        he1 = G1.T @ Th @ H
+        if N:
+            he1 = he1 - iota * (G1.T @ _blockdiag_S(S, N, n, bmat) @ H)
         sterm = e0.T @ S @ e0 - e1.T @ S @ e1
         rsum = sum((2 * k + 1) * (g.T @ R @ g) for k, g in enumerate(gam))
         phi = iota * (he0 + he0.T + sterm - rsum) + (he1 + he1.T) + h * (F.T @ R @ F)
-        out = [Block("phi", phi, "nsd")]
-        if N:
-            out.append(Block("theta", P + iota * _blockdiag_S(S, N, n, bmat), "psd"))
-        else:
-            out.append(Block("P_pos", P, "psd"))
-        return out + [Block("S_pos", S, "psd"), Block("R_pos", R, "psd")]
+        return [Block("phi", phi, "nsd"), Block("theta", Th, "psd"),
+                Block("S_pos", S, "psd"), Block("R_pos", R, "psd")]
+
+    def lyapunov_matrix(self, values: Mapping[str, np.ndarray], h: float) -> np.ndarray:
+        """P = Theta - (1/h) diag(0, S, 3S, ..., (2N-1)S) of a certificate."""
+        return values["Theta"] - _blockdiag_S(values["S"], self._N, self.n, np.block) / h
 
 
 def _blockdiag_S(S, N: int, n: int, bmat):
     """diag(0, S, 3S, ..., (2N-1)S) as a cvxpy or numpy block matrix."""
-    Z = np.zeros((n, n))
+    Z = np.zeros((n, n), dtype=int)
     rows = []
     for i in range(N + 1):
         rows.append([(2 * i - 1) * S if (i == j and i > 0) else Z for j in range(N + 1)])
@@ -285,7 +310,7 @@ class WirtingerLMI(BesselLegendreLMI):
         super().__init__(A, Ad, 1, **kw)
 
 
-def make_criterion(method: str, A, Ad, *, N: int | None = None,
+def make_criterion(method: MethodName, A, Ad, *, N: int | None = None,
                    margin: float = DEFAULT_MARGIN) -> _DelayAnalysis:
     """The criterion object for a method name of :data:`METHODS`."""
     if method == "bessel-legendre":
@@ -352,35 +377,45 @@ def certified_delay(lmi: _DelayAnalysis, *, h_lo: float = 1e-3, h_hi: float = 10
 
 @dataclass(frozen=True)
 class AutoOrder:
-    """Result of :func:`bessel_legendre_auto`: one bound per order tried."""
+    """Result of :func:`bessel_legendre_auto`: one bound per order tried.
+
+    ``N_reached`` is the first order whose gap to the exact margin is below
+    the tolerance (None when the cap was reached first).
+    """
 
     bounds: tuple[DelayBound, ...]
-    reached: bool          # gap below tolerance
+    N_reached: int | None
 
     @property
     def best(self) -> DelayBound:
+        """The bound at ``N_reached`` (or the largest bound when not reached)."""
+        if self.N_reached is not None:
+            return next(b for b in self.bounds if b.N == self.N_reached)
         return max(self.bounds, key=lambda b: b.h_certified)
 
 
 def bessel_legendre_auto(A, Ad, exact: float, *, gap_tol: float = 1e-4, N_max: int = 6,
-                         N_start: int = 0, rel_tol: float = 1e-5,
+                         N_through: int = 0, rel_tol: float = 1e-5,
                          margin: float = DEFAULT_MARGIN, h_hi: float = 100.0) -> AutoOrder:
-    """Raise the Bessel-Legendre order until ``1 - h_N / exact < gap_tol`` or N = N_max.
+    """Raise the Bessel-Legendre order N = 0, 1, ... until
+    ``1 - h_N / exact < gap_tol`` or N = ``N_max``.
 
-    Each order's bisection starts from the previous order's bound (the
-    hierarchy is non-decreasing in N). ``exact`` is the exact margin (s)
-    from :mod:`workbench.margins`; with ``exact = inf`` the gap never closes
-    and every order up to ``N_max`` is tried.
+    Orders up to ``N_through`` are computed in any case (for tables). Each
+    order's bisection starts from the previous order's bound (the hierarchy
+    is non-decreasing in N). ``exact`` is the exact margin (s) from
+    :mod:`workbench.margins`; with ``exact = inf`` the gap never closes.
     """
     out: list[DelayBound] = []
-    guess = None
-    for N in range(N_start, N_max + 1):
+    guess, reached = None, None
+    for N in range(0, max(N_max, N_through) + 1):
+        if N > N_through and (reached is not None or N > N_max):
+            break
         b = certified_delay(BesselLegendreLMI(A, Ad, N, margin=margin), rel_tol=rel_tol,
                             guess=guess, h_hi=h_hi)
         out.append(b)
         if b.h_certified > 0:
             guess = b.h_certified
-        if math.isfinite(exact) and exact > 0 and 1 - b.h_certified / exact < gap_tol:
-            return AutoOrder(tuple(out), True)
-    return AutoOrder(tuple(out), False)
-
+        if (reached is None and math.isfinite(exact) and exact > 0
+                and 1 - b.h_certified / exact < gap_tol):
+            reached = N
+    return AutoOrder(tuple(out), reached)

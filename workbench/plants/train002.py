@@ -116,9 +116,10 @@ class Train002:
 
 def latex_equations() -> list[str]:
     """The model's equations, rendered from the sympy expressions (for reports)."""
-    a_d = sp.Symbol("A(t - T_d)")
+    a_d = sp.Function("A")(sp.Symbol("t") - sp.Symbol("T_d"))
     return [
         r"A = " + sp.latex(STATIC_MAP) + r" \qquad \text{(002 eq 1)}",
-        r"\dot a = " + sp.latex(LAG_RATE.subs(A, a_d)) + r" \qquad \text{(002 eq 2, reconstructed)}",
+        r"\dot a = " + sp.latex(LAG_RATE.subs(A, a_d))
+        + r" \qquad \text{(002 eq 2, reconstructed)}",
         r"\dot v = " + sp.latex(SPEED_RATE) + r", \qquad \dot s = v",
     ]

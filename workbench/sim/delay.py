@@ -83,52 +83,51 @@ def simulate_linear_dde(A, Ad, h: float, x0, t_end: float, dt: float, *,
                         record_every: int = 1) -> SimResult:
     """Simulate x' = A x + A_d x(t - h), x(theta) = x0 on [-h, 0].
 
+    The step is shortened to h / N, N = ceil(h / dt), so that delayed values
+    fall on the grid; Heun's method then reads
+
+        x_{k+1} = M x_k + P x_{k-N} + Q x_{k-N+1},
+        M = I + dt A + dt^2 A^2 / 2,  P = dt A_d / 2 + dt^2 A A_d / 2,  Q = dt A_d / 2,
+
+    second order in dt (checked by :func:`step_halving`).
+
     Parameters
     ----------
     A, Ad : (n, n) array_like
         Instantaneous and delayed state matrices.
     h : float
-        Delay (s), >= dt.
+        Delay (s), > 0.
     x0 : (n,) array_like
         Constant initial function.
     t_end, dt : float
-        Horizon and step (s).
+        Horizon and largest step (s).
     record_every : int
         Keep one step in this many.
 
     Returns
     -------
     SimResult
-        ``u`` and ``u_applied`` are empty (m = 0).
+        ``u`` and ``u_applied`` are empty (m = 0); ``dt`` is the step used.
     """
     A, Ad = np.atleast_2d(np.asarray(A, float)), np.atleast_2d(np.asarray(Ad, float))
-    if not dt <= h:
-        raise ValueError(f"dt = {dt!r} > h = {h!r}; expected a step no larger than the delay")
-    x = np.array(x0, float).reshape(-1)
+    if not (h > 0 and dt > 0):
+        raise ValueError(f"h = {h!r}, dt = {dt!r}; expected positive delay and step (s)")
+    N = max(int(math.ceil(h / dt - 1e-9)), 1)
+    dt = h / N
+    n = A.shape[0]
+    I = np.eye(n)
+    M = I + dt * A + 0.5 * dt * dt * A @ A
+    P = 0.5 * dt * Ad + 0.5 * dt * dt * A @ Ad
+    Q = 0.5 * dt * Ad
     n_steps = int(round(t_end / dt))
-    X = np.empty((n_steps + 1, x.size))
-    X[0] = x
-    q = h / dt
-
-    def delayed(k_time: float):
-        # x(t_k - h) for t_k = k_time * dt (k_time may be fractional): linear interpolation.
-        s = k_time - q
-        if s <= 0:
-            return X[0]
-        i = int(math.floor(s))
-        w = s - i
-        return X[i] if w < 1e-12 else (1 - w) * X[i] + w * X[i + 1]
-
-    for k in range(n_steps):
-        xd0 = delayed(k)
-        xd1 = delayed(k + 1)
-        k1 = A @ X[k] + Ad @ xd0
-        xp = X[k] + dt * k1
-        k2 = A @ xp + Ad @ xd1
-        X[k + 1] = X[k] + 0.5 * dt * (k1 + k2)
+    X = np.empty((n_steps + N + 1, n))
+    X[:N + 1] = np.asarray(x0, float).reshape(-1)   # x_{-N}, ..., x_0
+    Mt, Pt, Qt = M.T.copy(), P.T.copy(), Q.T.copy()
+    for k in range(N, n_steps + N):
+        X[k + 1] = X[k] @ Mt + X[k - N] @ Pt + X[k - N + 1] @ Qt
+    X = X[N:]
     idx = np.arange(0, n_steps + 1, record_every)
-    t = idx * dt
-    return SimResult(t, X[idx].T, np.zeros((0, idx.size)), np.zeros((0, idx.size)),
+    return SimResult(idx * dt, X[idx].T, np.zeros((0, idx.size)), np.zeros((0, idx.size)),
                      np.zeros(idx.size, int), dt=dt)
 
 
@@ -185,7 +184,7 @@ def envelope_ratio(r: SimResult, period: float) -> float:
 # -- generic sampled closed loop ----------------------------------------------------
 def simulate_closed_loop(step: Callable, control: Callable, x0, *, h: float, dt: float,
                          t_end: float, u_init, record_every: int = 1,
-                         done: Callable | None = None) -> SimResult:
+                         done: Callable | None = None, line=None) -> SimResult:
     """Sampled closed loop with input delay: x_{n+1} = step(x_n, u(t - h), t_n, dt).
 
     Parameters
@@ -204,8 +203,11 @@ def simulate_closed_loop(step: Callable, control: Callable, x0, *, h: float, dt:
     record_every : int
     done : callable, optional
         ``done(t, x, phase) -> bool`` ends the run early.
+    line : DelayLine-like, optional
+        Input delay buffer to use instead of ``DelayLine(h, dt, u_init)``
+        (e.g. a :class:`~workbench.sim.history.BatchDelayLine`).
     """
-    line = DelayLine(h, dt, u_init)
+    line = DelayLine(h, dt, u_init) if line is None else line
     x = tuple(x0)
     n_steps = int(round(t_end / dt))
     T, Xs, U, UA, P = [], [], [], [], []
@@ -214,9 +216,10 @@ def simulate_closed_loop(step: Callable, control: Callable, x0, *, h: float, dt:
         u, phase = control(t, x, line)
         line.push(u)
         ua = line.delayed()
-        if n % record_every == 0 or n == n_steps:
+        last = n == n_steps or (done is not None and done(t, x, phase))
+        if n % record_every == 0 or last:
             T.append(t); Xs.append(x); U.append(u); UA.append(ua); P.append(phase)
-        if n == n_steps or (done is not None and done(t, x, phase)):
+        if last:
             break
         x = step(x, ua, t, dt)
     X = np.array(Xs, float).T

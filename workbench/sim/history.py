@@ -92,3 +92,37 @@ class DelayLine:
         n = self._n
         tail = 0.0 if self.f == 0.0 else self.f * self._get(n - self.N - 1)
         return self.dt * (self._sum + tail)
+
+
+class BatchDelayLine:
+    """:class:`DelayLine` for a batch whose runs have *different* delays.
+
+    Parameters
+    ----------
+    h : (B,) array_like
+        Delay of each run (s).
+    dt : float
+    initial : float
+        Signal before t = 0 (all runs).
+    """
+
+    def __init__(self, h, dt: float, initial):
+        import numpy as np
+        h = np.asarray(h, float)
+        parts = [split_delay(float(x), dt) for x in h]
+        self.N = np.array([p[0] for p in parts])
+        self.f = np.array([p[1] for p in parts])
+        self._L = int(self.N.max()) + 2
+        self._buf = np.full((self._L, h.size), float(initial))
+        self._cols = np.arange(h.size)
+        self._n = 0
+
+    def push(self, value) -> None:
+        self._buf[self._n % self._L] = value
+        self._n += 1
+
+    def delayed(self):
+        n = self._n - 1
+        a = self._buf[(n - self.N) % self._L, self._cols]
+        b = self._buf[(n - self.N - 1) % self._L, self._cols]
+        return (1.0 - self.f) * a + self.f * b

@@ -7,7 +7,7 @@ step, the pure delay as a FIFO of whole steps) and the controller runs every
 of independent runs (controllers, parameter sets, stations), so a whole
 parameter study is one loop over time.
 
-A run ends, per batch element, at the first sample after the profile's
+A run ends, per batch element, at the first plant step after the profile's
 braking has begun where the speed is 0: the train is then held by its parking
 brake (the ATO stop), and that time and position define the quality indices.
 """
@@ -41,8 +41,8 @@ class Route:
     grade: tuple[float, ...] = (0.0,)
 
     def gradient_at(self, s: np.ndarray) -> np.ndarray:
-        idx = np.searchsorted(np.asarray(self.grade_from), s, side="right") - 1
-        return np.asarray(self.grade)[np.clip(idx, 0, len(self.grade) - 1)]
+        """Gradient (-) at positions ``s`` (m); the first section extends backwards."""
+        return np.asarray(self.grade)[np.searchsorted(self.grade_from[1:], s, side="right")]
 
 
 @dataclass(frozen=True)
@@ -72,6 +72,12 @@ class TrackingRun:
     stop_time: np.ndarray
     stop_pos: np.ndarray
     traction_work: np.ndarray
+
+    def rows(self, idx) -> "TrackingRun":
+        """The runs ``idx`` (a slice or index array) of the batch."""
+        return TrackingRun(self.t, *(getattr(self, f)[idx] for f in
+                                     ("v", "s", "a", "u", "target", "stop_time", "stop_pos",
+                                      "traction_work")))
 
 
 Controller = Callable[[int, np.ndarray, np.ndarray], np.ndarray]
@@ -112,6 +118,8 @@ def simulate_tracking(train: Train002, route: Route, target: Callable[[np.ndarra
     gain_int = train.lag * (1.0 - decay)          # integral of (1 - e^{-t/T}) weight
     fifo = np.zeros((n_delay + 1, n))              # demands of the last n_delay steps
     head = 0
+    edges = np.asarray(route.grade_from[1:])
+    grade_acc = train.grade(np.asarray(route.grade))   # per section (m/s^2)
     v = np.zeros(n); s = np.zeros(n); a = np.zeros(n)
     work = np.zeros(n)
     stopped = np.zeros(n, bool)
@@ -125,23 +133,23 @@ def simulate_tracking(train: Train002, route: Route, target: Callable[[np.ndarra
         H["v"][:, k], H["s"][:, k], H["u"][:, k] = v, s, u
         H["target"][:, k] = target(np.array(t))
         demand = train.demand(u)
-        for _ in range(n_sub):
+        for j in range(n_sub):
             fifo[head] = demand
             head = (head + 1) % (n_delay + 1)
             A = fifo[head]                          # demand of n_delay steps ago
             # exact lag over the step with A held: a(t+dt) and its integral
             a_int = A * dt + (a - A) * gain_int
             a = A + (a - A) * decay
-            acc_ext = train.resistance(v) + train.grade(route.gradient_at(s))
-            dv = a_int - acc_ext * dt
-            v_new = np.maximum(v + dv, 0.0)         # no rolling back (holding brake)
+            acc_ext = train.resistance(v) + grade_acc[np.searchsorted(edges, s, side="right")]
+            v_new = np.maximum(v + a_int - acc_ext * dt, 0.0)   # no rolling back
             work += np.where(stopped, 0.0, np.maximum(a_int, 0.0) * v)
             s = s + np.where(stopped, 0.0, 0.5 * (v + v_new) * dt)
             v = np.where(stopped, 0.0, v_new)
-        now_stopped = ~stopped & (v <= 0.0) & (t + Ts >= brake_start)
-        stop_time = np.where(now_stopped, t + Ts, stop_time)
-        stop_pos = np.where(now_stopped, s, stop_pos)
-        stopped |= now_stopped
+            t_now = t + (j + 1) * dt
+            now_stopped = ~stopped & (v <= 0.0) & (t_now >= brake_start)
+            stop_time = np.where(now_stopped, t_now, stop_time)
+            stop_pos = np.where(now_stopped, s, stop_pos)
+            stopped |= now_stopped
         if stopped.all():
             K = k + 1
             break
@@ -188,3 +196,98 @@ def quality_indices(run: TrackingRun, distance: float, run_time: float) -> Quali
     rms = np.sqrt(np.mean((run.v[:, planned] - run.target[:, planned]) ** 2, axis=1))
     return QualityIndices(np.abs(run.stop_pos - distance), np.abs(t_stop - run_time) / run_time,
                           jerk_sum / t_stop, run.traction_work / distance, rms)
+
+
+# -- platoon (paper 001) ----------------------------------------------------------
+@dataclass(frozen=True)
+class PlatoonRun:
+    """Histories of a leader-follower platoon, sampled every step T.
+
+    Attributes
+    ----------
+    t : numpy.ndarray
+        Times (s), shape (K,).
+    x, v, u : numpy.ndarray
+        Positions (m), speeds (m/s), control forces (N); shape (K, n).
+    e, de, s : numpy.ndarray
+        Spacing errors (m), their rates (m/s) and the sliding variable used
+        by the law (m; zeros for laws without one); shape (K, n - 1).
+    lumped : numpy.ndarray
+        w + d of eq 5 as the controller sees it, m_nom v' - (u - f_nom - f_v,nom)
+        (N), shape (K, n).
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    v: np.ndarray
+    u: np.ndarray
+    e: np.ndarray
+    de: np.ndarray
+    s: np.ndarray
+    lumped: np.ndarray
+
+
+FollowerLaw = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+                       tuple[np.ndarray, np.ndarray]]
+"""``law(e, de, u1, a_pred) -> (u, s)`` for the followers (arrays of shape (n-1,))."""
+
+
+def simulate_platoon(nominal, true, law: FollowerLaw, leader_ref: Callable, *, n: int,
+                     spacing: float, T: float, horizon: float, w: np.ndarray,
+                     leader_gain: float, route: Route,
+                     initial_errors: np.ndarray | None = None) -> PlatoonRun:
+    """Step a platoon of ``n`` trains with sampling = integration step ``T``.
+
+    The leader tracks ``leader_ref(t) -> (v_ref, a_ref)`` (vectorised over the
+    array of step times) with
+    u_0 = m (a_ref + leader_gain (v_ref - v_0)) + u1 (nominal resistance and
+    gradient); followers use ``law``, fed at step k with their spacing errors,
+    their own u1 and the predecessor's acceleration of step k-1 (as it would be
+    communicated). All trains are stepped at once (arrays over the trains);
+    speeds are kept >= 0 (trains do not roll back) and positions advance by
+    the trapezoid rule.
+
+    Parameters
+    ----------
+    nominal, true : workbench.plants.platoon001.TrainParams
+        What the controllers assume; the true (per-train) values.
+    w : numpy.ndarray
+        External force (N), shape (K, n).
+    initial_errors : array, optional
+        e_i(0) of the followers (m); trains start at rest.
+    """
+    K = int(round(horizon / T))
+    e0 = np.zeros(n - 1) if initial_errors is None else np.asarray(initial_errors, float)
+    x = -np.arange(n) * spacing - np.concatenate([[0.0], np.cumsum(e0)])
+    v = np.zeros(n)
+    a_prev = np.zeros(n)
+    H = {k: np.zeros((K, n)) for k in ("x", "v", "u", "lumped")}
+    He = {k: np.zeros((K, n - 1)) for k in ("e", "de", "s")}
+    edges = np.asarray(route.grade_from[1:])
+    grade = np.asarray(route.grade)
+    # gradient forces per section (rows) and train (columns), nominal and true
+    fv_nom = nominal.grade_force(grade)[:, None] * np.ones(n)
+    fv_true = true.grade_force(grade[:, None]) * np.ones(n)
+    cols = np.arange(n)
+    t_all = np.arange(K) * T
+    v_ref, a_ref = leader_ref(t_all)
+    u_lead = nominal.m * a_ref
+    u = np.zeros(n)
+    for k in range(K):
+        sec = np.searchsorted(edges, x, side="right")
+        u1 = nominal.resistance(v) + fv_nom[sec, cols]
+        e = x[:-1] - x[1:] - spacing
+        de = v[:-1] - v[1:]
+        u_f, s = law(e, de, u1[1:], a_prev[:-1])
+        u[0] = u_lead[k] + nominal.m * leader_gain * (v_ref[k] - v[0]) + u1[0]
+        u[1:] = u_f
+        acc = (u - true.resistance(v) - fv_true[sec, cols] + w[k]) / true.m
+        v_new = np.maximum(v + T * acc, 0.0)
+        a_real = (v_new - v) / T
+        H["x"][k], H["v"][k], H["u"][k] = x, v, u
+        H["lumped"][k] = nominal.m * a_real - (u - u1)
+        He["e"][k], He["de"][k], He["s"][k] = e, de, s
+        x = x + 0.5 * T * (v + v_new)
+        v, a_prev = v_new, a_real
+    return PlatoonRun(t_all, H["x"], H["v"], H["u"], He["e"], He["de"], He["s"],
+                      H["lumped"])

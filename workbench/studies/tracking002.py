@@ -19,11 +19,13 @@ from ..controllers.pid import PID
 from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
 from ..plants.train002 import PARAMETER_UNITS, Train002
+from ..report.markdown import fmt
 from ..profiles import Profile, ProfileSpec, build_profile
 from ..sim.tracking import QualityIndices, Route, TrackingRun, quality_indices, simulate_tracking
 
 INDICES = QualityIndices.NAMES
 MFAC_KEYS = ("lam", "rho", "eta", "mu", "phi1")
+WINNER_DIGITS = 3   # significant digits at which two index values count as a tie
 
 
 @dataclass(frozen=True)
@@ -80,7 +82,9 @@ class Comparison:
         m, p = self.value("MFAC", index), self.value("PID", index)
         if not (np.isfinite(m) and np.isfinite(p)):
             return "undetermined"
-        return "MFAC" if m < p else "PID" if p < m else "tie"
+        if fmt(m, WINNER_DIGITS) == fmt(p, WINNER_DIGITS):
+            return "tie"          # equal at the digits the report prints
+        return "MFAC" if m < p else "PID"
 
 
 @dataclass(frozen=True)
@@ -97,11 +101,8 @@ class TrackingResult:
     stop_tolerance: float            # m
 
 
-def _section(r: Reader, *, with_source: bool) -> Section:
-    dist = r.quantity("distance", "m", positive=True)
-    T = r.quantity("run_time", "s", positive=True)
-    vlim = r.quantity("v_limit", "m/s", positive=True, hi=150.0)
-    name = r.string("name")
+def read_gradients(r: Reader) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """``grade_from`` (m, increasing from 0) and ``grade`` (-, |i| <= 0.05) of a table."""
     g_from = r.numbers("grade_from", default=(0.0,), what="positions (m)")
     grade = r.numbers("grade", default=(0.0,), what="gradients (-)")
     if len(g_from) != len(grade) or g_from[0] != 0.0 or list(g_from) != sorted(g_from):
@@ -109,6 +110,15 @@ def _section(r: Reader, *, with_source: bool) -> Section:
                      "entry of grade")
     if any(abs(x) > 0.05 for x in grade):
         raise r.fail("grade", list(grade), "gradients within +/-0.05 (50 permille)")
+    return g_from, grade
+
+
+def _section(r: Reader, *, with_source: bool) -> Section:
+    dist = r.quantity("distance", "m", positive=True)
+    T = r.quantity("run_time", "s", positive=True)
+    vlim = r.quantity("v_limit", "m/s", positive=True, hi=150.0)
+    name = r.string("name")
+    g_from, grade = read_gradients(r)
     src = r.string("source") if with_source else dist.source
     r.finish()
     return Section(name, Route(dist.value, g_from, grade), T.value, vlim.value, src)
@@ -128,9 +138,9 @@ class ATOTracking:
         pr.finish()
         tr = root.table("train")
         tr.string("model", choices=("delay-lag-002",))
-        train = {k: tr.quantity(k, unit, nonneg=(k == "e" or k.startswith("c")),
-                                positive=not (k == "e" or k.startswith("c")))
-                 if k != "e" else tr.quantity(k, unit) for k, unit in PARAMETER_UNITS.items()}
+        sign = {"e": {}, "c0": {"nonneg": True}, "c1": {"nonneg": True}, "c2": {"nonneg": True}}
+        train = {k: tr.quantity(k, unit, **sign.get(k, {"positive": True}))
+                 for k, unit in PARAMETER_UNITS.items()}
         u_lim = (tr.quantity("u_min", "m/s^2", hi=0.0).value,
                  tr.quantity("u_max", "m/s^2", positive=True).value)
         tr.finish()
@@ -207,8 +217,8 @@ class ATOTracking:
         sq = quality_indices(sweep, spec.main.route.distance, spec.main.run_time)
         sweep_rows = tuple((lam, _take(sq, i)) for i, lam in enumerate(lams))
         oat = _one_at_a_time(spec, train, main_prof, mg)
-        return TrackingResult(mg, pg, (len(combos), len(pid_combos)), comps[0], tuple(comps[1:]),
-                              sweep_rows, sweep, oat, int(_resets(spec, train, main_prof, mg)),
+        return TrackingResult(mg, pg, (len(combos), len(pid_combos)), comps[0][0],
+                              tuple(c for c, _ in comps[1:]), sweep_rows, sweep, oat, comps[0][1],
                               spec.stop_tolerance.value)
 
     def quantities(self, res: TrackingResult) -> dict:
@@ -271,12 +281,6 @@ def _run_mfac(spec, train, sec, prof, gains: dict) -> TrackingRun:
     return _sim(spec, train, sec, prof, lambda k, y, yn: ctl.step(y, yn), n)
 
 
-def _resets(spec, train, prof, gains) -> int:
-    ctl = _mfac(spec, train, gains, 1)
-    _sim(spec, train, spec.main, prof, lambda k, y, yn: ctl.step(y, yn), 1)
-    return ctl.resets[0]
-
-
 def _run_pid(spec, train, sec, prof, combos) -> TrackingRun:
     pids = [PID(kp, ki, kd, dt=spec.Ts, u_min=train.u_min, u_max=train.u_max)
             for kp, ki, kd in combos]
@@ -284,12 +288,17 @@ def _run_pid(spec, train, sec, prof, combos) -> TrackingRun:
     return _sim(spec, train, sec, prof, ctl, len(pids))
 
 
-def _compare(spec, train, sec, mg, pg) -> Comparison:
+def _compare(spec, train, sec, mg, pg) -> tuple[Comparison, int]:
+    """MFAC (row 0) and PID (row 1) in one batch; also the MFAC's PPD resets."""
     prof = build_profile(spec.profile_spec(sec), dt=spec.Ts)
-    m = _run_mfac(spec, train, sec, prof, mg)
-    p = _run_pid(spec, train, sec, prof, [(pg["kp"], pg["ki"], pg["kd"])])
+    mfac = _mfac(spec, train, mg, 1)
+    pid = PID(pg["kp"], pg["ki"], pg["kd"], dt=spec.Ts, u_min=train.u_min, u_max=train.u_max)
+    ctl = lambda k, y, yn: np.array([mfac.step(y[:1], yn[:1])[0], pid.step(yn[1] - y[1])])
+    both = _sim(spec, train, sec, prof, ctl, 2)
+    m, p = both.rows(slice(0, 1)), both.rows(slice(1, 2))
     d, T = sec.route.distance, sec.run_time
-    return Comparison(sec, prof, m, p, quality_indices(m, d, T), quality_indices(p, d, T))
+    return (Comparison(sec, prof, m, p, quality_indices(m, d, T), quality_indices(p, d, T)),
+            int(mfac.resets[0]))
 
 
 def _one_at_a_time(spec, train, prof, mg) -> dict:

@@ -2,7 +2,7 @@
 
 A :class:`Claim` is built from sympy objects by a module of ``proofs/`` (never
 from text: nothing here calls ``eval`` or ``sympify`` on strings). It asserts
-one of four things:
+one of five things:
 
 ``identity``
     ``lhs == rhs`` (scalars or matrices), possibly under equalities ``given``
@@ -24,11 +24,13 @@ one of four things:
     a worked number: an exact expression equals a printed value at its
     printed decimals.
 
-Every claim also gets a second, independent check: a seeded falsification
-search that samples the symbols in a box, keeps the points satisfying the
-hypotheses, and evaluates the claim numerically (for ``solution``: integrates
-the ODE with scipy). A failure found is re-evaluated with 30-digit arithmetic
-at rounded values before it is reported as a counterexample.
+Every claim but ``value`` also gets a second, independent check: a seeded
+falsification search (:mod:`workbench.symbolic.falsify`) samples the symbols
+in a box, keeps the points satisfying the hypotheses, and evaluates the
+residual numerically (for ``minimiser``: J at perturbed laws; for
+``solution``: the ODE, initial and terminal residuals). A failure found is
+re-evaluated with 30-digit arithmetic at rounded values before it is
+reported as a counterexample.
 
 Verdicts form a closed set (like sympy's ``is_stable``: True / False / None):
 PROVED, REFUTED (with a counterexample), INCONCLUSIVE (with what remains to
@@ -38,18 +40,16 @@ from __future__ import annotations
 
 import enum
 import itertools
+from dataclasses import dataclass
 from decimal import Decimal
-from dataclasses import dataclass, field
 from typing import Literal, Sequence
 
-import numpy as np
 import sympy as sp
+
+from .falsify import apply_given, elements, falsify
 
 KINDS = ("identity", "inequality", "minimiser", "solution", "value")
 OPS = (">=", ">", "<=", "<")
-#: Seed of the falsification search (fixed: same claims, same counterexamples).
-SEED = 20260
-N_SAMPLES = 1000
 LATEX_LIMIT = 700
 
 
@@ -64,8 +64,11 @@ class Hypothesis:
     """``symbol op bound`` (op in ``>=, >, <=, <``): an assumption a proof may use.
 
     The sign prover replaces ``symbol`` by ``bound + s`` (or ``bound - s``)
-    with a fresh slack ``s >= 0``; the falsification search keeps only the
-    sample points where the relation holds.
+    with a fresh slack ``s >= 0`` (``> 0`` for strict relations), in the order
+    the hypotheses are given; this covers every point where the hypothesis
+    holds, so a proof in the slack variables is a proof under the hypothesis
+    (a hypothesis whose symbol an earlier one eliminated is simply not used).
+    The falsification search keeps only the sample points where all hold.
     """
 
     symbol: sp.Symbol
@@ -129,6 +132,8 @@ class Claim:
         Falsification box; other symbols use [0.1, 3] (positive) or [-3, 3].
     digits : int
         ``value``: printed decimals.
+    nonzero : tuple of Symbol
+        Symbols assumed nonzero (their zero sign case is not split).
     expect : "proved" | "refuted"
         "refuted" marks the as-printed half of an erratum pair.
     display : str
@@ -154,6 +159,7 @@ class Claim:
     terms: tuple[sp.Expr, ...] = ()
     sample: tuple[tuple[sp.Symbol, float, float], ...] = ()
     digits: int | None = None
+    nonzero: tuple[sp.Symbol, ...] = ()
     display: str = ""
     expect: Literal["proved", "refuted"] = "proved"
     note: str = ""
@@ -198,7 +204,6 @@ class ProofResult:
     violation: float | None = None
     remaining: str = ""
     samples: int = 0
-    sign_proof: bool = field(default=False, compare=False)
 
     @property
     def ok(self) -> bool:
@@ -211,7 +216,8 @@ class ProofResult:
         return {"id": c.id, "paper": c.paper, "equations": c.equations,
                 "statement": c.statement, "kind": c.kind, "expect": c.expect,
                 "verdict": self.verdict.value, "ok": self.ok,
-                "counterexample": dict(self.counterexample) if self.counterexample else None,
+                "counterexample": (None if self.counterexample is None
+                                   else dict(self.counterexample)),
                 "violation": self.violation, "remaining": self.remaining,
                 "samples": self.samples,
                 "steps": [{"what": s.what, "latex": s.latex, "ok": s.ok} for s in self.steps]}
@@ -226,34 +232,27 @@ def tex(expr) -> str:
     return s
 
 
-def _elements(x) -> list:
-    return list(x) if isinstance(x, sp.MatrixBase) else [x]
-
-
-def _apply_given(expr, given):
-    for s, e in given:
-        expr = expr.subs(s, e)
-    return expr
-
-
 def _sign_atoms(expr) -> list[sp.Symbol]:
-    """Real symbols of unknown sign that appear inside Abs / sign."""
+    """Real symbols of unknown sign inside Abs / sign / Piecewise conditions."""
     out = set()
-    for f in expr.atoms(sp.Abs, sp.sign):
-        for s in f.args[0].free_symbols:
+    inside = [f.args[0] for f in expr.atoms(sp.Abs, sp.sign)]
+    inside += [cond for pw in expr.atoms(sp.Piecewise) for _, cond in pw.args]
+    for a in inside:
+        for s in a.free_symbols:
             if s.is_positive is None and s.is_negative is None:
                 out.add(s)
     return sorted(out, key=lambda s: s.name)
 
 
-def _cases(expr):
-    """Yield (description, expression) over the sign cases of ``_sign_atoms``."""
+def _cases(expr, nonzero=()):
+    """Yield (description, expression) over the sign cases of ``_sign_atoms``
+    (symbols in ``nonzero`` get no zero case)."""
     atoms = _sign_atoms(expr)
     if not atoms:
         yield "", expr
         return
     pos = {s: sp.Symbol(s.name + "_+", positive=True) for s in atoms}
-    for signs in itertools.product((1, -1, 0), repeat=len(atoms)):
+    for signs in itertools.product(*[(1, -1) if s in nonzero else (1, -1, 0) for s in atoms]):
         sub = {s: sg * pos[s] for s, sg in zip(atoms, signs)}
         desc = ", ".join(f"{sp.latex(s)} {'>' if sg > 0 else '<' if sg < 0 else '='} 0"
                          for s, sg in zip(atoms, signs))
@@ -263,7 +262,7 @@ def _cases(expr):
 def _is_zero(e) -> bool:
     if e == 0:
         return True
-    for f in (sp.expand, sp.cancel, sp.simplify):
+    for f in (sp.expand, sp.cancel, lambda x: sp.expand(sp.powdenest(x)), sp.simplify):
         try:
             r = f(e)
         except Exception:  # pragma: no cover - sympy internals
@@ -274,13 +273,16 @@ def _is_zero(e) -> bool:
     return False
 
 
-def is_identically_zero(expr) -> tuple[bool, str]:
+def is_identically_zero(expr, nonzero=()) -> tuple[bool, str]:
     """(True, "") when ``expr`` simplifies to 0 in every sign case, else
     (False, LaTeX of the first case that did not)."""
-    for e in _elements(expr):
-        for desc, ce in _cases(sp.sympify(e)):
+    entries = elements(expr)
+    for i, e in enumerate(entries):
+        for desc, ce in _cases(sp.sympify(e), nonzero):
             if not _is_zero(ce):
-                return False, (desc + ": " if desc else "") + tex(sp.simplify(ce)) + r" \overset{?}{=} 0"
+                where = (f"entry ({i // expr.cols + 1}, {i % expr.cols + 1}) "
+                         if len(entries) > 1 else "") + (desc + ": " if desc else "")
+                return False, where + tex(sp.simplify(ce)) + r" \overset{?}{=} 0"
     return True, ""
 
 
@@ -295,8 +297,20 @@ def _slack(expr, hypotheses):
     return expr
 
 
+def _exp_bounded(e):
+    """Replace exp(x), x <= 0, by 1 - p with a fresh p >= 0 (sound: it only
+    forgets that exp(x) > 0)."""
+    reps = {f: 1 - sp.Symbol(f"p_{i + 1}", nonnegative=True)
+            for i, f in enumerate(sorted(e.atoms(sp.exp), key=sp.default_sort_key))
+            if f.args[0].is_nonpositive}
+    return e.subs(reps) if reps else None
+
+
 def _nonneg(e) -> bool:
     if e.is_nonnegative:
+        return True
+    bounded = _exp_bounded(e)
+    if bounded is not None and _nonneg(bounded):
         return True
     for f in (sp.expand, sp.factor, sp.simplify, lambda x: sp.powsimp(sp.expand(x), force=False)):
         try:
@@ -307,98 +321,19 @@ def _nonneg(e) -> bool:
     return False
 
 
-def prove_nonnegative(expr, hypotheses: Sequence[Hypothesis] = (), *, strict=False
-                      ) -> tuple[bool, str]:
+def prove_nonnegative(expr, hypotheses: Sequence[Hypothesis] = (), *, strict=False,
+                      nonzero=()) -> tuple[bool, str]:
     """Show ``expr >= 0`` (``> 0`` if strict) from symbol assumptions and hypotheses.
 
     Returns (True, "") or (False, LaTeX of what remains to be shown).
     """
     e = _slack(sp.sympify(expr), hypotheses)
-    for desc, ce in _cases(e):
+    for desc, ce in _cases(e, nonzero):
         ok = (ce.is_positive or bool(sp.simplify(ce).is_positive)) if strict else _nonneg(ce)
         if not ok:
             rel = ">" if strict else r"\geq"
             return False, (desc + ": " if desc else "") + f"{tex(sp.simplify(ce))} {rel} 0"
     return True, ""
-
-
-# -- falsification ---------------------------------------------------------------------
-def _box(claim: Claim, symbols) -> dict:
-    box = {s: (lo, hi) for s, lo, hi in claim.sample}
-    out = {}
-    for s in symbols:
-        if s in box:
-            out[s] = box[s]
-        elif s.is_positive or s.is_nonnegative:
-            out[s] = (0.1, 3.0)
-        else:
-            out[s] = (-3.0, 3.0)
-    return out
-
-
-def _holds(h: Hypothesis, vals: dict, prec: int | None = None) -> bool:
-    lhs, rhs = h.symbol.subs(vals), h.bound.subs(vals)
-    if prec:
-        lhs, rhs = sp.N(lhs, prec), sp.N(rhs, prec)
-    return bool(h.relational.func(float(lhs), float(rhs)))
-
-
-def _round(x: float) -> float:
-    return float(f"{x:.4g}")
-
-
-def falsify(claim: Claim, residual, *, kind: Literal["zero", "nonneg"],
-            n: int = N_SAMPLES) -> tuple[tuple | None, float | None, int]:
-    """Seeded search for a point where ``residual`` is nonzero / negative.
-
-    ``residual`` is evaluated after ``claim.given``; the hypotheses filter the
-    samples. Returns (counterexample or None, violation, points used).
-    """
-    residual = [_apply_given(sp.sympify(r), claim.given) for r in _elements(residual)]
-    hyps = [Hypothesis(h.symbol, h.op, _apply_given(h.bound, claim.given)) for h in claim.hypotheses]
-    free = set().union(*(r.free_symbols for r in residual), *(h.bound.free_symbols | {h.symbol}
-                                                               for h in hyps))
-    symbols = sorted(free, key=lambda s: s.name)
-    if not symbols:
-        return None, None, 0
-    box = _box(claim, symbols)
-    rng = np.random.default_rng(np.random.SeedSequence([SEED, sum(map(ord, claim.id))]))
-    X = {s: rng.uniform(*box[s], n) for s in symbols}
-    keep = np.ones(n, bool)
-    for h in hyps:
-        f = sp.lambdify(symbols, sp.Add(h.symbol, -h.bound), "numpy")
-        d = np.broadcast_to(np.asarray(f(*[X[s] for s in symbols]), float), (n,))
-        keep &= {">=": d >= 0, ">": d > 0, "<=": d <= 0, "<": d < 0}[h.op]
-    used = int(keep.sum())
-    if not used:
-        return None, None, 0
-    worst, worst_i, worst_r = 0.0, None, None
-    for r in residual:
-        f = sp.lambdify(symbols, r, "numpy")
-        with np.errstate(all="ignore"):
-            val = np.broadcast_to(np.asarray(f(*[X[s] for s in symbols]), complex), (n,))
-        bad = np.where(np.isfinite(val) & keep, np.abs(val.imag) +
-                       (np.abs(val.real) if kind == "zero" else np.maximum(-val.real, 0)), 0)
-        scale = 1e-9 * (1 + np.abs(val))
-        bad = np.where(bad > scale, bad, 0)
-        i = int(np.argmax(bad))
-        if bad[i] > worst:
-            worst, worst_i, worst_r = bad[i], i, r
-    if worst_i is None:
-        return None, None, used
-    point = {s: float(X[s][worst_i]) for s in symbols}
-    for candidate in ({s: _round(v) for s, v in point.items()}, point):
-        vals = {s: sp.Float(v, 30) for s, v in candidate.items()}
-        if not all(_holds(h, vals, 30) for h in hyps):
-            continue
-        v = complex(sp.N(worst_r.subs(vals), 30))
-        viol = abs(v.imag) + (abs(v.real) if kind == "zero" else max(-v.real, 0.0))
-        if viol > 1e-12 * (1 + abs(v)):
-            cex = tuple((s.name, candidate[s]) for s in symbols)
-            derived = tuple((s.name, float(sp.N(_apply_given(s, claim.given).subs(vals), 15)))
-                            for s, _ in claim.given if s not in candidate)
-            return cex + derived, float(viol), used
-    return None, None, used
 
 
 # -- the checks ---------------------------------------------------------------------------
@@ -407,7 +342,8 @@ def _verdict(claim, steps, symbolic_ok: bool, remaining: str, residual, kind) ->
     cex, viol, used = falsify(claim, residual, kind=kind)
     if cex is not None:
         steps = steps + (Step("falsification search: counterexample found, re-checked with "
-                              "30 digits", ", ".join(f"{n} = {v:.6g}" for n, v in cex), False),)
+                              "30 digits", ", ".join(f"{n} = {v:.6g}" for n, v in cex)
+                              or r"\text{any values}", False),)
         if symbolic_ok:  # both cannot be right: never claim a proof then
             return ProofResult(claim, Verdict.INCONCLUSIVE, steps, cex, viol,
                                "the symbolic argument and a numeric counterexample disagree",
@@ -416,7 +352,7 @@ def _verdict(claim, steps, symbolic_ok: bool, remaining: str, residual, kind) ->
     steps = steps + (Step(f"falsification search: no counterexample in {used} seeded points "
                           "satisfying the hypotheses", "", True if used else None),)
     if symbolic_ok:
-        return ProofResult(claim, Verdict.PROVED, steps, samples=used, sign_proof=True)
+        return ProofResult(claim, Verdict.PROVED, steps, samples=used)
     return ProofResult(claim, Verdict.INCONCLUSIVE, steps, remaining=remaining, samples=used)
 
 
@@ -431,27 +367,29 @@ def _hyp_step(claim) -> tuple[Step, ...]:
 def _check_identity(c: Claim) -> ProofResult:
     diff = sp.Matrix(c.lhs) - sp.Matrix(c.rhs) if isinstance(c.lhs, sp.MatrixBase) else \
         sp.sympify(c.lhs) - sp.sympify(c.rhs)
-    d = _slack(_apply_given(diff, c.given), c.hypotheses)
-    ok, rest = is_identically_zero(d)
+    d = _slack(apply_given(diff, c.given), c.hypotheses)
+    ok, rest = is_identically_zero(d, c.nonzero)
     steps = _hyp_step(c) + (Step("identity (both sides simplified, sign cases split)",
                                  c.display or f"{tex(c.lhs)} = {tex(c.rhs)}", ok),)
+    if not ok:
+        steps += (Step("difference left by simplification (lhs - rhs)", rest, False),)
     return _verdict(c, steps, ok, "show " + rest if rest else "", diff, "zero")
 
 
 def _check_inequality(c: Claim) -> ProofResult:
-    margin = _apply_given(sp.sympify(c.rhs) - sp.sympify(c.lhs), c.given)
+    margin = apply_given(sp.sympify(c.rhs) - sp.sympify(c.lhs), c.given)
     terms = c.terms or (margin,)
     steps = _hyp_step(c) + (Step("claim", rf"{tex(c.lhs)} \leq {tex(c.rhs)}", None),)
     ok, remaining = True, ""
     if c.terms:
-        same, rest = is_identically_zero(sp.Add(*terms) - margin)
+        same, rest = is_identically_zero(sp.Add(*terms) - margin, c.nonzero)
         steps += (Step("decomposition of the margin into terms",
                        rf"{tex(c.rhs)} - \left({tex(c.lhs)}\right) = "
                        + " + ".join(rf"\left({tex(t)}\right)" for t in terms), same),)
         if not same:
             ok, remaining = False, "the terms do not add up to the margin: " + rest
     for t in terms:
-        t_ok, rest = prove_nonnegative(t, c.hypotheses)
+        t_ok, rest = prove_nonnegative(t, c.hypotheses, nonzero=c.nonzero)
         steps += (Step("term is nonnegative (hypotheses as slacks, sign cases split)",
                        rf"{tex(t)} \geq 0", t_ok),)
         if not t_ok and ok:
@@ -495,8 +433,8 @@ def _check_solution(c: Claim) -> ProofResult:
                           f"x({tex(tv[0])}) = {tex(x.subs(t, tv[0]))} = {tex(tv[1])}"))
     steps, ok, remaining = _hyp_step(c), True, ""
     for label, resid, latex in parts:
-        r = _apply_given(resid, c.given)
-        r_ok, rest = is_identically_zero(_slack(r, c.hypotheses))
+        r = apply_given(resid, c.given)
+        r_ok, rest = is_identically_zero(r, c.nonzero)
         steps += (Step(label, latex, r_ok),)
         if not r_ok and ok:
             ok, remaining = False, f"{label}: show {rest}"
@@ -511,9 +449,10 @@ def _check_value(c: Claim) -> ProofResult:
     half = sp.Rational(1, 2) * sp.Rational(10) ** (-c.digits)
     ok = bool(abs(got - printed) <= half)
     steps = (Step(f"exact value, compared at the printed {c.digits} decimals",
-                  f"{tex(exact)} = {sp.N(exact, 10)} \\approx {c.rhs}", ok),)
+                  f"{tex(exact)} = {sp.N(exact, 10)} "
+                  + (r"\approx " if ok else r"\not\approx ") + str(c.rhs), ok),)
     if ok:
-        return ProofResult(c, Verdict.PROVED, steps, sign_proof=True)
+        return ProofResult(c, Verdict.PROVED, steps)
     return ProofResult(c, Verdict.REFUTED, steps, (("computed", float(got)),),
                        float(abs(got - printed)))
 

@@ -1,0 +1,100 @@
+"""Paper 003's controllers in closed loop (short horizons; the full runs are
+the antiskid-run-* designs checked by `workbench verify`)."""
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from workbench.cli import main
+from workbench.controllers.antiskid003 import DIVERGED, simulate_antiskid
+from workbench.design import load_design
+from workbench.studies import antiskid_run as R
+
+DRY = Path("designs/antiskid-run-dry.toml")
+K_TABLE3 = (-0.0049, 10.5080)   # paper 003, Table 3, eps = 0.35
+
+
+@pytest.fixture(scope="module")
+def spec():
+    return load_design(DRY).spec
+
+
+def _run(spec, case_name, t_end, dt=0.01, **changes):
+    case = next(c for c in spec.cases if c.name == case_name)
+    cs = dataclasses.replace(R.controller_settings(spec, K_TABLE3, case), **changes)
+    rs = dataclasses.replace(R.run_settings(spec, cs), t_end=t_end)
+    return cs, rs, simulate_antiskid(rs, dt, record_dt=0.05)
+
+
+def test_acceleration_tracks_lambda_opt_and_hands_over(spec):
+    cs, _, (res, m) = _run(spec, "compensated", 34.0)
+    assert m.lam_max_traction <= cs.lambda_opt * 1.001
+    assert 30.0 < m.t_cruise < 32.0
+    assert math.isfinite(m.t_handover_done) and math.isnan(m.t_diverged)
+    assert abs(res.x[1, -1] - cs.lambda_d) < 0.003
+
+
+def test_printed_switch_to_cruise_spins_the_wheel(spec):
+    _, _, (res, m) = _run(spec, "paper", 34.0)
+    assert m.t_cruise < m.t_diverged < m.t_cruise + 1.0
+    assert res.phase[-1] == DIVERGED
+
+
+def test_stiff_sampling_converges_and_zoh_does_not(spec):
+    t = {}
+    for mode in ("stiff", "zoh"):
+        t[mode] = [_run(spec, "compensated", 32.0, dt, sampling=mode)[2][1].t_cruise
+                   for dt in (0.01, 0.005)]
+    assert abs(t["stiff"][0] - t["stiff"][1]) < 0.005
+    assert abs(t["zoh"][0] - t["zoh"][1]) > 0.03      # printed law held: first order in dt
+
+
+def test_batch_matches_single_run(spec):
+    cs, rs, (_, m1) = _run(spec, "compensated", 33.0)
+    plant = tuple(np.full(2, x) for x in rs.plant_params)
+    rb = dataclasses.replace(rs, plant_params=plant, h=np.full(2, rs.h))
+    _, mb = simulate_antiskid(rb, 0.01, record_dt=None, batch=2)
+    for k in ("t_cruise", "lam_max_traction", "v_max"):
+        np.testing.assert_allclose(getattr(mb, k), getattr(m1, k), rtol=1e-9)
+
+
+def test_switch_check_sign(spec):
+    cs = R.controller_settings(spec, K_TABLE3, spec.cases[0])
+    assert R.switch_check(cs, 70.0, cs.lambda_opt).abscissa > 0      # unstable at the peak
+    assert R.switch_check(cs, 70.0, cs.lambda_d).abscissa < 0        # stable at the cruise point
+
+
+def test_simulate_cli(capsys):
+    assert main(["simulate", str(DRY), "--case", "paper"]) == 0
+    assert "real time" in capsys.readouterr().out
+    assert main(["simulate", str(DRY), "--case", "nope"]) == 2
+
+
+def test_bad_design_is_exit_2(tmp_path, capsys):
+    bad = tmp_path / "antiskid-run-dry.toml"
+    bad.write_text(DRY.read_text().replace('cruise_entry = "creep"', 'cruise_entry = "later"', 1))
+    assert main(["verify", str(bad)]) == 2
+    assert "cruise_entry" in capsys.readouterr().err
+
+
+def test_sweep_is_seeded(tmp_path, capsys):
+    short = tmp_path / "antiskid-run-dry.toml"
+    text = DRY.read_text().replace('value = 300.0,  unit = "s"', 'value = 31.5,  unit = "s"')
+    short.write_text(text.replace('value = 420.0,', 'value = 32.0,'))
+    from workbench.sim.montecarlo import sweep
+    d = load_design(short)
+    a = sweep(d, 3, seed=7, workers=1, progress=False)
+    b = sweep(d, 3, seed=7, workers=1, progress=False)
+    c = sweep(d, 3, seed=8, workers=1, progress=False)
+    np.testing.assert_equal(a.samples, b.samples)
+    np.testing.assert_equal(a.metrics, b.metrics)
+    assert a.samples != c.samples
+    assert len(a.metrics["t_cruise"]) == 3
+    fig = tmp_path / "hist.png"
+    assert main(["sweep", str(short), "--samples", "2", "--seed", "1", "--workers", "1",
+                 "--figure", str(fig)]) == 0
+    assert fig.exists() and "violation" in capsys.readouterr().out

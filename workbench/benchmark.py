@@ -1,0 +1,321 @@
+"""Delay-LMI benchmark: every analysis criterion on literature examples with
+known exact margins (``workbench benchmark delay``).
+
+Examples are data files (``designs/benchmarks/*.toml``, one ``[example]``
+table each: name, title, source, A, Ad); the settings come from a design of
+kind ``delay-benchmark`` (``designs/delay-benchmarks.toml``), so the CLI
+table, the report and the claims are one computation. Published numbers
+appear only as claims of that design.
+
+For each example: the exact margin by two independent methods
+(:func:`~workbench.margins.delay_margin_eig`,
+:func:`~workbench.margins.delay_margin_sweep`), then for each method the
+certified bound by the shared bisection, its ratio to the exact margin,
+solver calls and seconds, and optionally the rational re-check of the
+certificate (:mod:`workbench.lmi.exact_check`).
+"""
+from __future__ import annotations
+
+import json
+import math
+import time
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .design import Reader, display_path
+from .errors import DesignError
+from .lmi.analysis import METHODS, bessel_legendre_auto, certified_delay, make_criterion
+from .lmi.core import DEFAULT_MARGIN
+from .margins import DelayMargin, delay_margin_eig, delay_margin_sweep
+
+AUTO = "bessel-legendre-auto"
+
+
+@dataclass(frozen=True)
+class Example:
+    """A literature example x' = A x + A_d x(t - h) (matrices as nested tuples)."""
+
+    name: str
+    title: str
+    source: str
+    A: tuple
+    Ad: tuple
+    path: str
+
+
+@dataclass(frozen=True)
+class BenchmarkSettings:
+    """What to run (from the ``[benchmark]`` table of a delay-benchmark design).
+
+    Attributes
+    ----------
+    examples : str
+        Folder of example files, relative to the design file.
+    methods : tuple[str, ...]
+        Subset of :data:`~workbench.lmi.analysis.METHODS`.
+    orders : int
+        Bessel-Legendre orders 0..orders are tabulated.
+    N_max : int
+        Cap of the automatic order search.
+    gap_tol : float
+        Automatic mode stops when 1 - h_N / h* < gap_tol.
+    margin, rel_tol, h_max : float
+        LMI definiteness margin, bracket width, delay search cap (s).
+    exact_check : bool
+        Re-check every certificate in rational arithmetic.
+    """
+
+    examples: str = "benchmarks"
+    methods: tuple[str, ...] = METHODS
+    orders: int = 5
+    N_max: int = 8
+    gap_tol: float = 1e-4
+    margin: float = DEFAULT_MARGIN
+    rel_tol: float = 1e-5
+    h_max: float = 100.0
+    exact_check: bool = False
+
+
+@dataclass(frozen=True)
+class MethodRow:
+    """One method on one example.
+
+    ``h_certified`` is the largest delay certified (s; ``inf`` for a
+    certified delay-independent test; ``h_max`` means "at least h_max"),
+    ``ratio`` = h_certified / h* (None when h* is infinite, except 1.0 when
+    both are), ``exact_check`` the rational re-check outcome of the
+    certificate (None when not run or nothing was certified).
+    """
+
+    method: str
+    N: int | None
+    h_certified: float
+    h_refuted: float
+    ratio: float | None
+    solves: int
+    seconds: float
+    exact_check: str | None
+
+    def to_json(self, *, with_check: bool = False) -> dict:
+        d = {"method": self.method, "N": self.N, "h_certified": _j(self.h_certified),
+             "ratio": _j(self.ratio), "solves": self.solves, "seconds": round(self.seconds, 4)}
+        if with_check:
+            d["exact_check"] = self.exact_check
+        return d
+
+
+@dataclass(frozen=True)
+class ExampleResult:
+    example: Example
+    exact: DelayMargin
+    exact_sweep: DelayMargin
+    rows: tuple[MethodRow, ...]
+
+    @property
+    def agreement(self) -> float:
+        """Relative difference of the two exact methods (0 when both inf)."""
+        a, b = self.exact.h, self.exact_sweep.h
+        if math.isinf(a) or math.isinf(b):
+            return 0.0 if a == b else math.inf
+        return abs(a - b) / max(1.0, abs(a))
+
+    def row(self, method: str, N: int | None = None) -> MethodRow | None:
+        return next((r for r in self.rows if r.method == method and
+                     (N is None or r.N == N)), None)
+
+    def bl_monotone(self, slack: float) -> bool:
+        """Bessel-Legendre bounds non-decreasing in N (relative slack for the
+        bisection's bracket width)."""
+        hs = [r.h_certified for r in sorted((r for r in self.rows if
+                                             r.method == "bessel-legendre"), key=lambda r: r.N)]
+        return all(b >= a * (1 - slack) for a, b in zip(hs, hs[1:]))
+
+
+@dataclass(frozen=True)
+class BenchmarkResult:
+    settings: BenchmarkSettings
+    examples: tuple[ExampleResult, ...]
+
+    def to_json(self, *, with_check: bool = False) -> dict:
+        """``{"examples": [{"name", "exact_margin", "methods": [{"method", "N",
+        "h_certified", "ratio", "solves", "seconds"}]}]}`` (issue 4), plus
+        ``exact_check`` per method when ``with_check``; infinite values are the
+        string ``"inf"`` (JSON has no infinity), undefined ratios ``null``."""
+        return {"examples": [{"name": e.example.name, "exact_margin": _j(e.exact.h),
+                              "methods": [r.to_json(with_check=with_check) for r in e.rows]}
+                             for e in self.examples]}
+
+    def max_ratio(self) -> float:
+        """Largest finite ratio over examples and methods (soundness: <= 1)."""
+        rs = [r.ratio for e in self.examples for r in e.rows
+              if r.ratio is not None and math.isfinite(e.exact.h)]
+        return max(rs) if rs else 0.0
+
+
+def _j(x):
+    if x is None:
+        return None
+    return "inf" if math.isinf(x) else float(x)
+
+
+# -- loading -------------------------------------------------------------------------
+def _matrix(r: Reader, name: str) -> tuple:
+    val = r.raw(name)
+    if (not isinstance(val, list) or not val or not all(isinstance(row, list) for row in val)
+            or any(len(row) != len(val) for row in val)):
+        raise r.fail(name, val, "a square matrix as a list of rows, e.g. [[-1.0, 0.0], "
+                     "[0.0, -2.0]]")
+    for i, row in enumerate(val):
+        for j, x in enumerate(row):
+            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+                raise r.fail(f"{name}[{i}][{j}]", x, "a finite number")
+    return tuple(tuple(float(x) for x in row) for row in val)
+
+
+def load_example(path: str | Path) -> Example:
+    """Read one example file (an ``[example]`` table); DesignError on any problem."""
+    shown = display_path(path)
+    try:
+        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise DesignError(shown, "<file>", "<unreadable>", f"a valid TOML example ({exc})") \
+            from None
+    root = Reader(shown, data)
+    ex = root.table("example")
+    name = ex.string("name")
+    if name != Path(path).stem:
+        raise ex.fail("name", name, f'the file name without .toml, "{Path(path).stem}"')
+    title, source = ex.string("title"), ex.string("source")
+    A, Ad = _matrix(ex, "A"), _matrix(ex, "Ad")
+    if len(A) != len(Ad):
+        raise ex.fail("Ad", [list(r) for r in Ad], f"a {len(A)} x {len(A)} matrix like A")
+    ex.finish()
+    root.finish()
+    return Example(name, title, source, A, Ad, shown)
+
+
+def load_examples(folder: Path) -> tuple[Example, ...]:
+    files = sorted(folder.glob("*.toml"))
+    if not files:
+        raise DesignError(display_path(folder), "<folder>", "<empty>", "example files (*.toml)")
+    return tuple(load_example(p) for p in files)
+
+
+def load_settings(r: Reader) -> BenchmarkSettings:
+    """The ``[benchmark]`` table (every key optional, defaults of the dataclass)."""
+    d = BenchmarkSettings()
+    methods = r.raw("methods", list(d.methods))
+    if (not isinstance(methods, list) or not methods
+            or any(m not in METHODS for m in methods) or len(set(methods)) != len(methods)):
+        raise r.fail("methods", methods, "distinct names among " + ", ".join(METHODS))
+    s = BenchmarkSettings(
+        examples=r.string("examples", default=d.examples), methods=tuple(methods),
+        orders=int(r.number("orders", default=d.orders, integer=True, lo=0, hi=10)),
+        N_max=int(r.number("N_max", default=d.N_max, integer=True, lo=0, hi=12)),
+        gap_tol=r.number("gap_tol", default=d.gap_tol, positive=True, hi=0.5),
+        margin=r.number("margin", default=d.margin, positive=True, hi=1e-2),
+        rel_tol=r.number("rel_tol", default=d.rel_tol, positive=True, hi=0.1),
+        h_max=r.number("h_max", default=d.h_max, positive=True),
+        exact_check=r.boolean("exact_check", default=d.exact_check))
+    r.finish()
+    return s
+
+
+# -- running -------------------------------------------------------------------------
+def _ratio(h: float, exact: float) -> float | None:
+    if math.isinf(exact):
+        return 1.0 if math.isinf(h) else None
+    return h / exact if exact > 0 else None
+
+
+def _check(lmi, bound, enabled: bool) -> str | None:
+    if not enabled or bound.bracket.certificate is None:
+        return None
+    from .lmi.exact_check import exact_check
+    step = bound.bracket.certificate
+    return exact_check(lmi, step.certificate, step.h).outcome.value
+
+
+def run_example(ex: Example, s: BenchmarkSettings) -> ExampleResult:
+    """Exact margins and every method of ``s`` on one example."""
+    A, Ad = np.array(ex.A), np.array(ex.Ad)
+    exact, sweep = delay_margin_eig(A, Ad), delay_margin_sweep(A, Ad)
+    h_star = exact.h
+    rows: list[MethodRow] = []
+    kw = dict(rel_tol=s.rel_tol, h_hi=s.h_max)
+    for m in s.methods:
+        if m == "bessel-legendre":
+            continue
+        lmi = make_criterion(m, A, Ad, margin=s.margin)
+        b = certified_delay(lmi, **kw)
+        rows.append(MethodRow(m, None, b.h_certified, b.bracket.h_refuted,
+                              _ratio(b.h_certified, h_star), b.solves, b.seconds,
+                              _check(lmi, b, s.exact_check)))
+    if "bessel-legendre" in s.methods:
+        auto = bessel_legendre_auto(A, Ad, h_star, gap_tol=s.gap_tol, N_max=s.N_max,
+                                    N_through=s.orders, margin=s.margin, **kw)
+        for b in auto.bounds:
+            if b.N <= s.orders:
+                lmi = make_criterion("bessel-legendre", A, Ad, N=b.N, margin=s.margin)
+                rows.append(MethodRow(b.method, b.N, b.h_certified, b.bracket.h_refuted,
+                                      _ratio(b.h_certified, h_star), b.solves, b.seconds,
+                                      _check(lmi, b, s.exact_check)))
+        best = auto.best
+        used = [b for b in auto.bounds if b.N <= best.N]
+        lmi = make_criterion("bessel-legendre", A, Ad, N=best.N, margin=s.margin)
+        rows.append(MethodRow(AUTO, best.N, best.h_certified, best.bracket.h_refuted,
+                              _ratio(best.h_certified, h_star), sum(b.solves for b in used),
+                              sum(b.seconds for b in used), _check(lmi, best, s.exact_check)))
+    return ExampleResult(ex, exact, sweep, tuple(rows))
+
+
+def run_benchmark(examples: tuple[Example, ...], s: BenchmarkSettings) -> BenchmarkResult:
+    return BenchmarkResult(s, tuple(run_example(e, s) for e in examples))
+
+
+# -- CLI -------------------------------------------------------------------------------
+def benchmark_delay(design_path: str, *, as_json: bool = False, exact_check: bool = False,
+                    out=print) -> int:
+    """``workbench benchmark delay [DESIGN] [--json] [--exact-check]``.
+
+    Runs the suite of a delay-benchmark design and prints method x example:
+    certified h, ratio to the exact margin, solves, seconds. Exit 0 when every
+    run finished and no certified bound exceeds its exact margin (and, with
+    ``--exact-check``, every certificate passes the rational re-check);
+    1 otherwise.
+    """
+    from dataclasses import replace
+
+    from .design import load_design
+    from .report.markdown import fmt, md_table
+    from .studies.delay_benchmark import STUDY
+
+    design = load_design(design_path)
+    if design.kind != STUDY.kind:
+        raise DesignError(design.path, "design.kind", design.kind, f'"{STUDY.kind}"')
+    spec = design.spec
+    if exact_check:
+        spec = replace(spec, settings=replace(spec.settings, exact_check=True))
+    t0 = time.perf_counter()
+    res = run_benchmark(spec.examples, spec.settings)
+    wall = time.perf_counter() - t0
+    checks = [r.exact_check for e in res.examples for r in e.rows if r.exact_check]
+    ok = res.max_ratio() <= 1 + spec.settings.rel_tol and all(c == "certified" for c in checks)
+    if as_json:
+        out(json.dumps(res.to_json(with_check=exact_check), indent=2))
+        return 0 if ok else 1
+    for e in res.examples:
+        out(f"\n{e.example.name}: h* = {fmt(e.exact.h, 7)} s (eig), {fmt(e.exact_sweep.h, 7)} "
+            f"s (phase sweep) — {e.example.title}")
+        table = [[r.method, "" if r.N is None else r.N, fmt(r.h_certified, 6), fmt(r.ratio, 6),
+                  r.solves, f"{r.seconds:.2f}"] + ([r.exact_check or "—"] if exact_check else [])
+                 for r in e.rows]
+        out(md_table(["method", "N", "h certified (s)", "ratio", "solves", "s"]
+                     + (["exact check"] if exact_check else []), table,
+                     "lrrrrr" + ("l" if exact_check else "")))
+    out(f"\n{len(res.examples)} examples in {wall:.1f} s; largest ratio "
+        f"{fmt(res.max_ratio(), 6)}" + ("" if ok else " — NOT OK"))
+    return 0 if ok else 1

@@ -1,0 +1,273 @@
+"""One gain for several operating points, and the decay-rate variant.
+
+:class:`DescriptorSynthesis` is a state-feedback synthesis LMI for
+x' = A_i x + B_i K x(t - h) at every operating point i at once (common Y and
+V, so one K = V Y^{-1}; Lyapunov-Krasovskii matrices per operating point),
+built from Fridman's descriptor method with the Jensen inequality and the
+slack P3 = eps P2; eps is searched automatically (:func:`synthesize_robust`),
+not fixed by hand. Every gain is then re-checked per operating point by
+the tighter Bessel-Legendre analysis and the exact margin
+(:func:`check_gain`) — an operating point whose loop is not stable even
+without delay is reported as such.
+
+Operating points are a finite list (e.g. rail x speed x mass corners of
+the antiskid linearisation): a certificate holds at each listed point, not
+in between (the linearisation is not affine in speed or mass).
+
+:func:`decay_rate_bound`: with x = e^{-alpha t} z the loop
+x' = A x + A_d x(t-h) becomes z' = (A + alpha I) z + e^{alpha h} A_d z(t-h);
+a Bessel-Legendre certificate of that system at h proves exponential
+stability with rate alpha at delay h, cross-checked by the spectral abscissa
+(:func:`~workbench.margins.spectral_abscissa` <= -alpha).
+
+References
+----------
+.. [FR01] Fridman E., "New Lyapunov-Krasovskii functionals for stability of
+   linear retarded and neutral type systems", Systems & Control Letters 43
+   (2001) 309-319 (descriptor method).
+.. [FS02] Fridman E., Shaked U., "An improved stabilization method for linear
+   time-delay systems", IEEE TAC 47(11), 2002 (P3 = eps P2 and the
+   congruence by Y = P2^{-1}).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import cvxpy as cp
+import numpy as np
+
+from ..margins import DelayMargin, delay_margin_eig, spectral_abscissa
+from .analysis import BesselLegendreLMI, certified_delay
+from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, bisect_delay
+
+
+class DescriptorSynthesis(MarginLMI):
+    """Jensen/descriptor synthesis LMI over operating points (eps a DPP parameter).
+
+    For each operating point i, with eta = [x; x'; x_d] and the descriptor
+    zero term 2 (x'P2' + x''P3')(-x' + A_i x + B_i K x_d), P3 = eps P2,
+    Y = P2^{-1}, V = K Y and the congruence diag(Y, Y, Y), the functional
+    V_i = x'P_i x + int x'S_i x + h int int x''R_i x' decreases if
+
+        [[A_i Y + Y'A_i' + S_i - R_i/h, P_i - Y + eps Y'A_i', B_i V + R_i/h],
+         [*, -eps (Y + Y') + h R_i, eps B_i V],
+         [*, *, -S_i - R_i/h]] <= 0,   P_i, S_i, R_i >= 0
+
+    (P_i, S_i stand for Y'P_iY, Y'S_iY and R_i for h Y'R_iY). Decision
+    variables: Y (n x n), V (m x n) common; P_i, S_i, R_i (symmetric n x n)
+    per point; ``P0`` is normalised. Feasible at h => the loop with
+    K = V Y^{-1} is asymptotically stable at delay h at every point; with
+    alpha = 0 also at every h' <= h (in terms of Y'RY the LMI changes only by
+    -(h^2 - h'^2) in the x' block).
+
+    With a decay rate ``alpha`` > 0 the LMI is written for
+    z' = (A_i + alpha I) z + e^{alpha h} B_i K z(t-h) (x = e^{-alpha t} z):
+    feasible => exponentially stable with rate alpha at delay h.
+    """
+
+    normaliser = "P0"
+
+    def __init__(self, points: Sequence[tuple[np.ndarray, np.ndarray]], eps: float,
+                 alpha: float = 0.0, **kw):
+        if not alpha >= 0:
+            raise ValueError(f"alpha = {alpha!r}; expected a non-negative rate (1/s)")
+        self.alpha = float(alpha)
+        pts = [(np.asarray(A, float), np.asarray(B, float)) for A, B in points]
+        if not pts:
+            raise ValueError("points = []; expected at least one (A, B)")
+        self.n, self.m = pts[0][1].shape
+        # decay rate alpha: A -> A + alpha I, B K -> e^{alpha h} B K (parameter ``ealpha``)
+        self.points = [(A + self.alpha * np.eye(self.n), B) for A, B in pts]
+        super().__init__(**kw)
+        self.set_eps(eps)
+
+    def parameters(self):
+        return ("eps", "ealpha")
+
+    def solve_at(self, h: float):
+        self.set_parameters(ealpha=math.exp(self.alpha * h))
+        return super().solve_at(h)
+
+    def set_eps(self, eps: float) -> None:
+        if not eps > 0:
+            raise ValueError(f"eps = {eps!r}; expected a positive number")
+        self.eps = float(eps)
+        self.set_parameters(eps=eps)
+
+    def variables(self):
+        n = self.n
+        v = {"Y": cp.Variable((n, n), name="Y"), "V": cp.Variable((self.m, n), name="V")}
+        for i in range(len(self.points)):
+            for k in "PSR":
+                v[f"{k}{i}"] = cp.Variable((n, n), symmetric=True, name=f"{k}{i}")
+        return v
+
+    def blocks(self, x, p, bmat):
+        Y, V, eps, h, iota = x["Y"], x["V"], p["eps"], p["h"], p["iota"]
+        out = []
+        for i, (A, B) in enumerate(self.points):
+            P, S, R = x[f"P{i}"], x[f"S{i}"], x[f"R{i}"]
+            AY, BV = A @ Y, p["ealpha"] * (B @ V)
+            lmi = bmat([[AY + AY.T + S - iota * R, P - Y + eps * AY.T, BV + iota * R],
+                        [P - Y.T + eps * AY, -eps * (Y + Y.T) + h * R, eps * BV],
+                        [BV.T + iota * R, eps * BV.T, -S - iota * R]])
+            out += [Block(f"lmi{i}", lmi, "nsd"), Block(f"P{i}_pos", P, "psd"),
+                    Block(f"S{i}_pos", S, "psd"), Block(f"R{i}_pos", R, "psd")]
+        return out
+
+    def gain(self, values) -> np.ndarray:
+        """K = V Y^{-1} from a certificate."""
+        return np.linalg.solve(values["Y"].T, values["V"].T).T
+
+
+@dataclass(frozen=True)
+class RobustSynthesis:
+    """Best eps and its bracket; K from the certificate (original coordinates).
+
+    Attributes
+    ----------
+    eps : float
+    bracket : Bracket
+    K : numpy.ndarray or None
+    eps_tried : tuple[tuple[float, float], ...]
+        (eps, h_certified) of the automatic search.
+    """
+
+    eps: float
+    bracket: Bracket
+    K: np.ndarray | None
+    eps_tried: tuple[tuple[float, float], ...]
+
+
+def _balancing(points):
+    """Common diagonal power-of-two scaling T (from the first point's A)."""
+    from ..synthesis import balancing
+    T = balancing(points[0][0])
+    Tinv = np.diag(1 / np.diag(T))
+    return T, Tinv, [(Tinv @ A @ T, Tinv @ B) for A, B in points]
+
+
+def synthesize_robust(points, *, alpha: float = 0.0,
+                      eps_grid: Sequence[float] = (0.03, 0.1, 0.3, 1.0, 3.0),
+                      golden_steps: int = 6, rel_tol: float = 1e-3,
+                      margin: float = DEFAULT_MARGIN, h_hi: float = 10.0) -> RobustSynthesis:
+    """Largest h with one gain certified at every point, eps searched automatically.
+
+    eps is chosen by a log grid, then golden-section refinement (in log eps)
+    around the best grid value; each eps is a certified bisection on h
+    (shared :func:`~workbench.lmi.core.bisect_delay`). Coordinates are
+    balanced by a common power-of-two diagonal T (exact), K is mapped back.
+    """
+    T, Tinv, pts = _balancing(points)
+    lmi = DescriptorSynthesis(pts, eps_grid[0], alpha, margin=margin)
+    tried: dict[float, Bracket] = {}
+
+    def run(eps: float) -> float:
+        eps = float(f"{eps:.12g}")        # golden points recur up to rounding
+        if eps not in tried:
+            lmi.set_eps(eps)
+            # start from the best bound so far (first: h_hi / 4, where the LMI is
+            # better scaled than at tiny h, where 1/h dominates the blocks)
+            guess = max((b.h_certified for b in tried.values()), default=0.0) or h_hi / 4
+            tried[eps] = bisect_delay(lmi.solve_at, h_lo=1e-4, h_hi=h_hi, rel_tol=rel_tol,
+                                      guess=guess)
+        return tried[eps].h_certified
+
+    for e in eps_grid:
+        run(e)
+    best = max(tried, key=lambda e: tried[e].h_certified)
+    k = list(eps_grid).index(best)
+    lo = math.log(eps_grid[max(k - 1, 0)])
+    hi = math.log(eps_grid[min(k + 1, len(eps_grid) - 1)])
+    g = (math.sqrt(5) - 1) / 2
+    for _ in range(golden_steps):             # golden section on log eps
+        a, b = hi - g * (hi - lo), lo + g * (hi - lo)
+        if run(math.exp(a)) >= run(math.exp(b)):
+            hi = b
+        else:
+            lo = a
+    best = max(tried, key=lambda e: tried[e].h_certified)
+    br = tried[best]
+    K = None
+    if br.certificate is not None:
+        K = lmi.gain(br.certificate.certificate) @ Tinv
+    pairs = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
+    return RobustSynthesis(best, br, K, pairs)
+
+
+@dataclass(frozen=True)
+class PointCheck:
+    """A gain checked at one operating point.
+
+    Attributes
+    ----------
+    stable_at_zero : bool
+        A + B K Hurwitz (False: the loop is unstable without delay — loud).
+    exact : DelayMargin
+        Exact margin of x' = A x + B K x(t-h).
+    h_certified : float
+        Bessel-Legendre (order N) certified bound with this K (s).
+    N : int
+    """
+
+    stable_at_zero: bool
+    exact: DelayMargin
+    h_certified: float
+    N: int
+
+
+def check_gain(points, K, *, N: int = 2, margin: float = DEFAULT_MARGIN,
+               rel_tol: float = 1e-4, h_hi: float = 100.0) -> tuple[PointCheck, ...]:
+    """Check a given K at every point: exact margin and certified BL bound."""
+    K = np.atleast_2d(np.asarray(K, float))
+    out = []
+    for A, B in points:
+        Ad = np.asarray(B, float) @ K
+        exact = delay_margin_eig(A, Ad)
+        stable = exact.reason != "unstable-at-zero-delay"
+        h = 0.0
+        if stable:
+            T, Tinv, ((At, _),) = _balancing([(A, B)])
+            h = certified_delay(BesselLegendreLMI(At, Tinv @ Ad @ T, N, margin=margin),
+                                rel_tol=rel_tol, h_hi=h_hi,
+                                guess=exact.h if math.isfinite(exact.h) else None).h_certified
+        out.append(PointCheck(stable, exact, h, N))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class DecayRate:
+    """Largest h with exponential stability of rate alpha certified.
+
+    ``abscissa`` is the spectral abscissa of the delay system at
+    ``bracket.h_certified`` (must be <= -alpha for the certificate to agree).
+    """
+
+    alpha: float
+    N: int
+    bracket: Bracket
+    abscissa: float | None
+
+
+def decay_rate_bound(A, Ad, alpha: float, *, N: int = 2, margin: float = DEFAULT_MARGIN,
+                     rel_tol: float = 1e-4, h_hi: float = 10.0) -> DecayRate:
+    """Bessel-Legendre bound for z' = (A + alpha I) z + e^{alpha h} A_d z(t-h).
+
+    The delayed matrix depends on h, so each step builds its own criterion
+    (no DPP re-use); the shared bisection decides.
+    """
+    if not alpha >= 0:
+        raise ValueError(f"alpha = {alpha!r}; expected a non-negative rate (1/s)")
+    A, Ad = np.atleast_2d(np.asarray(A, float)), np.atleast_2d(np.asarray(Ad, float))
+    T, Tinv, ((At, _),) = _balancing([(A, np.zeros((A.shape[0], 1)))])
+    Adt = Tinv @ Ad @ T
+    Aa = At + alpha * np.eye(A.shape[0])
+
+    def decide(h: float):
+        return BesselLegendreLMI(Aa, math.exp(alpha * h) * Adt, N, margin=margin).solve_at(h)
+
+    br = bisect_delay(decide, h_lo=1e-4, h_hi=h_hi, rel_tol=rel_tol)
+    sa = spectral_abscissa(A, Ad, br.h_certified) if br.outcome is Outcome.CERTIFIED else None
+    return DecayRate(alpha, N, br, sa)

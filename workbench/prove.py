@@ -1,0 +1,189 @@
+"""``workbench prove``: check the claims of ``proofs/``, for the CLI, verify and reports.
+
+``run_proofs(names)`` checks the selected claims with
+:func:`workbench.symbolic.proof.check_claim`; :func:`cmd_prove` prints them,
+:func:`verification_rows` feeds ``workbench verify`` and
+:func:`report_files` renders one report per paper (``reports/proofs-NNN.md``).
+"""
+from __future__ import annotations
+
+import importlib
+import json
+import sys
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import metadata
+from pathlib import Path
+
+from .errors import DesignError
+from .report.markdown import fmt, md_table
+from .symbolic.proof import ProofResult, Verdict, check_claim
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@dataclass(frozen=True)
+class ProofModule:
+    """One module of ``proofs/``: name, paper, title and its claims."""
+
+    name: str
+    paper: str
+    title: str
+    claims: tuple
+
+
+@lru_cache(maxsize=1)
+def proof_modules() -> tuple[ProofModule, ...]:
+    """Every module of ``proofs/`` (the package next to ``workbench/``)."""
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    pkg = importlib.import_module("proofs")
+    return tuple(ProofModule(m.__name__.rsplit(".", 1)[-1], m.PAPER, m.TITLE, tuple(m.claims()))
+                 for m in pkg.modules())
+
+
+def select(names: list[str] | tuple[str, ...] = ()) -> list[tuple[ProofModule, object]]:
+    """(module, claim) pairs chosen by paper ("003"), module ("p003_lmi") or claim id.
+
+    Raises
+    ------
+    DesignError
+        For a name that matches nothing (exit 2 in the CLI).
+    """
+    pairs = [(m, c) for m in proof_modules() for c in m.claims]
+    if not names:
+        return pairs
+    out = []
+    for n in names:
+        hit = [(m, c) for m, c in pairs if n in (m.paper, m.name, c.id)]
+        if not hit:
+            raise DesignError("<cli>", "PROOF", n, "a paper (" + ", ".join(sorted(
+                {m.paper for m in proof_modules()})) + "), a module of proofs/ ("
+                + ", ".join(m.name for m in proof_modules()) + ") or a claim id")
+        out += [p for p in hit if p not in out]
+    return out
+
+
+@lru_cache(maxsize=None)
+def _check(module: str, claim_id: str) -> ProofResult:
+    claim = next(c for m in proof_modules() if m.name == module for c in m.claims
+                 if c.id == claim_id)
+    return check_claim(claim)
+
+
+def run_proofs(names=()) -> list[tuple[ProofModule, ProofResult]]:
+    """Check the selected claims (each once per process)."""
+    return [(m, _check(m.name, c.id)) for m, c in select(tuple(names))]
+
+
+def _expected(r: ProofResult) -> str:
+    return "REFUTED (as printed)" if r.claim.expect == "refuted" else "PROVED"
+
+
+def _detail(r: ProofResult) -> str:
+    if r.counterexample is not None:
+        return "counterexample: " + ", ".join(f"{n} = {fmt(v, 6)}" for n, v in r.counterexample)
+    return ("remains: " + r.remaining) if r.remaining else ""
+
+
+def cmd_prove(args) -> int:
+    """``workbench prove [PROOF ...] [--json]``: exit 0 all ok, 1 otherwise, 2 bad name."""
+    results = run_proofs(args.proofs)
+    ok = all(r.ok for _, r in results)
+    if args.json:
+        print(json.dumps({"proofs": [dict(module=m.name, **r.to_json()) for m, r in results]},
+                         indent=2))
+        return 0 if ok else 1
+    rows = [[m.paper, r.claim.id, r.claim.equations, r.claim.kind, _expected(r),
+             r.verdict.value + ("" if r.ok else " ✗"), _detail(r)[:120]] for m, r in results]
+    print(md_table(["paper", "claim", "eqs", "kind", "expected", "verdict", "detail"], rows))
+    n_bad = sum(not r.ok for _, r in results)
+    print(f"\n{len(results) - n_bad} of {len(results)} proof claims ok"
+          + ("" if not n_bad else f"; {n_bad} not ok"))
+    return 0 if ok else 1
+
+
+def verification_rows() -> dict:
+    """Rows for ``workbench verify``: every proof claim, PROVED ok, REFUTED ok only
+    when expected (the as-printed half of an erratum pair), INCONCLUSIVE not ok."""
+    results = run_proofs()
+    rows = []
+    for m, r in results:
+        verdict = ("PASS (expected refuted)" if r.ok and r.claim.expect == "refuted"
+                   else "PASS" if r.ok else "FAIL ✗")
+        rows.append([f"proofs/{m.name}", r.claim.id, _expected(r), r.verdict.value, verdict,
+                     f"paper {m.paper}, eqs {r.claim.equations}"])
+    return {"rows": rows, "bad": sum(not r.ok for _, r in results),
+            "json": {"proofs": [dict(module=m.name, **r.to_json()) for m, r in results]}}
+
+
+# -- reports ---------------------------------------------------------------------------
+def _summary(results) -> str:
+    n, ok = len(results), sum(r.ok for r in results)
+    counts = {v: sum(r.verdict is v for r in results) for v in Verdict}
+    exp = sum(r.ok and r.claim.expect == "refuted" for r in results)
+    return (f"{ok}/{n} proof claims ok — {counts[Verdict.PROVED]} PROVED, "
+            f"{counts[Verdict.REFUTED]} REFUTED ({exp} as printed, expected), "
+            f"{counts[Verdict.INCONCLUSIVE]} INCONCLUSIVE")
+
+
+def _claim_section(module: ProofModule, r: ProofResult) -> str:
+    c = r.claim
+    mark = "" if r.ok else " — **NOT OK**"
+    lines = [f"### `{c.id}` — {r.verdict.value}{mark}", "",
+             f"{c.statement}. Paper {c.paper}, eqs {c.equations}; kind `{c.kind}`; "
+             f"expected {_expected(r)}; module `proofs/{module.name}.py`."]
+    if c.note:
+        lines += ["", f"> {c.note}"]
+    marks = {True: "✓", False: "✗", None: "—"}
+    lines += ["", md_table(["step", "result"], [[s.what, marks[s.ok]] for s in r.steps], "ll")]
+    for s in r.steps:
+        if s.latex and not s.what.startswith("falsification"):
+            lines += ["", f"*{s.what}:*", "", "$$", s.latex, "$$"]
+    if r.counterexample is not None:
+        lines += ["", f"**Counterexample** (re-checked with 30 digits; fails by "
+                  f"{fmt(r.violation, 3)}):", "",
+                  md_table(["symbol", "value"], [[f"${n}$" if n != "computed" else n, fmt(v, 6)]
+                                                 for n, v in r.counterexample], "lr")]
+    if r.remaining:
+        lines += ["", f"**Remains to be shown:** ${r.remaining}$"]
+    return "\n".join(lines)
+
+
+def render_paper_report(paper: str, pairs) -> str:
+    """Markdown of one paper's proof report (pure function of the results)."""
+    results = [r for _, r in pairs]
+    titles = sorted({m.title for m, _ in pairs})
+    table = md_table(["claim", "eqs", "statement", "expected", "verdict"],
+                     [[f"`{r.claim.id}`", r.claim.equations, r.claim.statement, _expected(r),
+                       f"**{r.verdict.value}**" + ("" if r.ok else " ✗")] for r in results],
+                     "llllr")
+    head = (f"# Proofs for paper {paper}\n\n" + "; ".join(titles) + ".\n\n"
+            f"**{_summary(results)}.**\n\n"
+            "Each claim is built as sympy objects in `proofs/` and checked by "
+            "`workbench.symbolic.proof`: identities by simplification (split into sign cases "
+            "where `Abs`/`sign` occur), inequalities by a decomposition into terms shown "
+            "nonnegative under the hypotheses, minimisers by solving the stationarity "
+            "condition and showing convexity, closed forms by substitution into the ODE; "
+            "then a seeded falsification search samples the hypotheses' set. REFUTED "
+            "claims come with a counterexample; a claim marked *as printed* is the paper's "
+            "form of an erratum and is expected to be refuted.")
+    body = [_claim_section(m, r) for m, r in pairs]
+    prov = (f"## Provenance\n\nsympy {metadata.version('sympy')}, numpy "
+            f"{metadata.version('numpy')}; falsification seed fixed in "
+            "`workbench/symbolic/falsify.py`. Generated by `workbench report`; do not edit "
+            "by hand.")
+    return "\n\n".join([head, "## Claims\n\n" + table, "## Checked steps", *body, prov]) + "\n"
+
+
+def report_files() -> list:
+    """``ReportFiles`` of every paper: ``proofs-NNN`` (one per paper)."""
+    from .report.writer import ReportFiles
+    results = run_proofs()
+    out = []
+    for paper in sorted({m.paper for m, _ in results}):
+        pairs = [(m, r) for m, r in results if m.paper == paper]
+        rs = [r for _, r in pairs]
+        out.append(ReportFiles(f"proofs-{paper}", render_paper_report(paper, pairs), (),
+                               all(r.ok for r in rs), _summary(rs)))
+    return out

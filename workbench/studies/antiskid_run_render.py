@@ -1,0 +1,315 @@
+"""Markdown and figures of the ``antiskid-run`` study (pure rendering)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..controllers.antiskid003 import (BRAKE, BRAKE_IN, PHASE_NAMES, CreepSpeedProfile, _Array,
+                                       creep_speed, wheel_speed)
+from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
+
+_COLORS = {"paper": "tab:red", "compensated": "tab:blue", "uncompensated": "tab:orange",
+           "recursive": "tab:purple"}
+_LABELS = {  # metric -> (label, unit, sig)
+    "t_cruise": ("time to reach v_d", "s", 4),
+    "lam_max_traction": ("max creep ratio, traction", "-", 4),
+    "lam_max_over_opt": ("max creep ratio / lambda_opt", "-", 4),
+    "v_max": ("max speed, traction", "m/s", 4),
+    "v_err_at_brake": ("v - v_d at t_brake", "m/s", 2),
+    "lam_err_at_brake": ("lambda - lambda_d at t_brake", "-", 2),
+    "braking_duration": ("braking: t_brake to v <= v_stop", "s", 3),
+    "omega3_after_brake": ("braking: t_brake to omega <= 3 rad/s", "s", 3),
+    "lam_min_brake": ("min creep ratio, braking", "-", 3),
+    "evs_max_tracking": ("max creep-speed error (omega > 3 rad/s, after 5 s)", "m/s", 2),
+    "evs_last": ("creep-speed error at the stop", "m/s", 2),
+    "t_diverged": ("|lambda| >= 0.9 at", "s", 4),
+}
+
+
+def _color(name):
+    return _COLORS.get(name, "tab:green")
+
+
+def _diverged_text(c) -> str:
+    t = c.metrics["t_diverged"]
+    if math.isnan(t):
+        return "no"
+    ph = c.metrics["phase_diverged"]
+    return f"yes, t = {fmt(t, 4)} s ({PHASE_NAMES[int(ph)]})"
+
+
+def render(design, res) -> Rendered:
+    spec = design.spec
+    sc = spec.scenario
+    sections = []
+    K = "[" + ", ".join(fmt(k, 4) for k in res.K) + "]"
+    Kt = "[" + ", ".join(fmt(k, 5) for k in spec.K_table) + "]"
+    rows = [["v(0), lambda(0)", f"{fmt(sc['v0'])} m/s, {fmt(sc['lambda0'])}"],
+            ["u on [-h, 0)", f"{fmt(sc['u_init'])} N m"],
+            ["input delay h (plant and predictor)", f"{fmt(sc['h'], 4)} s"],
+            ["v_d, lambda_d (solved), lambda_opt",
+             f"{fmt(sc['v_d'])} m/s, {fmt(res.lambda_d, 4)}, {fmt(res.lambda_opt, 4)}"],
+            ["braking from", f"{fmt(sc['t_brake'])} s"],
+            ["plant mass / nominal", fmt(spec.mass_factor, 3) + " (the controller keeps the nominal model)"],
+            ["cruise gain K used", f"{K} — {res.K_how}"
+             + (f", h_certified = {fmt(res.h_certified, 4)} s" if res.h_certified else "")],
+            ["printed gain", f"{Kt} ({spec.K_source})"],
+            ["k_ac, k_de", f"{fmt(spec.k_ac)}, {fmt(spec.k_de)} 1/s"],
+            ["step dt (reported at dt/2)", f"{fmt(res.dt)} s ({fmt(res.dt / 2)} s)"]]
+    sections.append(
+        f"## Scenario (paper 003, section 4)\n\nRail: **{spec.rail}**. Controller (75): "
+        "acceleration law (64), cruise law (61), braking law (69) with the desired creep speed "
+        "of eq (76); the predictor X(t+h) of Lemma 1, eq (2).\n\n"
+        + md_table(["item", "value"], rows, "ll") + "\n\n" + _cases_text(spec))
+    sections.append(_results_section(res))
+    sections.append(_switch_section(res))
+    sections.append(_convergence_section(res, spec))
+    sections.append(_linear_section(res))
+    sections.append(_numerics_section())
+    figs = (
+        Figure("speed", "Train speed v and wheel speed v_w = omega r.",
+               lambda fig, res=res: _plot_speed(fig, res), (7.0, 4.0)),
+        Figure("creep-ratio", "Creep ratio against lambda_opt and lambda_d.",
+               lambda fig, res=res: _plot_creep(fig, res), (7.0, 5.5)),
+        Figure("torque", "Wheel torque u(t) of the controller.",
+               lambda fig, res=res: _plot_torque(fig, res), (7.0, 4.0)),
+        Figure("creep-speed-error", "Creep-speed tracking error in braking.",
+               lambda fig, res=res, sp=spec: _plot_evs(fig, res, sp), (7.0, 4.0)),
+        Figure("linear-checks", "Linear error system E' = A E + B K E(t-h).",
+               lambda fig, res=res: _plot_linear(fig, res), (7.0, 4.0)),
+    )
+    sections.append(
+        "## Figures\n\n"
+        "![speed]({figdir}/speed.png)\n\nSpeed and wheel speed of every case (a case "
+        "that diverges ends where |lambda| reaches 0.9).\n\n"
+        "![creep ratio]({figdir}/creep-ratio.png)\n\nCreep ratio: whole run (top) and the "
+        "end of acceleration (bottom), with lambda_opt and lambda_d.\n\n"
+        "![torque]({figdir}/torque.png)\n\nTorque u(t) computed by the controller (it acts h "
+        "later).\n\n![creep speed error]({figdir}/creep-speed-error.png)\n\nCreep-speed error "
+        "e_vs = v_s - v_s*(t) in braking (Theorem 3, cf. Fig. 4 of the paper).\n\n"
+        "![linear checks]({figdir}/linear-checks.png)\n\n|E| of the linear error system with "
+        "the finite-margin gain at the multiples of its exact margin h*.")
+    return Rendered(tuple(sections), figs)
+
+
+def _cases_text(spec) -> str:
+    rows = [[f"`{c.name}`", "yes" if c.compensate else "no", c.cruise_entry, c.brake_entry,
+             c.description] for c in spec.cases]
+    return ("Cases (variants of controller 75):\n\n"
+            + md_table(["case", "predictor", "cruise entry", "braking entry", "what"], rows,
+                       "lllll")
+            + "\n\n*cruise entry* `speed`: law (61) from the first sample with v >= v_d, as "
+            "printed; `creep`: law (64) with target lambda_d first, law (61) once "
+            f"|lambda - lambda_d| <= {fmt(spec.handover_band)}.")
+
+
+def _results_section(res) -> str:
+    names = [c.case.name for c in res.cases]
+    rows = []
+    for key in ("t_cruise", "lam_max_traction", "lam_max_over_opt", "v_max", "v_err_at_brake",
+                "braking_duration", "omega3_after_brake", "lam_min_brake", "evs_max_tracking",
+                "evs_last"):
+        label, unit, sig = _LABELS[key]
+        rows.append([label, unit] + [fmt(None if math.isnan(c.metrics[key]) else c.metrics[key],
+                                         sig) for c in res.cases])
+    rows.append(["diverged (|lambda| >= 0.9)", ""] + [_diverged_text(c) for c in res.cases])
+    return ("## What happens\n\n"
+            + md_table(["metric", "unit"] + [f"`{n}`" for n in names], rows,
+                       "ll" + "r" * len(names))
+            + "\n\nAll values at dt/2 (see the convergence table). '—': not reached (the run "
+            "ended before).")
+
+
+def _switch_section(res) -> str:
+    rows = []
+    for c in res.cases:
+        sw = c.switch
+        if sw is None:
+            rows.append([f"`{c.case.name}`", "—", "—", "—", "—", "—", "—"])
+            continue
+        m = sw.margin
+        mtxt = ("unstable at h = 0" if m.reason == "unstable-at-zero-delay" else
+                "∞ (delay-independent)" if math.isinf(m.h) else fmt(m.h, 3) + " s")
+        rows.append([f"`{c.case.name}`", fmt(sw.v, 4), fmt(sw.lam, 4), fmt(sw.dmu_dlam, 3),
+                     f"${latex_matrix(sw.A_loc, 3)}$", fmt(sw.abscissa, 3), mtxt])
+    brows = []
+    for c in res.cases:
+        lb = c.metrics["lam_at_brake"]
+        if math.isnan(lb):
+            brows.append([f"`{c.case.name}`", "—", "— (braking not reached)", "—"])
+            continue
+        dv = c.metrics["t_diverged"]
+        after = ("diverged at t = " + fmt(dv, 4) + " s" if not math.isnan(dv) else
+                 "lambda < 0 after " + fmt(c.metrics["t_lam_negative"] - c.metrics["t_brake"], 3)
+                 + " s; stopped")
+        brows.append([f"`{c.case.name}`", fmt(lb, 4),
+                      "no (lambda > 0: traction side)" if lb > 0 else "yes", after])
+    return (
+        "## Phase switches: is the state where the next controller works?\n\n"
+        "**Acceleration → cruise.** The LMI certificate of law (61) is local to the cruise "
+        "linearisation at (v_d, lambda_d). At the state where law (61) takes over we freeze "
+        "the loop, linearising the traction form with the feed-forward part of (61), "
+        "x' = A_loc x + A_d x(t - h), A_d = (y3/den) B K, and give its delay-free spectral "
+        "abscissa and exact delay margin (Chen-Gu-Nett).\n\n"
+        + md_table(["case", "v (m/s)", "lambda", "d mu/d lambda", "A_loc", "abscissa (1/s)",
+                    "exact margin"], rows, "lrrrlrl")
+        + "\n\nAt lambda = lambda_opt the adhesion slope d mu/d lambda is zero: the restoring "
+        "term d2 of the cruise linearisation, which the synthesised K (k2 > 0, positive "
+        "feedback on lambda_e) relies on, has vanished, so the frozen loop is unstable "
+        "before any delay is added. Eq (75) as printed switches exactly there.\n\n"
+        "**Cruise → braking.** Law (69) is built on the braking form (eq 15, lambda <= 0). "
+        "State at t_brake:\n\n"
+        + md_table(["case", "lambda at t_brake", "in the braking form's domain?", "then"],
+                   brows, "lrll")
+        + "\n\nThe braking law starts on the traction side (lambda = lambda_d > 0), where its "
+        "model (the braking form, whose adhesion branch grows like e^{b lambda} for lambda > 0) "
+        "does not hold; eq (76) even asks for a *positive* creep speed during the first "
+        "0.75 s.\n\n"
+        "**omega <= 3 rad/s.** v_s* jumps to 0 (eq 76): the creep-speed error jumps and decays "
+        "at rate k_de; the train then coasts on running resistance to v_stop.")
+
+
+def _convergence_section(res, spec) -> str:
+    rows = []
+    for c in res.cases:
+        for key in _LABELS:
+            a, b = c.metrics_coarse[key], c.metrics[key]
+            if math.isnan(a) and math.isnan(b):
+                continue
+            label, unit, sig = _LABELS[key]
+            rows.append([f"`{c.case.name}`", label, fmt(a, 6), fmt(b, 6),
+                         "yes" if c.converged[key] else "**no**"])
+    return ("## Convergence in the step size\n\nEvery metric computed at dt = "
+            f"{fmt(res.dt)} s and dt/2 = {fmt(res.dt / 2)} s; converged when they agree within "
+            f"rtol = {fmt(spec.conv_rtol)} or the design's atol.\n\n"
+            + md_table(["case", "metric", "dt", "dt/2", "converged"], rows, "llrrl"))
+
+
+def _linear_section(res) -> str:
+    lc = res.linear
+    fm = lc.finite_margin
+    rows = [[fmt(f, 3), fmt(h, 4), fmt(r, 3), "decays" if r < 1 else "grows"]
+            for f, h, r in lc.ratios_finite]
+    prow = [[fmt(h, 3), fmt(r, 3), "decays" if r < 1 else "grows"] for h, r in lc.ratios_paper]
+    pm = lc.paper_margin
+    ptxt = "∞ (no crossing: stable for every constant delay)" if math.isinf(pm.h) else fmt(pm.h, 4)
+    return (
+        "## Linear cross-checks of the delay bound\n\n"
+        "E' = A E + B K E(t - h) on the cruise linearisation, simulated by Heun's method on "
+        "a grid with h = N dt. Accuracy, by step halving against the exact method-of-steps "
+        "solution of x' = -x(t - 0.7), x = 1 on [-0.7, 0], over 10 s:\n\n"
+        + md_table(["dt (s)", "max error", "observed order"],
+                   [[fmt(r.dt, 3), fmt(r.error, 3), fmt(r.order, 3)] for r in lc.halving],
+                   "rrr")
+        + "\n\nThe envelope ratio is max |E| over the last window / over the second window.\n\n"
+        f"Gain with a finite exact margin, K = [{', '.join(fmt(k, 3) for k in lc.K_finite)}]: "
+        f"h* = {fmt(fm.h, 4)} s at omega = {fmt(fm.omega, 4)} rad/s.\n\n"
+        + md_table(["h / h*", "h (s)", "envelope ratio", "verdict"], rows, "rrrl")
+        + f"\n\nSynthesised gain K = [{', '.join(fmt(k, 4) for k in lc.K_paper)}]: exact "
+        f"margin {ptxt}.\n\n"
+        + md_table(["h (s)", "envelope ratio", "verdict"], prow, "rrl")
+        + "\n\nThe LMI bound h_m is where the Lyapunov-Krasovskii criterion stops proving "
+        "stability, not where the loop stops being stable: with this gain the loop decays at "
+        "delays two orders of magnitude above h_m, as its infinite exact margin says.")
+
+
+def _numerics_section() -> str:
+    return (
+        "## Numerics\n\n"
+        "* Plant: v by explicit Euler; the creep ratio, stiff at low speed "
+        "(d lambda'/d lambda ~ -m g r^2 mu'/(J v), time constant ~ v/4000 s), by the "
+        "exponential Euler step with the sympy Jacobian, stable for any step; a step that "
+        "would move the creep ratio by more than 0.02 is halved (up to 8 times), since the "
+        "adhesion curve is far from linear over such a change.\n"
+        "* Delay: exact average of the delayed zero-order-hold input over each step "
+        "(`workbench/sim/history.py`).\n"
+        "* Predictor (eq 2): the phase's model run from x(t) through the inputs of the last h "
+        "seconds ('rollout'). The literal recursive form (summing f of past predictions) has "
+        "error dynamics e(t) = ∫ J e(s) ds over [t - h, t], neutral type, with J the stiff "
+        "creep-ratio Jacobian; where a design has a case with `predictor = \"recursive\"` "
+        "the tables above show what it does.\n"
+        "* Sampling: the controller runs every step. A torque held for one step moves the "
+        "stiff creep ratio to its quasi-steady value, so the printed law held constant "
+        "realises its rate only for dt |J| << 1 (at 3 m/s, |J| ~ 1000/s). Each law is held "
+        "as the torque that moves the exponential-Euler creep ratio by dt times the rate "
+        "the continuous law asks for; it equals the printed law when dt |J| -> 0. With the "
+        "printed value held, the time to cruise moved by 0.08 s per 5 ms of step.\n"
+        "* Phase switches use measured states; stops at v <= v_stop; a run ends as diverged "
+        "when |lambda| >= 0.9.\n"
+        "* Monte Carlo robustness (mass, adhesion between the wet and dry curves, true delay, "
+        "initial speed; the controller keeps the nominal dry model) is run by "
+        "`workbench sweep DESIGN --samples N --seed S --figure PNG`, outside this report "
+        "(its cost exceeds the report budget).")
+
+
+# -- figures ---------------------------------------------------------------------
+def _plot_speed(fig, res):
+    ax = fig.add_subplot(111)
+    for c in res.cases:
+        r = c.run
+        v, lam = r.x
+        vw = np.where(lam >= 0, v / (1 - np.minimum(lam, 0.999)), v * (1 + lam))
+        ax.plot(r.t, v, color=_color(c.case.name), label=f"{c.case.name}: v")
+        ax.plot(r.t, vw, color=_color(c.case.name), ls=":", label=f"{c.case.name}: v_w")
+    vmax = max(float(np.nanmax(c.run.x[0])) for c in res.cases)
+    ax.set_ylim(-5.0, 1.3 * vmax)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("speed (m/s), clipped")
+    ax.legend(fontsize=7, ncol=2)
+
+
+def _plot_creep(fig, res):
+    ax1, ax2 = fig.subplots(2, 1)
+    for ax in (ax1, ax2):
+        for c in res.cases:
+            r = c.run
+            ax.plot(r.t, np.clip(r.x[1], -1, 1), color=_color(c.case.name), label=c.case.name)
+        ax.axhline(res.lambda_opt, color="k", ls="--", lw=0.8, label="lambda_opt")
+        ax.axhline(res.lambda_d, color="gray", ls=":", lw=0.8, label="lambda_d")
+        ax.set_ylabel("creep ratio")
+    t_c = min((c.metrics["t_cruise"] for c in res.cases
+               if not math.isnan(c.metrics["t_cruise"])), default=0.0)
+    ax1.set_ylim(-0.2, 0.3)
+    ax2.set_xlim(t_c - 1.0, t_c + 3.0)
+    ax2.set_ylim(-0.1, 1.0)
+    ax2.set_xlabel("t (s)")
+    ax1.legend(fontsize=7, ncol=3)
+
+
+def _plot_torque(fig, res):
+    ax = fig.add_subplot(111)
+    for c in res.cases:
+        ax.plot(c.run.t, np.clip(c.run.u[0], -4e4, 4e4), color=_color(c.case.name),
+                label=c.case.name, lw=0.8)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("u (N m), clipped to ±4e4")
+    ax.legend(fontsize=7)
+
+
+def _plot_evs(fig, res, spec):
+    ax = fig.add_subplot(111)
+    prof = CreepSpeedProfile(t_brake=spec.scenario["t_brake"], **spec.profile)
+    r_wheel = spec.params["r"].value
+    for c in res.cases:
+        r = c.run
+        sel = (r.phase == BRAKE) | (r.phase == BRAKE_IN)
+        if not sel.any():
+            continue
+        t, v, lam = r.t[sel], r.x[0][sel], r.x[1][sel]
+        om = wheel_speed(np.maximum(v, 1e-3), lam, r_wheel, _Array)
+        vs, _ = prof(t, v, 0 * v, om, _Array)
+        ax.plot(t, creep_speed(v, lam, _Array) - vs, color=_color(c.case.name), label=c.case.name)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("e_vs = v_s - v_s* (m/s)")
+    ax.set_ylim(-0.3, 0.3)
+    ax.legend(fontsize=7)
+
+
+def _plot_linear(fig, res):
+    ax = fig.add_subplot(111)
+    for (fac, h, _), r in zip(res.linear.ratios_finite, res.linear.runs):
+        ax.semilogy(r.t, np.linalg.norm(r.x, axis=0) + 1e-300, label=f"h = {fac:g} h*")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("|E|")
+    ax.legend(fontsize=7)

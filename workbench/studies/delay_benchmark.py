@@ -1,0 +1,90 @@
+"""Study ``delay-benchmark``: every delay LMI on literature examples with
+known exact margins (the computation is :mod:`workbench.benchmark`).
+
+Design tables read here: ``[benchmark]`` (settings, see
+:class:`~workbench.benchmark.BenchmarkSettings`; ``examples`` names a folder
+of example files relative to the design). Quantities (for claims), with
+``<ex>`` an example name and ``<m>`` a method name:
+
+* ``examples[<ex>].exact_margin`` / ``.exact_margin_sweep`` (s, two methods),
+  ``.exact_agreement`` (relative difference);
+* ``examples[<ex>].<m>.h_certified`` / ``.ratio`` / ``.exact_check``, with
+  ``<m>`` one of the methods, ``bessel-legendre[N=k]`` or
+  ``bessel-legendre-auto`` (plus ``.N`` for the order reached);
+* ``examples[<ex>].bessel-legendre.monotone`` ("yes"/"no");
+* ``suite.max_ratio`` (largest h_certified / h* over finite margins).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..benchmark import (AUTO, BenchmarkResult, BenchmarkSettings, Example, load_examples,
+                         load_settings, run_benchmark)
+from ..design import Reader
+
+FIELDS = ("h_certified", "ratio", "exact_check")
+
+
+@dataclass(frozen=True)
+class BenchmarkSpec:
+    settings: BenchmarkSettings
+    examples: tuple[Example, ...]
+
+
+def _method_keys(s: BenchmarkSettings) -> list[str]:
+    keys = [m for m in s.methods if m != "bessel-legendre"]
+    if "bessel-legendre" in s.methods:
+        keys += [f"bessel-legendre[N={N}]" for N in range(s.orders + 1)] + [AUTO]
+    return keys
+
+
+def _row_key(r) -> str:
+    return f"bessel-legendre[N={r.N}]" if r.method == "bessel-legendre" else r.method
+
+
+class DelayBenchmark:
+    kind = "delay-benchmark"
+
+    def load(self, root: Reader) -> BenchmarkSpec:
+        settings = load_settings(root.table("benchmark"))
+        folder = Path(root.path).parent / settings.examples
+        return BenchmarkSpec(settings, load_examples(folder))
+
+    def quantity_names(self, spec: BenchmarkSpec) -> set[str]:
+        names = {"suite.max_ratio"}
+        for e in spec.examples:
+            base = f"examples[{e.name}]"
+            names |= {f"{base}.exact_margin", f"{base}.exact_margin_sweep",
+                      f"{base}.exact_agreement", f"{base}.bessel-legendre.monotone",
+                      f"{base}.{AUTO}.N"}
+            names |= {f"{base}.{k}.{f}" for k in _method_keys(spec.settings) for f in FIELDS}
+        return names
+
+    def run(self, design) -> BenchmarkResult:
+        return run_benchmark(design.spec.examples, design.spec.settings)
+
+    def quantities(self, res: BenchmarkResult) -> dict:
+        q = {"suite.max_ratio": res.max_ratio()}
+        for e in res.examples:
+            base = f"examples[{e.example.name}]"
+            q[f"{base}.exact_margin"] = e.exact.h
+            q[f"{base}.exact_margin_sweep"] = e.exact_sweep.h
+            q[f"{base}.exact_agreement"] = e.agreement
+            q[f"{base}.bessel-legendre.monotone"] = \
+                "yes" if e.bl_monotone(res.settings.rel_tol) else "no"
+            for r in e.rows:
+                k = _row_key(r)
+                q[f"{base}.{k}.h_certified"] = r.h_certified   # 0: nothing certified
+                q[f"{base}.{k}.ratio"] = r.ratio
+                q[f"{base}.{k}.exact_check"] = r.exact_check
+                if r.method == AUTO:
+                    q[f"{base}.{AUTO}.N"] = float(r.N)
+        return q
+
+    def render(self, design, res: BenchmarkResult):
+        from .delay_benchmark_render import render
+        return render(design, res)
+
+
+STUDY = DelayBenchmark()
