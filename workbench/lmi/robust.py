@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Callable, Sequence
 
 import cvxpy as cp
 import numpy as np
@@ -149,6 +149,78 @@ def _balancing(points):
     return T, Tinv, [(Tinv @ A @ T, Tinv @ B) for A, B in points]
 
 
+def maximise_log_scalar(value: Callable[[float], float], grid: Sequence[float], *,
+                        golden_steps: int = 6, stop_at: float = math.inf
+                        ) -> tuple[float, dict[float, float]]:
+    """Maximise ``value(eps)`` over eps > 0: log grid, then golden section.
+
+    The grid is evaluated in order; then ``golden_steps`` golden-section steps
+    in log eps refine the bracket formed by the best grid value's neighbours.
+    Each eps (rounded to 12 significant digits, as golden points recur up to
+    rounding) is evaluated once. The search stops early once a value reaches
+    ``stop_at`` (e.g. the delay search cap: nothing larger can be found).
+
+    Returns
+    -------
+    best : float
+        The first eps with the largest value.
+    values : dict[float, float]
+        Every eps evaluated, with its value, in evaluation order.
+    """
+    seen: dict[float, float] = {}
+
+    def run(eps: float) -> float:
+        eps = float(f"{eps:.12g}")
+        if eps not in seen:
+            seen[eps] = value(eps)
+        return seen[eps]
+
+    def done() -> bool:
+        return max(seen.values()) >= stop_at
+
+    for e in grid:
+        run(e)
+        if done():
+            break
+    best = max(seen, key=lambda e: seen[e])
+    if not done():
+        k = list(grid).index(best)
+        lo = math.log(grid[max(k - 1, 0)])
+        hi = math.log(grid[min(k + 1, len(grid) - 1)])
+        g = (math.sqrt(5) - 1) / 2
+        for _ in range(golden_steps):             # golden section on log eps
+            a, b = hi - g * (hi - lo), lo + g * (hi - lo)
+            if run(math.exp(a)) >= run(math.exp(b)):
+                hi = b
+            else:
+                lo = a
+            if done():
+                break
+        best = max(seen, key=lambda e: seen[e])
+    return best, seen
+
+
+def best_eps_bracket(lmi, eps_grid: Sequence[float], *, golden_steps: int, h_hi: float,
+                     rel_tol: float, stop_at: float = math.inf
+                     ) -> tuple[float, dict[float, Bracket]]:
+    """The eps of an LMI with a slack scalar (``lmi.set_eps``) that certifies
+    the largest delay, by :func:`maximise_log_scalar` over certified
+    bisections on h (each started from the best bound so far; the first from
+    ``h_hi / 4``, where the LMI is better scaled than at tiny h, where 1/h
+    dominates the blocks). Returns the best eps and every eps's bracket."""
+    tried: dict[float, Bracket] = {}
+
+    def h_of(eps: float) -> float:
+        lmi.set_eps(eps)
+        guess = max((b.h_certified for b in tried.values()), default=0.0) or h_hi / 4
+        tried[eps] = bisect_delay(lmi.solve_at, h_lo=1e-4, h_hi=h_hi, rel_tol=rel_tol,
+                                  guess=guess)
+        return tried[eps].h_certified
+
+    best, _ = maximise_log_scalar(h_of, eps_grid, golden_steps=golden_steps, stop_at=stop_at)
+    return best, tried
+
+
 def synthesize_robust(points, *, alpha: float = 0.0,
                       eps_grid: Sequence[float] = (0.03, 0.1, 0.3, 1.0, 3.0),
                       golden_steps: int = 6, rel_tol: float = 1e-3,
@@ -162,33 +234,8 @@ def synthesize_robust(points, *, alpha: float = 0.0,
     """
     T, Tinv, pts = _balancing(points)
     lmi = DescriptorSynthesis(pts, eps_grid[0], alpha, margin=margin)
-    tried: dict[float, Bracket] = {}
-
-    def run(eps: float) -> float:
-        eps = float(f"{eps:.12g}")        # golden points recur up to rounding
-        if eps not in tried:
-            lmi.set_eps(eps)
-            # start from the best bound so far (first: h_hi / 4, where the LMI is
-            # better scaled than at tiny h, where 1/h dominates the blocks)
-            guess = max((b.h_certified for b in tried.values()), default=0.0) or h_hi / 4
-            tried[eps] = bisect_delay(lmi.solve_at, h_lo=1e-4, h_hi=h_hi, rel_tol=rel_tol,
-                                      guess=guess)
-        return tried[eps].h_certified
-
-    for e in eps_grid:
-        run(e)
-    best = max(tried, key=lambda e: tried[e].h_certified)
-    k = list(eps_grid).index(best)
-    lo = math.log(eps_grid[max(k - 1, 0)])
-    hi = math.log(eps_grid[min(k + 1, len(eps_grid) - 1)])
-    g = (math.sqrt(5) - 1) / 2
-    for _ in range(golden_steps):             # golden section on log eps
-        a, b = hi - g * (hi - lo), lo + g * (hi - lo)
-        if run(math.exp(a)) >= run(math.exp(b)):
-            hi = b
-        else:
-            lo = a
-    best = max(tried, key=lambda e: tried[e].h_certified)
+    best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_hi,
+                                   rel_tol=rel_tol)
     br = tried[best]
     K = None
     if br.certificate is not None:

@@ -3,9 +3,11 @@ certified delay bound of problem (60), cross-checked with exact margins.
 
 Design tables read here: ``[plant]`` (parameters with units and sources),
 ``[operating_point]`` (v_d, optional pinned lambda_d), ``[synthesis]``
-(eps sweep and numerical settings) and ``[[synthesis.published]]`` (rows a
+(eps sweep and numerical settings), ``[[synthesis.published]]`` (rows a
 paper printed, compared with what we compute — data, never used as inputs
-to the synthesis itself).
+to the synthesis itself) and the optional ``[tight]`` (Wirtinger-based
+synthesis with its scalar searched automatically,
+:mod:`workbench.lmi.tight_synthesis`, shown next to the paper's row).
 """
 from __future__ import annotations
 
@@ -17,6 +19,8 @@ import numpy as np
 from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
 from ..lmi.core import DEFAULT_MARGIN
+from ..lmi.robust import PointCheck, check_gain
+from ..lmi.tight_synthesis import TightSynthesis, synthesize_tight
 from ..margins import DelayMargin, delay_margin_eig
 from ..plants.adhesion import PARAMETER_UNITS, NumericAdhesion
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
@@ -43,6 +47,28 @@ class Published:
 
 
 @dataclass(frozen=True)
+class TightSettings:
+    """``[tight]``: Wirtinger-based synthesis beyond the paper.
+
+    Attributes
+    ----------
+    h_max : float
+        Delay search cap (s) of the synthesis and of the analysis checks.
+    grid : tuple[float, ...]
+        Log grid of the descriptor scalar eps (refined by golden section).
+    order : int
+        Bessel-Legendre order N of the analysis check of each gain.
+    reference_eps : float
+        Row of the problem (60) sweep (and of the printed table) to compare with.
+    """
+
+    h_max: float
+    grid: tuple[float, ...]
+    order: int
+    reference_eps: float
+
+
+@dataclass(frozen=True)
 class CruiseSpec:
     rail: str
     params: dict
@@ -52,6 +78,7 @@ class CruiseSpec:
     settings: SynthesisSettings
     published: tuple[Published, ...]
     compare_published: bool
+    tight: TightSettings | None = None
 
 
 @dataclass(frozen=True)
@@ -82,6 +109,33 @@ class PublishedCheck:
 
 
 @dataclass(frozen=True)
+class TightComparison:
+    """The tight synthesis next to the paper's row and our problem (60) row.
+
+    Attributes
+    ----------
+    synthesis : TightSynthesis
+    reference : SynthesisRow
+        Our problem (60) row at ``reference_eps``.
+    reference_check : PointCheck or None
+        Bessel-Legendre bound and exact margin with that row's K.
+    published : Published or None
+        The printed row at ``reference_eps`` (if the design lists one).
+    published_check : PointCheck or None
+        Bessel-Legendre bound and exact margin with the printed K.
+    open_loop_hurwitz : bool
+        A itself is Hurwitz (then K = 0 is stable for every delay).
+    """
+
+    synthesis: TightSynthesis
+    reference: SynthesisRow
+    reference_check: PointCheck | None
+    published: Published | None
+    published_check: PointCheck | None
+    open_loop_hurwitz: bool
+
+
+@dataclass(frozen=True)
 class CruiseResult:
     lambda_opt: float
     lambda_d_solved: float
@@ -89,6 +143,7 @@ class CruiseResult:
     lin: Linearisation
     rows: tuple[SynthesisRow, ...]
     published: tuple[PublishedCheck, ...]
+    tight: TightComparison | None = None
 
     def row(self, eps: float) -> SynthesisRow:
         return next(r for r in self.rows if r.eps == eps)
@@ -141,13 +196,31 @@ class AntiskidCruise:
             pr.finish()
         compare = syn.boolean("compare_published", default=True)
         syn.finish()
+        tight = self._load_tight(root, eps) if root.has("tight") else None
         plant_values = {k: q.value for k, q in params.items()}
         try:  # an impossible operating point is bad input, found at load time
             NumericAdhesion.from_dict(plant_values).cruise_lambda(v_d.value)
         except ModelError as exc:
             raise DesignError(root.path, "operating_point.v_d", v_d.value,
                               f"a speed with a creep-region equilibrium ({exc})") from None
-        return CruiseSpec(rail, params, v_d, pinned, eps, settings, tuple(published), compare)
+        return CruiseSpec(rail, params, v_d, pinned, eps, settings, tuple(published), compare,
+                          tight)
+
+    @staticmethod
+    def _load_tight(root: Reader, eps: tuple[float, ...]) -> TightSettings | None:
+        t = root.table("tight")
+        enable = t.boolean("enable", default=True)
+        h_max = t.number("h_max", default=10.0, positive=True, hi=1e3, what="number (s)")
+        grid = t.numbers("grid", default=(0.01, 0.1, 1.0, 10.0, 100.0), positive=True,
+                         min_len=2, what="eps values")
+        if list(grid) != sorted(set(grid)):
+            raise t.fail("grid", list(grid), "distinct eps values in increasing order")
+        order = t.number("order", default=2, integer=True, lo=0, hi=8, what="integer N")
+        ref = t.number("reference_eps", default=eps[0], positive=True)
+        if ref not in eps:
+            raise t.fail("reference_eps", ref, "one of synthesis.eps " + str(list(eps)))
+        t.finish()
+        return TightSettings(h_max, grid, int(order), ref) if enable else None
 
     def quantity_names(self, spec: CruiseSpec) -> set[str]:
         names = {"operating_point.lambda_d", "operating_point.lambda_d_solved",
@@ -163,6 +236,8 @@ class AntiskidCruise:
         for p in spec.published:
             for f in ("h_paper_K", "exact_margin_paper_K", "eps_matching"):
                 names.add(f"published[eps={_eps_key(p.eps)}].{f}")
+        if spec.tight:
+            names |= {f"tight.{k}" for k in TIGHT_QUANTITIES}
         return names
 
     # -- run -------------------------------------------------------------------
@@ -185,7 +260,8 @@ class AntiskidCruise:
                 match = eps_for_bound(lin.A, lin.B, p.h_m, eps_lo, eps_hi,
                                       settings=spec.settings)
                 checks.append(PublishedCheck(p, ours, br.h_certified, br.h_refuted, em, match))
-        return CruiseResult(lam_opt, lam_solved, lam_used, lin, rows, tuple(checks))
+        tight = _run_tight(spec, lin, rows) if spec.tight else None
+        return CruiseResult(lam_opt, lam_solved, lam_used, lin, rows, tuple(checks), tight)
 
     def quantities(self, res: CruiseResult) -> dict:
         q = {"operating_point.lambda_d": res.lambda_d_used,
@@ -212,12 +288,52 @@ class AntiskidCruise:
             q[f"{base}.h_paper_K"] = c.h_paper_K
             q[f"{base}.exact_margin_paper_K"] = c.exact_paper_K.h
             q[f"{base}.eps_matching"] = c.eps_matching
+        if res.tight:
+            q.update(_tight_quantities(res.tight))
         return q
 
     # -- render ----------------------------------------------------------------
     def render(self, design, res: CruiseResult) -> Rendered:
         from .antiskid_cruise_render import render
         return render(design, res)
+
+
+#: Quantities of the ``[tight]`` comparison (prefixed ``tight.``).
+TIGHT_QUANTITIES = ("eps", "h_certified", "h_analysis", "exact_margin", "exact_margin_siso",
+                    "K1", "K2", "at_cap", "ratio_to_reference", "reference.h_analysis", "paper_K.h_analysis",
+                    "paper_K.exact_margin")
+
+
+def _run_tight(spec: CruiseSpec, lin: Linearisation, rows) -> TightComparison:
+    """Tight synthesis, and the Bessel-Legendre + exact check of the reference gains."""
+    ts, st = spec.tight, spec.settings
+    syn = synthesize_tight(lin.A, lin.B, eps_grid=ts.grid, h_max=ts.h_max, N=ts.order,
+                           margin=st.margin, rel_tol=max(st.rel_tol, 1e-3))
+
+    def check(K):
+        return check_gain([(lin.A, lin.B)], np.array([K]), N=ts.order, margin=st.margin,
+                          h_hi=ts.h_max)[0]
+    ref = next(r for r in rows if r.eps == ts.reference_eps)
+    pub = next((p for p in spec.published if p.eps == ts.reference_eps), None)
+    return TightComparison(syn, ref, check(ref.K) if ref.K else None, pub,
+                           check(pub.K) if pub else None,
+                           bool(np.max(np.linalg.eigvals(lin.A).real) < 0))
+
+
+def _tight_quantities(t: TightComparison) -> dict:
+    s, c = t.synthesis, t.synthesis.check
+    K = s.K.ravel() if s.K is not None else None
+    q = {"eps": s.eps, "h_certified": s.h_certified if s.h_certified > 0 else None,
+         "h_analysis": c.h_certified if c else None, "exact_margin": c.exact.h if c else None,
+         "exact_margin_siso": s.exact_siso.h if s.exact_siso else None,
+         "K1": None if K is None else float(K[0]), "K2": None if K is None else float(K[1]),
+         "at_cap": "yes" if s.at_cap else "no",
+         "ratio_to_reference": (s.h_certified / t.reference.h_certified
+                                if s.h_certified > 0 and t.reference.h_certified > 0 else None),
+         "reference.h_analysis": t.reference_check.h_certified if t.reference_check else None,
+         "paper_K.h_analysis": t.published_check.h_certified if t.published_check else None,
+         "paper_K.exact_margin": t.published_check.exact.h if t.published_check else None}
+    return {f"tight.{k}": v for k, v in q.items()}
 
 
 STUDY = AntiskidCruise()

@@ -7,8 +7,11 @@ cross-checks of the LMI delay bound.
 Design tables: ``[plant]`` (as ``antiskid-cruise``, plus ``mass_factor``
 applied to the plant only: the controller keeps the nominal model),
 ``[scenario]``, ``[controller]`` (+ ``[controller.profile]``, eqs 76-78),
-``[numerics]``, ``[[cases]]`` (named variants of controller 75) and
-``[linear_check]``.
+``[numerics]``, ``[[cases]]`` (named variants of controller 75),
+``[linear_check]`` and, optionally, ``[montecarlo]``: the ranges of the
+``workbench sweep`` robustness study plus ``samples``, ``seed``, ``workers``
+and ``chunk`` of a reduced sample that the study runs (in a process pool,
+while the cases run) and reports as ``montecarlo.*`` quantities.
 """
 from __future__ import annotations
 
@@ -118,6 +121,7 @@ class RunResult:
     cases: tuple
     linear: LinearCheck
     dt: float
+    montecarlo: object = None   # workbench.sim.montecarlo.SweepResult or None
 
     def case(self, name: str) -> CaseResult:
         return next(c for c in self.cases if c.case.name == name)
@@ -392,9 +396,14 @@ class AntiskidRun:
             mt = root.table("montecarlo")
             rng = lambda k, **kw: _range(mt, k, **kw)
             wet = {k: mt.quantity(f"wet_{k}", "1", positive=True).value for k in ("a", "b", "c")}
+            count = lambda k, **kw: mt.number(k, integer=True, what="integer", **kw)
             mc = SweepSpec(rng("mass_factor", positive=True), wet,
                            rng("adhesion", lo=0.0, hi=1.0), rng("h", lo=0.0, hi=1.0),
-                           rng("v0", positive=True), mt.string("case", choices=[c.name for c in cases]))
+                           rng("v0", positive=True),
+                           mt.string("case", choices=[c.name for c in cases]),
+                           count("samples", lo=1, hi=10**5), count("seed", nonneg=True),
+                           count("workers", lo=1, hi=256),
+                           count("chunk", default=None, lo=1, hi=10**5))
             mt.finish()
         vals = {k: q.value for k, q in params.items()}
         try:
@@ -416,6 +425,9 @@ class AntiskidRun:
             names |= {f"{b}.{m}" for m in METRICS}
             names |= {f"{b}.diverged", f"{b}.stopped", f"{b}.converged",
                       f"{b}.switch.abscissa", f"{b}.switch.margin", f"{b}.switch.dmu_dlam"}
+        if spec.montecarlo is not None:
+            from ..sim.montecarlo import montecarlo_quantity_names
+            names |= montecarlo_quantity_names()
         return names
 
     def run(self, design) -> RunResult:
@@ -425,6 +437,24 @@ class AntiskidRun:
         lam_d = nominal.cruise_lambda(v_d)
         lin = linearise_cruise(nominal, v_d, lam_d)
         K, how, h_cert = gain_for(spec)
+        pending = None
+        if spec.montecarlo is not None:   # its chunks run in a pool while the cases run here
+            from ..sim.montecarlo import start_sweep
+            ms = spec.montecarlo
+            pending = start_sweep(design, ms.samples, ms.seed, workers=ms.workers,
+                                  chunk=ms.chunk, pool=True, K=K)
+        try:
+            cases = self._cases(spec, K)
+            lc = linear_check(spec, lin.A, lin.B, K)
+        except BaseException:
+            if pending is not None:
+                pending.cancel()
+            raise
+        mc = None if pending is None else pending.result()
+        return RunResult(nominal.lambda_opt(), lam_d, tuple(K), how, h_cert, tuple(cases), lc,
+                         spec.dt, mc)
+
+    def _cases(self, spec: RunSpec, K) -> list[CaseResult]:
         cases = []
         for case in spec.cases:
             cs = controller_settings(spec, K, case)
@@ -440,9 +470,7 @@ class AntiskidRun:
             if math.isfinite(fine[f"lam_at_{key}"]):
                 sw = switch_check(cs, fine[f"v_at_{key}"], fine[f"lam_at_{key}"])
             cases.append(CaseResult(case, fine, coarse, conv, run2, sw))
-        lc = linear_check(spec, lin.A, lin.B, K)
-        return RunResult(nominal.lambda_opt(), lam_d, tuple(K), how, h_cert, tuple(cases), lc,
-                         spec.dt)
+        return cases
 
     def quantities(self, res: RunResult) -> dict:
         nan2none = lambda x: None if x is None or (isinstance(x, float) and math.isnan(x)) else x
@@ -464,6 +492,9 @@ class AntiskidRun:
             q[f"{b}.switch.abscissa"] = None if sw is None else sw.abscissa
             q[f"{b}.switch.margin"] = None if sw is None else sw.margin.h
             q[f"{b}.switch.dmu_dlam"] = None if sw is None else sw.dmu_dlam
+        if res.montecarlo is not None:
+            from ..sim.montecarlo import montecarlo_quantities
+            q.update(montecarlo_quantities(res.montecarlo))
         return q
 
     def render(self, design, res: RunResult):

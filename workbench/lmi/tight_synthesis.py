@@ -1,0 +1,267 @@
+"""Wirtinger-based delay-bound synthesis with an automatically searched scalar.
+
+For x'(t) = A x(t) + B K x(t - h) (constant delay h), :class:`WirtingerSynthesis`
+is the state-feedback synthesis LMI built from the Wirtinger-based criterion
+of Seuret & Gouaisbaut (2013, Theorem 5) with Fridman's descriptor zero term
+and the slack ``P3 = eps P2`` (Fridman & Shaked 2002), made linear by the
+congruence ``Y = P2^{-1}``, ``V = K Y``. The scalar eps is not fixed by hand:
+:func:`synthesize_tight` searches it (log grid + golden section, the shared
+:func:`~workbench.lmi.robust.best_eps_bracket`), each eps deciding the
+largest certified delay by the shared bracketed bisection
+(:func:`~workbench.lmi.core.bisect_delay`).
+
+Every synthesised gain is then checked twice, independently of the synthesis
+LMI: by the Bessel-Legendre *analysis* criterion of
+:mod:`workbench.lmi.analysis` with that K, and by the exact delay margin of
+:mod:`workbench.margins` (:func:`~workbench.lmi.robust.check_gain`).
+
+When the exact margin with the synthesised K is infinite (no imaginary-axis
+crossing: stable for every constant delay) the largest certified delay is
+bounded only by the search cap ``h_max``; a result at the cap says "at least
+h_max", not "at most".
+
+References
+----------
+.. [SG13] Seuret A., Gouaisbaut F., "Wirtinger-based integral inequality:
+   application to time-delay systems", Automatica 49(9), 2860-2866, 2013
+   (Lemma 3, Theorem 5).
+.. [FS02] Fridman E., Shaked U., "An improved stabilization method for linear
+   time-delay systems", IEEE TAC 47(11), 1931-1937, 2002 (descriptor method,
+   P3 = eps P2, congruence by P2^{-1}).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Mapping, Sequence
+
+import cvxpy as cp
+import numpy as np
+
+from ..margins import DelayMargin, delay_margin_siso
+from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI
+from .robust import DescriptorSynthesis, PointCheck, _balancing, best_eps_bracket, check_gain
+
+
+class WirtingerSynthesis(MarginLMI):
+    """Wirtinger-based state-feedback synthesis LMI (eps a DPP parameter).
+
+    Functional (SG13 Theorem 5), z = [x; int_{t-h}^t x(s) ds]:
+
+        V = z'Pz + int_{t-h}^t x'Sx + h int_{-h}^0 int_{t+s}^t x''R x'.
+
+    With xi = [x; x'; x_d; Omega], Omega = (1/h) int_{t-h}^t x, the descriptor
+    zero term 2 (x'P2' + x''eps P2')(-x' + A x + B K x_d), the Wirtinger bound
+    h int x''Rx' >= chi0'R chi0 + 3 chi1'R chi1 (chi0 = x - x_d,
+    chi1 = x + x_d - 2 Omega), the congruence diag(Y, Y, Y, Y), Y = P2^{-1},
+    and the change of variables P~ = diag(Y,Y)'P diag(Y,Y), S~ = Y'SY,
+    R~ = h Y'RY, V = K Y, the derivative is negative if
+
+        Psi = He(G0' Theta Gd) + h He(G1' Theta Gd) - He(G1' D(S~) Gd)
+              + diag(S~, h R~, -S~, 0) - (1/h)(chi0' R~ chi0 + 3 chi1' R~ chi1)
+              + He([I; eps I; 0; 0] [A Y, -Y, B V, 0]) <= 0,
+
+    where G0 xi = [x; 0], G1 xi = [0; Omega] (z = (G0 + h G1) xi), Gd xi = z' = [x'; x - x_d],
+    D(S~) = diag(0, S~) and Theta = P~ + (1/h) D(S~) (so that V >= z'(P + D(S)/h)z
+    by Jensen's inequality on the S term). Blocks: ``psi`` <= 0, ``theta``,
+    ``S_pos``, ``R_pos`` >= 0. The (2,2) block h R~ - eps (Y + Y') <= 0 makes
+    Y nonsingular, so K = V Y^{-1}.
+
+    Decision variables: Theta (2n symmetric, normalised), S, R (n symmetric),
+    Y (n x n), V (m x n). A CERTIFIED point at h proves that the loop with
+    K = V Y^{-1} is asymptotically stable at the constant delay h.
+
+    Parameters
+    ----------
+    A : (n, n) array
+    B : (n, m) array
+    eps : float
+        Descriptor slack scalar (P3 = eps P2), > 0.
+    """
+
+    normaliser = "Theta"
+
+    def __init__(self, A, B, eps: float, **kw):
+        self.A = np.atleast_2d(np.asarray(A, float))
+        self.B = np.asarray(B, float).reshape(self.A.shape[0], -1)
+        self.n, self.m = self.B.shape
+        super().__init__(**kw)
+        self.set_eps(eps)
+
+    def parameters(self) -> tuple[str, ...]:
+        return ("eps",)
+
+    #: Same slack scalar (DPP parameter ``eps``) and gain K = V Y^{-1} as the
+    #: Jensen descriptor synthesis of :mod:`workbench.lmi.robust`.
+    set_eps = DescriptorSynthesis.set_eps
+    gain = DescriptorSynthesis.gain
+
+    def variables(self) -> dict[str, cp.Variable]:
+        n = self.n
+        return {"Theta": cp.Variable((2 * n, 2 * n), symmetric=True, name="Theta"),
+                "S": cp.Variable((n, n), symmetric=True, name="S"),
+                "R": cp.Variable((n, n), symmetric=True, name="R"),
+                "Y": cp.Variable((n, n), name="Y"),
+                "V": cp.Variable((self.m, n), name="V")}
+
+    def _selectors(self):
+        n = self.n
+        I, O = np.eye(n, dtype=int), np.zeros((n, n), dtype=int)
+
+        def e(i):
+            return np.hstack([I if j == i else O for j in range(4)])
+        x, dx, xd, om = e(0), e(1), e(2), e(3)
+        Z = np.zeros_like(x)
+        G0, G1, Gd = np.vstack([x, Z]), np.vstack([Z, om]), np.vstack([dx, x - xd])
+        return x, dx, xd, om, G0, G1, Gd
+
+    def blocks(self, v: Mapping[str, object], p, bmat) -> list[Block]:
+        Th, S, R, Y, V = v["Theta"], v["S"], v["R"], v["Y"], v["V"]
+        h, iota, eps = p["h"], p["iota"], p["eps"]
+        x, dx, xd, om, G0, G1, Gd = self._selectors()
+        n = self.n
+        Z = np.zeros((n, n), dtype=int)
+        DS = bmat([[Z, Z], [Z, S]])
+        chi0, chi1 = x - xd, x + xd - 2 * om
+        he = G0.T @ Th @ Gd + h * (G1.T @ Th @ Gd) - G1.T @ DS @ Gd
+        row = bmat([[self.A @ Y, -Y, self.B @ V, Z]])           # -x' + A x + B K x_d, times Y
+        desc = x.T @ row + eps * (dx.T @ row)
+        psi = (he + he.T + x.T @ S @ x - xd.T @ S @ xd + h * (dx.T @ R @ dx)
+               - iota * (chi0.T @ R @ chi0 + 3 * (chi1.T @ R @ chi1)) + desc + desc.T)
+        return [Block("psi", psi, "nsd"), Block("theta", Th, "psd"),
+                Block("S_pos", S, "psd"), Block("R_pos", R, "psd")]
+
+
+@dataclass(frozen=True)
+class TightSynthesis:
+    """A Wirtinger-synthesised gain and its independent checks.
+
+    Attributes
+    ----------
+    eps : float
+        Best eps of the automatic search.
+    bracket : Bracket
+        Certified bisection of the synthesis LMI at ``eps`` (balanced
+        coordinates, see :func:`synthesize_tight`).
+    K : numpy.ndarray or None
+        Gain (original coordinates), None when nothing was certified.
+    eps_tried : tuple[tuple[float, float], ...]
+        (eps, h_certified) of the search, sorted by eps.
+    check : PointCheck or None
+        Bessel-Legendre analysis bound and exact margin with ``K``.
+    exact_siso : DelayMargin or None
+        Exact margin from python-control's crossovers (single input only).
+    h_max : float
+        Search cap (s) of both bisections.
+    T : numpy.ndarray
+        Balancing T (x = T x~) of the certificate's coordinates.
+    """
+
+    eps: float
+    bracket: Bracket
+    K: np.ndarray | None
+    eps_tried: tuple[tuple[float, float], ...]
+    check: PointCheck | None
+    exact_siso: DelayMargin | None
+    h_max: float
+    T: np.ndarray = field(repr=False)
+
+    @property
+    def h_certified(self) -> float:
+        """Delay certified by the synthesis LMI (s)."""
+        return self.bracket.h_certified
+
+    @property
+    def at_cap(self) -> bool:
+        """True when the synthesis bound is the search cap (a lower bound only)."""
+        return self.bracket.h_certified >= self.h_max
+
+
+def synthesize_tight(A, B, *, eps_grid: Sequence[float] = (0.01, 0.1, 1.0, 10.0, 100.0),
+                     golden_steps: int = 6, h_max: float = 10.0, rel_tol: float = 1e-3,
+                     N: int = 2, margin: float = DEFAULT_MARGIN) -> TightSynthesis:
+    """Largest delay certified by :class:`WirtingerSynthesis`, eps searched.
+
+    Parameters
+    ----------
+    A : (n, n) array_like
+        Open-loop matrix.
+    B : (n, m) array_like
+        Input matrix; the closed loop is x' = A x + B K x(t - h).
+    eps_grid : sequence of float
+        Log grid of the descriptor scalar, refined by golden section.
+    golden_steps : int
+    h_max : float
+        Delay search cap (s).
+    rel_tol : float
+        Relative bracket width of the delay bisection.
+    N : int
+        Bessel-Legendre order of the analysis check of the gain.
+    margin : float
+        LMI definiteness margin.
+
+    Returns
+    -------
+    TightSynthesis
+        The LMI is solved in balanced coordinates (exact power-of-two
+        scaling, :func:`workbench.synthesis.balancing`); K is mapped back.
+    """
+    A = np.atleast_2d(np.asarray(A, float))
+    B = np.asarray(B, float).reshape(A.shape[0], -1)
+    T, Tinv, ((At, Bt),) = _balancing([(A, B)])
+    lmi = WirtingerSynthesis(At, Bt, eps_grid[0], margin=margin)
+    best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_max,
+                                   rel_tol=rel_tol, stop_at=h_max)   # nothing beyond the cap
+    br = tried[best]
+    K = check = siso = None
+    if br.certificate is not None:
+        K = lmi.gain(br.certificate.certificate) @ Tinv
+        (check,) = check_gain([(A, B)], K, N=N, margin=margin, h_hi=h_max)
+        if B.shape[1] == 1:
+            siso = delay_margin_siso(A, B, K)
+    tried_h = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
+    return TightSynthesis(best, br, K, tried_h, check, siso,
+                          float(h_max), T)
+
+
+def recheck_tight(A, B, result: TightSynthesis,
+                  certificate: Mapping[str, np.ndarray] | None = None) -> dict[str, float]:
+    """Re-evaluate the synthesis LMI at ``result``'s eps and delay with numpy.
+
+    Parameters
+    ----------
+    A, B : array_like
+        The system the result was synthesised for.
+    result : TightSynthesis
+    certificate : mapping, optional
+        Decision variables to check (default: the result's own certificate);
+        pass a modified copy to see a tampered certificate fail.
+
+    Returns
+    -------
+    dict[str, float]
+        Smallest eigenvalue margin of each block (>= ``margin`` passes).
+    """
+    A = np.atleast_2d(np.asarray(A, float))
+    B = np.asarray(B, float).reshape(A.shape[0], -1)
+    Tinv = np.diag(1.0 / np.diag(result.T))
+    lmi = WirtingerSynthesis(Tinv @ A @ result.T, Tinv @ B, result.eps)
+    cert = result.bracket.certificate.certificate if certificate is None else certificate
+    return lmi.recheck(cert, result.bracket.h_certified)
+
+
+class WirtingerSynthesisFixedK(WirtingerSynthesis):
+    """The same LMI with the gain fixed (V = K Y): the descriptor form of the
+    Wirtinger *analysis* of a given K, e.g. to test the blocks against
+    :class:`~workbench.lmi.analysis.WirtingerLMI` and exact margins."""
+
+    def __init__(self, A, B, K, eps: float, **kw):
+        self.K = np.atleast_2d(np.asarray(K, float))
+        super().__init__(A, B, eps, **kw)
+
+    def variables(self):
+        v = super().variables()
+        del v["V"]
+        return v
+
+    def blocks(self, v, p, bmat):
+        return super().blocks({**v, "V": self.K @ v["Y"]}, p, bmat)
