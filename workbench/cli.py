@@ -57,12 +57,7 @@ def cmd_synthesize(args) -> int:
             if not (math.isfinite(e) and e > 0):
                 raise DesignError("<cli>", "--eps", e, "a positive number")
         eps = tuple(args.eps)
-    from .plants.adhesion import NumericAdhesion
-    from .symbolic.linearise import linearise_cruise
-    plant = NumericAdhesion.from_dict({k: q.value for k, q in spec.params.items()})
-    lam_solved = plant.cruise_lambda(spec.v_d.value)
-    lam = spec.lambda_d_pinned.value if spec.lambda_d_pinned else lam_solved
-    lin = linearise_cruise(plant, spec.v_d.value, lam)
+    _, lam_solved, lam, lin = antiskid_cruise.operating_point(spec)
     rows = synthesize_delay_bound(lin.A, lin.B, eps, spec.settings)
     ok = all(r.status.value == "certified" for r in rows)
     if args.json:

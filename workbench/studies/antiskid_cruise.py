@@ -155,6 +155,15 @@ class CruiseResult:
                 "rows": [r.to_json() for r in self.rows]}
 
 
+def operating_point(spec: CruiseSpec) -> tuple[float, float, float, Linearisation]:
+    """(lambda_opt, lambda_d solved, lambda_d used, linearisation) of a cruise spec."""
+    plant = NumericAdhesion.from_dict({k: q.value for k, q in spec.params.items()})
+    lam_solved = plant.cruise_lambda(spec.v_d.value)
+    lam_used = spec.lambda_d_pinned.value if spec.lambda_d_pinned else lam_solved
+    return (plant.lambda_opt(), lam_solved, lam_used,
+            linearise_cruise(plant, spec.v_d.value, lam_used))
+
+
 def _eps_key(eps: float) -> str:
     return f"{eps:g}"
 
@@ -243,11 +252,7 @@ class AntiskidCruise:
     # -- run -------------------------------------------------------------------
     def run(self, design) -> CruiseResult:
         spec: CruiseSpec = design.spec
-        plant = NumericAdhesion.from_dict({k: q.value for k, q in spec.params.items()})
-        lam_opt = plant.lambda_opt()
-        lam_solved = plant.cruise_lambda(spec.v_d.value)
-        lam_used = spec.lambda_d_pinned.value if spec.lambda_d_pinned else lam_solved
-        lin = linearise_cruise(plant, spec.v_d.value, lam_used)
+        lam_opt, lam_solved, lam_used, lin = operating_point(spec)
         rows = synthesize_delay_bound(lin.A, lin.B, spec.eps, spec.settings)
         checks = []
         if spec.compare_published:
