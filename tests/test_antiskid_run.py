@@ -53,6 +53,22 @@ def test_stiff_sampling_converges_and_zoh_does_not(spec):
     assert abs(t["zoh"][0] - t["zoh"][1]) > 0.03      # printed law held: first order in dt
 
 
+def test_stiff_hold_with_mismatch_estimate_converges():
+    """Plant mass +5 %: the slow cruise transient is set by where lambda
+    settles; without the mismatch estimate the stiff hold scales the mismatch
+    by phi1(dt J) and v(120 s) moves at first order in dt."""
+    plus5 = load_design(Path("designs/antiskid-run-dry-mass-plus5.toml")).spec
+    gap = {}
+    for tau in (0.2, 0.0):
+        case = next(c for c in plus5.cases if c.name == "compensated")
+        cs = dataclasses.replace(R.controller_settings(plus5, K_TABLE3, case), observer_tau=tau)
+        rs = dataclasses.replace(R.run_settings(plus5, cs), t_end=120.0)
+        v = [simulate_antiskid(rs, dt, record_dt=1.0)[0].x[0, -1] for dt in (0.01, 0.005)]
+        gap[tau] = abs(v[0] - v[1])
+    assert gap[0.2] < 0.005           # measured 0.0012 m/s
+    assert gap[0.0] > 0.04            # measured 0.087 m/s: first order
+
+
 def test_batch_matches_single_run(spec):
     cs, rs, (_, m1) = _run(spec, "compensated", 33.0)
     plant = tuple(np.full(2, x) for x in rs.plant_params)

@@ -29,7 +29,9 @@ are stiff (see the antiskid-run-dry report).
 
 Sampling: laws run every step; ``sampling = "stiff"`` holds the torque that
 moves the exponential-Euler creep ratio by dt times the rate the continuous
-law asks for (see :class:`ControllerSettings`).
+law asks for, including an estimate of the plant-model mismatch so that the
+sampled loop's fixed points are the continuous loop's (see
+:class:`ControllerSettings`, ``sampling`` and ``observer_tau``).
 
 Guards (as in the paper): below omega = omega_switch (3 rad/s, eq 76) the
 desired creep speed is 0 (creep speed, not creep ratio, is tracked in
@@ -172,6 +174,18 @@ class ControllerSettings:
     lam_diverged : float
         |lambda| at which the run is declared diverged and ended (the
         creep ratio of eq 4 lies in (-1, 1); near +-1 the wheel spins or locks).
+    observer_tau : float
+        Time constant (s) of the estimate of the model mismatch delta =
+        lambda'_plant - lambda'_model that ``sampling = "stiff"`` needs (0:
+        none). The stiff hold scales the model's rate g by 1/phi1(dt J); the
+        plant's rate is g + delta, and scaling only g leaves delta scaled by
+        phi1(dt J) = 1 + dt J / 2 + ..., which moves the loop's fixed points
+        by O(dt) when the plant differs from the model (the mass +-5 %
+        designs: the slow cruise transient, v - v_d at t_brake, converged only
+        at first order). With the estimate the hold realises g + delta, whose
+        zeros are the continuous loop's. Estimated in traction and cruise
+        only; in braking (speed, hence delta, changing on the time scale of
+        the estimate) the plain stiff hold is kept.
     """
 
     params: tuple
@@ -193,6 +207,7 @@ class ControllerSettings:
     v_stop: float = 0.05
     v_floor: float = 0.01
     lam_diverged: float = 0.9
+    observer_tau: float = 0.2
 
 
 def _forms(v, lam, p, fns, xp):
@@ -200,9 +215,11 @@ def _forms(v, lam, p, fns, xp):
     lambda >= 0, eq 15 otherwise): lambda' = lambda'_0 + lambda'_u u."""
     if not xp.batch:
         return fns["traction" if lam >= 0 else "braking"](v, lam, *p)
+    pos = lam >= 0
+    if pos.all() or not pos.any():     # one form for the whole batch (NaN: "braking")
+        return fns["traction" if pos.all() else "braking"](v, lam, *p)
     tr = fns["traction"](v, lam, *p)
     br = fns["braking"](v, lam, *p)
-    pos = lam >= 0
     return tuple(np.where(pos, a, b) for a, b in zip(tr, br))
 
 
@@ -216,12 +233,16 @@ def creep_speed(v, lam, xp):
     return xp.where(lam >= 0, lam * v / (1.0 - xp.minimum(lam, 0.999)), lam * v)
 
 
-def _exp_euler(v, lam, f1, f2, z, dt, xp):
-    """(v + dt f1, lambda + dt phi1(z) f2), z = dt d lambda'/d lambda."""
+def phi1(z, xp):
+    """phi1(z) = (e^z - 1) / z (1 + z/2 near 0)."""
     big = xp.abs(z) > 1e-8
     zs = xp.where(big, z, 1.0)
-    phi = xp.where(big, xp.expm1(zs) / zs, 1.0 + 0.5 * z)
-    return v + dt * f1, lam + dt * phi * f2
+    return xp.where(big, xp.expm1(zs) / zs, 1.0 + 0.5 * z)
+
+
+def _exp_euler(v, lam, f1, f2, z, dt, xp):
+    """(v + dt f1, lambda + dt phi1(z) f2), z = dt d lambda'/d lambda."""
+    return v + dt * f1, lam + dt * phi1(z, xp) * f2
 
 
 #: Largest creep-ratio change of one exponential-Euler step; larger steps are
@@ -326,6 +347,8 @@ class Antiskid003:
         self.fv = DelayLine(s.h_model, dt, zero, history=hist_v)
         self.fl = DelayLine(s.h_model, dt, zero, history=hist_l)
         self.uline = DelayLine(s.h_model, dt, u_init + zero)
+        self._prev = None          # (v, lambda) of the previous sample
+        self.delta = zero          # filtered estimate of the model-mismatch rate of lambda
 
     # -- predictors ----------------------------------------------------------------
     def _model_step(self, v, lam, u, dt, ph):
@@ -371,11 +394,44 @@ class Antiskid003:
         if self.s.sampling == "zoh":
             return u
         xp = self.xp
-        z = (j0 + ju * u) * self.dt
-        big = xp.abs(z) > 1e-8
-        zs = xp.where(big, z, 1.0)
-        phi = xp.where(big, xp.expm1(zs) / zs, 1.0 + 0.5 * z)
-        return ((f20 + f2u * u) / phi - f20) / f2u
+        phi = phi1((j0 + ju * u) * self.dt, xp)
+        # the plant's rate at t + h is the model's g = f20 + f2u u plus delta;
+        # P came from the model, which lacks delta: the plant at t + h is off
+        # by about delta (e^{hJ} - 1) / J, so its rate is g + delta e^{hJ}
+        d = self.delta
+        if self.s.compensate:
+            hj = xp.minimum(xp.maximum((j0 + ju * u) * self.s.h_model, -700.0), 20.0)
+            d = d * (1.0 + xp.expm1(hj))
+        return ((f20 + f2u * u) / phi + d * (1.0 / phi - 1.0) - f20) / f2u
+
+    def _observe(self, v, lam, ph):
+        """Update the filtered estimate ``delta`` of the mismatch rate
+        lambda'_plant - lambda'_model from the last step (see
+        ``ControllerSettings.observer_tau``): the model says the step from
+        the previous sample under the input the controller believes applied,
+        u(t - h_model), moves lambda by dt phi1(dt J) (f_model + delta)."""
+        s, xp, dt = self.s, self.xp, self.dt
+        braking = ph >= BRAKE_IN
+        if xp.batch and np.all(braking) or not xp.batch and braking:
+            self.delta = 0.0 * v
+        elif self._prev is not None and s.sampling == "stiff" and s.observer_tau > 0:
+            pv, pl, pph = self._prev
+            ua = self.uline.delayed()
+            _, f20, f2u, j0, ju = _forms(xp.maximum(pv, s.v_floor), pl, s.params, self.fns, xp)
+            cr = pph == CRUISE      # the cruise law's model is eq (62)
+            if xp.any(cr):
+                c, ve, le = s.lin, pv - s.v_d, pl - s.lambda_d
+                den = c["d4"] * ve + c["d5"] * le + c["d6"]
+                f20 = xp.where(cr, c["d1"] * ve + c["d2"] * le + c["d3"], f20)
+                f2u, j0 = xp.where(cr, den, f2u), xp.where(cr, c["d2"], j0)
+                ju = xp.where(cr, c["d5"], ju)
+            d = (lam - pl) / (dt * phi1((j0 + ju * ua) * dt, xp)) - (f20 + f2u * ua)
+            new = self.delta + -math.expm1(-dt / s.observer_tau) * (d - self.delta)
+            # not in braking (see observer_tau); a non-finite estimate is dropped
+            keep = ~(xp.abs(new) < 1e6) | (ph >= BRAKE_IN) if xp.batch else (
+                not abs(new) < 1e6 or ph >= BRAKE_IN)
+            self.delta = xp.where(keep, 0.0 * v, new)
+        self._prev = (v, lam, ph)
 
     def _accel(self, Pv, Pl, target):
         s, p = self.s, self.s.params
@@ -430,6 +486,7 @@ class Antiskid003:
         ph = xp.where(bad, DIVERGED, ph)
         self.phase = ph
         try:
+            self._observe(v, lam, ph)
             u, fv, fl = self._laws(t, v, lam, ph)
         except (OverflowError, ZeroDivisionError, ValueError):
             if xp.batch:   # numpy gives inf/nan instead; never reached
