@@ -250,6 +250,29 @@ class MarginLMI:
                     margins, values if ok else None, seconds)
 
 
+class FixedGain:
+    """Mixin turning a state-feedback synthesis LMI (variable ``V = K X``)
+    into the analysis of a *given* gain: ``V`` is replaced by ``K X``.
+
+    Use as ``class C(FixedGain, SomeSynthesis)`` with ``gain_basis`` naming X;
+    the constructor takes ``(A, B, K, eps, **kw)``.
+    """
+
+    gain_basis: str = "L"
+
+    def __init__(self, A, B, K, eps: float, **kw):
+        self.K = np.atleast_2d(np.asarray(K, float))
+        super().__init__(A, B, eps, **kw)
+
+    def variables(self):
+        v = super().variables()
+        del v["V"]
+        return v
+
+    def blocks(self, x, p, bmat):
+        return super().blocks({**x, "V": self.K @ x[self.gain_basis]}, p, bmat)
+
+
 def bisect_delay(decide: Callable[[float], Step], *, h_lo: float = 1e-4, h_hi: float = 100.0,
                  rel_tol: float = 1e-4, max_solves: int = 60, guess: float | None = None,
                  secant: bool = True) -> Bracket:

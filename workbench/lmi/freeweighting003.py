@@ -30,7 +30,7 @@ from typing import Mapping
 import cvxpy as cp
 import numpy as np
 
-from .core import Block, MarginLMI
+from .core import Block, FixedGain, MarginLMI
 
 
 class FreeWeighting003(MarginLMI):
@@ -104,23 +104,11 @@ class FreeWeighting003(MarginLMI):
         return np.linalg.solve(values["L"].T, values["V"].T).T
 
 
-class FreeWeighting003FixedK(FreeWeighting003):
+class FreeWeighting003FixedK(FixedGain, FreeWeighting003):
     """The same LMI with the gain fixed (V = K L): analysis of a given K.
 
     Used to ask what a printed gain certifies under the paper's own
     criterion.
     """
 
-    def __init__(self, A, B, K, eps: float, **kw):
-        self.K = np.atleast_2d(np.asarray(K, float))
-        super().__init__(A, B, eps, **kw)
-
-    def variables(self):
-        v = super().variables()
-        del v["V"]
-        return v
-
-    def blocks(self, x, p, bmat):
-        x = dict(x)
-        x["V"] = self.K @ x["L"]
-        return super().blocks(x, p, bmat)
+    gain_basis = "L"

@@ -38,7 +38,7 @@ import cvxpy as cp
 import numpy as np
 
 from ..margins import DelayMargin, delay_margin_siso
-from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI
+from .core import DEFAULT_MARGIN, Block, Bracket, FixedGain, MarginLMI
 from .robust import DescriptorSynthesis, PointCheck, _balancing, best_eps_bracket, check_gain
 
 
@@ -249,19 +249,9 @@ def recheck_tight(A, B, result: TightSynthesis,
     return lmi.recheck(cert, result.bracket.h_certified)
 
 
-class WirtingerSynthesisFixedK(WirtingerSynthesis):
+class WirtingerSynthesisFixedK(FixedGain, WirtingerSynthesis):
     """The same LMI with the gain fixed (V = K Y): the descriptor form of the
     Wirtinger *analysis* of a given K, e.g. to test the blocks against
     :class:`~workbench.lmi.analysis.WirtingerLMI` and exact margins."""
 
-    def __init__(self, A, B, K, eps: float, **kw):
-        self.K = np.atleast_2d(np.asarray(K, float))
-        super().__init__(A, B, eps, **kw)
-
-    def variables(self):
-        v = super().variables()
-        del v["V"]
-        return v
-
-    def blocks(self, v, p, bmat):
-        return super().blocks({**v, "V": self.K @ v["Y"]}, p, bmat)
+    gain_basis = "Y"
