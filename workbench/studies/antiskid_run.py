@@ -137,12 +137,18 @@ def _plant_values(spec: RunSpec, mass_factor: float = 1.0) -> dict:
     return v
 
 
-def controller_settings(spec: RunSpec, K, case: Case) -> ControllerSettings:
-    """Controller (75) data for one case (plain data: picklable)."""
+def _nominal_cruise(spec: RunSpec):
+    """(nominal plant, lambda_d, cruise linearisation) the controller is built on."""
     nominal = NumericAdhesion.from_dict(_plant_values(spec))
     v_d = spec.scenario["v_d"]
     lam_d = nominal.cruise_lambda(v_d)
-    lin = linearise_cruise(nominal, v_d, lam_d)
+    return nominal, lam_d, linearise_cruise(nominal, v_d, lam_d)
+
+
+def controller_settings(spec: RunSpec, K, case: Case) -> ControllerSettings:
+    """Controller (75) data for one case (plain data: picklable)."""
+    nominal, lam_d, lin = _nominal_cruise(spec)
+    v_d = spec.scenario["v_d"]
     prof = CreepSpeedProfile(t_brake=spec.scenario["t_brake"], **spec.profile)
     return ControllerSettings(
         params=tuple(_plant_values(spec)[k] for k in PARAM_ORDER), v_d=v_d, lambda_d=lam_d,
@@ -263,9 +269,7 @@ def gain_for(spec: RunSpec) -> tuple[tuple, str, float | None]:
     if spec.gain == "table":
         return tuple(spec.K_table), spec.K_source, None
     from ..synthesis import synthesize_delay_bound
-    nominal = NumericAdhesion.from_dict(_plant_values(spec))
-    v_d = spec.scenario["v_d"]
-    lin = linearise_cruise(nominal, v_d, nominal.cruise_lambda(v_d))
+    _, _, lin = _nominal_cruise(spec)
     row = synthesize_delay_bound(lin.A, lin.B, (spec.eps,))[0]
     if row.K is None:
         raise ModelError(f"synthesis at eps = {spec.eps} certified no gain")
@@ -432,10 +436,8 @@ class AntiskidRun:
 
     def run(self, design) -> RunResult:
         spec: RunSpec = design.spec
-        nominal = NumericAdhesion.from_dict(_plant_values(spec))
+        nominal, lam_d, lin = _nominal_cruise(spec)
         v_d = spec.scenario["v_d"]
-        lam_d = nominal.cruise_lambda(v_d)
-        lin = linearise_cruise(nominal, v_d, lam_d)
         K, how, h_cert = gain_for(spec)
         pending = None
         if spec.montecarlo is not None:   # its chunks run in a pool while the cases run here
