@@ -88,7 +88,9 @@ def main() -> None:
 
     res = sweep(design, args.samples, seed=1, workers=args.workers)
     per_run = res.seconds / args.samples
-    print(f"Monte Carlo: {args.samples} runs of up to {spec.scenario['t_end']:g} s, "
+    mc_dt = spec.montecarlo.dt or dt
+    print(f"Monte Carlo: {args.samples} runs of up to {spec.scenario['t_end']:g} s at "
+          f"dt = {mc_dt:g} s, "
           f"{res.workers} workers, {res.seconds:.1f} s -> {args.samples / res.seconds * 60:.0f} "
           f"runs/min; projected 1000 runs: {1000 * per_run:.0f} s (target <= 300 s); vs the "
           f"solve_ivp reference run sequentially: {spec.scenario['t_end'] / args.ref_horizon * wall_ref * 1000 / 60:.0f} min")

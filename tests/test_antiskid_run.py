@@ -100,6 +100,8 @@ def test_bad_design_is_exit_2(tmp_path, capsys):
 def test_sweep_is_seeded(tmp_path, capsys):
     short = tmp_path / "antiskid-run-dry.toml"
     text = DRY.read_text().replace('value = 300.0,  unit = "s"', 'value = 31.5,  unit = "s"')
+    text = text.replace("dt = 0.005                          # s, step of the sweep's runs",
+                        "dt = 0.01                          # s, step of the sweep's runs")
     short.write_text(text.replace('value = 420.0,', 'value = 32.0,'))
     from workbench.sim.montecarlo import sweep
     d = load_design(short)

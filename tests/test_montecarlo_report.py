@@ -25,7 +25,8 @@ def _short(tmp_path, samples=6, chunk=3, workers=2) -> Path:
     text = DRY.read_text()
     text = text.replace('value = 300.0,  unit = "s"', 'value = 9.5,  unit = "s"')
     text = text.replace("value = 420.0,", "value = 10.0,")
-    for key, val in (("samples", samples), ("chunk", chunk), ("workers", workers)):
+    for key, val in (("samples", samples), ("chunk", chunk), ("workers", workers),
+                     ("halving_samples", min(2, samples))):
         old = next(ln for ln in text.splitlines() if ln.startswith(f"{key} = "))
         text = text.replace(old, f"{key} = {val}", 1)
     path = tmp_path / "antiskid-run-dry.toml"
@@ -81,7 +82,8 @@ def test_study_quantities_and_identical_markdown(tmp_path):
 @pytest.mark.parametrize("line, key", [("samples = 0", "montecarlo.samples"),
                                        ("samples = 6.5", "montecarlo.samples"),
                                        ("workers = 0", "montecarlo.workers"),
-                                       ("chunk = -1", "montecarlo.chunk")])
+                                       ("chunk = -1", "montecarlo.chunk"),
+                                       ("halving_samples = 7", "montecarlo.halving_samples")])
 def test_bad_montecarlo_keys_are_exit_2(tmp_path, capsys, line, key):
     path = _short(tmp_path)
     name = line.split(" = ")[0]

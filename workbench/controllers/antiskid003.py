@@ -45,7 +45,14 @@ constant of about v / 4000 s on dry rail), by the exponential Euler step
 lambda+ = lambda + dt phi1(dt J) lambda', J = d lambda'/d lambda from the
 sympy Jacobian, phi1(z) = (e^z - 1)/z: exact for the linear part, stable for
 any dt J < 0; a step that would move lambda by more than MAX_DLAMBDA is
-halved (adaptive sub-stepping, :func:`stiff_step`).
+halved (adaptive sub-stepping, :func:`stiff_step`, per run in a batch). A
+single run may also run on a refined mesh (:class:`Mesh`: steps dt / 2**k
+where dt S / v is large), which the runs without the predictor need.
+
+Divergence: a run ends as diverged when |lambda| >= lam_diverged, when a
+law commands a torque beyond ``u_range``, or when a plant step cannot be
+resolved (:class:`ControllerSettings`); ``RunMetrics.diverged_how`` says
+which (:data:`DIVERGED_HOW`).
 """
 from __future__ import annotations
 
@@ -58,13 +65,15 @@ import numpy as np
 import sympy as sp
 
 from ..plants.adhesion import PARAMETER_UNITS, adhesion_model
-from ..sim.delay import SimResult, simulate_closed_loop
-from ..sim.history import BatchDelayLine, DelayLine
+from ..sim.delay import SimResult, simulate_closed_loop, simulate_closed_loop_mesh
+from ..sim.history import BatchDelayLine, DelayLine, TimedDelayLine
 
 ACCEL, HANDOVER, CRUISE, BRAKE_IN, BRAKE, STOPPED, DIVERGED = range(7)
 PHASE_NAMES = ("acceleration", "handover to cruise", "cruise", "handover to braking",
                "braking", "stopped", "diverged")
 PARAM_ORDER = tuple(PARAMETER_UNITS)
+#: Why a run was declared diverged (``RunMetrics.diverged_how``).
+DIVERGED_HOW = ("|lambda| >= lam_diverged", "step not resolved", "torque out of range")
 
 
 @lru_cache(maxsize=4)
@@ -86,13 +95,13 @@ class _Scalar:
     where = staticmethod(lambda c, a, b: a if c else b)
     maximum, minimum, abs = staticmethod(max), staticmethod(min), staticmethod(abs)
     expm1, sqrt = staticmethod(math.expm1), staticmethod(math.sqrt)
-    any = staticmethod(bool)
+    any, logical_not = staticmethod(bool), staticmethod(lambda x: not x)
     batch = False
 
 
 class _Array:
     where, maximum, minimum, abs = np.where, np.maximum, np.minimum, np.abs
-    expm1, sqrt, any = np.expm1, np.sqrt, np.any
+    expm1, sqrt, any, logical_not = np.expm1, np.sqrt, np.any, np.logical_not
     batch = True
 
 
@@ -174,6 +183,17 @@ class ControllerSettings:
     lam_diverged : float
         |lambda| at which the run is declared diverged and ended (the
         creep ratio of eq 4 lies in (-1, 1); near +-1 the wheel spins or locks).
+        A run is also declared diverged when a law commands |u| > ``u_range``
+        or a plant step cannot be resolved
+        (a sub-step of dt / 2**MAX_HALVINGS still moves lambda by more than
+        MAX_DLAMBDA): the applied torque has left any physical range (e.g.
+        law (69) evaluated on the traction side, where its e^{b lambda} terms
+        blow up) and the state after that step is not a trajectory of the
+        model at any step size; no metric uses it.
+    u_range : float
+        |u| (N m) above which a commanded torque is out of any physical range
+        and the run is declared diverged (inf: never); the designs set it to
+        a multiple of the peak adhesion torque mu(lambda_opt) m g r.
     observer_tau : float
         Time constant (s) of the estimate of the model mismatch delta =
         lambda'_plant - lambda'_model that ``sampling = "stiff"`` needs (0:
@@ -207,6 +227,7 @@ class ControllerSettings:
     v_stop: float = 0.05
     v_floor: float = 0.01
     lam_diverged: float = 0.9
+    u_range: float = math.inf
     observer_tau: float = 0.2
 
 
@@ -250,25 +271,46 @@ def _exp_euler(v, lam, f1, f2, z, dt, xp):
 MAX_DLAMBDA = 0.02
 
 
+#: Halvings :func:`stiff_step` may make (smallest sub-step dt / 2**MAX_HALVINGS).
+MAX_HALVINGS = 8
+
+
 def stiff_step(v, lam, u, dt, evalf, xp, mask=True, depth=0):
     """Explicit Euler in v, exponential Euler in the stiff creep ratio, with
     ``evalf(v, lam) -> (v', lambda'_0, lambda'_u, J_0, J_u)``; halved
-    recursively (up to 8 times) while the creep ratio would move by more than
-    MAX_DLAMBDA (in a batch: in a run where ``mask`` is true)."""
+    recursively (up to MAX_HALVINGS times) while the creep ratio would move by
+    more than MAX_DLAMBDA; in a batch, per run (runs where ``mask`` is false
+    are never halved), so each run follows its single-run trajectory."""
+    return _stiff_step(v, lam, u, dt, evalf, xp, mask, depth)[:2]
+
+
+def _stiff_step(v, lam, u, dt, evalf, xp, mask, depth):
+    """:func:`stiff_step` plus ``unresolved``: true (per run) when a sub-step
+    of dt / 2**MAX_HALVINGS still moved the creep ratio by more than
+    MAX_DLAMBDA, i.e. the step could not be resolved."""
     f1, f20, f2u, j0, ju = evalf(v, lam)
     out = _exp_euler(v, lam, f1, f20 + f2u * u, (j0 + ju * u) * dt, dt, xp)
-    if depth < 8 and xp.any(~(xp.abs(out[1] - lam) <= MAX_DLAMBDA) & mask if xp.batch
-                            else not abs(out[1] - lam) <= MAX_DLAMBDA):
-        hv, hl = stiff_step(v, lam, u, dt / 2, evalf, xp, mask, depth + 1)
-        return stiff_step(hv, hl, u, dt / 2, evalf, xp, mask, depth + 1)
-    return out
+    big = ~(xp.abs(out[1] - lam) <= MAX_DLAMBDA) & mask if xp.batch else \
+        not abs(out[1] - lam) <= MAX_DLAMBDA
+    if depth < MAX_HALVINGS and xp.any(big):
+        sub = mask & big if xp.batch else mask
+        hv, hl, bad1 = _stiff_step(v, lam, u, dt / 2, evalf, xp, sub, depth + 1)
+        nv, nl, bad2 = _stiff_step(hv, hl, u, dt / 2, evalf, xp, sub, depth + 1)
+        if not xp.batch:
+            return nv, nl, bad1 or bad2
+        # per run: only the runs that need it take the half steps, so a run
+        # of a batch follows exactly its single-run trajectory
+        return np.where(big, nv, out[0]), np.where(big, nl, out[1]), big & (bad1 | bad2)
+    return out[0], out[1], big
 
 
-def plant_step(x, u, p, dt, fns, xp, v_floor=1e-3, mask=True):
+def plant_step(x, u, p, dt, fns, xp, v_floor=1e-3, mask=True, with_flag=False):
     """One step of the adhesion plant (module docstring), the form (eq 12 or
-    15) chosen by the sign of lambda."""
-    return stiff_step(x[0], x[1], u, dt,
-                      lambda v, lam: _forms(xp.maximum(v, v_floor), lam, p, fns, xp), xp, mask)
+    15) chosen by the sign of lambda; ``with_flag``: also return the
+    ``unresolved`` flag of :func:`_stiff_step`."""
+    out = _stiff_step(x[0], x[1], u, dt,
+                      lambda v, lam: _forms(xp.maximum(v, v_floor), lam, p, fns, xp), xp, mask, 0)
+    return out if with_flag else out[:2]
 
 
 @dataclass
@@ -292,8 +334,10 @@ class RunMetrics:
     lam_at_handover: object = math.nan
     t_diverged: object = math.nan
     phase_diverged: object = math.nan
+    diverged_how: object = math.nan   # index into DIVERGED_HOW
+    t_past_peak: object = math.nan    # braking: first lambda < -lambda_opt (lock onset)
     evs_last: object = math.nan
-    evs_max_tracking: object = 0.0
+    evs_max_tracking: object = math.nan   # NaN: the tracking window was never entered
 
 
 class Antiskid003:
@@ -317,11 +361,18 @@ class Antiskid003:
         The creep-speed error is tracked from t_brake + evs_settle (s) while
         omega > omega_switch (``evs_max_tracking``); ``evs_last`` is its
         value at the last braking sample.
+    k_max : int or None
+        None: every step is ``dt``. Else the loop runs on a refined mesh
+        (:func:`~workbench.sim.delay.simulate_closed_loop_mesh`, steps
+        dt / 2**k, k <= k_max, announced by :meth:`set_step`); the histories
+        are then :class:`~workbench.sim.history.TimedDelayLine` and the
+        predictor's rollout still integrates eq (2) in steps of ``dt``.
     """
 
     def __init__(self, s: ControllerSettings, x0, u_init: float, dt: float, batch=None,
-                 plant_r=None, evs_settle: float = 5.0):
-        self.s, self.dt = s, dt
+                 plant_r=None, evs_settle: float = 5.0, k_max: int | None = None):
+        self.s, self.dt, self._dt_prev = s, dt, dt
+        self._ticks = self._base = None if k_max is None else 2 ** k_max
         self.xp = _Scalar if batch is None else _Array
         self.fns = model_functions("math" if batch is None else "numpy")
         self.r_c = s.params[PARAM_ORDER.index("r")]
@@ -344,11 +395,26 @@ class Antiskid003:
             hist_v.append((nv - v) / dt)
             hist_l.append((nl - lam) / dt)
             v, lam = nv, nl
-        self.fv = DelayLine(s.h_model, dt, zero, history=hist_v)
-        self.fl = DelayLine(s.h_model, dt, zero, history=hist_l)
-        self.uline = DelayLine(s.h_model, dt, u_init + zero)
+        if k_max is None:
+            self.fv = DelayLine(s.h_model, dt, zero, history=hist_v)
+            self.fl = DelayLine(s.h_model, dt, zero, history=hist_l)
+            self.uline = DelayLine(s.h_model, dt, u_init + zero)
+        else:
+            tick, H = dt / self._base, s.h_model * self._base / dt
+            self.fv, self.fl = (TimedDelayLine(H, tick, zero, history=hist,
+                                               history_ticks=self._base)
+                                for hist in (hist_v, hist_l))
+            self.uline = TimedDelayLine(H, tick, u_init + zero)
         self._prev = None          # (v, lambda) of the previous sample
         self.delta = zero          # filtered estimate of the model-mismatch rate of lambda
+        #: set by the plant step: the last step could not be resolved (see
+        #: ControllerSettings.lam_diverged)
+        self.unresolved = False if batch is None else np.zeros(batch, bool)
+        self._track_prev = None    # (omega, e_vs left of the switch) of the last tracked sample
+
+    def set_step(self, ticks: int, tick: float) -> None:
+        """The step about to start lasts ``ticks`` ticks of ``tick`` s (refined mesh)."""
+        self._ticks, self.dt = ticks, ticks * tick
 
     # -- predictors ----------------------------------------------------------------
     def _model_step(self, v, lam, u, dt, ph):
@@ -377,13 +443,12 @@ class Antiskid003:
 
     def _rollout(self, v, lam, ph):
         """X(t + h) of eq (2) by running the phase's model from x(t) through
-        the inputs of the last h seconds (exact ZOH weights of the window)."""
-        line, dt = self.uline, self.dt
-        n = line._n
-        if line.f > 0:
-            v, lam = self._model_step(v, lam, line._get(n - line.N - 1), line.f * dt, ph)
-        for k in range(n - line.N, n):
-            v, lam = self._model_step(v, lam, line._get(k), dt, ph)
+        the inputs of the last h seconds (exact ZOH weights of the window; on
+        a refined mesh, in pieces of the base step with the exact average
+        input over each)."""
+        line = self.uline
+        for u, d in (line.pieces() if self._base is None else line.pieces(self._ticks)):
+            v, lam = self._model_step(v, lam, u, d, ph)
         return v, lam
 
     # -- the three laws -------------------------------------------------------------
@@ -410,7 +475,7 @@ class Antiskid003:
         ``ControllerSettings.observer_tau``): the model says the step from
         the previous sample under the input the controller believes applied,
         u(t - h_model), moves lambda by dt phi1(dt J) (f_model + delta)."""
-        s, xp, dt = self.s, self.xp, self.dt
+        s, xp, dt = self.s, self.xp, self._dt_prev
         braking = ph >= BRAKE_IN
         if xp.batch and np.all(braking) or not xp.batch and braking:
             self.delta = 0.0 * v
@@ -476,10 +541,12 @@ class Antiskid003:
         in_brake = (ph == BRAKE_IN) | (ph == BRAKE) if B else ph in (BRAKE_IN, BRAKE)
         to_stop = in_brake & (v <= s.v_stop) if B else (in_brake and v <= s.v_stop)
         ph = xp.where(to_stop, STOPPED, ph)
-        bad = ~(xp.abs(lam) < s.lam_diverged) & (ph < STOPPED) if B else (
-            not abs(lam) < s.lam_diverged and ph < STOPPED)
+        unres = self.unresolved
+        bad = (~(xp.abs(lam) < s.lam_diverged) | unres) & (ph < STOPPED) if B else (
+            (not abs(lam) < s.lam_diverged or unres) and ph < STOPPED)
         self.m.t_diverged = xp.where(bad, t, self.m.t_diverged)
         self.m.phase_diverged = xp.where(bad, ph, self.m.phase_diverged)
+        self.m.diverged_how = xp.where(bad, xp.where(unres, 1.0, 0.0), self.m.diverged_how)
         self.m.t_handover_done = xp.where(handed, t, self.m.t_handover_done)
         self.m.v_at_handover = xp.where(handed, v, self.m.v_at_handover)
         self.m.lam_at_handover = xp.where(handed, lam, self.m.lam_at_handover)
@@ -496,10 +563,19 @@ class Antiskid003:
             self.m.t_diverged, self.m.phase_diverged = t, ph
             self.phase = ph = DIVERGED
             u = fv = fl = 0.0
-        self.fv.push(fv)
-        self.fl.push(fl)
-        self.uline.push(u)
+        wild = ~(xp.abs(u) <= s.u_range) & (ph < STOPPED) if B else (
+            not abs(u) <= s.u_range and ph < STOPPED)
+        if xp.any(wild):    # the law has left any physical range: the run has diverged
+            self.m.t_diverged = xp.where(wild, t, self.m.t_diverged)
+            self.m.phase_diverged = xp.where(wild, ph, self.m.phase_diverged)
+            self.m.diverged_how = xp.where(wild, 2.0, self.m.diverged_how)
+            self.phase = ph = xp.where(wild, DIVERGED, ph)
+            u, fv, fl = (xp.where(wild, 0.0, a) for a in (u, fv, fl))
+        self.fv.push(fv, self._ticks)
+        self.fl.push(fl, self._ticks)
+        self.uline.push(u, self._ticks)
         self._metrics(t, v, lam, ph, to_cruise, to_brake, to_stop)
+        self._dt_prev = self.dt
         return u, ph
 
     def _laws(self, t, v, lam, ph):
@@ -528,7 +604,7 @@ class Antiskid003:
         w = xp.where
         # crossing time of v = v_d, interpolated between the last two samples
         frac = (v - s.v_d) / xp.maximum(v - self._v_prev, 1e-12)
-        m.t_cruise = w(to_cruise, t - self.dt * xp.minimum(frac, 1.0), m.t_cruise)
+        m.t_cruise = w(to_cruise, t - self._dt_prev * xp.minimum(frac, 1.0), m.t_cruise)
         self._v_prev = v
         m.v_at_cruise = w(to_cruise, v, m.v_at_cruise)
         m.lam_at_cruise = w(to_cruise, lam, m.lam_at_cruise)
@@ -547,17 +623,43 @@ class Antiskid003:
         m.t_lam_negative = w(first_neg, t, m.t_lam_negative)
         m.lam_min_brake = w(brk, xp.minimum(m.lam_min_brake, lam), m.lam_min_brake)
         omega = wheel_speed(xp.maximum(v, s.v_floor), lam, self.r_p, xp)
-        low = brk & (omega <= s.profile.omega_switch) & (m.t_omega3 != m.t_omega3) if xp.batch \
-            else (omega <= s.profile.omega_switch and math.isnan(m.t_omega3))
-        m.t_omega3 = w(low, t, m.t_omega3)
-        # creep-speed error of Theorem 3, e_vs = v_s - v_s*(t) (measured)
+        ws, no = s.profile.omega_switch, xp.logical_not
+        # creep-speed error of Theorem 3, e_vs = v_s - v_s*(t) (measured), and
+        # its left limit at omega = omega_switch (v_s* still on the profile)
         vs_star, _ = s.profile(t, v, 0.0 * v, omega, xp)
-        e = xp.abs(creep_speed(v, lam, xp) - vs_star)
+        vs_on, _ = s.profile(t, v, 0.0 * v, math.inf + 0.0 * v, xp)
+        vs = creep_speed(v, lam, xp)
+        e, e_on = xp.abs(vs - vs_star), xp.abs(vs - vs_on)
         m.evs_last = w(brk, e, m.evs_last)
-        hi = omega > s.profile.omega_switch
-        late = brk & hi & (t >= s.profile.t_brake + self.evs_settle) if xp.batch else (
-            brk and hi and t >= s.profile.t_brake + self.evs_settle)
-        m.evs_max_tracking = w(late, xp.maximum(m.evs_max_tracking, e), m.evs_max_tracking)
+        # The tracking window runs from t_brake + evs_settle to the first of
+        # omega <= omega_switch (v_s* drops to 0, eq 76) and the lock onset,
+        # lambda < -lambda_opt (the wheel passes the braking adhesion peak; the
+        # divergence metrics report what follows). Both crossings are
+        # interpolated linearly between the samples around them: the error
+        # may be steep there, and the first sample past a crossing alone would
+        # make the metric depend on where the grid falls.
+        in_window = (m.t_omega3 != m.t_omega3) & (m.t_past_peak != m.t_past_peak)
+        cross_w = brk & (omega <= ws) & (m.t_omega3 != m.t_omega3)
+        cross_l = brk & (lam < -s.lambda_opt) & (m.t_past_peak != m.t_past_peak)
+        if self._track_prev is None:
+            f_w = f_l = 1.0 + 0.0 * v
+            e_prev = e_on
+        else:
+            w_prev, e_prev, l_prev = self._track_prev
+            clip = lambda x: xp.minimum(xp.maximum(x, 0.0), 1.0)
+            f_w = clip((w_prev - ws) / xp.maximum(w_prev - omega, 1e-300))
+            f_l = clip((l_prev + s.lambda_opt) / xp.maximum(l_prev - lam, 1e-300))
+        m.t_omega3 = w(cross_w, t - self._dt_prev * (1.0 - f_w), m.t_omega3)
+        m.t_past_peak = w(cross_l, t - self._dt_prev * (1.0 - f_l), m.t_past_peak)
+        settled = brk & in_window & (t >= s.profile.t_brake + self.evs_settle)
+        inside = settled & no(cross_w) & no(cross_l)
+        fmax = lambda a, b: w(a != a, b, xp.maximum(a, b))   # NaN = no value yet
+        m.evs_max_tracking = w(inside, fmax(m.evs_max_tracking, e), m.evs_max_tracking)
+        f_end = xp.minimum(w(cross_w, f_w, 1.0), w(cross_l, f_l, 1.0))
+        e_end = e_prev + f_end * (e_on - e_prev)
+        end = settled & (cross_w | cross_l)
+        m.evs_max_tracking = w(end, fmax(m.evs_max_tracking, e_end), m.evs_max_tracking)
+        self._track_prev = (omega, e_on, lam)
 
 
 @dataclass(frozen=True)
@@ -574,8 +676,47 @@ class RunSettings:
     t_end: float = 400.0
 
 
+@lru_cache(maxsize=1)
+def _creep_rate_coefficient():
+    """S(params) with S / v the creep-ratio rate |d lambda'/d lambda| at
+    lambda = 0, the steepest point of the adhesion curve: m g r^2 mu'(0) / J
+    (eq 13, dominant term; the rest is O(zeta / J))."""
+    mdl = adhesion_model()
+    p = mdl.params
+    S = sp.diff(mdl.mu_traction, mdl.lam).subs(mdl.lam, 0) * p["m"] * p["g"] * p["r"] ** 2 / p["J"]
+    return sp.lambdify([p[k] for k in PARAM_ORDER], S, "math")
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """Refined mesh of a single run, set by the creep-ratio time constant.
+
+    The step is dt / 2**k with k the smallest level (at most ``k_max``) with
+    (dt_ref / 2**k) S / v <= ``courant``, S / v the fastest creep-ratio rate
+    (:func:`_creep_rate_coefficient`, ~3800/v 1/s on dry rail). ``dt_ref``
+    is the design's step: a run at dt_ref / 2 then takes exactly half of
+    every step of the run at dt_ref, so step halving still compares a mesh
+    with its refinement.
+
+    Why: without the predictor, the loop at low speed is close to neutral
+    (near a creep ratio with slope J, lambda' ~ J lambda - (J + k) lambda(t - h),
+    roots decaying at only (1/h) ln(|J| / |J + k|)), so fast features of
+    width ~1/|J| set at the start persist for seconds; the exponential step
+    keeps them stable but only a step below 1/|J| resolves them.
+    """
+
+    dt_ref: float
+    courant: float
+    k_max: int
+
+    def level(self, v: float, S: float) -> int:
+        rate = self.dt_ref * S / (self.courant * max(v, 1e-3))
+        return 0 if rate <= 1.0 else min(self.k_max, math.ceil(math.log2(rate)))
+
+
 def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 0.05,
-                      batch: int | None = None) -> tuple[SimResult | None, RunMetrics]:
+                      batch: int | None = None,
+                      mesh: Mesh | None = None) -> tuple[SimResult | None, RunMetrics]:
     """Simulate controller (75) on the delayed plant.
 
     Parameters
@@ -588,23 +729,31 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     record_dt : float or None
         Recording interval (s); None records nothing (batch Monte Carlo).
     batch : int or None
+    mesh : Mesh, optional
+        Single runs only: refine the step where the creep ratio is fast
+        (:class:`Mesh`); None: every step is ``dt``.
 
     Returns
     -------
     (SimResult or None, RunMetrics)
     """
+    if mesh is not None and batch is not None:
+        raise ValueError("a refined mesh is for single runs (batch=None)")
     xp = _Scalar if batch is None else _Array
     fns = model_functions("math" if batch is None else "numpy")
     p = run.plant_params
     ctrl = Antiskid003(run.controller, run.x0, run.u_init, dt, batch,
-                       plant_r=p[PARAM_ORDER.index("r")])
+                       plant_r=p[PARAM_ORDER.index("r")],
+                       k_max=None if mesh is None else mesh.k_max)
     zero = 0.0 if batch is None else np.zeros(batch)
 
     def step(x, u, t, dt_):
         if batch is None:
-            return plant_step(x, u, p, dt_, fns, xp)
+            *nx, ctrl.unresolved = plant_step(x, u, p, dt_, fns, xp, with_flag=True)
+            return tuple(nx)
         stop = ctrl.phase >= STOPPED
-        nx = plant_step(x, u, p, dt_, fns, xp, mask=~stop)
+        *nx, unres = plant_step(x, u, p, dt_, fns, xp, mask=~stop, with_flag=True)
+        ctrl.unresolved = unres & ~stop
         return (np.where(stop, x[0], nx[0]), np.where(stop, x[1], nx[1]))
 
     def done(t, x, ph):
@@ -615,9 +764,16 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     line = None if batch is None else BatchDelayLine(np.broadcast_to(run.h, (batch,)), dt,
                                                       run.u_init)
     with np.errstate(all="ignore"):
-        res = simulate_closed_loop(step, ctrl, x0, h=float(np.max(run.h)), dt=dt,
-                                   t_end=run.t_end, u_init=run.u_init + zero,
-                                   record_every=every, done=done, line=line)
+        if mesh is None:
+            res = simulate_closed_loop(step, ctrl, x0, h=float(np.max(run.h)), dt=dt,
+                                       t_end=run.t_end, u_init=run.u_init + zero,
+                                       record_every=every, done=done, line=line)
+        else:
+            S = _creep_rate_coefficient()(*p)
+            res = simulate_closed_loop_mesh(step, ctrl, x0, h=float(run.h), dt=dt,
+                                            t_end=run.t_end, u_init=run.u_init,
+                                            level=lambda x: mesh.level(x[0], S),
+                                            k_max=mesh.k_max, record_dt=record_dt, done=done)
     if record_dt is None:
         res = None
     else:

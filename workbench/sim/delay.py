@@ -18,6 +18,13 @@ Two entry points:
     can use an exponential or implicit step). States may be floats or numpy
     arrays (a batch of runs in one pass).
 
+:func:`simulate_closed_loop_mesh`
+    The same loop on a refined mesh: the step is dt / 2**k with the level k
+    chosen at each step from the state (e.g. from a plant's fastest rate),
+    the histories kept per step in a :class:`~workbench.sim.history.TimedDelayLine`.
+    Halving dt halves every step of the mesh, so step-halving studies
+    still compare a mesh with its refinement.
+
 Results are :class:`SimResult` (time, states, inputs, phase arrays), which
 convert to ``control.TimeResponseData``.
 
@@ -34,7 +41,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from .history import DelayLine
+from .history import DelayLine, TimedDelayLine
 
 
 @dataclass(frozen=True)
@@ -224,4 +231,44 @@ def simulate_closed_loop(step: Callable, control: Callable, x0, *, h: float, dt:
         x = step(x, ua, t, dt)
     X = np.array(Xs, float).T
     return SimResult(np.array(T), X, np.atleast_2d(np.array(U, float)),
+                     np.atleast_2d(np.array(UA, float)), np.array(P, int), dt=dt)
+
+
+def simulate_closed_loop_mesh(step: Callable, control: Callable, x0, *, h: float, dt: float,
+                              t_end: float, u_init, level: Callable, k_max: int,
+                              record_dt: float | None = None,
+                              done: Callable | None = None) -> SimResult:
+    """:func:`simulate_closed_loop` with the step dt / 2**level(x) (level in
+    [0, k_max]) chosen at each step.
+
+    Time is counted in ticks of dt / 2**k_max, so step ends are exact. The
+    controller is told each step before it is called,
+    ``control.set_step(ticks, tick)``, and receives the input history as a
+    :class:`~workbench.sim.history.TimedDelayLine`. Recorded every
+    ``record_dt`` seconds (at the first step end at or after each multiple;
+    None: first and last sample only).
+    """
+    tick = dt / 2 ** k_max
+    line = TimedDelayLine(h / tick, tick, u_init)
+    T_end = int(round(t_end / tick))
+    rec = None if record_dt is None else max(int(round(record_dt / tick)), 1)
+    x, T, next_rec = tuple(x0), 0, 0
+    Ts, Xs, U, UA, P = [], [], [], [], []
+    while True:
+        n = min(2 ** (k_max - min(max(int(level(x)), 0), k_max)), max(T_end - T, 1))
+        t = T * tick
+        control.set_step(n, tick)
+        u, phase = control(t, x, line)
+        line.push(u, n)
+        ua = line.delayed()
+        last = T >= T_end or (done is not None and done(t, x, phase))
+        if T == 0 or last or (rec is not None and T >= next_rec):
+            Ts.append(t); Xs.append(x); U.append(u); UA.append(ua); P.append(phase)
+            if rec is not None:
+                next_rec = (T // rec + 1) * rec
+        if last:
+            break
+        x = step(x, ua, t, n * tick)
+        T += n
+    return SimResult(np.array(Ts), np.array(Xs, float).T, np.atleast_2d(np.array(U, float)),
                      np.atleast_2d(np.array(UA, float)), np.array(P, int), dt=dt)

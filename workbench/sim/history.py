@@ -71,8 +71,9 @@ class DelayLine:
         """Sample k (k < 0: the initial value)."""
         return self._buf[k % self._L]
 
-    def push(self, value) -> None:
-        """Append the sample s_n of the current step."""
+    def push(self, value, ticks=None) -> None:
+        """Append the sample s_n of the current step (``ticks`` is for the
+        interface of :class:`TimedDelayLine`; the step here is fixed)."""
         n = self._n
         if self.N > 0:
             self._sum = self._sum + value - self._get(n - self.N)
@@ -92,6 +93,94 @@ class DelayLine:
         n = self._n
         tail = 0.0 if self.f == 0.0 else self.f * self._get(n - self.N - 1)
         return self.dt * (self._sum + tail)
+
+    def pieces(self) -> list:
+        """The window [t_n - h, t_n) (t_n as in :meth:`window_integral`) as
+        (value, duration in s) pieces, oldest first."""
+        n, dt = self._n, self.dt
+        out = [(self._get(n - self.N - 1), self.f * dt)] if self.f > 0 else []
+        return out + [(self._get(k), dt) for k in range(n - self.N, n)]
+
+
+class TimedDelayLine:
+    """:class:`DelayLine` for steps of varying length (a refined mesh).
+
+    Time is counted in integer *ticks* (the finest step), so step ends are
+    exact; the delay ``H`` (in ticks) need not be whole. The signal is
+    zero-order hold: sample s_k holds over its step [T_k, T_k + n_k).
+
+    Parameters
+    ----------
+    H : float
+        Delay in ticks, >= 0.
+    tick : float
+        Tick length (s).
+    initial : float
+        Signal before the first stored sample.
+    history : sequence, optional
+        Samples before t = 0, oldest first, each held for ``history_ticks``.
+    history_ticks : int
+    """
+
+    def __init__(self, H: float, tick: float, initial, history=(), history_ticks: int = 1):
+        if not (H >= 0 and tick > 0):
+            raise ValueError(f"H = {H!r}, tick = {tick!r}; expected H >= 0 and tick > 0")
+        self.H, self.tick, self.initial = H, tick, initial
+        self._segs = []          # [start, end, value], oldest first, ticks
+        self._first = 0          # index of the oldest segment still needed
+        start = -len(history) * history_ticks
+        for value in history:
+            self._segs.append((start, start + history_ticks, value))
+            start += history_ticks
+        self._T = 0              # end of the last pushed step = time of the next sample
+
+    def push(self, value, ticks: int) -> None:
+        """Append the sample of the step that starts now and lasts ``ticks``."""
+        T0 = self._T
+        self._T = T0 + ticks
+        self._segs.append((T0, self._T, value))
+        keep = T0 - self.H               # nothing before this is read again
+        while self._segs[self._first][1] <= keep - 1:
+            self._first += 1
+        if self._first > 4096:           # compact now and then
+            del self._segs[:self._first]
+            self._first = 0
+
+    def integral(self, a: float, b: float):
+        """Integral of s over [a, b) (ticks; result in signal x ticks)."""
+        segs = self._segs
+        total = 0.0 * self.initial
+        i = self._first
+        if i >= len(segs) or a < segs[i][0]:
+            lo = segs[i][0] if i < len(segs) else b
+            total = total + self.initial * (min(b, lo) - a)
+        while i < len(segs) and segs[i][0] < b:
+            s0, s1, val = segs[i]
+            lo, hi = max(a, s0), min(b, s1)
+            if hi > lo:
+                total = total + val * (hi - lo)
+            i += 1
+        return total
+
+    def delayed(self):
+        """Average of s(t - h) over the last pushed step."""
+        T0, T1, _ = self._segs[-1]
+        return self.integral(T0 - self.H, T1 - self.H) / (T1 - T0)
+
+    def window_integral(self):
+        """Integral (signal x s) of s over [t - h, t), t the time of the next sample."""
+        return self.integral(self._T - self.H, self._T) * self.tick
+
+    def pieces(self, ticks: int) -> list:
+        """The window [t - h, t) cut, from its end, into pieces of ``ticks``
+        (the first one shorter), each as (average of s, duration in s)."""
+        out, b = [], float(self._T)
+        a_end = self._T - self.H
+        while b > a_end + 1e-9:
+            a = max(b - ticks, a_end)
+            out.append((self.integral(a, b) / (b - a), (b - a) * self.tick))
+            b = a
+        return out[::-1]
 
 
 class BatchDelayLine:

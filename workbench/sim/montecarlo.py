@@ -9,14 +9,20 @@ parameters. Each worker simulates one chunk of samples as a batch (arrays,
 one pass of the fixed-step loop) and returns plain lists; a local process
 pool runs the chunks; progress goes to stderr.
 
-A batch halves a step for all its runs when one of them needs it
+A batch halves a step only for the runs that need it
 (:func:`workbench.controllers.antiskid003.stiff_step`), so a run's metrics
-depend slightly on its chunk mates. The partition into chunks therefore
-depends on the sample count (and ``chunk``) only, never on the worker count:
-the same seed gives identical results with any number of workers.
+do not depend on its chunk mates (up to rounding: the batch evaluates the
+model with numpy, a single run with ``math``). The partition into chunks
+depends on the sample count (and ``chunk``) only, never on the worker count.
 
 The controller always uses the design's nominal model (dry rail, nominal
 mass): the sweep measures robustness, not re-tuning.
+
+Step-size check (issue 5, item 1): :func:`start_halving` simulates the first
+n runs of the sweep (the same draws) as one batch at the design's dt and as
+one batch at dt / 2, and compares their metrics and outcomes per run with
+the design's convergence tolerances (:class:`HalvingCheck`,
+:func:`halving_section`).
 """
 from __future__ import annotations
 
@@ -24,19 +30,27 @@ import math
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-#: Summary statistics reported per metric.
-SUMMARY_METRICS = ("lam_max_over_opt", "t_cruise", "braking_duration")
+#: Summary statistics reported per metric. The time to the stop (v <= v_stop)
+#: is not one: after omega <= 3 rad/s the desired creep speed steps to 0 and
+#: the train coasts on running resistance, ~46 s per m/s of speed left when the
+#: creep is released; that release is a transient at dt |J| ~ 40 which the
+#: fixed step resolves for the nominal plant (the design's braking time agrees
+#: with a refined mesh) but not for mismatched plants (dt / 2 moved it by up
+#: to 13 s in the halving check). The stop itself is the ``not_stopped``
+#: outcome; ``omega3_after_brake`` (the end of creep-controlled braking, the
+#: paper's "about 350 s") is converged.
+SUMMARY_METRICS = ("lam_max_over_opt", "t_cruise", "omega3_after_brake")
 
 #: Statistics of each summary metric (over its finite values).
 STATISTICS = ("n_finite", "min", "median", "p95", "max")
 
 #: Checks counted per run: key -> what a violation means.
 VIOLATIONS = {"above_lambda_opt": "creep ratio above the sample's lambda_opt in traction",
-              "diverged": "diverged (|lambda| >= 0.9)",
+              "diverged": "diverged (|lambda| >= 0.9, torque out of range, or step not resolved)",
               "not_stopped": "not stopped by t_end"}
 
 #: Default number of chunks a sweep is cut into (independent of the workers).
@@ -59,6 +73,8 @@ class SweepSpec:
     seed: int
     workers: int
     chunk: int | None = None
+    halving: int = 0        # first runs re-checked at dt and dt / 2 (:func:`start_halving`)
+    dt: float | None = None  # step of the sweep's runs (None: the design's [numerics] dt)
 
 
 @dataclass(frozen=True)
@@ -151,8 +167,9 @@ def _progress(done: int, total: int, t0: float, stream=sys.stderr) -> None:
 
 class PendingSweep:
     """A sweep whose chunks are running (in a process pool, or still to run
-    in-process); :meth:`result` waits for them and returns the
-    :class:`SweepResult`."""
+    in-process); :meth:`result` waits for them and returns what ``collect``
+    makes of their outputs (:class:`SweepResult`, or :class:`HalvingCheck`
+    for :func:`start_halving`)."""
 
     def __init__(self, payloads: list, collect, workers: int, pool: bool):
         self._payloads, self._collect, self.workers = payloads, collect, workers
@@ -162,7 +179,7 @@ class PendingSweep:
         self._futures = None if self._pool is None else [
             self._pool.submit(_chunk_worker, p) for p in payloads]
 
-    def result(self, progress: bool = False) -> SweepResult:
+    def result(self, progress: bool = False):
         n, outs = len(self._payloads), []
         if progress:
             _progress(0, n, self._t0)
@@ -182,18 +199,13 @@ class PendingSweep:
             self._pool.shutdown(wait=True, cancel_futures=True)
 
 
-def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
-                chunk: int | None = None, pool: bool | None = None,
-                K: tuple | None = None) -> PendingSweep:
-    """Draw the samples of an ``antiskid-run`` design's sweep and start its
-    chunks (see :func:`sweep`); ``pool`` (default: ``workers > 1``) runs them
-    in a process pool now, so the caller can work meanwhile, else in-process
-    in :meth:`PendingSweep.result`. ``K``: the cruise gain if the caller has
-    it (default: :func:`~workbench.studies.antiskid_run.gain_for`)."""
-    import os
-
+def _sweep_inputs(design, samples: int, seed: int, K: tuple | None) -> dict:
+    """The first ``samples`` runs of the design's sweep with ``seed`` as
+    plain data: ``draws``, per-run ``plant`` parameters, the nominal values
+    ``base``, the ``controller`` (``asdict`` of the case's settings), the
+    ``scenario`` and ``dt``; ``K``: the cruise gain if the caller has it
+    (default: :func:`~workbench.studies.antiskid_run.gain_for`)."""
     from ..controllers.antiskid003 import PARAM_ORDER
-    from ..plants.adhesion import NumericAdhesion
     from ..studies.antiskid_run import _plant_values, controller_settings, gain_for
 
     spec = design.spec
@@ -208,33 +220,68 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
     for k in ("a", "b", "c"):
         plant[k] = ms.wet[k] + s * (base[k] - ms.wet[k])
     plant["m"] = base["m"] * draws["mass"]
+    return {"draws": draws, "plant": plant, "base": base, "controller": asdict(cs),
+            "scenario": spec.scenario, "dt": ms.dt or spec.dt}
+
+
+def _payload(inp: dict, i0: int, i1: int, dt: float) -> dict:
+    """The :func:`_chunk_worker` payload of runs ``i0 <= i < i1`` at step ``dt``."""
+    sl, sc, d = slice(i0, i1), inp["scenario"], inp["draws"]
+    return {"index": i0, "controller": inp["controller"],
+            "plant": {k: v[sl].tolist() for k, v in inp["plant"].items()},
+            "h": d["h"][sl].tolist(), "v0": d["v0"][sl].tolist(),
+            "lambda0": sc["lambda0"], "u_init": sc["u_init"], "t_end": sc["t_end"], "dt": dt}
+
+
+def _lambda_opt(inp: dict) -> np.ndarray:
+    """lambda_opt of each run's own adhesion curve."""
+    from ..plants.adhesion import NumericAdhesion
+    base, plant = inp["base"], inp["plant"]
+    return np.array([NumericAdhesion.from_dict(
+        {**base, "a": plant["a"][i], "b": plant["b"][i], "c": plant["c"][i]}).lambda_opt()
+        for i in range(len(plant["a"]))])
+
+
+def _per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]:
+    """(metrics, violations) per run, as arrays, from a batch's raw
+    :class:`~workbench.controllers.antiskid003.RunMetrics` arrays."""
+    from ..controllers.antiskid003 import BRAKE_IN
+    # the max over the phase a run diverged in is where the test fired
+    in_traction = raw["phase_diverged"] < BRAKE_IN      # NaN (not diverged): False
+    metrics = {"lam_max_over_opt": np.where(in_traction, np.nan,
+                                            raw["lam_max_traction"] / lam_opt),
+               "t_cruise": raw["t_cruise"],
+               "omega3_after_brake": raw["t_omega3"] - t_brake,
+               "t_diverged": raw["t_diverged"],
+               "phase_diverged": raw["phase_diverged"]}
+    viol = {"above_lambda_opt": raw["lam_max_traction"] > lam_opt * 1.001,
+            "diverged": np.isfinite(raw["t_diverged"]),
+            "not_stopped": ~np.isfinite(raw["t_stop"])}
+    return metrics, viol
+
+
+def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
+                chunk: int | None = None, pool: bool | None = None,
+                K: tuple | None = None) -> PendingSweep:
+    """Draw the samples of an ``antiskid-run`` design's sweep and start its
+    chunks (see :func:`sweep`); ``pool`` (default: ``workers > 1``) runs them
+    in a process pool now, so the caller can work meanwhile, else in-process
+    in :meth:`PendingSweep.result`. ``K``: the cruise gain if the caller has
+    it (default: :func:`~workbench.studies.antiskid_run.gain_for`)."""
+    import os
+
+    inp = _sweep_inputs(design, samples, seed, K)
     workers = max(1, workers or os.cpu_count() or 1)
     chunk = chunk or max(1, math.ceil(samples / DEFAULT_CHUNKS))
-    sc = spec.scenario
-    cdict = asdict(cs)
-    payloads = []
-    for i0 in range(0, samples, chunk):
-        sl = slice(i0, min(i0 + chunk, samples))
-        payloads.append({"index": i0, "controller": cdict,
-                         "plant": {k: v[sl].tolist() for k, v in plant.items()},
-                         "h": draws["h"][sl].tolist(), "v0": draws["v0"][sl].tolist(),
-                         "lambda0": sc["lambda0"], "u_init": sc["u_init"],
-                         "t_end": sc["t_end"], "dt": spec.dt})
+    payloads = [_payload(inp, i0, min(i0 + chunk, samples), inp["dt"])
+                for i0 in range(0, samples, chunk)]
 
     def collect(outs: list, seconds: float, n_workers: int) -> SweepResult:
         raw = {k: np.concatenate([o["metrics"][k] for o in outs]) for k in outs[0]["metrics"]}
-        lam_opt = np.array([NumericAdhesion.from_dict(
-            {**base, "a": plant["a"][i], "b": plant["b"][i], "c": plant["c"][i]}).lambda_opt()
-            for i in range(samples)])
-        metrics = {"lam_max_over_opt": (raw["lam_max_traction"] / lam_opt).tolist(),
-                   "t_cruise": raw["t_cruise"].tolist(),
-                   "braking_duration": (raw["t_stop"] - sc["t_brake"]).tolist(),
-                   "t_diverged": raw["t_diverged"].tolist()}
-        viol = {"above_lambda_opt": (raw["lam_max_traction"] > lam_opt * 1.001).tolist(),
-                "diverged": np.isfinite(raw["t_diverged"]).tolist(),
-                "not_stopped": (~np.isfinite(raw["t_stop"])).tolist()}
-        return SweepResult({k: v.tolist() for k, v in draws.items()}, metrics, viol, seconds,
-                           n_workers)
+        metrics, viol = _per_run(raw, _lambda_opt(inp), inp["scenario"]["t_brake"])
+        return SweepResult({k: v.tolist() for k, v in inp["draws"].items()},
+                           {k: v.tolist() for k, v in metrics.items()},
+                           {k: v.tolist() for k, v in viol.items()}, seconds, n_workers)
 
     return PendingSweep(payloads, collect, workers, workers > 1 if pool is None else pool)
 
@@ -259,6 +306,229 @@ def sweep(design, samples: int, seed: int, *, workers: int | None = None,
     return start_sweep(design, samples, seed, workers=workers, chunk=chunk).result(progress)
 
 
+# ---- step-halving check of the sweep's runs ------------------------------------------
+
+#: Metrics compared at dt and dt / 2 by :func:`start_halving`.
+HALVING_METRICS = SUMMARY_METRICS + ("t_diverged",)
+
+#: Outcomes compared (as booleans) at dt and dt / 2.
+HALVING_OUTCOMES = ("diverged", "stopped", "above_lambda_opt")
+
+
+@dataclass(frozen=True)
+class HalvingCheck:
+    """The first ``n`` runs of a design's sweep at dt and at dt / 2.
+
+    Attributes
+    ----------
+    case : str
+        The sweep's case.
+    seed : int
+    dt : float
+        The sweep's step (s); each step simulated all n runs as one batch.
+    rtol : float
+    atol : dict
+        Metric -> absolute tolerance (0 where the design gives none).
+    draws : dict
+        Sample name -> tuple of n draws (as :func:`draw_samples`).
+    coarse, fine : dict
+        Metric or outcome -> tuple of n values at dt and at dt / 2
+        (``lam_max_over_opt`` NaN for a run that diverged in traction at
+        either step: see :func:`compare_steps`).
+    agree : dict
+        Metric or outcome -> tuple of n bools.
+    seconds : float
+        Wall time (not compared).
+    workers : int
+        Processes (not compared).
+    """
+
+    case: str
+    seed: int
+    dt: float
+    rtol: float
+    atol: dict
+    draws: dict
+    coarse: dict
+    fine: dict
+    agree: dict
+    seconds: float = field(default=math.nan, compare=False)
+    workers: int = field(default=1, compare=False)
+
+    @property
+    def n(self) -> int:
+        return len(self.draws["h"])
+
+    @property
+    def run_agree(self) -> tuple:
+        """Per run: every metric and outcome agrees."""
+        return tuple(all(self.agree[k][i] for k in self.agree) for i in range(self.n))
+
+
+def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict) -> tuple[dict, dict, dict]:
+    """Compare per-run values at dt (``coarse``) and dt / 2 (``fine``).
+
+    Parameters
+    ----------
+    coarse, fine : dict
+        :data:`HALVING_METRICS` -> floats per run, :data:`HALVING_OUTCOMES`
+        -> bools per run, and ``phase_diverged`` (phase index where the run
+        diverged, NaN if it did not).
+    rtol : float
+    atol : dict
+        Metric -> absolute tolerance (missing: 0).
+
+    Returns
+    -------
+    (coarse, fine, agree) : dict, dict, dict
+        Values (tuples per run) and agree flags. A metric agrees by
+        :func:`workbench.studies.antiskid_run._agree` (both NaN agree, one
+        NaN disagrees); an outcome when it is equal. ``lam_max_over_opt``
+        is set NaN at both steps (not compared) for a run that diverged in
+        a traction phase (``phase_diverged`` < BRAKE_IN) at either step:
+        its maximum there is where the divergence test fired, as for the
+        nominal cases (:func:`~workbench.studies.antiskid_run.case_metrics`).
+    """
+    from ..controllers.antiskid003 import BRAKE_IN
+    from ..studies.antiskid_run import _agree
+
+    traction = (np.asarray(coarse["phase_diverged"], float) < BRAKE_IN) | (
+        np.asarray(fine["phase_diverged"], float) < BRAKE_IN)
+    out = []
+    for vals in (coarse, fine):
+        d = {k: tuple(float(x) for x in vals[k]) for k in HALVING_METRICS}
+        d["lam_max_over_opt"] = tuple(math.nan if t else x
+                                      for x, t in zip(d["lam_max_over_opt"], traction))
+        d.update({k: tuple(bool(x) for x in vals[k]) for k in HALVING_OUTCOMES})
+        out.append(d)
+    c, f = out
+    agree = {k: tuple(_agree(a, b, rtol, atol.get(k, 0.0)) for a, b in zip(c[k], f[k]))
+             for k in HALVING_METRICS}
+    agree.update({k: tuple(a == b for a, b in zip(c[k], f[k])) for k in HALVING_OUTCOMES})
+    return c, f, agree
+
+
+def _step_values(metrics: dict, viol: dict) -> dict:
+    """Per-run metrics and outcomes of one step, as :func:`compare_steps` takes them."""
+    return {**{k: np.asarray(metrics[k], float) for k in HALVING_METRICS + ("phase_diverged",)},
+            "diverged": np.asarray(viol["diverged"], bool),
+            "stopped": ~np.asarray(viol["not_stopped"], bool),
+            "above_lambda_opt": np.asarray(viol["above_lambda_opt"], bool)}
+
+
+def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
+                  coarse: bool = True) -> PendingSweep:
+    """Start the step-halving check of the first ``n`` runs of an
+    ``antiskid-run`` design's sweep (its ``[montecarlo]`` seed and draws).
+
+    The n runs are simulated as one batch at the sweep's dt and as one
+    batch at dt / 2. ``pool``: the batches run in a process pool now, so
+    the caller can work meanwhile, else in-process in
+    :meth:`PendingSweep.result`, which returns the :class:`HalvingCheck`.
+    ``coarse=False``: only the dt / 2 batch runs and ``result()`` returns a
+    function of the sweep's :class:`SweepResult` (whose first n runs are the
+    dt side: each run of a batch follows its single-run trajectory, whatever
+    its chunk) that makes the :class:`HalvingCheck`. ``K``: as
+    :func:`start_sweep`.
+    """
+    spec = design.spec
+    ms: SweepSpec = spec.montecarlo
+    if not n >= 1:
+        raise ValueError(f"halving check of {n} runs: need at least 1")
+    inp = _sweep_inputs(design, n, ms.seed, K)
+    payloads = ([_payload(inp, 0, n, inp["dt"])] if coarse else []) + [
+        _payload(inp, 0, n, inp["dt"] / 2)]
+    atol = {k: spec.conv_atol.get(k, 0.0) for k in HALVING_METRICS}
+
+    def check(steps: list, seconds: float, n_workers: int) -> HalvingCheck:
+        c, f, agree = compare_steps(*steps, spec.conv_rtol, atol)
+        return HalvingCheck(ms.case, ms.seed, inp["dt"], spec.conv_rtol, atol,
+                            {k: tuple(v.tolist()) for k, v in inp["draws"].items()},
+                            c, f, agree, seconds, n_workers)
+
+    def collect(outs: list, seconds: float, n_workers: int):
+        lam_opt = _lambda_opt(inp)
+        steps = []
+        for o in outs:
+            raw = {k: np.asarray(v, float) for k, v in o["metrics"].items()}
+            steps.append(_step_values(*_per_run(raw, lam_opt, inp["scenario"]["t_brake"])))
+        if coarse:
+            return check(steps, seconds, n_workers)
+
+        def with_sweep(res: SweepResult) -> HalvingCheck:
+            if res.n < n:
+                raise ValueError(f"the sweep has {res.n} runs; the check needs its first {n}")
+            first = _step_values({k: v[:n] for k, v in res.metrics.items()},
+                                 {k: v[:n] for k, v in res.violations.items()})
+            return check([first, steps[0]], seconds, n_workers)
+        return with_sweep
+
+    return PendingSweep(payloads, collect, len(payloads) if pool else 1, pool)
+
+
+def halving_quantity_names() -> set[str]:
+    """Quantities of :func:`halving_quantities`."""
+    return {"montecarlo.halving.runs", "montecarlo.halving.agree",
+            "montecarlo.halving.fraction_agree"}
+
+
+def halving_quantities(hc: HalvingCheck) -> dict:
+    """Runs checked, runs whose every metric and outcome agrees, and their
+    fraction."""
+    k = sum(hc.run_agree)
+    return {"montecarlo.halving.runs": hc.n, "montecarlo.halving.agree": k,
+            "montecarlo.halving.fraction_agree": k / hc.n}
+
+
+#: Column labels of the draws in :func:`halving_section`.
+_DRAW_LABELS = (("mass", "mass factor"), ("adhesion", "adhesion s"), ("h", "h (s)"),
+                ("v0", "v(0) (m/s)"))
+
+
+def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
+    """Markdown (no heading) of a :class:`HalvingCheck`: what was done, a
+    row per metric (runs finite at both steps, runs that agree, largest
+    |difference| over the runs finite at both), a row per outcome, and the
+    disagreeing runs (``sig`` significant digits for their values).
+    ``spec``: the design's ``RunSpec``, for the size of the sweep (optional;
+    the tolerances are the check's own)."""
+    from ..report.markdown import fmt, md_table
+    n, k = hc.n, sum(hc.run_agree)
+    of = "the sweep's runs" if spec is None or spec.montecarlo is None else \
+        f"the sweep's {spec.montecarlo.samples} runs"
+    tol = ", ".join(f"`{m}` {fmt(a)}" for m, a in hc.atol.items() if a > 0) or "none"
+    text = (f"The first {n} of {of} (seed {hc.seed}, case `{hc.case}`, the same draws) were "
+            f"simulated again as one batch at dt = {fmt(hc.dt)} s and as one batch at dt / 2 "
+            f"(each run of a batch follows its single-run trajectory). A metric agrees when "
+            f"|a − b| <= atol + rtol max(|a|, |b|), rtol = {fmt(hc.rtol)}, atol: {tol} "
+            f"(else 0); two missing values agree, a missing and a finite one do not; "
+            f"`lam_max_over_opt` is not compared for a run that diverged in traction at "
+            f"either step. An outcome agrees when it is the same at both steps. "
+            f"**{k} of {n} runs agree in every metric and outcome.**\n\n")
+    rows = []
+    for m in HALVING_METRICS:
+        a, b = np.asarray(hc.coarse[m], float), np.asarray(hc.fine[m], float)
+        both = np.isfinite(a) & np.isfinite(b)
+        diff = float(np.max(np.abs(a[both] - b[both]))) if both.any() else None
+        rows.append([f"`{m}`", fmt(hc.atol[m]), int(both.sum()), sum(hc.agree[m]),
+                     fmt(diff, 2)])
+    text += md_table(["metric", "atol", "finite at both", f"agree (of {n})",
+                      "largest |difference|"], rows, "lrrrr")
+    text += "\n\n" + md_table(
+        ["outcome", "runs at dt", "runs at dt / 2", f"agree (of {n})"],
+        [[f"`{o}`", sum(hc.coarse[o]), sum(hc.fine[o]), sum(hc.agree[o])]
+         for o in HALVING_OUTCOMES], "lrrr")
+    bad = [[i] + [fmt(hc.draws[d][i], 4) for d, _ in _DRAW_LABELS]
+           + [f"`{key}`", fmt(hc.coarse[key][i], sig), fmt(hc.fine[key][i], sig)]
+           for i in range(n) for key in hc.agree if not hc.agree[key][i]]
+    text += "\n\nRuns that disagree:"
+    if not bad:
+        return text + " none."
+    return text + "\n\n" + md_table(["run"] + [lab for _, lab in _DRAW_LABELS]
+                                    + ["metric or outcome", "at dt", "at dt / 2"],
+                                    bad, "rrrrrlrr")
+
+
 def draw_histograms(fig, res: SweepResult) -> None:
     """Histograms of the summary metrics (pure)."""
     axes = fig.subplots(1, len(SUMMARY_METRICS))
@@ -281,7 +551,7 @@ def draw_outcomes(fig, res: SweepResult) -> None:
     div = np.asarray(res.violations["diverged"], bool)
     stuck = np.asarray(res.violations["not_stopped"], bool) & ~div
     groups = (("stopped", ~div & ~stuck, "tab:blue", "o"),
-              ("diverged (|lambda| >= 0.9)", div, "tab:red", "x"),
+              ("diverged", div, "tab:red", "x"),
               ("not stopped, not diverged", stuck, "tab:gray", "s"))
     for ax, (kx, ky, lx, ly) in zip(fig.subplots(1, 2), (
             ("adhesion", "h", "adhesion s (0 wet, 1 dry)", "true input delay h (s)"),
