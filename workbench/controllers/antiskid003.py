@@ -73,7 +73,7 @@ PHASE_NAMES = ("acceleration", "handover to cruise", "cruise", "handover to brak
                "braking", "stopped", "diverged")
 PARAM_ORDER = tuple(PARAMETER_UNITS)
 #: Why a run was declared diverged (``RunMetrics.diverged_how``).
-DIVERGED_HOW = ("|lambda| >= lam_diverged", "step not resolved", "torque out of range")
+DIVERGED_HOW = ("|lambda| at its limit: spin or lock", "step not resolved", "torque out of range")
 
 
 @lru_cache(maxsize=4)

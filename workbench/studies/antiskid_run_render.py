@@ -246,7 +246,8 @@ def _montecarlo_section(design, mc, halving=None) -> str:
                       fmt(above[sel].mean(), 2) if n else "—"])
     return (
         "## Monte Carlo robustness (reduced sample)\n\n"
-        f"{mc.n} runs of case `{ms.case}` with seed {ms.seed}: a reduced sample of the "
+        f"{mc.n} runs of case `{ms.case}` with seed {ms.seed} at dt = "
+        f"{fmt(ms.dt or design.spec.dt)} s (the `[montecarlo]` step): a reduced sample of the "
         f"`workbench sweep designs/{design.name}.toml --samples N --seed {ms.seed}` study, "
         f"with the same sampler (run i has the same draws for every N, so these are the first {mc.n} runs of "
         "that study; each run of a batch follows its single-run trajectory). The claims "
@@ -328,7 +329,8 @@ def _numerics_section(with_montecarlo: bool = False) -> str:
         "0.205 / 0.198 / 0.194 / 0.192 / 0.1905 / 0.1898 at dt = 10 ms down to 0.16 ms). "
         "With the predictor, plant and rollout share one discretisation and the fixed step "
         "converges: a refined mesh (rollout on the mesh too) gave the same dry-rail metrics "
-        "(time to cruise 31.042 / 31.043 s, braking 86.29 / 86.35 s) at 15-100 times the cost; "
+        "(time to cruise 31.042 / 31.043 s, braking 86.29 / 86.35 s) at 15-100 times the cost "
+        "(`benchmarks/mesh.py` re-runs both comparisons); "
         "refining the plant but not the rollout is inconsistent and stops the train 35 s "
         "early (the predictor's error then keeps lambda at -0.03 after omega <= 3 rad/s).\n"
         "* Monte Carlo robustness (mass, adhesion between the wet and dry curves, true delay, "
