@@ -65,7 +65,7 @@ import numpy as np
 import sympy as sp
 
 from ..plants.adhesion import PARAMETER_UNITS, adhesion_model
-from ..sim.delay import SimResult, simulate_closed_loop, simulate_closed_loop_mesh
+from ..sim.delay import SimResult, simulate_closed_loop
 from ..sim.history import BatchDelayLine, DelayLine, TimedDelayLine
 
 ACCEL, HANDOVER, CRUISE, BRAKE_IN, BRAKE, STOPPED, DIVERGED = range(7)
@@ -363,10 +363,12 @@ class Antiskid003:
         value at the last braking sample.
     k_max : int or None
         None: every step is ``dt``. Else the loop runs on a refined mesh
-        (:func:`~workbench.sim.delay.simulate_closed_loop_mesh`, steps
+        (:func:`~workbench.sim.delay.simulate_closed_loop` with a level, steps
         dt / 2**k, k <= k_max, announced by :meth:`set_step`); the histories
         are then :class:`~workbench.sim.history.TimedDelayLine` and the
-        predictor's rollout still integrates eq (2) in steps of ``dt``.
+        predictor's rollout integrates eq (2) in pieces of the current step,
+        the plant's discretisation (a coarser rollout than the plant is
+        inconsistent: see ``benchmarks/mesh.py``).
     """
 
     def __init__(self, s: ControllerSettings, x0, u_init: float, dt: float, batch=None,
@@ -444,7 +446,7 @@ class Antiskid003:
     def _rollout(self, v, lam, ph):
         """X(t + h) of eq (2) by running the phase's model from x(t) through
         the inputs of the last h seconds (exact ZOH weights of the window; on
-        a refined mesh, in pieces of the base step with the exact average
+        a refined mesh, in pieces of the current step with the exact average
         input over each)."""
         line = self.uline
         for u, d in (line.pieces() if self._base is None else line.pieces(self._ticks)):
@@ -626,8 +628,8 @@ class Antiskid003:
         ws, no = s.profile.omega_switch, xp.logical_not
         # creep-speed error of Theorem 3, e_vs = v_s - v_s*(t) (measured), and
         # its left limit at omega = omega_switch (v_s* still on the profile)
-        vs_star, _ = s.profile(t, v, 0.0 * v, omega, xp)
         vs_on, _ = s.profile(t, v, 0.0 * v, math.inf + 0.0 * v, xp)
+        vs_star = xp.where(omega > ws, vs_on, 0.0)          # eq (76)
         vs = creep_speed(v, lam, xp)
         e, e_on = xp.abs(vs - vs_star), xp.abs(vs - vs_on)
         m.evs_last = w(brk, e, m.evs_last)
@@ -763,17 +765,15 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     x0 = (run.x0[0] + zero, run.x0[1] + zero)
     line = None if batch is None else BatchDelayLine(np.broadcast_to(run.h, (batch,)), dt,
                                                       run.u_init)
+    level = None
+    if mesh is not None:
+        S = _creep_rate_coefficient()(*p)
+        level = lambda x: mesh.level(x[0], S)
     with np.errstate(all="ignore"):
-        if mesh is None:
-            res = simulate_closed_loop(step, ctrl, x0, h=float(np.max(run.h)), dt=dt,
-                                       t_end=run.t_end, u_init=run.u_init + zero,
-                                       record_every=every, done=done, line=line)
-        else:
-            S = _creep_rate_coefficient()(*p)
-            res = simulate_closed_loop_mesh(step, ctrl, x0, h=float(run.h), dt=dt,
-                                            t_end=run.t_end, u_init=run.u_init,
-                                            level=lambda x: mesh.level(x[0], S),
-                                            k_max=mesh.k_max, record_dt=record_dt, done=done)
+        res = simulate_closed_loop(step, ctrl, x0, h=float(np.max(run.h)), dt=dt,
+                                   t_end=run.t_end, u_init=run.u_init + zero,
+                                   record_every=every, done=done, line=line, level=level,
+                                   k_max=0 if mesh is None else mesh.k_max)
     if record_dt is None:
         res = None
     else:

@@ -18,8 +18,7 @@ Two entry points:
     can use an exponential or implicit step). States may be floats or numpy
     arrays (a batch of runs in one pass).
 
-:func:`simulate_closed_loop_mesh`
-    The same loop on a refined mesh: the step is dt / 2**k with the level k
+    Optionally on a refined mesh: the step is dt / 2**k with the level k
     chosen at each step from the state (e.g. from a plant's fastest rate),
     the histories kept per step in a :class:`~workbench.sim.history.TimedDelayLine`.
     Halving dt halves every step of the mesh, so step-halving studies
@@ -191,84 +190,64 @@ def envelope_ratio(r: SimResult, period: float) -> float:
 # -- generic sampled closed loop ----------------------------------------------------
 def simulate_closed_loop(step: Callable, control: Callable, x0, *, h: float, dt: float,
                          t_end: float, u_init, record_every: int = 1,
-                         done: Callable | None = None, line=None) -> SimResult:
-    """Sampled closed loop with input delay: x_{n+1} = step(x_n, u(t - h), t_n, dt).
+                         done: Callable | None = None, line=None,
+                         level: Callable | None = None, k_max: int = 0) -> SimResult:
+    """Sampled closed loop with input delay: x_{n+1} = step(x_n, u(t - h), t_n, dt_n).
 
     Parameters
     ----------
     step : callable
         ``step(x, u_applied, t, dt) -> x_next`` (x a tuple of floats/arrays).
     control : callable
-        ``control(t, x, inputs: DelayLine) -> (u, phase)``; ``inputs`` holds
-        the past controller outputs (for predictors).
+        ``control(t, x, inputs) -> (u, phase)``; ``inputs`` (the delay
+        buffer) holds the past controller outputs (for predictors).
     x0 : tuple
         Initial state.
     h, dt, t_end : float
-        Input delay, step, horizon (s).
+        Input delay, (base) step, horizon (s).
     u_init : float or numpy.ndarray
         Input on [-h, 0).
     record_every : int
+        Keep one sample per this many base steps dt (the first and the last
+        sample are always kept).
     done : callable, optional
         ``done(t, x, phase) -> bool`` ends the run early.
     line : DelayLine-like, optional
         Input delay buffer to use instead of ``DelayLine(h, dt, u_init)``
-        (e.g. a :class:`~workbench.sim.history.BatchDelayLine`).
-    """
-    line = DelayLine(h, dt, u_init) if line is None else line
-    x = tuple(x0)
-    n_steps = int(round(t_end / dt))
-    T, Xs, U, UA, P = [], [], [], [], []
-    for n in range(n_steps + 1):
-        t = n * dt
-        u, phase = control(t, x, line)
-        line.push(u)
-        ua = line.delayed()
-        last = n == n_steps or (done is not None and done(t, x, phase))
-        if n % record_every == 0 or last:
-            T.append(t); Xs.append(x); U.append(u); UA.append(ua); P.append(phase)
-        if last:
-            break
-        x = step(x, ua, t, dt)
-    X = np.array(Xs, float).T
-    return SimResult(np.array(T), X, np.atleast_2d(np.array(U, float)),
-                     np.atleast_2d(np.array(UA, float)), np.array(P, int), dt=dt)
-
-
-def simulate_closed_loop_mesh(step: Callable, control: Callable, x0, *, h: float, dt: float,
-                              t_end: float, u_init, level: Callable, k_max: int,
-                              record_dt: float | None = None,
-                              done: Callable | None = None) -> SimResult:
-    """:func:`simulate_closed_loop` with the step dt / 2**level(x) (level in
-    [0, k_max]) chosen at each step.
-
-    Time is counted in ticks of dt / 2**k_max, so step ends are exact. The
-    controller is told each step before it is called,
-    ``control.set_step(ticks, tick)``, and receives the input history as a
-    :class:`~workbench.sim.history.TimedDelayLine`. Recorded every
-    ``record_dt`` seconds (at the first step end at or after each multiple;
-    None: first and last sample only).
+        (e.g. a :class:`~workbench.sim.history.BatchDelayLine`); fixed step only.
+    level, k_max : callable, int
+        Refined mesh (``k_max > 0``): each step is dt / 2**level(x), level
+        in [0, k_max]. Time is then counted in ticks of dt / 2**k_max, so
+        step ends are exact; the controller is told each step before it is
+        called, ``control.set_step(ticks, tick)``, and the buffer is a
+        :class:`~workbench.sim.history.TimedDelayLine`. With ``k_max = 0``
+        every step is dt.
     """
     tick = dt / 2 ** k_max
-    line = TimedDelayLine(h / tick, tick, u_init)
+    if line is None:
+        line = DelayLine(h, dt, u_init) if k_max == 0 else TimedDelayLine(h / tick, tick, u_init)
+    elif k_max:
+        raise ValueError("a refined mesh keeps its own TimedDelayLine (line must be None)")
+    set_step = getattr(control, "set_step", None) if k_max else None
     T_end = int(round(t_end / tick))
-    rec = None if record_dt is None else max(int(round(record_dt / tick)), 1)
-    x, T, next_rec = tuple(x0), 0, 0
+    rec = record_every * 2 ** k_max
+    x, T, n_prev = tuple(x0), 0, 1
     Ts, Xs, U, UA, P = [], [], [], [], []
     while True:
-        n = min(2 ** (k_max - min(max(int(level(x)), 0), k_max)), max(T_end - T, 1))
+        n = 1 if k_max == 0 else min(2 ** (k_max - min(max(int(level(x)), 0), k_max)),
+                                     max(T_end - T, 1))
         t = T * tick
-        control.set_step(n, tick)
+        if set_step is not None:
+            set_step(n, tick)
         u, phase = control(t, x, line)
         line.push(u, n)
         ua = line.delayed()
         last = T >= T_end or (done is not None and done(t, x, phase))
-        if T == 0 or last or (rec is not None and T >= next_rec):
+        if T % rec < n_prev or last:  # the first step end at or after each multiple
             Ts.append(t); Xs.append(x); U.append(u); UA.append(ua); P.append(phase)
-            if rec is not None:
-                next_rec = (T // rec + 1) * rec
         if last:
             break
         x = step(x, ua, t, n * tick)
-        T += n
+        T, n_prev = T + n, n
     return SimResult(np.array(Ts), np.array(Xs, float).T, np.atleast_2d(np.array(U, float)),
                      np.atleast_2d(np.array(UA, float)), np.array(P, int), dt=dt)

@@ -206,7 +206,7 @@ class BatchDelayLine:
         self._cols = np.arange(h.size)
         self._n = 0
 
-    def push(self, value) -> None:
+    def push(self, value, ticks=None) -> None:
         self._buf[self._n % self._L] = value
         self._n += 1
 
