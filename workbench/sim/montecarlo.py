@@ -325,7 +325,8 @@ class HalvingCheck:
         The sweep's case.
     seed : int
     dt : float
-        The sweep's step (s); each step simulated all n runs as one batch.
+        The sweep's step (s): the n runs at dt (the sweep's own, or one
+        batch) and at dt / 2 (one batch).
     rtol : float
     atol : dict
         Metric -> absolute tolerance (0 where the design gives none).
@@ -497,9 +498,10 @@ def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
     of = "the sweep's runs" if spec is None or spec.montecarlo is None else \
         f"the sweep's {spec.montecarlo.samples} runs"
     tol = ", ".join(f"`{m}` {fmt(a)}" for m, a in hc.atol.items() if a > 0) or "none"
-    text = (f"The first {n} of {of} (seed {hc.seed}, case `{hc.case}`, the same draws) were "
-            f"simulated again as one batch at dt = {fmt(hc.dt)} s and as one batch at dt / 2 "
-            f"(each run of a batch follows its single-run trajectory). A metric agrees when "
+    text = (f"The first {n} of {of} (seed {hc.seed}, case `{hc.case}`, the same draws), "
+            f"run at the sweep's dt = {fmt(hc.dt)} s, were simulated again as one batch at "
+            f"dt / 2 (each run of a batch follows its single-run trajectory, so a run's "
+            f"values do not depend on its chunk). A metric agrees when "
             f"|a − b| <= atol + rtol max(|a|, |b|), rtol = {fmt(hc.rtol)}, atol: {tol} "
             f"(else 0); two missing values agree, a missing and a finite one do not; "
             f"`lam_max_over_opt` is not compared for a run that diverged in traction at "
