@@ -6,6 +6,10 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 WB     := $(VENV)/bin/workbench
 STAMP  := $(VENV)/.installed
+# One OpenBLAS thread: the core count must not change the rounding.
+export OPENBLAS_NUM_THREADS ?= 1
+# A second CPU's BLAS kernels (no FMA): the report check must hold under it too.
+OTHER_KERNEL ?= Sandybridge
 
 .PHONY: install report test bench clean
 
@@ -21,11 +25,15 @@ install: $(STAMP)
 report: install
 	$(WB) report --all
 
-## tests, then every claim (designs and proofs), then report freshness
+## tests, then every claim (designs and proofs), then report freshness; then
+## the report check and the golden report again under another CPU's kernels
 test: install
 	$(PY) -m pytest
 	$(WB) verify
 	$(WB) report --all --check
+	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(WB) report --all --check
+	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(PY) -m pytest -q -p no:cacheprovider \
+	  tests/test_cli_and_reports.py::test_golden_report
 
 bench: install
 	for b in benchmarks/*.py; do $(PY) $$b || exit 1; done

@@ -1,0 +1,11 @@
+"""workbench: robust-control design and verification for train control.
+
+Determinism: OpenBLAS may split a product across threads, and how it splits
+depends on the machine's core count. The workbench runs OpenBLAS on one
+thread so that the same inputs give the same bits on every machine; this is
+set here, before numpy is imported by any workbench module, and a value the
+user set in the environment wins.
+"""
+import os as _os
+
+_os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")

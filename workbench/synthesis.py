@@ -1,8 +1,11 @@
 """Certified delay-bound synthesis (paper 003, Theorem 1 + Remark 3).
 
 :func:`synthesize_delay_bound` sweeps eps, bisects the delay for each with
-the DPP problem built once, and cross-checks every gain with the exact delay
-margins of :mod:`workbench.margins`.
+the DPP problem built once, takes the canonical (well-posed) gain of each
+row (:mod:`workbench.lmi.gain`: minimum-norm certificate at
+``gain_fraction * h_certified``, K rounded to ``gain_digits`` significant
+digits, then certified on its own with K fixed), and cross-checks every gain
+with the exact delay margins of :mod:`workbench.margins`.
 
 Numerical conditioning: A of the antiskid linearisation mixes m/s and a
 dimensionless creep ratio (entries from 4e-2 to 6e1). The LMI is solved in
@@ -22,6 +25,7 @@ import scipy.linalg as sl
 
 from .lmi.core import DEFAULT_MARGIN, Bracket, Outcome, bisect_delay
 from .lmi.freeweighting003 import FreeWeighting003, FreeWeighting003FixedK
+from .lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
 from .margins import DelayMargin, delay_margin_eig, delay_margin_siso
 
 
@@ -32,13 +36,17 @@ class SynthesisSettings:
     Attributes
     ----------
     margin : float
-        Named LMI definiteness margin (at trace(L) <= 1).
+        Named relative LMI definiteness margin (see :mod:`workbench.lmi.core`).
     rel_tol : float
         Relative width of the final bracket [h_certified, h_refuted].
     h_min, h_max : float
         Delay search range (s).
     max_solves : int
         Solver budget per row.
+    gain_fraction : float
+        The canonical gain is taken at ``gain_fraction * h_certified``.
+    gain_digits : int
+        Significant digits of the canonical gain.
     """
 
     margin: float = DEFAULT_MARGIN
@@ -46,6 +54,13 @@ class SynthesisSettings:
     h_min: float = 1e-4
     h_max: float = 100.0
     max_solves: int = 60
+    gain_fraction: float = DEFAULT_FRACTION
+    gain_digits: int = DEFAULT_DIGITS
+
+    def bisection(self) -> dict:
+        """Keyword arguments of :func:`~workbench.lmi.core.bisect_delay`."""
+        return dict(h_lo=self.h_min, h_hi=self.h_max, rel_tol=self.rel_tol,
+                    max_solves=self.max_solves)
 
 
 @dataclass(frozen=True)
@@ -56,26 +71,33 @@ class SynthesisRow:
     ----------
     eps : float
     h_certified, h_refuted : float
-        Bracket (s): certified by an optimal solve with a passing re-check /
-        refuted by an optimal solve (``inf``: none refuted in range).
+        Bracket (s) of the criterion: certified by an optimal solve with a
+        passing re-check / refuted by an optimal solve (``inf``: none refuted
+        in range).
     K : tuple[float, ...] or None
-        Gain from the certificate at ``h_certified`` (original coordinates).
+        Canonical gain (original coordinates, rounded to the settings'
+        ``gain_digits``); see :mod:`workbench.lmi.gain`.
     status : Outcome
+        CERTIFIED when the bracket is certified and the canonical gain
+        certifies a positive delay on its own.
     exact : DelayMargin or None
         Exact delay margin of x' = A x + B K x(t - h) (eigenvalue method).
     exact_siso : DelayMargin or None
         Same, from python-control's crossovers (independent method).
     recheck_min : float or None
-        Smallest re-check eigenvalue margin of the certificate.
+        Smallest relative re-check margin of the canonical certificate.
     solves : int
     seconds : float
     statuses : tuple[str, ...]
         Outcome letter per solve (c / r / i), in order.
     recheck : dict[str, float]
-        Re-check eigenvalue margin of every LMI block at ``h_certified``.
+        Relative re-check margin of every LMI block of the canonical
+        certificate (at ``gain.h_design``).
     certificate : dict[str, numpy.ndarray]
-        Decision variables at ``h_certified`` (balanced coordinates, see
-        module docstring).
+        Decision variables of the canonical certificate (balanced
+        coordinates, see module docstring).
+    gain : CanonicalGain or None
+        The canonical gain with its own certified bracket.
     """
 
     eps: float
@@ -91,6 +113,12 @@ class SynthesisRow:
     statuses: tuple[str, ...] = field(repr=False)
     recheck: dict = field(default_factory=dict, repr=False)
     certificate: dict = field(default_factory=dict, repr=False)
+    gain: CanonicalGain | None = field(default=None, repr=False)
+
+    @property
+    def h_gain(self) -> float | None:
+        """Delay (s) the canonical gain certifies on its own (None: no gain)."""
+        return None if self.gain is None else self.gain.h_certified
 
     @property
     def ratio(self) -> float | None:
@@ -103,7 +131,10 @@ class SynthesisRow:
         em = None if self.exact is None else ("inf" if math.isinf(self.exact.h) else self.exact.h)
         return {"eps": self.eps, "h_certified": self.h_certified,
                 "h_refuted": "inf" if math.isinf(self.h_refuted) else self.h_refuted,
-                "K": None if self.K is None else list(self.K), "exact_margin": em,
+                "K": None if self.K is None else list(self.K),
+                "h_gain": self.h_gain,
+                "h_design": None if self.gain is None else self.gain.h_design,
+                "exact_margin": em,
                 "status": self.status.value, "solves": self.solves,
                 "seconds": round(self.seconds, 4)}
 
@@ -122,20 +153,33 @@ def _balanced(A, B):
     return Tinv @ A @ T, Tinv @ B, T, Tinv
 
 
-def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, Tinv) -> SynthesisRow:
-    K = exact = exact_siso = rmin = None
+def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, T,
+         settings: SynthesisSettings) -> SynthesisRow:
+    K = exact = exact_siso = rmin = gain = None
     recheck, cert = {}, {}
+    status, steps = br.outcome, list(br.steps)
     if br.certificate is not None:
-        recheck, cert = dict(br.certificate.recheck), dict(br.certificate.certificate)
-        Kmat = crit.gain(br.certificate.certificate) @ Tinv
-        K = tuple(float(k) for k in Kmat.ravel())
-        exact = delay_margin_eig(A, B @ Kmat)
-        if B.shape[1] == 1:
-            exact_siso = delay_margin_siso(A, B, Kmat)
-        rmin = min(br.certificate.recheck.values())
-    return SynthesisRow(float(eps), br.h_certified, br.h_refuted, K, br.outcome, exact,
-                        exact_siso, rmin, br.solves, br.seconds,
-                        tuple(s.outcome.value[0] for s in br.steps), recheck, cert)
+        gain = canonical_gain(
+            crit, br.h_certified,
+            lambda Kt: FreeWeighting003FixedK(crit.A, crit.B, crit.eps, K=Kt,
+                                              margin=settings.margin),
+            T, fraction=settings.gain_fraction, digits=settings.gain_digits,
+            **settings.bisection())
+        steps.append(gain.point)
+        if gain.analysis is not None:
+            steps += gain.analysis.steps
+        if gain.K is None or gain.outcome is not Outcome.CERTIFIED:
+            status = Outcome.INCONCLUSIVE
+        if gain.K is not None:
+            recheck, cert = dict(gain.point.recheck), dict(gain.point.certificate)
+            rmin = min(recheck.values())
+            K = tuple(float(k) for k in gain.K.ravel())
+            exact = delay_margin_eig(A, B @ gain.K)
+            if B.shape[1] == 1:
+                exact_siso = delay_margin_siso(A, B, gain.K)
+    return SynthesisRow(float(eps), br.h_certified, br.h_refuted, K, status, exact,
+                        exact_siso, rmin, len(steps), sum(s.seconds for s in steps),
+                        tuple(s.outcome.value[0] for s in br.steps), recheck, cert, gain)
 
 
 def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = SynthesisSettings()
@@ -158,16 +202,15 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
         In the order of ``eps_values``.
     """
     A, B = np.asarray(A, float), np.asarray(B, float).reshape(np.shape(A)[0], -1)
-    At, Bt, _, Tinv = _balanced(A, B)
+    At, Bt, T, _ = _balanced(A, B)
     crit = FreeWeighting003(At, Bt, eps_values[0], margin=settings.margin)
     rows, guess = [], None
     for eps in eps_values:
         crit.set_eps(eps)
-        br = bisect_delay(crit.solve_at, h_lo=settings.h_min, h_hi=settings.h_max,
-                          rel_tol=settings.rel_tol, max_solves=settings.max_solves, guess=guess)
+        br = bisect_delay(crit.solve_at, guess=guess, **settings.bisection())
         if br.h_certified > 0:
             guess = br.h_certified
-        rows.append(_row(eps, br, crit, A, B, Tinv))
+        rows.append(_row(eps, br, crit, A, B, T, settings))
     return tuple(rows)
 
 
@@ -176,9 +219,8 @@ def certify_given_gain(A, B, K, eps: float, settings: SynthesisSettings = Synthe
     """Largest delay the criterion of problem (60) certifies for a *given* K
     (V = K L fixed), e.g. a gain printed in a paper."""
     At, Bt, T, _ = _balanced(A, B)
-    crit = FreeWeighting003FixedK(At, Bt, np.atleast_2d(K) @ T, eps, margin=settings.margin)
-    return bisect_delay(crit.solve_at, h_lo=settings.h_min, h_hi=settings.h_max,
-                        rel_tol=settings.rel_tol, max_solves=settings.max_solves)
+    crit = FreeWeighting003FixedK(At, Bt, eps, K=np.atleast_2d(K) @ T, margin=settings.margin)
+    return bisect_delay(crit.solve_at, **settings.bisection())
 
 
 def eps_for_bound(A, B, h_target: float, eps_lo: float, eps_hi: float, *,
@@ -194,9 +236,7 @@ def eps_for_bound(A, B, h_target: float, eps_lo: float, eps_hi: float, *,
 
     def h_of(eps):
         crit.set_eps(eps)
-        return bisect_delay(crit.solve_at, h_lo=settings.h_min, h_hi=settings.h_max,
-                            rel_tol=settings.rel_tol, max_solves=settings.max_solves,
-                            guess=h_target).h_certified
+        return bisect_delay(crit.solve_at, guess=h_target, **settings.bisection()).h_certified
 
     lo, hi = eps_lo, eps_hi
     if not (h_of(lo) <= h_target <= h_of(hi)):

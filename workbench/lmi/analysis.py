@@ -4,8 +4,8 @@ Each criterion is a :class:`~workbench.lmi.core.MarginLMI`: blocks written
 once, solved as "maximise t" by Clarabel, re-checked with numpy; the largest
 certified h comes from the shared bracketed bisection
 (:func:`~workbench.lmi.core.bisect_delay`) through :func:`certified_delay`.
-Every criterion normalises the Lyapunov matrix ``P`` (trace(P) <= 1; for the
-Bessel-Legendre hierarchy its positive lower bound Theta, see the class).
+Margins are relative to the largest block norm (see :mod:`workbench.lmi.core`),
+so no criterion depends on how its Lyapunov matrix is scaled.
 
 Notation (block selectors on the augmented vector xi):
 ``x = x(t)``, ``x_d = x(t - h)``, and for the Bessel-Legendre hierarchy the
@@ -77,9 +77,8 @@ def _sym(n: int, name: str) -> cp.Variable:
 
 
 class _DelayAnalysis(MarginLMI):
-    """Common parts: the system matrices and the normalised P."""
+    """Common parts: the system matrices."""
 
-    normaliser = "P"
     method: str = ""
     retry_settings = RETRY_SETTINGS
 
@@ -215,7 +214,7 @@ class BesselLegendreLMI(_DelayAnalysis):
         Theta_N(h) = P + (1/h) diag(0, S, 3S, ..., (2N-1)S) >= 0,  S, R >= 0
 
     (Theta from int x'Sx >= (1/h) sum (2k+1) (h Omega_k)' S (h Omega_k)).
-    Decision variables: Theta ((N+1) n symmetric, the normalised one, with
+    Decision variables: Theta ((N+1) n symmetric, with
     P = Theta - (1/h) diag(0, S, ..., (2N-1) S) substituted), S, R (n x n
     symmetric).
     N = 0 is the Jensen criterion, N = 1 the Wirtinger one of SG13; the bound
@@ -223,7 +222,6 @@ class BesselLegendreLMI(_DelayAnalysis):
     """
 
     method = "bessel-legendre"
-    normaliser = "Theta"
 
     def __init__(self, A, Ad, N: int, **kw):
         if not (isinstance(N, (int, np.integer)) and N >= 0):
@@ -238,7 +236,8 @@ class BesselLegendreLMI(_DelayAnalysis):
     def variables(self):
         n, N = self.n, self._N
         # Theta (not P) is the variable: P = Theta - (1/h) D(S), so the
-        # normalisation trace(Theta) <= 1 bounds a positive semidefinite matrix.
+        # block norm bound of the solver's normalisation applies to a
+        # positive semidefinite matrix.
         return {"Theta": _sym((N + 1) * n, "Theta"), "S": _sym(n, "S"), "R": _sym(n, "R")}
 
     def selectors(self):

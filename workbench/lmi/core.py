@@ -9,14 +9,25 @@ How a delay value is decided (a closed set of outcomes, cf. cvxpy's status
 groups):
 
 * the problem is solved as **maximise t** subject to every negative block
-  ``F(x) <= -t I`` and every positive block ``G(x) >= t I``, with the
-  normalisation ``trace(X_norm) <= 1`` (all criteria are homogeneous, so
-  this only fixes the scale) and ``|x| <= bound`` on the other variables;
+  ``F(x) <= -t I, trace(-F(x)) <= 1`` and every positive block
+  ``G(x) >= t I, trace(G(x)) <= 1`` (all criteria are homogeneous, so bounding
+  every block's size by 1 only fixes the scale) and ``|x| <= bound`` on the
+  decision variables;
+* the **margin is relative**: a point's margin is the smallest definiteness
+  of its blocks divided by the size of the largest block,
+  ``min_i lambda_min(-F_i) / max_j ||F_j||_*`` with the nuclear norm
+  ``||F||_*`` (sum of absolute eigenvalues; the trace of a definite block)
+  (:func:`relative_margins`). It does not change when the certificate is
+  scaled, so how a loop is scaled (a near-zero gain entry, a slow mode, the
+  time unit of the decision variables) does not decide what is certified;
+  the optimal ``t*`` of the solve above is exactly the best relative margin
+  of the criterion at ``h`` (the size constraints are linear, so the
+  normalisation costs no extra cone);
 * **CERTIFIED** when the solver reports ``optimal``, ``t* >= margin`` and the
-  numpy re-check finds every block's eigenvalue margin ``>= margin`` (no
-  strict LMIs: ``margin`` is the named definiteness margin);
+  numpy re-check finds every block's relative margin ``>= margin`` (no
+  strict LMIs: ``margin`` is the named relative definiteness margin);
 * **REFUTED** when the solver reports ``optimal`` with ``t* < margin``: no
-  point of the criterion (at this normalisation) holds with that margin;
+  point of the criterion holds with that relative margin;
 * **INCONCLUSIVE** otherwise (inaccurate, solver error, or a point that
   fails its re-check) — never certified.
 
@@ -38,9 +49,11 @@ from typing import Callable, Mapping, Sequence
 import cvxpy as cp
 import numpy as np
 
-#: Named definiteness margin of every LMI (absolute, at trace(X_norm) <= 1).
+#: Named definiteness margin of every LMI, relative to the largest block norm
+#: of the certificate (see the module docstring).
 DEFAULT_MARGIN = 1e-7
-#: Bound on the decision variables other than the normalised one.
+#: Bound on every decision variable entry, relative to the unit block size of
+#: the solver's normalisation.
 DEFAULT_BOUND = 1e3
 #: Clarabel settings: tighter than its defaults (1e-8) because the optimum
 #: of these GEVPs is degenerate.
@@ -119,6 +132,29 @@ class Bracket:
         return sum(s.seconds for s in self.steps)
 
 
+def relative_margins(blocks: Sequence[Block]) -> dict[str, float]:
+    """Relative definiteness margin of every block, recomputed with numpy.
+
+    Each entry is ``-lambda_max(F)`` (negative blocks) or ``lambda_min(G)``
+    (positive blocks) divided by the largest nuclear norm (sum of absolute
+    eigenvalues) among all blocks, so it is unchanged when the whole
+    certificate is scaled; positive means satisfied. A block that is not
+    symmetric to 1e-9 relative to that norm gets ``-inf``; so does every
+    block when all of them vanish.
+    """
+    mats = [(b.name, b.sense, np.asarray(b.matrix, dtype=float)) for b in blocks]
+    eigs = {name: np.linalg.eigvalsh((m + m.T) / 2) for name, _, m in mats}
+    scale = max((float(np.sum(np.abs(e))) for e in eigs.values()), default=0.0)
+    out: dict[str, float] = {}
+    for name, sense, m in mats:
+        if not scale > 0 or np.max(np.abs(m - m.T)) > 1e-9 * scale:
+            out[name] = -math.inf
+            continue
+        e = eigs[name]
+        out[name] = float(-e[-1] if sense == "nsd" else e[0]) / scale
+    return out
+
+
 class MarginLMI:
     """An LMI criterion in a scalar delay parameter, built once (DPP).
 
@@ -129,27 +165,26 @@ class MarginLMI:
     Parameters
     ----------
     margin : float
-        Definiteness margin (see module docstring).
+        Relative definiteness margin (see module docstring).
     bound : float
-        Bound on every non-normalised decision variable.
+        Bound on every decision variable entry (at unit block size).
     """
 
-    #: Name of the variable whose trace is normalised to <= 1.
-    normaliser: str = "L"
     #: Clarabel settings tried in order after an ``optimal_inaccurate`` answer
     #: (each on top of :data:`CLARABEL_SETTINGS`); a retry can only certify
     #: through the same numpy re-check.
     retry_settings: tuple[dict, ...] = ()
 
     def __init__(self, *, margin: float = DEFAULT_MARGIN, bound: float = DEFAULT_BOUND):
-        if not margin > 0:
-            raise ValueError(f"margin = {margin!r}; expected a positive number")
+        if not 0 < margin < 1:
+            raise ValueError(f"margin = {margin!r}; expected a relative margin in (0, 1)")
         self.margin, self.bound = float(margin), float(bound)
         self._params = {k: cp.Parameter(nonneg=True, name=k)
                         for k in ("h", "iota") + tuple(self.parameters())}
         self._vars = self.variables()
         self._t = cp.Variable(name="t")
         self._problem = self._build()
+        self._canonical: cp.Problem | None = None
 
     # -- to be written by each criterion -----------------------------------
     def variables(self) -> dict[str, cp.Variable]:
@@ -172,20 +207,25 @@ class MarginLMI:
                 raise KeyError(k)
             self._params[k].value = float(v)
 
+    def set_delay(self, h: float) -> None:
+        """Set the delay parameters (``h`` and ``iota = 1/h``) before a solve;
+        criteria with further delay-dependent parameters extend it."""
+        self._params["h"].value, self._params["iota"].value = float(h), 1.0 / float(h)
+
     # -- machinery ----------------------------------------------------------
-    def _build(self) -> cp.Problem:
-        t, cons = self._t, []
+    def _symmetric_blocks(self):
         for blk in self.blocks(self._vars, self._params, cp.bmat):
             m = blk.matrix
-            sym = (m + m.T) / 2
-            eye = np.eye(sym.shape[0])
-            cons.append(sym << -t * eye if blk.sense == "nsd" else sym >> t * eye)
-        for name, var in self._vars.items():
-            if name == self.normaliser:
-                cons.append(cp.trace(var) <= 1)
+            yield blk, (m + m.T) / 2, np.eye(m.shape[0])
+
+    def _build(self) -> cp.Problem:
+        t, cons = self._t, []
+        for blk, sym, eye in self._symmetric_blocks():
+            if blk.sense == "nsd":
+                cons += [sym << -t * eye, -cp.trace(sym) <= 1]
             else:
-                cons.append(cp.abs(var) <= self.bound)
-        cons.append(t <= 1.0)
+                cons += [sym >> t * eye, cp.trace(sym) <= 1]
+        cons += [cp.abs(var) <= self.bound for var in self._vars.values()]
         return cp.Problem(cp.Maximize(t), cons)
 
     def evaluate_blocks(self, values: Mapping[str, np.ndarray], h: float) -> list[Block]:
@@ -195,22 +235,9 @@ class MarginLMI:
         return self.blocks(values, p, np.block)
 
     def recheck(self, values: Mapping[str, np.ndarray], h: float) -> dict[str, float]:
-        """Smallest eigenvalue margin of every block, recomputed with numpy.
-
-        A positive entry means the block satisfies its inequality with that
-        much room; a block that is not symmetric to 1e-9 (relative) gets
-        ``-inf``.
-        """
-        out: dict[str, float] = {}
-        for blk in self.evaluate_blocks(values, h):
-            m = np.asarray(blk.matrix, dtype=float)
-            scale = max(1.0, float(np.max(np.abs(m))))
-            if np.max(np.abs(m - m.T)) > 1e-9 * scale:
-                out[blk.name] = -math.inf
-                continue
-            eig = np.linalg.eigvalsh((m + m.T) / 2)
-            out[blk.name] = float(-eig[-1]) if blk.sense == "nsd" else float(eig[0])
-        return out
+        """Relative margin of every block at ``values`` and delay ``h``,
+        recomputed with numpy (:func:`relative_margins`)."""
+        return relative_margins(self.evaluate_blocks(values, h))
 
     def solve_at(self, h: float) -> Step:
         """Decide the criterion at delay ``h`` (s); see the module docstring.
@@ -226,28 +253,73 @@ class MarginLMI:
             spent += step.seconds
         return dataclasses.replace(step, seconds=spent)
 
-    def _solve_once(self, h: float, settings: Mapping) -> Step:
-        self._params["h"].value, self._params["iota"].value = float(h), 1.0 / float(h)
+    def _run(self, problem: cp.Problem, h: float, settings: Mapping) -> tuple[str, float]:
+        self.set_delay(h)
         t0 = time.perf_counter()
         try:
             with warnings.catch_warnings():   # "inaccurate" is an outcome, not a warning
                 warnings.simplefilter("ignore", UserWarning)
-                self._problem.solve(solver=cp.CLARABEL, **settings)
-            status = str(self._problem.status)
+                problem.solve(solver=cp.CLARABEL, **settings)
+            status = str(problem.status)
         except cp.error.SolverError as exc:  # an answer, not a crash
             status = f"error: {exc}".splitlines()[0]
-        seconds = time.perf_counter() - t0
+        return status, time.perf_counter() - t0
+
+    def _checked(self, h: float, status: str, t_opt: float, seconds: float) -> Step:
+        values = {k: np.array(v.value, dtype=float) for k, v in self._vars.items()}
+        margins = self.recheck(values, h)
+        ok = all(m >= self.margin for m in margins.values())
+        return Step(h, Outcome.CERTIFIED if ok else Outcome.INCONCLUSIVE, status, t_opt,
+                    margins, values if ok else None, seconds)
+
+    def _solve_once(self, h: float, settings: Mapping) -> Step:
+        status, seconds = self._run(self._problem, h, settings)
         t_opt = self._t.value if status == cp.OPTIMAL else None
         if t_opt is None:
             return Step(h, Outcome.INCONCLUSIVE, status, None, {}, None, seconds)
         t_opt = float(t_opt)
         if t_opt < self.margin:
             return Step(h, Outcome.REFUTED, status, t_opt, {}, None, seconds)
-        values = {k: np.array(v.value, dtype=float) for k, v in self._vars.items()}
-        margins = self.recheck(values, h)
-        ok = all(m >= self.margin for m in margins.values())
-        return Step(h, Outcome.CERTIFIED if ok else Outcome.INCONCLUSIVE, status, t_opt,
-                    margins, values if ok else None, seconds)
+        return self._checked(h, status, t_opt, seconds)
+
+    def canonical_point(self, h: float) -> Step:
+        """The minimum-norm certificate at delay ``h``: a unique point.
+
+        The optimum of :meth:`solve_at` is in general not unique (at a
+        degenerate GEVP optimum a whole face is optimal), so the point a
+        solver returns, and any gain computed from it, depends on the
+        solver's path and on the CPU's BLAS kernels. This solve has one
+        solution instead: minimise the Euclidean norm of all decision
+        variables' entries subject to ``F(x) <= -I`` and ``G(x) >= I`` — the
+        projection of 0 onto a closed convex set, unique whenever the
+        criterion holds at ``h`` with a positive margin (written as a
+        second-order cone, which Clarabel solves more reliably here than the
+        equivalent quadratic objective). After an inaccurate answer it is
+        retried with :attr:`retry_settings`. The point is re-checked like
+        any other (relative margins >= ``margin``).
+
+        Returns
+        -------
+        Step
+            CERTIFIED with the point, or INCONCLUSIVE (solver not optimal,
+            infeasible at ``h``, or a failed re-check); ``t_opt`` is the
+            point's smallest relative margin.
+        """
+        if self._canonical is None:
+            cons = [sym << -eye if blk.sense == "nsd" else sym >> eye
+                    for blk, sym, eye in self._symmetric_blocks()]
+            size = cp.norm(cp.hstack([cp.vec(v, order="F") for v in self._vars.values()]), 2)
+            self._canonical = cp.Problem(cp.Minimize(size), cons)
+        status, seconds = self._run(self._canonical, h, CLARABEL_SETTINGS)
+        for extra in self.retry_settings:
+            if status == cp.OPTIMAL:
+                break
+            status, more = self._run(self._canonical, h, {**CLARABEL_SETTINGS, **extra})
+            seconds += more
+        if status != cp.OPTIMAL:
+            return Step(h, Outcome.INCONCLUSIVE, status, None, {}, None, seconds)
+        step = self._checked(h, status, 0.0, seconds)
+        return dataclasses.replace(step, t_opt=min(step.recheck.values()))
 
 
 class FixedGain:
@@ -255,14 +327,15 @@ class FixedGain:
     into the analysis of a *given* gain: ``V`` is replaced by ``K X``.
 
     Use as ``class C(FixedGain, SomeSynthesis)`` with ``gain_basis`` naming X;
-    the constructor takes ``(A, B, K, eps, **kw)``.
+    the constructor takes the synthesis LMI's arguments and the gain as the
+    keyword ``K``.
     """
 
     gain_basis: str = "L"
 
-    def __init__(self, A, B, K, eps: float, **kw):
+    def __init__(self, *args, K, **kw):
         self.K = np.atleast_2d(np.asarray(K, float))
-        super().__init__(A, B, eps, **kw)
+        super().__init__(*args, **kw)
 
     def variables(self):
         v = super().variables()

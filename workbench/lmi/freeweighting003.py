@@ -50,7 +50,6 @@ class FreeWeighting003(MarginLMI):
         Scalar of Remark 3, R = eps L (> 0).
     """
 
-    normaliser = "L"
 
     def __init__(self, A, B, eps: float, **kw):
         self.A, self.B = np.asarray(A, float), np.asarray(B, float)

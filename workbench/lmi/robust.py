@@ -40,7 +40,8 @@ import numpy as np
 
 from ..margins import DelayMargin, delay_margin_eig, spectral_abscissa
 from .analysis import BesselLegendreLMI, certified_delay
-from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, bisect_delay
+from .core import DEFAULT_MARGIN, Block, Bracket, FixedGain, MarginLMI, Outcome, bisect_delay
+from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
 
 
 class DescriptorSynthesis(MarginLMI):
@@ -57,7 +58,7 @@ class DescriptorSynthesis(MarginLMI):
 
     (P_i, S_i stand for Y'P_iY, Y'S_iY and R_i for h Y'R_iY). Decision
     variables: Y (n x n), V (m x n) common; P_i, S_i, R_i (symmetric n x n)
-    per point; ``P0`` is normalised. Feasible at h => the loop with
+    per point. Feasible at h => the loop with
     K = V Y^{-1} is asymptotically stable at delay h at every point; with
     alpha = 0 also at every h' <= h (in terms of Y'RY the LMI changes only by
     -(h^2 - h'^2) in the x' block).
@@ -67,7 +68,6 @@ class DescriptorSynthesis(MarginLMI):
     feasible => exponentially stable with rate alpha at delay h.
     """
 
-    normaliser = "P0"
 
     def __init__(self, points: Sequence[tuple[np.ndarray, np.ndarray]], eps: float,
                  alpha: float = 0.0, **kw):
@@ -86,9 +86,9 @@ class DescriptorSynthesis(MarginLMI):
     def parameters(self):
         return ("eps", "ealpha")
 
-    def solve_at(self, h: float):
+    def set_delay(self, h: float) -> None:
+        super().set_delay(h)
         self.set_parameters(ealpha=math.exp(self.alpha * h))
-        return super().solve_at(h)
 
     def set_eps(self, eps: float) -> None:
         if not eps > 0:
@@ -122,23 +122,34 @@ class DescriptorSynthesis(MarginLMI):
         return np.linalg.solve(values["Y"].T, values["V"].T).T
 
 
+class DescriptorSynthesisFixedK(FixedGain, DescriptorSynthesis):
+    """The same LMI with the gain fixed (V = K Y): what a given K certifies
+    at every operating point at once."""
+
+    gain_basis = "Y"
+
+
 @dataclass(frozen=True)
 class RobustSynthesis:
-    """Best eps and its bracket; K from the certificate (original coordinates).
+    """Best eps and its bracket; the canonical K (original coordinates).
 
     Attributes
     ----------
     eps : float
     bracket : Bracket
     K : numpy.ndarray or None
+        Canonical gain (:mod:`workbench.lmi.gain`), rounded.
     eps_tried : tuple[tuple[float, float], ...]
         (eps, h_certified) of the automatic search.
+    gain : CanonicalGain or None
+        How K was chosen, and the delay it certifies on its own.
     """
 
     eps: float
     bracket: Bracket
     K: np.ndarray | None
     eps_tried: tuple[tuple[float, float], ...]
+    gain: CanonicalGain | None = None
 
 
 def _balancing(points):
@@ -224,24 +235,31 @@ def best_eps_bracket(lmi, eps_grid: Sequence[float], *, golden_steps: int, h_hi:
 def synthesize_robust(points, *, alpha: float = 0.0,
                       eps_grid: Sequence[float] = (0.03, 0.1, 0.3, 1.0, 3.0),
                       golden_steps: int = 6, rel_tol: float = 1e-3,
-                      margin: float = DEFAULT_MARGIN, h_hi: float = 10.0) -> RobustSynthesis:
+                      margin: float = DEFAULT_MARGIN, h_hi: float = 10.0,
+                      gain_fraction: float = DEFAULT_FRACTION,
+                      gain_digits: int = DEFAULT_DIGITS) -> RobustSynthesis:
     """Largest h with one gain certified at every point, eps searched automatically.
 
     eps is chosen by a log grid, then golden-section refinement (in log eps)
     around the best grid value; each eps is a certified bisection on h
     (shared :func:`~workbench.lmi.core.bisect_delay`). Coordinates are
     balanced by a common power-of-two diagonal T (exact), K is mapped back.
+    K is the canonical gain (:func:`~workbench.lmi.gain.canonical_gain`).
     """
     T, Tinv, pts = _balancing(points)
     lmi = DescriptorSynthesis(pts, eps_grid[0], alpha, margin=margin)
     best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_hi,
                                    rel_tol=rel_tol)
     br = tried[best]
-    K = None
+    gain = None
     if br.certificate is not None:
-        K = lmi.gain(br.certificate.certificate) @ Tinv
+        lmi.set_eps(best)
+        gain = canonical_gain(
+            lmi, br.h_certified,
+            lambda Kt: DescriptorSynthesisFixedK(pts, best, alpha, K=Kt, margin=margin), T,
+            fraction=gain_fraction, digits=gain_digits, h_hi=h_hi, rel_tol=rel_tol)
     pairs = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
-    return RobustSynthesis(best, br, K, pairs)
+    return RobustSynthesis(best, br, None if gain is None else gain.K, pairs, gain)
 
 
 @dataclass(frozen=True)

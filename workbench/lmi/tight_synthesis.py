@@ -10,8 +10,11 @@ congruence ``Y = P2^{-1}``, ``V = K Y``. The scalar eps is not fixed by hand:
 largest certified delay by the shared bracketed bisection
 (:func:`~workbench.lmi.core.bisect_delay`).
 
-Every synthesised gain is then checked twice, independently of the synthesis
-LMI: by the Bessel-Legendre *analysis* criterion of
+The gain is the canonical one of :mod:`workbench.lmi.gain` (minimum-norm
+certificate at ``gain_fraction * h_certified`` of the best eps, rounded to
+``gain_digits`` significant digits, certified on its own by
+:class:`WirtingerSynthesisFixedK`). It is then checked twice, independently
+of the synthesis LMI: by the Bessel-Legendre *analysis* criterion of
 :mod:`workbench.lmi.analysis` with that K, and by the exact delay margin of
 :mod:`workbench.margins` (:func:`~workbench.lmi.robust.check_gain`).
 
@@ -39,6 +42,7 @@ import numpy as np
 
 from ..margins import DelayMargin, delay_margin_siso
 from .core import DEFAULT_MARGIN, Block, Bracket, FixedGain, MarginLMI
+from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
 from .robust import DescriptorSynthesis, PointCheck, _balancing, best_eps_bracket, check_gain
 
 
@@ -66,7 +70,7 @@ class WirtingerSynthesis(MarginLMI):
     ``S_pos``, ``R_pos`` >= 0. The (2,2) block h R~ - eps (Y + Y') <= 0 makes
     Y nonsingular, so K = V Y^{-1}.
 
-    Decision variables: Theta (2n symmetric, normalised), S, R (n symmetric),
+    Decision variables: Theta (2n symmetric), S, R (n symmetric),
     Y (n x n), V (m x n). A CERTIFIED point at h proves that the loop with
     K = V Y^{-1} is asymptotically stable at the constant delay h.
 
@@ -78,7 +82,6 @@ class WirtingerSynthesis(MarginLMI):
         Descriptor slack scalar (P3 = eps P2), > 0.
     """
 
-    normaliser = "Theta"
 
     def __init__(self, A, B, eps: float, **kw):
         self.A = np.atleast_2d(np.asarray(A, float))
@@ -143,7 +146,8 @@ class TightSynthesis:
         Certified bisection of the synthesis LMI at ``eps`` (balanced
         coordinates, see :func:`synthesize_tight`).
     K : numpy.ndarray or None
-        Gain (original coordinates), None when nothing was certified.
+        Canonical gain (original coordinates, rounded), None when nothing
+        was certified.
     eps_tried : tuple[tuple[float, float], ...]
         (eps, h_certified) of the search, sorted by eps.
     check : PointCheck or None
@@ -154,6 +158,8 @@ class TightSynthesis:
         Search cap (s) of both bisections.
     T : numpy.ndarray
         Balancing T (x = T x~) of the certificate's coordinates.
+    gain : CanonicalGain or None
+        How K was chosen, and the delay it certifies on its own.
     """
 
     eps: float
@@ -164,6 +170,7 @@ class TightSynthesis:
     exact_siso: DelayMargin | None
     h_max: float
     T: np.ndarray = field(repr=False)
+    gain: CanonicalGain | None = field(default=None, repr=False)
 
     @property
     def h_certified(self) -> float:
@@ -178,7 +185,9 @@ class TightSynthesis:
 
 def synthesize_tight(A, B, *, eps_grid: Sequence[float] = (0.01, 0.1, 1.0, 10.0, 100.0),
                      golden_steps: int = 6, h_max: float = 10.0, rel_tol: float = 1e-3,
-                     N: int = 2, margin: float = DEFAULT_MARGIN) -> TightSynthesis:
+                     N: int = 2, margin: float = DEFAULT_MARGIN,
+                     gain_fraction: float = DEFAULT_FRACTION,
+                     gain_digits: int = DEFAULT_DIGITS) -> TightSynthesis:
     """Largest delay certified by :class:`WirtingerSynthesis`, eps searched.
 
     Parameters
@@ -197,7 +206,9 @@ def synthesize_tight(A, B, *, eps_grid: Sequence[float] = (0.01, 0.1, 1.0, 10.0,
     N : int
         Bessel-Legendre order of the analysis check of the gain.
     margin : float
-        LMI definiteness margin.
+        Relative LMI definiteness margin.
+    gain_fraction, gain_digits
+        Canonical gain (:func:`~workbench.lmi.gain.canonical_gain`).
 
     Returns
     -------
@@ -212,15 +223,20 @@ def synthesize_tight(A, B, *, eps_grid: Sequence[float] = (0.01, 0.1, 1.0, 10.0,
     best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_max,
                                    rel_tol=rel_tol, stop_at=h_max)   # nothing beyond the cap
     br = tried[best]
-    K = check = siso = None
+    K = check = siso = gain = None
     if br.certificate is not None:
-        K = lmi.gain(br.certificate.certificate) @ Tinv
+        lmi.set_eps(best)
+        gain = canonical_gain(
+            lmi, br.h_certified,
+            lambda Kt: WirtingerSynthesisFixedK(At, Bt, best, K=Kt, margin=margin), T,
+            fraction=gain_fraction, digits=gain_digits, h_hi=h_max, rel_tol=rel_tol)
+        K = gain.K
+    if K is not None:
         (check,) = check_gain([(A, B)], K, N=N, margin=margin, h_hi=h_max)
         if B.shape[1] == 1:
             siso = delay_margin_siso(A, B, K)
     tried_h = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
-    return TightSynthesis(best, br, K, tried_h, check, siso,
-                          float(h_max), T)
+    return TightSynthesis(best, br, K, tried_h, check, siso, float(h_max), T, gain)
 
 
 def recheck_tight(A, B, result: TightSynthesis,

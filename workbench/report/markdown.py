@@ -86,3 +86,12 @@ def _tex_num(v, sig):
         m, e = s.split("e")
         return rf"{m}\times 10^{{{int(e)}}}"
     return s.replace("−", "-")
+
+
+def margin_text(margin: float) -> str:
+    """A re-check margin as the decade it lies in (``"≥ 1e-05"`` for 3.2e-5),
+    or ``"fail"``: the digits of a solver's internal value that hold on every
+    machine."""
+    if not (math.isfinite(margin) and margin > 0):
+        return "fail"
+    return f"≥ 1e{math.floor(math.log10(margin)):+03d}"

@@ -20,6 +20,7 @@ from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
 from ..lmi.core import DEFAULT_MARGIN
 from ..lmi.robust import PointCheck, check_gain
+from ..lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
 from ..lmi.tight_synthesis import TightSynthesis, synthesize_tight
 from ..margins import DelayMargin, delay_margin_eig
 from ..plants.adhesion import PARAMETER_UNITS, NumericAdhesion
@@ -193,6 +194,10 @@ class AntiskidCruise:
             margin=syn.number("margin", default=DEFAULT_MARGIN, positive=True, hi=1e-2),
             rel_tol=syn.number("rel_tol", default=1e-4, positive=True, hi=0.1),
             h_max=syn.number("h_max", default=100.0, positive=True),
+            gain_fraction=syn.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
+                                     hi=1.0, what="fraction of h_certified"),
+            gain_digits=int(syn.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
+                                       lo=2, hi=8)),
         )
         published = []
         for pr in syn.tables("published", default=[]):
@@ -313,7 +318,8 @@ def _run_tight(spec: CruiseSpec, lin: Linearisation, rows) -> TightComparison:
     """Tight synthesis, and the Bessel-Legendre + exact check of the reference gains."""
     ts, st = spec.tight, spec.settings
     syn = synthesize_tight(lin.A, lin.B, eps_grid=ts.grid, h_max=ts.h_max, N=ts.order,
-                           margin=st.margin, rel_tol=max(st.rel_tol, 1e-3))
+                           margin=st.margin, rel_tol=max(st.rel_tol, 1e-3),
+                           gain_fraction=st.gain_fraction, gain_digits=st.gain_digits)
 
     def check(K):
         return check_gain([(lin.A, lin.B)], np.array([K]), N=ts.order, margin=st.margin,

@@ -21,6 +21,7 @@ import numpy as np
 from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
 from ..lmi.core import DEFAULT_MARGIN
+from ..lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
 from ..lmi.robust import PointCheck, RobustSynthesis, check_gain, synthesize_robust
 from ..margins import spectral_abscissa
 from ..plants.adhesion import PARAMETER_UNITS, NumericAdhesion
@@ -65,6 +66,8 @@ class RobustSpec:
     h_max: float
     margin: float
     order: int
+    gain_fraction: float
+    gain_digits: int
     compare: tuple[Compare, ...]
 
 
@@ -135,7 +138,11 @@ class AntiskidRobust:
             rel_tol=syn.number("rel_tol", default=1e-2, positive=True, hi=0.1),
             h_max=syn.number("h_max", default=10.0, positive=True),
             margin=syn.number("margin", default=DEFAULT_MARGIN, positive=True, hi=1e-2),
-            order=int(syn.number("analysis_order", default=2, integer=True, lo=0, hi=6)))
+            order=int(syn.number("analysis_order", default=2, integer=True, lo=0, hi=6)),
+            gain_fraction=syn.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
+                                     hi=1.0, what="fraction of h_certified"),
+            gain_digits=int(syn.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
+                                       lo=2, hi=8)))
         syn.finish()
         compare = []
         for c in root.tables("compare", default=[]):
@@ -147,7 +154,8 @@ class AntiskidRobust:
         return RobustSpec(common, rails, points, compare=tuple(compare), **spec)
 
     def quantity_names(self, spec: RobustSpec) -> set[str]:
-        names = {"synthesis.h_certified", "synthesis.eps", "synthesis.K1", "synthesis.K2",
+        names = {"synthesis.h_certified", "synthesis.h_gain", "synthesis.eps", "synthesis.K1",
+                 "synthesis.K2",
                  "robust.all_stable", "robust.min_exact_margin", "robust.max_abscissa_at_h",
                  "robust.min_exact_over_certified"}
         for p in spec.points:
@@ -163,11 +171,12 @@ class AntiskidRobust:
         pts = [(p.A, p.B) for p in s.points]
         syn = synthesize_robust(pts, alpha=s.alpha, eps_grid=s.eps_grid,
                                 golden_steps=s.golden_steps, rel_tol=s.rel_tol,
-                                margin=s.margin, h_hi=s.h_max)
+                                margin=s.margin, h_hi=s.h_max, gain_fraction=s.gain_fraction,
+                                gain_digits=s.gain_digits)
         checks, absc = (), ()
         if syn.K is not None:
             checks = check_gain(pts, syn.K, N=s.order, margin=s.margin)
-            h = syn.bracket.h_certified
+            h = syn.gain.h_certified          # what the rounded canonical K certifies
             absc = tuple(spectral_abscissa(A, B @ syn.K, h) for A, B in pts)
         compared = tuple(check_gain(pts, np.array([c.K]), N=s.order, margin=s.margin)
                          for c in s.compare)
@@ -176,7 +185,9 @@ class AntiskidRobust:
     def quantities(self, res: RobustResult) -> dict:
         syn = res.synthesis
         h = syn.bracket.h_certified
-        q = {"synthesis.h_certified": h if h > 0 else None, "synthesis.eps": syn.eps,
+        h_gain = syn.gain.h_certified if syn.gain else 0.0
+        q = {"synthesis.h_certified": h if h > 0 else None,
+             "synthesis.h_gain": h_gain if h_gain > 0 else None, "synthesis.eps": syn.eps,
              "synthesis.K1": None if syn.K is None else float(syn.K[0, 0]),
              "synthesis.K2": None if syn.K is None else float(syn.K[0, 1])}
         spec_points = res.points
@@ -184,7 +195,8 @@ class AntiskidRobust:
             q["robust.all_stable"] = "yes" if all(c.stable_at_zero for c in res.checks) else "no"
             q["robust.min_exact_margin"] = min(c.exact.h for c in res.checks)
             q["robust.max_abscissa_at_h"] = max(res.abscissa)
-            q["robust.min_exact_over_certified"] = min(c.exact.h for c in res.checks) / h
+            q["robust.min_exact_over_certified"] = (min(c.exact.h for c in res.checks) / h_gain
+                                                    if h_gain > 0 else None)
             for p, c, a in zip(spec_points, res.checks, res.abscissa):
                 q[f"points[{p.id}].exact_margin"] = c.exact.h
                 q[f"points[{p.id}].h_certified"] = c.h_certified

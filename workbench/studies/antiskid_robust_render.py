@@ -36,11 +36,16 @@ def render(design, res) -> Rendered:
     if syn.K is None:
         return Rendered((prob, "## Robust gain\n\n**No gain was certified** at these points "
                          f"(best eps {fmt(syn.eps, 3)})."))
-    gain = (f"## Robust gain\n\n$K = {latex_matrix(syn.K, 4)}$, certified at every point "
-            f"with decay rate {fmt(res.alpha)} 1/s at the delay **h = {fmt(h, 3)} s** "
-            f"(eps = {fmt(syn.eps, 3)}; bracket [{fmt(h, 4)}, {fmt(syn.bracket.h_refuted, 4)}] "
-            f"s; {syn.bracket.solves} solves at the chosen eps, "
-            f"{len(syn.eps_tried)} eps values tried).\n\n"
+    g = syn.gain
+    gain = (f"## Robust gain\n\n$K = {latex_matrix(syn.K, g.digits)}$, certified at every point "
+            f"with decay rate {fmt(res.alpha)} 1/s at the delay **h = {fmt(g.h_certified, 3)} s**."
+            f"\n\nThe synthesis LMI's bound is the bracket [{fmt(h, 4)}, "
+            f"{fmt(syn.bracket.h_refuted, 4)}] s at eps = {fmt(syn.eps, 3)} "
+            f"({len(syn.eps_tried)} eps values tried). K is its canonical gain: the "
+            f"minimum-norm certificate at {fmt(g.h_design / h, 3)} × the bound (a problem with "
+            f"one solution, unlike the degenerate optimum), rounded to {g.digits} significant "
+            "digits; h above is what that rounded K certifies on its own (same LMI, V = K Y "
+            "fixed).\n\n"
             + md_table(["point", "exact margin h* (s)", f"certified, BL N={res.order} (s)",
                         "spectral abscissa at h (1/s)"],
                        [[f"`{p.id}`", _margin(c), fmt(c.h_certified, 4), fmt(a, 3)]

@@ -1,0 +1,135 @@
+"""A well-posed gain from a state-feedback synthesis LMI.
+
+At the largest certified delay of a synthesis LMI the optimum is degenerate:
+the Lyapunov variable (L of paper 003's problem (60), Y of the descriptor
+LMIs) tends to a singular matrix and a whole face of points is optimal, so
+the gain ``K = V L^{-1}`` a solver returns there is not determined by the
+problem. It depends on the solver's path and on the CPU's BLAS kernels
+(paper 003's dry design gave K1 = -0.0050126, -0.0050141 and -0.0050132 under
+three OpenBLAS kernels). :func:`canonical_gain` replaces that arbitrary point
+by a unique one:
+
+1. the bisection gives the criterion's bracket ``[h_certified, h_refuted]``
+   (this does not depend on which optimal point the solver returns);
+2. at ``h_design = fraction * h_certified`` (strictly inside the certified
+   range, default 0.99) the *minimum-norm certificate* is computed
+   (:meth:`~workbench.lmi.core.MarginLMI.canonical_point`: the unique point
+   of least Frobenius norm with every block definite by at least 1) and
+   ``K = V L^{-1}`` is taken from it;
+3. K is rounded to ``digits`` significant digits (default 4): the printed
+   gain *is* the gain that is certified and simulated;
+4. the rounded K is certified on its own by the same LMI with the gain fixed
+   (``V = K L``), by the shared bisection: its own bracket.
+
+References
+----------
+.. [BEFB94] Boyd S., El Ghaoui L., Feron E., Balakrishnan V., *Linear Matrix
+   Inequalities in System and Control Theory*, SIAM 1994, sec. 2.4 (analytic
+   centre and other canonical points of an LMI's feasible set).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .core import Bracket, MarginLMI, Outcome, Step, bisect_delay
+
+#: Fraction of the certified delay at which the canonical point is computed.
+DEFAULT_FRACTION = 0.99
+#: Significant digits of a canonical gain.
+DEFAULT_DIGITS = 4
+
+
+def round_significant(x: np.ndarray, digits: int) -> np.ndarray:
+    """Every entry of ``x`` rounded to ``digits`` significant (decimal) digits,
+    through its decimal representation (the same on every machine)."""
+    if not (isinstance(digits, int) and digits >= 1):
+        raise ValueError(f"digits = {digits!r}; expected an integer >= 1")
+    x = np.asarray(x, float)
+    return np.array([float(f"{v:.{digits - 1}e}") for v in x.ravel()]).reshape(x.shape)
+
+
+@dataclass(frozen=True)
+class CanonicalGain:
+    """The canonical gain of a synthesis and what it certifies on its own.
+
+    Attributes
+    ----------
+    K : numpy.ndarray or None
+        Gain in original coordinates, rounded to ``digits`` significant
+        digits; None when the canonical point could not be certified.
+    digits : int
+    h_design : float
+        Delay (s) of the minimum-norm certificate K was taken from.
+    point : Step
+        That certificate (balanced coordinates) with its relative re-check
+        margins.
+    analysis : Bracket or None
+        The synthesis LMI with ``K`` fixed: the delay bracket (s) the rounded
+        gain certifies by itself.
+    """
+
+    K: np.ndarray | None
+    digits: int
+    h_design: float
+    point: Step
+    analysis: Bracket | None
+
+    @property
+    def outcome(self) -> Outcome:
+        """CERTIFIED when the rounded K certifies a positive delay on its own."""
+        return Outcome.INCONCLUSIVE if self.analysis is None else self.analysis.outcome
+
+    @property
+    def h_certified(self) -> float:
+        """Delay (s) the rounded gain certifies on its own (0 when none)."""
+        return 0.0 if self.analysis is None else self.analysis.h_certified
+
+
+def canonical_gain(lmi: MarginLMI, h_certified: float, fixed: Callable[[np.ndarray], MarginLMI],
+                   T: np.ndarray, *, fraction: float = DEFAULT_FRACTION,
+                   digits: int = DEFAULT_DIGITS, h_lo: float = 1e-4, h_hi: float = 100.0,
+                   rel_tol: float = 1e-4, max_solves: int = 60) -> CanonicalGain:
+    """The well-posed gain of a synthesis LMI (see the module docstring).
+
+    Parameters
+    ----------
+    lmi : MarginLMI
+        The synthesis LMI, with its scalar parameters (eps) already set; it
+        must have a ``gain(values)`` method (K in its own coordinates).
+    h_certified : float
+        Largest delay (s) certified by the bisection of ``lmi`` (> 0).
+    fixed : callable
+        ``fixed(K) -> MarginLMI``: the same LMI with the gain fixed to ``K``
+        (given in ``lmi``'s coordinates).
+    T : (n, n) array
+        Coordinates of ``lmi``: x = T x~ (K = K~ T^{-1}); a power-of-two
+        diagonal, so mapping K is exact.
+    fraction : float
+        ``h_design = fraction * h_certified``, in (0, 1].
+    digits : int
+        Significant digits of K.
+    h_lo, h_hi, rel_tol, max_solves
+        Bisection settings of the fixed-gain analysis.
+
+    Returns
+    -------
+    CanonicalGain
+    """
+    if not 0 < fraction <= 1:
+        raise ValueError(f"fraction = {fraction!r}; expected a number in (0, 1]")
+    if not h_certified > 0:
+        raise ValueError(f"h_certified = {h_certified!r}; expected a positive delay (s)")
+    h = fraction * h_certified
+    point = lmi.canonical_point(h)
+    if point.outcome is not Outcome.CERTIFIED:
+        return CanonicalGain(None, digits, h, point, None)
+    T = np.asarray(T, float)
+    K = round_significant(lmi.gain(point.certificate) @ np.diag(1.0 / np.diag(T)), digits)
+    crit = fixed(K @ T)
+    analysis = bisect_delay(crit.solve_at, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol,
+                            max_solves=max_solves, guess=min(max(h, h_lo), h_hi))
+    return CanonicalGain(K, digits, h, point, analysis)
+
