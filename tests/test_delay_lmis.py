@@ -252,3 +252,28 @@ def test_robust_design_bad_input(tmp_path, capsys, old, new, key):
     path.write_text(src.replace(old, new), encoding="utf-8")
     assert main(["verify", str(path)]) == 2
     assert key in capsys.readouterr().err
+
+
+def test_hierarchy_never_goes_backwards(monkeypatch):
+    """An order whose own search fails (as after an inaccurate solve) reports
+    the lower order's certificate, which proves it feasible (SG15 Thm 4)."""
+    import workbench.lmi.analysis as an
+    real = an.certified_delay
+
+    def flaky(lmi, **kw):
+        b = real(lmi, **kw)
+        if lmi.N == 2:                       # order 2's search "lost" its bound
+            return an.DelayBound(b.method, 2, an.Bracket(0.0, math.inf, Outcome.INCONCLUSIVE,
+                                                         None, b.bracket.steps))
+        return b
+    monkeypatch.setattr(an, "certified_delay", flaky)
+    auto = an.bessel_legendre_auto(A, AD, EXACT, N_max=2, N_through=2, rel_tol=1e-3,
+                                   margin=MARGIN)
+    h = [b.h_certified for b in auto.bounds]
+    assert h == sorted(h) and h[2] == h[1] > 0
+    assert auto.bounds[2].certified_by == 1 and auto.bounds[1].certified_by is None
+
+
+def test_make_criterion_rejects_an_order_it_would_ignore():
+    with pytest.raises(ValueError, match="N = 3; expected None"):
+        make_criterion("jensen", A, AD, N=3)

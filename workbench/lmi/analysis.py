@@ -314,8 +314,11 @@ def make_criterion(method: MethodName, A, Ad, *, N: int | None = None,
     """The criterion object for a method name of :data:`METHODS`."""
     if method == "bessel-legendre":
         if N is None:
-            raise ValueError("bessel-legendre needs an order N")
+            raise ValueError("N = None; expected an integer order >= 0 for bessel-legendre")
         return BesselLegendreLMI(A, Ad, N, margin=margin)
+    if N is not None:
+        raise ValueError(f"N = {N!r}; expected None for method {method!r} (only "
+                         "bessel-legendre has an order)")
     cls = {"delay-independent": DelayIndependentLMI, "jensen": JensenLMI,
            "free-weighting": FreeWeightingLMI, "wirtinger": WirtingerLMI}.get(method)
     if cls is None:
@@ -336,11 +339,17 @@ class DelayBound:
         From :func:`~workbench.lmi.core.bisect_delay`; for the
         delay-independent test a single solve (``h_certified = inf`` when
         certified, else 0).
+    certified_by : int or None
+        Bessel-Legendre order whose certificate gives ``bracket`` when it is
+        not ``N`` itself: a lower order certified more than order N's own
+        search (an inaccurate solve there). A certificate of order N - 1 at h
+        makes order N feasible at h (SG15 Theorem 4), so the bound stands.
     """
 
     method: str
     N: int | None
     bracket: Bracket
+    certified_by: int | None = None
 
     @property
     def h_certified(self) -> float:
@@ -403,6 +412,10 @@ def bessel_legendre_auto(A, Ad, exact: float, *, gap_tol: float = 1e-4, N_max: i
     order's bisection starts from the previous order's bound (the hierarchy
     is non-decreasing in N). ``exact`` is the exact margin (s) from
     :mod:`workbench.margins`; with ``exact = inf`` the gap never closes.
+    The hierarchy never goes backwards: when order N's own search certifies
+    less than order N - 1 (an inaccurate solve there), order N reports the
+    lower order's certificate (``certified_by``), which proves order N
+    feasible at that delay.
     """
     out: list[DelayBound] = []
     guess, reached = None, None
@@ -411,6 +424,10 @@ def bessel_legendre_auto(A, Ad, exact: float, *, gap_tol: float = 1e-4, N_max: i
             break
         b = certified_delay(BesselLegendreLMI(A, Ad, N, margin=margin), rel_tol=rel_tol,
                             guess=guess, h_hi=h_hi)
+        if out and b.h_certified < out[-1].h_certified:
+            prev = out[-1]
+            b = DelayBound(b.method, N, prev.bracket,
+                           prev.certified_by if prev.certified_by is not None else prev.N)
         out.append(b)
         if b.h_certified > 0:
             guess = b.h_certified
