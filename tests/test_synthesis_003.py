@@ -48,7 +48,13 @@ def test_table3(rows, lin, eps, h_m, K):
     assert r.h_certified <= r.h_refuted <= r.h_certified * (1 + 2e-4)
     if REPRODUCES[eps]:
         assert _truncated(r.h_certified) == h_m
-        assert r.K[1] == pytest.approx(K[1], rel=0.01)      # K is not unique
+        # K is not unique at the optimum (a face of optimal points; the
+        # printed K is one of them). Ours is the canonical gain, taken at
+        # 0.99 h_certified, rounded, and certified on its own by at least that:
+        assert r.gain.h_design <= r.h_gain <= r.h_certified * (1 + 2e-4)
+        # it lies near the printed point (the 1 % step back in h moves k2 by
+        # about 2 %; a 1 % tolerance applied to the old, arbitrary optimum)
+        assert r.K[1] == pytest.approx(K[1], rel=0.03)
         assert r.K[0] == pytest.approx(K[0], abs=0.0006)
     else:
         # Not reproduced: our bound is higher, and the printed gain itself
