@@ -68,6 +68,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import cvxpy as cp
 import numpy as np
@@ -104,15 +105,21 @@ class _Selectors:
         return E
 
 
-class _VaryingTerms:
-    """The Wirtinger / reciprocally convex terms shared by analysis and synthesis.
+Windows = Literal["delay", "fixed"]
 
-    ``names`` lists xi's blocks; ``x``, ``xh`` (= x(t - h(t))), ``x2``,
-    ``nu2``, ``nu3`` always, ``x1`` and ``nu1`` when h1 > 0.
+
+class _VaryingTerms:
+    """The functional's terms shared by the analysis and the synthesis LMIs.
+
+    ``names`` lists xi's blocks: ``x``, ``xh`` (= x(t - h(t))), ``x2``,
+    ``nu2``, ``nu3`` always, ``x1`` and ``nu1`` when h1 > 0 (the synthesis
+    adds ``dx`` = x'). Subclasses set ``h1``, ``mu``, ``windows``, ``n`` and
+    ``_e`` (a :class:`_Selectors`) before ``MarginLMI.__init__``.
     """
 
     h1: float
     mu: float | None
+    windows: str
     n: int
 
     @property
@@ -121,8 +128,17 @@ class _VaryingTerms:
 
     @property
     def with_Q(self) -> bool:
-        """The Q term needs a known derivative bound below 1."""
-        return self.mu is not None and self.mu < 1
+        """The Q term: with delay windows at every known mu (h' is a vertex
+        value); with fixed windows only for mu < 1 (worst case 1 - mu > 0)."""
+        if self.mu is None:
+            return False
+        return self.windows == "delay" or self.mu < 1
+
+    def _vertices(self) -> tuple[tuple[str, float], ...]:
+        """(h(t) vertex, h'(t) value) pairs at which Phi is checked."""
+        if self.windows == "delay":
+            return tuple((v, d) for v in ("h1", "h2") for d in (-self.mu, self.mu))
+        return (("h1", self.mu or 0.0), ("h2", self.mu or 0.0))
 
     def parameters(self) -> tuple[str, ...]:
         return ("h12", "h12sq")
@@ -139,9 +155,23 @@ class _VaryingTerms:
         self.set_delay(h)        # h12 parameters of this h, not of the last solve
         return MarginLMI.evaluate_blocks(self, values, h)
 
+    def _init_terms(self, h1, mu, windows, n, extra_names=()):
+        self.h1, self.mu = _check_interval(h1, mu)
+        if windows is None:
+            windows = "fixed" if self.mu is None else "delay"
+        if windows not in ("delay", "fixed"):
+            raise ValueError(f"windows = {windows!r}; expected 'delay' or 'fixed'")
+        if windows == "delay" and self.mu is None:
+            raise ValueError("windows = 'delay', mu = None; expected a derivative bound mu "
+                             "(delay windows put h'(t) into z'), or windows = 'fixed'")
+        self.windows, self.n = windows, n
+        names = (("x", "x1", "xh", "x2", "nu1", "nu2", "nu3") if self.with_h1
+                 else ("x", "xh", "x2", "nu2", "nu3")) + tuple(extra_names)
+        self._e = _Selectors(n, self.with_h1, names)
+
     def _lkf_variables(self) -> dict[str, cp.Variable]:
         n = self.n
-        k = 3 if self.with_h1 else 2
+        k = 2 + int(self.with_h1) + int(self.windows == "delay")
         v = {"P": cp.Variable((k * n, k * n), symmetric=True, name="P"),
              "S2": cp.Variable((n, n), symmetric=True, name="S2"),
              "R2": cp.Variable((n, n), symmetric=True, name="R2"),
@@ -153,25 +183,27 @@ class _VaryingTerms:
             v["Q"] = cp.Variable((n, n), symmetric=True, name="Q")
         return v
 
-    def _common(self, e, v, p, bmat, F, Fdot_weight):
-        """Everything in V' but He(G' P H): the S, Q terms, the x'' weights
-        (``Fdot_weight(W)`` returns the quadratic form of x' with weight W)
-        and the Wirtinger / reciprocally convex lower bounds."""
-        n = self.n
+    def _common(self, v, p, bmat, dx_form):
+        """Everything in V' but He(G' P H) and the Q term: the S terms, the
+        x'' weights (``dx_form(W)`` is the quadratic form of x' with weight W
+        on xi) and the Wirtinger / reciprocally convex lower bounds."""
+        e = self._e
         x, xh, x2, x1 = e("x"), e("xh"), e("x2"), e("x1")
-        R2, X = v["R2"], v["X"]
-        out = x1.T @ v["S2"] @ x1 - x2.T @ v["S2"] @ x2
-        out = out + p["h12sq"] * Fdot_weight(R2)
+        out = x1.T @ v["S2"] @ x1 - x2.T @ v["S2"] @ x2 + p["h12sq"] * dx_form(v["R2"])
         if self.with_h1:
-            S1, R1, nu1 = v["S1"], v["R1"], e("nu1")
-            c0, c1 = x - x1, x + x1 - 2 * nu1
-            out = (out + x.T @ S1 @ x - x1.T @ S1 @ x1 + self.h1 ** 2 * Fdot_weight(R1)
+            S1, R1 = v["S1"], v["R1"]
+            c0, c1 = x - x1, x + x1 - 2 * e("nu1")
+            out = (out + x.T @ S1 @ x - x1.T @ S1 @ x1 + self.h1 ** 2 * dx_form(R1)
                    - c0.T @ R1 @ c0 - 3 * (c1.T @ R1 @ c1))
-        if self.with_Q:
-            Q = v["Q"]
-            out = out + x.T @ Q @ x - (1.0 - self.mu) * (xh.T @ Q @ xh)
         gam = np.vstack([x1 - xh, x1 + xh - 2 * e("nu2"), xh - x2, xh + x2 - 2 * e("nu3")])
         return out - gam.T @ self._rcc(v, bmat) @ gam
+
+    def _Q_term(self, v, d: float):
+        """x'Qx - (1 - h') x(t-h)'Q x(t-h) at h' = d (fixed windows: d = mu)."""
+        if not self.with_Q:
+            return 0
+        x, xh, Q = self._e("x"), self._e("xh"), v["Q"]
+        return x.T @ Q @ x - (1.0 - d) * (xh.T @ Q @ xh)
 
     def _rcc(self, v, bmat):
         n = self.n
@@ -180,14 +212,28 @@ class _VaryingTerms:
         Rt = bmat([[R2, Z], [Z, 3 * R2]])
         return bmat([[Rt, X], [X.T, Rt]])
 
-    def _G_H(self, e, p, F, vertex: str):
-        """z = G xi at h(t) = h1 (``vertex='h1'``) or h2, and z' = H xi."""
-        x, x1, x2 = e("x"), e("x1"), e("x2")
+    def _G_H(self, p, dx, vertex: str, d: float):
+        """Row blocks of z = G xi at h(t) = h1 or h2 and of z' = H xi at h' = d
+        (``dx`` is the row block of x')."""
+        e = self._e
+        x, x1, xh, x2 = e("x"), e("x1"), e("xh"), e("x2")
         c2, c3 = (0, p["h12"]) if vertex == "h1" else (p["h12"], 0)
-        last = c2 * e("nu2") + c3 * e("nu3")
-        if self.with_h1:
-            return [x, self.h1 * e("nu1"), last], [F, x - x1, x1 - x2]
-        return [x, last], [F, x - x2]
+        head_G = [x] + ([self.h1 * e("nu1")] if self.with_h1 else [])
+        head_H = [dx] + ([x - x1] if self.with_h1 else [])
+        if self.windows == "delay":     # [int_{t-h(t)}^{t-h1} x; int_{t-h2}^{t-h(t)} x]
+            return (head_G + [c2 * e("nu2"), c3 * e("nu3")],
+                    head_H + [x1 - (1.0 - d) * xh, (1.0 - d) * xh - x2])
+        return head_G + [c2 * e("nu2") + c3 * e("nu3")], head_H + [x1 - x2]
+
+    def _phi_blocks(self, v, p, bmat, dx, dx_form, extra=0) -> list[Block]:
+        common = self._common(v, p, bmat, dx_form) + extra
+        out = []
+        for vertex, d in self._vertices():
+            G, H = self._G_H(p, dx, vertex, d)
+            name = f"phi_{vertex}" + (f"_d{d:+g}" if self.windows == "delay" else "")
+            out.append(Block(name, _he_GPH(G, v["P"], H) + self._Q_term(v, d) + common,
+                             "nsd"))
+        return out
 
     def _positive_blocks(self, v, bmat) -> list[Block]:
         out = [Block("P", v["P"], "psd"), Block("S2", v["S2"], "psd"),
@@ -196,15 +242,14 @@ class _VaryingTerms:
         return out
 
 
-def _he_GPH(G_rows, P, H_rows, vstack):
+def _he_GPH(G_rows, P, H_rows):
     """He(G' P H) for G, H given as lists of row blocks (G may hold parameters)."""
     k = len(G_rows)
     n = H_rows[0].shape[0]
     out = 0
     for i in range(k):
         for j in range(k):
-            Pij = P[i * n:(i + 1) * n, j * n:(j + 1) * n]
-            term = G_rows[i].T @ Pij @ H_rows[j]
+            term = G_rows[i].T @ P[i * n:(i + 1) * n, j * n:(j + 1) * n] @ H_rows[j]
             out = out + term + term.T
     return out
 
@@ -216,11 +261,13 @@ class VaryingDelayLMI(_VaryingTerms, MarginLMI):
     certificate proves. The blocks (``x' = F xi``, F = [A, A_d] on
     [x; x(t - h(t))]):
 
-        Phi(h(t)) = He(G(h(t))' P H) + [S, Q terms]
-                    + F'(h1^2 R1 + h12^2 R2)F - Gamma1' diag(R1, 3R1) Gamma1
-                    - Gamma' [[R~2, X], [X', R~2]] Gamma  <= 0
+        Phi(h(t), h') = He(G(h(t))' P H(h')) + [S, Q terms]
+                        + F'(h1^2 R1 + h12^2 R2)F - Gamma1' diag(R1, 3R1) Gamma1
+                        - Gamma' [[R~2, X], [X', R~2]] Gamma  <= 0
 
-    at h(t) = h1 and h(t) = h2 (Phi is affine in h(t)).
+    at h(t) in {h1, h2} (and h' in {-mu, mu} with delay windows). Phi is
+    affine in h(t) and in h' separately, so its largest eigenvalue is convex
+    in each and the vertices decide the whole box.
 
     Parameters
     ----------
@@ -229,8 +276,12 @@ class VaryingDelayLMI(_VaryingTerms, MarginLMI):
         Lower delay bound (s), >= 0. The upper bound h2 is the delay of
         :meth:`solve_at` (bisected by :func:`certified_varying_delay`).
     mu : float or None
-        Bound on |h'(t)|; None for an unknown derivative (the Q term is
-        removed, as for any mu >= 1).
+        Bound on |h'(t)|; None for an unknown derivative.
+    windows : {"delay", "fixed"}, optional
+        Windows of z's integrals: ``"delay"`` (SG13 Theorem 7: split at
+        t - h(t), four vertex LMIs; default when mu is given) or ``"fixed"``
+        ([t-h2, t-h1]: h' only in the Q term, removed for mu None or >= 1;
+        the only choice for mu None).
     margin, bound
         See :class:`~workbench.lmi.core.MarginLMI`.
     """
@@ -238,17 +289,14 @@ class VaryingDelayLMI(_VaryingTerms, MarginLMI):
     method = "wirtinger-rcc"
     retry_settings = RETRY_SETTINGS
 
-    def __init__(self, A, Ad, *, h1: float = 0.0, mu: float | None = None, **kw):
-        self.h1, self.mu = _check_interval(h1, mu)
+    def __init__(self, A, Ad, *, h1: float = 0.0, mu: float | None = None,
+                 windows: Windows | None = None, **kw):
         self.A = np.atleast_2d(np.asarray(A, float))
         self.Ad = np.atleast_2d(np.asarray(Ad, float))
         if self.A.shape != self.Ad.shape or self.A.shape[0] != self.A.shape[1]:
             raise ValueError(f"A {self.A.shape}, A_d {self.Ad.shape}; expected equal square "
                              "shapes")
-        self.n = self.A.shape[0]
-        names = (("x", "x1", "xh", "x2", "nu1", "nu2", "nu3") if self.with_h1
-                 else ("x", "xh", "x2", "nu2", "nu3"))
-        self._e = _Selectors(self.n, self.with_h1, names)
+        self._init_terms(h1, mu, windows, self.A.shape[0])
         super().__init__(**kw)
 
     def variables(self):
@@ -257,12 +305,8 @@ class VaryingDelayLMI(_VaryingTerms, MarginLMI):
     def blocks(self, v, p, bmat):
         e = self._e
         F = self.A @ e("x") + self.Ad @ e("xh")
-        common = self._common(e, v, p, bmat, F, lambda W: F.T @ W @ F)
-        out = []
-        for vertex in ("h1", "h2"):
-            G, H = self._G_H(e, p, F, vertex)
-            out.append(Block(f"phi_{vertex}", _he_GPH(G, v["P"], H, None) + common, "nsd"))
-        return out + self._positive_blocks(v, bmat)
+        return (self._phi_blocks(v, p, bmat, F, lambda W: F.T @ W @ F)
+                + self._positive_blocks(v, bmat))
 
 
 @dataclass(frozen=True)
@@ -283,6 +327,8 @@ class VaryingDelayBound:
         Lower delay bound (s).
     mu : float or None
         Derivative bound; None = unknown.
+    windows : str
+        ``"delay"`` or ``"fixed"`` (see :class:`VaryingDelayLMI`).
     bracket : Bracket
         Bisection on h2 (s) from :func:`~workbench.lmi.core.bisect_delay`.
     """
@@ -290,6 +336,7 @@ class VaryingDelayBound:
     method: str
     h1: float
     mu: float | None
+    windows: str
     bracket: Bracket
 
     form = "interval"
@@ -314,7 +361,7 @@ class VaryingDelayBound:
 
 
 def certified_varying_delay(A, Ad, *, h1: float = 0.0, mu: float | None = None,
-                            h_hi: float = 100.0, rel_tol: float = 1e-4,
+                            windows: Windows | None = None, h_hi: float = 100.0, rel_tol: float = 1e-4,
                             guess: float | None = None, max_solves: int = 60,
                             margin: float = DEFAULT_MARGIN) -> VaryingDelayBound:
     """Largest h2 such that :class:`VaryingDelayLMI` certifies [h1, h2] with |h'| <= mu.
@@ -327,6 +374,8 @@ def certified_varying_delay(A, Ad, *, h1: float = 0.0, mu: float | None = None,
         Lower delay bound (s), >= 0.
     mu : float or None
         Bound on |h'(t)| (dimensionless); None = unknown derivative.
+    windows : {"delay", "fixed"}, optional
+        See :class:`VaryingDelayLMI`.
     h_hi : float
         Search cap on h2 (s); a result at the cap means "at least h_hi".
     rel_tol, guess, max_solves
@@ -339,8 +388,8 @@ def certified_varying_delay(A, Ad, *, h1: float = 0.0, mu: float | None = None,
     VaryingDelayBound
         An interval certificate [h1, h2] (see its docstring).
     """
-    lmi = VaryingDelayLMI(A, Ad, h1=h1, mu=mu, margin=margin)
+    lmi = VaryingDelayLMI(A, Ad, h1=h1, mu=mu, windows=windows, margin=margin)
     h_lo = h1 + max(1e-3, 1e-3 * h1)
     br = bisect_delay(lmi.solve_at, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol, guess=guess,
                       max_solves=max_solves)
-    return VaryingDelayBound(lmi.method, lmi.h1, lmi.mu, br)
+    return VaryingDelayBound(lmi.method, lmi.h1, lmi.mu, lmi.windows, br)
