@@ -365,8 +365,9 @@ class VaryingDelayBound:
 
 
 def certified_varying_delay(A, Ad, *, h1: float = 0.0, mu: float | None = None,
-                            windows: Windows | None = None, h_hi: float = 100.0, rel_tol: float = 1e-4,
-                            guess: float | None = None, max_solves: int = 60,
+                            windows: Windows | None = None, h_hi: float = 100.0,
+                            rel_tol: float = 1e-4, guess: float | None = None,
+                            max_solves: int = 60,
                             margin: float = DEFAULT_MARGIN) -> VaryingDelayBound:
     """Largest h2 such that :class:`VaryingDelayLMI` certifies [h1, h2] with |h'| <= mu.
 

@@ -261,8 +261,8 @@ def synthesize_varying(A, B, *, h1: float = 0.0, mu: float | None = None,
                                            windows=lmi.windows, h_hi=h_max, rel_tol=rel_tol,
                                            margin=margin, guess=br.h_certified)
     pairs = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
-    return VaryingSynthesis(lmi.h1, lmi.mu, lmi.windows, best, br, K, pairs, gain, analysis, exact,
-                            float(h_max), T)
+    return VaryingSynthesis(lmi.h1, lmi.mu, lmi.windows, best, br, K, pairs, gain, analysis,
+                            exact, float(h_max), T)
 
 
 def recheck_varying(A, B, result: VaryingSynthesis,
