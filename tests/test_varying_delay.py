@@ -146,9 +146,18 @@ def test_lower_bound_h1_interval():
     """h1 > 0: the certified interval [h1, h2] stays below the exact margin
     and a larger h1 with the same mu certifies no larger h2 than exact."""
     exact = delay_margin_eig(A, AD).h
-    b = certified_varying_delay(A, AD, h1=1.0, mu=0.3, rel_tol=1e-3, h_hi=20.0)
+    b = certified_varying_delay(A, AD, h1=1.0, mu=0.3, rel_tol=1e-3, h_hi=20.0, guess=2.5)
     assert b.bracket.outcome is Outcome.CERTIFIED
     assert b.interval[0] == 1.0 and 1.0 < b.h2 <= exact * (1 + SOUND_TOL)
+
+
+def test_nothing_certified_when_unstable_at_zero_delay():
+    """x' = x - 0.5 x(t - h) is unstable at every constant delay (a + b > 0):
+    no interval [0, h2] may be certified, for any derivative bound."""
+    for mu in (0.5, None):
+        b = certified_varying_delay([[1.0]], [[-0.5]], mu=mu, rel_tol=1e-3, h_hi=10.0)
+        assert b.h2 == 0.0 and b.interval is None
+        assert b.bracket.outcome is Outcome.REFUTED
 
 
 # -- time-domain check ----------------------------------------------------------
