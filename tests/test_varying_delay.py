@@ -284,3 +284,15 @@ def test_synthesised_loop_decays_in_time_domain(scalar_synthesis):
     run = simulate_varying_delay(SCALAR[0], Ad, delay, h2, [1.0], t_end=150.0, dt=0.005,
                                  record_every=100)
     assert run.decay() < 1e-3
+
+
+def test_synthesis_with_lower_delay_bound():
+    """h1 = 0.3 s: the certificate is the interval [0.3, h2], still below the
+    constant-delay limit and the exact margin of the rounded gain."""
+    from workbench.lmi.varying_synthesis import synthesize_varying
+    r = synthesize_varying(*SCALAR, h1=0.3, mu=0.5, eps_grid=(3.0, 30.0), golden_steps=0,
+                           h_max=5.0, rel_tol=1e-3)
+    assert r.bracket.outcome is Outcome.CERTIFIED and 0.3 < r.h2 < SCALAR_LIMIT
+    assert r.analysis.interval[0] == 0.3
+    assert r.gain.h_certified <= r.exact.h * (1 + SOUND_TOL)
+    assert r.analysis.h2 <= r.exact.h * (1 + SOUND_TOL)
