@@ -13,15 +13,17 @@ from workbench.margins import delay_margin_eig
 from workbench.sim.varying_delay import (simulate_varying_delay, switching_delay,
                                          triangle_delay)
 
-# The classic example (He, Wang, Lin & Wu 2007; SG13 sec. 4, Example 1):
+# The classic 2x2 example of the delay literature (used in SG13 sec. 4):
 A = np.array([[-2.0, 0.0], [0.0, -0.9]])
 AD = np.array([[-1.0, 0.0], [-1.0, -1.0]])
 
 # Seuret & Gouaisbaut 2013 (Automatica 49(9)), Table 2, row "Theorem 7", h1 = 0:
 # maximal h2 for |h'| <= mu, printed to 3 decimals (the paper does not say
 # whether it rounds or truncates: tolerance one unit of the last digit, 1e-3).
-# The stored reference corpus did not hold the paper: these numbers are the
-# ones quoted for SG13 Th. 7 in the later literature, not re-read here.
+# Provenance caveat: the stored reference corpus did not hold the paper or a
+# table quoting it, so these three numbers were NOT re-read from SG13 in this
+# change; they are the values commonly quoted for SG13 Th. 7 (check them
+# against the paper before relying on the third digit).
 SG13_TABLE2 = [(0.1, 4.703), (0.5, 2.420), (0.8, 2.137)]
 PRINTED = 1e-3
 # Solver margin under which our LMI reproduces SG13's numbers: the boundary of
