@@ -162,6 +162,14 @@ def _cmd_fit(args) -> int:
     return fit_design(args.design, as_json=args.json)
 
 
+def cmd_init(args) -> int:
+    from .scaffold import DEFAULT_REQUIREMENT, init_project
+    files = init_project(args.path, papers=args.papers,
+                         requirement=args.requirement or DEFAULT_REQUIREMENT)
+    print(f"wrote {len(files)} files in {args.path}/; next: cd {args.path} && workbench verify")
+    return 0
+
+
 def cmd_benchmark(args) -> int:
     from .benchmark import benchmark_delay
     return benchmark_delay(args.design, as_json=args.json, exact_check=args.exact_check)
@@ -189,6 +197,7 @@ COMMANDS: dict[str, tuple[str, Callable]] = {
     "fit": ("fit paper 000's brake model to a brake-fit design's synthetic logs", _cmd_fit),
     "report": ("write reports/<design>.md and figures (--check: fail if stale)", cmd_report),
     "prove": ("check the claims of proofs/: PROVED / REFUTED / INCONCLUSIVE", _cmd_prove),
+    "init": ("write a project skeleton: designs/, proofs/, reports/, CI files", cmd_init),
 }
 
 
@@ -241,6 +250,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("proofs", nargs="*", metavar="PROOF",
                    help="paper (e.g. 003), module of proofs/ or claim id (default: all)")
     p.add_argument("--json", action="store_true")
+    p = sub.add_parser("init", help=COMMANDS["init"][0])
+    p.add_argument("path", metavar="PATH", help="new or empty folder")
+    p.add_argument("--papers", action="store_true",
+                   help="copy the shipped designs and proofs of papers 000-004 instead of "
+                        "the example")
+    p.add_argument("--requirement", help="what the CI files pip-install (default: "
+                   "workbench==<this version>)")
     return ap
 
 

@@ -45,9 +45,8 @@ def junit_xml(run, *, name: str = "workbench verify") -> str:
             if not c.ok:
                 f = ET.SubElement(tc, "failure", message=c.message, type=c.verdict)
                 f.text = c.detail
-            out = c.out if c.ok else c.detail
-            if out:
-                ET.SubElement(tc, "system-out").text = out
+            if c.out:
+                ET.SubElement(tc, "system-out").text = c.out
     ET.indent(root)
     return ('<?xml version="1.0" encoding="UTF-8"?>\n'
             + ET.tostring(root, encoding="unicode") + "\n")
