@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import ast
 import subprocess
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 from .errors import DesignError
@@ -135,7 +135,7 @@ def _closure(start: Path, package: str, siblings: Path | None = None) -> frozens
     return frozenset(seen)
 
 
-@lru_cache(maxsize=None)
+@cache
 def study_files(kind: str) -> frozenset[Path]:
     """Package files a design of ``kind`` runs (see the module docstring)."""
     from . import studies

@@ -103,7 +103,8 @@ def design_cases(ev) -> list[Case]:
 
 def proof_cases(results) -> list[Case]:
     """Cases of ``(ProofModule, ProofResult)`` pairs from :func:`workbench.prove.run_proofs`."""
-    from .prove import _detail, _expected as proof_expected
+    from .prove import _detail
+    from .prove import _expected as proof_expected
     out = []
     for m, r in results:
         c = r.claim

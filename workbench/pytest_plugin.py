@@ -48,9 +48,15 @@ def _active(config) -> bool:
     return bool(config.getoption("workbench", default=False))
 
 
+_PROJECT = pytest.StashKey[object]()
+
+
 def _project(config):
-    from .project import find_project
-    return find_project(config.invocation_params.dir)
+    """The project of the folder pytest was started from (found once per run)."""
+    if _PROJECT not in config.stash:
+        from .project import find_project
+        config.stash[_PROJECT] = find_project(config.invocation_params.dir)
+    return config.stash[_PROJECT]
 
 
 def pytest_configure(config):
