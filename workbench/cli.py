@@ -17,7 +17,6 @@ from typing import Callable
 from .errors import DesignError, ModelError
 
 DESIGNS_DIR = Path("designs")
-REPORTS_DIR = Path("reports")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -33,9 +32,11 @@ class _BadArgs(Exception):
 def _designs(paths: list[str]) -> list:
     from .design import load_design
     if not paths:
-        paths = [str(p) for p in sorted(DESIGNS_DIR.glob("*.toml"))]
+        from .project import find_project
+        folder = find_project().designs  # designs/ of the project root, never the package's
+        paths = [str(p) for p in sorted(folder.glob("*.toml"))]
         if not paths:
-            raise DesignError("<cli>", "DESIGN", str(DESIGNS_DIR), "a folder with design files")
+            raise DesignError("<cli>", "DESIGN", str(folder), "a folder with design files")
     return [load_design(p) for p in paths]
 
 
@@ -85,11 +86,17 @@ def cmd_synthesize(args) -> int:
 
 
 def cmd_verify(args) -> int:
+    from .ci import run_verify, timing_table
+    from .prove import verification_rows
     from .report.markdown import fmt, md_table
-    from .verify import evaluate_design
 
-    evs = [evaluate_design(d) for d in _designs(args.designs)]
-    extra = _extra_verifications(args)
+    run = run_verify(args.designs, changed_since=args.changed_since)
+    evs = run.evaluations
+    extra = verification_rows(list(run.proofs)) if run.proofs else {}
+    if args.junit_xml:
+        from .junit import write_junit
+        from .project import find_project
+        write_junit(run, args.junit_xml, name=find_project().name)
     if args.json:
         out = {"designs": [{"design": e.design.name, "path": e.design.path, "ok": e.ok,
                             "claims": [c.to_json() for c in e.claims]} for e in evs]}
@@ -107,8 +114,12 @@ def cmd_verify(args) -> int:
         n_bad = sum(not c.ok for e in evs for c in e.claims) + extra.get("bad", 0)
         n = sum(len(e.claims) for e in evs) + len(extra.get("rows", []))
         print(f"\n{n - n_bad} of {n} claims ok" + ("" if not n_bad else f"; {n_bad} not ok"))
-    ok = all(e.ok for e in evs) and not extra.get("bad", 0)
-    return 0 if ok else 1
+    if run.skipped:  # stderr: stdout stays the verdicts only
+        print(f"--changed-since {args.changed_since}: {len(run.skipped)} unchanged, not "
+              f"checked: {', '.join(run.skipped)}", file=sys.stderr)
+    if run.seconds:
+        print("\n" + timing_table(run.seconds), file=sys.stderr)
+    return 0 if run.ok else 1
 
 
 def _extra_verifications(args) -> dict:
@@ -130,7 +141,9 @@ def cmd_report(args) -> int:
     if index:
         from .prove import report_files
         files += report_files()
-    out = Path(args.out)
+    from .design import display_path
+    from .project import find_project
+    out = Path(args.out or display_path(find_project().reports))
     if args.check:
         problems = check_reports(files, out, index=index)
         for p in problems:
@@ -151,6 +164,14 @@ def _cmd_prove(args) -> int:
 def _cmd_fit(args) -> int:
     from .fit import fit_design
     return fit_design(args.design, as_json=args.json)
+
+
+def cmd_init(args) -> int:
+    from .scaffold import DEFAULT_REQUIREMENT, init_project
+    files = init_project(args.path, papers=args.papers,
+                         requirement=args.requirement or DEFAULT_REQUIREMENT)
+    print(f"wrote {len(files)} files in {args.path}/; next: cd {args.path} && workbench verify")
+    return 0
 
 
 def cmd_benchmark(args) -> int:
@@ -180,6 +201,7 @@ COMMANDS: dict[str, tuple[str, Callable]] = {
     "fit": ("fit paper 000's brake model to a brake-fit design's synthetic logs", _cmd_fit),
     "report": ("write reports/<design>.md and figures (--check: fail if stale)", cmd_report),
     "prove": ("check the claims of proofs/: PROVED / REFUTED / INCONCLUSIVE", _cmd_prove),
+    "init": ("write a project skeleton: designs/, proofs/, reports/, CI files", cmd_init),
 }
 
 
@@ -219,15 +241,26 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("verify", help=COMMANDS["verify"][0])
     p.add_argument("designs", nargs="*", help="design files (default: all of designs/)")
     p.add_argument("--json", action="store_true")
+    p.add_argument("--junit-xml", metavar="FILE",
+                   help="also write one JUnit test case per claim to FILE")
+    p.add_argument("--changed-since", metavar="REF",
+                   help="only designs and proofs depending on files changed since git REF")
     p = sub.add_parser("report", help=COMMANDS["report"][0])
     p.add_argument("designs", nargs="*", help="design files (default: all of designs/)")
     p.add_argument("--all", action="store_true", help="every design in designs/ and the index")
     p.add_argument("--check", action="store_true", help="exit 1 if a committed report is stale")
-    p.add_argument("--out", default=str(REPORTS_DIR), help="output folder (default: reports)")
+    p.add_argument("--out", help="output folder (default: reports/ of the project root)")
     p = sub.add_parser("prove", help=COMMANDS["prove"][0])
     p.add_argument("proofs", nargs="*", metavar="PROOF",
                    help="paper (e.g. 003), module of proofs/ or claim id (default: all)")
     p.add_argument("--json", action="store_true")
+    p = sub.add_parser("init", help=COMMANDS["init"][0])
+    p.add_argument("path", metavar="PATH", help="new or empty folder")
+    p.add_argument("--papers", action="store_true",
+                   help="copy the shipped designs and proofs of papers 000-004 instead of "
+                        "the example")
+    p.add_argument("--requirement", help="what the CI files pip-install (default: "
+                   "workbench==<this version>)")
     return ap
 
 

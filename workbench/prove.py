@@ -7,9 +7,13 @@
 """
 from __future__ import annotations
 
+import hashlib
 import importlib
+import importlib.util
 import json
+import pkgutil
 import sys
+import types
 from dataclasses import dataclass
 from functools import lru_cache
 from importlib import metadata
@@ -18,8 +22,6 @@ from pathlib import Path
 from .errors import DesignError
 from .report.markdown import fmt, md_table
 from .symbolic.proof import ProofResult, Verdict, check_claim
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 @dataclass(frozen=True)
@@ -32,14 +34,55 @@ class ProofModule:
     claims: tuple
 
 
-@lru_cache(maxsize=1)
-def proof_modules() -> tuple[ProofModule, ...]:
-    """Every module of ``proofs/`` (the package next to ``workbench/``)."""
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    pkg = importlib.import_module("proofs")
-    return tuple(ProofModule(m.__name__.rsplit(".", 1)[-1], m.PAPER, m.TITLE, tuple(m.claims()))
-                 for m in pkg.modules())
+def proofs_folder() -> Path:
+    """``proofs/`` of the current project (see :mod:`workbench.project`)."""
+    from .project import find_project
+    return find_project().proofs
+
+
+def _import_folder(folder: Path) -> list:
+    """Import every module of ``folder`` not starting with ``_`` (name order).
+
+    The folder is imported as a package under a name private to its path
+    (``_workbench_proofs_<hash>``), so two projects never share modules and
+    nothing is looked up on ``sys.path``. An ``__init__.py`` is optional.
+    """
+    pkg = "_workbench_proofs_" + hashlib.sha1(str(folder).encode()).hexdigest()[:12]
+    if pkg not in sys.modules:
+        init = folder / "__init__.py"
+        if init.is_file():
+            spec = importlib.util.spec_from_file_location(
+                pkg, init, submodule_search_locations=[str(folder)])
+            module = importlib.util.module_from_spec(spec)
+            sys.modules[pkg] = module
+            spec.loader.exec_module(module)
+        else:
+            module = types.ModuleType(pkg)
+            module.__path__ = [str(folder)]
+            sys.modules[pkg] = module
+    names = sorted(m.name for m in pkgutil.iter_modules([str(folder)])
+                   if not m.name.startswith("_"))
+    return [importlib.import_module(f"{pkg}.{n}") for n in names]
+
+
+@lru_cache(maxsize=None)
+def _modules_in(folder: Path) -> tuple[ProofModule, ...]:
+    if not folder.is_dir():
+        return ()
+    out = []
+    for m in _import_folder(folder):
+        name = m.__name__.rsplit(".", 1)[-1]
+        for attr in ("PAPER", "TITLE", "claims"):
+            if not hasattr(m, attr):
+                raise DesignError(str(folder / f"{name}.py"), attr, "<missing>",
+                                  "PAPER, TITLE and claims() in every proof module")
+        out.append(ProofModule(name, m.PAPER, m.TITLE, tuple(m.claims())))
+    return tuple(out)
+
+
+def proof_modules(folder: str | Path | None = None) -> tuple[ProofModule, ...]:
+    """Every module of the project's ``proofs/`` (or of ``folder``); none if absent."""
+    return _modules_in(Path(folder).resolve() if folder else proofs_folder())
 
 
 def select(names: list[str] | tuple[str, ...] = ()) -> list[tuple[ProofModule, object]]:
@@ -50,7 +93,8 @@ def select(names: list[str] | tuple[str, ...] = ()) -> list[tuple[ProofModule, o
     DesignError
         For a name that matches nothing (exit 2 in the CLI).
     """
-    pairs = [(m, c) for m in proof_modules() for c in m.claims]
+    modules = proof_modules()
+    pairs = [(m, c) for m in modules for c in m.claims]
     if not names:
         return pairs
     out = []
@@ -58,22 +102,23 @@ def select(names: list[str] | tuple[str, ...] = ()) -> list[tuple[ProofModule, o
         hit = [(m, c) for m, c in pairs if n in (m.paper, m.name, c.id)]
         if not hit:
             raise DesignError("<cli>", "PROOF", n, "a paper (" + ", ".join(sorted(
-                {m.paper for m in proof_modules()})) + "), a module of proofs/ ("
-                + ", ".join(m.name for m in proof_modules()) + ") or a claim id")
+                {m.paper for m in modules})) + "), a module of proofs/ ("
+                + ", ".join(m.name for m in modules) + ") or a claim id")
         out += [p for p in hit if p not in out]
     return out
 
 
 @lru_cache(maxsize=None)
-def _check(module: str, claim_id: str) -> ProofResult:
-    claim = next(c for m in proof_modules() if m.name == module for c in m.claims
+def _check(folder: Path, module: str, claim_id: str) -> ProofResult:
+    claim = next(c for m in proof_modules(folder) if m.name == module for c in m.claims
                  if c.id == claim_id)
     return check_claim(claim)
 
 
 def run_proofs(names=()) -> list[tuple[ProofModule, ProofResult]]:
-    """Check the selected claims (each once per process)."""
-    return [(m, _check(m.name, c.id)) for m, c in select(tuple(names))]
+    """Check the selected claims of the project's ``proofs/`` (each once per process)."""
+    folder = proofs_folder()
+    return [(m, _check(folder, m.name, c.id)) for m, c in select(tuple(names))]
 
 
 def _expected(r: ProofResult) -> str:
@@ -103,10 +148,11 @@ def cmd_prove(args) -> int:
     return 0 if ok else 1
 
 
-def verification_rows() -> dict:
-    """Rows for ``workbench verify``: every proof claim, PROVED ok, REFUTED ok only
-    when expected (the as-printed half of an erratum pair), INCONCLUSIVE not ok."""
-    results = run_proofs()
+def verification_rows(results=None) -> dict:
+    """Rows for ``workbench verify``: every proof claim (or those of ``results``, from
+    :func:`run_proofs`), PROVED ok, REFUTED ok only when expected (the as-printed half
+    of an erratum pair), INCONCLUSIVE not ok."""
+    results = run_proofs() if results is None else results
     rows = []
     for m, r in results:
         verdict = ("PASS (expected refuted)" if r.ok and r.claim.expect == "refuted"

@@ -1,0 +1,23 @@
+"""The wheel's package list matches the source folders (issue 18)."""
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_every_package_folder_is_listed_in_pyproject():
+    conf = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    listed = set(conf["packages"])
+    found = {".".join(p.parent.relative_to(ROOT).parts)
+             for p in (ROOT / "workbench").rglob("__init__.py")}
+    mapped = set(conf["package-dir"])
+    assert found | mapped == listed
+    assert conf["package-dir"] == {"workbench._examples.proofs": "proofs",
+                                   "workbench._examples.designs": "designs"}
+
+
+def test_scaffold_templates_are_package_data():
+    conf = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    from workbench.scaffold import COMMON, EXAMPLE, FILES
+    assert conf["package-data"]["workbench.scaffold"] == ["files/*"]
+    assert sorted(p.name for p in FILES.iterdir()) == sorted({**COMMON, **EXAMPLE})
