@@ -11,7 +11,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 # A second CPU's BLAS kernels (no FMA): the report check must hold under it too.
 OTHER_KERNEL ?= Sandybridge
 
-.PHONY: install report test bench clean
+.PHONY: install report test test-wheel bench clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -34,6 +34,11 @@ test: install
 	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(WB) report --all --check
 	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(PY) -m pytest -q -p no:cacheprovider \
 	  tests/test_cli_and_reports.py::test_golden_report
+
+## the wheel in a fresh venv outside the checkout: init, verify --junit-xml,
+## pytest --workbench (needs PyPI for the dependencies; run by .ci/run)
+test-wheel: install
+	$(PY) -m pytest -m wheel tests/test_wheel.py
 
 bench: install
 	for b in benchmarks/*.py; do $(PY) $$b || exit 1; done

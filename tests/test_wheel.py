@@ -21,7 +21,7 @@ import xmlschema
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = xmlschema.XMLSchema(ROOT / "tests" / "data" / "junit.xsd")
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.wheel]   # run by `make test-wheel` (.ci/run)
 
 
 def _run(cmd, cwd, env, ok=(0,), timeout=900):
