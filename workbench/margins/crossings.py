@@ -20,9 +20,10 @@ Re lambda(theta) = 0, with its direction and multiplicity:
     Sweep of theta in [0, pi] (M(2 pi - theta) is the conjugate of M(theta))
     following *every* eigenvalue branch of M(theta): neighbouring grid points are
     matched through the first-order prediction lambda + dlambda/dtheta dtheta,
-    and an interval is bisected until every branch is either separated from the
-    imaginary axis by more than the prediction error or crosses it once. Cost
-    O(n^3) per grid point.
+    and an interval is bisected until every branch either stays on one side of
+    the imaginary axis by more than half the prediction error u (a branch with
+    bounded curvature leaves its chord by about u / 4) or crosses it once, with
+    an unambiguous match. Cost O(n^3) per grid point.
 
 Every tolerance is relative: eigenvalue residuals to R = ||A||_2 + ||A_d||_2
 (the bound on |lambda(M(theta))|, so on every crossing frequency), and phases
@@ -53,8 +54,9 @@ TWO_PI = 2 * math.pi
 AXIS_RTOL = 64 * EPS
 #: |dRe lambda/dtheta| / R below which a crossing is a tangency (direction 0).
 TANGENT_RTOL = 1e3 * EPS
-#: |w| / R below which an axis eigenvalue is the root s = 0.
-ZERO_RTOL = 1e3 * EPS
+#: |lambda| / R below which an eigenvalue of A + A_d is the root s = 0 (and |w| / R
+#: below which a crossing frequency is 0).
+ZERO_RTOL = 16 * EPS
 #: Two crossings are one when w agrees to this fraction of R and theta to this (rad).
 MERGE_RTOL = 1e-7
 #: Eigenvalues of M(theta) within this fraction of R of j w count towards the multiplicity.
@@ -63,6 +65,8 @@ CLUSTER_RTOL = 1e-7
 PENCIL_PREFILTER = 1e-3
 #: Largest number of halvings of a sweep interval.
 MAX_DEPTH = 40
+#: Largest number of intervals examined by one sweep.
+MAX_INTERVALS = 100_000
 
 
 @dataclass(frozen=True)
@@ -155,12 +159,18 @@ def _multiplicity(A, Ad, theta: float, lam: complex, R: float) -> int:
     return max(1, int(np.sum(np.abs(ev - lam) <= CLUSTER_RTOL * R)))
 
 
+def zero_root(A, Ad, R: float) -> bool:
+    """s = 0 is a root at every delay: A + A_d has an eigenvalue within
+    ZERO_RTOL R of 0 (rounding of an exactly singular matrix)."""
+    return bool(np.min(np.abs(np.linalg.eigvals(A + Ad))) <= ZERO_RTOL * R)
+
+
 def _to_crossing(A, Ad, theta: float, lam: complex, d: complex, R: float):
     """(theta in [0, pi], axis eigenvalue lam) -> Crossing with omega > 0, or
-    "zero" for s = 0, or None (w = 0 away from theta = 0: h = inf)."""
+    None for w = 0 (s = 0 is handled by :func:`zero_root`; elsewhere h = inf)."""
     w = float(lam.imag)
     if abs(w) <= ZERO_RTOL * R:
-        return "zero" if min(theta, TWO_PI - theta) <= MERGE_RTOL else None
+        return None
     mult = _multiplicity(A, Ad, theta, lam, R)
     if w > 0:
         return Crossing(w, theta % TWO_PI, _direction(d.real, R), mult)
@@ -184,14 +194,8 @@ def _merge(found, R: float) -> tuple[Crossing, ...]:
 
 
 def _collect(A, Ad, polished, R: float) -> CrossingSet:
-    found, zero = [], False
-    for theta, lam, d in polished:
-        c = _to_crossing(A, Ad, theta, lam, d, R)
-        if c == "zero":
-            zero = True
-        elif c is not None:
-            found.append(c)
-    return CrossingSet(_merge(found, R), zero)
+    found = [_to_crossing(A, Ad, theta, lam, d, R) for theta, lam, d in polished]
+    return CrossingSet(_merge([c for c in found if c is not None], R), False)
 
 
 # -- Newton on Re lambda(theta) = 0 ------------------------------------------------
@@ -238,7 +242,7 @@ def kronecker_crossings(A: np.ndarray, Ad: np.ndarray) -> CrossingSet:
     [CGN95], each polished by Newton's method (inputs already checked)."""
     n = A.shape[0]
     R = scale(A, Ad)
-    if R == 0:
+    if R == 0 or zero_root(A, Ad, R):
         return CrossingSet((), True)
     I, N = np.eye(n), n * n
     P2, P1, P0 = np.kron(Ad, I), np.kron(A, I) + np.kron(I, A), np.kron(I, Ad)
@@ -268,16 +272,21 @@ def phase_crossings(A: np.ndarray, Ad: np.ndarray, *, grid: int | None = None) -
     intervals, default 32 + 4 n)."""
     n = A.shape[0]
     R = scale(A, Ad)
-    if R == 0:
+    if R == 0 or zero_root(A, Ad, R):
         return CrossingSet((), True)
-    tiny = 64 * EPS * R
+    noise = 64 * EPS * R
     m = grid or 32 + 4 * n
     thetas = np.linspace(0.0, math.pi, m + 1)
     ev, dv = _eig_derivative_batch(A, Ad, thetas)
     stack = [(thetas[i], ev[i], dv[i], thetas[i + 1], ev[i + 1], dv[i + 1], 0)
              for i in range(m)]
     brackets = []
+    budget = MAX_INTERVALS
     while stack:
+        budget -= 1
+        if budget < 0:
+            raise ArithmeticError(f"phase sweep not resolved in {MAX_INTERVALS} intervals "
+                                  "(eigenvalue branches too close to the imaginary axis)")
         ta, la, da, tb, lb, db, depth = stack.pop()
         dt = tb - ta
         fwd = np.abs((la + da * dt)[:, None] - lb[None, :])     # a-branch k -> b-eig j
@@ -287,18 +296,18 @@ def phase_crossings(A: np.ndarray, Ad: np.ndarray, *, grid: int | None = None) -
         found, refine = [], False
         for k in range(n):
             j = mk[k]
-            u = max(fwd[k, j], bwd[j, k])
-            u = (u if np.isfinite(u) else math.inf) + tiny
+            err = max(fwd[k, j], bwd[j, k])
+            u = (err if np.isfinite(err) else math.inf) + noise
             cand = np.flatnonzero(fwd[k] <= 2 * u)
             ra, rbs = la[k].real, lb[cand].real
-            same = np.all((rbs > 0) == (ra > 0))
-            if same and min(abs(ra), np.min(np.abs(rbs))) > 2 * u:
-                continue                                         # clear of the axis
-            crosses = ra * lb[j].real <= 0
-            if crosses and (len(cand) == 1 and back[j] == k or depth >= MAX_DEPTH
-                            or np.all((rbs > 0) != (ra > 0))):
+            same = bool(np.all((rbs > 0) == (ra > 0)))
+            if same and min(abs(ra), np.min(np.abs(rbs))) > u / 2:
+                continue              # clear of the axis: the chord deviates by ~u/4
+            final = err <= noise or depth >= MAX_DEPTH    # halving cannot help
+            if ra * lb[j].real <= 0 and (final or len(cand) == 1 and back[j] == k
+                                         or np.all((rbs > 0) != (ra > 0))):
                 found.append((ta, tb, la[k], lb[j]))
-            elif depth < MAX_DEPTH:
+            elif not final:
                 refine = True
                 break
         if refine:
