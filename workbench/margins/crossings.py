@@ -275,6 +275,7 @@ def phase_crossings(A: np.ndarray, Ad: np.ndarray, *, grid: int | None = None) -
     if R == 0 or zero_root(A, Ad, R):
         return CrossingSet((), True)
     noise = 64 * EPS * R
+    idx = np.arange(n)
     m = grid or 32 + 4 * n
     thetas = np.linspace(0.0, math.pi, m + 1)
     ev, dv = _eig_derivative_batch(A, Ad, thetas)
@@ -293,18 +294,20 @@ def phase_crossings(A: np.ndarray, Ad: np.ndarray, *, grid: int | None = None) -
         bwd = np.abs((lb - db * dt)[:, None] - la[None, :])     # b-eig j -> a-branch k
         mk = np.argmin(fwd, axis=1)
         back = np.argmin(bwd, axis=1)
+        err = np.maximum(fwd[idx, mk], bwd[mk, idx])
+        u = np.where(np.isfinite(err), err, np.inf) + noise
+        cand = fwd <= 2 * u[:, None]                          # possible continuations
+        pos_a, pos_b = la.real > 0, lb.real > 0
+        same = ~np.any(cand & (pos_b[None, :] != pos_a[:, None]), axis=1)
+        low = np.minimum(np.abs(la.real),
+                         np.min(np.where(cand, np.abs(lb.real)[None, :], np.inf), axis=1))
+        clear = same & (low > u / 2)        # off the axis: the chord deviates by ~u/4
         found, refine = [], False
-        for k in range(n):
+        for k in np.flatnonzero(~clear):
             j = mk[k]
-            err = max(fwd[k, j], bwd[j, k])
-            u = (err if np.isfinite(err) else math.inf) + noise
-            cand = np.flatnonzero(fwd[k] <= 2 * u)
-            ra, rbs = la[k].real, lb[cand].real
-            same = bool(np.all((rbs > 0) == (ra > 0)))
-            if same and min(abs(ra), np.min(np.abs(rbs))) > u / 2:
-                continue              # clear of the axis: the chord deviates by ~u/4
-            final = err <= noise or depth >= MAX_DEPTH    # halving cannot help
-            if ra * lb[j].real <= 0 and (final or len(cand) == 1 and back[j] == k
+            ra, rbs = la[k].real, lb[cand[k]].real
+            final = err[k] <= noise or depth >= MAX_DEPTH   # halving cannot help
+            if ra * lb[j].real <= 0 and (final or len(rbs) == 1 and back[j] == k
                                          or np.all((rbs > 0) != (ra > 0))):
                 found.append((ta, tb, la[k], lb[j]))
             elif not final:
