@@ -373,3 +373,11 @@ def test_no_complex_warning():
             delay_margin_eig([[-1.0 + 0j]], [[0.5 + 1e-3j]])
         with pytest.raises(ValueError, match="complex"):
             delay_margin_eig([[-1.0]], [[0.5 + 1e-3j]])
+
+
+def test_horizon_with_too_many_crossings_is_refused():
+    # x' = -1e6 x(t-h) crosses at 1e6 rad/s: 1.6e7 crossing delays below h_max = 100 s
+    with pytest.raises(ValueError, match=r"h_max = 100.0; expected a horizon with at most"):
+        stability_windows([[0.0]], [[-1e6]], 100.0)
+    ((a, b),) = stability_windows([[0.0]], [[-1e6]], 1e-3)
+    assert a == 0.0 and relative_difference(b, math.pi / 2 * 1e-6) <= 1e-15

@@ -166,7 +166,7 @@ def zero_root(A, Ad, R: float) -> bool:
 
 
 def _to_crossing(A, Ad, theta: float, lam: complex, d: complex, R: float):
-    """(theta in [0, pi], axis eigenvalue lam) -> Crossing with omega > 0, or
+    """(theta, axis eigenvalue lam of M(theta)) -> Crossing with omega > 0, or
     None for w = 0 (s = 0 is handled by :func:`zero_root`; elsewhere h = inf)."""
     w = float(lam.imag)
     if abs(w) <= ZERO_RTOL * R:
@@ -260,7 +260,7 @@ def kronecker_crossings(A: np.ndarray, Ad: np.ndarray) -> CrossingSet:
         ev = np.linalg.eigvals(A + Ad * np.exp(-1j * theta))
         for lam in ev[np.abs(ev.real) <= PENCIL_PREFILTER * R]:
             p = _newton_phase(A, Ad, theta, lam, R)
-            if p is not None and 0 <= p[0] <= math.pi:
+            if p is not None:          # any theta: _to_crossing folds it to omega > 0
                 polished.append(p)
     return _collect(A, Ad, polished, R)
 

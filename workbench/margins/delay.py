@@ -24,6 +24,8 @@ AGREEMENT_RTOL = 1e-8
 KRONECKER_MAX_N = 14
 #: Two crossing delays closer than this fraction are one event.
 EVENT_RTOL = 1e-10
+#: Largest number of crossing delays below the horizon of :func:`stability_windows`.
+MAX_EVENTS = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -196,6 +198,10 @@ def windows_from_crossings(A, Ad, cs: CrossingSet, h_max: float) -> tuple[tuple[
     """
     if cs.zero_root:
         return ()
+    total = sum(max(0.0, (h_max * c.omega - c.theta) / (2 * math.pi)) for c in cs.crossings)
+    if not total <= MAX_EVENTS:
+        raise ValueError(f"h_max = {h_max!r}; expected a horizon with at most {MAX_EVENTS} "
+                         f"crossing delays (found about {total:.3g})")
     ev = np.linalg.eigvals(A + Ad)
     count = int(np.sum(ev.real > 0))
     events: dict[float, int] = {}
@@ -258,7 +264,8 @@ def stability_windows(A, Ad, h_max: float, *,
     Raises
     ------
     ValueError
-        Bad matrices, h_max not a positive finite number, or an unknown method.
+        Bad matrices, h_max not a positive finite number (or beyond 10^6
+        crossing delays), or an unknown method.
     ArithmeticError
         Crossing directions that would make the root count negative.
 
