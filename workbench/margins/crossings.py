@@ -173,9 +173,15 @@ def _to_crossing(A, Ad, theta: float, lam: complex, d: complex, R: float):
         return None
     mult = _multiplicity(A, Ad, theta, lam, R)
     if w > 0:
-        return Crossing(w, theta % TWO_PI, _direction(d.real, R), mult)
+        return Crossing(w, _wrap(theta), _direction(d.real, R), mult)
     # conjugate branch: conj(lambda(theta)) is an eigenvalue of M(2 pi - theta)
-    return Crossing(-w, (TWO_PI - theta) % TWO_PI, -_direction(d.real, R), mult)
+    return Crossing(-w, _wrap(-theta), -_direction(d.real, R), mult)
+
+
+def _wrap(theta: float) -> float:
+    """theta mod 2 pi in [0, 2 pi) (a rounding to 2 pi becomes 0)."""
+    t = theta % TWO_PI
+    return 0.0 if t >= TWO_PI else t
 
 
 def _merge(found, R: float) -> tuple[Crossing, ...]:
