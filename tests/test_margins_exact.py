@@ -394,3 +394,33 @@ def test_repeated_eigenvalues_cross_together():
     for method in ("sweep", "kronecker"):
         (w,) = stability_windows(A, Ad, 50.0, method=method)
         assert w[0] == 0.0 and relative_difference(w[1], 2 * math.pi / (3 * math.sqrt(3))) <= 1e-12
+
+
+@pytest.mark.parametrize("c", [1e-6, 1.0, 1e6])
+def test_siso_in_other_time_units(c):
+    # x' = -c x(t-h): pi/(2c); the anchor oscillator in units scaled by c: h* / c
+    assert relative_difference(delay_margin_siso([[0.0]], [[1.0]], [[-c]]).h,
+                               math.pi / 2 / c) <= 1e-12
+    A, Ad = oscillator(1.0, 0.5)
+    expected = (math.pi / 2) / ((0.5 + math.sqrt(4.25)) / 2) / c
+    assert relative_difference(delay_margin_siso(c * A, [[0.0], [c]], [[0.0, -0.5]]).h,
+                               expected) <= 1e-12
+
+
+def test_spectral_abscissa_four_states_long_delays():
+    # issue 21 item 3 (a 4-state system at h = 50 was under-resolved at order 40): the
+    # oscillator x'' + x = -0.1 x'(t-h) driving two stable states, at seeded h in [40, 60]
+    A2, Ad2 = oscillator(1.0, 0.1)
+    A, Ad = np.zeros((4, 4)), np.zeros((4, 4))
+    A[:2, :2], Ad[:2, :2] = A2, Ad2
+    A[2:, 2:] = [[-1.0, 0.5], [0.0, -2.0]]
+    A[2:, :2] = [[0.3, -0.2], [0.1, 0.4]]
+    Ad[2:, :2] = [[0.5, 0.0], [-0.3, 0.2]]
+    windows = stability_windows(A, Ad, 60.0)          # block-triangular: the oscillator's
+    assert len(windows) == len(stability_windows(A2, Ad2, 60.0)) >= 5
+    assert all(relative_difference(a, b) <= 1e-12 for wa, wb in
+               zip(windows, stability_windows(A2, Ad2, 60.0)) for a, b in zip(wa, wb))
+    rng = np.random.default_rng(np.random.SeedSequence(50))
+    for h in rng.uniform(40.0, 60.0, 6):
+        sp = rightmost_roots(A, Ad, h)
+        assert (sp.alpha < 0) == any(a < h < b for a, b in windows), (h, sp.order)
