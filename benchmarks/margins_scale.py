@@ -17,7 +17,6 @@ Run: ``.venv/bin/python benchmarks/margins_scale.py [--kron-max N]``
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import time
 

@@ -35,23 +35,18 @@ def oscillator_crossings(a: float, k: float):
 
 def analytic_windows(a: float, k: float, h_max: float):
     """Stability set from the analytic crossings: 2 roots in the RHP at h = 0 when
-    k < 0, none when k > 0; +-2 at each crossing delay (theta + 2 pi m)/w."""
-    events = sorted((th + 2 * math.pi * m) / w for w, th, d in oscillator_crossings(a, k)
-                    for m in range(200) if (th + 2 * math.pi * m) / w <= h_max * 3)
-    dirs = {}
-    for w, th, d in oscillator_crossings(a, k):
-        for m in range(200):
-            dirs[(th + 2 * math.pi * m) / w] = d
+    k < 0, none when k > 0; +-2 at each crossing delay (theta + 2 pi m)/w. Each
+    sequence runs one period past h_max, so every window starting below h_max closes."""
+    events = sorted(((th + 2 * math.pi * m) / w, d) for w, th, d in oscillator_crossings(a, k)
+                    for m in range(int(h_max * w / (2 * math.pi)) + 2))
     count, start, out = (0, 0.0, []) if k > 0 else (2, None, [])
-    for h in events:
-        count += 2 * dirs[h]
+    for h, d in events:
+        count += 2 * d
         if start is not None and count > 0:
             out.append((start, h))
             start = None
         elif start is None and count == 0:
             start = h
-        if start is None and h > h_max:
-            break
     return tuple(w for w in out if w[0] <= h_max)
 
 

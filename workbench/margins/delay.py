@@ -15,7 +15,7 @@ import control
 import numpy as np
 
 from . import _input
-from .crossings import Crossing, CrossingSet, kronecker_crossings, phase_crossings, scale
+from .crossings import Crossing, CrossingSet, kronecker_crossings, phase_crossings
 
 #: Default relative tolerance within which the two exact methods must agree.
 AGREEMENT_RTOL = 1e-8
