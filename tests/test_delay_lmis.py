@@ -185,20 +185,22 @@ def test_cli_benchmark_json_schema(tmp_path, capsys):
     data = json.loads(capsys.readouterr().out)
     (ex,) = data["examples"]
     assert ex["name"] == "pure" and ex["exact_margin"] == pytest.approx(math.pi / 2)
-    keys = {"method", "N", "h_certified", "ratio", "solves", "seconds"}
+    keys = {"method", "N", "h_certified", "h_refuted", "outcome", "at_cap", "ratio", "solves",
+            "seconds"}
     assert all(keys <= set(m) for m in ex["methods"])
     assert [(m["method"], m["N"]) for m in ex["methods"]] == [
         ("free-weighting", None), ("bessel-legendre", 0), ("bessel-legendre", 1),
         ("bessel-legendre", 2), ("bessel-legendre-auto", 2)]
     assert all(0 < m["ratio"] <= 1 and m["exact_check"] == "certified" for m in ex["methods"])
-    assert set(ex) == {"name", "exact_margin", "methods"}
+    assert set(ex) == {"name", "exact_margin", "exact_margin_sweep", "exact_agreement",
+                       "exact_methods_agree", "methods"}
 
 
 def test_cli_benchmark_json_exact_schema(tmp_path, capsys):
     assert main(["benchmark", "delay", str(_small_design(tmp_path)), "--json"]) == 0
     (ex,) = json.loads(capsys.readouterr().out)["examples"]
-    assert all(set(m) == {"method", "N", "h_certified", "ratio", "solves", "seconds"}
-               for m in ex["methods"])
+    assert all(set(m) == {"method", "N", "h_certified", "h_refuted", "outcome", "at_cap",
+                          "ratio", "solves", "seconds"} for m in ex["methods"])
 
 
 def test_cli_benchmark_bad_input(tmp_path, capsys):

@@ -29,7 +29,8 @@ from .design import Reader, display_path
 from .errors import DesignError
 from .lmi.analysis import METHODS, bessel_legendre_auto, certified_delay, make_criterion
 from .lmi.core import DEFAULT_MARGIN
-from .margins import DelayMargin, delay_margin_eig, delay_margin_sweep
+from .margins import (AGREEMENT_RTOL, Agreement, DelayMargin, compare_margins, delay_margin_eig,
+                      delay_margin_sweep)
 
 AUTO = "bessel-legendre-auto"
 
@@ -87,7 +88,10 @@ class MethodRow:
     certified delay-independent test; ``h_max`` means "at least h_max"),
     ``ratio`` = h_certified / h* (None when h* is infinite, except 1.0 when
     both are), ``exact_check`` the rational re-check outcome of the
-    certificate (None when not run or nothing was certified).
+    certificate (None when not run or nothing was certified), ``outcome`` the
+    bracket's outcome (``certified`` / ``refuted`` / ``inconclusive``) and
+    ``at_cap`` whether ``h_certified`` is only the search cap (the true bound
+    is at least that).
     """
 
     method: str
@@ -98,9 +102,12 @@ class MethodRow:
     solves: int
     seconds: float
     exact_check: str | None
+    outcome: str = "inconclusive"
+    at_cap: bool = False
 
     def to_json(self, *, with_check: bool = False) -> dict:
         d = {"method": self.method, "N": self.N, "h_certified": _j(self.h_certified),
+             "h_refuted": _j(self.h_refuted), "outcome": self.outcome, "at_cap": self.at_cap,
              "ratio": _j(self.ratio), "solves": self.solves, "seconds": round(self.seconds, 4)}
         if with_check:
             d["exact_check"] = self.exact_check
@@ -116,11 +123,16 @@ class ExampleResult:
 
     @property
     def agreement(self) -> float:
-        """Relative difference of the two exact methods (0 when both inf)."""
-        a, b = self.exact.h, self.exact_sweep.h
-        if math.isinf(a) or math.isinf(b):
-            return 0.0 if a == b else math.inf
-        return abs(a - b) / max(1.0, abs(a))
+        """Relative difference |a - b| / max(|a|, |b|) of the two exact methods
+        (0 when equal, inf when only one is infinite; no absolute floor)."""
+        return compare_margins(self.exact, self.exact_sweep, AGREEMENT_RTOL)[1]
+
+    @property
+    def exact_agree(self) -> bool:
+        """The two exact methods agree (same reason, relative difference <=
+        :data:`~workbench.margins.AGREEMENT_RTOL`)."""
+        return compare_margins(self.exact, self.exact_sweep,
+                               AGREEMENT_RTOL)[0] is Agreement.AGREE
 
     def row(self, method: str, N: int | None = None) -> MethodRow | None:
         return next((r for r in self.rows if r.method == method and
@@ -140,13 +152,24 @@ class BenchmarkResult:
     examples: tuple[ExampleResult, ...]
 
     def to_json(self, *, with_check: bool = False) -> dict:
-        """``{"examples": [{"name", "exact_margin", "methods": [{"method", "N",
-        "h_certified", "ratio", "solves", "seconds"}]}]}`` (issue 4), plus
-        ``exact_check`` per method when ``with_check``; infinite values are the
-        string ``"inf"`` (JSON has no infinity), undefined ratios ``null``."""
-        return {"examples": [{"name": e.example.name, "exact_margin": _j(e.exact.h),
+        """``{"h_max", "exact_methods_agree", "examples": [{"name", "exact_margin",
+        "exact_margin_sweep", "exact_agreement", "exact_methods_agree", "methods":
+        [{"method", "N", "h_certified", "h_refuted", "outcome", "at_cap", "ratio",
+        "solves", "seconds"}]}]}`` (issues 4 and 21), plus ``exact_check`` per
+        method when ``with_check``; infinite values are the string ``"inf"``
+        (JSON has no infinity), undefined ratios ``null``."""
+        return {"h_max": _j(self.settings.h_max), "exact_methods_agree": self.exact_agree,
+                "examples": [{"name": e.example.name, "exact_margin": _j(e.exact.h),
+                              "exact_margin_sweep": _j(e.exact_sweep.h),
+                              "exact_agreement": _j(e.agreement),
+                              "exact_methods_agree": e.exact_agree,
                               "methods": [r.to_json(with_check=with_check) for r in e.rows]}
                              for e in self.examples]}
+
+    @property
+    def exact_agree(self) -> bool:
+        """Both exact methods agree on every example."""
+        return all(e.exact_agree for e in self.examples)
 
     def max_ratio(self) -> float:
         """Largest finite ratio over examples and methods (soundness: <= 1)."""
@@ -225,6 +248,13 @@ def load_settings(r: Reader) -> BenchmarkSettings:
 
 
 # -- running -------------------------------------------------------------------------
+def _row(s: BenchmarkSettings, method: str, N: int | None, b, h_star: float, solves: int,
+         seconds: float, check: str | None) -> MethodRow:
+    h = b.h_certified
+    return MethodRow(method, N, h, b.bracket.h_refuted, _ratio(h, h_star), solves, seconds,
+                     check, b.bracket.outcome.value, bool(s.h_max <= h < math.inf))
+
+
 def _ratio(h: float, exact: float) -> float | None:
     if math.isinf(exact):
         return 1.0 if math.isinf(h) else None
@@ -251,24 +281,21 @@ def run_example(ex: Example, s: BenchmarkSettings) -> ExampleResult:
             continue
         lmi = make_criterion(m, A, Ad, margin=s.margin)
         b = certified_delay(lmi, **kw)
-        rows.append(MethodRow(m, None, b.h_certified, b.bracket.h_refuted,
-                              _ratio(b.h_certified, h_star), b.solves, b.seconds,
-                              _check(lmi, b, s.exact_check)))
+        rows.append(_row(s, m, None, b, h_star, b.solves, b.seconds,
+                         _check(lmi, b, s.exact_check)))
     if "bessel-legendre" in s.methods:
         auto = bessel_legendre_auto(A, Ad, h_star, gap_tol=s.gap_tol, N_max=s.N_max,
                                     N_through=s.orders, margin=s.margin, **kw)
         for b in auto.bounds:
             if b.N <= s.orders:
                 lmi = make_criterion("bessel-legendre", A, Ad, N=b.N, margin=s.margin)
-                rows.append(MethodRow(b.method, b.N, b.h_certified, b.bracket.h_refuted,
-                                      _ratio(b.h_certified, h_star), b.solves, b.seconds,
-                                      _check(lmi, b, s.exact_check)))
+                rows.append(_row(s, b.method, b.N, b, h_star, b.solves, b.seconds,
+                                 _check(lmi, b, s.exact_check)))
         best = auto.best
         used = [b for b in auto.bounds if b.N <= best.N]
         lmi = make_criterion("bessel-legendre", A, Ad, N=best.N, margin=s.margin)
-        rows.append(MethodRow(AUTO, best.N, best.h_certified, best.bracket.h_refuted,
-                              _ratio(best.h_certified, h_star), sum(b.solves for b in used),
-                              sum(b.seconds for b in used), _check(lmi, best, s.exact_check)))
+        rows.append(_row(s, AUTO, best.N, best, h_star, sum(b.solves for b in used),
+                         sum(b.seconds for b in used), _check(lmi, best, s.exact_check)))
     return ExampleResult(ex, exact, sweep, tuple(rows))
 
 
@@ -283,9 +310,10 @@ def benchmark_delay(design_path: str, *, as_json: bool = False, exact_check: boo
 
     Runs the suite of a delay-benchmark design and prints method x example:
     certified h, ratio to the exact margin, solves, seconds. Exit 0 when every
-    run finished and no certified bound exceeds its exact margin (and, with
-    ``--exact-check``, every certificate passes the rational re-check);
-    1 otherwise.
+    run finished, the two exact methods agree on every example (relative
+    difference <= :data:`~workbench.margins.AGREEMENT_RTOL`), no certified bound
+    exceeds its exact margin (and, with ``--exact-check``, every certificate
+    passes the rational re-check); 1 otherwise.
     """
     from dataclasses import replace
 
@@ -303,14 +331,18 @@ def benchmark_delay(design_path: str, *, as_json: bool = False, exact_check: boo
     res = run_benchmark(spec.examples, spec.settings)
     wall = time.perf_counter() - t0
     checks = [r.exact_check for e in res.examples for r in e.rows if r.exact_check]
-    ok = res.max_ratio() <= 1 + spec.settings.rel_tol and all(c == "certified" for c in checks)
+    ok = (res.max_ratio() <= 1 + spec.settings.rel_tol and all(c == "certified" for c in checks)
+          and res.exact_agree)
     if as_json:
         out(json.dumps(res.to_json(with_check=exact_check), indent=2))
         return 0 if ok else 1
     for e in res.examples:
+        agree = ("" if e.exact_agree else
+                 f" — EXACT METHODS DISAGREE (rel. diff {fmt(e.agreement, 2)})")
         out(f"\n{e.example.name}: h* = {fmt(e.exact.h, 7)} s (eig), {fmt(e.exact_sweep.h, 7)} "
-            f"s (phase sweep) — {e.example.title}")
-        table = [[r.method, "" if r.N is None else r.N, fmt(r.h_certified, 6), fmt(r.ratio, 6),
+            f"s (phase sweep){agree} — {e.example.title}")
+        table = [[r.method, "" if r.N is None else r.N,
+                  fmt(r.h_certified, 6) + (" (>= cap)" if r.at_cap else ""), fmt(r.ratio, 6),
                   r.solves, f"{r.seconds:.2f}"] + ([r.exact_check or "—"] if exact_check else [])
                  for r in e.rows]
         out(md_table(["method", "N", "h certified (s)", "ratio", "solves", "s"]

@@ -12,7 +12,10 @@ of example files relative to the design). Quantities (for claims), with
   ``<m>`` one of the methods, ``bessel-legendre[N=k]`` or
   ``bessel-legendre-auto`` (plus ``.N`` for the order reached);
 * ``examples[<ex>].bessel-legendre.monotone`` ("yes"/"no");
-* ``suite.max_ratio`` (largest h_certified / h* over finite margins).
+* ``suite.max_ratio`` (largest h_certified / h* over finite margins);
+* ``suite.exact_methods_agree`` ("yes" when the two exact methods agree on
+  every example within :data:`~workbench.margins.AGREEMENT_RTOL`, else "no").
+
 """
 from __future__ import annotations
 
@@ -52,7 +55,7 @@ class DelayBenchmark:
         return BenchmarkSpec(settings, load_examples(folder))
 
     def quantity_names(self, spec: BenchmarkSpec) -> set[str]:
-        names = {"suite.max_ratio"}
+        names = {"suite.max_ratio", "suite.exact_methods_agree"}
         for e in spec.examples:
             base = f"examples[{e.name}]"
             names |= {f"{base}.exact_margin", f"{base}.exact_margin_sweep",
@@ -65,7 +68,8 @@ class DelayBenchmark:
         return run_benchmark(design.spec.examples, design.spec.settings)
 
     def quantities(self, res: BenchmarkResult) -> dict:
-        q = {"suite.max_ratio": res.max_ratio()}
+        q = {"suite.max_ratio": res.max_ratio(),
+             "suite.exact_methods_agree": "yes" if res.exact_agree else "no"}
         for e in res.examples:
             base = f"examples[{e.example.name}]"
             q[f"{base}.exact_margin"] = e.exact.h

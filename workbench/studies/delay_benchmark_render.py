@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from ..benchmark import AUTO, BenchmarkResult
+from ..margins import AGREEMENT_RTOL
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
 
 METHOD_DOC = {
@@ -42,8 +43,10 @@ def render(design, res: BenchmarkResult) -> Rendered:
                 e.example.source] for e in res.examples]
     intro = ("## Examples\n\nx'(t) = A x(t) + A_d x(t - h), constant delay. Exact margin h* "
              "by two independent methods: Chen-Gu-Nett (Kronecker-sum eigenproblem, "
-             "`delay_margin_eig`) and a sweep of the delay phase theta with Newton-polished "
-             "crossings of eig(A + A_d e^{-j theta}) (`delay_margin_sweep`). Example files: "
+             "`delay_margin_eig`) and a sweep of the delay phase theta following every "
+             "eigenvalue branch of A + A_d e^{-j theta}, with Newton-polished crossings "
+             "(`delay_margin_sweep`); they must agree to a relative "
+             f"{fmt(AGREEMENT_RTOL)} (claim `exact-methods-agree`). Example files: "
              f"`{s.examples}/` next to this design.\n\n"
              + md_table(["example", "system", "n", "h* eig (s)", "h* sweep (s)",
                          "rel. diff", "source"], ex_rows, "llrrrrl"))
