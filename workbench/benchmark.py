@@ -114,6 +114,20 @@ class MethodRow:
         return d
 
 
+#: Below this relative difference two exact margins differ by rounding only.
+AGREEMENT_FLOOR = 1e-12
+
+
+def agreement_bound(rel_diff: float) -> float:
+    """The power of ten a relative difference stays below, floored at
+    :data:`AGREEMENT_FLOOR` (``inf`` stays ``inf``): the digits of an
+    agreement that hold on every CPU (rounding differs between kernels)."""
+    if not math.isfinite(rel_diff):
+        return math.inf
+    return max(AGREEMENT_FLOOR, 10.0 ** math.ceil(math.log10(rel_diff))) if rel_diff > 0 \
+        else AGREEMENT_FLOOR
+
+
 @dataclass(frozen=True)
 class ExampleResult:
     example: Example

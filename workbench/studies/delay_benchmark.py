@@ -7,7 +7,8 @@ of example files relative to the design). Quantities (for claims), with
 ``<ex>`` an example name and ``<m>`` a method name:
 
 * ``examples[<ex>].exact_margin`` / ``.exact_margin_sweep`` (s, two methods),
-  ``.exact_agreement`` (relative difference);
+  ``.exact_agreement`` (the relative difference as the power of ten it stays
+  below, floored at 1e-12: :func:`agreement_bound`);
 * ``examples[<ex>].<m>.h_certified`` / ``.ratio`` / ``.exact_check``, with
   ``<m>`` one of the methods, ``bessel-legendre[N=k]`` or
   ``bessel-legendre-auto`` (plus ``.N`` for the order reached);
@@ -22,8 +23,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..benchmark import (AUTO, BenchmarkResult, BenchmarkSettings, Example, load_examples,
-                         load_settings, run_benchmark)
+from ..benchmark import (AUTO, BenchmarkResult, BenchmarkSettings, Example, agreement_bound,
+                         load_examples, load_settings, run_benchmark)
 from ..design import Reader
 
 FIELDS = ("h_certified", "ratio", "exact_check")
@@ -74,7 +75,7 @@ class DelayBenchmark:
             base = f"examples[{e.example.name}]"
             q[f"{base}.exact_margin"] = e.exact.h
             q[f"{base}.exact_margin_sweep"] = e.exact_sweep.h
-            q[f"{base}.exact_agreement"] = e.agreement
+            q[f"{base}.exact_agreement"] = agreement_bound(e.agreement)
             q[f"{base}.bessel-legendre.monotone"] = \
                 "yes" if e.bl_monotone(res.settings.rel_tol) else "no"
             for r in e.rows:
