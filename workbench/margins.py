@@ -42,7 +42,6 @@ import math
 import warnings
 from dataclasses import dataclass
 
-import control
 import numpy as np
 import scipy.linalg as sl
 
@@ -159,6 +158,7 @@ def delay_margin_siso(A, B, K) -> DelayMargin:
     method = "python-control stability_margins"
     if not is_hurwitz(A + B @ K):
         return _unstable(method)
+    import control   # (and matplotlib with it): only where the crossovers are needed
     loop = control.ss(A, B, -K, 0.0)   # L(s) = -K (sI - A)^{-1} B, u = -L e
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -1,0 +1,134 @@
+"""Each study result computed once per process, and how long it took.
+
+``workbench check`` (verify, then the report check) and the test session
+evaluate the same designs more than once in one process. :func:`run_study`
+runs a design's study the first time and hands back that same result for
+any later design with an equal spec (the study's input: its ``run`` reads
+nothing else of the design). Results are frozen dataclasses, and report
+rendering is pure, so sharing one is the same as recomputing it.
+
+Nothing is kept across processes and nothing is written to disk: every
+``workbench`` command and every test session computes each study afresh,
+once.
+
+:func:`study_times` is the timing hook: wall and CPU seconds (this process
+and the worker processes it waited for) of every study that ran.
+"""
+from __future__ import annotations
+
+import dataclasses
+import enum
+import math
+import os
+import time
+from dataclasses import dataclass
+from pathlib import PurePath
+from typing import Any, Callable
+
+try:
+    import resource
+except ImportError:  # pragma: no cover  (not on Windows)
+    resource = None
+
+
+@dataclass(frozen=True)
+class StudyTime:
+    """One study run: the design that asked for it and its cost.
+
+    Attributes
+    ----------
+    design : str
+        Design name (its file stem).
+    kind : str
+        Study kind.
+    wall, cpu : float
+        Seconds; ``cpu`` is user + system time of this process and of the
+        worker processes that ended meanwhile (the Monte Carlo pools).
+    """
+
+    design: str
+    kind: str
+    wall: float
+    cpu: float
+
+
+_RESULTS: dict[tuple, Any] = {}
+_TIMES: list[StudyTime] = []
+
+
+class _Unkeyable(Exception):
+    pass
+
+
+def _key(x: Any) -> Any:
+    """A hashable, exact image of a spec (floats by value, arrays by bytes);
+    raises :class:`_Unkeyable` on a type it does not know (then no sharing)."""
+    if x is None or isinstance(x, (bool, int, str)):
+        return (type(x).__name__, x)
+    if isinstance(x, float):
+        return ("float", x.hex() if math.isfinite(x) else repr(x))
+    if isinstance(x, enum.Enum):
+        return (type(x).__qualname__, _key(x.value))
+    if isinstance(x, PurePath):
+        return ("path", str(x))
+    if isinstance(x, (tuple, list)):
+        return (type(x).__name__, tuple(_key(v) for v in x))
+    if isinstance(x, (set, frozenset)):
+        return ("set", tuple(sorted(_key(v) for v in x)))
+    if isinstance(x, dict):
+        return ("dict", tuple(sorted((_key(k), _key(v)) for k, v in x.items())))
+    if dataclasses.is_dataclass(x) and not isinstance(x, type):
+        return (type(x).__module__, type(x).__qualname__,
+                tuple((f.name, _key(getattr(x, f.name))) for f in dataclasses.fields(x)))
+    import numpy as np
+    if isinstance(x, np.ndarray):
+        if x.dtype.hasobject:
+            return ("ndarray-object", x.shape, tuple(_key(v) for v in x.ravel().tolist()))
+        return ("ndarray", x.dtype.str, x.shape, np.ascontiguousarray(x).tobytes())
+    if isinstance(x, np.generic):
+        return (type(x).__name__, _key(x.item()))
+    raise _Unkeyable(type(x).__qualname__)
+
+
+def _cpu() -> float:
+    t = os.times()
+    own = t.user + t.system
+    if resource is None:  # pragma: no cover
+        return own
+    ch = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own + ch.ru_utime + ch.ru_stime
+
+
+def run_study(design, run: Callable[[Any], Any]) -> Any:
+    """``run(design)``, computed once per process for an equal (kind, spec).
+
+    Parameters
+    ----------
+    design : workbench.design.Design
+    run : callable
+        The study's ``run``.
+    """
+    try:
+        key = (design.kind, _key(design.spec))
+    except (_Unkeyable, TypeError):
+        key = None
+    if key is not None and key in _RESULTS:
+        return _RESULTS[key]
+    w0, c0 = time.perf_counter(), _cpu()
+    result = run(design)
+    _TIMES.append(StudyTime(design.name, design.kind, time.perf_counter() - w0, _cpu() - c0))
+    if key is not None:
+        _RESULTS[key] = result
+    return result
+
+
+def study_times() -> tuple[StudyTime, ...]:
+    """Every study run of this process so far, in order (shared results are
+    not repeated)."""
+    return tuple(_TIMES)
+
+
+def clear() -> None:
+    """Forget every result and time (tests)."""
+    _RESULTS.clear()
+    _TIMES.clear()
