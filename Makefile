@@ -21,11 +21,18 @@ install: $(STAMP)
 report: install
 	$(WB) report --all
 
-## tests, then every claim (designs and proofs), then report freshness
+## tests, every claim (designs and proofs) and report freshness. `workbench check`
+## is `workbench verify` + `workbench report --all --check` in one process (each
+## study computed once); it runs next to pytest (two cores), its output is shown
+## after pytest's and ends with the time each design's study took.
 test: install
-	$(PY) -m pytest
-	$(WB) verify
-	$(WB) report --all --check
+	@log=$$(mktemp); \
+	$(WB) check > $$log 2>&1 & check=$$!; \
+	$(PY) -m pytest; tests=$$?; \
+	wait $$check; checked=$$?; \
+	echo; echo "== workbench check (verify + report --all --check)"; cat $$log; rm -f $$log; \
+	echo "pytest exit $$tests, workbench check exit $$checked"; \
+	test $$tests -eq 0 && test $$checked -eq 0
 
 bench: install
 	for b in benchmarks/*.py; do $(PY) $$b || exit 1; done

@@ -141,15 +141,21 @@ def cmd_report(args) -> int:
 
 def cmd_check(args) -> int:
     """``workbench verify`` then ``workbench report --all --check`` in one
-    process, each study computed once (:mod:`workbench.memo`); then the time
-    of every design's study, slowest first, on stderr. Exit code: the
-    larger of the two."""
-    from .memo import study_times
+    process, each study computed once (:mod:`workbench.memo`; the Monte
+    Carlo pools start first and run while the other designs are checked);
+    then the time of every design's study, slowest first, on stderr. Exit
+    code: the larger of the two."""
+    from . import studies
+    from .memo import cancel_started, start_studies, study_times
 
-    code = cmd_verify(argparse.Namespace(designs=[], json=False))
-    print()
-    code = max(code, cmd_report(argparse.Namespace(designs=[], all=True, check=True,
-                                                   out=args.out)))
+    try:
+        start_studies(_designs([]), studies.REGISTRY)   # the Monte Carlo pools, first
+        code = cmd_verify(argparse.Namespace(designs=[], json=False))
+        print()
+        code = max(code, cmd_report(argparse.Namespace(designs=[], all=True, check=True,
+                                                       out=args.out)))
+    finally:
+        cancel_started()
     print(study_times_table(study_times()), file=sys.stderr)
     return code
 

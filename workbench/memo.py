@@ -11,6 +11,10 @@ Nothing is kept across processes and nothing is written to disk: every
 ``workbench`` command and every test session computes each study afresh,
 once.
 
+:func:`start_studies` starts the parts of studies that run in worker
+processes ahead of time (``workbench check`` starts the Monte Carlo pools
+first, so they run while the other designs are checked).
+
 :func:`study_times` is the timing hook: wall and CPU seconds (this process
 and the worker processes it waited for) of every study that ran.
 """
@@ -42,8 +46,10 @@ class StudyTime:
     kind : str
         Study kind.
     wall, cpu : float
-        Seconds; ``cpu`` is user + system time of this process and of the
-        worker processes that ended meanwhile (the Monte Carlo pools).
+        Seconds from the study's start to its result; ``cpu`` is user +
+        system time of this process and of the worker processes that ended
+        meanwhile (the Monte Carlo pools). For a study started early
+        (:func:`start_studies`) both include whatever ran in between.
     """
 
     design: str
@@ -54,6 +60,7 @@ class StudyTime:
 
 _RESULTS: dict[tuple, Any] = {}
 _TIMES: list[StudyTime] = []
+_STARTED: dict[tuple, tuple] = {}     # key -> (study, handle, wall clock, cpu) at start
 
 
 class _Unkeyable(Exception):
@@ -90,6 +97,15 @@ def _key(x: Any) -> Any:
     raise _Unkeyable(type(x).__qualname__)
 
 
+def spec_key(x: Any) -> Any:
+    """A hashable, exact key of ``x`` (a spec or part of one), or None when
+    ``x`` holds a type this module cannot key exactly (then: do not share)."""
+    try:
+        return _key(x)
+    except (_Unkeyable, TypeError):
+        return None
+
+
 def _cpu() -> float:
     t = os.times()
     own = t.user + t.system
@@ -99,23 +115,53 @@ def _cpu() -> float:
     return own + ch.ru_utime + ch.ru_stime
 
 
-def run_study(design, run: Callable[[Any], Any]) -> Any:
+def _design_key(design) -> tuple | None:
+    spec = spec_key(design.spec)
+    return None if spec is None else (design.kind, spec)
+
+
+def start_studies(designs, registry) -> None:
+    """Start now the parts of these designs' studies that run in worker
+    processes (studies with a ``start(design)`` method: the Monte Carlo
+    pools of ``antiskid-run``), so that they overlap the other designs;
+    :func:`run_study` hands the handle to the study's ``run``. Call
+    :func:`cancel_started` when leaving early."""
+    for d in designs:
+        key, study = _design_key(d), registry[d.kind]
+        if key is None or key in _RESULTS or key in _STARTED or not hasattr(study, "start"):
+            continue
+        w0, c0 = time.perf_counter(), _cpu()
+        _STARTED[key] = (study, study.start(d), w0, c0)
+
+
+def cancel_started() -> None:
+    """Stop the worker processes of started studies that never ran."""
+    while _STARTED:
+        _, (_, handle, _, _) = _STARTED.popitem()
+        for p in handle or ():
+            if p is not None:
+                p.cancel()
+
+
+def run_study(design, run: Callable[..., Any]) -> Any:
     """``run(design)``, computed once per process for an equal (kind, spec).
 
     Parameters
     ----------
     design : workbench.design.Design
     run : callable
-        The study's ``run``.
+        The study's ``run``; called as ``run(design, started=handle)`` when
+        :func:`start_studies` started the design.
     """
-    try:
-        key = (design.kind, _key(design.spec))
-    except (_Unkeyable, TypeError):
-        key = None
+    key = _design_key(design)
     if key is not None and key in _RESULTS:
         return _RESULTS[key]
     w0, c0 = time.perf_counter(), _cpu()
-    result = run(design)
+    if key is not None and key in _STARTED:
+        _, handle, w0, c0 = _STARTED.pop(key)
+        result = run(design, started=handle)
+    else:
+        result = run(design)
     _TIMES.append(StudyTime(design.name, design.kind, time.perf_counter() - w0, _cpu() - c0))
     if key is not None:
         _RESULTS[key] = result

@@ -264,7 +264,11 @@ def creep_speed(v, lam, xp):
 
 def phi1(z, xp):
     """phi1(z) = (e^z - 1) / z (1 + z/2 near 0)."""
+    if not xp.batch:
+        return math.expm1(z) / z if abs(z) > 1e-8 else 1.0 + 0.5 * z
     big = xp.abs(z) > 1e-8
+    if big.all():          # the usual case: the same values, fewer array passes
+        return np.expm1(z) / z
     zs = xp.where(big, z, 1.0)
     return xp.where(big, xp.expm1(zs) / zs, 1.0 + 0.5 * z)
 
