@@ -175,6 +175,7 @@ def study_times() -> tuple[StudyTime, ...]:
 
 
 def clear() -> None:
-    """Forget every result and time (tests)."""
+    """Forget every result and time, and stop what was started (tests)."""
+    cancel_started()
     _RESULTS.clear()
     _TIMES.clear()
