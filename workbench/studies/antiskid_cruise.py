@@ -15,8 +15,6 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
 from ..plants.units import ADHESION_003 as PARAMETER_UNITS
@@ -257,6 +255,8 @@ class AntiskidCruise:
 
     # -- run -------------------------------------------------------------------
     def run(self, design) -> CruiseResult:
+        import numpy as np
+
         from ..margins import delay_margin_eig
         from ..synthesis import certify_given_gain, eps_for_bound, synthesize_delay_bound
         spec: CruiseSpec = design.spec
@@ -319,6 +319,8 @@ TIGHT_QUANTITIES = ("eps", "h_certified", "h_analysis", "exact_margin", "exact_m
 
 def _run_tight(spec: CruiseSpec, lin: Linearisation, rows) -> TightComparison:
     """Tight synthesis, and the Bessel-Legendre + exact check of the reference gains."""
+    import numpy as np
+
     from ..lmi.robust import check_gain
     from ..lmi.tight_synthesis import synthesize_tight
     ts, st = spec.tight, spec.settings
