@@ -167,7 +167,9 @@ def study_times_table(times) -> str:
             for t in sorted(times, key=lambda t: -t.wall)]
     total = [["total", "", f"{sum(t.wall for t in times):.1f}",
               f"{sum(t.cpu for t in times):.1f}"]]
-    return ("\nper-design study time (each computed once):\n"
+    return ("\nper-design study time (each computed once; wall from the study's start, which "
+            "for a Monte Carlo design is the start of `check`; cpu: this process, not the "
+            "pool workers):\n"
             + md_table(["design", "kind", "wall s", "cpu s"], rows + total, "llrr"))
 
 

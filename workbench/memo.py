@@ -15,8 +15,8 @@ once.
 processes ahead of time (``workbench check`` starts the Monte Carlo pools
 first, so they run while the other designs are checked).
 
-:func:`study_times` is the timing hook: wall and CPU seconds (this process
-and the worker processes it waited for) of every study that ran.
+:func:`study_times` is the timing hook: wall and CPU seconds (this
+process) of every study that ran.
 """
 from __future__ import annotations
 
@@ -28,12 +28,6 @@ import time
 from dataclasses import dataclass
 from pathlib import PurePath
 from typing import Any, Callable
-
-try:
-    import resource
-except ImportError:  # pragma: no cover  (not on Windows)
-    resource = None
-
 
 @dataclass(frozen=True)
 class StudyTime:
@@ -47,9 +41,9 @@ class StudyTime:
         Study kind.
     wall, cpu : float
         Seconds from the study's start to its result; ``cpu`` is user +
-        system time of this process and of the worker processes that ended
-        meanwhile (the Monte Carlo pools). For a study started early
-        (:func:`start_studies`) both include whatever ran in between.
+        system time of this process only (the Monte Carlo pools' workers
+        are not in it). For a study started early (:func:`start_studies`)
+        both include whatever this process did in between.
     """
 
     design: str
@@ -108,11 +102,7 @@ def spec_key(x: Any) -> Any:
 
 def _cpu() -> float:
     t = os.times()
-    own = t.user + t.system
-    if resource is None:  # pragma: no cover
-        return own
-    ch = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own + ch.ru_utime + ch.ru_stime
+    return t.user + t.system
 
 
 def _design_key(design) -> tuple | None:
