@@ -25,12 +25,20 @@ install: $(STAMP)
 report: install
 	$(WB) report --all
 
-## tests, then every claim (designs and proofs), then report freshness; then
-## the report check and the golden report again under another CPU's kernels
+## tests, every claim (designs and proofs) and report freshness. `workbench check`
+## is `workbench verify` + `workbench report --all --check` in one process (each
+## study computed once); it runs next to pytest (two cores), its output is shown
+## after pytest's and ends with the time each design's study took. Then the
+## report check and the golden report again under another CPU's BLAS kernels.
 test: install
-	$(PY) -m pytest
-	$(WB) verify
-	$(WB) report --all --check
+	@log=$$(mktemp); \
+	$(WB) check > $$log 2>&1 & check=$$!; \
+	$(PY) -m pytest; tests=$$?; \
+	wait $$check; checked=$$?; \
+	echo; echo "== workbench check (verify + report --all --check)"; cat $$log; rm -f $$log; \
+	echo "pytest exit $$tests, workbench check exit $$checked"; \
+	test $$tests -eq 0 && test $$checked -eq 0
+	@echo "== report check and golden report under OPENBLAS_CORETYPE=$(OTHER_KERNEL)"
 	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(WB) report --all --check
 	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(PY) -m pytest -q -p no:cacheprovider \
 	  tests/test_cli_and_reports.py::test_golden_report

@@ -156,6 +156,41 @@ def cmd_report(args) -> int:
     return 0
 
 
+def cmd_check(args) -> int:
+    """``workbench verify`` then ``workbench report --all --check`` in one
+    process, each study computed once (:mod:`workbench.memo`; the Monte
+    Carlo pools start first and run while the other designs are checked);
+    then the time of every design's study, slowest first, on stderr. Exit
+    code: the larger of the two."""
+    from . import studies
+    from .memo import cancel_started, start_studies, study_times
+
+    try:
+        start_studies(_designs([]), studies.REGISTRY)   # the Monte Carlo pools, first
+        code = cmd_verify(argparse.Namespace(designs=[], json=False, junit_xml=None,
+                                              changed_since=None))
+        print()
+        code = max(code, cmd_report(argparse.Namespace(designs=[], all=True, check=True,
+                                                       out=args.out)))
+    finally:
+        cancel_started()
+    print(study_times_table(study_times()), file=sys.stderr)
+    return code
+
+
+def study_times_table(times) -> str:
+    """Markdown table of :func:`workbench.memo.study_times`, slowest first."""
+    from .report.markdown import md_table
+    rows = [[t.design, t.kind, f"{t.wall:.1f}", f"{t.cpu:.1f}"]
+            for t in sorted(times, key=lambda t: -t.wall)]
+    total = [["total", "", f"{sum(t.wall for t in times):.1f}",
+              f"{sum(t.cpu for t in times):.1f}"]]
+    return ("\nper-design study time (each computed once; wall from the study's start, which "
+            "for a Monte Carlo design is the start of `check`; cpu: this process, not the "
+            "pool workers):\n"
+            + md_table(["design", "kind", "wall s", "cpu s"], rows + total, "llrr"))
+
+
 def _cmd_prove(args) -> int:
     from .prove import cmd_prove
     return cmd_prove(args)
@@ -200,6 +235,8 @@ COMMANDS: dict[str, tuple[str, Callable]] = {
     "verify": ("evaluate every claim; exit 1 if any is not ok", cmd_verify),
     "fit": ("fit paper 000's brake model to a brake-fit design's synthetic logs", _cmd_fit),
     "report": ("write reports/<design>.md and figures (--check: fail if stale)", cmd_report),
+    "check": ("verify + report --all --check in one process, each study computed once",
+              cmd_check),
     "prove": ("check the claims of proofs/: PROVED / REFUTED / INCONCLUSIVE", _cmd_prove),
     "init": ("write a project skeleton: designs/, proofs/, reports/, CI files", cmd_init),
 }
@@ -250,6 +287,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--all", action="store_true", help="every design in designs/ and the index")
     p.add_argument("--check", action="store_true", help="exit 1 if a committed report is stale")
     p.add_argument("--out", help="output folder (default: reports/ of the project root)")
+    p = sub.add_parser("check", help=COMMANDS["check"][0])
+    p.add_argument("--out", help="report folder (default: reports/ of the project root)")
     p = sub.add_parser("prove", help=COMMANDS["prove"][0])
     p.add_argument("proofs", nargs="*", metavar="PROOF",
                    help="paper (e.g. 003), module of proofs/ or claim id (default: all)")

@@ -7,6 +7,7 @@ from typing import Any
 from . import studies
 from .claims import ClaimResult, check_claim
 from .design import Design
+from .memo import run_study
 
 
 @dataclass(frozen=True)
@@ -23,9 +24,10 @@ class Evaluation:
 
 
 def evaluate_design(design: Design) -> Evaluation:
-    """Run the design's study and check each of its claims."""
+    """Run the design's study (once per process for an equal spec,
+    :func:`workbench.memo.run_study`) and check each of its claims."""
     study = studies.REGISTRY[design.kind]
-    result = study.run(design)
+    result = run_study(design, study.run)
     q = study.quantities(result)
     return Evaluation(design, result, tuple(check_claim(c, q.get(c.quantity))
                                             for c in design.claims))

@@ -99,9 +99,17 @@ class _Scalar:
     batch = False
 
 
+def _any_of(x) -> bool:
+    """``np.any`` of a mask, by the array's own method when it is one (the
+    loop asks this several times a step; the function form's dispatch costs
+    more than the test)."""
+    return x.any() if isinstance(x, np.ndarray) else bool(np.any(x))
+
+
 class _Array:
     where, maximum, minimum, abs = np.where, np.maximum, np.minimum, np.abs
-    expm1, sqrt, any, logical_not = np.expm1, np.sqrt, np.any, np.logical_not
+    expm1, sqrt, logical_not = np.expm1, np.sqrt, np.logical_not
+    any = staticmethod(_any_of)
     batch = True
 
 
@@ -256,7 +264,11 @@ def creep_speed(v, lam, xp):
 
 def phi1(z, xp):
     """phi1(z) = (e^z - 1) / z (1 + z/2 near 0)."""
+    if not xp.batch:
+        return math.expm1(z) / z if abs(z) > 1e-8 else 1.0 + 0.5 * z
     big = xp.abs(z) > 1e-8
+    if big.all():          # the usual case: the same values, fewer array passes
+        return np.expm1(z) / z
     zs = xp.where(big, z, 1.0)
     return xp.where(big, xp.expm1(zs) / zs, 1.0 + 0.5 * z)
 
@@ -419,28 +431,43 @@ class Antiskid003:
         self._ticks, self.dt = ticks, ticks * tick
 
     # -- predictors ----------------------------------------------------------------
-    def _model_step(self, v, lam, u, dt, ph):
+    def _model_masks(self, ph):
+        """Which runs use which prediction model, for the phases ``ph``:
+        (traction, braking, cruise), each None (no run) or (mask, every run)."""
+        xp = self.xp
+        if not xp.batch:
+            return tuple((True, True) if on else None
+                         for on in (ph not in (CRUISE, BRAKE), ph == BRAKE, ph == CRUISE))
+        out = []
+        for sel in ((ph != CRUISE) & (ph < BRAKE), ph == BRAKE, ph == CRUISE):
+            out.append((sel, bool(sel.all())) if sel.any() else None)
+        return tuple(out)
+
+    def _model_step(self, v, lam, u, dt, ph, masks=None):
         """One step of the phase's prediction model: traction form (eq 65) in
         acceleration and handovers, linear error model (eq 62) in cruise,
-        braking form (eq 70) in braking; exponential Euler in lambda."""
+        braking form (eq 70) in braking; exponential Euler in lambda.
+        ``masks``: :meth:`_model_masks` of ``ph`` (computed when None)."""
         s, xp, p, c = self.s, self.xp, self.s.params, self.s.lin
+        m_tr, m_br, m_cr = self._model_masks(ph) if masks is None else masks
         out_v, out_l = v, lam
-        for forms, sel in (("traction", (ph != CRUISE) & (ph < BRAKE) if xp.batch
-                            else ph not in (CRUISE, BRAKE)),
-                           ("braking", ph == BRAKE)):
-            if xp.any(sel):
+        for forms, m in (("traction", m_tr), ("braking", m_br)):
+            if m is not None:
+                sel, every = m
                 fn = self.fns[forms]
                 nv, nl = stiff_step(v, lam, u, dt, lambda vv, ll: fn(
                     xp.maximum(vv, s.v_floor), ll, *p), xp, sel)
-                out_v, out_l = xp.where(sel, nv, out_v), xp.where(sel, nl, out_l)
-        sel = ph == CRUISE
-        if xp.any(sel):
+                out_v, out_l = (nv, nl) if every else (xp.where(sel, nv, out_v),
+                                                       xp.where(sel, nl, out_l))
+        if m_cr is not None:
+            sel, every = m_cr
             ve, le = v - s.v_d, lam - s.lambda_d
             den = c["d4"] * ve + c["d5"] * le + c["d6"]
             f2 = c["d1"] * ve + c["d2"] * le + c["d3"] + den * u
             nv, nl = _exp_euler(v, lam, c["a1"] * ve + c["a2"] * le, f2,
                                 (c["d2"] + c["d5"] * u) * dt, dt, xp)
-            out_v, out_l = xp.where(sel, nv, out_v), xp.where(sel, nl, out_l)
+            out_v, out_l = (nv, nl) if every else (xp.where(sel, nv, out_v),
+                                                   xp.where(sel, nl, out_l))
         return out_v, out_l
 
     def _rollout(self, v, lam, ph):
@@ -448,9 +475,9 @@ class Antiskid003:
         the inputs of the last h seconds (exact ZOH weights of the window; on
         a refined mesh, in pieces of the current step with the exact average
         input over each)."""
-        line = self.uline
+        line, masks = self.uline, self._model_masks(ph)
         for u, d in (line.pieces() if self._base is None else line.pieces(self._ticks)):
-            v, lam = self._model_step(v, lam, u, d, ph)
+            v, lam = self._model_step(v, lam, u, d, ph, masks)
         return v, lam
 
     # -- the three laws -------------------------------------------------------------
@@ -479,7 +506,7 @@ class Antiskid003:
         u(t - h_model), moves lambda by dt phi1(dt J) (f_model + delta)."""
         s, xp, dt = self.s, self.xp, self._dt_prev
         braking = ph >= BRAKE_IN
-        if xp.batch and np.all(braking) or not xp.batch and braking:
+        if xp.batch and braking.all() or not xp.batch and braking:
             self.delta = 0.0 * v
         elif self._prev is not None and s.sampling == "stiff" and s.observer_tau > 0:
             pv, pl, pph = self._prev
@@ -759,7 +786,7 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
         return (np.where(stop, x[0], nx[0]), np.where(stop, x[1], nx[1]))
 
     def done(t, x, ph):
-        return bool(np.all(ph >= STOPPED))
+        return bool((ph >= STOPPED).all()) if batch is not None else ph >= STOPPED
 
     every = 10**12 if record_dt is None else max(int(round(record_dt / dt)), 1)
     x0 = (run.x0[0] + zero, run.x0[1] + zero)

@@ -11,7 +11,6 @@ import warnings
 from dataclasses import dataclass
 from typing import Literal
 
-import control
 import numpy as np
 
 from . import _input
@@ -170,6 +169,7 @@ def delay_margin_siso(A, B, K) -> DelayMargin:
     method = "python-control stability_margins"
     if not np.max(np.linalg.eigvals(A + B @ K).real) < 0:
         return DelayMargin(0.0, None, "unstable-at-zero-delay", method)
+    import control   # (and matplotlib with it): only where the crossovers are needed
     loop = control.ss(A, B, -K, 0.0)   # L(s) = -K (sI - A)^{-1} B, u = -L e
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -19,14 +19,12 @@ import sympy as sp
 from scipy.optimize import brentq
 
 from ..errors import ModelError
+from .units import ADHESION_003
 
 #: Parameter names of the model with their SI units (the design loader checks
-#: that a design states exactly these units).
-PARAMETER_UNITS: dict[str, str] = {
-    "a": "1", "b": "1", "c": "1",
-    "J": "kg m^2", "r": "m", "m": "kg", "zeta": "N m s/rad",
-    "c0": "N", "c1": "N s/m", "c2": "N s^2/m^2", "g": "m/s^2",
-}
+#: that a design states exactly these units; kept as data in
+#: :mod:`workbench.plants.units`).
+PARAMETER_UNITS: dict[str, str] = ADHESION_003
 
 
 @dataclass(frozen=True)

@@ -14,23 +14,56 @@ Each study module provides an object with
 ``render(design, result) -> workbench.report.Rendered``
     Markdown sections and figures (pure).
 
-New capabilities add a module here and one line to :data:`REGISTRY`.
+New capabilities add a module here and one line to :data:`STUDIES`.
+
+Loading is lazy: :data:`REGISTRY` imports a study's module the first time
+its kind is looked up, so reading (or rejecting) a design imports only its
+own study. A study module keeps its top level light (the design tables,
+specs and quantity names); the solvers, the symbolic model and the plotting
+libraries (cvxpy, control, sympy, matplotlib) are imported inside the
+functions that compute or render.
 """
 from __future__ import annotations
 
-from . import antiskid_cruise, platoon001, tracking002
-from . import brake004, fit000, stopping000
-from . import antiskid_run
-from . import antiskid_robust, delay_benchmark
+import importlib
+from collections.abc import Mapping
+from typing import Any, Iterator
 
-REGISTRY = {
-    antiskid_cruise.STUDY.kind: antiskid_cruise.STUDY,
-    delay_benchmark.STUDY.kind: delay_benchmark.STUDY,
-    antiskid_robust.STUDY.kind: antiskid_robust.STUDY,
-    antiskid_run.STUDY.kind: antiskid_run.STUDY,
-    stopping000.STUDY.kind: stopping000.STUDY,
-    brake004.STUDY.kind: brake004.STUDY,
-    fit000.STUDY.kind: fit000.STUDY,
-    tracking002.STUDY.kind: tracking002.STUDY,
-    platoon001.STUDY.kind: platoon001.STUDY,
+#: kind -> "module:attribute" of the study object (module relative to this package).
+STUDIES: dict[str, str] = {
+    "antiskid-cruise": "antiskid_cruise:STUDY",
+    "delay-benchmark": "delay_benchmark:STUDY",
+    "antiskid-robust": "antiskid_robust:STUDY",
+    "antiskid-run": "antiskid_run:STUDY",
+    "station-stopping": "stopping000:STUDY",
+    "closed-loop-brake": "brake004:STUDY",
+    "brake-fit": "fit000:STUDY",
+    "ato-tracking": "tracking002:STUDY",
+    "ntsm-platoon": "platoon001:STUDY",
 }
+
+
+class _LazyRegistry(Mapping):
+    """kind -> study object, each module imported on first lookup."""
+
+    def __init__(self, table: dict[str, str]):
+        self._table, self._loaded = table, {}
+
+    def __getitem__(self, kind: str) -> Any:
+        if kind not in self._loaded:
+            module, attr = self._table[kind].split(":")
+            study = getattr(importlib.import_module(f"{__name__}.{module}"), attr)
+            if study.kind != kind:
+                raise RuntimeError(f"{module}:{attr} is a {study.kind!r} study, not {kind!r}")
+            self._loaded[kind] = study
+        return self._loaded[kind]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._table)
+
+    def __len__(self) -> int:
+        return len(self._table)
+
+
+#: kind -> study object (imported on demand, see the module docstring).
+REGISTRY: Mapping[str, Any] = _LazyRegistry(STUDIES)

@@ -13,21 +13,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
-from ..lmi.core import DEFAULT_MARGIN
-from ..lmi.robust import PointCheck, check_gain
-from ..lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
-from ..lmi.tight_synthesis import TightSynthesis, synthesize_tight
-from ..margins import DelayMargin, delay_margin_eig
-from ..plants.adhesion import PARAMETER_UNITS, NumericAdhesion
-from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
-from ..symbolic.linearise import Linearisation, linearise_cruise
-from ..synthesis import (SynthesisRow, SynthesisSettings, certify_given_gain, eps_for_bound,
-                         synthesize_delay_bound)
+from ..plants.units import ADHESION_003 as PARAMETER_UNITS
+
+if TYPE_CHECKING:   # the solvers and the symbolic model load when a design runs
+    from ..lmi.robust import PointCheck
+    from ..lmi.tight_synthesis import TightSynthesis
+    from ..margins import DelayMargin
+    from ..report.markdown import Rendered
+    from ..symbolic.linearise import Linearisation
+    from ..synthesis import SynthesisRow, SynthesisSettings
 
 PARAM_DOC = {
     "a": "adhesion peak parameter", "b": "adhesion slope parameter",
@@ -158,6 +156,8 @@ class CruiseResult:
 
 def operating_point(spec: CruiseSpec) -> tuple[float, float, float, Linearisation]:
     """(lambda_opt, lambda_d solved, lambda_d used, linearisation) of a cruise spec."""
+    from ..plants.adhesion import NumericAdhesion
+    from ..symbolic.linearise import linearise_cruise
     plant = NumericAdhesion.from_dict({k: q.value for k, q in spec.params.items()})
     lam_solved = plant.cruise_lambda(spec.v_d.value)
     lam_used = spec.lambda_d_pinned.value if spec.lambda_d_pinned else lam_solved
@@ -190,6 +190,9 @@ class AntiskidCruise:
         eps = syn.numbers("eps", positive=True, what="eps values")
         if len(set(eps)) != len(eps):
             raise syn.fail("eps", list(eps), "distinct eps values")
+        from ..lmi.core import DEFAULT_MARGIN
+        from ..lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
+        from ..synthesis import SynthesisSettings
         settings = SynthesisSettings(
             margin=syn.number("margin", default=DEFAULT_MARGIN, positive=True, hi=1e-2),
             rel_tol=syn.number("rel_tol", default=1e-4, positive=True, hi=0.1),
@@ -211,6 +214,7 @@ class AntiskidCruise:
         compare = syn.boolean("compare_published", default=True)
         syn.finish()
         tight = self._load_tight(root, eps) if root.has("tight") else None
+        from ..plants.adhesion import NumericAdhesion
         plant_values = {k: q.value for k, q in params.items()}
         try:  # an impossible operating point is bad input, found at load time
             NumericAdhesion.from_dict(plant_values).cruise_lambda(v_d.value)
@@ -256,6 +260,10 @@ class AntiskidCruise:
 
     # -- run -------------------------------------------------------------------
     def run(self, design) -> CruiseResult:
+        import numpy as np
+
+        from ..margins import delay_margin_eig
+        from ..synthesis import certify_given_gain, eps_for_bound, synthesize_delay_bound
         spec: CruiseSpec = design.spec
         lam_opt, lam_solved, lam_used, lin = operating_point(spec)
         rows = synthesize_delay_bound(lin.A, lin.B, spec.eps, spec.settings)
@@ -316,6 +324,10 @@ TIGHT_QUANTITIES = ("eps", "h_certified", "h_analysis", "exact_margin", "exact_m
 
 def _run_tight(spec: CruiseSpec, lin: Linearisation, rows) -> TightComparison:
     """Tight synthesis, and the Bessel-Legendre + exact check of the reference gains."""
+    import numpy as np
+
+    from ..lmi.robust import check_gain
+    from ..lmi.tight_synthesis import synthesize_tight
     ts, st = spec.tight, spec.settings
     syn = synthesize_tight(lin.A, lin.B, eps_grid=ts.grid, h_max=ts.h_max, N=ts.order,
                            margin=st.margin, rel_tol=max(st.rel_tol, 1e-3),

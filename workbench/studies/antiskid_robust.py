@@ -15,17 +15,16 @@ equilibrium lambda_d. Certificates hold at the listed points only.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
-from ..lmi.core import DEFAULT_MARGIN
-from ..lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
-from ..lmi.robust import PointCheck, RobustSynthesis, check_gain, synthesize_robust
-from ..margins import spectral_abscissa
-from ..plants.adhesion import PARAMETER_UNITS, NumericAdhesion
-from ..symbolic.linearise import linearise_cruise
+from ..plants.units import ADHESION_003 as PARAMETER_UNITS
+
+if TYPE_CHECKING:   # the solvers load when a design runs
+    from ..lmi.robust import PointCheck, RobustSynthesis
 
 RAIL_KEYS = ("a", "b", "c")
 
@@ -88,6 +87,8 @@ class RobustResult:
 
 
 def _points(path, common, rails, op: Reader) -> tuple[Point, ...]:
+    from ..plants.adhesion import NumericAdhesion
+    from ..symbolic.linearise import linearise_cruise
     names = op.raw("rails")
     if not isinstance(names, list) or not names or any(r not in rails for r in names):
         raise op.fail("rails", names, "a list of rails among " + ", ".join(sorted(rails)))
@@ -131,6 +132,8 @@ class AntiskidRobust:
         plant.finish()
         points = _points(root.path, common, rails, root.table("operating_points"))
         syn = root.table("synthesis")
+        from ..lmi.core import DEFAULT_MARGIN
+        from ..lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
         spec = dict(
             alpha=syn.number("alpha", nonneg=True, hi=10.0, what="decay rate (1/s)"),
             eps_grid=syn.numbers("eps_grid", positive=True, min_len=2, what="eps values"),
@@ -169,6 +172,8 @@ class AntiskidRobust:
     def run(self, design) -> RobustResult:
         s: RobustSpec = design.spec
         pts = [(p.A, p.B) for p in s.points]
+        from ..lmi.robust import check_gain, synthesize_robust
+        from ..margins import spectral_abscissa
         syn = synthesize_robust(pts, alpha=s.alpha, eps_grid=s.eps_grid,
                                 golden_steps=s.golden_steps, rel_tol=s.rel_tol,
                                 margin=s.margin, h_hi=s.h_max, gain_fraction=s.gain_fraction,

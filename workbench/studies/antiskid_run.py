@@ -291,18 +291,31 @@ def _range(t: Reader, key: str, **kw) -> tuple[float, float]:
     return lo_hi
 
 
+#: gain_for's answers in this process, keyed by what they depend on (the
+#: sweep, the halving check and the cases of a design all ask for the same K).
+_GAINS: dict = {}
+
+
 def gain_for(spec: RunSpec) -> tuple[tuple, str, float | None]:
     """(K, how it was obtained, h_certified or None): from the certified
     synthesis of problem (60) at the design's eps on the nominal cruise
-    linearisation, or the design's table gain."""
+    linearisation, or the design's table gain (each synthesis once per
+    process: the answer depends on the nominal plant, v_d and eps only)."""
     if spec.gain == "table":
         return tuple(spec.K_table), spec.K_source, None
-    from ..synthesis import synthesize_delay_bound
-    _, _, lin = _nominal_cruise(spec)
-    row = synthesize_delay_bound(lin.A, lin.B, (spec.eps,))[0]
-    if row.K is None:
-        raise ModelError(f"synthesis at eps = {spec.eps} certified no gain")
-    return row.K, f"synthesis, problem (60) at eps = {spec.eps:g}", row.h_certified
+    from ..memo import spec_key
+    key = spec_key((spec.params, spec.scenario["v_d"], spec.eps))
+    if key is None or key not in _GAINS:
+        from ..synthesis import synthesize_delay_bound
+        _, _, lin = _nominal_cruise(spec)
+        row = synthesize_delay_bound(lin.A, lin.B, (spec.eps,))[0]
+        if row.K is None:
+            raise ModelError(f"synthesis at eps = {spec.eps} certified no gain")
+        out = (row.K, f"synthesis, problem (60) at eps = {spec.eps:g}", row.h_certified)
+        if key is None:
+            return out
+        _GAINS[key] = out
+    return _GAINS[key]
 
 
 def simulate_design(design, case_name: str | None, dt: float | None) -> dict:
@@ -476,19 +489,33 @@ class AntiskidRun:
                 names |= halving_quantity_names()
         return names
 
-    def run(self, design) -> RunResult:
+    def start(self, design):
+        """Start the Monte Carlo part of :meth:`run` (its process pools) now,
+        so that it overlaps whatever the caller does next; returns the
+        handle :meth:`run` takes as ``started`` (None: nothing to start)."""
+        spec: RunSpec = design.spec
+        if spec.montecarlo is None:
+            return None
+        from ..sim.montecarlo import start_halving, start_sweep
+        K = gain_for(spec)[0]
+        ms = spec.montecarlo
+        pending = start_sweep(design, ms.samples, ms.seed, workers=ms.workers,
+                              chunk=ms.chunk, pool=True, K=K)
+        halving = None
+        if ms.halving:    # its dt side is the sweep's first runs
+            halving = start_halving(design, ms.halving, K=K, pool=True, coarse=False)
+        return pending, halving
+
+    def run(self, design, started=None) -> RunResult:
+        """The cases, the linear checks and the Monte Carlo part (its chunks
+        run in a pool while the cases run here; ``started``: the handle of
+        :meth:`start` if it was started already)."""
         spec: RunSpec = design.spec
         nominal, lam_d, lin = _nominal_cruise(spec)
-        v_d = spec.scenario["v_d"]
         K, how, h_cert = gain_for(spec)
-        pending, halving = None, None
-        if spec.montecarlo is not None:   # its chunks run in a pool while the cases run here
-            from ..sim.montecarlo import start_halving, start_sweep
-            ms = spec.montecarlo
-            pending = start_sweep(design, ms.samples, ms.seed, workers=ms.workers,
-                                  chunk=ms.chunk, pool=True, K=K)
-            if ms.halving:    # its dt side is the sweep's first runs
-                halving = start_halving(design, ms.halving, K=K, pool=True, coarse=False)
+        if started is None:
+            started = self.start(design)
+        pending, halving = started or (None, None)
         try:
             cases = self._cases(spec, K)
             lc = linear_check(spec, lin.A, lin.B, K)

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import control
 import numpy as np
 import sympy as sp
 
@@ -44,6 +43,7 @@ class Linearisation:
 
     def state_space(self) -> control.StateSpace:
         """The error system as a ``control.StateSpace`` (output = state)."""
+        import control
         return control.ss(self.A, self.B, np.eye(2), np.zeros((2, 1)))
 
 

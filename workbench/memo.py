@@ -1,0 +1,171 @@
+"""Each study result computed once per process, and how long it took.
+
+``workbench check`` (verify, then the report check) and the test session
+evaluate the same designs more than once in one process. :func:`run_study`
+runs a design's study the first time and hands back that same result for
+any later design with an equal spec (the study's input: its ``run`` reads
+nothing else of the design). Results are frozen dataclasses, and report
+rendering is pure, so sharing one is the same as recomputing it.
+
+Nothing is kept across processes and nothing is written to disk: every
+``workbench`` command and every test session computes each study afresh,
+once.
+
+:func:`start_studies` starts the parts of studies that run in worker
+processes ahead of time (``workbench check`` starts the Monte Carlo pools
+first, so they run while the other designs are checked).
+
+:func:`study_times` is the timing hook: wall and CPU seconds (this
+process) of every study that ran.
+"""
+from __future__ import annotations
+
+import dataclasses
+import enum
+import math
+import os
+import time
+from dataclasses import dataclass
+from pathlib import PurePath
+from typing import Any, Callable
+
+@dataclass(frozen=True)
+class StudyTime:
+    """One study run: the design that asked for it and its cost.
+
+    Attributes
+    ----------
+    design : str
+        Design name (its file stem).
+    kind : str
+        Study kind.
+    wall, cpu : float
+        Seconds from the study's start to its result; ``cpu`` is user +
+        system time of this process only (the Monte Carlo pools' workers
+        are not in it). For a study started early (:func:`start_studies`)
+        both include whatever this process did in between.
+    """
+
+    design: str
+    kind: str
+    wall: float
+    cpu: float
+
+
+_RESULTS: dict[tuple, Any] = {}
+_TIMES: list[StudyTime] = []
+_STARTED: dict[tuple, tuple] = {}     # key -> (study, handle, wall clock, cpu) at start
+
+
+class _Unkeyable(Exception):
+    pass
+
+
+def _key(x: Any) -> Any:
+    """A hashable, exact image of a spec (floats by value, arrays by bytes);
+    raises :class:`_Unkeyable` on a type it does not know (then no sharing)."""
+    if x is None or isinstance(x, (bool, int, str)):
+        return (type(x).__name__, x)
+    if isinstance(x, float):
+        return ("float", x.hex() if math.isfinite(x) else repr(x))
+    if isinstance(x, enum.Enum):
+        return (type(x).__qualname__, _key(x.value))
+    if isinstance(x, PurePath):
+        return ("path", str(x))
+    if isinstance(x, (tuple, list)):
+        return (type(x).__name__, tuple(_key(v) for v in x))
+    if isinstance(x, (set, frozenset)):
+        return ("set", tuple(sorted(_key(v) for v in x)))
+    if isinstance(x, dict):
+        return ("dict", tuple(sorted((_key(k), _key(v)) for k, v in x.items())))
+    if dataclasses.is_dataclass(x) and not isinstance(x, type):
+        return (type(x).__module__, type(x).__qualname__,
+                tuple((f.name, _key(getattr(x, f.name))) for f in dataclasses.fields(x)))
+    import numpy as np
+    if isinstance(x, np.ndarray):
+        if x.dtype.hasobject:
+            return ("ndarray-object", x.shape, tuple(_key(v) for v in x.ravel().tolist()))
+        return ("ndarray", x.dtype.str, x.shape, np.ascontiguousarray(x).tobytes())
+    if isinstance(x, np.generic):
+        return (type(x).__name__, _key(x.item()))
+    raise _Unkeyable(type(x).__qualname__)
+
+
+def spec_key(x: Any) -> Any:
+    """A hashable, exact key of ``x`` (a spec or part of one), or None when
+    ``x`` holds a type this module cannot key exactly (then: do not share)."""
+    try:
+        return _key(x)
+    except (_Unkeyable, TypeError):
+        return None
+
+
+def _cpu() -> float:
+    t = os.times()
+    return t.user + t.system
+
+
+def _design_key(design) -> tuple | None:
+    spec = spec_key(design.spec)
+    return None if spec is None else (design.kind, spec)
+
+
+def start_studies(designs, registry) -> None:
+    """Start now the parts of these designs' studies that run in worker
+    processes (studies with a ``start(design)`` method: the Monte Carlo
+    pools of ``antiskid-run``), so that they overlap the other designs;
+    :func:`run_study` hands the handle to the study's ``run``. Call
+    :func:`cancel_started` when leaving early."""
+    for d in designs:
+        key, study = _design_key(d), registry[d.kind]
+        if key is None or key in _RESULTS or key in _STARTED or not hasattr(study, "start"):
+            continue
+        w0, c0 = time.perf_counter(), _cpu()
+        _STARTED[key] = (study, study.start(d), w0, c0)
+
+
+def cancel_started() -> None:
+    """Stop the worker processes of started studies that never ran."""
+    while _STARTED:
+        _, (_, handle, _, _) = _STARTED.popitem()
+        for p in handle or ():
+            if p is not None:
+                p.cancel()
+
+
+def run_study(design, run: Callable[..., Any]) -> Any:
+    """``run(design)``, computed once per process for an equal (kind, spec).
+
+    Parameters
+    ----------
+    design : workbench.design.Design
+    run : callable
+        The study's ``run``; called as ``run(design, started=handle)`` when
+        :func:`start_studies` started the design.
+    """
+    key = _design_key(design)
+    if key is not None and key in _RESULTS:
+        return _RESULTS[key]
+    w0, c0 = time.perf_counter(), _cpu()
+    if key is not None and key in _STARTED:
+        _, handle, w0, c0 = _STARTED.pop(key)
+        result = run(design, started=handle)
+    else:
+        result = run(design)
+    _TIMES.append(StudyTime(design.name, design.kind, time.perf_counter() - w0, _cpu() - c0))
+    if key is not None:
+        _RESULTS[key] = result
+    return result
+
+
+def study_times() -> tuple[StudyTime, ...]:
+    """Every study run of this process so far, in order (shared results are
+    not repeated)."""
+    return tuple(_TIMES)
+
+
+def clear() -> None:
+    """Forget every result and time, and stop what was started (tests)."""
+    cancel_started()
+    _RESULTS.clear()
+    _TIMES.clear()
