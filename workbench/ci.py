@@ -173,7 +173,6 @@ def run_verify(paths: list[str], *, changed_since: str | None = None) -> VerifyR
     from .design import load_design
     from .errors import DesignError
     from .project import find_project
-    from .prove import proof_modules, run_proofs
     from .verify import evaluate_design
 
     project = find_project()
@@ -181,8 +180,11 @@ def run_verify(paths: list[str], *, changed_since: str | None = None) -> VerifyR
     if not files and not paths and not project.proofs.is_dir():
         raise DesignError("<cli>", "DESIGN", str(project.designs),
                           "a folder with design files (run `workbench init PATH` for a project)")
-    designs = [load_design(p) for p in files]
-    modules = list(proof_modules()) if not paths else []
+    designs = [load_design(p) for p in files]   # a bad design answers before any proof loads
+    modules = []
+    if not paths:
+        from .prove import proof_modules, run_proofs
+        modules = list(proof_modules())
     skipped: list[str] = []
     if changed_since is not None:
         from .changes import changed_files, design_changed, proof_changed

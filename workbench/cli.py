@@ -87,12 +87,14 @@ def cmd_synthesize(args) -> int:
 
 def cmd_verify(args) -> int:
     from .ci import run_verify, timing_table
-    from .prove import verification_rows
     from .report.markdown import fmt, md_table
 
     run = run_verify(args.designs, changed_since=args.changed_since)
     evs = run.evaluations
-    extra = verification_rows(list(run.proofs)) if run.proofs else {}
+    extra = {}
+    if run.proofs:
+        from .prove import verification_rows
+        extra = verification_rows(list(run.proofs))
     if args.junit_xml:
         from .junit import write_junit
         from .project import find_project
