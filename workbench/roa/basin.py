@@ -90,7 +90,7 @@ class BasinEstimate:
         Boxes evaluated and left unresolved by the annulus cover.
     budget_hit : bool
     min_width : float
-        Smallest relative box width of the cover.
+        Smallest box width of the cover, relative to the box's distance from x*.
     samples : int
         Points the falsifier evaluated.
     seed : int
@@ -150,7 +150,7 @@ class BasinEstimate:
 
 def estimate_basin(problem: BasinProblem, c_search: float, *, seed: int = 0,
                    n_samples: int = 20_000, n_rays: int = 512,
-                   min_width: float = 2.0**-14, max_boxes: int = 400_000) -> BasinEstimate:
+                   min_width: float = 2.0**-12, max_boxes: int = 400_000) -> BasinEstimate:
     """Bracket the largest level {V <= c} with V' < 0 (module docstring).
 
     Parameters

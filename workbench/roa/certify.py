@@ -1,5 +1,9 @@
 """Verified level sets: V' < 0 on {c_inner < V <= c}, by interval arithmetic.
 
+Both arguments work in whitened coordinates z, x = x* + T z with P = L L',
+T = L^-T (:class:`~workbench.roa.problem.BasinProblem`), where the level sets
+are near-balls; V = z' M z with M = T' P T enclosed rigorously.
+
 Two arguments, each sound on its own region:
 
 1. **Ball around the equilibrium** (:func:`ball_argument`). Interval boxes
@@ -7,7 +11,10 @@ Two arguments, each sound on its own region:
    small; there Taylor's theorem is used instead. With e = x - x*,
    V'(x*) = 0 exactly (V' = 2 e'P f), so
 
-       V'(x) = g'e + 1/2 e' H_bar e,   g = grad V'(x*) = 2 P f(x*),
+       V'(x) = g'e + 1/2 e' H_bar e,   g = grad V'(x*) = 2 P f(x*)
+
+   (written here in x; the code applies it to V'(x* + T z) in z, with
+   |z| and c_inner = lambda_max(M) (2 |g| / mu)^2),
 
    where H_bar = 2 int_0^1 (1 - s) H(x* + s e) ds lies in the convex hull of
    the Hessian of V' on any convex set holding the segment, here the
@@ -27,8 +34,9 @@ Two arguments, each sound on its own region:
    {c0 < V <= c}, branch and bound in layers. A box is dropped when V > c
    on it, when V <= c0 on it (the ball), or when the enclosure of V' on it
    (:meth:`~workbench.roa.problem.BasinProblem.vdot_enclosure`) is < 0;
-   otherwise it is split in two across its widest side (relative to the
-   first box). A box that reaches the smallest width unresolved lowers the
+   otherwise it is split in two across its widest side. A box whose width
+   is below ``min_width`` times its distance from x* (at least the ball's
+   radius) and is still unresolved lowers the
    level to the lower bound of V on it: every point of a lower level lies in
    a box that was proven or discarded, so V' < 0 on {c0 < V <= c_certified}.
 
@@ -75,6 +83,24 @@ def _lambda_max_upper(M: np.ndarray) -> float:
     return lam + 1e-12 * M.shape[0] * float(np.linalg.norm(M)) + 1e-300
 
 
+def _neg_def_margin(L: np.ndarray, U: np.ndarray) -> float:
+    """mu > 0 with z' H z <= -mu |z|^2 for every symmetric H with L <= H <= U
+    (0 when not shown). Rohn's bound after a diagonal congruence D H D,
+    D = diag(|mid_ii|^-1/2) (exact powers of two), so that a Hessian with very
+    different diagonal entries (slow and fast modes) is judged on its
+    relative spread: lambda_max(D H D) <= -m gives mu = m min_i d_i^-2."""
+    mid = 0.5 * (L + U)
+    diag = np.abs(np.diag(mid))
+    if not np.all(diag > 0):
+        return 0.0
+    d = 2.0 ** np.round(-0.5 * np.log2(diag))          # powers of two: scaling is exact
+    Ls, Us = L * np.outer(d, d), U * np.outer(d, d)
+    ms = 0.5 * (Ls + Us)
+    rad = np.nextafter(np.maximum(Us - ms, ms - Ls), np.inf)
+    m = -(_lambda_max_upper(ms) + float(np.linalg.norm(rad)) * (1 + 1e-12))
+    return float(m * np.min(1.0 / d**2)) if m > 0 else 0.0
+
+
 def ball_argument(problem: BasinProblem, c_start: float, *, shrinks: int = 40) -> BallResult:
     """Largest c0 in {c_start 4^-k} on which the Hessian argument proves V' < 0
     (module docstring, argument 1).
@@ -88,33 +114,34 @@ def ball_argument(problem: BasinProblem, c_start: float, *, shrinks: int = 40) -
         Number of divisions by 4 tried before giving up.
     """
     n = len(problem.states)
-    x = problem.x_eq[None, :]
-    grads, amb0 = problem.vdot_grad_interval(x, x)
+    z0 = np.zeros((1, n))
+    grads, amb0 = problem.vdot_z_grad_interval(z0, z0)
     g_mag = np.array([max(abs(g.lo[0]), abs(g.hi[0])) for g in grads])
     g_norm = float(np.nextafter(np.sqrt(np.sum(g_mag**2)) * (1 + 1e-15), np.inf))
     if not np.isfinite(g_norm) or bool(amb0[0]):
         return BallResult(0.0, 0.0, 0.0)
-    lam_P = _lambda_max_upper(problem.P)
+    _, lam_M = problem.M_eig_bounds()
     c0 = float(c_start)
     for _ in range(shrinks + 1):
-        lo, hi = problem.bounding_box(c0)
-        ents, amb = problem.vdot_hessian_interval(lo[None, :], hi[None, :])
+        lo, hi = problem.bounding_box_z(c0)
+        ents, amb = problem.vdot_z_hessian_interval(lo[None, :], hi[None, :])
         if not amb[0]:
             L = np.array([e.lo[0] for e in ents]).reshape(n, n)
             U = np.array([e.hi[0] for e in ents]).reshape(n, n)
             L, U = np.maximum(L, L.T), np.minimum(U, U.T)     # both enclose the symmetric H
             if np.all(np.isfinite(L)) and np.all(np.isfinite(U)) and np.all(L <= U):
-                mid = 0.5 * (L + U)
-                rad = np.nextafter(np.maximum(U - mid, mid - L), np.inf)
-                bound = _lambda_max_upper(mid) + float(np.linalg.norm(rad)) * (1 + 1e-12)
-                mu = -bound
+                mu = _neg_def_margin(L, U)
                 if mu > 0:
                     rho = 2.0 * g_norm / mu
-                    c_inner = 0.0 if g_norm == 0 else lam_P * rho * rho * (1 + 1e-9)
+                    c_inner = 0.0 if g_norm == 0 else lam_M * rho * rho * (1 + 1e-9)
                     if c_inner < c0:
                         return BallResult(c0, c_inner, mu)
         c0 /= 4.0
     return BallResult(0.0, 0.0, 0.0)
+
+
+def _to_x(problem: BasinProblem, z: np.ndarray) -> tuple:
+    return tuple(float(v) for v in problem.x_eq + problem.T @ z)
 
 
 @dataclass(frozen=True)
@@ -145,7 +172,7 @@ class AnnulusResult:
 
 
 def verify_annulus(problem: BasinProblem, c0: float, c_top: float, *,
-                   min_width: float = 2.0**-14, max_boxes: int = 400_000) -> AnnulusResult:
+                   min_width: float = 2.0**-12, max_boxes: int = 400_000) -> AnnulusResult:
     """Adaptive interval cover of {c0 < V <= c_top} (module docstring, argument 2).
 
     Parameters
@@ -156,17 +183,19 @@ def verify_annulus(problem: BasinProblem, c0: float, c_top: float, *,
     c_top : float
         Level to verify.
     min_width : float
-        Smallest box width, relative to the first box (the bounding box of
-        {V <= c_top}).
+        Smallest box width, relative to the box's distance from x* (at
+        least the radius of the ball {V <= c0}): near x*, where V' is
+        quadratically small, boxes may be as small as they need.
     max_boxes : int
         Largest number of boxes in one layer.
     """
-    lo0, hi0 = problem.bounding_box(c_top)
-    scale = hi0 - lo0
+    lo0, hi0 = problem.bounding_box_z(c_top)
+    _, lam_M = problem.M_eig_bounds()
+    r0 = np.sqrt(max(c0, 1e-300) / lam_M)
     lo, hi = lo0[None, :], hi0[None, :]
     c_bound, boxes, unresolved, budget_hit, witness = c_top, 0, 0, False, None
     while len(lo):
-        Vi = problem.V_interval(lo, hi)
+        Vi = problem.V_interval_z(lo, hi)
         live = (Vi.lo <= c_bound) & (Vi.hi > c0)
         lo, hi, vlo = lo[live], hi[live], Vi.lo[live]
         if not len(lo):
@@ -175,21 +204,23 @@ def verify_annulus(problem: BasinProblem, c0: float, c_top: float, *,
         vd, _ = problem.vdot_enclosure(lo, hi)
         open_ = ~(vd.hi < 0)
         lo, hi, vlo = lo[open_], hi[open_], vlo[open_]
-        rel = (hi - lo) / scale
-        small = rel.max(axis=1) <= min_width
+        width = (hi - lo).max(axis=1)
+        dist = np.maximum(np.sqrt(vlo / lam_M), r0)       # lower bound of |z| on the box
+        small = width <= min_width * dist
+        rel = hi - lo
         if small.any():
             k = int(np.argmin(np.where(small, vlo, np.inf)))
             if vlo[k] < c_bound:
-                c_bound, witness = float(vlo[k]), tuple(0.5 * (lo[k] + hi[k]))
+                c_bound, witness = float(vlo[k]), _to_x(problem, 0.5 * (lo[k] + hi[k]))
             unresolved += int(small.sum())
         go = ~small & (vlo <= c_bound)
         lo, hi, rel = lo[go], hi[go], rel[go]
         if 2 * len(lo) > max_boxes:
             budget_hit, unresolved = True, unresolved + len(lo)
-            k = int(np.argmin(problem.V_interval(lo, hi).lo))
-            vmin = float(problem.V_interval(lo, hi).lo[k])
-            if vmin < c_bound:
-                c_bound, witness = vmin, tuple(0.5 * (lo[k] + hi[k]))
+            vlo_all = problem.V_interval_z(lo, hi).lo
+            k = int(np.argmin(vlo_all))
+            if vlo_all[k] < c_bound:
+                c_bound, witness = float(vlo_all[k]), _to_x(problem, 0.5 * (lo[k] + hi[k]))
             break
         axis = np.argmax(rel, axis=1)
         rows = np.arange(len(lo))

@@ -70,7 +70,7 @@ def check_basin(f: Sequence[sp.Expr], states: Sequence[sp.Symbol], x_eq: Sequenc
                 A_cl=None, P=None, Q=None, points: Sequence[tuple[str, Sequence[float]]] = (),
                 c_search: float | None = None, domain: tuple | None = None,
                 names: Sequence[str] | None = None, loop: str = "delay-free closed loop",
-                seed: int = 0, min_width: float = 2.0**-14) -> BasinCheck:
+                seed: int = 0, min_width: float = 2.0**-12) -> BasinCheck:
     """Certified basin of a closed loop and the verdict for named states.
 
     Parameters
@@ -99,7 +99,7 @@ def check_basin(f: Sequence[sp.Expr], states: Sequence[sp.Symbol], x_eq: Sequenc
     seed : int
         Seed of the falsifier.
     min_width : float
-        Smallest relative box width of the interval cover.
+        Smallest box width of the cover, relative to the box's distance from x*.
 
     Raises
     ------

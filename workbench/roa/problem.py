@@ -20,7 +20,7 @@ References
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
 from functools import cached_property
 from typing import Literal, Sequence
 
@@ -131,7 +131,128 @@ class BasinProblem:
         self.P_source = P_source
         self.names = tuple(names) if names is not None else tuple(str(s) for s in self.states)
 
-    # --- symbolic --------------------------------------------------------------------------
+    # --- whitened coordinates z: x = x* + T z, T = L^-T with P = L L' ------------------
+    # The box cover and the Taylor ball work in z, where {V <= c} is (almost) a
+    # ball: an axis-aligned cover of a thin tilted ellipse would hold mostly
+    # points outside it. T is any float matrix: V(x* + T z) = z' M z with
+    # M = T' P T enclosed rigorously (close to I), and every expression in z is
+    # the exact composition f(x* + T z), so rounding in T is harmless.
+    @cached_property
+    def T(self) -> np.ndarray:
+        return np.linalg.inv(np.linalg.cholesky(self.P).T)
+
+    @cached_property
+    def z(self) -> tuple:
+        return tuple(sp.Symbol(f"_z{i}", real=True) for i in range(len(self.states)))
+
+    @cached_property
+    def M_interval(self) -> tuple[np.ndarray, np.ndarray]:
+        """Rigorous enclosure (lo, hi) of M = T' P T."""
+        n, T, P = len(self.states), self.T, self.P
+        pt = lambda v: Interval(np.array([v]), np.array([v]))
+        lo, hi = np.zeros((n, n)), np.zeros((n, n))
+        for i in range(n):
+            for j in range(n):
+                acc = pt(0.0)
+                for k in range(n):
+                    for m in range(n):
+                        acc = iadd(acc, imul(imul(pt(T[k, i]), pt(P[k, m])), pt(T[m, j])))
+                lo[i, j], hi[i, j] = acc.lo[0], acc.hi[0]
+        return np.minimum(lo, lo.T), np.maximum(hi, hi.T)
+
+    def M_eig_bounds(self) -> tuple[float, float]:
+        """(lower bound of lambda_min, upper bound of lambda_max) over the
+        symmetric matrices of the enclosure of M (Rohn: mid +- ||radius||_F;
+        1e-12 relative allowance for LAPACK's rounding)."""
+        lo, hi = self.M_interval
+        mid = 0.5 * (lo + hi)
+        rad = float(np.linalg.norm(np.nextafter(np.maximum(hi - mid, mid - lo), np.inf)))
+        ev = np.linalg.eigvalsh(mid)
+        slack = 1e-12 * len(ev) * float(np.linalg.norm(mid)) + rad * (1 + 1e-12)
+        return float(ev[0] - slack), float(ev[-1] + slack)
+
+    @cached_property
+    def _x_of_z(self) -> dict:
+        n = len(self.states)
+        return {s: sp.Float(float(self.x_eq[i])) + sum(sp.Float(float(self.T[i, j])) * self.z[j]
+                                                        for j in range(n))
+                for i, s in enumerate(self.states)}
+
+    @cached_property
+    def vdot_z(self) -> sp.Expr:
+        """V'(x* + T z) = 2 (T z)' P f(x* + T z)."""
+        n = len(self.states)
+        e = [self._x_of_z[s] - sp.Float(float(self.x_eq[i])) for i, s in enumerate(self.states)]
+        fz = [fi.xreplace(self._x_of_z) for fi in self.f]
+        return 2 * sum(e[i] * sp.Float(float(self.P[i, j])) * fz[j]
+                       for i in range(n) for j in range(n))
+
+    @cached_property
+    def vdot_z_interval(self) -> IntervalFunction:
+        return IntervalFunction([self.vdot_z], self.z)
+
+    @cached_property
+    def vdot_z_grad_interval(self) -> IntervalFunction:
+        return IntervalFunction([sp.diff(self.vdot_z, w) for w in self.z], self.z)
+
+    @cached_property
+    def vdot_z_hessian_interval(self) -> IntervalFunction:
+        g = [sp.diff(self.vdot_z, w) for w in self.z]
+        return IntervalFunction([sp.diff(gi, w) for gi in g for w in self.z], self.z)
+
+    def V_interval_z(self, lo: np.ndarray, hi: np.ndarray) -> Interval:
+        """Enclosure of V = z' M z on the z-boxes lo <= z <= hi ((N, n))."""
+        n, N = len(self.states), len(lo)
+        Mlo, Mhi = self.M_interval
+        zs = [Interval(lo[:, i], hi[:, i]) for i in range(n)]
+        acc = None
+        for i in range(n):
+            for j in range(i, n):
+                if i == j:
+                    sq = imul(zs[i], zs[i])
+                    prod = Interval(np.maximum(sq.lo, 0.0), sq.hi)
+                    m = Interval(np.full(N, Mlo[i, i]), np.full(N, Mhi[i, i]))
+                else:
+                    prod = imul(zs[i], zs[j])
+                    m = Interval(np.full(N, 2.0 * Mlo[i, j]), np.full(N, 2.0 * Mhi[i, j]))
+                term = imul(prod, m)
+                acc = term if acc is None else iadd(acc, term)
+        return Interval(np.maximum(acc.lo, 0.0), acc.hi)
+
+    def vdot_enclosure(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Interval, np.ndarray]:
+        """Enclosure of V' on z-boxes: the natural extension intersected, where
+        no Piecewise condition is undetermined, with the mean-value form
+        V'(m) + sum_i [d V'/d z_i](box) [z_i - m_i] (m the box centre).
+
+        Returns (enclosure, ambiguous) -- ``ambiguous`` as in
+        :class:`~workbench.roa.interval.IntervalFunction`.
+        """
+        (nat,), amb = self.vdot_z_interval(lo, hi)
+        mid = 0.5 * (lo + hi)
+        (at_mid,), amb_m = self.vdot_z_interval(mid, mid)
+        grads, amb_g = self.vdot_z_grad_interval(lo, hi)
+        acc = at_mid
+        for i, g in enumerate(grads):
+            dx = iadd(Interval(lo[:, i], hi[:, i]), Interval(-mid[:, i], -mid[:, i]))
+            acc = iadd(acc, imul(g, dx))
+        amb = amb | amb_m | amb_g
+        lo_v = np.where(amb, nat.lo, np.maximum(nat.lo, acc.lo))
+        hi_v = np.where(amb, nat.hi, np.minimum(nat.hi, acc.hi))
+        return Interval(lo_v, hi_v), amb
+
+    def bounding_box_z(self, c: float) -> tuple[np.ndarray, np.ndarray]:
+        """A z-box containing {V <= c} = {z' M z <= c}: |z_i| <= sqrt(c /
+        lambda_min(M)), enlarged by 1e-6 relative and rounded up to 3
+        significant digits (the cover then does not depend on the last bits
+        LAPACK returns)."""
+        lam_min, _ = self.M_eig_bounds()
+        if not lam_min > 0:
+            raise ModelError("T' P T is not provably positive definite")
+        half = float(round_up(math.sqrt(c / lam_min) * (1 + 1e-6), 3))
+        n = len(self.states)
+        return np.full(n, -half), np.full(n, half)
+
+    # --- original coordinates x ------------------------------------------------------------
     @cached_property
     def error(self) -> sp.Matrix:
         return sp.Matrix([s - sp.Float(float(x)) for s, x in zip(self.states, self.x_eq)])
@@ -148,10 +269,6 @@ class BasinProblem:
     @cached_property
     def vdot_grad(self) -> list[sp.Expr]:
         return [sp.diff(self.vdot, s) for s in self.states]
-
-    @cached_property
-    def vdot_hessian(self) -> list[list[sp.Expr]]:
-        return [[sp.diff(g, s) for s in self.states] for g in self.vdot_grad]
 
     # --- numeric (floats) ------------------------------------------------------------------
     @cached_property
@@ -187,14 +304,6 @@ class BasinProblem:
         return IntervalFunction([self.vdot], self.states)
 
     @cached_property
-    def vdot_grad_interval(self) -> IntervalFunction:
-        return IntervalFunction(self.vdot_grad, self.states)
-
-    @cached_property
-    def vdot_hessian_interval(self) -> IntervalFunction:
-        return IntervalFunction([h for row in self.vdot_hessian for h in row], self.states)
-
-    @cached_property
     def f_interval(self) -> IntervalFunction:
         return IntervalFunction(list(self.f), self.states)
 
@@ -202,36 +311,7 @@ class BasinProblem:
         """Enclosure of V on the boxes lo <= x <= hi ((N, n) arrays)."""
         return quadratic_enclosure(self.P, self.x_eq, lo, hi)
 
-    def vdot_enclosure(self, lo: np.ndarray, hi: np.ndarray) -> tuple[Interval, np.ndarray]:
-        """Enclosure of V' on boxes: the natural extension intersected, where
-        no Piecewise condition is undetermined, with the mean-value form
-        V'(m) + sum_i [d V'/d x_i](box) [x_i - m_i] (m the box centre).
-
-        Returns (enclosure, ambiguous) -- ``ambiguous`` as in
-        :class:`~workbench.roa.interval.IntervalFunction`.
-        """
-        (nat,), amb = self.vdot_interval(lo, hi)
-        mid = 0.5 * (lo + hi)
-        (at_mid,), amb_m = self.vdot_interval(mid, mid)
-        grads, amb_g = self.vdot_grad_interval(lo, hi)
-        acc = at_mid
-        for i, g in enumerate(grads):
-            dx = iadd(Interval(lo[:, i], hi[:, i]), Interval(-mid[:, i], -mid[:, i]))
-            acc = iadd(acc, imul(g, dx))
-        amb = amb | amb_m | amb_g
-        lo_v = np.where(amb, nat.lo, np.maximum(nat.lo, acc.lo))
-        hi_v = np.where(amb, nat.hi, np.minimum(nat.hi, acc.hi))
-        return Interval(lo_v, hi_v), amb
-
     def level_of(self, x) -> Interval:
         """Rigorous enclosure of V at one point x."""
         x = np.asarray(x, float)[None, :]
         return self.V_interval(x, x)
-
-    def bounding_box(self, c: float) -> tuple[np.ndarray, np.ndarray]:
-        """A box containing the ellipsoid {V <= c} (half-widths
-        sqrt(c (P^-1)_ii), enlarged by 1e-6 relative for rounding, then rounded
-        up to 3 significant digits so that the cover does not depend on the
-        last bits LAPACK returns)."""
-        half = round_up(np.sqrt(c * np.diag(np.linalg.inv(self.P))) * (1 + 1e-6), 3)
-        return self.x_eq - half, self.x_eq + half

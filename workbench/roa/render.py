@@ -47,7 +47,7 @@ def render_basin_markdown(check: BasinCheck, *, heading: str = "### Region of at
         f"| ball argument (Taylor, interval Hessian) up to | {fmt_level(est.c_ball)} |",
         f"| c_inner | {inner} |", "",
         "Verification: interval arithmetic with outward rounding on an adaptive box cover "
-        "of the annulus (smallest box 2^-14 of the first); the neighbourhood of x* by "
+        "of the annulus (a box may shrink to 2^-12 of its distance from x*); the neighbourhood of x* by "
         "Taylor's theorem with an interval bound of the Hessian of V'. Falsification: "
         f"seeded samples (seed {est.seed}), rays and SLSQP, each hit confirmed by interval "
         "arithmetic.",

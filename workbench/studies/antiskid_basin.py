@@ -1,0 +1,234 @@
+"""Basin of attraction of paper 003's cruise law (61) and the phase-switch checks.
+
+The loop: the adhesion plant (eq 12 for lambda >= 0, eq 15 below, as in the
+runs) under the cruise law (61), written in the error coordinates
+(v_e, lambda_e) = (v - v_d, lambda - lambda_d) of eq (19), *delay-free*:
+
+    u = (-d3 + K E) / (d4 v_e + d5 lambda_e + d6),
+
+i.e. the loop seen under exact prediction (paper 003, Theorems 2-3 argue on
+this loop for laws (64) and (69)). Law (61) as printed feeds the *current*
+error to the numerator (K E(t)) and the prediction to the denominator, so
+the true loop keeps a delayed term B K E(t - h); its local stability is the
+LMI certificate's subject (Theorem 1), the basin here is that of the loop
+without it. Both are needed for a switch to be safe.
+
+Results:
+
+* :func:`cruise_basin` -- certified level set of V = E' P E (P from the
+  Lyapunov equation of A + B K, Q = diag(1, q), q from a small grid chosen
+  to certify the switch states: P_source "optimised"), the verdict for the
+  switch states, sampled delay-free trajectories (figure);
+* :func:`safe_k2_range` -- the range of cruise gains k2 (k1 kept) for which
+  the printed switch state (v_d, lambda_opt) lies in a certified basin.
+
+References
+----------
+.. [003] Cai L., Yue Y., Huang D., "Antiskid control of high-speed trains
+   with input delay", Control Theory & Applications 43(3), 2026: eqs (12),
+   (15), (19), (23), (61), (75); Theorems 1-3; Table 3.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import sympy as sp
+from scipy.integrate import solve_ivp
+
+from ..errors import ModelError
+from ..plants.adhesion import NumericAdhesion, adhesion_model
+from ..roa import BasinEstimate, BasinProblem, LevelOutcome, estimate_basin, lyapunov_P
+from ..roa.check import BasinCheck, PointCheck, largest_level_in_box
+from ..symbolic.linearise import linearise_cruise
+
+#: Weights q of Q = diag(1, q) tried for P (lambda_e is ~1e-2 where v_e is ~1 m/s).
+Q_GRID = (1e2, 1e3, 1e4, 1e5, 1e6)
+#: Domain of the model the basin may use: lambda in [LAM_LO, LAM_HI], v >= V_MIN.
+LAM_LO, LAM_HI, V_MIN = -0.5, 0.5, 1.0
+LOOP = ("adhesion plant (eq 12 / eq 15) under the cruise law (61), delay-free: the loop under "
+        "exact prediction (paper 003, Theorems 2-3), with the predicted error also in the "
+        "numerator; the delayed term B K E(t - h) of law (61) as printed is the subject of the "
+        "LMI certificate (Theorem 1), not of this basin")
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A sampled delay-free trajectory in the (v_e, lambda_e) plane."""
+
+    x0: tuple
+    path: np.ndarray          # (N, 2)
+    fate: str                 # "converges" (enters the certified set), "diverges", "undecided"
+
+
+@dataclass(frozen=True)
+class CruiseBasin:
+    """Basin of the cruise law for one design (no rendering).
+
+    Attributes
+    ----------
+    check : BasinCheck
+        Estimate and the verdict for each switch state (error coordinates).
+    K : tuple
+    q : float
+        Weight of Q = diag(1, q) of the Lyapunov equation chosen.
+    lambda_d, lambda_opt, v_d : float
+    trajectories : tuple of Trajectory
+        Sampled trajectories (seeded grid) and one from each switch state.
+    """
+
+    check: BasinCheck
+    K: tuple
+    q: float
+    v_d: float
+    lambda_d: float
+    lambda_opt: float
+    trajectories: tuple
+
+
+@lru_cache(maxsize=32)
+def _loop(values: tuple, v_d: float, K: tuple):
+    """(f, states, A_cl, lambda_d) of the delay-free cruise loop (module docstring)."""
+    vals = dict(values)
+    plant = NumericAdhesion.from_dict(vals)
+    lam_d = plant.cruise_lambda(v_d)
+    lin = linearise_cruise(plant, v_d, lam_d)
+    c = lin.coefficients
+    mdl = adhesion_model()
+    ve, le = sp.symbols("v_e lambda_e", real=True)
+    at = {mdl.v: sp.Float(v_d) + ve, mdl.lam: sp.Float(lam_d) + le}
+    sub = lambda e: mdl.substitute(e, vals).subs(at)
+    F = lambda x: sp.Float(float(x))
+    u = (F(-c["d3"]) + F(K[0]) * ve + F(K[1]) * le) / (F(c["d4"]) * ve + F(c["d5"]) * le
+                                                       + F(c["d6"]))
+    (y1, y2, y3), (z1, z2, z3) = mdl.traction, mdl.braking
+    trac = sp.Float(lam_d) + le >= 0
+    f = [sp.Piecewise((sub(y1), trac), (sub(z1), True)),
+         sp.Piecewise((sub(y2) + sub(y3) * u, trac), (sub(z2) + sub(z3) * u, True))]
+    A_cl = lin.A + lin.B @ np.array([K], float)
+    return f, (ve, le), A_cl, lam_d, plant.lambda_opt()
+
+
+def _domain(v_d: float, lam_d: float):
+    return ((V_MIN - v_d, LAM_LO - lam_d), (v_d, LAM_HI - lam_d))
+
+
+def _estimate(values, v_d, K, points, q, *, seed=0, min_width=2.0**-14):
+    f, states, A_cl, lam_d, _ = _loop(values, v_d, tuple(K))
+    P = lyapunov_P(A_cl, np.diag([1.0, q]))
+    prob = BasinProblem(f, states, (0.0, 0.0), P, P_source="optimised",
+                        names=("v - v_d (m/s)", "lambda - lambda_d"))
+    cap = largest_level_in_box(P, np.zeros(2), *_domain(v_d, lam_d))
+    lv = [float(prob.V(np.asarray(x)[None, :])[0]) for x in points]
+    c_search = min(cap, 4.0 * max(lv)) if lv and max(lv) > 0 else cap
+    return prob, estimate_basin(prob, c_search, seed=seed, min_width=min_width)
+
+
+def _score(est: BasinEstimate, points) -> tuple:
+    """Sort key of a P: certified switch states first, then the margin of
+    the worst of them (c_certified / level)."""
+    if not points:
+        return (0, est.c_certified)
+    lv = [est.level_bounds(x)[1] for x in points]
+    ok = sum(l <= est.c_certified for l in lv)
+    return (ok, min(est.c_certified / l if l > 0 else math.inf for l in lv))
+
+
+def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
+                 n_traj: int = 24, t_traj: float = 3.0) -> CruiseBasin:
+    """Certified basin of law (61) and the verdict for each switch state.
+
+    Parameters
+    ----------
+    values : dict
+        Plant constants (SI, keys of PARAMETER_UNITS), the nominal model the
+        controller is built on.
+    v_d : float
+        Cruise speed (m/s).
+    K : (k1, k2)
+        Cruise gain.
+    switch_points : sequence of (label, (v, lambda))
+        States (absolute coordinates) where law (61) takes over.
+    seed : int
+        Seed of the falsifier and of the sampled trajectories.
+    n_traj : int
+        Sampled trajectories for the figure.
+    t_traj : float
+        Their horizon (s).
+    """
+    vals = tuple(sorted((k, float(v)) for k, v in values.items()))
+    f, states, A_cl, lam_d, lam_opt = _loop(vals, v_d, tuple(K))
+    pts = [(lab, (float(v) - v_d, float(l) - lam_d)) for lab, (v, l) in switch_points]
+    best = None
+    for q in Q_GRID:
+        try:
+            prob, est = _estimate(vals, v_d, K, [x for _, x in pts], q, seed=seed)
+        except ModelError:
+            continue
+        key = _score(est, [x for _, x in pts])
+        if best is None or key > best[0]:
+            best = (key, q, prob, est)
+    if best is None:
+        raise ModelError(f"cruise loop with K = {tuple(K)} has no Hurwitz linearisation")
+    _, q, prob, est = best
+    checks = tuple(PointCheck(lab, x, est.point_verdict(x)) for lab, x in pts)
+    check = BasinCheck(est, checks, LOOP)
+    trajs = _trajectories(prob, est, pts, seed, n_traj, t_traj, lam_d)
+    return CruiseBasin(check, tuple(float(k) for k in K), q, v_d, lam_d, lam_opt, trajs)
+
+
+def _trajectories(prob, est, pts, seed, n, T, lam_d):
+    """Delay-free trajectories from a seeded set of states around the basin
+    and from each switch state (Radau, rtol 1e-8): "converges" when a sample
+    enters {V <= c_certified}, "diverges" when lambda leaves (-0.9, 0.9) or
+    the step fails, else "undecided" within T."""
+    rng = np.random.default_rng(np.random.SeedSequence([seed, 1]))
+    half = np.array([max(abs(x[0]) for _, x in pts) * 2 + 1.0,
+                     max(abs(x[1]) for _, x in pts) * 1.5 + 0.02]) if pts else np.array([2, 0.1])
+    starts = [tuple(x) for _, x in pts]
+    starts += [tuple(rng.uniform(-1, 1, 2) * half) for _ in range(n)]
+    fn = prob.f_numeric
+    out = []
+    for x0 in starts:
+        def rhs(t, x):
+            return fn(x[None, :])[0]
+
+        def spin(t, x):
+            return 0.9 - abs(x[1] + lam_d)
+        spin.terminal = True
+        with np.errstate(all="ignore"):
+            sol = solve_ivp(rhs, (0.0, T), np.array(x0, float), method="Radau", rtol=1e-8,
+                            atol=1e-10, events=spin, max_step=0.05)
+        path = sol.y.T
+        inside = prob.V(path) <= est.c_certified
+        if inside.any():
+            fate, path = "converges", path[:int(np.argmax(inside)) + 1]
+        elif sol.status != 0 or not np.all(np.isfinite(path)):
+            fate = "diverges"
+        else:
+            fate = "undecided"
+        out.append(Trajectory(tuple(float(v) for v in x0), path, fate))
+    return tuple(out)
+
+
+def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0) -> tuple:
+    """(outcome, q) for one switch state (absolute (v, lambda)): the best
+    verdict over the Q grid (CERTIFIED if any P certifies the state)."""
+    vals = tuple(sorted((k, float(v)) for k, v in values.items()))
+    _, _, _, lam_d, _ = _loop(vals, v_d, tuple(K))
+    x = (float(point[0]) - v_d, float(point[1]) - lam_d)
+    rank = {LevelOutcome.CERTIFIED: 2, LevelOutcome.INCONCLUSIVE: 1, LevelOutcome.REFUTED: 0}
+    best = (LevelOutcome.REFUTED, None)
+    for q in Q_GRID:
+        try:
+            _, est = _estimate(vals, v_d, K, [x], q, seed=seed)
+        except ModelError:
+            continue
+        out = est.point_verdict(x).outcome
+        if rank[out] > rank[best[0]]:
+            best = (out, q)
+        if out is LevelOutcome.CERTIFIED:
+            break
+    return best
