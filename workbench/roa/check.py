@@ -16,7 +16,8 @@ import sympy as sp
 
 from ..errors import ModelError
 from .basin import BasinEstimate, LevelVerdict, estimate_basin
-from .problem import BasinProblem, lyapunov_P
+from .lyapunov import lyapunov_P, modal_P
+from .problem import BasinProblem
 
 
 @dataclass(frozen=True)

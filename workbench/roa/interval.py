@@ -155,6 +155,10 @@ class IntervalFunction:
         substituted by a number).
     symbols : sequence of sympy.Symbol
         Order of the box coordinates.
+    stages : sequence of sequences of (Symbol, Expr), optional
+        Intermediate quantities, defined in order (each stage may use the
+        box coordinates and earlier stages); the expressions may use them.
+        An enclosure of a stage's symbol is the enclosure of its expression.
 
     Raises
     ------
@@ -164,16 +168,27 @@ class IntervalFunction:
         relational conditions, and/or).
     """
 
-    def __init__(self, exprs: Sequence[sp.Expr], symbols: Sequence[sp.Symbol]):
+    def __init__(self, exprs: Sequence[sp.Expr], symbols: Sequence[sp.Symbol],
+                 stages: Sequence[Sequence[tuple]] = ()):
         self.symbols = tuple(symbols)
-        free = set().union(*(sp.sympify(e).free_symbols for e in exprs)) - set(self.symbols)
-        if free:
-            raise UnsupportedExpression(
-                f"expressions depend on {sorted(map(str, free))}, not only on "
-                f"{[str(s) for s in self.symbols]}")
-        repl, reduced = sp.cse(list(exprs), optimizations=None)
-        self._steps = [(s, self._compile(e)) for s, e in repl]
-        self._outs = [self._compile(e) for e in reduced]
+        known = set(self.symbols)
+        self._steps = []
+        for stage in (*stages, [(None, e) for e in exprs]):
+            stage = list(stage)
+            free = set().union(set(), *(sp.sympify(e).free_symbols for _, e in stage)) - known
+            if free:
+                raise UnsupportedExpression(
+                    f"expressions depend on {sorted(map(str, free))}, not only on "
+                    f"{[str(s) for s in self.symbols]}")
+            repl, reduced = sp.cse([e for _, e in stage], optimizations=None,
+                                   symbols=sp.numbered_symbols(f"_cse{len(self._steps)}_"))
+            self._steps += [(s, self._compile(e)) for s, e in repl]
+            outs = [(s, self._compile(e)) for (s, _), e in zip(stage, reduced)]
+            if stage and stage[0][0] is None:
+                self._outs = [fn for _, fn in outs]
+            else:
+                self._steps += outs
+                known |= {s for s, _ in stage}
 
     def __call__(self, lo: np.ndarray, hi: np.ndarray) -> tuple[list[Interval], np.ndarray]:
         """Enclosures on the N boxes ``lo <= x <= hi`` ((N, n) arrays).

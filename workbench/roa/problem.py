@@ -25,53 +25,13 @@ from functools import cached_property
 from typing import Literal, Sequence
 
 import numpy as np
-import scipy.linalg as sla
 import sympy as sp
 
 from ..errors import ModelError
 from .interval import IntervalFunction, Interval, iadd, imul
+from .lyapunov import round_up
 
-PSource = Literal["lyapunov", "certificate", "given", "optimised"]
-
-
-def round_up(x, digits: int) -> np.ndarray:
-    """x >= 0 rounded up to ``digits`` significant digits (elementwise)."""
-    x = np.asarray(x, float)
-    e = np.floor(np.log10(np.where(x > 0, x, 1.0))) - (digits - 1)
-    return np.where(x > 0, np.ceil(x / 10.0**e) * 10.0**e, 0.0)
-
-
-def lyapunov_P(A_cl, Q=None, *, digits: int = 10) -> np.ndarray:
-    """P of the Lyapunov equation A_cl' P + P A_cl = -Q (Q = I by default).
-
-    Parameters
-    ----------
-    A_cl : (n, n) array_like
-        Closed-loop linearisation A + B K at the equilibrium (Hurwitz).
-    Q : (n, n) array_like, optional
-        Symmetric positive definite weight.
-    digits : int
-        P is rounded to this many significant digits (relative to its
-        largest entry): V is then the same function on every CPU, whatever
-        the last bits LAPACK returns.
-
-    Raises
-    ------
-    ModelError
-        When A_cl is not Hurwitz or P is not positive definite.
-    """
-    A = np.asarray(A_cl, float)
-    Q = np.eye(A.shape[0]) if Q is None else np.asarray(Q, float)
-    eig = np.linalg.eigvals(A)
-    if not np.all(eig.real < 0):
-        raise ModelError(f"closed-loop linearisation is not Hurwitz: eigenvalues {eig}")
-    P = sla.solve_continuous_lyapunov(A.T, -Q)
-    P = 0.5 * (P + P.T)
-    scale = 10.0 ** (np.floor(np.log10(np.max(np.abs(P)))) - digits + 1)
-    P = np.round(P / scale) * scale
-    if not np.all(np.linalg.eigvalsh(P) > 0):
-        raise ModelError("Lyapunov equation gave a P that is not positive definite")
-    return P
+PSource = Literal["lyapunov", "modal", "certificate", "given", "optimised"]
 
 
 def quadratic_enclosure(P: np.ndarray, x_eq: np.ndarray, lo: np.ndarray,
@@ -109,11 +69,17 @@ class BasinProblem:
         How P was chosen (reported).
     names : sequence of str, optional
         Display names of the state coordinates (default: the symbols).
+    derivatives : (jacobian, hessians), optional
+        d f_i/d x_j and d^2 f_k/d x_i d x_j as nested lists of sympy
+        expressions in ``states`` (a caller that builds many problems from
+        one model derives them once); derived with ``sympy.diff`` otherwise.
     """
 
     def __init__(self, f: Sequence[sp.Expr], states: Sequence[sp.Symbol], x_eq: Sequence[float],
-                 P, *, P_source: PSource = "given", names: Sequence[str] | None = None):
+                 P, *, P_source: PSource = "given", names: Sequence[str] | None = None,
+                 derivatives: tuple | None = None):
         self.f = tuple(sp.sympify(e) for e in f)
+        self._derivs = derivatives
         self.states = tuple(states)
         n = len(self.states)
         if len(self.f) != n:
@@ -172,33 +138,81 @@ class BasinProblem:
         return float(ev[0] - slack), float(ev[-1] + slack)
 
     @cached_property
-    def _x_of_z(self) -> dict:
-        n = len(self.states)
-        return {s: sp.Float(float(self.x_eq[i])) + sum(sp.Float(float(self.T[i, j])) * self.z[j]
-                                                        for j in range(n))
-                for i, s in enumerate(self.states)}
+    def jacobian(self) -> list:
+        """d f_i / d x_j (sympy; given to the constructor or derived once)."""
+        if self._derivs is not None:
+            return self._derivs[0]
+        return [[sp.diff(fi, s) for s in self.states] for fi in self.f]
 
     @cached_property
-    def vdot_z(self) -> sp.Expr:
-        """V'(x* + T z) = 2 (T z)' P f(x* + T z)."""
-        n = len(self.states)
-        e = [self._x_of_z[s] - sp.Float(float(self.x_eq[i])) for i, s in enumerate(self.states)]
-        fz = [fi.xreplace(self._x_of_z) for fi in self.f]
-        return 2 * sum(e[i] * sp.Float(float(self.P[i, j])) * fz[j]
-                       for i in range(n) for j in range(n))
+    def hessians(self) -> list:
+        """d^2 f_k / d x_i d x_j (sympy; given or derived once)."""
+        if self._derivs is not None:
+            return self._derivs[1]
+        return [[[sp.diff(Jki, s) for s in self.states] for Jki in row] for row in self.jacobian]
+
+    # Each interval function in z is a chain of stages (IntervalFunction
+    # ``stages``): x = x* + T z; f, J, H at x; e = T z; P e; then small
+    # products. Nothing is differentiated or expanded per problem.
+    @cached_property
+    def _sym(self) -> dict:
+        n, mk = len(self.states), lambda name: sp.Symbol(name, real=True)
+        return {"F": [mk(f"_F{k}") for k in range(n)],
+                "J": [[mk(f"_J{k}_{i}") for i in range(n)] for k in range(n)],
+                "H": [[[mk(f"_H{k}_{i}_{j}") for j in range(n)] for i in range(n)]
+                      for k in range(n)],
+                "E": [mk(f"_E{i}") for i in range(n)], "PE": [mk(f"_PE{i}") for i in range(n)],
+                "G": [mk(f"_G{i}") for i in range(n)],
+                "PJ": [[mk(f"_PJ{i}_{j}") for j in range(n)] for i in range(n)],
+                "HX": [[mk(f"_HX{i}_{j}") for j in range(n)] for i in range(n)]}
+
+    def _stages(self, *, jac: bool = False, hess: bool = False, values: bool = True) -> list:
+        n, S = len(self.states), self._sym
+        Fl = lambda v: sp.Float(float(v))
+        x_st = [(s, Fl(self.x_eq[i]) + sum(Fl(self.T[i, j]) * self.z[j] for j in range(n)))
+                for i, s in enumerate(self.states)]
+        model = []
+        if values:
+            model += list(zip(S["F"], self.f))
+        if jac:
+            model += [(S["J"][k][i], self.jacobian[k][i]) for k in range(n) for i in range(n)]
+        if hess:
+            model += [(S["H"][k][i][j], self.hessians[k][i][j])
+                      for k in range(n) for i in range(n) for j in range(n)]
+        e_st = [(S["E"][i], sum(Fl(self.T[i, j]) * self.z[j] for j in range(n))) for i in range(n)]
+        pe_st = [(S["PE"][i], sum(Fl(self.P[i, j]) * S["E"][j] for j in range(n)))
+                 for i in range(n)]
+        return [x_st, model, e_st, pe_st]
 
     @cached_property
     def vdot_z_interval(self) -> IntervalFunction:
-        return IntervalFunction([self.vdot_z], self.z)
+        """V'(x* + T z) = 2 (P e)' f(x* + T z), e = T z."""
+        S = self._sym
+        out = 2 * sum(pe * F for pe, F in zip(S["PE"], S["F"]))
+        return IntervalFunction([out], self.z, self._stages())
 
     @cached_property
     def vdot_z_grad_interval(self) -> IntervalFunction:
-        return IntervalFunction([sp.diff(self.vdot_z, w) for w in self.z], self.z)
+        """d V'/d z = T' g, g_i = 2 (P f)_i + 2 sum_k (P e)_k J_ki (chain rule)."""
+        n, S, Fl = len(self.states), self._sym, lambda v: sp.Float(float(v))
+        g_st = [(S["G"][i], 2 * sum(Fl(self.P[i, k]) * S["F"][k] for k in range(n))
+                 + 2 * sum(S["PE"][k] * S["J"][k][i] for k in range(n))) for i in range(n)]
+        outs = [sum(Fl(self.T[i, a]) * S["G"][i] for i in range(n)) for a in range(n)]
+        return IntervalFunction(outs, self.z, [*self._stages(jac=True), g_st])
 
     @cached_property
     def vdot_z_hessian_interval(self) -> IntervalFunction:
-        g = [sp.diff(self.vdot_z, w) for w in self.z]
-        return IntervalFunction([sp.diff(gi, w) for gi in g for w in self.z], self.z)
+        """d^2 V'/d z^2 = T' H T, H = 2 (P J + (P J)' + sum_k (P e)_k H_k)."""
+        n, S, Fl = len(self.states), self._sym, lambda v: sp.Float(float(v))
+        pj = [(S["PJ"][i][j], sum(Fl(self.P[i, k]) * S["J"][k][j] for k in range(n)))
+              for i in range(n) for j in range(n)]
+        hx = [(S["HX"][i][j], 2 * (S["PJ"][i][j] + S["PJ"][j][i]
+                                   + sum(S["PE"][k] * S["H"][k][i][j] for k in range(n))))
+              for i in range(n) for j in range(n)]
+        outs = [sum(Fl(self.T[i, a]) * S["HX"][i][j] * Fl(self.T[j, b])
+                    for i in range(n) for j in range(n)) for a in range(n) for b in range(n)]
+        stages = self._stages(jac=True, hess=True, values=False)
+        return IntervalFunction(outs, self.z, [*stages, pj, hx])
 
     def V_interval_z(self, lo: np.ndarray, hi: np.ndarray) -> Interval:
         """Enclosure of V = z' M z on the z-boxes lo <= z <= hi ((N, n))."""
@@ -268,7 +282,12 @@ class BasinProblem:
 
     @cached_property
     def vdot_grad(self) -> list[sp.Expr]:
-        return [sp.diff(self.vdot, s) for s in self.states]
+        """d V'/d x = 2 P f + 2 J' P e (chain rule on the given derivatives)."""
+        n = len(self.states)
+        e = list(self.error)
+        Pe = [sum(sp.Float(self.P[i, j]) * e[j] for j in range(n)) for i in range(n)]
+        return [2 * sum(sp.Float(self.P[i, k]) * self.f[k] for k in range(n))
+                + 2 * sum(Pe[k] * self.jacobian[k][i] for k in range(n)) for i in range(n)]
 
     # --- numeric (floats) ------------------------------------------------------------------
     @cached_property

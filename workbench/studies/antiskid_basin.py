@@ -15,10 +15,11 @@ without it. Both are needed for a switch to be safe.
 
 Results:
 
-* :func:`cruise_basin` -- certified level set of V = E' P E (P from the
-  Lyapunov equation of A + B K, Q = diag(1, q), q from a small grid chosen
-  to certify the switch states: P_source "optimised"), the verdict for the
-  switch states, sampled delay-free trajectories (figure);
+* :func:`cruise_basin` -- certified level set of V = E' P E, P the modal
+  Lyapunov matrix of A + B K (:func:`workbench.roa.modal_P`, weights
+  [1, w] on the slow speed mode and the fast creep mode, w from a small grid
+  chosen to certify the switch states: P_source "optimised"), the verdict
+  for the switch states, sampled delay-free trajectories (figure);
 * :func:`safe_k2_range` -- the range of cruise gains k2 (k1 kept) for which
   the printed switch state (v_d, lambda_opt) lies in a certified basin.
 
@@ -40,12 +41,13 @@ from scipy.integrate import solve_ivp
 
 from ..errors import ModelError
 from ..plants.adhesion import NumericAdhesion, adhesion_model
-from ..roa import BasinEstimate, BasinProblem, LevelOutcome, estimate_basin, lyapunov_P
+from ..roa import BasinEstimate, BasinProblem, LevelOutcome, estimate_basin, modal_P
 from ..roa.check import BasinCheck, PointCheck, largest_level_in_box
 from ..symbolic.linearise import linearise_cruise
 
-#: Weights q of Q = diag(1, q) tried for P (lambda_e is ~1e-2 where v_e is ~1 m/s).
-Q_GRID = (1e2, 1e3, 1e4, 1e5, 1e6)
+#: Weights w of the fast (creep-ratio) mode against the slow (speed) mode
+#: tried for P = modal_P(A + B K, [1, w]).
+W_GRID = (10.0, 100.0, 1e3, 1e4)
 #: Domain of the model the basin may use: lambda in [LAM_LO, LAM_HI], v >= V_MIN.
 LAM_LO, LAM_HI, V_MIN = -0.5, 0.5, 1.0
 LOOP = ("adhesion plant (eq 12 / eq 15) under the cruise law (61), delay-free: the loop under "
@@ -73,7 +75,7 @@ class CruiseBasin:
         Estimate and the verdict for each switch state (error coordinates).
     K : tuple
     q : float
-        Weight of Q = diag(1, q) of the Lyapunov equation chosen.
+        Weight w of the fast mode in P = modal_P(A + B K, [1, w]).
     lambda_d, lambda_opt, v_d : float
     trajectories : tuple of Trajectory
         Sampled trajectories (seeded grid) and one from each switch state.
@@ -88,9 +90,11 @@ class CruiseBasin:
     trajectories: tuple
 
 
-@lru_cache(maxsize=32)
-def _loop(values: tuple, v_d: float, K: tuple):
-    """(f, states, A_cl, lambda_d) of the delay-free cruise loop (module docstring)."""
+@lru_cache(maxsize=8)
+def _loop_symbolic(values: tuple, v_d: float):
+    """(f, jacobian, hessians, states, gain symbols, linearisation, lambda_d,
+    lambda_opt) of the delay-free cruise loop with the gain (k1, k2) as
+    symbols: derived once per plant and cruise speed."""
     vals = dict(values)
     plant = NumericAdhesion.from_dict(vals)
     lam_d = plant.cruise_lambda(v_d)
@@ -98,32 +102,50 @@ def _loop(values: tuple, v_d: float, K: tuple):
     c = lin.coefficients
     mdl = adhesion_model()
     ve, le = sp.symbols("v_e lambda_e", real=True)
+    k1, k2 = sp.symbols("k_1 k_2", real=True)
     at = {mdl.v: sp.Float(v_d) + ve, mdl.lam: sp.Float(lam_d) + le}
     sub = lambda e: mdl.substitute(e, vals).subs(at)
     F = lambda x: sp.Float(float(x))
-    u = (F(-c["d3"]) + F(K[0]) * ve + F(K[1]) * le) / (F(c["d4"]) * ve + F(c["d5"]) * le
-                                                       + F(c["d6"]))
+    u = (F(-c["d3"]) + k1 * ve + k2 * le) / (F(c["d4"]) * ve + F(c["d5"]) * le + F(c["d6"]))
     (y1, y2, y3), (z1, z2, z3) = mdl.traction, mdl.braking
     trac = sp.Float(lam_d) + le >= 0
     f = [sp.Piecewise((sub(y1), trac), (sub(z1), True)),
          sp.Piecewise((sub(y2) + sub(y3) * u, trac), (sub(z2) + sub(z3) * u, True))]
+    states = (ve, le)
+    J = [[sp.diff(fi, s) for s in states] for fi in f]
+    H = [[[sp.diff(Jki, s) for s in states] for Jki in row] for row in J]
+    return f, J, H, states, (k1, k2), lin, lam_d, plant.lambda_opt()
+
+
+def _loop(values: tuple, v_d: float, K: tuple):
+    """(f, derivatives, states, A_cl, lambda_d, lambda_opt) at the gain K."""
+    f, J, H, states, ks, lin, lam_d, lam_opt = _loop_symbolic(values, v_d)
+    rep = {ks[0]: sp.Float(float(K[0])), ks[1]: sp.Float(float(K[1]))}
+    put = lambda e: e.xreplace(rep)
+    f = [put(e) for e in f]
+    J = [[put(e) for e in row] for row in J]
+    H = [[[put(e) for e in r] for r in Hk] for Hk in H]
     A_cl = lin.A + lin.B @ np.array([K], float)
-    return f, (ve, le), A_cl, lam_d, plant.lambda_opt()
+    return f, (J, H), states, A_cl, lam_d, lam_opt
 
 
 def _domain(v_d: float, lam_d: float):
     return ((V_MIN - v_d, LAM_LO - lam_d), (v_d, LAM_HI - lam_d))
 
 
-def _estimate(values, v_d, K, points, q, *, seed=0, min_width=2.0**-14):
-    f, states, A_cl, lam_d, _ = _loop(values, v_d, tuple(K))
-    P = lyapunov_P(A_cl, np.diag([1.0, q]))
+def _estimate(values, v_d, K, points, w, *, seed=0, c_search=None):
+    """Basin estimate with P = modal_P(A + B K, [1, w]) (slow mode weight 1,
+    fast mode w); c_search: 4 x the largest level of ``points`` (capped by
+    the model's domain) unless given."""
+    f, derivs, states, A_cl, lam_d, _ = _loop(values, v_d, tuple(K))
+    P = modal_P(A_cl, [1.0, w])
     prob = BasinProblem(f, states, (0.0, 0.0), P, P_source="optimised",
-                        names=("v - v_d (m/s)", "lambda - lambda_d"))
+                        names=("v - v_d (m/s)", "lambda - lambda_d"), derivatives=derivs)
     cap = largest_level_in_box(P, np.zeros(2), *_domain(v_d, lam_d))
     lv = [float(prob.V(np.asarray(x)[None, :])[0]) for x in points]
-    c_search = min(cap, 4.0 * max(lv)) if lv and max(lv) > 0 else cap
-    return prob, estimate_basin(prob, c_search, seed=seed, min_width=min_width)
+    if c_search is None:
+        c_search = 4.0 * max(lv) if lv and max(lv) > 0 else cap
+    return prob, estimate_basin(prob, min(c_search, cap), seed=seed)
 
 
 def _score(est: BasinEstimate, points) -> tuple:
@@ -159,10 +181,10 @@ def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
         Their horizon (s).
     """
     vals = tuple(sorted((k, float(v)) for k, v in values.items()))
-    f, states, A_cl, lam_d, lam_opt = _loop(vals, v_d, tuple(K))
+    lam_d, lam_opt = _loop_symbolic(vals, v_d)[6:8]
     pts = [(lab, (float(v) - v_d, float(l) - lam_d)) for lab, (v, l) in switch_points]
     best = None
-    for q in Q_GRID:
+    for q in W_GRID:
         try:
             prob, est = _estimate(vals, v_d, K, [x for _, x in pts], q, seed=seed)
         except ModelError:
@@ -217,11 +239,11 @@ def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0) -> tup
     """(outcome, q) for one switch state (absolute (v, lambda)): the best
     verdict over the Q grid (CERTIFIED if any P certifies the state)."""
     vals = tuple(sorted((k, float(v)) for k, v in values.items()))
-    _, _, _, lam_d, _ = _loop(vals, v_d, tuple(K))
+    lam_d = _loop_symbolic(vals, v_d)[6]
     x = (float(point[0]) - v_d, float(point[1]) - lam_d)
     rank = {LevelOutcome.CERTIFIED: 2, LevelOutcome.INCONCLUSIVE: 1, LevelOutcome.REFUTED: 0}
     best = (LevelOutcome.REFUTED, None)
-    for q in Q_GRID:
+    for q in W_GRID:
         try:
             _, est = _estimate(vals, v_d, K, [x], q, seed=seed)
         except ModelError:
