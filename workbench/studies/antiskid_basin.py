@@ -235,22 +235,72 @@ def _trajectories(prob, est, pts, seed, n, T, lam_d):
     return tuple(out)
 
 
-def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0) -> tuple:
-    """(outcome, q) for one switch state (absolute (v, lambda)): the best
-    verdict over the Q grid (CERTIFIED if any P certifies the state)."""
+@dataclass(frozen=True)
+class SwitchVerdict:
+    """Best verdict over the weight grid for one switch state and gain.
+
+    Attributes
+    ----------
+    outcome : LevelOutcome
+        CERTIFIED if some P of the grid certifies the state; REFUTED if each
+        P that exists refutes its level, or A + B K is not Hurwitz (no basin).
+    w : float or None
+        Weight of the deciding P (None: no Hurwitz linearisation).
+    hurwitz : bool
+    fate : str
+        The delay-free trajectory from the state: "converges" (enters a
+        certified level set, from which it converges), "diverges" (lambda
+        reaches 0.9: the wheel spins), "undecided" (neither within 10 s).
+    """
+
+    outcome: LevelOutcome
+    w: float | None
+    hurwitz: bool
+    fate: str
+
+
+def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0,
+                    t_sim: float = 10.0) -> SwitchVerdict:
+    """Is the switch state ``point`` (absolute (v, lambda)) inside a certified
+    basin of law (61) with gain K? Best verdict over :data:`W_GRID`, and the
+    fate of the delay-free trajectory from it (:class:`SwitchVerdict`)."""
     vals = tuple(sorted((k, float(v)) for k, v in values.items()))
     lam_d = _loop_symbolic(vals, v_d)[6]
     x = (float(point[0]) - v_d, float(point[1]) - lam_d)
     rank = {LevelOutcome.CERTIFIED: 2, LevelOutcome.INCONCLUSIVE: 1, LevelOutcome.REFUTED: 0}
-    best = (LevelOutcome.REFUTED, None)
-    for q in W_GRID:
+    best, sets = (LevelOutcome.REFUTED, None), []
+    for w in W_GRID:
         try:
-            _, est = _estimate(vals, v_d, K, [x], q, seed=seed)
+            prob, est = _estimate(vals, v_d, K, [x], w, seed=seed)
         except ModelError:
-            continue
+            return SwitchVerdict(LevelOutcome.REFUTED, None, False,
+                                 _fate(vals, v_d, K, x, lam_d, [], t_sim))
+        sets.append((prob, est))
         out = est.point_verdict(x).outcome
         if rank[out] > rank[best[0]]:
-            best = (out, q)
+            best = (out, w)
         if out is LevelOutcome.CERTIFIED:
             break
-    return best
+    return SwitchVerdict(best[0], best[1], True, _fate(vals, v_d, K, x, lam_d, sets, t_sim))
+
+
+def _fate(vals, v_d, K, x0, lam_d, sets, T) -> str:
+    """Fate of the delay-free trajectory from x0 (see :class:`SwitchVerdict`)."""
+    f, _, states, *_ = _loop(vals, v_d, tuple(K))
+    fn = sp.lambdify(states, f, "math")
+
+    def rhs(t, x):
+        return list(fn(x[0], x[1]))
+
+    def spin(t, x):
+        return 0.9 - abs(x[1] + lam_d)
+    spin.terminal = True
+    with np.errstate(all="ignore"):
+        sol = solve_ivp(rhs, (0.0, T), np.array(x0, float), method="Radau", rtol=1e-8,
+                        atol=1e-10, events=spin, max_step=0.05)
+    path = sol.y.T
+    if any(est.c_certified > 0 and np.any(prob.V(path) <= est.c_certified) for prob, est in sets):
+        return "converges"
+    if sol.status != 0 or not np.all(np.isfinite(path)) or len(sol.t_events[0]):
+        return "diverges"
+    return "undecided"
