@@ -105,7 +105,11 @@ class BasinProblem:
     # the exact composition f(x* + T z), so rounding in T is harmless.
     @cached_property
     def T(self) -> np.ndarray:
-        return np.linalg.inv(np.linalg.cholesky(self.P).T)
+        """L^-T rounded to 8 significant digits of its largest entry (any T is
+        sound; a rounded one is the same on every CPU, so is the cover)."""
+        T = np.linalg.inv(np.linalg.cholesky(self.P).T)
+        scale = 10.0 ** (np.floor(np.log10(np.max(np.abs(T)))) - 7)
+        return np.round(T / scale) * scale
 
     @cached_property
     def z(self) -> tuple:
