@@ -68,7 +68,7 @@ def largest_level_in_box(P: np.ndarray, x_eq: np.ndarray, lo: Sequence[float],
 
 
 def check_basin(f: Sequence[sp.Expr], states: Sequence[sp.Symbol], x_eq: Sequence[float], *,
-                A_cl=None, P=None, Q=None, points: Sequence[tuple[str, Sequence[float]]] = (),
+                A_cl=None, P=None, Q=None, weights=None, points: Sequence[tuple[str, Sequence[float]]] = (),
                 c_search: float | None = None, domain: tuple | None = None,
                 names: Sequence[str] | None = None, loop: str = "delay-free closed loop",
                 seed: int = 0, min_width: float = 2.0**-12) -> BasinCheck:
@@ -85,6 +85,10 @@ def check_basin(f: Sequence[sp.Expr], states: Sequence[sp.Symbol], x_eq: Sequenc
         The certificate's P (takes precedence).
     Q : (n, n) array_like, optional
         Weight of the Lyapunov equation (identity by default).
+    weights : sequence of float, optional
+        With ``A_cl``: P = :func:`~workbench.roa.lyapunov.modal_P` (A_cl,
+        weights) instead of the Lyapunov equation (better when the loop has
+        slow and fast modes).
     points : sequence of (label, state)
         States to judge (e.g. the states at the phase switches).
     c_search : float, optional
@@ -109,6 +113,8 @@ def check_basin(f: Sequence[sp.Expr], states: Sequence[sp.Symbol], x_eq: Sequenc
     """
     if P is not None:
         Pm, src = np.asarray(P, float), "certificate"
+    elif A_cl is not None and weights is not None:
+        Pm, src = modal_P(A_cl, weights), "modal"
     elif A_cl is not None:
         Pm, src = lyapunov_P(A_cl, Q), "lyapunov"
     else:

@@ -133,7 +133,7 @@ def _domain(v_d: float, lam_d: float):
     return ((V_MIN - v_d, LAM_LO - lam_d), (v_d, LAM_HI - lam_d))
 
 
-def _estimate(values, v_d, K, points, w, *, seed=0, c_search=None):
+def estimate_cruise(values, v_d, K, points, w, *, seed=0, c_search=None):
     """Basin estimate with P = modal_P(A + B K, [1, w]) (slow mode weight 1,
     fast mode w); c_search: 4 x the largest level of ``points`` (capped by
     the model's domain) unless given."""
@@ -186,7 +186,7 @@ def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
     best = None
     for q in W_GRID:
         try:
-            prob, est = _estimate(vals, v_d, K, [x for _, x in pts], q, seed=seed)
+            prob, est = estimate_cruise(vals, v_d, K, [x for _, x in pts], q, seed=seed)
         except ModelError:
             continue
         key = _score(est, [x for _, x in pts])
@@ -271,7 +271,7 @@ def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0,
     best, sets = (LevelOutcome.REFUTED, None), []
     for w in W_GRID:
         try:
-            prob, est = _estimate(vals, v_d, K, [x], w, seed=seed)
+            prob, est = estimate_cruise(vals, v_d, K, [x], w, seed=seed)
         except ModelError:
             return SwitchVerdict(LevelOutcome.REFUTED, None, False,
                                  _fate(vals, v_d, K, x, lam_d, [], t_sim))
@@ -304,3 +304,8 @@ def _fate(vals, v_d, K, x0, lam_d, sets, T) -> str:
     if sol.status != 0 or not np.all(np.isfinite(path)) or len(sol.t_events[0]):
         return "diverges"
     return "undecided"
+
+
+def cruise_lambda_d(values: tuple, v_d: float) -> float:
+    """lambda_d of the cruise loop (``values`` as sorted (name, value) pairs)."""
+    return _loop_symbolic(values, v_d)[6]

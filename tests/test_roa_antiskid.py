@@ -1,0 +1,49 @@
+"""Basin of paper 003's cruise law (61): the printed switch at lambda_opt is
+outside every certified basin and diverges; the workbench's handover state is
+inside; a small k2 makes the printed switch safe (workbench.studies.antiskid_basin)."""
+import numpy as np
+import pytest
+
+from workbench.plants.adhesion import NumericAdhesion
+from workbench.roa import LevelOutcome
+from workbench.studies import antiskid_basin as AB
+
+# 003 Tables 1-2 (dry rail); the gain is the workbench's certified synthesis at
+# eps = 0.35 (reports/antiskid-run-dry.md: K = [-0.004575, 10.27])
+DRY = dict(a=0.3315, b=40.19, c=5.392, J=80.0, r=0.445, m=12000.0, zeta=0.01, c0=180.9,
+           c1=112.2, c2=2.6, g=9.8)
+K = (-0.004575, 10.27)
+
+
+@pytest.fixture(scope="module")
+def lam_opt():
+    return NumericAdhesion.from_dict(DRY).lambda_opt()
+
+
+def test_printed_switch_is_refuted_and_diverges(lam_opt):
+    v = AB.switch_in_basin(DRY, 70.0, K, (70.0, lam_opt))
+    assert v.outcome is LevelOutcome.REFUTED and v.hurwitz
+    assert v.fate == "diverges"
+
+
+def test_handover_state_is_certified_and_converges():
+    # the compensated variant's handover state (reports/antiskid-run-dry.md)
+    v = AB.switch_in_basin(DRY, 70.0, K, (70.29, 0.02145))
+    assert v.outcome is LevelOutcome.CERTIFIED and v.fate == "converges"
+
+
+def test_small_k2_makes_the_printed_switch_safe(lam_opt):
+    v = AB.switch_in_basin(DRY, 70.0, (K[0], 0.0), (70.0, lam_opt))
+    assert v.outcome is LevelOutcome.CERTIFIED and v.fate == "converges"
+
+
+def test_cruise_loop_linearisation_matches_A_plus_BK():
+    vals = tuple(sorted(DRY.items()))
+    f, _, states, A_cl, lam_d, _ = AB._loop(vals, 70.0, K)
+    import sympy as sp
+    fn = sp.lambdify(states, f, "math")
+    assert max(abs(c) for c in fn(0.0, 0.0)) < 1e-12          # equilibrium at E = 0
+    h = np.array([1e-5, 1e-8])
+    J = np.column_stack([(np.array(fn(*(h[j] * np.eye(2)[j]))) -
+                          np.array(fn(*(-h[j] * np.eye(2)[j])))) / (2 * h[j]) for j in range(2)])
+    assert np.allclose(J, A_cl, rtol=1e-5, atol=1e-9)
