@@ -36,9 +36,19 @@ def basin_quantity_names(labels, with_sweep: bool) -> set:
     return names
 
 
-def render_basin_section(basin, sweep, *, rail: str) -> str:
+def render_basin_result(res, *, rail: str) -> str:
+    """Section of a :class:`~workbench.studies.antiskid_basin_run.BasinResult`."""
+    text = render_basin_section(res.basin, res.sweep, rail=rail,
+                                compare_source=res.compare_source)
+    if res.mass_factor != 1.0:
+        text += (f"\nThe plant of this design has {fmt(res.mass_factor, 3)} x the nominal mass; "
+                 "the basin is that of the controller's nominal model (the switch states are "
+                 "this design's simulated ones).\n")
+    return text
+
+
+def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—") -> str:
     """The report section: loop, certified bracket, switch verdicts, k2 rule."""
-    est = basin.check.estimate
     K = "[" + ", ".join(fmt(k, 4) for k in basin.K) + "]"
     head = (
         "## Regions of attraction: does each switch land in the basin of the law that "
@@ -66,10 +76,10 @@ def render_basin_section(basin, sweep, *, rail: str) -> str:
             "(\"diverges\": lambda reaches 0.9, the wheel spins). The cruise → braking switch "
             "hands over to law (69), which tracks a time-varying creep speed: it has no "
             "equilibrium basin; see the phase-switch section for its domain check.\n")
-    return head + body + sw + (_k2_text(sweep, basin) if sweep is not None else "")
+    return head + body + sw + (_k2_text(sweep, compare_source) if sweep is not None else "")
 
 
-def _k2_text(sweep, basin) -> str:
+def _k2_text(sweep, compare_source) -> str:
     v, lam = sweep.point
     rows = [[fmt(r.k1, 4), fmt(r.k2, 5), r.source, r.verdict.outcome.value,
              "—" if r.verdict.w is None else fmt(r.verdict.w), r.verdict.fate]
@@ -87,7 +97,8 @@ def _k2_text(sweep, basin) -> str:
     return ("\n### Which cruise gains make the printed switch safe?\n\n"
             f"Switch state of eq (75) as printed: v = {fmt(v, 4)} m/s, lambda = lambda_opt = "
             f"{fmt(lam, 4)}. Each k2 is judged with every P of the weight grid (CERTIFIED if "
-            "one certifies the state); the gains compared are judged with their own k1.\n\n"
+            "one certifies the state); the gains compared (" + compare_source + ") are judged "
+            "with their own k1.\n\n"
             + md_table(["k1", "k2", "row", "switch state in a certified basin?", "w",
                         "delay-free trajectory"], rows, "rrllrl")
             + "\n\n" + rule + " The rule is sufficient (a quadratic V); where the "
