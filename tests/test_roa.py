@@ -175,3 +175,21 @@ def test_roa_respects_the_layers():
             if isinstance(node, (ast.Import, ast.ImportFrom)):
                 mod = getattr(node, "module", None) or ""
                 assert not any(mod.startswith(f"workbench.{b}") for b in banned)
+
+
+@pytest.mark.parametrize("A", [np.array([[0.0, -1.0], [1.0, -1.0]]),          # complex pair
+                               np.array([[-0.04, 57.7], [0.006, -12.65]])])    # slow + fast
+def test_modal_P_is_a_lyapunov_matrix(A):
+    from workbench.roa import modal_P
+    P = modal_P(A, [1.0, 10.0] if np.isreal(np.linalg.eigvals(A)).all() else None)
+    assert np.all(np.linalg.eigvalsh(P) > 0)
+    assert np.all(np.linalg.eigvalsh(P @ A + A.T @ P) < 0)
+
+
+def test_modal_P_rejects_unstable_and_bad_weights():
+    from workbench.errors import ModelError
+    from workbench.roa import modal_P
+    with pytest.raises(ModelError, match="Hurwitz"):
+        modal_P(np.array([[0.1, 0.0], [0.0, -1.0]]))
+    with pytest.raises(ModelError, match="positive weights"):
+        modal_P(-np.eye(2) - np.diag([0, 1.0]), [1.0, -2.0])

@@ -47,3 +47,21 @@ def test_cruise_loop_linearisation_matches_A_plus_BK():
     J = np.column_stack([(np.array(fn(*(h[j] * np.eye(2)[j]))) -
                           np.array(fn(*(-h[j] * np.eye(2)[j])))) / (2 * h[j]) for j in range(2)])
     assert np.allclose(J, A_cl, rtol=1e-5, atol=1e-9)
+
+
+def test_certified_cruise_level_holds_no_sampled_point_with_vdot_nonnegative(lam_opt):
+    vals = tuple(sorted(DRY.items()))
+    lam_d = AB.cruise_lambda_d(vals, 70.0)
+    prob, est = AB.estimate_cruise(vals, 70.0, K, [(0.0, lam_opt - lam_d)], 100.0)
+    assert 0 < est.c_certified < est.c_refuted < prob.V(np.array([[0.0, lam_opt - lam_d]]))[0]
+    rng = np.random.default_rng(5)
+    u = rng.standard_normal((100_000, 2))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    u *= np.sqrt(rng.random((100_000, 1)) * est.c_certified * (1 - 1e-9))
+    X = u @ np.linalg.inv(np.linalg.cholesky(prob.P).T).T
+    V = prob.V(X)
+    keep = V > 1e-12 * est.c_certified
+    assert np.all(prob.vdot_numeric(X[keep]) < 0)
+    # the counterexample really has V' >= 0 below the switch state's level
+    cx = np.array([est.counterexample])
+    assert prob.vdot_numeric(cx)[0] >= 0
