@@ -211,11 +211,14 @@ def _trajectories(prob, est, pts, seed, n, T, lam_d):
                      max(abs(x[1]) for _, x in pts) * 1.5 + 0.02]) if pts else np.array([2, 0.1])
     starts = [tuple(x) for _, x in pts]
     starts += [tuple(rng.uniform(-1, 1, 2) * half) for _ in range(n)]
-    fn = prob.f_numeric
+    fm = sp.lambdify(prob.states, list(prob.f), "math")
     out = []
     for x0 in starts:
         def rhs(t, x):
-            return fn(x[None, :])[0]
+            try:
+                return list(fm(x[0], x[1]))
+            except (OverflowError, ValueError, ZeroDivisionError):
+                return [math.nan, math.nan]
 
         def spin(t, x):
             return 0.9 - abs(x[1] + lam_d)
@@ -290,7 +293,10 @@ def _fate(vals, v_d, K, x0, lam_d, sets, T) -> str:
     fn = sp.lambdify(states, f, "math")
 
     def rhs(t, x):
-        return list(fn(x[0], x[1]))
+        try:
+            return list(fn(x[0], x[1]))
+        except (OverflowError, ValueError, ZeroDivisionError):
+            return [math.nan, math.nan]
 
     def spin(t, x):
         return 0.9 - abs(x[1] + lam_d)
