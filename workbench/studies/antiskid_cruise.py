@@ -20,7 +20,7 @@ from ..errors import DesignError, ModelError
 from ..plants.units import ADHESION_003 as PARAMETER_UNITS
 
 if TYPE_CHECKING:   # the solvers and the symbolic model load when a design runs
-    from ..lmi.robust import PointCheck
+    from ..crosscheck import PointCheck
     from ..lmi.tight_synthesis import TightSynthesis
     from ..margins import DelayMargin
     from ..report.markdown import Rendered
@@ -124,6 +124,10 @@ class TightComparison:
         Bessel-Legendre bound and exact margin with the printed K.
     open_loop_hurwitz : bool
         A itself is Hurwitz (then K = 0 is stable for every delay).
+    check : PointCheck or None
+        Bessel-Legendre analysis bound and exact margin with the tight K.
+    exact_siso : DelayMargin or None
+        python-control's single-input exact margin with the tight K.
     """
 
     synthesis: TightSynthesis
@@ -132,6 +136,8 @@ class TightComparison:
     published: Published | None
     published_check: PointCheck | None
     open_loop_hurwitz: bool
+    check: PointCheck | None = None
+    exact_siso: DelayMargin | None = None
 
 
 @dataclass(frozen=True)
@@ -326,12 +332,14 @@ def _run_tight(spec: CruiseSpec, lin: Linearisation, rows) -> TightComparison:
     """Tight synthesis, and the Bessel-Legendre + exact check of the reference gains."""
     import numpy as np
 
-    from ..lmi.robust import check_gain
+    from ..crosscheck import check_gain, check_tight
     from ..lmi.tight_synthesis import synthesize_tight
     ts, st = spec.tight, spec.settings
-    syn = synthesize_tight(lin.A, lin.B, eps_grid=ts.grid, h_max=ts.h_max, N=ts.order,
+    syn = synthesize_tight(lin.A, lin.B, eps_grid=ts.grid, h_max=ts.h_max,
                            margin=st.margin, rel_tol=max(st.rel_tol, 1e-3),
                            gain_fraction=st.gain_fraction, gain_digits=st.gain_digits)
+    own = (check_tight(lin.A, lin.B, syn.K, N=ts.order, margin=st.margin, h_hi=ts.h_max)
+           if syn.K is not None else None)
 
     def check(K):
         return check_gain([(lin.A, lin.B)], np.array([K]), N=ts.order, margin=st.margin,
@@ -340,15 +348,16 @@ def _run_tight(spec: CruiseSpec, lin: Linearisation, rows) -> TightComparison:
     pub = next((p for p in spec.published if p.eps == ts.reference_eps), None)
     return TightComparison(syn, ref, check(ref.K) if ref.K else None, pub,
                            check(pub.K) if pub else None,
-                           bool(np.max(np.linalg.eigvals(lin.A).real) < 0))
+                           bool(np.max(np.linalg.eigvals(lin.A).real) < 0),
+                           own.check if own else None, own.exact_siso if own else None)
 
 
 def _tight_quantities(t: TightComparison) -> dict:
-    s, c = t.synthesis, t.synthesis.check
+    s, c = t.synthesis, t.check
     K = s.K.ravel() if s.K is not None else None
     q = {"eps": s.eps, "h_certified": s.h_certified if s.h_certified > 0 else None,
          "h_analysis": c.h_certified if c else None, "exact_margin": c.exact.h if c else None,
-         "exact_margin_siso": s.exact_siso.h if s.exact_siso else None,
+         "exact_margin_siso": t.exact_siso.h if t.exact_siso else None,
          "K1": None if K is None else float(K[0]), "K2": None if K is None else float(K[1]),
          "at_cap": "yes" if s.at_cap else "no",
          "ratio_to_reference": (s.h_certified / t.reference.h_certified

@@ -223,7 +223,7 @@ def _closed_loop_eigs(A, B, K) -> str:
 def _tight_section(t, A, B) -> str:
     """``## Tight synthesis beyond the paper`` (the ``[tight]`` table of a design)."""
     s, cap = t.synthesis, t.synthesis.h_max
-    N = s.check.N if s.check else None
+    N = t.check.N if t.check else None
     rows = []
 
     def bl(c):
@@ -241,7 +241,7 @@ def _tight_section(t, A, B) -> str:
                  fmt(r.h_gain, 4), bl(t.reference_check), em(t.reference_check),
                  _closed_loop_eigs(A, B, r.K)])
     rows.append(["tight: Wirtinger synthesis, eps searched", fmt(s.eps, 3), _gain(s.K),
-                 _capped(s.gain.h_certified if s.gain else None, cap), bl(s.check), em(s.check),
+                 _capped(s.gain.h_certified if s.gain else None, cap), bl(t.check), em(t.check),
                  _closed_loop_eigs(A, B, s.K)])
     table = md_table(["design", "eps", "K", "certified h with this K, own LMI (s)",
                       f"certified h, Bessel-Legendre N = {N} analysis with this K (s)",
@@ -259,7 +259,7 @@ def _tight_section(t, A, B) -> str:
         "gain is then re-certified by the Bessel-Legendre *analysis* LMI (independent of the "
         "synthesis LMI) and by the exact delay margin.",
     ]
-    if s.check is not None and s.at_cap and math.isinf(s.check.exact.h):
+    if t.check is not None and s.at_cap and math.isinf(t.check.exact.h):
         notes.append(
             f"**The tight bound is the search cap, not a limit.** The synthesis certifies the "
             f"cap h_max = {fmt(cap, 4)} s and the exact margin with its gain is infinite, so the "
