@@ -6,11 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from workbench.lmi.core import Outcome
-from workbench.lmi.robust import maximise_log_scalar
-from workbench.lmi.analysis import WirtingerLMI, certified_delay
-from workbench.lmi.core import bisect_delay
 from workbench.crosscheck import check_tight
+from workbench.lmi.analysis import WirtingerLMI, certified_delay
+from workbench.lmi.core import Outcome
+from workbench.lmi.core import bisect_delay
+from workbench.lmi.robust import maximise_log_scalar
 from workbench.lmi.tight_synthesis import (WirtingerSynthesis, WirtingerSynthesisFixedK,
                                            recheck_tight, synthesize_tight)
 from workbench.margins import delay_margin_eig

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from decimal import ROUND_DOWN, ROUND_HALF_EVEN, Decimal
 from typing import Any
 
-from .design import Reader
+from .reader import Reader
 
 COMPARES = (">=", "<=", "==", "within")
 

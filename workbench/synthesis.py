@@ -17,7 +17,6 @@ runs in the same coordinates, and K is mapped back (K = K~ T^{-1}).
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, field
 
 import numpy as np

@@ -39,8 +39,8 @@ import cvxpy as cp
 import numpy as np
 
 from .analysis import BesselLegendreLMI, certified_delay
-from .core import DEFAULT_MARGIN, Block, Bracket, FixedGain, MarginLMI, Outcome, bisect_delay
-from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
+from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, bisect_delay
+from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
 from .scaling import balance_points
 
 

@@ -40,8 +40,8 @@ from typing import Mapping, Sequence
 import cvxpy as cp
 import numpy as np
 
-from .core import DEFAULT_MARGIN, Block, Bracket, FixedGain, MarginLMI
-from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
+from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI
+from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
 from .robust import DescriptorSynthesis, best_eps_bracket
 from .scaling import balance_points
 

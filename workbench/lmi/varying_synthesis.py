@@ -48,8 +48,8 @@ from typing import Sequence
 import cvxpy as cp
 import numpy as np
 
-from .core import DEFAULT_MARGIN, Block, Bracket, FixedGain, MarginLMI, Outcome, bisect_delay
-from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
+from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, bisect_delay
+from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
 
 #: Fractions of the certified h2 at which the canonical gain is tried, in order.
 GAIN_FRACTIONS = (DEFAULT_FRACTION, 0.95, 0.9, 0.8, 0.6)

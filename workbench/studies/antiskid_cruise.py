@@ -11,19 +11,17 @@ synthesis with its scalar searched automatically,
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
 from ..plants.units import ADHESION_003 as PARAMETER_UNITS
+from ..reader import Quantity, Reader
 
 if TYPE_CHECKING:   # the solvers and the symbolic model load when a design runs
     from ..crosscheck import PointCheck
     from ..lmi.tight_synthesis import TightSynthesis
     from ..margins import DelayMargin
-    from ..report.markdown import Rendered
     from ..symbolic.linearise import Linearisation
     from ..synthesis import SynthesisRow, SynthesisSettings
 
@@ -317,9 +315,6 @@ class AntiskidCruise:
         return q
 
     # -- render ----------------------------------------------------------------
-    def render(self, design, res: CruiseResult) -> Rendered:
-        from .antiskid_cruise_render import render
-        return render(design, res)
 
 
 #: Quantities of the ``[tight]`` comparison (prefixed ``tight.``).

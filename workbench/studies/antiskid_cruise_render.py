@@ -6,7 +6,7 @@ import math
 import numpy as np
 import sympy as sp
 
-from ..plants.adhesion import PARAMETER_UNITS, adhesion_model
+from ..plants.adhesion import adhesion_model
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, margin_text, md_table
 
 

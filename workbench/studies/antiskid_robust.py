@@ -19,9 +19,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
 from ..plants.units import ADHESION_003 as PARAMETER_UNITS
+from ..reader import Quantity, Reader
 
 if TYPE_CHECKING:   # the solvers load when a design runs
     from ..crosscheck import PointCheck
@@ -218,10 +218,6 @@ class AntiskidRobust:
             for p, k in zip(spec_points, checks):
                 q[f"compare[{c.name}].points[{p.id}].exact_margin"] = k.exact.h
         return q
-
-    def render(self, design, res: RobustResult):
-        from .antiskid_robust_render import render
-        return render(design, res)
 
 
 STUDY = AntiskidRobust()

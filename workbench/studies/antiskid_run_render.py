@@ -5,9 +5,10 @@ import math
 
 import numpy as np
 
-from ..controllers.antiskid003 import (BRAKE, BRAKE_IN, DIVERGED_HOW, PHASE_NAMES, CreepSpeedProfile, _Array,
-                                       creep_speed, wheel_speed)
+from ..controllers.antiskid003_settings import (BRAKE, BRAKE_IN, DIVERGED_HOW, PHASE_NAMES,
+                                                CreepSpeedProfile)
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
+from ..sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
 
 _COLORS = {"paper": "tab:red", "compensated": "tab:blue", "uncompensated": "tab:orange",
            "recursive": "tab:purple"}
@@ -82,7 +83,7 @@ def render(design, res) -> Rendered:
                lambda fig, res=res: _plot_linear(fig, res), (7.0, 4.0)),
     )
     if res.montecarlo is not None:
-        from ..sim.montecarlo import draw_histograms, draw_outcomes
+        from .antiskid_montecarlo_render import draw_histograms, draw_outcomes
         figs += (
             Figure("montecarlo-histograms", "Monte Carlo: histograms of the summary metrics.",
                    lambda fig, mc=res.montecarlo: draw_histograms(fig, mc), (9.0, 3.2)),
@@ -224,7 +225,7 @@ def _linear_section(res) -> str:
 
 
 def _montecarlo_section(design, mc, halving=None) -> str:
-    from ..sim.montecarlo import halving_section, summary_tables
+    from .antiskid_montecarlo_render import halving_section, summary_tables
     ms = design.spec.montecarlo
     rng = lambda lo_hi, sig=3: f"[{fmt(lo_hi[0], sig)}, {fmt(lo_hi[1], sig)}]"
     rows = [["plant mass / nominal", rng(ms.mass)],
@@ -396,9 +397,9 @@ def _plot_evs(fig, res, spec):
         if not sel.any():
             continue
         t, v, lam = r.t[sel], r.x[0][sel], r.x[1][sel]
-        om = wheel_speed(np.maximum(v, 1e-3), lam, r_wheel, _Array)
-        vs, _ = prof(t, v, 0 * v, om, _Array)
-        ax.plot(t, creep_speed(v, lam, _Array) - vs, color=_color(c.case.name), label=c.case.name)
+        om = wheel_speed(np.maximum(v, 1e-3), lam, r_wheel, ArrayOps)
+        vs, _ = prof(t, v, 0 * v, om, ArrayOps)
+        ax.plot(t, creep_speed(v, lam, ArrayOps) - vs, color=_color(c.case.name), label=c.case.name)
     ax.set_xlabel("t (s)")
     ax.set_ylabel("e_vs = v_s - v_s* (m/s)")
     ax.set_ylim(-0.3, 0.3)

@@ -34,7 +34,7 @@ import sympy as sp
 
 from ..controllers.fuzzy import FuzzyIncrement
 from ..controllers.pid import PID
-from ..design import Quantity, Reader
+from ..reader import Quantity, Reader
 from ..sim.stopping import batch_params, simulate
 from .stopping000 import load_plant
 
@@ -364,10 +364,6 @@ class ClosedLoopBrake:
                 q[f"{b}.electric_loss.{mode}.abs_m"] = res.max_abs(speed_kmh=s, mode=mode,
                                                                    electric=False)
         return q
-
-    def render(self, design, res: Result004):
-        from .brake004_render import render
-        return render(design, res)
 
 
 STUDY = ClosedLoopBrake()

@@ -21,8 +21,8 @@ import numpy as np
 from ..controllers.pid import PID
 from ..controllers.smarc import AdaptiveSlidingModeController
 from ..controllers.smc import SlidingGains, SlidingModeController
-from ..design import Quantity, Reader
 from ..plants.brake000 import PARAMETER_UNITS
+from ..reader import Quantity, Reader
 from ..sim.stopping import TargetCurve, batch_params, simulate
 
 #: Paper 000's three controllers, then SMARC with the discontinuous sgn of eq 22
@@ -302,10 +302,6 @@ class StationStopping:
         q["order"] = "<".join(order)
         q["best"] = order[0]
         return q
-
-    def render(self, design, res: StopResult):
-        from .stopping000_render import render
-        return render(design, res)
 
 
 STUDY = StationStopping()
