@@ -69,7 +69,6 @@ def render(design, res) -> Rendered:
     sections.append(_linear_section(res))
     if res.montecarlo is not None:
         sections.append(_montecarlo_section(design, res.montecarlo, res.halving))
-    sections.append(_numerics_section(res.montecarlo is not None))
     figs = (
         Figure("speed", "Train speed v and wheel speed v_w = omega r.",
                lambda fig, res=res: _plot_speed(fig, res), (7.0, 4.0)),
@@ -100,6 +99,7 @@ def render(design, res) -> Rendered:
         "e_vs = v_s - v_s*(t) in braking (Theorem 3, cf. Fig. 4 of the paper).\n\n"
         "![linear checks]({figdir}/linear-checks.png)\n\n|E| of the linear error system with "
         "the finite-margin gain at the multiples of its exact margin h*.")
+    sections.append(_numerics_section(res.montecarlo is not None, spec.rail))
     return Rendered(tuple(sections), figs)
 
 
@@ -164,10 +164,7 @@ def _switch_section(res) -> str:
         "abscissa and exact delay margin (Chen-Gu-Nett).\n\n"
         + md_table(["case", "v (m/s)", "lambda", "d mu/d lambda", "A_loc", "abscissa (1/s)",
                     "exact margin"], rows, "lrrrlrl")
-        + "\n\nAt lambda = lambda_opt the adhesion slope d mu/d lambda is zero: the restoring "
-        "term d2 of the cruise linearisation, which the synthesised K (k2 > 0, positive "
-        "feedback on lambda_e) relies on, has vanished, so the frozen loop is unstable "
-        "before any delay is added. Eq (75) as printed switches exactly there.\n\n"
+        + "\n\n" + _switch_note(res) + "\n\n"
         "**Cruise → braking.** Law (69) is built on the braking form (eq 15, lambda <= 0). "
         "State at t_brake:\n\n"
         + md_table(["case", "lambda at t_brake", "in the braking form's domain?", "then"],
@@ -178,6 +175,25 @@ def _switch_section(res) -> str:
         "0.75 s.\n\n"
         "**omega <= 3 rad/s.** v_s* jumps to 0 (eq 76): the creep-speed error jumps and decays "
         "at rate k_de; the train then coasts on running resistance to v_stop.")
+
+
+def _switch_note(res) -> str:
+    """What the slope at the printed switch means, from the measured d mu/d lambda."""
+    paper = next((c.switch for c in res.cases if c.case.name == "paper" and c.switch), None)
+    if paper is None:
+        return ""
+    slope = fmt(paper.dmu_dlam, 3)
+    where = ("zero there (the peak of the plant's curve)" if abs(paper.dmu_dlam) < 1e-6 else
+             f"{slope} on this plant's curve (the controller's lambda_opt is the nominal "
+             "model's peak, not this plant's)")
+    stable = ("unstable before any delay is added" if paper.abscissa > 0 else
+              "stable without delay")
+    return (f"Eq (75) as printed switches to the cruise law at lambda = lambda_opt of the "
+            f"controller's model, where the adhesion slope d mu/d lambda is {where}. The "
+            "synthesised K (k2 > 0, positive feedback on lambda_e) relies on the restoring "
+            "term d2 of the cruise linearisation at lambda_d, which the slope there sets; "
+            f"the frozen loop at the switch has delay-free spectral abscissa "
+            f"{fmt(paper.abscissa, 3)} 1/s: {stable}.")
 
 
 def _convergence_section(res, spec) -> str:
@@ -254,7 +270,7 @@ def _montecarlo_section(design, mc, halving=None) -> str:
         "that study; each run of a batch follows its single-run trajectory). The claims "
         "`mc-*-vs-full` compare "
         "these fractions with the full 1000-run sweep. Draws, uniform and independent; the "
-        "controller keeps the nominal dry model and the design's h:\n\n"
+        f"controller keeps the nominal {design.spec.rail}-rail model and the design's h:\n\n"
         + md_table(["parameter", "range"], rows, "ll")
         + "\n\nSummary statistics (3 significant digits; `lam_max_over_opt` is the max creep "
         "ratio in traction over the sample's own lambda_opt, not given for a run that diverged "
@@ -278,9 +294,12 @@ def _montecarlo_section(design, mc, halving=None) -> str:
            + halving_section(halving, design.spec)))
 
 
-def _numerics_section(with_montecarlo: bool = False) -> str:
+def _numerics_section(with_montecarlo: bool, rail: str) -> str:
+    """Appendix: how the runs are integrated. Measurements behind these
+    choices are re-run by ``benchmarks/mesh.py`` and ``benchmarks/simulate.py``,
+    not typed here."""
     return (
-        "## Numerics\n\n"
+        "## Appendix: numerics\n\n"
         "* Plant: v by explicit Euler; the creep ratio, stiff at low speed "
         "(d lambda'/d lambda ~ -m g r^2 mu'/(J v), time constant ~ v/4000 s), by the "
         "exponential Euler step with the sympy Jacobian, stable for any step; a step that "
@@ -297,16 +316,15 @@ def _numerics_section(with_montecarlo: bool = False) -> str:
         "stiff creep ratio to its quasi-steady value, so the printed law held constant "
         "realises its rate only for dt |J| << 1 (at 3 m/s, |J| ~ 1000/s). Each law is held "
         "as the torque that moves the exponential-Euler creep ratio by dt times the rate "
-        "the continuous law asks for; it equals the printed law when dt |J| -> 0. With the "
-        "printed value held, the time to cruise moved by 0.08 s per 5 ms of step.\n"
+        "the continuous law asks for; it equals the printed law when dt |J| -> 0 (with the "
+        "printed value held, the time to cruise moves with the step).\n"
         "* Model mismatch in the hold: the plant's creep-ratio rate is the model's plus a "
         "mismatch delta (mass, adhesion, true delay). Scaling only the model's rate by "
         "1/phi1(dt J) leaves delta scaled by phi1(dt J) = 1 + dt J/2 + ..., which moves the "
-        "loop's fixed points by O(dt): with the plant mass +5 %, v - v_d at t_brake (the end "
-        "of a ~270 s slow transient set by where lambda settles) was -3.133 / -3.220 / "
-        "-3.264 m/s at dt = 10 / 5 / 2.5 ms. The hold therefore also realises an estimate of "
+        "loop's fixed points by O(dt) (with a mismatched plant mass, v - v_d at t_brake "
+        "then moved with each halving of the step). The hold therefore also realises an estimate of "
         "delta from the last step (the measured lambda against the model's step under the "
-        "input the controller believes applied, filtered over 0.2 s), carried to t + h for "
+        "input the controller believes applied, filtered over `observer_tau`), carried to t + h for "
         "the predictor (delta e^{hJ}); its fixed points are the continuous loop's. It is not "
         "used in braking.\n"
         "* Phase switches use measured states; stops at v <= v_stop. A run ends as diverged "
@@ -321,21 +339,18 @@ def _numerics_section(with_montecarlo: bool = False) -> str:
         "* Refined mesh for the cases without the predictor (`mesh_courant`, `mesh_levels` "
         "in `[numerics]`): the step is dt / 2^k, k <= mesh_levels the smallest level with "
         "step x S/v <= mesh_courant, S/v = m g r^2 mu'(0) / (J v) the fastest creep-ratio "
-        "rate (~3800/v 1/s on dry rail); dt/2 halves every step of the mesh. Why: without "
+        "rate; dt/2 halves every step of the mesh. Why: without "
         "the predictor the loop at low speed is close to neutral (lambda' ~ J lambda - "
-        "(J + k_ac) lambda(t - h): roots decay at only (1/h) ln(|J|/|J + k_ac|), ~0.2/s at "
-        "3 m/s), so features of width ~1/|J| ~ 1 ms set at the start persist for seconds; the "
-        "exponential step keeps them stable but does not resolve them. On the fixed step the "
-        "mass -5 % run's max creep ratio in traction converged only at first order (0.216 / "
-        "0.205 / 0.198 / 0.194 / 0.192 / 0.1905 / 0.1898 at dt = 10 ms down to 0.16 ms). "
+        "(J + k_ac) lambda(t - h): roots decay at only (1/h) ln(|J|/|J + k_ac|) at "
+        "low speed), so features of width ~1/|J| set at the start persist for seconds; the "
+        "exponential step keeps them stable but does not resolve them, and on the fixed step "
+        "such a run's max creep ratio in traction converges only at first order. "
         "With the predictor, plant and rollout share one discretisation and the fixed step "
-        "converges: a refined mesh (rollout on the mesh too) gave the same dry-rail metrics "
-        "(time to cruise 31.042 / 31.043 s, braking 86.29 / 86.35 s) at 15-100 times the cost "
-        "(`benchmarks/mesh.py` re-runs both comparisons); "
-        "refining the plant but not the rollout is inconsistent and stops the train 35 s "
-        "early (the predictor's error then keeps lambda at -0.03 after omega <= 3 rad/s).\n"
-        "* Monte Carlo robustness (mass, adhesion between the wet and dry curves, true delay, "
-        "initial speed; the controller keeps the nominal dry model) is run by "
+        "converges: a refined mesh (rollout on the mesh too) gives the same metrics at many "
+        "times the cost, while refining the plant but not the rollout is inconsistent "
+        "(`benchmarks/mesh.py` re-runs these comparisons and prints them).\n"
+        f"* Monte Carlo robustness (mass, adhesion between the wet and dry curves, true delay, "
+        "initial speed; the controller keeps the nominal {rail}-rail model) is run by "
         "`workbench sweep DESIGN --samples N --seed S --figure PNG`"
         + (", the runs of a chunk as one batch (arrays) at the `[montecarlo]` step; the "
            "reduced sample above is run with this report, and its first runs again at that "

@@ -268,6 +268,7 @@ def _collect(spec: StopSpec, blocks) -> StopResult:
 
 class StationStopping:
     kind = "station-stopping"
+    uses_solver = False    # no convex solver runs: the report says so
 
     def load(self, root: Reader) -> StopSpec:
         return load_stop_spec(root)
