@@ -5,13 +5,11 @@ import math
 
 import numpy as np
 
-from ..controllers.antiskid003_settings import (BRAKE, BRAKE_IN, DIVERGED_HOW, PHASE_NAMES,
-                                                CreepSpeedProfile)
+from ..controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
-from ..sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
+from .antiskid_run_figures import (plot_adhesion, plot_creep, plot_evs, plot_linear,
+                                   plot_speed, plot_torque)
 
-_COLORS = {"paper": "tab:red", "compensated": "tab:blue", "uncompensated": "tab:orange",
-           "recursive": "tab:purple"}
 _LABELS = {  # metric -> (label, unit, sig)
     "t_cruise": ("time to reach v_d", "s", 4),
     "lam_max_traction": ("max creep ratio, traction", "-", 4),
@@ -26,10 +24,6 @@ _LABELS = {  # metric -> (label, unit, sig)
     "evs_last": ("creep-speed error at the stop", "m/s", 2),
     "t_diverged": ("diverged at", "s", 4),
 }
-
-
-def _color(name):
-    return _COLORS.get(name, "tab:green")
 
 
 def _diverged_text(c) -> str:
@@ -71,15 +65,17 @@ def render(design, res) -> Rendered:
         sections.append(_montecarlo_section(design, res.montecarlo, res.halving))
     figs = (
         Figure("speed", "Train speed v and wheel speed v_w = omega r.",
-               lambda fig, res=res: _plot_speed(fig, res), (7.0, 4.0)),
+               lambda fig, res=res: plot_speed(fig, res), (7.0, 4.0)),
         Figure("creep-ratio", "Creep ratio against lambda_opt and lambda_d.",
-               lambda fig, res=res: _plot_creep(fig, res), (7.0, 5.5)),
+               lambda fig, res=res: plot_creep(fig, res), (7.0, 5.5)),
         Figure("torque", "Wheel torque u(t) of the controller.",
-               lambda fig, res=res: _plot_torque(fig, res), (7.0, 4.0)),
+               lambda fig, res=res: plot_torque(fig, res), (7.0, 4.0)),
         Figure("creep-speed-error", "Creep-speed tracking error in braking.",
-               lambda fig, res=res, sp=spec: _plot_evs(fig, res, sp), (7.0, 4.0)),
+               lambda fig, res=res, sp=spec: plot_evs(fig, res, sp), (7.0, 4.0)),
         Figure("linear-checks", "Linear error system E' = A E + B K E(t-h).",
-               lambda fig, res=res: _plot_linear(fig, res), (7.0, 4.0)),
+               lambda fig, res=res: plot_linear(fig, res), (7.0, 4.0)),
+        Figure("adhesion", "The plant's adhesion curve with each run's operating points.",
+               lambda fig, res=res, sp=spec: plot_adhesion(fig, res, sp), (9.0, 3.8)),
     )
     if res.montecarlo is not None:
         from .antiskid_montecarlo_render import draw_histograms, draw_outcomes
@@ -98,7 +94,11 @@ def render(design, res) -> Rendered:
         "later).\n\n![creep speed error]({figdir}/creep-speed-error.png)\n\nCreep-speed error "
         "e_vs = v_s - v_s*(t) in braking (Theorem 3, cf. Fig. 4 of the paper).\n\n"
         "![linear checks]({figdir}/linear-checks.png)\n\n|E| of the linear error system with "
-        "the finite-margin gain at the multiples of its exact margin h*.")
+        "the finite-margin gain at the multiples of its exact margin h*.\n\n"
+        "![adhesion]({figdir}/adhesion.png)\n\nLeft: the plant's adhesion curve mu(lambda) "
+        "(eq 6, the plant's own parameters) with the (lambda, mu) each run visits; past the "
+        "peak at lambda_opt the wheel loses adhesion (spin in traction, lock in braking). "
+        "Right: the same runs in the (v, lambda) plane, from the start (o) to the end (x).")
     sections.append(_numerics_section(res.montecarlo is not None, spec.rail))
     return Rendered(tuple(sections), figs)
 
@@ -356,75 +356,3 @@ def _numerics_section(with_montecarlo: bool, rail: str) -> str:
            "reduced sample above is run with this report, and its first runs again at that "
            "step and its half (the step-size check of the Monte Carlo section)."
            if with_montecarlo else ", outside this report."))
-
-
-# -- figures ---------------------------------------------------------------------
-def _plot_speed(fig, res):
-    ax = fig.add_subplot(111)
-    for c in res.cases:
-        r = c.run
-        v, lam = r.x
-        vw = np.where(lam >= 0, v / (1 - np.minimum(lam, 0.999)), v * (1 + lam))
-        ax.plot(r.t, v, color=_color(c.case.name), label=f"{c.case.name}: v")
-        ax.plot(r.t, vw, color=_color(c.case.name), ls=":", label=f"{c.case.name}: v_w")
-    vmax = max(float(np.nanmax(c.run.x[0])) for c in res.cases)
-    ax.set_ylim(-5.0, 1.3 * vmax)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("speed (m/s), clipped")
-    ax.legend(fontsize=7, ncol=2)
-
-
-def _plot_creep(fig, res):
-    ax1, ax2 = fig.subplots(2, 1)
-    for ax in (ax1, ax2):
-        for c in res.cases:
-            r = c.run
-            ax.plot(r.t, np.clip(r.x[1], -1, 1), color=_color(c.case.name), label=c.case.name)
-        ax.axhline(res.lambda_opt, color="k", ls="--", lw=0.8, label="lambda_opt")
-        ax.axhline(res.lambda_d, color="gray", ls=":", lw=0.8, label="lambda_d")
-        ax.set_ylabel("creep ratio")
-    t_c = min((c.metrics["t_cruise"] for c in res.cases
-               if not math.isnan(c.metrics["t_cruise"])), default=0.0)
-    ax1.set_ylim(-0.2, 0.3)
-    ax2.set_xlim(t_c - 1.0, t_c + 3.0)
-    ax2.set_ylim(-0.1, 1.0)
-    ax2.set_xlabel("t (s)")
-    ax1.legend(fontsize=7, ncol=3)
-
-
-def _plot_torque(fig, res):
-    ax = fig.add_subplot(111)
-    for c in res.cases:
-        ax.plot(c.run.t, np.clip(c.run.u[0], -4e4, 4e4), color=_color(c.case.name),
-                label=c.case.name, lw=0.8)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("u (N m), clipped to ±4e4")
-    ax.legend(fontsize=7)
-
-
-def _plot_evs(fig, res, spec):
-    ax = fig.add_subplot(111)
-    prof = CreepSpeedProfile(t_brake=spec.scenario["t_brake"], **spec.profile)
-    r_wheel = spec.params["r"].value
-    for c in res.cases:
-        r = c.run
-        sel = (r.phase == BRAKE) | (r.phase == BRAKE_IN)
-        if not sel.any():
-            continue
-        t, v, lam = r.t[sel], r.x[0][sel], r.x[1][sel]
-        om = wheel_speed(np.maximum(v, 1e-3), lam, r_wheel, ArrayOps)
-        vs, _ = prof(t, v, 0 * v, om, ArrayOps)
-        ax.plot(t, creep_speed(v, lam, ArrayOps) - vs, color=_color(c.case.name), label=c.case.name)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("e_vs = v_s - v_s* (m/s)")
-    ax.set_ylim(-0.3, 0.3)
-    ax.legend(fontsize=7)
-
-
-def _plot_linear(fig, res):
-    ax = fig.add_subplot(111)
-    for (fac, h, _), r in zip(res.linear.ratios_finite, res.linear.runs):
-        ax.semilogy(r.t, np.linalg.norm(r.x, axis=0) + 1e-300, label=f"h = {fac:g} h*")
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("|E|")
-    ax.legend(fontsize=7)
