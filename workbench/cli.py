@@ -107,7 +107,9 @@ def cmd_verify(args) -> int:
         rows = []
         for e in evs:
             for c in e.claims:
-                v = c.verdict.value + (" (expected)" if c.claim.expect == "fail" and c.ok else "")
+                sev = c.claim.severity
+                v = c.verdict.value + (f" (expected; {sev})" if c.claim.expect == "fail" and c.ok
+                                       else f" ({sev})" if sev else "")
                 rows.append([e.design.name, c.claim.id, f"{c.claim.compare} {fmt(c.claim.value, 6)}",
                              fmt(c.got, 6), v if c.ok else v + " ✗", c.claim.source])
         rows += extra.get("rows", [])

@@ -34,11 +34,15 @@ def claims_table(results: tuple[ClaimResult, ...]) -> str:
         if c.digits is not None:
             exp += f" ({c.digits} decimals, {'truncated' if c.rounding == 'truncate' else 'rounded'})"
         verdict = r.verdict.value
-        if c.expect == "fail":
+        if not r.severity_holds:
+            verdict += " (not a rounding: more than 0.1 % off)"
+        elif c.expect == "fail":
             verdict += " (expected)" if r.ok else " (expected FAIL, now passes: update the design)"
         elif r.verdict is Verdict.INCONCLUSIVE and c.allow_inconclusive:
             verdict += " (allowed)"
-        note = c.description + (f" — known discrepancy: {c.reason}" if c.expect == "fail" else "")
+        note = c.description + (f" — known discrepancy ({c.severity}): {c.reason}"
+                                if c.expect == "fail" else
+                                f" — workbench finding ({c.severity})" if c.severity else "")
         rows.append([f"`{c.id}`", note, f"`{c.quantity}`", exp, fmt(r.got, 5),
                      f"**{verdict}**", c.source])
     return md_table(["claim", "statement", "quantity", "expected", "got", "verdict", "source"],
