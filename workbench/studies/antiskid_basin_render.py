@@ -12,10 +12,13 @@ _FATE_COLOR = {"converges": "tab:green", "diverges": "tab:red", "undecided": "0.
 _SWITCH_MARK = {"CERTIFIED": "o", "REFUTED": "X", "INCONCLUSIVE": "s"}
 
 
-def basin_quantities(basin, sweep) -> dict:
-    """Claim quantities of the basin check (names documented in the report)."""
+def basin_quantities(basin, sweep, labels=()) -> dict:
+    """Claim quantities of the basin check (``labels``: every case; a case
+    whose cruise law never started gets None)."""
     est = basin.check.estimate
     q = {"basin.c_certified": est.c_certified, "basin.c_refuted": est.c_refuted}
+    for lab in labels:
+        q[f"switch.cruise[{lab}].in_basin"] = q[f"switch.cruise[{lab}].fate"] = None
     for p, tr in zip(basin.check.points, basin.trajectories):
         q[f"switch.cruise[{p.label}].in_basin"] = p.verdict.outcome.value
         q[f"switch.cruise[{p.label}].fate"] = tr.fate
