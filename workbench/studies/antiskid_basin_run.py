@@ -116,3 +116,30 @@ def run_basin(settings: BasinSettings, values: dict, v_d: float, K, lambda_opt: 
     sweep = safe_k2_range(values, v_d, float(K[0]), (v_d, lambda_opt), grid=settings.k2_grid,
                           compare=settings.compare, bisect=settings.bisect, seed=settings.seed)
     return BasinResult(basin, sweep, settings.compare_source, mass_factor)
+
+
+def basin_quantities(basin, sweep, labels=()) -> dict:
+    """Claim quantities of the basin check (``labels``: every case; a case
+    whose cruise law never started gets None)."""
+    est = basin.check.estimate
+    q = {"basin.c_certified": est.c_certified, "basin.c_refuted": est.c_refuted}
+    for lab in labels:
+        q[f"switch.cruise[{lab}].in_basin"] = q[f"switch.cruise[{lab}].fate"] = None
+    for p, tr in zip(basin.check.points, basin.trajectories):
+        q[f"switch.cruise[{p.label}].in_basin"] = p.verdict.outcome.value
+        q[f"switch.cruise[{p.label}].fate"] = tr.fate
+    if sweep is not None:
+        q["basin.k2_safe_max"] = None if sweep.edge is None else sweep.edge[0]
+        q["basin.k2_unsafe_min"] = None if sweep.edge is None else sweep.edge[1]
+        q["basin.compared_certified"] = sum(r.verdict.outcome.value == "CERTIFIED"
+                                            for r in sweep.compared)
+    return q
+
+
+def basin_quantity_names(labels, with_sweep: bool) -> set:
+    names = {"basin.c_certified", "basin.c_refuted"}
+    for lab in labels:
+        names |= {f"switch.cruise[{lab}].in_basin", f"switch.cruise[{lab}].fate"}
+    if with_sweep:
+        names |= {"basin.k2_safe_max", "basin.k2_unsafe_min", "basin.compared_certified"}
+    return names

@@ -256,7 +256,7 @@ class AntiskidRun:
             if spec.montecarlo.halving:
                 names |= halving_quantity_names()
         if spec.basin is not None:
-            from .antiskid_basin_render import basin_quantity_names
+            from .antiskid_basin_run import basin_quantity_names
             names |= basin_quantity_names([c.name for c in spec.cases], True)
         return names
 
@@ -351,7 +351,7 @@ class AntiskidRun:
             if res.halving is not None:
                 q.update(halving_quantities(res.halving))
         if res.basin is not None:
-            from .antiskid_basin_render import basin_quantities
+            from .antiskid_basin_run import basin_quantities
             q.update(basin_quantities(res.basin.basin, res.basin.sweep,
                                       [c.case.name for c in res.cases]))
         return q
