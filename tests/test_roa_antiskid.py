@@ -65,3 +65,22 @@ def test_certified_cruise_level_holds_no_sampled_point_with_vdot_nonnegative(lam
     # the counterexample really has V' >= 0 below the switch state's level
     cx = np.array([est.counterexample])
     assert prob.vdot_numeric(cx)[0] >= 0
+
+
+@pytest.mark.parametrize("old, new, key", [
+    ("bisect = 4", "bisect = 2.5", "basin.bisect"),
+    ("compare_gains = [[-0.0049, 10.5080],", "compare_gains = [[-0.0049],", "basin.compare_gains[0]"),
+    ("k2_grid = [-40.0,", 'k2_grid = ["a",', "basin.k2_grid[0]"),
+])
+def test_bad_basin_table_is_exit_2(tmp_path, capsys, old, new, key):
+    from pathlib import Path
+
+    from workbench.cli import main
+    src = Path(__file__).resolve().parents[1] / "designs" / "antiskid-run-dry.toml"
+    bad = tmp_path / "antiskid-run-dry.toml"
+    text = src.read_text()
+    assert old in text
+    bad.write_text(text.replace(old, new, 1))
+    assert main(["verify", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert key in err and "Traceback" not in err
