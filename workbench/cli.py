@@ -43,21 +43,25 @@ def _designs(paths: list[str]) -> list:
 # -- verbs ------------------------------------------------------------------------
 def cmd_synthesize(args) -> int:
     from .design import load_design
-    from .report.markdown import fmt, md_table
+    from .report.markdown import fmt
     from .synthesis import synthesize_delay_bound
     from .studies import antiskid_cruise
 
     design = load_design(args.design)
-    if design.kind != antiskid_cruise.STUDY.kind:
+    kinds = (antiskid_cruise.STUDY.kind, "delay-feedback")
+    if design.kind not in kinds:
         raise DesignError(design.path, "design.kind", design.kind,
-                          f'a design with a delay-bound synthesis ("{antiskid_cruise.STUDY.kind}")')
-    spec = design.spec
-    eps = spec.eps
+                          "a design with a delay-bound synthesis ("
+                          + " or ".join(f'"{k}"' for k in kinds) + ")")
     if args.eps:
         for e in args.eps:
             if not (math.isfinite(e) and e > 0):
                 raise DesignError("<cli>", "--eps", e, "a positive number")
-        eps = tuple(args.eps)
+    if design.kind == "delay-feedback":
+        from .studies.delay_feedback_cli import synthesize_command
+        return synthesize_command(design, eps=args.eps, as_json=args.json)
+    spec = design.spec
+    eps = tuple(args.eps) if args.eps else spec.eps
     _, lam_solved, lam, lin = antiskid_cruise.operating_point(spec)
     rows = synthesize_delay_bound(lin.A, lin.B, eps, spec.settings)
     ok = all(r.status.value == "certified" for r in rows)
@@ -67,22 +71,31 @@ def cmd_synthesize(args) -> int:
     print(f"{design.name}: problem (60) of paper 003 at v_d = {fmt(spec.v_d.value)} m/s, "
           f"lambda_d = {fmt(lam, 5)} ({'pinned' if spec.lambda_d_pinned else 'solved'}; "
           f"solved {fmt(lam_solved, 6)})")
-    digits = spec.settings.gain_digits
+    print(synthesis_table(rows, spec.settings))
+    return 0 if ok else 1
+
+
+def synthesis_table(rows, settings) -> str:
+    """The printed table of a problem (60) eps sweep (``workbench synthesize
+    delay-bound``), with its notes; one function for every design kind, so
+    the same rows print the same digits."""
+    from .report.markdown import fmt, md_table
+    digits = settings.gain_digits
     table = [[fmt(r.eps), fmt(r.h_certified, 5), fmt(r.h_refuted, 5),
               "—" if r.K is None else "[" + ", ".join(fmt(k, digits) for k in r.K) + "]",
               fmt(r.h_gain, 4), fmt(r.exact.h if r.exact else None, 5),
               fmt(r.exact_siso.h if r.exact_siso else None, 5),
               fmt(r.ratio, 3), r.status.value] for r in rows]
-    print(md_table(["eps", "h_certified", "h_refuted", "K (canonical)", "h certified by K",
-                    "h* (eig)", "h* (pyctrl)", "ratio", "status"], table, "rrrlrrrrl"))
-    print(f"K (canonical): the minimum-norm certificate at {fmt(spec.settings.gain_fraction)} "
-          f"x h_certified, rounded to {digits} significant digits, then certified on its own "
-          "with K fixed (h certified by K).")
+    out = [md_table(["eps", "h_certified", "h_refuted", "K (canonical)", "h certified by K",
+                     "h* (eig)", "h* (pyctrl)", "ratio", "status"], table, "rrrlrrrrl"),
+           f"K (canonical): the minimum-norm certificate at {fmt(settings.gain_fraction)} "
+           f"x h_certified, rounded to {digits} significant digits, then certified on its own "
+           "with K fixed (h certified by K)."]
     if any(r.exact and math.isinf(r.exact.h) for r in rows):
-        print("h* = inf: no characteristic root reaches the imaginary axis for any delay — the "
-              "loop is stable for every constant delay; h_certified is the limit of the LMI "
-              "criterion, not of the loop.")
-    return 0 if ok else 1
+        out.append("h* = inf: no characteristic root reaches the imaginary axis for any delay "
+                   "— the loop is stable for every constant delay; h_certified is the limit "
+                   "of the LMI criterion, not of the loop.")
+    return "\n".join(out)
 
 
 def cmd_verify(args) -> int:
@@ -217,6 +230,11 @@ def cmd_benchmark(args) -> int:
 
 
 def cmd_simulate(args) -> int:
+    from .design import load_design
+    design = load_design(args.design)
+    if design.kind == "delay-feedback":
+        from .studies.delay_feedback_cli import simulate_command as simulate_feedback
+        return simulate_feedback(design, case=args.case, dt=args.dt, as_json=args.json)
     from .studies.antiskid_run import simulate_command
     return simulate_command(args.design, case=args.case, dt=args.dt, as_json=args.json)
 

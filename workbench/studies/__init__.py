@@ -40,6 +40,7 @@ STUDIES: dict[str, str] = {
     "brake-fit": "fit000:STUDY",
     "ato-tracking": "tracking002:STUDY",
     "ntsm-platoon": "platoon001:STUDY",
+    "delay-feedback": "delay_feedback:STUDY",
 }
 
 
