@@ -137,6 +137,8 @@ class _Checker:
                 raise self.fail(node, f"the operator {op}")
             self.check(node.left, d)
             self.check(node.right, d)
+            if isinstance(node.op, ast.Pow):
+                self.check_power(node)
         elif isinstance(node, ast.UnaryOp):
             if not isinstance(node.op, (ast.USub, ast.UAdd)):
                 raise self.fail(node, "this unary operator")
@@ -152,6 +154,19 @@ class _Checker:
             self.check(node.comparators[0], d)
         else:
             raise self.fail(node, _WHAT.get(type(node), f"a {type(node).__name__} node"))
+
+    def check_power(self, node: ast.BinOp) -> None:
+        """Numeric exponents at most MAX_EXPONENT; numeric powers at most
+        MAX_POWER_BITS bits (checked on the tree, before anything is built)."""
+        e = _constant(node.right)
+        if e is None:
+            return
+        if not abs(e) <= MAX_EXPONENT:
+            raise self.fail(node.right, f"an exponent beyond +/-{MAX_EXPONENT}")
+        b = _constant(node.left)
+        if b is not None and b != 0 and math.isfinite(b):
+            if abs(math.log2(abs(b))) * abs(e) > MAX_POWER_BITS:
+                raise self.fail(node, f"a power larger than {MAX_POWER_BITS} bits")
 
     def check_call(self, node: ast.Call, d: int) -> None:
         f = node.func
@@ -209,6 +224,34 @@ def check_expression(text: Any, names: Iterable[str], *, path: str, key: str) ->
     return tree
 
 
+def _constant(node: ast.AST) -> float | None:
+    """Value of a numbers-only subtree (already checked) in floating point
+    (``inf`` past the float range), or None when it holds a name or a call."""
+    if isinstance(node, ast.Constant):
+        return float(node.value)
+    if isinstance(node, ast.UnaryOp):
+        v = _constant(node.operand)
+        return None if v is None else (-v if isinstance(node.op, ast.USub) else v)
+    if isinstance(node, ast.BinOp):
+        a, b = _constant(node.left), _constant(node.right)
+        if a is None or b is None:
+            return None
+        try:
+            op = type(node.op)
+            if op is ast.Add:
+                return a + b
+            if op is ast.Sub:
+                return a - b
+            if op is ast.Mult:
+                return a * b
+            if op is ast.Div:
+                return a / b if b != 0 else math.inf
+            return math.inf if abs(b) > MAX_EXPONENT else float(abs(a) ** b)
+        except (OverflowError, ZeroDivisionError):
+            return math.inf
+    return None
+
+
 class _Builder:
     def __init__(self, text, path, key, symbols):
         import sympy as sp
@@ -234,25 +277,12 @@ class _Builder:
                 return a * b
             if op is ast.Div:
                 return a / b
-            return self.power(node, a, b)
+            return a ** b   # exponent size checked by _Checker.check_power
         if isinstance(node, ast.Compare):
             a, b = self.build(node.left), self.build(node.comparators[0])
             return {ast.Lt: sp.Lt, ast.LtE: sp.Le, ast.Gt: sp.Gt,
                     ast.GtE: sp.Ge}[type(node.ops[0])](a, b)
         return self.call(node)
-
-    def power(self, node, a, b):
-        if b.is_Number:
-            if not abs(float(b)) <= MAX_EXPONENT:
-                raise _fail(self.path, self.key, self.text, node.right,
-                            f"an exponent beyond +/-{MAX_EXPONENT}")
-            if a.is_Rational and a != 0:
-                p, q = a.as_numer_denom()
-                bits = max(int(abs(p)).bit_length(), int(abs(q)).bit_length())
-                if bits * abs(float(b)) > MAX_POWER_BITS:
-                    raise _fail(self.path, self.key, self.text, node,
-                                f"a power larger than {MAX_POWER_BITS} bits")
-        return a ** b
 
     def call(self, node: ast.Call):
         sp = self.sp
