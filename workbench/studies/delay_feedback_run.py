@@ -98,6 +98,7 @@ class DelayFeedbackResult:
     scenarios: tuple = ()
     vertex_points: tuple = ()
     delay: object = None       # DelaySpec of the design
+    names: tuple = ()          # state names, then input names
 
     def to_json(self) -> dict:
         s = self.synthesis
@@ -172,7 +173,8 @@ def run(spec) -> DelayFeedbackResult:
     scen = tuple(simulate_scenario(spec, model, values, op, syn.K, s)
                  for s in spec.scenarios) if syn.K is not None else ()
     return DelayFeedbackResult(op, A, B, syn, exact, tuple(windows), stable, checks, scen,
-                               points, spec.delay)
+                               points, spec.delay,
+                               spec.plant.state_names + spec.plant.input_names)
 
 
 # -- simulation -----------------------------------------------------------------------
@@ -237,11 +239,18 @@ def metrics(spec, op, scenario, r) -> dict:
     for i, k in enumerate(spec.plant.state_names):
         out[f"peak_error.{k}"] = math.nan if diverged else float(np.max(E[i]))
         out[f"final_error.{k}"] = math.nan if diverged else float(E[i, -1])
-    du = np.abs(r.u - op.u.reshape(-1, 1))
+    du = np.abs(input_history(r, op.u.size) - op.u.reshape(-1, 1))
     for i, k in enumerate(spec.plant.input_names):
         out[f"peak_input_dev.{k}"] = math.nan if diverged else float(np.max(du[i]))
     out["diverged"] = 1.0 if diverged else 0.0
     return out
+
+
+def input_history(r, m: int) -> np.ndarray:
+    """Controller outputs of a run as an (m, K) array (the loop records
+    array-valued inputs one row per sample)."""
+    U = np.atleast_2d(np.asarray(r.u, float))
+    return U if U.shape[0] == m and U.shape[1] == r.t.size else U.reshape(r.t.size, m).T
 
 
 def agree(coarse: dict, fine: dict, rtol: float) -> bool:
@@ -280,6 +289,8 @@ def quantities(res: DelayFeedbackResult) -> dict:
          "exact.agreement": None if res.exact is None else res.exact.outcome.value,
          "exact.delay_range_stable": None if res.range_stable is None
          else ("yes" if res.range_stable else "no")}
+    for k, v in zip(res.names, np.concatenate([res.op.x, res.op.u])):
+        q[f"operating_point.{k}"] = float(v)
     n, m = res.B.shape
     for i in range(n):
         for j in range(n):
