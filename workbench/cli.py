@@ -224,6 +224,13 @@ def cmd_init(args) -> int:
     return 0
 
 
+def cmd_new(args) -> int:
+    from .scaffold.new import new_design
+    path = new_design(args.kind, args.name, args.dir)
+    print(f"wrote {path}; next: workbench verify {path}")
+    return 0
+
+
 def cmd_benchmark(args) -> int:
     from .benchmark import benchmark_delay
     return benchmark_delay(args.design, as_json=args.json, exact_check=args.exact_check)
@@ -259,6 +266,7 @@ COMMANDS: dict[str, tuple[str, Callable]] = {
               cmd_check),
     "prove": ("check the claims of proofs/: PROVED / REFUTED / INCONCLUSIVE", _cmd_prove),
     "init": ("write a project skeleton: designs/, proofs/, reports/, CI files", cmd_init),
+    "new": ("write a commented template design (new delay-feedback NAME)", cmd_new),
 }
 
 
@@ -320,6 +328,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "the example")
     p.add_argument("--requirement", help="what the CI files pip-install (default: "
                    "workbench==<this version>)")
+    p = sub.add_parser("new", help=COMMANDS["new"][0])
+    p.add_argument("kind", metavar="KIND", help="design kind (delay-feedback)")
+    p.add_argument("name", metavar="NAME", help="design name (the file stem)")
+    p.add_argument("--dir", default=str(DESIGNS_DIR), help="folder (default: designs/)")
     return ap
 
 
