@@ -67,6 +67,7 @@ class SynthesisChoice:
     grid: tuple[float, ...]
     order: int
     settings: object   # workbench.synthesis.SynthesisSettings
+    decay_rate: float = 0.0   # 1/s, robust-descriptor only
 
 
 @dataclass(frozen=True)
@@ -223,6 +224,10 @@ def _synthesis(root: Reader, delay: DelaySpec) -> SynthesisChoice:
         if list(grid) != sorted(set(grid)):
             raise s.fail("grid", list(grid), "distinct eps values in increasing order")
     order = int(s.number("order", default=2, integer=True, lo=0, hi=8, what="integer N"))
+    alpha = 0.0
+    if method == "robust-descriptor":
+        alpha = s.number("decay_rate", default=0.0, nonneg=True, hi=10.0,
+                         what="decay rate (1/s)")
     settings = SynthesisSettings(
         margin=s.number("margin", default=DEFAULT_MARGIN, positive=True, hi=1e-2),
         rel_tol=s.number("rel_tol", default=1e-4 if method == METHODS[0] else 1e-3,
@@ -235,7 +240,7 @@ def _synthesis(root: Reader, delay: DelaySpec) -> SynthesisChoice:
         gain_digits=int(s.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
                                  lo=2, hi=8)))
     s.finish()
-    return SynthesisChoice(method, eps, grid, order, settings)
+    return SynthesisChoice(method, eps, grid, order, settings, alpha)
 
 
 def _vertices(root: Reader, plant: PlantSpec) -> tuple[Vertex, ...]:
@@ -340,7 +345,7 @@ class DelayFeedback:
             for f in ("h_certified", "h_refuted", "h_gain", "status", "exact_margin"):
                 names.add(f"synthesis.rows[eps={_eps_key(e)}].{f}")
         for v in spec.vertices:
-            for f in ("exact_margin", "h_analysis", "stable_at_zero"):
+            for f in ("exact_margin", "h_analysis", "stable_at_zero", "abscissa_at_h_gain"):
                 names.add(f"vertices.{v.name}.{f}")
         for s in spec.scenarios:
             b = f"simulation.{s.name}"

@@ -125,7 +125,8 @@ def synthesise(spec, A, B, points=()) -> SynthesisOutcome:
                                 best.h_certified >= st.h_max, rows=rows)
     if points:
         from ..lmi.robust import check_gain, synthesize_robust
-        r = synthesize_robust(list(points), eps_grid=syn.grid, h_hi=st.h_max,
+        r = synthesize_robust(list(points), alpha=syn.decay_rate, eps_grid=syn.grid,
+                              h_hi=st.h_max,
                               rel_tol=max(st.rel_tol, 1e-3), margin=st.margin,
                               gain_fraction=st.gain_fraction, gain_digits=st.gain_digits)
         ok = r.bracket.outcome.value == "certified" and r.gain is not None and \
@@ -135,8 +136,9 @@ def synthesise(spec, A, B, points=()) -> SynthesisOutcome:
         h_an = min(c.h_certified for c in checks) if checks else None
         return SynthesisOutcome("robust-descriptor", r.bracket.h_certified, r.bracket.h_refuted,
                                 r.K, None if r.gain is None else r.gain.h_certified,
-                                "certified" if ok else "inconclusive", r.eps, h_an, True,
-                                r.bracket.h_certified >= st.h_max, robust=(r, checks))
+                                "certified" if ok else "inconclusive", r.eps, h_an,
+                                syn.decay_rate == 0, r.bracket.h_certified >= st.h_max,
+                                robust=(r, checks))
     from ..lmi.tight_synthesis import synthesize_tight
     t = synthesize_tight(A, B, eps_grid=syn.grid, h_max=st.h_max, N=syn.order,
                          margin=st.margin, rel_tol=max(st.rel_tol, 1e-3),
@@ -169,7 +171,15 @@ def run(spec) -> DelayFeedbackResult:
         windows = stability_windows(A, Ad, spec.window_horizon)
         stable = delay_range_stable(windows, spec.delay.h_min, spec.delay.h_max)
         if syn.robust is not None:
-            checks = tuple(zip(spec.vertices, syn.robust[1]))
+            from ..margins import SpectrumNotConverged, spectral_abscissa
+            ab = []
+            for A_i, B_i in points:    # decay-rate certificate vs the spectrum, at h_gain
+                try:
+                    ab.append(spectral_abscissa(A_i, B_i @ syn.K, syn.h_gain)
+                              if syn.h_gain else None)
+                except SpectrumNotConverged:
+                    ab.append(None)
+            checks = tuple(zip(spec.vertices, syn.robust[1], ab))
     scen = tuple(simulate_scenario(spec, model, values, op, syn.K, s)
                  for s in spec.scenarios) if syn.K is not None else ()
     return DelayFeedbackResult(op, A, B, syn, exact, tuple(windows), stable, checks, scen,
@@ -310,7 +320,8 @@ def quantities(res: DelayFeedbackResult) -> dict:
         q[f"{b}.h_gain"] = r.h_gain
         q[f"{b}.status"] = r.status.value
         q[f"{b}.exact_margin"] = r.exact.h if r.exact else None
-    for v, c in res.vertex_checks:
+    for v, c, ab in res.vertex_checks:
+        q[f"vertices.{v.name}.abscissa_at_h_gain"] = ab
         q[f"vertices.{v.name}.exact_margin"] = c.exact.h
         q[f"vertices.{v.name}.h_analysis"] = c.h_certified
         q[f"vertices.{v.name}.stable_at_zero"] = "yes" if c.stable_at_zero else "no"
