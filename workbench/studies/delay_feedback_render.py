@@ -66,7 +66,7 @@ _GREEK = {"lam": r"\lambda", "lambda_": r"\lambda", "mu": r"\mu", "zeta": r"\zet
 def _tex_name(n: str) -> str:
     head, _, sub = n.partition("_")
     head = _GREEK.get(head, head)
-    return f"{head}_{{{sub}}}" if sub else head
+    return f"{head}_{{{sub.replace('_', ',')}}}" if sub else head
 
 
 def render(design, res) -> Rendered:
