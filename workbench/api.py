@@ -173,7 +173,7 @@ def _recheck_analysis(method, A, Ad, N, margin, step, T):
 def _analysis(method, A, Ad, N, margin, rel_tol, h_max):
     """Certified bracket of an analysis criterion on the balanced loop."""
     from .lmi.analysis import certified_delay, make_criterion
-    from .synthesis import balancing
+    from .lmi.scaling import balancing
     T = balancing(A)
     Tinv = np.diag(1.0 / np.diag(T))
     crit = make_criterion(method, Tinv @ A @ T, Tinv @ Ad @ T,
@@ -292,9 +292,8 @@ def _synthesis(method, A, B, N, eps, margin, rel_tol, h_max):
         return (K, r.h_certified, r.h_refuted, r.status.value, dict(r.recheck),
                 "every delay in [0, h]")
     from .lmi.tight_synthesis import recheck_tight, synthesize_tight
-    t = synthesize_tight(A, B, h_max=h_max, N=N if method == "bessel-legendre" else 2,
-                         margin=margin, rel_tol=rel_tol, gain_fraction=DEFAULT_FRACTION,
-                         gain_digits=DEFAULT_DIGITS)
+    t = synthesize_tight(A, B, h_max=h_max, margin=margin, rel_tol=rel_tol,
+                         gain_fraction=DEFAULT_FRACTION, gain_digits=DEFAULT_DIGITS)
     if t.K is None:
         return None, t.h_certified, t.bracket.h_refuted, t.bracket.outcome.value, {}, "at h"
     if method == "wirtinger":

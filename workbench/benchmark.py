@@ -25,12 +25,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .design import Reader, display_path
 from .errors import DesignError
 from .lmi.analysis import METHODS, bessel_legendre_auto, certified_delay, make_criterion
 from .lmi.core import DEFAULT_MARGIN
 from .margins import (AGREEMENT_RTOL, Agreement, DelayMargin, compare_margins, delay_margin_eig,
                       delay_margin_sweep)
+from .reader import Reader, display_path
 
 AUTO = "bessel-legendre-auto"
 
@@ -318,7 +318,7 @@ def run_benchmark(examples: tuple[Example, ...], s: BenchmarkSettings) -> Benchm
 
 
 # -- CLI -------------------------------------------------------------------------------
-def benchmark_delay(design_path: str, *, as_json: bool = False, exact_check: bool = False,
+def benchmark_delay(design, *, as_json: bool = False, exact_check: bool = False,
                     out=print) -> int:
     """``workbench benchmark delay [DESIGN] [--json] [--exact-check]``.
 
@@ -327,17 +327,13 @@ def benchmark_delay(design_path: str, *, as_json: bool = False, exact_check: boo
     run finished, the two exact methods agree on every example (relative
     difference <= :data:`~workbench.margins.AGREEMENT_RTOL`), no certified bound
     exceeds its exact margin (and, with ``--exact-check``, every certificate
-    passes the rational re-check); 1 otherwise.
+    passes the rational re-check); 1 otherwise. ``design`` is a loaded
+    ``delay-benchmark`` design (the CLI loads and checks its kind).
     """
     from dataclasses import replace
 
-    from .design import load_design
     from .report.markdown import fmt, md_table
-    from .studies.delay_benchmark import STUDY
 
-    design = load_design(design_path)
-    if design.kind != STUDY.kind:
-        raise DesignError(design.path, "design.kind", design.kind, f'"{STUDY.kind}"')
     spec = design.spec
     if exact_check:
         spec = replace(spec, settings=replace(spec.settings, exact_check=True))

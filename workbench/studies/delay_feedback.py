@@ -363,9 +363,5 @@ class DelayFeedback:
         from .delay_feedback_run import quantities
         return quantities(res)
 
-    def render(self, design, res):
-        from .delay_feedback_render import render
-        return render(design, res)
-
 
 STUDY = DelayFeedback()

@@ -124,7 +124,8 @@ def synthesise(spec, A, B, points=()) -> SynthesisOutcome:
                                 best.status.value, best.eps, None, True,
                                 best.h_certified >= st.h_max, rows=rows)
     if points:
-        from ..lmi.robust import check_gain, synthesize_robust
+        from ..crosscheck import check_gain
+        from ..lmi.robust import synthesize_robust
         r = synthesize_robust(list(points), alpha=syn.decay_rate, eps_grid=syn.grid,
                               h_hi=st.h_max,
                               rel_tol=max(st.rel_tol, 1e-3), margin=st.margin,
@@ -139,16 +140,19 @@ def synthesise(spec, A, B, points=()) -> SynthesisOutcome:
                                 "certified" if ok else "inconclusive", r.eps, h_an,
                                 syn.decay_rate == 0, r.bracket.h_certified >= st.h_max,
                                 robust=(r, checks))
+    from ..crosscheck import check_tight
     from ..lmi.tight_synthesis import synthesize_tight
-    t = synthesize_tight(A, B, eps_grid=syn.grid, h_max=st.h_max, N=syn.order,
+    t = synthesize_tight(A, B, eps_grid=syn.grid, h_max=st.h_max,
                          margin=st.margin, rel_tol=max(st.rel_tol, 1e-3),
                          gain_fraction=st.gain_fraction, gain_digits=st.gain_digits)
     ok = t.bracket.outcome.value == "certified" and t.gain is not None and \
         t.gain.outcome.value == "certified"
+    check = None if t.K is None else check_tight(A, B, t.K, N=syn.order, margin=st.margin,
+                                                 h_hi=st.h_max).check
     return SynthesisOutcome(syn.method, t.h_certified, t.bracket.h_refuted, t.K,
                             None if t.gain is None else t.gain.h_certified,
                             "certified" if ok else "inconclusive", t.eps,
-                            None if t.check is None else t.check.h_certified, False,
+                            None if check is None else check.h_certified, False,
                             t.at_cap, tight=t)
 
 
