@@ -36,8 +36,8 @@ import keyword
 import re
 from dataclasses import dataclass
 
-from ..design import Quantity, Reader
-from .delay_feedback_model import OperatingEntry, PlantSpec, Variable
+from ..design import Reader
+from .delay_feedback_spec import OperatingEntry, PlantSpec, Variable
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 METHODS = ("free-weighting-003", "wirtinger", "bessel-legendre")
