@@ -24,7 +24,7 @@ Tables (see ``designs/antiskid-cruise-dry-generic.toml`` for a full file)::
     [delay]        h = { value, unit = "s", source } | min = {...}, max = {...}
     [synthesis]    method = "free-weighting-003" | "wirtinger" | "bessel-legendre"
     [[vertices]]   name, source, parameter = value ...   (optional: robust gain)
-    [[scenarios]]  name, t_end, dt, x0 = {...}, setpoint = {...}, h, rtol
+    [[scenarios]]  name, t_end, dt, x0 = {...}, setpoint = {...}, h, rtol, predictor
 
 The design tables are read here (light: no sympy until the operating point
 is solved); :mod:`.delay_feedback_run` computes, :mod:`.delay_feedback_render`
@@ -90,6 +90,7 @@ class Scenario:
     dt: float
     h: float
     rtol: float
+    predictor: bool = False
 
 
 @dataclass(frozen=True)
@@ -298,8 +299,9 @@ def _scenarios(root: Reader, plant: PlantSpec, delay: DelaySpec) -> tuple[Scenar
             raise r.fail("dt", dt, "at most 2e6 steps over t_end")
         h = r.number("h", default=delay.h_max, positive=True, what="number (s)")
         rtol = r.number("rtol", default=1e-3, positive=True, hi=0.5)
+        predictor = r.boolean("predictor", default=False)
         r.finish()
-        out.append(Scenario(name, x0, sp, t_end, dt, h, rtol))
+        out.append(Scenario(name, x0, sp, t_end, dt, h, rtol, predictor))
     return tuple(out)
 
 

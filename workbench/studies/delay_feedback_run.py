@@ -207,10 +207,33 @@ def reference(spec, op: OperatingPoint, scenario):
     return ref
 
 
+def predict(f, x, pieces, dt: float) -> np.ndarray:
+    """x(t + h) predicted from x(t) by integrating the plant model over the
+    inputs already sent, [t - h, t) (``pieces``: (value, duration) oldest
+    first), with Runge-Kutta 4 steps of at most ``dt``: the predictor of
+    paper 003, Lemma 1 (eq 2), X(t + h) = X(t) + int_{t-h}^{t} f(X(s + h), U(s)) ds."""
+    x = np.asarray(x, float)
+    for u, d in pieces:
+        if not d > 0:
+            continue
+        u = np.atleast_1d(u)
+        n = max(int(np.ceil(d / dt - 1e-9)), 1)
+        s = d / n
+        for _ in range(n):
+            k1 = f(x, u)
+            k2 = f(x + 0.5 * s * k1, u)
+            k3 = f(x + 0.5 * s * k2, u)
+            k4 = f(x + s * k3, u)
+            x = x + s / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return x
+
+
 def simulate(spec, model, values, op, K, scenario, dt: float):
     """The nonlinear closed loop u = u_op + K (x - x_ref(t)) with the input
     delay h, classical Runge-Kutta 4 per step with the delayed ZOH input held
-    (its exact step average, :class:`workbench.sim.history.DelayLine`)."""
+    (its exact step average, :class:`workbench.sim.history.DelayLine`). With
+    ``scenario.predictor`` the law acts on the predicted state instead,
+    u = u_op + K (x_hat(t + h) - x_ref(t + h)) (:func:`predict`)."""
     from ..sim.delay import simulate_closed_loop
     f = model.rhs(values)
     ref = reference(spec, op, scenario)
@@ -231,6 +254,9 @@ def simulate(spec, model, values, op, K, scenario, dt: float):
         return tuple(x + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4))
 
     def control(t, x, line):
+        if scenario.predictor:
+            xp = predict(f, x, line.pieces(), dt)
+            return op.u + K @ (xp - ref(t + scenario.h)), 0
         return op.u + K @ (np.asarray(x, float) - ref(t)), 0
 
     def done(t, x, phase):
