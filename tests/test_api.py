@@ -72,6 +72,7 @@ def test_arrays_and_free_weighting_003():
     r = workbench.delay_bound(A, B, method="free-weighting-003", eps=(0.35,), h_max=5.0)
     assert r.certificate_kind == "every delay in [0, h]"
     assert r.status == "certified" and 0 < r.h_certified <= r.exact_margin
+    assert r.recheck_passed and set(r.recheck) >= {"eq54", "eq59", "L_pos"}
 
 
 def test_simulate_delay_returns_time_response(bl3):

@@ -98,7 +98,10 @@ class DelayBoundResult:
         The loop x' = A x + A_d x(t - h) that was certified (A_d = B K).
     recheck : dict[str, float]
         Relative margin of every LMI block of the certificate, recomputed
-        with numpy by a fresh criterion object.
+        with numpy by a fresh criterion object: the bracket's certificate
+        (analysis, Bessel-Legendre), the synthesis certificate at
+        h_certified (Wirtinger), or the canonical certificate the gain was
+        taken from, at 0.99 h_certified (problem (60)).
     recheck_passed : bool
         Every block margin >= ``margin``.
     margin : float
@@ -289,7 +292,15 @@ def _synthesis(method, A, B, N, eps, margin, rel_tol, h_max):
         rows = synthesize_delay_bound(A, B, eps, st)
         r = max(rows, key=lambda r: r.h_certified)
         K = None if r.K is None else np.array(r.K).reshape(B.shape[1], -1)
-        return (K, r.h_certified, r.h_refuted, r.status.value, dict(r.recheck),
+        recheck = {}
+        if r.certificate and r.gain is not None:   # a fresh criterion object re-checks it
+            from .lmi.freeweighting003 import FreeWeighting003
+            from .lmi.scaling import balancing
+            T = balancing(A)
+            Tinv = np.diag(1.0 / np.diag(T))
+            crit = FreeWeighting003(Tinv @ A @ T, Tinv @ B, r.eps, margin=margin)
+            recheck = crit.recheck(r.certificate, r.gain.h_design)
+        return (K, r.h_certified, r.h_refuted, r.status.value, recheck,
                 "every delay in [0, h]")
     from .lmi.tight_synthesis import recheck_tight, synthesize_tight
     t = synthesize_tight(A, B, h_max=h_max, margin=margin, rel_tol=rel_tol,
