@@ -22,12 +22,19 @@ Criteria (weakest to tightest on the classic example):
 
 What a CERTIFIED step proves: at the delay tested, the Lyapunov-Krasovskii
 functional of the criterion is positive definite and strictly decreasing
-along solutions, so the system is asymptotically stable for that constant
-delay (for the free-weighting criterion, whose LMI is affine in h with a
-positive semidefinite slope: for every constant delay in [0, h]). The
-bisection treats the certified set as an interval [0, h], as the literature
-does; the benchmark and the soundness suite compare every bound with the
-exact margin of :mod:`workbench.margins`.
+along solutions, so the system is asymptotically stable **at that constant
+delay** (a point certificate). Feasibility is not monotone in h: a system can
+be stable on several separate windows, and a bisection over point
+certificates can land in a later one, so :func:`certified_delay` reports a
+point, never a margin. Intervals ("stable for every constant delay in
+[h_a, h_b]") come from :mod:`workbench.lmi.interval`, which solves the
+criterion once with the decision variables shared at both ends (each class
+declares in ``h_blocks`` how its blocks depend on h). The free-weighting
+criterion is a delay-range criterion: a certificate at h bounds the
+derivative of a functional for every constant delay tau <= h (the
+free-weighting term -2 xi'N int_{t-tau}^t x' <= tau xi'N Z^{-1} N' xi +
+int_{t-tau}^t x''Z x', and tau <= h), so its point at h is the interval
+[0, h] (``range_from_zero``).
 
 References
 ----------
@@ -46,6 +53,8 @@ References
 """
 from __future__ import annotations
 
+import copy
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Literal, Mapping
@@ -53,7 +62,8 @@ from typing import Literal, Mapping
 import cvxpy as cp
 import numpy as np
 
-from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, bisect_delay
+from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, Step, bisect_delay
+from .delay_input import check_bisection, search_range, system_matrices
 
 #: Clarabel settings of the retries after an ``optimal_inaccurate`` answer,
 #: tried in order (near the bound the higher Bessel-Legendre orders are
@@ -83,12 +93,23 @@ class _DelayAnalysis(MarginLMI):
     retry_settings = RETRY_SETTINGS
 
     def __init__(self, A, Ad, **kw):
-        self.A = np.atleast_2d(np.asarray(A, float))
-        self.Ad = np.atleast_2d(np.asarray(Ad, float))
-        if self.A.shape != self.Ad.shape or self.A.shape[0] != self.A.shape[1]:
-            raise ValueError(f"A {self.A.shape}, A_d {self.Ad.shape}; expected equal square shapes")
+        self.A, self.Ad = system_matrices(A, Ad)
         self.n = self.A.shape[0]
         super().__init__(**kw)
+
+    def solve_at(self, h: float) -> Step:
+        """:meth:`MarginLMI.solve_at`; an answer still INCONCLUSIVE after the
+        settings retries is retried once more on a twin problem with the
+        variable bound 100 times larger (another scaling of the same
+        criterion; its point passes the same re-check of the same blocks)."""
+        step = super().solve_at(h)
+        if step.outcome is not Outcome.INCONCLUSIVE:
+            return step
+        if getattr(self, "_twin_lmi", None) is None:
+            self._twin_lmi = copy.copy(self)
+            MarginLMI.__init__(self._twin_lmi, margin=self.margin, bound=100 * self.bound)
+        again = MarginLMI.solve_at(self._twin_lmi, h)
+        return dataclasses.replace(again, seconds=step.seconds + again.seconds)
 
     @property
     def N(self) -> int | None:
@@ -105,6 +126,7 @@ class DelayIndependentLMI(_DelayAnalysis):
     """
 
     method = "delay-independent"
+    h_blocks: dict[str, str] = {}
 
     def variables(self):
         return {"P": _sym(self.n, "P"), "Q": _sym(self.n, "Q")}
@@ -129,6 +151,7 @@ class JensenLMI(_DelayAnalysis):
     """
 
     method = "jensen"
+    h_blocks = {"lmi": "h"}     # h * block = phi0 + h^2 F'RF, R >= 0
 
     def variables(self):
         return {k: _sym(self.n, k) for k in ("P", "S", "R")}
@@ -159,6 +182,9 @@ class FreeWeightingLMI(_DelayAnalysis):
     """
 
     method = "free-weighting"
+    h_blocks = {"lmi": "1"}     # affine in h
+    #: a certificate at h proves every constant delay in [0, h] (class docstring)
+    range_from_zero = True
 
     def variables(self):
         v = {k: _sym(self.n, k) for k in ("P", "Q", "Z")}
@@ -222,6 +248,7 @@ class BesselLegendreLMI(_DelayAnalysis):
     """
 
     method = "bessel-legendre"
+    h_blocks = {"phi": "h"}     # h * Phi_N = X + h He(G1' Theta H) + h^2 F'RF, R >= 0
 
     def __init__(self, A, Ad, N: int, **kw):
         if not (isinstance(N, (int, np.integer)) and N >= 0):
@@ -328,7 +355,12 @@ def make_criterion(method: MethodName, A, Ad, *, N: int | None = None,
 
 @dataclass(frozen=True)
 class DelayBound:
-    """Largest delay a criterion certifies, with its bracket.
+    """Largest delay at which a criterion certifies stability, with its bracket.
+
+    A **point** certificate: stable at ``h_certified`` (the LMIs of this
+    module are not monotone in h in general; a system may be stable on
+    several windows). The interval form is
+    :func:`~workbench.lmi.interval.certified_interval`.
 
     Attributes
     ----------
@@ -351,6 +383,8 @@ class DelayBound:
     bracket: Bracket
     certified_by: int | None = None
 
+    form = "point"              # see workbench.lmi.interval.Form
+
     @property
     def h_certified(self) -> float:
         return self.bracket.h_certified
@@ -364,14 +398,41 @@ class DelayBound:
         return self.bracket.seconds
 
 
-def certified_delay(lmi: _DelayAnalysis, *, h_lo: float = 1e-3, h_hi: float = 100.0,
-                    rel_tol: float = 1e-5, guess: float | None = None,
-                    max_solves: int = 60) -> DelayBound:
-    """Largest constant delay (s) the criterion certifies, by the shared bisection.
+def certified_delay(lmi: _DelayAnalysis, *, h_lo: float | None = None,
+                    h_hi: float | None = None, rel_tol: float = 1e-5,
+                    guess: float | None = None, max_solves: int = 60) -> DelayBound:
+    """Largest constant delay (s) at which the criterion certifies stability: a
+    **point** certificate (stable at ``h_certified``; nothing is said about
+    smaller delays — see :func:`~workbench.lmi.interval.certified_interval`
+    for intervals), by the shared bisection.
 
     The delay-independent test does not depend on h: one solve decides it
-    (certified => ``h_certified = inf``).
+    (certified => ``h_certified = inf``, which is an interval [0, inf)).
+
+    Parameters
+    ----------
+    lmi : criterion of :data:`METHODS` (:func:`make_criterion`)
+    h_lo, h_hi : float, optional
+        Search range (s), 0 < h_lo < h_hi; default 1e-4 and 1e4 times the
+        system's time scale 1 / (||A||_2 + ||A_d||_2).
+    rel_tol : float
+        Relative bracket width, in (0, 1).
+    guess : float, optional
+        First delay tried (s).
+    max_solves : int
+        Solver budget.
+
+    Raises
+    ------
+    ValueError
+        h_lo >= h_hi, NaN/inf or non-positive delays, rel_tol outside (0, 1),
+        a bad budget (expected-versus-found message).
     """
+    if not isinstance(lmi, _DelayAnalysis):
+        raise ValueError(f"lmi = {type(lmi).__name__}; expected a delay criterion of "
+                         "workbench.lmi.analysis (make_criterion)")
+    h_lo, h_hi = search_range(lmi.A, lmi.Ad, h_lo, h_hi)
+    check_bisection(rel_tol, guess, max_solves)
     if isinstance(lmi, DelayIndependentLMI):
         step = lmi.solve_at(1.0)
         ok = step.outcome is Outcome.CERTIFIED
@@ -381,57 +442,3 @@ def certified_delay(lmi: _DelayAnalysis, *, h_lo: float = 1e-3, h_hi: float = 10
     br = bisect_delay(lmi.solve_at, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol, guess=guess,
                       max_solves=max_solves)
     return DelayBound(lmi.method, lmi.N, br)
-
-
-@dataclass(frozen=True)
-class AutoOrder:
-    """Result of :func:`bessel_legendre_auto`: one bound per order tried.
-
-    ``N_reached`` is the first order whose gap to the exact margin is below
-    the tolerance (None when the cap was reached first).
-    """
-
-    bounds: tuple[DelayBound, ...]
-    N_reached: int | None
-
-    @property
-    def best(self) -> DelayBound:
-        """The bound at ``N_reached`` (or the largest bound when not reached)."""
-        if self.N_reached is not None:
-            return next(b for b in self.bounds if b.N == self.N_reached)
-        return max(self.bounds, key=lambda b: b.h_certified)
-
-
-def bessel_legendre_auto(A, Ad, exact: float, *, gap_tol: float = 1e-4, N_max: int = 6,
-                         N_through: int = 0, rel_tol: float = 1e-5,
-                         margin: float = DEFAULT_MARGIN, h_hi: float = 100.0) -> AutoOrder:
-    """Raise the Bessel-Legendre order N = 0, 1, ... until
-    ``1 - h_N / exact < gap_tol`` or N = ``N_max``.
-
-    Orders up to ``N_through`` are computed in any case (for tables). Each
-    order's bisection starts from the previous order's bound (the hierarchy
-    is non-decreasing in N). ``exact`` is the exact margin (s) from
-    :mod:`workbench.margins`; with ``exact = inf`` the gap never closes.
-    The hierarchy never goes backwards: when order N's own search certifies
-    less than order N - 1 (an inaccurate solve there), order N reports the
-    lower order's certificate (``certified_by``), which proves order N
-    feasible at that delay.
-    """
-    out: list[DelayBound] = []
-    guess, reached = None, None
-    for N in range(0, max(N_max, N_through) + 1):
-        if N > N_through and (reached is not None or N > N_max):
-            break
-        b = certified_delay(BesselLegendreLMI(A, Ad, N, margin=margin), rel_tol=rel_tol,
-                            guess=guess, h_hi=h_hi)
-        if out and b.h_certified < out[-1].h_certified:
-            prev = out[-1]
-            b = DelayBound(b.method, N, prev.bracket,
-                           prev.certified_by if prev.certified_by is not None else prev.N)
-        out.append(b)
-        if b.h_certified > 0:
-            guess = b.h_certified
-        if (reached is None and math.isfinite(exact) and exact > 0
-                and 1 - b.h_certified / exact < gap_tol):
-            reached = N
-    return AutoOrder(tuple(out), reached)
