@@ -39,12 +39,14 @@ class AutoOrder:
 
 def bessel_legendre_auto(A, Ad, exact: float, *, gap_tol: float = 1e-4, N_max: int = 6,
                          N_through: int = 0, rel_tol: float = 1e-5,
-                         margin: float = DEFAULT_MARGIN, h_hi: float | None = None
-                         ) -> AutoOrder:
+                         margin: float = DEFAULT_MARGIN, h_hi: float | None = None,
+                         guess: float | None = None) -> AutoOrder:
     """Raise the Bessel-Legendre order N = 0, 1, ... until
     ``1 - h_N / exact < gap_tol`` or N = ``N_max``.
 
-    Orders up to ``N_through`` are computed in any case (for tables). Each
+    Orders up to ``N_through`` are computed in any case (for tables). Order 0
+    starts from ``guess`` (s, optional; e.g. inside a stability window that
+    does not start at 0). Each
     order's bisection starts from the previous order's bound (the hierarchy
     is non-decreasing in N). ``exact`` is the exact margin (s) from
     :mod:`workbench.margins`; with ``exact = inf`` the gap never closes.
@@ -54,7 +56,7 @@ def bessel_legendre_auto(A, Ad, exact: float, *, gap_tol: float = 1e-4, N_max: i
     feasible at that delay.
     """
     out: list[DelayBound] = []
-    guess, reached = None, None
+    reached = None
     for N in range(0, max(N_max, N_through) + 1):
         if N > N_through and (reached is not None or N > N_max):
             break

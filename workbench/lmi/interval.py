@@ -360,7 +360,7 @@ def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] =
 
 
 #: Largest number of links a chain adds on one side.
-MAX_LINKS = 12
+MAX_LINKS = 32
 
 
 def _chain(win: IntervalLMI, links: list[Link], limit: float, rel_tol: float,
