@@ -280,13 +280,16 @@ def _find(decide: Callable[[float], Step], first: float, floor: float, budget: l
 
 #: Smallest delay an interval search tries, as a fraction of :func:`time_scale`.
 FLOOR_FRACTION = 1e-4
+#: Default number of grid points of the scan of :func:`certified_interval`.
+SCAN_POINTS = 24
 #: Lower ends grown down from a start stop at this fraction of the start.
 LOWER_FRACTION = 1e-6
 
 
 def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] = (),
                        from_zero: bool = True, guess: float | None = None,
-                       rel_tol: float = 1e-5, max_solves: int = 120) -> IntervalSearch:
+                       rel_tol: float = 1e-5, max_solves: int = 120,
+                       scan: int = SCAN_POINTS) -> IntervalSearch:
     """Largest interval of constant delays the criterion certifies, by shared variables.
 
     Parameters
@@ -310,6 +313,10 @@ def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] =
         Relative accuracy of each searched end.
     max_solves : int
         Budget of solver calls.
+    scan : int
+        When neither h = 0 nor any start gave an interval: point solves on a
+        geometric grid from 0.01 time scales to ``h_hi``, the first certified
+        one a start (0: no scan).
 
     Returns
     -------
@@ -341,7 +348,7 @@ def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] =
             links = [Link(0.0, hb, st or hit[1])]
             _chain(win, links, h_hi, rel_tol, budget, steps, up=True)
             found.append(IntervalCertificate(0.0, links[-1].hi, tuple(links)))
-    for h0 in sorted(starts):
+    for h0 in _starts(starts, found, scan, tau, h_hi, lmi, budget, steps):
         if budget[0] <= 0 or any(iv.contains(h0) for iv in found) or not 0 < h0 <= h_hi:
             continue
         s = _run(lmi.solve_at, h0, budget, steps)
@@ -357,6 +364,21 @@ def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] =
     zero_iv = next((iv for iv in found if iv.lo == 0), None)
     best = zero_iv or max(found, key=lambda iv: iv.hi - iv.lo, default=None)
     return _result(best, found, steps)
+
+
+def _starts(starts, found, scan, tau, h_hi, lmi, budget, steps):
+    """The given starts in increasing order, then (nothing certified yet) the
+    first certified point of a geometric scan."""
+    yield from sorted(starts)
+    if found or not scan or not math.isfinite(tau):
+        return
+    lo = min(1e-2 * tau, h_hi)
+    for h in np.geomspace(lo, h_hi, int(scan)) if lo < h_hi else [h_hi]:
+        if budget[0] <= 0 or found:
+            return
+        if _run(lmi.solve_at, float(h), budget, steps).outcome is Outcome.CERTIFIED:
+            yield float(h)
+            return
 
 
 #: Largest number of links a chain adds on one side.
