@@ -186,21 +186,27 @@ def test_cli_benchmark_json_schema(tmp_path, capsys):
     (ex,) = data["examples"]
     assert ex["name"] == "pure" and ex["exact_margin"] == pytest.approx(math.pi / 2)
     keys = {"method", "N", "h_certified", "h_refuted", "outcome", "at_cap", "ratio", "solves",
-            "seconds"}
+            "seconds", "certified_interval", "interval_ratio", "interval_solves"}
     assert all(keys <= set(m) for m in ex["methods"])
+    # issue 13: the exact windows and an interval certificate per method
+    assert ex["stable_windows"] == [[0.0, pytest.approx(math.pi / 2)]] and ex["sound"]
+    for m in ex["methods"]:
+        lo, hi = m["certified_interval"]
+        assert lo == 0.0 and 0 < hi < math.pi / 2
     assert [(m["method"], m["N"]) for m in ex["methods"]] == [
         ("free-weighting", None), ("bessel-legendre", 0), ("bessel-legendre", 1),
         ("bessel-legendre", 2), ("bessel-legendre-auto", 2)]
     assert all(0 < m["ratio"] <= 1 and m["exact_check"] == "certified" for m in ex["methods"])
     assert set(ex) == {"name", "exact_margin", "exact_margin_sweep", "exact_agreement",
-                       "exact_methods_agree", "methods"}
+                       "exact_methods_agree", "stable_windows", "sound", "methods"}
 
 
 def test_cli_benchmark_json_exact_schema(tmp_path, capsys):
     assert main(["benchmark", "delay", str(_small_design(tmp_path)), "--json"]) == 0
     (ex,) = json.loads(capsys.readouterr().out)["examples"]
     assert all(set(m) == {"method", "N", "h_certified", "h_refuted", "outcome", "at_cap",
-                          "ratio", "solves", "seconds"} for m in ex["methods"])
+                          "ratio", "solves", "seconds", "certified_interval", "interval_ratio",
+                          "interval_solves"} for m in ex["methods"])
 
 
 def test_cli_benchmark_bad_input(tmp_path, capsys):

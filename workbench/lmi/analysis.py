@@ -57,6 +57,7 @@ import copy
 import dataclasses
 import math
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Literal, Mapping
 
 import cvxpy as cp
@@ -64,6 +65,7 @@ import numpy as np
 
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, Step, bisect_delay
 from .delay_input import check_bisection, search_range, system_matrices
+from .legendre import blockdiag_S, legendre_derivative_coefficients
 
 #: Clarabel settings of the retries after an ``optimal_inaccurate`` answer,
 #: tried in order (near the bound the higher Bessel-Legendre orders are
@@ -75,6 +77,11 @@ RETRY_SETTINGS = (
      "iterative_refinement_max_iter": 50},
     {"tol_gap_abs": 1e-7, "tol_gap_rel": 1e-7, "tol_feas": 1e-7, "tol_ktratio": 1e-5},
 )
+
+#: Blocks' time unit: within sqrt 2 of UNIT_SCALE / (||A||_2 + ||A_d||_2). Any fixed
+#: multiple of 1/R makes the margins independent of the unit of A; 4 keeps the classic
+#: 2 x 2 example (R = 3.4) in its published unit (u = 1), as measured in issue 4.
+UNIT_SCALE = 4.0
 
 MethodName = Literal["delay-independent", "jensen", "free-weighting", "wirtinger",
                      "bessel-legendre"]
@@ -95,7 +102,22 @@ class _DelayAnalysis(MarginLMI):
     def __init__(self, A, Ad, **kw):
         self.A, self.Ad = system_matrices(A, Ad)
         self.n = self.A.shape[0]
+        R = float(np.linalg.norm(self.A, 2) + np.linalg.norm(self.Ad, 2))
+        #: time unit (s) of the blocks: the power of two nearest UNIT_SCALE / R
+        self.unit = 2.0 ** round(math.log2(UNIT_SCALE / R)) if R > 0 else 1.0
         super().__init__(**kw)
+
+    def scaled(self, p):
+        """(A u, A_d u, h / u, iota u) with u = :attr:`unit`: every block is written
+        for the system in its own time unit (exact: u is a power of two), so
+        the relative margins and the solver's scaling do not depend on the
+        unit of A (time scaling (c A, c A_d) changes u by at most a factor
+        sqrt 2). Certificates are those of the scaled system at h / u, which is
+        the same system."""
+        u = self.unit
+        if self.A.dtype == object:          # exact rational re-check
+            u = Fraction(u)
+        return self.A * u, self.Ad * u, p["h"] * (1 / u), p["iota"] * u
 
     def solve_at(self, h: float) -> Step:
         """:meth:`MarginLMI.solve_at`; an answer still INCONCLUSIVE after the
@@ -132,7 +154,8 @@ class DelayIndependentLMI(_DelayAnalysis):
         return {"P": _sym(self.n, "P"), "Q": _sym(self.n, "Q")}
 
     def blocks(self, x, p, bmat):
-        P, Q, A, Ad = x["P"], x["Q"], self.A, self.Ad
+        P, Q = x["P"], x["Q"]
+        A, Ad, _, _ = self.scaled(p)
         lmi = bmat([[A.T @ P + P @ A + Q, P @ Ad], [Ad.T @ P, -Q]])
         return [Block("lmi", lmi, "nsd"), Block("P_pos", P, "psd"), Block("Q_pos", Q, "psd")]
 
@@ -157,11 +180,12 @@ class JensenLMI(_DelayAnalysis):
         return {k: _sym(self.n, k) for k in ("P", "S", "R")}
 
     def blocks(self, x, p, bmat):
-        P, S, R, A, Ad = x["P"], x["S"], x["R"], self.A, self.Ad
+        P, S, R = x["P"], x["S"], x["R"]
+        A, Ad, h, iota = self.scaled(p)
         PA, PAd = P @ A, P @ Ad
         phi0 = bmat([[PA + PA.T + S - R, PAd + R], [PAd.T + R, -S - R]])
         F = np.hstack([A, Ad])
-        lmi = p["iota"] * phi0 + p["h"] * (F.T @ R @ F)
+        lmi = iota * phi0 + h * (F.T @ R @ F)
         return [Block("lmi", lmi, "nsd")] + [Block(f"{k}_pos", x[k], "psd") for k in "PSR"]
 
 
@@ -193,8 +217,8 @@ class FreeWeightingLMI(_DelayAnalysis):
         return v
 
     def blocks(self, x, p, bmat):
-        P, Q, Zm, N1, N2, A, Ad, h = x["P"], x["Q"], x["Z"], x["N1"], x["N2"], self.A, \
-            self.Ad, p["h"]
+        P, Q, Zm, N1, N2 = x["P"], x["Q"], x["Z"], x["N1"], x["N2"]
+        A, Ad, h, _ = self.scaled(p)
         O = np.zeros((self.n, self.n), dtype=int)
         p11 = P @ A + A.T @ P + N1 + N1.T + Q
         p12 = P @ Ad - N1 + N2.T
@@ -204,18 +228,6 @@ class FreeWeightingLMI(_DelayAnalysis):
                     [h * N1.T, h * N2.T, -h * Zm, O],
                     [h * (Zm @ A), h * (Zm @ Ad), O, -h * Zm]])
         return [Block("lmi", lmi, "nsd")] + [Block(f"{k}_pos", x[k], "psd") for k in "PQZ"]
-
-
-def legendre_derivative_coefficients(N: int) -> np.ndarray:
-    """c[k, j] with l_k'(u) = sum_{j<k} c[k, j] l_j(u) on [0, 1].
-
-    For l_k(u) = P_k(2u - 1): c[k, j] = (2j + 1)(1 - (-1)^(k+j)) (SG15, eq. 4).
-    """
-    c = np.zeros((N + 1, N + 1), dtype=int)
-    for k in range(N + 1):
-        for j in range(k):
-            c[k, j] = (2 * j + 1) * (1 - (-1) ** (k + j))
-    return c
 
 
 class BesselLegendreLMI(_DelayAnalysis):
@@ -267,8 +279,11 @@ class BesselLegendreLMI(_DelayAnalysis):
         # positive semidefinite matrix.
         return {"Theta": _sym((N + 1) * n, "Theta"), "S": _sym(n, "S"), "R": _sym(n, "R")}
 
-    def selectors(self):
-        """(G0, G1, H, F, [Gamma_0..Gamma_N]) as numpy arrays (see class doc)."""
+    def selectors(self, A=None, Ad=None):
+        """(G0, G1, H, F, [Gamma_0..Gamma_N]) as numpy arrays (see class doc);
+        F from ``A``, ``A_d`` (default: the system's)."""
+        A = self.A if A is None else A
+        Ad = self.Ad if Ad is None else Ad
         n, N = self.n, self._N
         I = np.eye(n, dtype=int)      # integer selectors keep exact re-checks exact
         m = (N + 2) * n
@@ -284,7 +299,7 @@ class BesselLegendreLMI(_DelayAnalysis):
             for j in range(k):
                 g = g - c[k, j] * e(2 + j)
             gam.append(g)
-        F = self.A @ e(0) + self.Ad @ e(1)
+        F = A @ e(0) + Ad @ e(1)
         G0 = np.vstack([e(0)] + [np.zeros((n, m), dtype=int)] * N)
         G1 = np.vstack([np.zeros((n, m), dtype=int)] + [e(2 + k) for k in range(N)])
         H = np.vstack([F] + gam[:N])
@@ -293,15 +308,15 @@ class BesselLegendreLMI(_DelayAnalysis):
     def blocks(self, x, p, bmat):
         Th, S, R = x["Theta"], x["S"], x["R"]
         n, N = self.n, self._N
-        G0, G1, H, F, gam = self.selectors()
-        h, iota = p["h"], p["iota"]
+        A, Ad, h, iota = self.scaled(p)
+        G0, G1, H, F, gam = self.selectors(A, Ad)
         e0, e1 = G0[:n], np.eye(n, (N + 2) * n, n, dtype=int)
         # G0' D(S) = 0, so (1/h) He(G0' P H) = (1/h) He(G0' Theta H): affine in the
         # parameters (DPP); He(G1' P H) = He(G1' Theta H) - (1/h) He(G1' D(S) H).
         he0 = G0.T @ Th @ H
         he1 = G1.T @ Th @ H
         if N:
-            he1 = he1 - iota * (G1.T @ _blockdiag_S(S, N, n, bmat) @ H)
+            he1 = he1 - iota * (G1.T @ blockdiag_S(S, N, n, bmat) @ H)
         sterm = e0.T @ S @ e0 - e1.T @ S @ e1
         rsum = sum((2 * k + 1) * (g.T @ R @ g) for k, g in enumerate(gam))
         phi = iota * (he0 + he0.T + sterm - rsum) + (he1 + he1.T) + h * (F.T @ R @ F)
@@ -309,17 +324,10 @@ class BesselLegendreLMI(_DelayAnalysis):
                 Block("S_pos", S, "psd"), Block("R_pos", R, "psd")]
 
     def lyapunov_matrix(self, values: Mapping[str, np.ndarray], h: float) -> np.ndarray:
-        """P = Theta - (1/h) diag(0, S, 3S, ..., (2N-1)S) of a certificate."""
-        return values["Theta"] - _blockdiag_S(values["S"], self._N, self.n, np.block) / h
-
-
-def _blockdiag_S(S, N: int, n: int, bmat):
-    """diag(0, S, 3S, ..., (2N-1)S) as a cvxpy or numpy block matrix."""
-    Z = np.zeros((n, n), dtype=int)
-    rows = []
-    for i in range(N + 1):
-        rows.append([(2 * i - 1) * S if (i == j and i > 0) else Z for j in range(N + 1)])
-    return bmat(rows)
+        """P = Theta - (u/h) diag(0, S, 3S, ..., (2N-1)S) of a certificate (in the
+        time unit u = :attr:`unit` of the blocks)."""
+        return values["Theta"] - blockdiag_S(values["S"], self._N, self.n,
+                                              np.block) * (self.unit / h)
 
 
 class WirtingerLMI(BesselLegendreLMI):

@@ -193,7 +193,7 @@ def _draw_set(fig, e) -> None:
 def _draw_gap(fig, res: BenchmarkResult) -> None:
     ax = fig.add_subplot(111)
     for e in res.examples:
-        if not math.isfinite(e.exact.h):
+        if not 0 < e.exact.h < math.inf:
             continue
         rows = [r for r in e.rows if r.method == "bessel-legendre"]
         gaps = [max(1 - r.h_certified / e.exact.h, 1e-8) for r in rows]
