@@ -171,3 +171,21 @@ def test_search_range_is_relative_to_the_time_scale():
     lo, hi = an.search_range(lmi.A, lmi.Ad, None, None)
     lo6, hi6 = an.search_range(fast.A, fast.Ad, None, None)
     assert math.isclose(lo / lo6, 1e6) and math.isclose(hi / hi6, 1e6)
+
+
+def test_point_search_is_resumed_past_an_inconclusive_answer(monkeypatch):
+    """Issue 21 item 4: the first trial answered inaccurately (as when the
+    bracket closed near zero) no longer decides the bound."""
+    lmi = an.make_criterion("wirtinger", *CLASSIC)
+    real, calls = an._DelayAnalysis.solve_at, []
+
+    def flaky(self, h):
+        calls.append(h)
+        if len(calls) == 1:
+            return _step(h, Outcome.INCONCLUSIVE)
+        return real(self, h)
+    monkeypatch.setattr(an._DelayAnalysis, "solve_at", flaky)
+    b = an.certified_delay(lmi, guess=5.0, rel_tol=1e-4)
+    assert b.bracket.outcome is Outcome.CERTIFIED
+    # without the resume the bound stops at the inconclusive 5.0; SG13 Table 1 gives 6.059
+    assert 6.05 < b.h_certified < 6.172581371221286

@@ -1,11 +1,9 @@
 """Analysis LMIs for x'(t) = A x(t) + A_d x(t - h) with a constant delay h.
 
-Each criterion is a :class:`~workbench.lmi.core.MarginLMI`: blocks written
-once, solved as "maximise t" by Clarabel, re-checked with numpy; the largest
-certified h comes from the shared bracketed bisection
-(:func:`~workbench.lmi.core.bisect_delay`) through :func:`certified_delay`.
-Margins are relative to the largest block norm (see :mod:`workbench.lmi.core`),
-so no criterion depends on how its Lyapunov matrix is scaled.
+Each criterion is a :class:`~workbench.lmi.core.MarginLMI` (blocks written
+once, solved by Clarabel, re-checked with numpy, margins relative to the
+largest block norm); :func:`certified_delay` bisects with
+:func:`~workbench.lmi.core.bisect_delay`.
 
 Notation (block selectors on the augmented vector xi):
 ``x = x(t)``, ``x_d = x(t - h)``, and for the Bessel-Legendre hierarchy the
@@ -13,12 +11,9 @@ Legendre moments ``Omega_k = (1/h) int_{t-h}^t l_k(u(s)) x(s) ds`` with the
 shifted Legendre polynomials ``l_k(u) = P_k(2u - 1)``, ``u = (s - t + h)/h``
 (``l_k(1) = 1``, ``l_k(0) = (-1)^k``, ``int_0^1 l_j l_k = delta_jk/(2k+1)``).
 
-Criteria (weakest to tightest on the classic example):
-
-* :class:`DelayIndependentLMI` — stable for every h >= 0;
-* :class:`JensenLMI` and :class:`FreeWeightingLMI` (He et al. 2004);
-* :class:`WirtingerLMI` (Seuret & Gouaisbaut 2013) = Bessel-Legendre N = 1;
-* :class:`BesselLegendreLMI` of order N (Seuret & Gouaisbaut 2015).
+Criteria: :class:`DelayIndependentLMI` (every h >= 0), :class:`JensenLMI`,
+:class:`FreeWeightingLMI` (He et al. 2004), :class:`WirtingerLMI` (Seuret &
+Gouaisbaut 2013; Bessel-Legendre N = 1), :class:`BesselLegendreLMI` (SG15).
 
 What a CERTIFIED step proves: at the delay tested, the Lyapunov-Krasovskii
 functional of the criterion is positive definite and strictly decreasing
@@ -66,12 +61,11 @@ import numpy as np
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, Step, bisect_delay
 from .delay_input import check_bisection, search_range, system_matrices
 from .legendre import blockdiag_S, legendre_derivative_coefficients
+from .point_search import resumed
 
-#: Clarabel settings of the retries after an ``optimal_inaccurate`` answer,
-#: tried in order (near the bound the higher Bessel-Legendre orders are
-#: degenerate enough for the default refinement to stop short). The looser
-#: tolerances of the second retry cannot make a step CERTIFIED on their own:
-#: every certified point is re-checked with numpy against the margin.
+#: Clarabel settings of the retries after an ``optimal_inaccurate`` answer, in order
+#: (near the bound the higher Bessel-Legendre orders are degenerate); a retry certifies
+#: only through the same numpy re-check.
 RETRY_SETTINGS = (
     {"iterative_refinement_reltol": 1e-14, "iterative_refinement_abstol": 1e-14,
      "iterative_refinement_max_iter": 50},
@@ -415,7 +409,9 @@ def certified_delay(lmi: _DelayAnalysis, *, h_lo: float | None = None,
     for intervals), by the shared bisection.
 
     The delay-independent test does not depend on h: one solve decides it
-    (certified => ``h_certified = inf``, which is an interval [0, inf)).
+    (certified => ``h_certified = inf``, which is an interval [0, inf)). A
+    search ended by an inconclusive answer is resumed above it
+    (:mod:`workbench.lmi.point_search`).
 
     Parameters
     ----------
@@ -449,4 +445,5 @@ def certified_delay(lmi: _DelayAnalysis, *, h_lo: float | None = None,
         return DelayBound(lmi.method, None, br)
     br = bisect_delay(lmi.solve_at, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol, guess=guess,
                       max_solves=max_solves)
+    br = resumed(lmi.solve_at, br, h_hi=h_hi, rel_tol=rel_tol, max_solves=max_solves)
     return DelayBound(lmi.method, lmi.N, br)
