@@ -9,9 +9,13 @@ appear only as claims of that design.
 
 For each example: the exact margin by two independent methods
 (:func:`~workbench.margins.delay_margin_eig`,
-:func:`~workbench.margins.delay_margin_sweep`), then for each method the
-certified bound by the shared bisection, its ratio to the exact margin,
-solver calls and seconds, and optionally the rational re-check of the
+:func:`~workbench.margins.delay_margin_sweep`) and the exact stability
+windows up to the search cap, then for each method two certificates, kept
+apart (issue 13): the **point** bound of the shared bisection (stable at
+that delay; its ratio to the exact margin) and the **interval** certificate
+(stable for every constant delay in [lo, hi], :mod:`workbench.lmi.interval`),
+each compared with the exact windows (:mod:`workbench.benchmark_windows`);
+solver calls and seconds, and optionally the rational re-check of the point
 certificate (:mod:`workbench.lmi.exact_check`).
 """
 from __future__ import annotations
@@ -96,7 +100,8 @@ class MethodRow:
     ``at_cap`` whether ``h_certified`` is only the search cap. ``interval``
     is the **interval** certificate [lo, hi] — stable for every constant
     delay in it (:func:`~workbench.lmi.interval.certified_interval`; from 0
-    when found, else the longest window) — or None; ``interval_ratio`` its
+    when found, else the longest window) — or None, ``intervals`` every
+    disjoint certified interval (one per window reached); ``interval_ratio`` its
     end over h* when it starts at 0. ``point_sound`` / ``interval_sound``:
     the point lies in an exact stable window / the interval lies inside one
     (None when nothing was certified).
@@ -113,6 +118,7 @@ class MethodRow:
     outcome: str = "inconclusive"
     at_cap: bool = False
     interval: tuple[float, float] | None = None
+    intervals: tuple[tuple[float, float], ...] = ()
     interval_solves: int = 0
     point_sound: bool | None = None
     interval_sound: bool | None = None
@@ -124,6 +130,7 @@ class MethodRow:
              "ratio": _j(self.ratio), "solves": self.solves, "seconds": round(self.seconds, 4),
              "certified_interval": None if self.interval is None else
              [_j(self.interval[0]), _j(self.interval[1])],
+             "certified_intervals": [[_j(a), _j(b)] for a, b in self.intervals],
              "interval_ratio": _j(self.interval_ratio), "interval_solves": self.interval_solves}
         if with_check:
             d["exact_check"] = self.exact_check
@@ -365,7 +372,8 @@ def run_example(ex: Example, s: BenchmarkSettings) -> ExampleResult:
                    lmi if best.N not in by_N else None, windows)
         if best.N in by_N:          # the same order's interval, not searched twice
             t = by_N[best.N]
-            row = replace(row, interval=t.interval, interval_solves=t.interval_solves,
+            row = replace(row, interval=t.interval, intervals=t.intervals,
+                          interval_solves=t.interval_solves,
                           interval_sound=t.interval_sound, interval_ratio=t.interval_ratio)
         rows.append(row)
     curve = abscissa_curve(A, Ad, windows, h_star, s.h_max,

@@ -46,7 +46,7 @@ def interval_inside(lo: float, hi: float, windows, rtol: float = WINDOW_RTOL) ->
 def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: float,
                     guess=None) -> dict:
     """Interval search of one criterion and its comparison with the exact windows:
-    ``interval``, ``interval_solves``, ``interval_ratio``, ``point_sound``,
+    ``interval``, ``intervals``, ``interval_solves``, ``interval_ratio``, ``point_sound``,
     ``interval_sound`` (keyword fields of a benchmark row). ``lmi`` None: the
     point comparison only."""
     h = bound.h_certified
@@ -60,7 +60,8 @@ def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: f
                                 guess=guess or (h if 0 < h < h_max else None),
                                 max_solves=260)
     iv = search.bounds
-    out.update(interval=iv, interval_solves=search.solves)
+    out.update(interval=iv, interval_solves=search.solves,
+               intervals=tuple((c.lo, c.hi) for c in search.intervals))
     if iv is not None:
         out["interval_sound"] = all(interval_inside(c.lo, c.hi, windows)
                                     for c in search.intervals)

@@ -43,12 +43,24 @@ def _windows(e) -> str:
                       for a, b in e.windows)
 
 
+def _sig(x: float, sig: int, up: bool) -> str:
+    """x to ``sig`` significant digits, rounded outwards-safe: down for an upper
+    end, up for a lower end (a printed interval never claims more)."""
+    if x == 0 or math.isinf(x):
+        return fmt(x)
+    q = 10.0 ** (math.floor(math.log10(abs(x))) - sig + 1)
+    v = (math.ceil(x / q) if up else math.floor(x / q)) * q
+    return fmt(v, sig)
+
+
 def _interval(r) -> str:
     if r.interval is None:
         return "—"
-    lo, hi = r.interval
-    cap = " (≥ cap)" if math.isfinite(hi) and r.at_cap and hi >= r.h_certified else ""
-    return f"[{fmt(lo, 4)}, {fmt(hi, 4)}]{cap}"
+    parts = []
+    for lo, hi in r.intervals or (r.interval,):
+        cap = " (≥ cap)" if math.isfinite(hi) and r.at_cap and hi >= r.h_certified else ""
+        parts.append(f"[{_sig(lo, 4, True)}, {_sig(hi, 4, False)}]{cap}")
+    return " ∪ ".join(parts)
 
 
 def render(design, res: BenchmarkResult) -> Rendered:
@@ -112,8 +124,9 @@ def render(design, res: BenchmarkResult) -> Rendered:
         and math.isfinite(e.exact.h) else "") for e in res.examples]
         for i, e0r in enumerate(res.examples[0].rows)]
     intervals = ("### Interval certificates (stable for every constant delay in [lo, hi])"
-                 "\n\nEach cell: the certified interval [lo, hi] (s) / hi over h* when it "
-                 "starts at 0 and h* is finite (truncated). How "
+                 "\n\nEach cell: the certified intervals [lo, hi] (s; lo rounded up and hi "
+                 "down to 4 digits) / hi over h* when the first starts at 0 and h* is finite "
+                 "(truncated). How "
                  "(`workbench.lmi.interval`): the criterion's LMIs at both ends of [lo, hi] "
                  "with the same decision variables. Times a positive weight (h or 1), every "
                  "block is affine in h or quadratic with a positive semidefinite h^2 "
@@ -125,8 +138,7 @@ def render(design, res: BenchmarkResult) -> Rendered:
                  "free-weighting criterion is a delay-range criterion (a certificate at h "
                  "covers [0, h]). When the system is unstable at h = 0, or has a later "
                  "window, the search starts in the middle of each exact window and grows "
-                 "both ends; the cell shows the interval from 0 when there is one, else the "
-                 "longest. Every certified point lies in an exact stable window and every "
+                 "both ends (one interval per window reached). Every certified point lies in an exact stable window and every "
                  "certified interval inside one: "
                  f"**{'yes' if res.sound else 'NO'}** (claim `suite-sound`).\n\n"
                  + md_table(["method"] + [f"`{n}`" for n in names], ivs,
