@@ -12,7 +12,8 @@ of example files relative to the design). Quantities (for claims), with
 * ``examples[<ex>].<m>.h_certified`` / ``.ratio`` / ``.exact_check`` (the
   **point** certificate: stable at h_certified), ``.interval_lo`` /
   ``.interval_hi`` / ``.interval_ratio`` (the **interval** certificate:
-  stable for every constant delay in [lo, hi]; None when none), with
+  stable for every constant delay in [lo, hi]; None when none; ends to 4
+  significant digits rounded inwards, ratio truncated to 4 decimals), with
   ``<m>`` one of the methods, ``bessel-legendre[N=k]`` or
   ``bessel-legendre-auto`` (plus ``.N`` for the order reached);
 * ``examples[<ex>].windows`` (number of exact stable windows in [0, h_max]),
@@ -28,6 +29,7 @@ of example files relative to the design). Quantities (for claims), with
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -56,6 +58,16 @@ def _method_keys(s: BenchmarkSettings) -> list[str]:
 
 def _row_key(r) -> str:
     return f"bessel-legendre[N={r.N}]" if r.method == "bessel-legendre" else r.method
+
+
+def directed(x: float, *, up: bool, sig: int = 4) -> float:
+    """x to ``sig`` significant digits, rounded up (a lower end) or down (an upper
+    end): an interval quantity never claims more than was certified, and its
+    last digits, which differ between CPUs, are dropped."""
+    if x == 0 or math.isinf(x):
+        return x
+    q = 10.0 ** (math.floor(math.log10(abs(x))) - sig + 1)
+    return float(f"{(math.ceil(x / q) if up else math.floor(x / q)) * q:.{sig}g}")
 
 
 class DelayBenchmark:
@@ -100,9 +112,11 @@ class DelayBenchmark:
                 q[f"{base}.{k}.h_certified"] = r.h_certified   # 0: nothing certified
                 q[f"{base}.{k}.ratio"] = r.ratio
                 q[f"{base}.{k}.exact_check"] = r.exact_check
-                iv = r.interval or (None, None)
-                q[f"{base}.{k}.interval_lo"], q[f"{base}.{k}.interval_hi"] = iv
-                q[f"{base}.{k}.interval_ratio"] = r.interval_ratio
+                lo, hi = r.interval or (None, None)      # printed digits (see module doc)
+                q[f"{base}.{k}.interval_lo"] = None if lo is None else directed(lo, up=True)
+                q[f"{base}.{k}.interval_hi"] = None if hi is None else directed(hi, up=False)
+                q[f"{base}.{k}.interval_ratio"] = (None if r.interval_ratio is None else
+                                                   math.floor(r.interval_ratio * 1e4) / 1e4)
                 if r.method == AUTO:
                     q[f"{base}.{AUTO}.N"] = float(r.N)
         return q
