@@ -19,9 +19,9 @@ import dataclasses
 import time
 from pathlib import Path
 
-from workbench.controllers.antiskid003 import Mesh, simulate_antiskid
 from workbench.design import load_design
-from workbench.studies import antiskid_run as R
+from workbench.studies import antiskid_run_spec as S
+from workbench.studies.antiskid_scenario import Mesh, simulate_antiskid
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -34,10 +34,10 @@ def _timed(rs, dt, mesh=None):
 
 def _settings(path: Path, case_name: str, t_end: float | None = None):
     spec = load_design(path).spec
-    K, _, _ = R.gain_for(spec)
+    K, _, _ = S.gain_for(spec)
     case = next(c for c in spec.cases if c.name == case_name)
-    cs = R.controller_settings(spec, K, case)
-    rs = R.run_settings(spec, cs)
+    cs = S.controller_settings(spec, K, case)
+    rs = S.run_settings(spec, cs)
     return spec, cs, (rs if t_end is None else dataclasses.replace(rs, t_end=t_end))
 
 
@@ -56,7 +56,7 @@ def main() -> None:
         print(f"dry, compensated (dt = {spec.dt:g} s; mesh courant {spec.mesh_courant:g}, "
               f"{spec.mesh_levels} levels)")
         for name, m, wall in rows:
-            mm = R.case_metrics(m, cs, t_b)
+            mm = S.case_metrics(m, cs, t_b)
             print(f"  {name:11s} time to cruise {mm['t_cruise']:.4f} s, braking "
                   f"{mm['braking_duration']:.3f} s, to omega <= 3 rad/s "
                   f"{mm['omega3_after_brake']:.3f} s, max |e_vs| {mm['evs_max_tracking']:.2e} "

@@ -10,7 +10,7 @@ Prints, in one process:
    sample interval the delayed input is known history, so the interval is
    an ODE) — over the first ``--ref-horizon`` seconds, and the difference in
    the time to cruise;
-3. batched Monte Carlo throughput (``workbench.sim.montecarlo.sweep``,
+3. batched Monte Carlo throughput (``workbench.studies.antiskid_montecarlo.sweep``,
    process pool) and the projected time for 1000 runs.
 
 Usage: .venv/bin/python benchmarks/simulate.py [--samples N] [--workers W]
@@ -24,12 +24,13 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from workbench.controllers.antiskid003 import (Antiskid003, _forms, _Scalar, model_functions,
-                                               simulate_antiskid)
+from workbench.controllers.antiskid003 import Antiskid003
 from workbench.design import load_design
 from workbench.sim.history import DelayLine
-from workbench.sim.montecarlo import sweep
-from workbench.studies import antiskid_run as R
+from workbench.sim.wheel_slip import ScalarOps, model_functions, plant_forms
+from workbench.studies import antiskid_run_spec as S
+from workbench.studies.antiskid_montecarlo import sweep
+from workbench.studies.antiskid_scenario import simulate_antiskid
 
 
 def reference_run(rs, dt: float, t_end: float) -> tuple[float, float]:
@@ -41,7 +42,7 @@ def reference_run(rs, dt: float, t_end: float) -> tuple[float, float]:
     x = np.array(rs.x0, float)
 
     def rhs(t, y, u):
-        f1, f20, f2u, *_ = _forms(max(y[0], 1e-3), y[1], p, fns, _Scalar)
+        f1, f20, f2u, *_ = plant_forms(max(y[0], 1e-3), y[1], p, fns, ScalarOps)
         return [f1, f20 + f2u * u]
 
     t0 = time.perf_counter()
@@ -63,9 +64,9 @@ def main() -> None:
     args = ap.parse_args()
     design = load_design("designs/antiskid-run-dry.toml")
     spec = design.spec
-    K = R.gain_for(spec)[0]
+    K = S.gain_for(spec)[0]
     case = next(c for c in spec.cases if c.name == "compensated")
-    rs = R.run_settings(spec, R.controller_settings(spec, K, case))
+    rs = S.run_settings(spec, S.controller_settings(spec, K, case))
     dt = spec.dt
 
     t0 = time.perf_counter()

@@ -9,11 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from workbench.controllers.antiskid003 import (DIVERGED_HOW, PARAM_ORDER, Mesh, RunSettings,
-                                               simulate_antiskid)
+from workbench.controllers.antiskid003_settings import DIVERGED_HOW
 from workbench.design import load_design
 from workbench.sim.history import DelayLine, TimedDelayLine
-from workbench.studies import antiskid_run as R
+from workbench.sim.wheel_slip import PARAM_ORDER
+from workbench.studies import antiskid_run_spec as S
+from workbench.studies.antiskid_scenario import Mesh, RunSettings, simulate_antiskid
 
 K_TABLE3 = (-0.0049, 10.5080)   # paper 003, Table 3, eps = 0.35
 
@@ -32,8 +33,8 @@ def _settings(spec, case_name, t_end, **scenario):
     case = next(c for c in spec.cases if c.name == case_name)
     if scenario:
         spec = dataclasses.replace(spec, scenario={**spec.scenario, **scenario})
-    cs = R.controller_settings(spec, K_TABLE3, case)
-    return spec, cs, dataclasses.replace(R.run_settings(spec, cs), t_end=t_end)
+    cs = S.controller_settings(spec, K_TABLE3, case)
+    return spec, cs, dataclasses.replace(S.run_settings(spec, cs), t_end=t_end)
 
 
 def _zoh_integral(segs, initial, a, b, n=100_000):
@@ -134,8 +135,8 @@ def test_braking_law_on_the_traction_side_diverges_by_torque(spec):
     case = next(c for c in sp.cases if c.name == "uncompensated")
     out = []
     for dt in (0.01, 0.005):
-        _, m = simulate_antiskid(rs, dt, record_dt=None, mesh=R.case_mesh(sp, case))
-        met = R.case_metrics(m, cs, 40.0)
+        _, m = simulate_antiskid(rs, dt, record_dt=None, mesh=S.case_mesh(sp, case))
+        met = S.case_metrics(m, cs, 40.0)
         assert DIVERGED_HOW[int(met["diverged_how"])] == "torque out of range"
         assert math.isnan(met["lam_min_brake"])
         out.append(met["t_diverged"])

@@ -10,9 +10,11 @@ import numpy as np
 import pytest
 
 from workbench.cli import main
-from workbench.controllers.antiskid003 import DIVERGED, simulate_antiskid
+from workbench.controllers.antiskid003_settings import DIVERGED
 from workbench.design import load_design
 from workbench.studies import antiskid_run as R
+from workbench.studies import antiskid_run_spec as S
+from workbench.studies.antiskid_scenario import simulate_antiskid
 
 DRY = Path("designs/antiskid-run-dry.toml")
 K_TABLE3 = (-0.0049, 10.5080)   # paper 003, Table 3, eps = 0.35
@@ -25,8 +27,8 @@ def spec():
 
 def _run(spec, case_name, t_end, dt=0.01, **changes):
     case = next(c for c in spec.cases if c.name == case_name)
-    cs = dataclasses.replace(R.controller_settings(spec, K_TABLE3, case), **changes)
-    rs = dataclasses.replace(R.run_settings(spec, cs), t_end=t_end)
+    cs = dataclasses.replace(S.controller_settings(spec, K_TABLE3, case), **changes)
+    rs = dataclasses.replace(S.run_settings(spec, cs), t_end=t_end)
     return cs, rs, simulate_antiskid(rs, dt, record_dt=0.05)
 
 
@@ -61,8 +63,8 @@ def test_stiff_hold_with_mismatch_estimate_converges():
     gap = {}
     for tau in (0.2, 0.0):
         case = next(c for c in plus5.cases if c.name == "compensated")
-        cs = dataclasses.replace(R.controller_settings(plus5, K_TABLE3, case), observer_tau=tau)
-        rs = dataclasses.replace(R.run_settings(plus5, cs), t_end=120.0)
+        cs = dataclasses.replace(S.controller_settings(plus5, K_TABLE3, case), observer_tau=tau)
+        rs = dataclasses.replace(S.run_settings(plus5, cs), t_end=120.0)
         v = [simulate_antiskid(rs, dt, record_dt=1.0)[0].x[0, -1] for dt in (0.01, 0.005)]
         gap[tau] = abs(v[0] - v[1])
     assert gap[0.2] < 0.005           # measured 0.0012 m/s
@@ -79,7 +81,7 @@ def test_batch_matches_single_run(spec):
 
 
 def test_switch_check_sign(spec):
-    cs = R.controller_settings(spec, K_TABLE3, spec.cases[0])
+    cs = S.controller_settings(spec, K_TABLE3, spec.cases[0])
     assert R.switch_check(cs, 70.0, cs.lambda_opt).abscissa > 0      # unstable at the peak
     assert R.switch_check(cs, 70.0, cs.lambda_d).abscissa < 0        # stable at the cruise point
 
@@ -103,7 +105,7 @@ def test_sweep_is_seeded(tmp_path, capsys):
     text = text.replace("dt = 0.005                          # s, step of the sweep's runs",
                         "dt = 0.01                          # s, step of the sweep's runs")
     short.write_text(text.replace('value = 420.0,', 'value = 32.0,'))
-    from workbench.sim.montecarlo import sweep
+    from workbench.studies.antiskid_montecarlo import sweep
     d = load_design(short)
     a = sweep(d, 3, seed=7, workers=1, progress=False)
     b = sweep(d, 3, seed=7, workers=1, progress=False)

@@ -1,6 +1,5 @@
 """CLI exit codes, bad input, claims and verdicts, reports and their freshness."""
 import json
-import shutil
 from pathlib import Path
 
 import pytest
@@ -8,7 +7,6 @@ import pytest
 from workbench.claims import Verdict, check_claim
 from workbench.cli import main
 from workbench.design import load_design
-from workbench.errors import DesignError
 
 DATA = Path("tests/data")
 GOLDEN = Path("tests/golden")

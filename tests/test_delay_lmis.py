@@ -217,7 +217,8 @@ def test_cli_benchmark_bad_input(tmp_path, capsys):
 
 # -- robust synthesis and decay rate ----------------------------------------------------
 def test_robust_synthesis_is_sound_at_every_point():
-    from workbench.lmi.robust import check_gain, synthesize_robust
+    from workbench.crosscheck import check_gain
+    from workbench.lmi.robust import synthesize_robust
     # two double-integrator-like points with different input gains (synthetic)
     pts = [(np.array([[0.0, 1.0], [0.0, -0.5]]), np.array([[0.0], [b]])) for b in (0.8, 1.2)]
     syn = synthesize_robust(pts, eps_grid=(0.3, 1.0, 3.0), golden_steps=1, rel_tol=1e-2)
@@ -229,7 +230,7 @@ def test_robust_synthesis_is_sound_at_every_point():
 
 
 def test_check_gain_reports_an_unstable_point():
-    from workbench.lmi.robust import check_gain
+    from workbench.crosscheck import check_gain
     pts = [(np.array([[-1.0]]), np.array([[1.0]])), (np.array([[-1.0]]), np.array([[-1.0]]))]
     good, bad = check_gain(pts, [[-0.5]])                      # A + B K = -1.5 and -0.5
     assert good.stable_at_zero and good.exact.h == math.inf
@@ -239,7 +240,7 @@ def test_check_gain_reports_an_unstable_point():
 
 
 def test_decay_rate_cross_checked_with_spectral_abscissa():
-    from workbench.lmi.robust import decay_rate_bound
+    from workbench.crosscheck import decay_rate_bound
     from workbench.margins import spectral_abscissa
     d = decay_rate_bound([[0.0]], [[-1.0]], 0.2, N=2, rel_tol=1e-3)
     h = d.bracket.h_certified

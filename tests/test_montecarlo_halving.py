@@ -10,13 +10,14 @@ import math
 import numpy as np
 import pytest
 
-from workbench.controllers.antiskid003 import BRAKE, BRAKE_IN, CRUISE
+from workbench.controllers.antiskid003_settings import BRAKE, BRAKE_IN, CRUISE
 from workbench.design import load_design
-from workbench.sim.montecarlo import (HALVING_METRICS, HALVING_OUTCOMES, HalvingCheck,
-                                      SweepSpec, compare_steps, draw_samples, halving_quantities,
-                                      halving_quantity_names, halving_section, start_halving,
-                                      sweep)
-from workbench.studies.antiskid_run import gain_for
+from workbench.studies.antiskid_halving import (HALVING_METRICS, HALVING_OUTCOMES, HalvingCheck,
+                                                compare_steps, halving_quantities,
+                                                halving_quantity_names, start_halving)
+from workbench.studies.antiskid_montecarlo import SweepSpec, draw_samples, sweep
+from workbench.studies.antiskid_montecarlo_render import halving_section
+from workbench.studies.antiskid_run_spec import gain_for
 
 N = 4
 

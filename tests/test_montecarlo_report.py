@@ -11,9 +11,10 @@ import pytest
 
 from workbench.cli import main
 from workbench.design import load_design
-from workbench.sim.montecarlo import (VIOLATIONS, draw_samples, montecarlo_quantities,
-                                      montecarlo_quantity_names, start_sweep, sweep, summary_tables)
 from workbench.studies import antiskid_run as R
+from workbench.studies.antiskid_montecarlo import (VIOLATIONS, draw_samples, montecarlo_quantities,
+                                                   montecarlo_quantity_names, start_sweep, sweep)
+from workbench.studies.antiskid_montecarlo_render import summary_tables
 from workbench.studies.antiskid_run_render import _montecarlo_section
 
 DRY = Path("designs/antiskid-run-dry.toml")

@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from workbench.controllers.antiskid003 import PARAM_ORDER, _Scalar, model_functions, plant_step
 from workbench.sim.delay import (envelope_ratio, exact_scalar_dde, simulate_closed_loop,
                                  simulate_linear_dde, step_halving)
 from workbench.sim.history import BatchDelayLine, DelayLine, split_delay
+from workbench.sim.wheel_slip import PARAM_ORDER, ScalarOps, model_functions, plant_step
 
 DRY = dict(a=0.3315, b=40.19, c=5.392, J=80.0, r=0.445, m=12000.0, zeta=0.01, c0=180.9,
            c1=112.2, c2=2.6, g=9.8)  # paper 003, Tables 1-2
@@ -91,7 +91,7 @@ def test_stiff_creep_step_is_stable_at_low_speed():
     x = (0.2, -0.05)
     lams = []
     for _ in range(50):
-        x = plant_step(x, -2000.0, p, 0.01, fns, _Scalar)
+        x = plant_step(x, -2000.0, p, 0.01, fns, ScalarOps)
         lams.append(x[1])
     assert all(abs(l) < 1 for l in lams)
     assert abs(lams[-1] - lams[-2]) < 1e-6     # settled on the quasi-steady creep ratio

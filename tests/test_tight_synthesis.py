@@ -6,10 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from workbench.lmi.core import Outcome
-from workbench.lmi.robust import maximise_log_scalar
+from workbench.crosscheck import check_tight
 from workbench.lmi.analysis import WirtingerLMI, certified_delay
+from workbench.lmi.core import Outcome
 from workbench.lmi.core import bisect_delay
+from workbench.lmi.robust import maximise_log_scalar
 from workbench.lmi.tight_synthesis import (WirtingerSynthesis, WirtingerSynthesisFixedK,
                                            recheck_tight, synthesize_tight)
 from workbench.margins import delay_margin_eig
@@ -90,8 +91,9 @@ def test_sound_on_textbook_examples(system, scalar):
     assert r.K is not None and not r.at_cap
     exact = delay_margin_eig(A, B @ r.K).h
     assert math.isfinite(exact)
-    assert r.check.exact.h == pytest.approx(exact)
-    assert r.exact_siso.h == pytest.approx(exact, rel=1e-6)      # two independent methods
+    c = check_tight(A, B, r.K, h_hi=r.h_max)
+    assert c.check.exact.h == pytest.approx(exact)
+    assert c.exact_siso.h == pytest.approx(exact, rel=1e-6)      # two independent methods
     # synthesis LMI sound: the gain of the bisection's own certificate ...
     Tinv = np.diag(1.0 / np.diag(r.T))
     lmi = WirtingerSynthesis(Tinv @ A @ r.T, Tinv @ B, r.eps)
@@ -99,12 +101,12 @@ def test_sound_on_textbook_examples(system, scalar):
     assert r.h_certified <= delay_margin_eig(A, B @ K_bisection).h * (1 + SOUND_TOL)
     # ... and the canonical gain, on its own and by the BL analysis
     assert r.gain.h_certified <= exact * (1 + SOUND_TOL)
-    assert r.check.h_certified <= exact * (1 + SOUND_TOL)
+    assert c.check.h_certified <= exact * (1 + SOUND_TOL)
     # The BL analysis (N = 2) of the same K is the tighter criterion in exact
     # arithmetic than the descriptor Wirtinger LMI with that K fixed; with
     # relative margins and the canonical gain this holds on every kernel.
     assert r.gain.h_certified >= r.gain.h_design
-    assert r.check.h_certified >= r.gain.h_certified * (1 - SOUND_TOL)
+    assert c.check.h_certified >= r.gain.h_certified * (1 - SOUND_TOL)
     assert r.h_certified < 1.0                                     # 1/a: no static gain beyond
     assert r.h_certified > 0.9                                     # but close to it
 
@@ -123,8 +125,9 @@ def test_tight_bound_exceeds_free_weighting_on_antiskid(lin):
     assert fw.status is Outcome.CERTIFIED
     assert r.h_certified >= fw.h_certified
     # A is Hurwitz and the loop has no crossing: the bound is only the cap
-    assert r.at_cap and math.isinf(r.check.exact.h)
-    assert r.check.h_certified >= 1.0
+    c = check_tight(lin.A, lin.B, r.K, h_hi=r.h_max)
+    assert r.at_cap and math.isinf(c.check.exact.h)
+    assert c.check.h_certified >= 1.0
 
 
 def test_eps_search_stops_at_the_cap_and_refines_otherwise():

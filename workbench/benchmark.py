@@ -29,14 +29,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .design import Reader, display_path
+from .benchmark_windows import abscissa_curve, exact_windows, interval_fields, middle
 from .errors import DesignError
 from .lmi.analysis import METHODS, certified_delay, make_criterion
 from .lmi.core import DEFAULT_MARGIN
 from .lmi.hierarchy import bessel_legendre_auto
-from .benchmark_windows import abscissa_curve, exact_windows, interval_fields, middle
 from .margins import (AGREEMENT_RTOL, Agreement, DelayMargin, compare_margins, delay_margin_eig,
                       delay_margin_sweep)
+from .reader import Reader, display_path
 
 AUTO = "bessel-legendre-auto"
 
@@ -386,7 +386,7 @@ def run_benchmark(examples: tuple[Example, ...], s: BenchmarkSettings) -> Benchm
 
 
 # -- CLI -------------------------------------------------------------------------------
-def benchmark_delay(design_path: str, *, as_json: bool = False, exact_check: bool = False,
+def benchmark_delay(design, *, as_json: bool = False, exact_check: bool = False,
                     out=print) -> int:
     """``workbench benchmark delay [DESIGN] [--json] [--exact-check]``.
 
@@ -399,15 +399,11 @@ def benchmark_delay(design_path: str, *, as_json: bool = False, exact_check: boo
     certified point lies in an exact stable window and every certified
     interval inside one, no interval [0, hi] reaches h* (and, with
     ``--exact-check``, every certificate passes the rational re-check); 1
-    otherwise.
+    otherwise. ``design`` is a loaded ``delay-benchmark`` design (the CLI
+    loads and checks its kind).
     """
-    from .design import load_design
     from .report.markdown import fmt, md_table
-    from .studies.delay_benchmark import STUDY
 
-    design = load_design(design_path)
-    if design.kind != STUDY.kind:
-        raise DesignError(design.path, "design.kind", design.kind, f'"{STUDY.kind}"')
     spec = design.spec
     if exact_check:
         spec = replace(spec, settings=replace(spec.settings, exact_check=True))

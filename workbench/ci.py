@@ -84,8 +84,13 @@ def design_cases(ev) -> list[Case]:
                             f"design file: {ev.design.path}"])
         note = ""
         if c.expect == "fail":
-            note = f"expected to fail (known discrepancy): {c.reason}"
-        if r.ok:
+            note = f"expected to fail (known discrepancy, severity {c.severity}): {c.reason}"
+        elif c.severity is not None:
+            note = f"workbench finding, severity {c.severity}"
+        if not r.severity_holds:
+            message = (f"severity 'rounding' does not hold (the difference is more than "
+                       f"0.1 % of the value): {facts}")
+        elif r.ok:
             message = ""
             if r.verdict.value == "INCONCLUSIVE":
                 note = "INCONCLUSIVE, allowed by allow_inconclusive = true"
@@ -103,20 +108,20 @@ def design_cases(ev) -> list[Case]:
 
 def proof_cases(results) -> list[Case]:
     """Cases of ``(ProofModule, ProofResult)`` pairs from :func:`workbench.prove.run_proofs`."""
-    from .prove import _detail
-    from .prove import _expected as proof_expected
+    from .prove import expected_verdict as proof_expected
+    from .prove import result_detail
     out = []
     for m, r in results:
         c = r.claim
         want = proof_expected(r)
         facts = (f"expected {want}, got {r.verdict.value}"
-                 + (f"; {_detail(r)}" if _detail(r) else "")
+                 + (f"; {result_detail(r)}" if result_detail(r) else "")
                  + (f"; tolerance: {c.digits} printed digits" if c.digits is not None else "")
                  + f"; source: paper {m.paper}, eqs {c.equations}")
         detail = "\n".join([f"proofs/{m.name}::{c.id}: {c.statement}", f"kind: {c.kind}",
                             f"expected: {want}", f"got: {r.verdict.value}",
                             f"source: paper {m.paper}, eqs {c.equations}"]
-                           + ([_detail(r)] if _detail(r) else []))
+                           + ([result_detail(r)] if result_detail(r) else []))
         note = (f"expected REFUTED (as printed): {c.note}" if c.expect == "refuted" else "")
         message = "" if r.ok else (
             f"INCONCLUSIVE (counted as a failure): {facts}" if r.verdict.value == "INCONCLUSIVE"

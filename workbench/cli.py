@@ -10,7 +10,6 @@ import argparse
 import json
 import math
 import sys
-from dataclasses import replace
 from pathlib import Path
 from typing import Callable
 
@@ -111,7 +110,9 @@ def cmd_verify(args) -> int:
         rows = []
         for e in evs:
             for c in e.claims:
-                v = c.verdict.value + (" (expected)" if c.claim.expect == "fail" and c.ok else "")
+                sev = c.claim.severity
+                v = c.verdict.value + (f" (expected; {sev})" if c.claim.expect == "fail" and c.ok
+                                       else f" ({sev})" if sev else "")
                 rows.append([e.design.name, c.claim.id, f"{c.claim.compare} {fmt(c.claim.value, 6)}",
                              fmt(c.got, 6), v if c.ok else v + " ✗", c.claim.source])
         rows += extra.get("rows", [])
@@ -137,11 +138,11 @@ def _extra_verifications(args) -> dict:
 
 
 def cmd_report(args) -> int:
-    from .report.writer import build, check_reports, write_reports
-    from .verify import evaluate_design
+    from .report.writer import check_reports, write_reports
+    from .verify import evaluate_design, report_files
 
     designs = _designs([] if args.all else args.designs)
-    files = [build(evaluate_design(d)) for d in designs]
+    files = [report_files(evaluate_design(d)) for d in designs]
     index = args.all or not args.designs
     if index:
         from .prove import report_files
@@ -201,9 +202,19 @@ def _cmd_prove(args) -> int:
     return cmd_prove(args)
 
 
+def _load_kind(path: str, kind: str):
+    """Load a design for a verb that needs one kind (else a design error, exit 2)."""
+    from .design import load_design
+    from .errors import DesignError
+    design = load_design(path)
+    if design.kind != kind:
+        raise DesignError(design.path, "design.kind", design.kind, f'a "{kind}" design')
+    return design
+
+
 def _cmd_fit(args) -> int:
-    from .fit import fit_design
-    return fit_design(args.design, as_json=args.json)
+    from .studies.fit000 import fit_command
+    return fit_command(_load_kind(args.design, "brake-fit"), as_json=args.json)
 
 
 def cmd_init(args) -> int:
@@ -216,17 +227,18 @@ def cmd_init(args) -> int:
 
 def cmd_benchmark(args) -> int:
     from .benchmark import benchmark_delay
-    return benchmark_delay(args.design, as_json=args.json, exact_check=args.exact_check)
+    return benchmark_delay(_load_kind(args.design, "delay-benchmark"), as_json=args.json,
+                           exact_check=args.exact_check)
 
 
 def cmd_simulate(args) -> int:
     from .studies.antiskid_run import simulate_command
-    return simulate_command(args.design, case=args.case, dt=args.dt, as_json=args.json)
+    return simulate_command(_load_kind(args.design, "antiskid-run"), case=args.case, dt=args.dt, as_json=args.json)
 
 
 def cmd_sweep(args) -> int:
-    from .sim.montecarlo import sweep_command
-    return sweep_command(args.design, samples=args.samples, seed=args.seed,
+    from .studies.antiskid_run import sweep_command
+    return sweep_command(_load_kind(args.design, "antiskid-run"), samples=args.samples, seed=args.seed,
                          workers=args.workers, figure=args.figure, as_json=args.json)
 
 

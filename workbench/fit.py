@@ -17,11 +17,11 @@ quantisation, so parameter recovery can be checked. Two optimisers:
 K1 and K2 enter eq 7 only as K1/K2 (see :mod:`workbench.plants.brake000`):
 they are not separately identifiable, and the recovery table says so.
 
-``workbench fit DESIGN`` runs a ``brake-fit`` design and prints the table.
+``workbench fit DESIGN`` runs a ``brake-fit`` design and prints the table
+(:func:`workbench.studies.fit000.fit_command`).
 """
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import dataclass
 
@@ -195,23 +195,3 @@ def existing_rmse(base: dict, logs: list[Log], *, delay: float, lag: float, dt: 
         sq += float(rmse_cm(v, lg.speed)) ** 2 * len(lg.t)
         n += len(lg.t)
     return float(np.sqrt(sq / n))
-
-
-def fit_design(path: str, *, as_json: bool = False) -> int:
-    """The ``workbench fit DESIGN`` verb: run a ``brake-fit`` design, print recovery."""
-    from .design import load_design
-    from .errors import DesignError
-    from .report.markdown import md_table
-    from .studies.fit000 import STUDY, recovery_rows
-
-    design = load_design(path)
-    if design.kind != STUDY.kind:
-        raise DesignError(design.path, "design.kind", design.kind, f'a "{STUDY.kind}" design')
-    res = STUDY.run(design)
-    if as_json:
-        print(json.dumps(res.to_json(), indent=2))
-        return 0
-    head, rows = recovery_rows(res)
-    print(f"{design.name}: SYNTHETIC logs ({len(res.logs)}), fit by eq 12")
-    print(md_table(head, rows, "l" + "r" * (len(head) - 1)))
-    return 0

@@ -109,7 +109,8 @@ def select(names: list[str] | tuple[str, ...] = ()) -> list[tuple[ProofModule, o
 
 
 @lru_cache(maxsize=None)
-def _check(folder: Path, module: str, claim_id: str) -> ProofResult:
+def check_proof_claim(folder: Path, module: str, claim_id: str) -> ProofResult:
+    """Check one claim of a ``proofs/`` module (once per process)."""
     claim = next(c for m in proof_modules(folder) if m.name == module for c in m.claims
                  if c.id == claim_id)
     return check_claim(claim)
@@ -118,14 +119,16 @@ def _check(folder: Path, module: str, claim_id: str) -> ProofResult:
 def run_proofs(names=()) -> list[tuple[ProofModule, ProofResult]]:
     """Check the selected claims of the project's ``proofs/`` (each once per process)."""
     folder = proofs_folder()
-    return [(m, _check(folder, m.name, c.id)) for m, c in select(tuple(names))]
+    return [(m, check_proof_claim(folder, m.name, c.id)) for m, c in select(tuple(names))]
 
 
-def _expected(r: ProofResult) -> str:
+def expected_verdict(r: ProofResult) -> str:
+    """What the claim expects: "PROVED", or "REFUTED (as printed)" for a known error."""
     return "REFUTED (as printed)" if r.claim.expect == "refuted" else "PROVED"
 
 
-def _detail(r: ProofResult) -> str:
+def result_detail(r: ProofResult) -> str:
+    """One line of evidence: the counterexample, or what remains to be shown."""
     if r.counterexample is not None:
         return "counterexample: " + ", ".join(f"{n} = {fmt(v, 6)}" for n, v in r.counterexample)
     return ("remains: " + r.remaining) if r.remaining else ""
@@ -139,8 +142,8 @@ def cmd_prove(args) -> int:
         print(json.dumps({"proofs": [dict(module=m.name, **r.to_json()) for m, r in results]},
                          indent=2))
         return 0 if ok else 1
-    rows = [[m.paper, r.claim.id, r.claim.equations, r.claim.kind, _expected(r),
-             r.verdict.value + ("" if r.ok else " ✗"), _detail(r)[:120]] for m, r in results]
+    rows = [[m.paper, r.claim.id, r.claim.equations, r.claim.kind, expected_verdict(r),
+             r.verdict.value + ("" if r.ok else " ✗"), result_detail(r)[:120]] for m, r in results]
     print(md_table(["paper", "claim", "eqs", "kind", "expected", "verdict", "detail"], rows))
     n_bad = sum(not r.ok for _, r in results)
     print(f"\n{len(results) - n_bad} of {len(results)} proof claims ok"
@@ -157,13 +160,26 @@ def verification_rows(results=None) -> dict:
     for m, r in results:
         verdict = ("PASS (expected refuted)" if r.ok and r.claim.expect == "refuted"
                    else "PASS" if r.ok else "FAIL ✗")
-        rows.append([f"proofs/{m.name}", r.claim.id, _expected(r), r.verdict.value, verdict,
+        rows.append([f"proofs/{m.name}", r.claim.id, expected_verdict(r), r.verdict.value, verdict,
                      f"paper {m.paper}, eqs {r.claim.equations}"])
     return {"rows": rows, "bad": sum(not r.ok for _, r in results),
             "json": {"proofs": [dict(module=m.name, **r.to_json()) for m, r in results]}}
 
 
 # -- reports ---------------------------------------------------------------------------
+def _index_cells(pairs) -> tuple[str, ...]:
+    """The index row of a paper's proof report (see
+    :func:`workbench.report.findings.index_cells`): derivation steps refuted
+    as printed are errata; their severity is not assessed."""
+    rs = [r for _, r in pairs]
+    bad = sum(not r.ok for r in rs)
+    errata = [r for r in rs if r.verdict is Verdict.REFUTED]
+    return ("verified" if not bad else f"**NOT OK** ({bad})",
+            f"{sum(r.verdict is Verdict.PROVED for r in rs)} of {len(rs)} steps proved",
+            f"{len(errata)} refuted as printed (errata; severity not assessed)" if errata else "none",
+            f"erratum: {errata[0].claim.statement}" if errata else "—")
+
+
 def _summary(results) -> str:
     n, ok = len(results), sum(r.ok for r in results)
     counts = {v: sum(r.verdict is v for r in results) for v in Verdict}
@@ -178,7 +194,7 @@ def _claim_section(module: ProofModule, r: ProofResult) -> str:
     mark = "" if r.ok else " — **NOT OK**"
     lines = [f"### `{c.id}` — {r.verdict.value}{mark}", "",
              f"{c.statement}. Paper {c.paper}, eqs {c.equations}; kind `{c.kind}`; "
-             f"expected {_expected(r)}; module `proofs/{module.name}.py`."]
+             f"expected {expected_verdict(r)}; module `proofs/{module.name}.py`."]
     if c.note:
         lines += ["", f"> {c.note}"]
     marks = {True: "✓", False: "✗", None: "—"}
@@ -201,7 +217,7 @@ def render_paper_report(paper: str, pairs) -> str:
     results = [r for _, r in pairs]
     titles = sorted({m.title for m, _ in pairs})
     table = md_table(["claim", "eqs", "statement", "expected", "verdict"],
-                     [[f"`{r.claim.id}`", r.claim.equations, r.claim.statement, _expected(r),
+                     [[f"`{r.claim.id}`", r.claim.equations, r.claim.statement, expected_verdict(r),
                        f"**{r.verdict.value}**" + ("" if r.ok else " ✗")] for r in results],
                      "llllr")
     head = (f"# Proofs for paper {paper}\n\n" + "; ".join(titles) + ".\n\n"
@@ -224,12 +240,13 @@ def render_paper_report(paper: str, pairs) -> str:
 
 def report_files() -> list:
     """``ReportFiles`` of every paper: ``proofs-NNN`` (one per paper)."""
+    from .report.markdown import github_math
     from .report.writer import ReportFiles
     results = run_proofs()
     out = []
     for paper in sorted({m.paper for m, _ in results}):
         pairs = [(m, r) for m, r in results if m.paper == paper]
         rs = [r for _, r in pairs]
-        out.append(ReportFiles(f"proofs-{paper}", render_paper_report(paper, pairs), (),
-                               all(r.ok for r in rs), _summary(rs)))
+        out.append(ReportFiles(f"proofs-{paper}", github_math(render_paper_report(paper, pairs)), (),
+                               all(r.ok for r in rs), _summary(rs), _index_cells(pairs)))
     return out

@@ -158,9 +158,9 @@ class ProofFile(_ClaimFile):
 
     def run_cases(self) -> list:
         from .ci import proof_cases
-        from .prove import _check
+        from .prove import check_proof_claim
         folder = self.path.resolve().parent
-        return proof_cases([(self.module, _check(folder, self.module.name, c.id))
+        return proof_cases([(self.module, check_proof_claim(folder, self.module.name, c.id))
                             for c in self.module.claims])
 
 

@@ -17,15 +17,14 @@ runs in the same coordinates, and K is mapped back (K = K~ T^{-1}).
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as sl
 
 from .lmi.core import DEFAULT_MARGIN, Bracket, Outcome, bisect_delay
 from .lmi.freeweighting003 import FreeWeighting003, FreeWeighting003FixedK
 from .lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
+from .lmi.scaling import balancing
 from .margins import DelayMargin, delay_margin_eig, delay_margin_siso, stability_windows
 
 
@@ -154,12 +153,6 @@ class SynthesisRow:
                 else list(self.certified_interval),
                 "status": self.status.value, "solves": self.solves,
                 "seconds": round(self.seconds, 4)}
-
-
-def balancing(A: np.ndarray) -> np.ndarray:
-    """Diagonal power-of-two T with T^{-1} A T balanced (exact in floating point)."""
-    _, (scale, _) = sl.matrix_balance(np.asarray(A, float), permute=False, separate=True)
-    return np.diag(scale)
 
 
 def _balanced(A, B):

@@ -31,3 +31,16 @@ def evaluate_design(design: Design) -> Evaluation:
     q = study.quantities(result)
     return Evaluation(design, result, tuple(check_claim(c, q.get(c.quantity))
                                             for c in design.claims))
+
+
+def report_files(ev: Evaluation):
+    """The report of an evaluated design: the study renders its sections,
+    :func:`workbench.report.writer.build` assembles them (the writer never
+    runs a study)."""
+    from .lmi.core import CLARABEL_SETTINGS
+    from .report.writer import build
+    rendered = studies.renderer(ev.design.kind)(ev.design, ev.result)
+    solver = None
+    if getattr(studies.REGISTRY[ev.design.kind], "uses_solver", True):
+        solver = ", ".join(f"{k}={v}" for k, v in CLARABEL_SETTINGS.items()) or "Clarabel defaults"
+    return build(ev, rendered, solver)

@@ -30,7 +30,8 @@ from typing import Mapping
 import cvxpy as cp
 import numpy as np
 
-from .core import Block, FixedGain, MarginLMI
+from .core import Block, MarginLMI
+from .gain import FixedGain
 
 
 class FreeWeighting003(MarginLMI):

@@ -133,3 +133,26 @@ def canonical_gain(lmi: MarginLMI, h_certified: float, fixed: Callable[[np.ndarr
                             max_solves=max_solves, guess=min(max(h, h_lo), h_hi))
     return CanonicalGain(K, digits, h, point, analysis)
 
+
+class FixedGain:
+    """Mixin turning a state-feedback synthesis LMI (variable ``V = K X``)
+    into the analysis of a *given* gain: ``V`` is replaced by ``K X``.
+
+    Use as ``class C(FixedGain, SomeSynthesis)`` with ``gain_basis`` naming X;
+    the constructor takes the synthesis LMI's arguments and the gain as the
+    keyword ``K``.
+    """
+
+    gain_basis: str = "L"
+
+    def __init__(self, *args, K, **kw):
+        self.K = np.atleast_2d(np.asarray(K, float))
+        super().__init__(*args, **kw)
+
+    def variables(self):
+        v = super().variables()
+        del v["V"]
+        return v
+
+    def blocks(self, x, p, bmat):
+        return super().blocks({**x, "V": self.K @ x[self.gain_basis]}, p, bmat)

@@ -5,20 +5,20 @@ x' = A_i x + B_i K x(t - h) at every operating point i at once (common Y and
 V, so one K = V Y^{-1}; Lyapunov-Krasovskii matrices per operating point),
 built from Fridman's descriptor method with the Jensen inequality and the
 slack P3 = eps P2; eps is searched automatically (:func:`synthesize_robust`),
-not fixed by hand. Every gain is then re-checked per operating point by
-the tighter Bessel-Legendre analysis and the exact margin
-(:func:`check_gain`) — an operating point whose loop is not stable even
-without delay is reported as such.
+not fixed by hand. :func:`gain_delay_bound` is the tighter
+Bessel-Legendre analysis of a given gain; the layer above puts it next to
+the exact margin (:func:`workbench.crosscheck.check_gain`) — the LMI never
+sees the exact answer.
 
 Operating points are a finite list (e.g. rail x speed x mass corners of
 the antiskid linearisation): a certificate holds at each listed point, not
 in between (the linearisation is not affine in speed or mass).
 
-:func:`decay_rate_bound`: with x = e^{-alpha t} z the loop
+:func:`decay_rate_bracket`: with x = e^{-alpha t} z the loop
 x' = A x + A_d x(t-h) becomes z' = (A + alpha I) z + e^{alpha h} A_d z(t-h);
 a Bessel-Legendre certificate of that system at h proves exponential
-stability with rate alpha at delay h, cross-checked by the spectral abscissa
-(:func:`~workbench.margins.spectral_abscissa` <= -alpha).
+stability with rate alpha at delay h (cross-checked by the spectral
+abscissa in :func:`workbench.crosscheck.decay_rate_bound`).
 
 References
 ----------
@@ -38,10 +38,10 @@ from typing import Callable, Sequence
 import cvxpy as cp
 import numpy as np
 
-from ..margins import DelayMargin, delay_margin_eig, spectral_abscissa
 from .analysis import BesselLegendreLMI, certified_delay
-from .core import DEFAULT_MARGIN, Block, Bracket, FixedGain, MarginLMI, Outcome, bisect_delay
-from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
+from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, bisect_delay
+from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
+from .scaling import balance_points
 
 
 class DescriptorSynthesis(MarginLMI):
@@ -152,14 +152,6 @@ class RobustSynthesis:
     gain: CanonicalGain | None = None
 
 
-def _balancing(points):
-    """Common diagonal power-of-two scaling T (from the first point's A)."""
-    from ..synthesis import balancing
-    T = balancing(points[0][0])
-    Tinv = np.diag(1 / np.diag(T))
-    return T, Tinv, [(Tinv @ A @ T, Tinv @ B) for A, B in points]
-
-
 def maximise_log_scalar(value: Callable[[float], float], grid: Sequence[float], *,
                         golden_steps: int = 6, stop_at: float = math.inf
                         ) -> tuple[float, dict[float, float]]:
@@ -246,7 +238,7 @@ def synthesize_robust(points, *, alpha: float = 0.0,
     balanced by a common power-of-two diagonal T (exact), K is mapped back.
     K is the canonical gain (:func:`~workbench.lmi.gain.canonical_gain`).
     """
-    T, Tinv, pts = _balancing(points)
+    T, Tinv, pts = balance_points(points)
     lmi = DescriptorSynthesis(pts, eps_grid[0], alpha, margin=margin)
     best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_hi,
                                    rel_tol=rel_tol)
@@ -262,77 +254,41 @@ def synthesize_robust(points, *, alpha: float = 0.0,
     return RobustSynthesis(best, br, None if gain is None else gain.K, pairs, gain)
 
 
-@dataclass(frozen=True)
-class PointCheck:
-    """A gain checked at one operating point.
+def gain_delay_bound(A, B, K, *, N: int = 2, margin: float = DEFAULT_MARGIN,
+                     rel_tol: float = 1e-4, h_hi: float = 100.0) -> Bracket:
+    """Bessel-Legendre (order N) certified bound of x' = A x + B K x(t - h).
 
-    Attributes
-    ----------
-    stable_at_zero : bool
-        A + B K Hurwitz (False: the loop is unstable without delay — loud).
-    exact : DelayMargin
-        Exact margin of x' = A x + B K x(t-h).
-    h_certified : float
-        Bessel-Legendre (order N) certified bound with this K (s).
-    N : int
+    The LMI side of a gain check: it knows nothing of the exact margin
+    (:func:`workbench.crosscheck.check_gain` puts the two side by side).
+    The point certificate holds at ``h_certified``; see :class:`Bracket`.
     """
-
-    stable_at_zero: bool
-    exact: DelayMargin
-    h_certified: float
-    N: int
-
-
-def check_gain(points, K, *, N: int = 2, margin: float = DEFAULT_MARGIN,
-               rel_tol: float = 1e-4, h_hi: float = 100.0) -> tuple[PointCheck, ...]:
-    """Check a given K at every point: exact margin and certified BL bound."""
-    K = np.atleast_2d(np.asarray(K, float))
-    out = []
-    for A, B in points:
-        Ad = np.asarray(B, float) @ K
-        exact = delay_margin_eig(A, Ad)
-        stable = exact.reason != "unstable-at-zero-delay"
-        h = 0.0
-        if stable:
-            T, Tinv, ((At, _),) = _balancing([(A, B)])
-            h = certified_delay(BesselLegendreLMI(At, Tinv @ Ad @ T, N, margin=margin),
-                                rel_tol=rel_tol, h_hi=h_hi,
-                                guess=exact.h if math.isfinite(exact.h) else None).h_certified
-        out.append(PointCheck(stable, exact, h, N))
-    return tuple(out)
+    A = np.atleast_2d(np.asarray(A, float))
+    Ad = np.asarray(B, float).reshape(A.shape[0], -1) @ np.atleast_2d(np.asarray(K, float))
+    T, Tinv, ((At, _),) = balance_points([(A, B)])
+    return certified_delay(BesselLegendreLMI(At, Tinv @ Ad @ T, N, margin=margin),
+                           rel_tol=rel_tol, h_hi=h_hi)
 
 
-@dataclass(frozen=True)
-class DecayRate:
-    """Largest h with exponential stability of rate alpha certified.
-
-    ``abscissa`` is the spectral abscissa of the delay system at
-    ``bracket.h_certified`` (must be <= -alpha for the certificate to agree).
-    """
-
-    alpha: float
-    N: int
-    bracket: Bracket
-    abscissa: float | None
-
-
-def decay_rate_bound(A, Ad, alpha: float, *, N: int = 2, margin: float = DEFAULT_MARGIN,
-                     rel_tol: float = 1e-4, h_hi: float = 10.0) -> DecayRate:
+def decay_rate_bracket(A, Ad, alpha: float, *, N: int = 2, margin: float = DEFAULT_MARGIN,
+                       rel_tol: float = 1e-4, h_hi: float = 10.0) -> Bracket:
     """Bessel-Legendre bound for z' = (A + alpha I) z + e^{alpha h} A_d z(t-h).
 
-    The delayed matrix depends on h, so each step builds its own criterion
-    (no DPP re-use); the shared bisection decides.
+    A certificate at h proves exponential stability with rate alpha of
+    x' = A x + A_d x(t-h) at that delay. The delayed matrix depends on h,
+    so each step builds its own criterion (no DPP re-use); the shared
+    bisection decides. The first trial delay is relative to the system's
+    time scale (1e-4 / ||A|| + ||A_d||), not an absolute number of seconds.
     """
     if not alpha >= 0:
         raise ValueError(f"alpha = {alpha!r}; expected a non-negative rate (1/s)")
     A, Ad = np.atleast_2d(np.asarray(A, float)), np.atleast_2d(np.asarray(Ad, float))
-    T, Tinv, ((At, _),) = _balancing([(A, np.zeros((A.shape[0], 1)))])
+    T, Tinv, ((At, _),) = balance_points([(A, np.zeros((A.shape[0], 1)))])
     Adt = Tinv @ Ad @ T
     Aa = At + alpha * np.eye(A.shape[0])
 
     def decide(h: float):
         return BesselLegendreLMI(Aa, math.exp(alpha * h) * Adt, N, margin=margin).solve_at(h)
 
-    br = bisect_delay(decide, h_lo=1e-4, h_hi=h_hi, rel_tol=rel_tol)
-    sa = spectral_abscissa(A, Ad, br.h_certified) if br.outcome is Outcome.CERTIFIED else None
-    return DecayRate(alpha, N, br, sa)
+    rate = np.linalg.norm(A, 2) + np.linalg.norm(Ad, 2) + alpha
+    h_lo = min(1e-4 / rate, h_hi / 2) if rate > 0 else 1e-4 * h_hi
+    return bisect_delay(decide, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol)

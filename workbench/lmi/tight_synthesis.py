@@ -13,10 +13,10 @@ largest certified delay by the shared bracketed bisection
 The gain is the canonical one of :mod:`workbench.lmi.gain` (minimum-norm
 certificate at ``gain_fraction * h_certified`` of the best eps, rounded to
 ``gain_digits`` significant digits, certified on its own by
-:class:`WirtingerSynthesisFixedK`). It is then checked twice, independently
-of the synthesis LMI: by the Bessel-Legendre *analysis* criterion of
-:mod:`workbench.lmi.analysis` with that K, and by the exact delay margin of
-:mod:`workbench.margins` (:func:`~workbench.lmi.robust.check_gain`).
+:class:`WirtingerSynthesisFixedK`). The layer above checks it twice,
+independently of the synthesis LMI (:func:`workbench.crosscheck.check_gain`):
+by the Bessel-Legendre *analysis* criterion of :mod:`workbench.lmi.analysis`
+with that K, and by the exact delay margin of :mod:`workbench.margins`.
 
 When the exact margin with the synthesised K is infinite (no imaginary-axis
 crossing: stable for every constant delay) the largest certified delay is
@@ -40,10 +40,10 @@ from typing import Mapping, Sequence
 import cvxpy as cp
 import numpy as np
 
-from ..margins import DelayMargin, delay_margin_siso
-from .core import DEFAULT_MARGIN, Block, Bracket, FixedGain, MarginLMI
-from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
-from .robust import DescriptorSynthesis, PointCheck, _balancing, best_eps_bracket, check_gain
+from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI
+from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
+from .robust import DescriptorSynthesis, best_eps_bracket
+from .scaling import balance_points
 
 
 class WirtingerSynthesis(MarginLMI):
@@ -150,10 +150,6 @@ class TightSynthesis:
         was certified.
     eps_tried : tuple[tuple[float, float], ...]
         (eps, h_certified) of the search, sorted by eps.
-    check : PointCheck or None
-        Bessel-Legendre analysis bound and exact margin with ``K``.
-    exact_siso : DelayMargin or None
-        Exact margin from python-control's crossovers (single input only).
     h_max : float
         Search cap (s) of both bisections.
     T : numpy.ndarray
@@ -166,8 +162,6 @@ class TightSynthesis:
     bracket: Bracket
     K: np.ndarray | None
     eps_tried: tuple[tuple[float, float], ...]
-    check: PointCheck | None
-    exact_siso: DelayMargin | None
     h_max: float
     T: np.ndarray = field(repr=False)
     gain: CanonicalGain | None = field(default=None, repr=False)
@@ -185,7 +179,7 @@ class TightSynthesis:
 
 def synthesize_tight(A, B, *, eps_grid: Sequence[float] = (0.01, 0.1, 1.0, 10.0, 100.0),
                      golden_steps: int = 6, h_max: float = 10.0, rel_tol: float = 1e-3,
-                     N: int = 2, margin: float = DEFAULT_MARGIN,
+                     margin: float = DEFAULT_MARGIN,
                      gain_fraction: float = DEFAULT_FRACTION,
                      gain_digits: int = DEFAULT_DIGITS) -> TightSynthesis:
     """Largest delay certified by :class:`WirtingerSynthesis`, eps searched.
@@ -203,8 +197,6 @@ def synthesize_tight(A, B, *, eps_grid: Sequence[float] = (0.01, 0.1, 1.0, 10.0,
         Delay search cap (s).
     rel_tol : float
         Relative bracket width of the delay bisection.
-    N : int
-        Bessel-Legendre order of the analysis check of the gain.
     margin : float
         Relative LMI definiteness margin.
     gain_fraction, gain_digits
@@ -214,16 +206,16 @@ def synthesize_tight(A, B, *, eps_grid: Sequence[float] = (0.01, 0.1, 1.0, 10.0,
     -------
     TightSynthesis
         The LMI is solved in balanced coordinates (exact power-of-two
-        scaling, :func:`workbench.synthesis.balancing`); K is mapped back.
+        scaling, :func:`workbench.lmi.scaling.balancing`); K is mapped back.
     """
     A = np.atleast_2d(np.asarray(A, float))
     B = np.asarray(B, float).reshape(A.shape[0], -1)
-    T, Tinv, ((At, Bt),) = _balancing([(A, B)])
+    T, Tinv, ((At, Bt),) = balance_points([(A, B)])
     lmi = WirtingerSynthesis(At, Bt, eps_grid[0], margin=margin)
     best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_max,
                                    rel_tol=rel_tol, stop_at=h_max)   # nothing beyond the cap
     br = tried[best]
-    K = check = siso = gain = None
+    K = gain = None
     if br.certificate is not None:
         lmi.set_eps(best)
         gain = canonical_gain(
@@ -231,12 +223,8 @@ def synthesize_tight(A, B, *, eps_grid: Sequence[float] = (0.01, 0.1, 1.0, 10.0,
             lambda Kt: WirtingerSynthesisFixedK(At, Bt, best, K=Kt, margin=margin), T,
             fraction=gain_fraction, digits=gain_digits, h_hi=h_max, rel_tol=rel_tol)
         K = gain.K
-    if K is not None:
-        (check,) = check_gain([(A, B)], K, N=N, margin=margin, h_hi=h_max)
-        if B.shape[1] == 1:
-            siso = delay_margin_siso(A, B, K)
     tried_h = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
-    return TightSynthesis(best, br, K, tried_h, check, siso, float(h_max), T, gain)
+    return TightSynthesis(best, br, K, tried_h, float(h_max), T, gain)
 
 
 def recheck_tight(A, B, result: TightSynthesis,

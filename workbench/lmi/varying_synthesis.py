@@ -25,10 +25,10 @@ asymptotically stable for every delay function h(t) in [h1, h2] with
 :func:`~workbench.lmi.robust.maximise_log_scalar`), bisects h2 for each eps,
 takes the canonical gain of the best eps (:func:`~workbench.lmi.gain.canonical_gain`:
 minimum-norm certificate, K rounded, certified on its own by
-:class:`VaryingDelaySynthesisFixedK`) and checks K independently: the
-analysis criterion on (A, B K) and the exact constant-delay margin
-(:func:`~workbench.margins.delay_margin_eig`; the time-varying set can never
-exceed it).
+:class:`VaryingDelaySynthesisFixedK`) and checks K by the analysis criterion
+on (A, B K). The exact constant-delay margin (an upper bound the time-varying
+set can never exceed) is the caller's cross-check: the LMI layer never
+computes or sees it.
 
 References
 ----------
@@ -48,13 +48,13 @@ from typing import Sequence
 import cvxpy as cp
 import numpy as np
 
-from ..margins import DelayMargin, delay_margin_eig
-from .core import DEFAULT_MARGIN, Block, Bracket, FixedGain, MarginLMI, Outcome, bisect_delay
-from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
+from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, bisect_delay
+from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
 
 #: Fractions of the certified h2 at which the canonical gain is tried, in order.
 GAIN_FRACTIONS = (DEFAULT_FRACTION, 0.95, 0.9, 0.8, 0.6)
-from .robust import DescriptorSynthesis, _balancing, maximise_log_scalar
+from .robust import DescriptorSynthesis, maximise_log_scalar
+from .scaling import balance_points
 from .varying import (RETRY_SETTINGS, VaryingDelayBound, Windows, _VaryingTerms,
                       certified_varying_delay)
 
@@ -148,9 +148,6 @@ class VaryingSynthesis:
     analysis : VaryingDelayBound or None
         The analysis criterion on (A, B K): an independent interval
         certificate for the rounded K.
-    exact : DelayMargin or None
-        Exact constant-delay margin of x' = A x + B K x(t - h): an upper
-        bound of every interval certificate with h1 = 0.
     h_max : float
         Search cap on h2 (s).
     """
@@ -164,7 +161,6 @@ class VaryingSynthesis:
     eps_tried: tuple[tuple[float, float], ...]
     gain: CanonicalGain | None
     analysis: VaryingDelayBound | None
-    exact: DelayMargin | None
     h_max: float
     T: np.ndarray = field(repr=False)
 
@@ -222,7 +218,7 @@ def synthesize_varying(A, B, *, h1: float = 0.0, mu: float | None = None,
     """
     A = np.atleast_2d(np.asarray(A, float))
     B = np.asarray(B, float).reshape(A.shape[0], -1)
-    T, Tinv, ((At, Bt),) = _balancing([(A, B)])
+    T, Tinv, ((At, Bt),) = balance_points([(A, B)])
     lmi = VaryingDelaySynthesis(At, Bt, eps_grid[0], h1=h1, mu=mu, windows=windows,
                                 margin=margin)
     h_lo = lmi.h1 + max(1e-3, 1e-3 * lmi.h1)
@@ -238,7 +234,7 @@ def synthesize_varying(A, B, *, h1: float = 0.0, mu: float | None = None,
     best, _ = maximise_log_scalar(h_of, list(eps_grid), golden_steps=golden_steps,
                                   stop_at=h_max)
     br = tried[best]
-    K = gain = analysis = exact = None
+    K = gain = analysis = None
     if br.certificate is not None:
         lmi.set_eps(best)
         for fraction in gain_fractions:
@@ -256,13 +252,12 @@ def synthesize_varying(A, B, *, h1: float = 0.0, mu: float | None = None,
         K = None if gain is None else gain.K
     if K is not None:
         Ad = B @ K
-        exact = delay_margin_eig(A, Ad)
         analysis = certified_varying_delay(At, Tinv @ Ad @ T, h1=lmi.h1, mu=lmi.mu,
                                            windows=lmi.windows, h_hi=h_max, rel_tol=rel_tol,
                                            margin=margin, guess=br.h_certified)
     pairs = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
     return VaryingSynthesis(lmi.h1, lmi.mu, lmi.windows, best, br, K, pairs, gain, analysis,
-                            exact, float(h_max), T)
+                            float(h_max), T)
 
 
 def recheck_varying(A, B, result: VaryingSynthesis,

@@ -11,10 +11,17 @@ Each study module provides an object with
     Compute (a frozen dataclass with ``to_json()``).
 ``quantities(result) -> dict[str, float | str | None]``
     Values of the named quantities (``None``: not determined).
-``render(design, result) -> workbench.report.Rendered``
+``uses_solver`` (optional attribute, default True)
+    False when the study runs no convex solver (its report's provenance
+    then names none).
+and, in the study's render module (``<study>_render.py``, which imports the
+study module, never the other way round), a function
+
+``render(design, result) -> workbench.report.markdown.Rendered``
     Markdown sections and figures (pure).
 
-New capabilities add a module here and one line to :data:`STUDIES`.
+New capabilities add a module here and one line to :data:`STUDIES` and to
+:data:`RENDERERS`.
 
 Loading is lazy: :data:`REGISTRY` imports a study's module the first time
 its kind is looked up, so reading (or rejecting) a design imports only its
@@ -41,6 +48,26 @@ STUDIES: dict[str, str] = {
     "ato-tracking": "tracking002:STUDY",
     "ntsm-platoon": "platoon001:STUDY",
 }
+
+
+#: kind -> "module:function" of the study's renderer (see the module docstring).
+RENDERERS: dict[str, str] = {
+    "antiskid-cruise": "antiskid_cruise_render:render",
+    "delay-benchmark": "delay_benchmark_render:render",
+    "antiskid-robust": "antiskid_robust_render:render",
+    "antiskid-run": "antiskid_run_render:render",
+    "station-stopping": "stopping000_render:render",
+    "closed-loop-brake": "brake004_render:render",
+    "brake-fit": "fit000:render",
+    "ato-tracking": "tracking002_render:render",
+    "ntsm-platoon": "platoon001_render:render",
+}
+
+
+def renderer(kind: str):
+    """The render function of a study kind, ``render(design, result)``."""
+    module, attr = RENDERERS[kind].split(":")
+    return getattr(importlib.import_module(f"{__name__}.{module}"), attr)
 
 
 class _LazyRegistry(Mapping):

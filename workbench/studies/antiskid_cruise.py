@@ -11,19 +11,17 @@ synthesis with its scalar searched automatically,
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
 from ..plants.units import ADHESION_003 as PARAMETER_UNITS
+from ..reader import Quantity, Reader
 
 if TYPE_CHECKING:   # the solvers and the symbolic model load when a design runs
-    from ..lmi.robust import PointCheck
+    from ..crosscheck import PointCheck
     from ..lmi.tight_synthesis import TightSynthesis
     from ..margins import DelayMargin
-    from ..report.markdown import Rendered
     from ..symbolic.linearise import Linearisation
     from ..synthesis import SynthesisRow, SynthesisSettings
 
@@ -124,6 +122,10 @@ class TightComparison:
         Bessel-Legendre bound and exact margin with the printed K.
     open_loop_hurwitz : bool
         A itself is Hurwitz (then K = 0 is stable for every delay).
+    check : PointCheck or None
+        Bessel-Legendre analysis bound and exact margin with the tight K.
+    exact_siso : DelayMargin or None
+        python-control's single-input exact margin with the tight K.
     """
 
     synthesis: TightSynthesis
@@ -132,6 +134,8 @@ class TightComparison:
     published: Published | None
     published_check: PointCheck | None
     open_loop_hurwitz: bool
+    check: PointCheck | None = None
+    exact_siso: DelayMargin | None = None
 
 
 @dataclass(frozen=True)
@@ -143,6 +147,9 @@ class CruiseResult:
     rows: tuple[SynthesisRow, ...]
     published: tuple[PublishedCheck, ...]
     tight: TightComparison | None = None
+    #: (h, spectral abscissa of x' = A x + B K x(t - h)) for the canonical gain
+    #: of the row with the largest certified bound (the figure of the loop's set)
+    abscissa_vs_h: tuple = ()
 
     def row(self, eps: float) -> SynthesisRow:
         return next(r for r in self.rows if r.eps == eps)
@@ -279,7 +286,8 @@ class AntiskidCruise:
                                       settings=spec.settings)
                 checks.append(PublishedCheck(p, ours, br.h_certified, br.h_refuted, em, match))
         tight = _run_tight(spec, lin, rows) if spec.tight else None
-        return CruiseResult(lam_opt, lam_solved, lam_used, lin, rows, tuple(checks), tight)
+        return CruiseResult(lam_opt, lam_solved, lam_used, lin, rows, tuple(checks), tight,
+                            _abscissa_vs_h(lin, rows))
 
     def quantities(self, res: CruiseResult) -> dict:
         q = {"operating_point.lambda_d": res.lambda_d_used,
@@ -311,9 +319,6 @@ class AntiskidCruise:
         return q
 
     # -- render ----------------------------------------------------------------
-    def render(self, design, res: CruiseResult) -> Rendered:
-        from .antiskid_cruise_render import render
-        return render(design, res)
 
 
 #: Quantities of the ``[tight]`` comparison (prefixed ``tight.``).
@@ -322,16 +327,39 @@ TIGHT_QUANTITIES = ("eps", "h_certified", "h_analysis", "exact_margin", "exact_m
                     "paper_K.exact_margin")
 
 
+def _abscissa_vs_h(lin: Linearisation, rows) -> tuple:
+    """Spectral abscissa of the loop with the best row's canonical gain on a
+    log grid of delays from 1/100 to 100 times its certified bound (the exact
+    side: :func:`workbench.margins.spectral_abscissa`; a delay where the
+    adaptive collocation does not converge is left out, never guessed)."""
+    import numpy as np
+
+    from ..margins import SpectrumNotConverged, spectral_abscissa
+    best = max((r for r in rows if r.K is not None), key=lambda r: r.h_certified, default=None)
+    if best is None or not best.h_certified > 0:
+        return ()
+    Ad = lin.B @ np.array([best.K])
+    out = []
+    for h in np.geomspace(best.h_certified / 100, best.h_certified * 100, 25):
+        try:
+            out.append((float(h), float(spectral_abscissa(lin.A, Ad, h))))
+        except SpectrumNotConverged:
+            continue
+    return tuple(out)
+
+
 def _run_tight(spec: CruiseSpec, lin: Linearisation, rows) -> TightComparison:
     """Tight synthesis, and the Bessel-Legendre + exact check of the reference gains."""
     import numpy as np
 
-    from ..lmi.robust import check_gain
+    from ..crosscheck import check_gain, check_tight
     from ..lmi.tight_synthesis import synthesize_tight
     ts, st = spec.tight, spec.settings
-    syn = synthesize_tight(lin.A, lin.B, eps_grid=ts.grid, h_max=ts.h_max, N=ts.order,
+    syn = synthesize_tight(lin.A, lin.B, eps_grid=ts.grid, h_max=ts.h_max,
                            margin=st.margin, rel_tol=max(st.rel_tol, 1e-3),
                            gain_fraction=st.gain_fraction, gain_digits=st.gain_digits)
+    own = (check_tight(lin.A, lin.B, syn.K, N=ts.order, margin=st.margin, h_hi=ts.h_max)
+           if syn.K is not None else None)
 
     def check(K):
         return check_gain([(lin.A, lin.B)], np.array([K]), N=ts.order, margin=st.margin,
@@ -340,15 +368,16 @@ def _run_tight(spec: CruiseSpec, lin: Linearisation, rows) -> TightComparison:
     pub = next((p for p in spec.published if p.eps == ts.reference_eps), None)
     return TightComparison(syn, ref, check(ref.K) if ref.K else None, pub,
                            check(pub.K) if pub else None,
-                           bool(np.max(np.linalg.eigvals(lin.A).real) < 0))
+                           bool(np.max(np.linalg.eigvals(lin.A).real) < 0),
+                           own.check if own else None, own.exact_siso if own else None)
 
 
 def _tight_quantities(t: TightComparison) -> dict:
-    s, c = t.synthesis, t.synthesis.check
+    s, c = t.synthesis, t.check
     K = s.K.ravel() if s.K is not None else None
     q = {"eps": s.eps, "h_certified": s.h_certified if s.h_certified > 0 else None,
          "h_analysis": c.h_certified if c else None, "exact_margin": c.exact.h if c else None,
-         "exact_margin_siso": s.exact_siso.h if s.exact_siso else None,
+         "exact_margin_siso": t.exact_siso.h if t.exact_siso else None,
          "K1": None if K is None else float(K[0]), "K2": None if K is None else float(K[1]),
          "at_cap": "yes" if s.at_cap else "no",
          "ratio_to_reference": (s.h_certified / t.reference.h_certified

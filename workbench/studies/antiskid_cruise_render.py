@@ -6,7 +6,7 @@ import math
 import numpy as np
 import sympy as sp
 
-from ..plants.adhesion import PARAMETER_UNITS, adhesion_model
+from ..plants.adhesion import adhesion_model
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, margin_text, md_table
 
 
@@ -132,11 +132,36 @@ def render(design, res) -> Rendered:
         sections.append(_tight_section(res.tight, res.lin.A, res.lin.B))
     figs = (Figure("delay-bound-vs-eps",
                    "Certified bound and refuted bound against eps; printed values for comparison.",
-                   lambda fig, res=res: _plot_bounds(fig, res)),)
-    sections.append("## Figure\n\n![Certified bound vs eps](" + "{figdir}/delay-bound-vs-eps.png)\n\n"
-                    "Certified bound (filled) and refuted bound (open) per eps, with the printed "
-                    "values (crosses). " + ("The exact margin is infinite for every row, so it "
-                                           "does not appear on the axis." if _all_inf(res) else ""))
+                   lambda fig, res=res: _plot_bounds(fig, res)),
+            Figure("loop", "Loop L(s) = -K (sI - A)^-1 B: Bode and Nyquist.",
+                   lambda fig, res=res: _plot_loop(fig, res), (9.0, 3.6)))
+    best = max((r for r in res.rows if r.K is not None), key=lambda r: r.h_certified,
+               default=None)
+    text = ("## Figures\n\n![Certified bound vs eps](" + "{figdir}/delay-bound-vs-eps.png)\n\n"
+            "Certified bound (filled) and refuted bound (open) per eps, with the printed "
+            "values (crosses). " + ("The exact margin is infinite for every row, so it "
+                                   "does not appear on the axis." if _all_inf(res) else ""))
+    if best is not None:
+        text += ("\n\n![Loop](" + "{figdir}/loop.png)\n\n"
+                 f"Bode and Nyquist plots of L(s) = -K (sI - A)⁻¹ B with the canonical gain of "
+                 f"eps = {fmt(best.eps)} (K = {_gain(best.K)}): a delay e^(-sh) only rotates "
+                 "L(jω) by -ωh, so the loop can lose stability only at a frequency where "
+                 "|L(jω)| = 1; "
+                 + _gain_crossing_text(res.lin.A, res.lin.B, np.array([best.K]),
+                                       best.exact is not None and math.isinf(best.exact.h)))
+    if res.abscissa_vs_h:
+        figs += (Figure("abscissa-vs-h", "Rightmost characteristic root against the delay.",
+                        lambda fig, res=res: _plot_abscissa(fig, res)),)
+        worst = max(a for _, a in res.abscissa_vs_h)
+        text += ("\n\n![Spectral abscissa vs h](" + "{figdir}/abscissa-vs-h.png)\n\n"
+                 "Spectral abscissa (real part of the rightmost root) of x' = A x + B K "
+                 f"x(t − h) with the same gain, for h from {fmt(res.abscissa_vs_h[0][0], 3)} to "
+                 f"{fmt(res.abscissa_vs_h[-1][0], 3)} s; largest value {fmt(worst, 3)} 1/s. "
+                 + ("It stays negative: the loop is stable for every delay shown, as the "
+                    "infinite exact margin says (no root ever reaches the imaginary axis)."
+                    if worst < 0 and _all_inf(res) else
+                    "A positive value is a delay at which the loop is unstable."))
+    sections.append(text)
     return Rendered(tuple(sections), figs)
 
 
@@ -198,6 +223,58 @@ def _plot_bounds(fig, res):
     ax.legend()
 
 
+def _loop_response(A, B, K, w):
+    """L(jω) = -K (jωI - A)^-1 B at the frequencies ``w`` (single input)."""
+    n = A.shape[0]
+    return np.array([-(np.atleast_2d(K) @ np.linalg.solve(1j * x * np.eye(n) - A, B))[0, 0]
+                     for x in w])
+
+
+def _gain_crossing_text(A, B, K, infinite: bool) -> str:
+    """The largest |L(jω)| on the plotted grid (ω = 0 and 1e-4..1e3 rad/s)."""
+    w = np.concatenate([[0.0], np.geomspace(1e-4, 1e3, 600)])
+    peak = float(np.max(np.abs(_loop_response(A, B, K, w))))
+    text = f"on the plotted frequencies max |L(jω)| = {fmt(peak, 3)}"
+    if peak < 1 and infinite:
+        return text + (", below 1, as the infinite exact margin (no gain crossing at all, "
+                       "computed without this grid) requires.")
+    return text + "."
+
+
+def _plot_loop(fig, res):
+    best = max((r for r in res.rows if r.K is not None), key=lambda r: r.h_certified)
+    A, B = res.lin.A, res.lin.B
+    w = np.geomspace(1e-4, 1e3, 600)
+    L = _loop_response(A, B, np.array([best.K]), w)
+    ax_m, ax_p, ax_n = fig.subplots(1, 3)
+    ax_m.loglog(w, np.abs(L), color="C0")
+    ax_m.axhline(1.0, color="k", lw=0.8, ls="--")
+    ax_m.set_xlabel("ω (rad/s)")
+    ax_m.set_ylabel("|L(jω)|")
+    ax_p.semilogx(w, np.degrees(np.unwrap(np.angle(L))), color="C0")
+    ax_p.set_xlabel("ω (rad/s)")
+    ax_p.set_ylabel("arg L(jω) (deg)")
+    ax_n.plot(L.real, L.imag, color="C0", label="ω > 0")
+    ax_n.plot(L.real, -L.imag, color="C0", ls=":", label="ω < 0")
+    ax_n.plot([-1], [0], "rx", label="-1")
+    ax_n.set_xlabel("Re L")
+    ax_n.set_ylabel("Im L")
+    ax_n.legend(fontsize=7)
+    fig.suptitle(f"Loop with the canonical gain of eps = {fmt(best.eps)}", fontsize=9)
+
+
+def _plot_abscissa(fig, res):
+    h, a = zip(*res.abscissa_vs_h)
+    ax = fig.add_subplot(111)
+    ax.semilogx(h, a, "o-", ms=3, color="C0", label="spectral abscissa")
+    ax.axhline(0.0, color="k", lw=0.8)
+    best = max((r for r in res.rows if r.K is not None), key=lambda r: r.h_certified)
+    ax.axvline(best.h_certified, color="C1", ls="--", label="h certified (LMI)")
+    ax.set_xlabel("constant delay h (s)")
+    ax.set_ylabel("max Re s (1/s)")
+    ax.legend(fontsize=8)
+
+
 def _capped(h, cap) -> str:
     """A certified bound, marked when it is the search cap (a lower bound only)."""
     if h is None:
@@ -223,7 +300,7 @@ def _closed_loop_eigs(A, B, K) -> str:
 def _tight_section(t, A, B) -> str:
     """``## Tight synthesis beyond the paper`` (the ``[tight]`` table of a design)."""
     s, cap = t.synthesis, t.synthesis.h_max
-    N = s.check.N if s.check else None
+    N = t.check.N if t.check else None
     rows = []
 
     def bl(c):
@@ -241,7 +318,7 @@ def _tight_section(t, A, B) -> str:
                  fmt(r.h_gain, 4), bl(t.reference_check), em(t.reference_check),
                  _closed_loop_eigs(A, B, r.K)])
     rows.append(["tight: Wirtinger synthesis, eps searched", fmt(s.eps, 3), _gain(s.K),
-                 _capped(s.gain.h_certified if s.gain else None, cap), bl(s.check), em(s.check),
+                 _capped(s.gain.h_certified if s.gain else None, cap), bl(t.check), em(t.check),
                  _closed_loop_eigs(A, B, s.K)])
     table = md_table(["design", "eps", "K", "certified h with this K, own LMI (s)",
                       f"certified h, Bessel-Legendre N = {N} analysis with this K (s)",
@@ -259,7 +336,7 @@ def _tight_section(t, A, B) -> str:
         "gain is then re-certified by the Bessel-Legendre *analysis* LMI (independent of the "
         "synthesis LMI) and by the exact delay margin.",
     ]
-    if s.check is not None and s.at_cap and math.isinf(s.check.exact.h):
+    if t.check is not None and s.at_cap and math.isinf(t.check.exact.h):
         notes.append(
             f"**The tight bound is the search cap, not a limit.** The synthesis certifies the "
             f"cap h_max = {fmt(cap, 4)} s and the exact margin with its gain is infinite, so the "

@@ -19,12 +19,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
 from ..plants.units import ADHESION_003 as PARAMETER_UNITS
+from ..reader import Quantity, Reader
 
 if TYPE_CHECKING:   # the solvers load when a design runs
-    from ..lmi.robust import PointCheck, RobustSynthesis
+    from ..crosscheck import PointCheck
+    from ..lmi.robust import RobustSynthesis
 
 RAIL_KEYS = ("a", "b", "c")
 
@@ -172,7 +173,8 @@ class AntiskidRobust:
     def run(self, design) -> RobustResult:
         s: RobustSpec = design.spec
         pts = [(p.A, p.B) for p in s.points]
-        from ..lmi.robust import check_gain, synthesize_robust
+        from ..crosscheck import check_gain
+        from ..lmi.robust import synthesize_robust
         from ..margins import spectral_abscissa
         syn = synthesize_robust(pts, alpha=s.alpha, eps_grid=s.eps_grid,
                                 golden_steps=s.golden_steps, rel_tol=s.rel_tol,
@@ -216,10 +218,6 @@ class AntiskidRobust:
             for p, k in zip(spec_points, checks):
                 q[f"compare[{c.name}].points[{p.id}].exact_margin"] = k.exact.h
         return q
-
-    def render(self, design, res: RobustResult):
-        from .antiskid_robust_render import render
-        return render(design, res)
 
 
 STUDY = AntiskidRobust()

@@ -34,7 +34,7 @@ import sympy as sp
 
 from ..controllers.fuzzy import FuzzyIncrement
 from ..controllers.pid import PID
-from ..design import Quantity, Reader
+from ..reader import Quantity, Reader
 from ..sim.stopping import batch_params, simulate
 from .stopping000 import load_plant
 
@@ -309,6 +309,7 @@ def _key(x: float) -> str:
 
 class ClosedLoopBrake:
     kind = "closed-loop-brake"
+    uses_solver = False    # no convex solver runs: the report says so
 
     def load(self, root: Reader) -> Spec004:
         return _load(root)
@@ -364,10 +365,6 @@ class ClosedLoopBrake:
                 q[f"{b}.electric_loss.{mode}.abs_m"] = res.max_abs(speed_kmh=s, mode=mode,
                                                                    electric=False)
         return q
-
-    def render(self, design, res: Result004):
-        from .brake004_render import render
-        return render(design, res)
 
 
 STUDY = ClosedLoopBrake()

@@ -35,7 +35,7 @@ from pathlib import Path
 
 from ..benchmark import (AUTO, BenchmarkResult, BenchmarkSettings, Example, agreement_bound,
                          load_examples, load_settings, run_benchmark)
-from ..design import Reader
+from ..reader import Reader
 
 FIELDS = ("h_certified", "ratio", "exact_check", "interval_lo", "interval_hi",
           "interval_ratio")
@@ -120,10 +120,6 @@ class DelayBenchmark:
                 if r.method == AUTO:
                     q[f"{base}.{AUTO}.N"] = float(r.N)
         return q
-
-    def render(self, design, res: BenchmarkResult):
-        from .delay_benchmark_render import render
-        return render(design, res)
 
 
 STUDY = DelayBenchmark()

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..controllers.ntsm import NTSMGains, convergence_time, ntsm_force, pd_force, surface
-from ..design import Quantity, Reader
 from ..plants.platoon001 import PARAMETER_UNITS, TrainParams, external_force, perturbed
 from ..profiles import Profile, build_profile, spec_for_cruise
+from ..reader import Quantity, Reader
 from ..sim.tracking import PlatoonRun, Route, simulate_platoon
 from .tracking002 import read_gradients
 
@@ -174,6 +174,7 @@ def _odd(r: Reader, name: str) -> int:
 
 class NTSMPlatoon:
     kind = "ntsm-platoon"
+    uses_solver = False    # no convex solver runs: the report says so
 
     def load(self, root: Reader) -> PlatoonSpec:
         pl = root.table("plant")
@@ -285,10 +286,6 @@ class NTSMPlatoon:
         q["convergence.max_ratio_eq22"] = max(
             c.slide_measured / c.slide_eq22 for c in done) if ok else None
         return q
-
-    def render(self, design, res: PlatoonResult):
-        from .platoon001_render import render
-        return render(design, res)
 
 
 def _metrics(r: PlatoonRun, window, m: float, bound: float) -> RunMetrics:

@@ -16,11 +16,11 @@ import numpy as np
 
 from ..controllers.mfac import MFAC, MFACGains
 from ..controllers.pid import PID
-from ..design import Quantity, Reader
 from ..errors import DesignError, ModelError
 from ..plants.train002 import PARAMETER_UNITS, Train002
-from ..report.markdown import fmt
 from ..profiles import Profile, ProfileSpec, build_profile
+from ..reader import Quantity, Reader
+from ..report.markdown import fmt
 from ..sim.tracking import QualityIndices, Route, TrackingRun, quality_indices, simulate_tracking
 
 INDICES = QualityIndices.NAMES
@@ -126,6 +126,7 @@ def _section(r: Reader, *, with_source: bool) -> Section:
 
 class ATOTracking:
     kind = "ato-tracking"
+    uses_solver = False    # no convex solver runs: the report says so
 
     # -- load ----------------------------------------------------------------
     def load(self, root: Reader) -> TrackingSpec:
@@ -243,10 +244,6 @@ class ATOTracking:
             q[f"sensitivity.oat.{k}"] = _finite(v)
         q["sensitivity.most_sensitive"] = max(res.oat, key=res.oat.get)
         return q
-
-    def render(self, design, res: TrackingResult):
-        from .tracking002_render import render
-        return render(design, res)
 
 
 def _finite(x):

@@ -1,0 +1,237 @@
+"""Monte Carlo robustness sweep of an ``antiskid-run`` design.
+
+Samples (seeded, numpy ``SeedSequence``): plant mass factor, adhesion
+between the wet and the dry curve (a, b, c interpolated with s in [0, 1]:
+s = 0 wet, s = 1 dry), true input delay in [0, h_max] (the predictor keeps
+the design's h), initial speed. Sample i is row i of one (n, 4) uniform draw,
+so the first n runs of a larger sweep with the same seed have the same
+parameters. Each worker simulates one chunk of samples as a batch (arrays,
+one pass of the fixed-step loop) and returns plain lists; a local process
+pool runs the chunks (:mod:`workbench.sim.batch`); progress goes to stderr.
+
+A batch halves a step only for the runs that need it
+(:func:`workbench.sim.wheel_slip.stiff_step`), so a run's metrics
+do not depend on its chunk mates (up to rounding: the batch evaluates the
+model with numpy, a single run with ``math``). The partition into chunks
+depends on the sample count (and ``chunk``) only, never on the worker count.
+
+The controller always uses the design's nominal model (dry rail, nominal
+mass): the sweep measures robustness, not re-tuning.
+
+The step-size check of the sweep's runs is :mod:`workbench.studies.antiskid_halving`;
+the rendering is :mod:`workbench.studies.antiskid_montecarlo_render`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from ..sim.batch import PendingBatch, uniform_draws
+from .antiskid_run_spec import SweepSpec
+
+#: Summary statistics reported per metric. The time to the stop (v <= v_stop)
+#: is not one: after omega <= 3 rad/s the desired creep speed steps to 0 and
+#: the train coasts on running resistance, ~46 s per m/s of speed left when the
+#: creep is released; that release is a transient at dt |J| ~ 40 which the
+#: fixed step resolves for the nominal plant (the design's braking time agrees
+#: with a refined mesh) but not for mismatched plants (dt / 2 moved it by up
+#: to 13 s in the halving check). The stop itself is the ``not_stopped``
+#: outcome; ``omega3_after_brake`` (the end of creep-controlled braking, the
+#: paper's "about 350 s") is converged.
+SUMMARY_METRICS = ("lam_max_over_opt", "t_cruise", "omega3_after_brake")
+
+#: Statistics of each summary metric (over its finite values).
+STATISTICS = ("n_finite", "min", "median", "p95", "max")
+
+#: Checks counted per run: key -> what a violation means.
+VIOLATIONS = {"above_lambda_opt": "creep ratio above the sample's lambda_opt in traction",
+              "diverged": "diverged (|lambda| >= 0.9, torque out of range, or step not resolved)",
+              "not_stopped": "not stopped by t_end"}
+
+#: Default number of chunks a sweep is cut into (independent of the workers).
+DEFAULT_CHUNKS = 4
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    samples: dict           # name -> list of floats
+    metrics: dict           # name -> list of floats
+    violations: dict        # key of VIOLATIONS -> list of bool
+    seconds: float
+    workers: int
+
+    @property
+    def n(self) -> int:
+        return len(self.metrics["t_cruise"])
+
+    def summary_rows(self) -> list[list]:
+        """[metric, n finite, min, median, 95th percentile, max] per summary
+        metric (None where no run has a finite value)."""
+        rows = []
+        for k in SUMMARY_METRICS:
+            x = np.asarray(self.metrics[k], float)
+            ok = x[np.isfinite(x)]
+            if ok.size == 0:
+                rows.append([k, 0, None, None, None, None])
+                continue
+            rows.append([k, int(ok.size), float(ok.min()), float(np.median(ok)),
+                         float(np.percentile(ok, 95)), float(ok.max())])
+        return rows
+
+    def statistics(self) -> dict:
+        """``{"<metric>.<statistic>": value}`` from :meth:`summary_rows` and
+        ``{"fraction.<violation>": value}`` (fraction of all runs)."""
+        out = {f"{r[0]}.{s}": x for r in self.summary_rows() for s, x in zip(STATISTICS, r[1:])}
+        out.update({f"fraction.{k}": sum(v) / self.n for k, v in self.violations.items()})
+        return out
+
+
+def montecarlo_quantity_names() -> set[str]:
+    """Quantities of a sweep run by the ``antiskid-run`` study:
+    ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>`` and
+    ``montecarlo.fraction.<violation>``."""
+    return ({"montecarlo.samples"}
+            | {f"montecarlo.{m}.{s}" for m in SUMMARY_METRICS for s in STATISTICS}
+            | {f"montecarlo.fraction.{k}" for k in VIOLATIONS})
+
+
+def montecarlo_quantities(res: SweepResult) -> dict:
+    """The values of :func:`montecarlo_quantity_names` (None: no finite value)."""
+    return {"montecarlo.samples": res.n,
+            **{f"montecarlo.{k}": v for k, v in res.statistics().items()}}
+
+
+def draw_samples(n: int, seed: int, spec: SweepSpec) -> dict:
+    """n samples of (mass factor, adhesion s, delay h, v0), uniform, seeded;
+    sample i does not depend on n."""
+    return uniform_draws(n, seed, {"mass": spec.mass, "adhesion": spec.adhesion, "h": spec.h,
+                                   "v0": spec.v0})
+
+
+def chunk_worker(payload: dict) -> dict:
+    """Simulate one chunk (plain data in, plain data out)."""
+    from ..controllers.antiskid003_settings import ControllerSettings, CreepSpeedProfile
+    from ..sim.wheel_slip import PARAM_ORDER
+    from .antiskid_scenario import RunSettings, simulate_antiskid
+    cs_d = dict(payload["controller"])
+    cs_d["profile"] = CreepSpeedProfile(**cs_d["profile"])
+    cs_d["params"] = tuple(cs_d["params"])
+    cs_d["K"] = tuple(cs_d["K"])
+    cs = ControllerSettings(**cs_d)
+    plant = tuple(np.asarray(payload["plant"][k], float) for k in PARAM_ORDER)
+    n = len(payload["h"])
+    run = RunSettings(plant, cs, np.asarray(payload["h"], float),
+                      (np.asarray(payload["v0"], float), payload["lambda0"]),
+                      payload["u_init"], payload["t_end"])
+    _, m = simulate_antiskid(run, payload["dt"], record_dt=None, batch=n)
+    return {"index": payload["index"], "metrics": {k: np.asarray(v, float).tolist()
+                                                   for k, v in vars(m).items()}}
+
+
+def sweep_inputs(design, samples: int, seed: int, K: tuple | None) -> dict:
+    """The first ``samples`` runs of the design's sweep with ``seed`` as
+    plain data: ``draws``, per-run ``plant`` parameters, the nominal values
+    ``base``, the ``controller`` (``asdict`` of the case's settings), the
+    ``scenario`` and ``dt``; ``K``: the cruise gain if the caller has it
+    (default: :func:`~workbench.studies.antiskid_run.gain_for`)."""
+    from ..sim.wheel_slip import PARAM_ORDER
+    from .antiskid_run_spec import controller_settings, gain_for, plant_values
+
+    spec = design.spec
+    ms: SweepSpec = spec.montecarlo
+    case = next(c for c in spec.cases if c.name == ms.case)
+    K = gain_for(spec)[0] if K is None else K
+    cs = controller_settings(spec, K, case)
+    draws = draw_samples(samples, seed, ms)
+    base = plant_values(spec)
+    plant = {k: np.full(samples, base[k], float) for k in PARAM_ORDER}
+    s = draws["adhesion"]
+    for k in ("a", "b", "c"):
+        plant[k] = ms.wet[k] + s * (base[k] - ms.wet[k])
+    plant["m"] = base["m"] * draws["mass"]
+    return {"draws": draws, "plant": plant, "base": base, "controller": asdict(cs),
+            "scenario": spec.scenario, "dt": ms.dt or spec.dt}
+
+
+def chunk_payload(inp: dict, i0: int, i1: int, dt: float) -> dict:
+    """The :func:`chunk_worker` payload of runs ``i0 <= i < i1`` at step ``dt``."""
+    sl, sc, d = slice(i0, i1), inp["scenario"], inp["draws"]
+    return {"index": i0, "controller": inp["controller"],
+            "plant": {k: v[sl].tolist() for k, v in inp["plant"].items()},
+            "h": d["h"][sl].tolist(), "v0": d["v0"][sl].tolist(),
+            "lambda0": sc["lambda0"], "u_init": sc["u_init"], "t_end": sc["t_end"], "dt": dt}
+
+
+def run_lambda_opt(inp: dict) -> np.ndarray:
+    """lambda_opt of each run's own adhesion curve."""
+    from ..plants.adhesion import NumericAdhesion
+    base, plant = inp["base"], inp["plant"]
+    return np.array([NumericAdhesion.from_dict(
+        {**base, "a": plant["a"][i], "b": plant["b"][i], "c": plant["c"][i]}).lambda_opt()
+        for i in range(len(plant["a"]))])
+
+
+def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]:
+    """(metrics, violations) per run, as arrays, from a batch's raw
+    :class:`~workbench.studies.antiskid_scenario.RunMetrics` arrays."""
+    from ..controllers.antiskid003_settings import BRAKE_IN
+    # the max over the phase a run diverged in is where the test fired
+    in_traction = raw["phase_diverged"] < BRAKE_IN      # NaN (not diverged): False
+    metrics = {"lam_max_over_opt": np.where(in_traction, np.nan,
+                                            raw["lam_max_traction"] / lam_opt),
+               "t_cruise": raw["t_cruise"],
+               "omega3_after_brake": raw["t_omega3"] - t_brake,
+               "t_diverged": raw["t_diverged"],
+               "phase_diverged": raw["phase_diverged"]}
+    viol = {"above_lambda_opt": raw["lam_max_traction"] > lam_opt * 1.001,
+            "diverged": np.isfinite(raw["t_diverged"]),
+            "not_stopped": ~np.isfinite(raw["t_stop"])}
+    return metrics, viol
+
+
+def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
+                chunk: int | None = None, pool: bool | None = None,
+                K: tuple | None = None) -> PendingBatch:
+    """Draw the samples of an ``antiskid-run`` design's sweep and start its
+    chunks (see :func:`sweep`); ``pool`` (default: ``workers > 1``) runs them
+    in a process pool now, so the caller can work meanwhile, else in-process
+    in :meth:`PendingBatch.result`. ``K``: the cruise gain if the caller has
+    it (default: :func:`~workbench.studies.antiskid_run.gain_for`)."""
+    import os
+
+    inp = sweep_inputs(design, samples, seed, K)
+    workers = max(1, workers or os.cpu_count() or 1)
+    chunk = chunk or max(1, math.ceil(samples / DEFAULT_CHUNKS))
+    payloads = [chunk_payload(inp, i0, min(i0 + chunk, samples), inp["dt"])
+                for i0 in range(0, samples, chunk)]
+
+    def collect(outs: list, seconds: float, n_workers: int) -> SweepResult:
+        raw = {k: np.concatenate([o["metrics"][k] for o in outs]) for k in outs[0]["metrics"]}
+        metrics, viol = per_run(raw, run_lambda_opt(inp), inp["scenario"]["t_brake"])
+        return SweepResult({k: v.tolist() for k, v in inp["draws"].items()},
+                           {k: v.tolist() for k, v in metrics.items()},
+                           {k: v.tolist() for k, v in viol.items()}, seconds, n_workers)
+
+    return PendingBatch(chunk_worker, payloads, collect, workers, workers > 1 if pool is None else pool)
+
+
+def sweep(design, samples: int, seed: int, *, workers: int | None = None,
+          chunk: int | None = None, progress: bool = True) -> SweepResult:
+    """Run the Monte Carlo sweep of an ``antiskid-run`` design.
+
+    Parameters
+    ----------
+    design : workbench.design.Design
+        Of kind ``antiskid-run`` with a ``[montecarlo]`` table.
+    samples, seed : int
+    workers : int, optional
+        Process count (default: CPU count); 1 runs in-process.
+    chunk : int, optional
+        Samples per batch (default: samples / DEFAULT_CHUNKS, at least 1).
+        The results depend on it, not on ``workers``.
+    progress : bool
+        Progress bar on stderr.
+    """
+    return start_sweep(design, samples, seed, workers=workers, chunk=chunk).result(progress)
