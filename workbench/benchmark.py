@@ -29,7 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .benchmark_windows import abscissa_curve, exact_windows, interval_fields, middle
+from .benchmark_windows import (abscissa_curve, directed, exact_windows, interval_fields, middle,
+                                show_window)
 from .errors import DesignError
 from .lmi.analysis import METHODS, certified_delay, make_criterion
 from .lmi.core import DEFAULT_MARGIN
@@ -419,7 +420,7 @@ def benchmark_delay(design, *, as_json: bool = False, exact_check: bool = False,
     for e in res.examples:
         agree = ("" if e.exact_agree else
                  f" — EXACT METHODS DISAGREE (rel. diff {fmt(e.agreement, 2)})")
-        wins = " U ".join(f"[{fmt(a, 7)}, {fmt(b, 7)})" for a, b in e.windows) or "none"
+        wins = " U ".join(show_window(a, b, lambda x: fmt(x, 7)) for a, b in e.windows) or "none"
         out(f"\n{e.example.name}: h* = {fmt(e.exact.h, 7)} s (eig), {fmt(e.exact_sweep.h, 7)} "
             f"s (phase sweep){agree} — {e.example.title}\nexact stable windows in "
             f"[0, {fmt(spec.settings.h_max)}] s: {wins}" + ("" if e.sound else
@@ -427,7 +428,8 @@ def benchmark_delay(design, *, as_json: bool = False, exact_check: bool = False,
         table = [[r.method, "" if r.N is None else r.N,
                   fmt(r.h_certified, 6) + (" (>= cap)" if r.at_cap else ""), fmt(r.ratio, 6),
                   "—" if r.interval is None else
-                  f"[{fmt(r.interval[0], 5)}, {fmt(r.interval[1], 5)}]",
+                  f"[{fmt(directed(r.interval[0], up=True, sig=5), 5)}, "
+                  f"{fmt(directed(r.interval[1], up=False, sig=5), 5)}]",
                   f"{r.solves}+{r.interval_solves}", f"{r.seconds:.2f}"]
                  + ([r.exact_check or "—"] if exact_check else []) for r in e.rows]
         out(md_table(["method", "N", "stable at h (point, s)", "ratio", "stable on [lo, hi] "

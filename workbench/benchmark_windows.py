@@ -20,6 +20,21 @@ WINDOW_RTOL = 1e-9
 CURVE_POINTS = 161
 
 
+def directed(x: float, *, up: bool, sig: int = 4) -> float:
+    """x to ``sig`` significant digits, rounded up (a lower end) or down (an upper
+    end): an interval quantity never claims more than was certified, and its
+    last digits, which differ between CPUs, are dropped."""
+    if x == 0 or math.isinf(x):
+        return x
+    q = 10.0 ** (math.floor(math.log10(abs(x))) - sig + 1)
+    return float(f"{(math.ceil(x / q) if up else math.floor(x / q)) * q:.{sig}g}")
+
+
+def show_window(a: float, b: float, fmt) -> str:
+    """A window as text: closed at 0, open at a crossing delay."""
+    return ("[0" if a == 0 else f"({fmt(a)}") + f", {fmt(b)})"
+
+
 def exact_windows(A, Ad, h_max: float) -> tuple[tuple[float, float], ...]:
     """Exact stability windows intersected with [0, h_max] (s); a window that
     never closes keeps ``hi = inf`` (stable for every larger delay)."""

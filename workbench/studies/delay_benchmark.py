@@ -35,6 +35,7 @@ from pathlib import Path
 
 from ..benchmark import (AUTO, BenchmarkResult, BenchmarkSettings, Example, agreement_bound,
                          load_examples, load_settings, run_benchmark)
+from ..benchmark_windows import directed
 from ..reader import Reader
 
 FIELDS = ("h_certified", "ratio", "exact_check", "interval_lo", "interval_hi",
@@ -58,16 +59,6 @@ def _method_keys(s: BenchmarkSettings) -> list[str]:
 
 def _row_key(r) -> str:
     return f"bessel-legendre[N={r.N}]" if r.method == "bessel-legendre" else r.method
-
-
-def directed(x: float, *, up: bool, sig: int = 4) -> float:
-    """x to ``sig`` significant digits, rounded up (a lower end) or down (an upper
-    end): an interval quantity never claims more than was certified, and its
-    last digits, which differ between CPUs, are dropped."""
-    if x == 0 or math.isinf(x):
-        return x
-    q = 10.0 ** (math.floor(math.log10(abs(x))) - sig + 1)
-    return float(f"{(math.ceil(x / q) if up else math.floor(x / q)) * q:.{sig}g}")
 
 
 class DelayBenchmark:

@@ -9,9 +9,9 @@ import math
 import numpy as np
 
 from ..benchmark import AUTO, BenchmarkResult, agreement_bound
+from ..benchmark_windows import directed, show_window
 from ..margins import AGREEMENT_RTOL
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
-from .delay_benchmark import directed
 
 METHOD_DOC = {
     "delay-independent": "delay-independent LKF (Gu, Kharitonov & Chen 2003)",
@@ -46,8 +46,7 @@ def _label(r) -> str:
 def _windows(e) -> str:
     if not e.windows:
         return "none (unstable for every h ≤ h_max)"
-    return " ∪ ".join(("[0" if a == 0 else f"({fmt(a, 7)}") + f", {fmt(b, 7)})"
-                      for a, b in e.windows)
+    return " ∪ ".join(show_window(a, b, lambda x: fmt(x, 7)) for a, b in e.windows)
 
 
 def _interval(r) -> str:
