@@ -234,7 +234,8 @@ def cmd_simulate(args) -> int:
 def cmd_sweep(args) -> int:
     from .studies.antiskid_run import sweep_command
     return sweep_command(_load_kind(args.design, "antiskid-run"), samples=args.samples, seed=args.seed,
-                         workers=args.workers, figure=args.figure, as_json=args.json)
+                         workers=args.workers, figure=args.figure, as_json=args.json,
+                         kernel=args.kernel)
 
 
 COMMANDS: dict[str, tuple[str, Callable]] = {
@@ -285,6 +286,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--samples", type=int, required=True)
     p.add_argument("--seed", type=int, required=True)
     p.add_argument("--workers", type=int, help="processes (default: CPU count)")
+    p.add_argument("--kernel", help="stepping path: compiled (numba; the default when "
+                   "installed) or numpy (the reference)")
     p.add_argument("--figure", help="write the histogram PNG here")
     p.add_argument("--json", action="store_true")
     p = sub.add_parser("verify", help=COMMANDS["verify"][0])

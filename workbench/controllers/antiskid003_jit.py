@@ -10,7 +10,6 @@ paths are compared run by run in ``tests/test_compiled_kernel.py``).
 
 Supported: ``predictor = "rollout"`` (or ``compensate = False``), either
 ``sampling``, either entry; on the fixed step (no refined mesh).
-:func:`supports` says whether a settings object is covered.
 
 State of a run, passed between calls as arrays:
 
@@ -59,15 +58,9 @@ E_HANDOVER, E_V_HANDOVER, E_LAM_HANDOVER = (_EV["t_handover_done"], _EV["v_at_ha
 E_T_DIV, E_PH_DIV, E_HOW = _EV["t_diverged"], _EV["phase_diverged"], _EV["diverged_how"]
 
 
-def supports(s: ControllerSettings) -> bool:
-    """Whether the compiled controller covers these settings (the literal
-    recursive predictor is numpy-only)."""
-    return not (s.compensate and s.predictor != "rollout")
-
-
 def settings_array(s: ControllerSettings, dt: float) -> np.ndarray:
     """The settings of ``s`` at step ``dt`` as the float array ``cfg`` (:data:`CFG`)."""
-    if not supports(s):
+    if s.compensate and s.predictor != "rollout":
         raise ValueError(f"predictor = {s.predictor!r}; the compiled controller runs "
                          "predictor = 'rollout' (or compensate = false)")
     N, f = split_delay(s.h_model, dt)
@@ -114,7 +107,7 @@ def _model_step(v, lam, u, dt, kind, cfg, p):
     """One step of the prediction model ``kind`` (TRACTION, BRAKING, or 0:
     the linear cruise error model, eq 62)."""
     if kind != 0:
-        nv, nl, _ = stiff_step(v, lam, u, dt, p, cfg[V_FLOOR], kind, 0)
+        nv, nl, _ = stiff_step(v, lam, u, dt, p, cfg[V_FLOOR], kind)
         return nv, nl
     ve, le = v - cfg[V_D], lam - cfg[LAMBDA_D]
     den = cfg[D4] * ve + cfg[D5] * le + cfg[D6]

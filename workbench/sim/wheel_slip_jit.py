@@ -90,7 +90,22 @@ def phi1(z):
 
 
 @numba.njit(**_JIT)
-def stiff_step(v, lam, u, dt, p, v_floor, form, depth):
+def _halved(v, lam, u, dt, p, v_floor, form, depth):
+    """The recursion of :func:`stiff_step` (kept apart: a recursive numba
+    function is called, never inlined, and most steps need no halving)."""
+    f1, f20, f2u, j0, ju = forms(fmax(v, v_floor), lam, p, form)
+    nv = v + dt * f1
+    nl = lam + dt * phi1((j0 + ju * u) * dt) * (f20 + f2u * u)
+    big = not abs(nl - lam) <= MAX_DLAMBDA
+    if depth < MAX_HALVINGS and big:
+        hv, hl, bad1 = _halved(v, lam, u, dt / 2, p, v_floor, form, depth + 1)
+        nv2, nl2, bad2 = _halved(hv, hl, u, dt / 2, p, v_floor, form, depth + 1)
+        return nv2, nl2, bad1 or bad2
+    return nv, nl, big
+
+
+@numba.njit(**_JIT)
+def stiff_step(v, lam, u, dt, p, v_floor, form):
     """(v, lambda, unresolved) after one step of :func:`forms` (speed
     floored at ``v_floor`` in the model), halved recursively as
     :func:`workbench.sim.wheel_slip.stiff_step_flagged`."""
@@ -98,9 +113,9 @@ def stiff_step(v, lam, u, dt, p, v_floor, form, depth):
     nv = v + dt * f1
     nl = lam + dt * phi1((j0 + ju * u) * dt) * (f20 + f2u * u)
     big = not abs(nl - lam) <= MAX_DLAMBDA
-    if depth < MAX_HALVINGS and big:
-        hv, hl, bad1 = stiff_step(v, lam, u, dt / 2, p, v_floor, form, depth + 1)
-        nv2, nl2, bad2 = stiff_step(hv, hl, u, dt / 2, p, v_floor, form, depth + 1)
+    if MAX_HALVINGS > 0 and big:
+        hv, hl, bad1 = _halved(v, lam, u, dt / 2, p, v_floor, form, 1)
+        nv2, nl2, bad2 = _halved(hv, hl, u, dt / 2, p, v_floor, form, 1)
         return nv2, nl2, bad1 or bad2
     return nv, nl, big
 

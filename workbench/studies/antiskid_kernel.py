@@ -47,6 +47,12 @@ def default_kernel() -> Kernel:
     return "compiled" if compiled_available() else "numpy"
 
 
+def compiled_covers(s) -> bool:
+    """Whether the compiled kernel covers the controller settings ``s`` (the
+    literal recursive predictor is numpy-only)."""
+    return not (s.compensate and s.predictor != "rollout")
+
+
 def _build():
     """Compile-on-first-use: the numba functions of this kernel."""
     import numba
@@ -151,7 +157,7 @@ def _build():
                 ua = (1.0 - f) * a + f * pbuf[(n - 2 - N) % L]
                 if T >= T_end or ph >= STOPPED:
                     break
-                v, lam, unres = stiff_step(v, lam, ua, dt, p, 1e-3, BY_SIGN, 0)
+                v, lam, unres = stiff_step(v, lam, ua, dt, p, 1e-3, BY_SIGN)
                 st[C.UNRES] = 1.0 if unres else 0.0
                 T += 1
             out[i] = m
@@ -201,8 +207,11 @@ def simulate_batch_compiled(run: RunSettings, dt: float, *,
 
 
 def simulate_batch(run: RunSettings, dt: float, kernel: Kernel) -> RunMetrics:
-    """A batch's :class:`RunMetrics` by the ``kernel`` path (:data:`KERNELS`)."""
-    if kernel == "compiled":
+    """A batch's :class:`RunMetrics` by the ``kernel`` path (:data:`KERNELS`;
+    "compiled" runs the numpy path where :func:`compiled_covers` says no)."""
+    if kernel not in KERNELS:
+        raise ValueError(f"kernel = {kernel!r}; expected one of {KERNELS}")
+    if kernel == "compiled" and compiled_covers(run.controller):
         return simulate_batch_compiled(run, dt)
     from .antiskid_scenario import simulate_antiskid
     B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))

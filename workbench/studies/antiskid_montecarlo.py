@@ -114,18 +114,18 @@ def chunk_worker(payload: dict) -> dict:
     """Simulate one chunk (plain data in, plain data out)."""
     from ..controllers.antiskid003_settings import ControllerSettings, CreepSpeedProfile
     from ..sim.wheel_slip import PARAM_ORDER
-    from .antiskid_scenario import RunSettings, simulate_antiskid
+    from .antiskid_kernel import simulate_batch
+    from .antiskid_scenario import RunSettings
     cs_d = dict(payload["controller"])
     cs_d["profile"] = CreepSpeedProfile(**cs_d["profile"])
     cs_d["params"] = tuple(cs_d["params"])
     cs_d["K"] = tuple(cs_d["K"])
     cs = ControllerSettings(**cs_d)
     plant = tuple(np.asarray(payload["plant"][k], float) for k in PARAM_ORDER)
-    n = len(payload["h"])
     run = RunSettings(plant, cs, np.asarray(payload["h"], float),
                       (np.asarray(payload["v0"], float), payload["lambda0"]),
                       payload["u_init"], payload["t_end"])
-    _, m = simulate_antiskid(run, payload["dt"], record_dt=None, batch=n)
+    m = simulate_batch(run, payload["dt"], payload.get("kernel", "numpy"))
     return {"index": payload["index"], "metrics": {k: np.asarray(v, float).tolist()
                                                    for k, v in vars(m).items()}}
 
@@ -155,10 +155,12 @@ def sweep_inputs(design, samples: int, seed: int, K: tuple | None) -> dict:
             "scenario": spec.scenario, "dt": ms.dt or spec.dt}
 
 
-def chunk_payload(inp: dict, i0: int, i1: int, dt: float) -> dict:
-    """The :func:`chunk_worker` payload of runs ``i0 <= i < i1`` at step ``dt``."""
+def chunk_payload(inp: dict, i0: int, i1: int, dt: float, kernel: str = "numpy") -> dict:
+    """The :func:`chunk_worker` payload of runs ``i0 <= i < i1`` at step
+    ``dt``, simulated by the ``kernel`` path
+    (:data:`~workbench.studies.antiskid_kernel.KERNELS`)."""
     sl, sc, d = slice(i0, i1), inp["scenario"], inp["draws"]
-    return {"index": i0, "controller": inp["controller"],
+    return {"index": i0, "kernel": kernel, "controller": inp["controller"],
             "plant": {k: v[sl].tolist() for k, v in inp["plant"].items()},
             "h": d["h"][sl].tolist(), "v0": d["v0"][sl].tolist(),
             "lambda0": sc["lambda0"], "u_init": sc["u_init"], "t_end": sc["t_end"], "dt": dt}
@@ -193,18 +195,22 @@ def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]
 
 def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
                 chunk: int | None = None, pool: bool | None = None,
-                K: tuple | None = None) -> PendingBatch:
+                K: tuple | None = None, kernel: str | None = None) -> PendingBatch:
     """Draw the samples of an ``antiskid-run`` design's sweep and start its
     chunks (see :func:`sweep`); ``pool`` (default: ``workers > 1``) runs them
     in a process pool now, so the caller can work meanwhile, else in-process
     in :meth:`PendingBatch.result`. ``K``: the cruise gain if the caller has
-    it (default: :func:`~workbench.studies.antiskid_run.gain_for`)."""
+    it (default: :func:`~workbench.studies.antiskid_run.gain_for`). ``kernel``:
+    "compiled" or "numpy" (default: compiled when numba is installed)."""
     import os
+
+    from .antiskid_kernel import default_kernel
 
     inp = sweep_inputs(design, samples, seed, K)
     workers = max(1, workers or os.cpu_count() or 1)
     chunk = chunk or max(1, math.ceil(samples / DEFAULT_CHUNKS))
-    payloads = [chunk_payload(inp, i0, min(i0 + chunk, samples), inp["dt"])
+    kernel = kernel or default_kernel()
+    payloads = [chunk_payload(inp, i0, min(i0 + chunk, samples), inp["dt"], kernel)
                 for i0 in range(0, samples, chunk)]
 
     def collect(outs: list, seconds: float, n_workers: int) -> SweepResult:
@@ -218,7 +224,8 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
 
 
 def sweep(design, samples: int, seed: int, *, workers: int | None = None,
-          chunk: int | None = None, progress: bool = True) -> SweepResult:
+          chunk: int | None = None, progress: bool = True,
+          kernel: str | None = None) -> SweepResult:
     """Run the Monte Carlo sweep of an ``antiskid-run`` design.
 
     Parameters
@@ -233,5 +240,9 @@ def sweep(design, samples: int, seed: int, *, workers: int | None = None,
         The results depend on it, not on ``workers``.
     progress : bool
         Progress bar on stderr.
+    kernel : {"compiled", "numpy"}, optional
+        The stepping path (default: compiled when numba is installed); the
+        results agree to rounding (``tests/test_compiled_kernel.py``).
     """
-    return start_sweep(design, samples, seed, workers=workers, chunk=chunk).result(progress)
+    return start_sweep(design, samples, seed, workers=workers, chunk=chunk,
+                       kernel=kernel).result(progress)

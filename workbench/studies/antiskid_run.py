@@ -196,7 +196,7 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
 
 
 def sweep_command(design, *, samples: int, seed: int, workers: int | None,
-                  figure: str | None, as_json: bool) -> int:
+                  figure: str | None, as_json: bool, kernel: str | None = None) -> int:
     """``workbench sweep`` on a loaded ``antiskid-run`` design: run, print summary statistics (and JSON), write
     the histogram figure; exit 0 (violations are reported, not failures)."""
     import json
@@ -213,7 +213,13 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     if design.spec.montecarlo is None:
         raise DesignError(design.path, "montecarlo", "<missing>",
                           "an antiskid-run design with a [montecarlo] table")
-    res = sweep(design, samples, seed, workers=workers)
+    from .antiskid_kernel import KERNELS, compiled_available
+    if kernel is not None and kernel not in KERNELS:
+        raise DesignError("<cli>", "--kernel", kernel, " or ".join(KERNELS))
+    if kernel == "compiled" and not compiled_available():
+        raise DesignError("<cli>", "--kernel", kernel,
+                          "numpy here: numba is not installed (pip install 'workbench[fast]')")
+    res = sweep(design, samples, seed, workers=workers, kernel=kernel)
     if figure:
         from ..report.figures import save_figure
         save_figure(Figure(Path(figure).stem, "Monte Carlo histograms",
