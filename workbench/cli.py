@@ -88,7 +88,7 @@ def cmd_verify(args) -> int:
     from .ci import run_verify, timing_table
     from .report.markdown import fmt, md_table
 
-    run = run_verify(args.designs, changed_since=args.changed_since)
+    run = run_verify(args.designs, changed_since=args.changed_since, progress=not args.json)
     evs = run.evaluations
     extra = {}
     if run.proofs:
@@ -136,8 +136,10 @@ def cmd_report(args) -> int:
     from .report.writer import check_reports, write_reports
     from .verify import evaluate_design, report_files
 
+    from .sim.progress import progress
     designs = _designs([] if args.all else args.designs)
-    files = [report_files(evaluate_design(d)) for d in designs]
+    files = [report_files(evaluate_design(d))
+             for d in progress(designs, desc="report", unit="design", enabled=len(designs) > 1)]
     index = args.all or not args.designs
     if index:
         from .prove import report_files

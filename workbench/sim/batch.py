@@ -4,16 +4,18 @@ A job is a list of plain-data payloads and a module-level worker function
 (picklable by reference); each chunk is a pure function of its payload, so
 the results do not depend on the pool, its size or the order chunks finish
 in. Nothing here knows what is simulated: the studies provide the worker,
-the payloads and what to make of the outputs (``collect``).
+the payloads and what to make of the outputs (``collect``). Progress is a
+:func:`workbench.sim.progress.progress` bar (terminal only).
 """
 from __future__ import annotations
 
-import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Callable
 
 import numpy as np
+
+from .progress import progress as progress_bar
 
 
 def uniform_draws(n: int, seed: int, ranges: dict) -> dict:
@@ -25,16 +27,6 @@ def uniform_draws(n: int, seed: int, ranges: dict) -> dict:
     """
     u = np.random.default_rng(np.random.SeedSequence(seed)).uniform(size=(n, len(ranges)))
     return {k: lo + (hi - lo) * u[:, j] for j, (k, (lo, hi)) in enumerate(ranges.items())}
-
-
-def _progress(done: int, total: int, t0: float, stream=sys.stderr) -> None:
-    width = 30
-    k = int(width * done / total)
-    stream.write(f"\r[{'#' * k}{'.' * (width - k)}] {done}/{total} chunks, "
-                 f"{time.perf_counter() - t0:.0f} s")
-    if done == total:
-        stream.write("\n")
-    stream.flush()
 
 
 class PendingBatch:
@@ -54,10 +46,18 @@ class PendingBatch:
     pool : bool
         True: start the pool now (the caller can work meanwhile); False: run
         the chunks in-process in :meth:`result`.
+    sizes : list of int, optional
+        Units of work in each payload (e.g. runs), for the progress bar's
+        count, rate and ETA (default: 1 per payload).
+    unit : str
+        What ``sizes`` count.
     """
 
-    def __init__(self, worker: Callable, payloads: list, collect, workers: int, pool: bool):
+    def __init__(self, worker: Callable, payloads: list, collect, workers: int, pool: bool,
+                 sizes: list | None = None, unit: str = "chunk"):
         self._worker = worker
+        self._sizes = [1] * len(payloads) if sizes is None else list(sizes)
+        self._unit = unit
         self._payloads, self._collect, self.workers = payloads, collect, workers
         self._t0 = time.perf_counter()
         self._pool = ProcessPoolExecutor(max_workers=min(workers, len(payloads))) if pool \
@@ -66,16 +66,25 @@ class PendingBatch:
             self._pool.submit(worker, p) for p in payloads]
 
     def result(self, progress: bool = False):
-        n, outs = len(self._payloads), []
-        if progress:
-            _progress(0, n, self._t0)
+        """Wait for every chunk; ``progress``: a bar on stderr (terminal only)."""
+        n = len(self._payloads)
+        outs = [None] * n
+        bar = progress_bar(total=sum(self._sizes), unit=self._unit, enabled=progress)
         try:
-            for i, p in enumerate(self._payloads):
-                outs.append(self._worker(p) if self._pool is None
-                            else self._futures[i].result())
-                if progress:
-                    _progress(len(outs), n, self._t0)
+            if self._pool is None:
+                for i, p in enumerate(self._payloads):
+                    outs[i] = self._worker(p)
+                    bar.update(self._sizes[i])
+            else:
+                index = {f: i for i, f in enumerate(self._futures)}
+                pending = set(self._futures)
+                while pending:
+                    done, pending = wait(pending, return_when=FIRST_COMPLETED)
+                    for f in done:
+                        outs[index[f]] = f.result()
+                        bar.update(self._sizes[index[f]])
         finally:
+            bar.close()
             self.cancel()
         return self._collect(outs, time.perf_counter() - self._t0, self.workers)
 

@@ -168,6 +168,20 @@ def _build():
 _KERNEL = None
 
 
+def compile_kernel() -> None:
+    """Compile the kernel in this process now (a few seconds, once). A
+    process pool started afterwards by ``fork`` inherits the compiled code,
+    so its workers do not compile it again."""
+    global _KERNEL
+    if _KERNEL is None:
+        from numba import float64, int64
+        k = _build()
+        a1, a2 = float64[::1], float64[:, ::1]
+        k.compile((a2, int64[::1], a1, a1, float64, float64, int64, a1, a1, float64, a1, a1,
+                   a1, a2))
+        _KERNEL = k
+
+
 def simulate_batch_compiled(run: RunSettings, dt: float, *,
                             evs_settle: float = 5.0) -> RunMetrics:
     """Compiled counterpart of ``simulate_antiskid(run, dt, record_dt=None,
@@ -182,13 +196,11 @@ def simulate_batch_compiled(run: RunSettings, dt: float, *,
     evs_settle : float
         As :class:`~workbench.studies.antiskid_scenario.MetricsRecorder`.
     """
-    global _KERNEL
     from ..controllers.antiskid003_jit import initial_state, settings_array
     from ..sim.wheel_slip import PARAM_ORDER
     if PARAM_ORDER.index("r") != 4:
         raise RuntimeError("PARAM_ORDER changed: update run_batch's index of r")
-    if _KERNEL is None:
-        _KERNEL = _build()
+    compile_kernel()
     B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))
     plant = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(x, float), (B,))
                                            for x in run.plant_params], axis=1))

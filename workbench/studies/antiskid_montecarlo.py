@@ -210,6 +210,10 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
     workers = max(1, workers or os.cpu_count() or 1)
     chunk = chunk or max(1, math.ceil(samples / DEFAULT_CHUNKS))
     kernel = kernel or default_kernel()
+    pool = workers > 1 if pool is None else pool
+    if kernel == "compiled" and pool and len(payloads) > 1:
+        from .antiskid_kernel import compile_kernel
+        compile_kernel()     # once, here: the forked workers inherit it
     payloads = [chunk_payload(inp, i0, min(i0 + chunk, samples), inp["dt"], kernel)
                 for i0 in range(0, samples, chunk)]
 
@@ -220,7 +224,8 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
                            {k: v.tolist() for k, v in metrics.items()},
                            {k: v.tolist() for k, v in viol.items()}, seconds, n_workers)
 
-    return PendingBatch(chunk_worker, payloads, collect, workers, workers > 1 if pool is None else pool)
+    return PendingBatch(chunk_worker, payloads, collect, workers, pool,
+                        sizes=[len(p["h"]) for p in payloads], unit="run")
 
 
 def sweep(design, samples: int, seed: int, *, workers: int | None = None,

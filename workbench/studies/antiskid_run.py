@@ -219,7 +219,7 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     if kernel == "compiled" and not compiled_available():
         raise DesignError("<cli>", "--kernel", kernel,
                           "numpy here: numba is not installed (pip install 'workbench[fast]')")
-    res = sweep(design, samples, seed, workers=workers, kernel=kernel)
+    res = sweep(design, samples, seed, workers=workers, kernel=kernel, progress=not as_json)
     if figure:
         from ..report.figures import save_figure
         save_figure(Figure(Path(figure).stem, "Monte Carlo histograms",
