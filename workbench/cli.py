@@ -237,7 +237,7 @@ def cmd_sweep(args) -> int:
     from .studies.antiskid_run import sweep_command
     return sweep_command(_load_kind(args.design, "antiskid-run"), samples=args.samples, seed=args.seed,
                          workers=args.workers, figure=args.figure, as_json=args.json,
-                         kernel=args.kernel)
+                         kernel=args.kernel, scheduler=args.scheduler)
 
 
 COMMANDS: dict[str, tuple[str, Callable]] = {
@@ -290,6 +290,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, help="processes (default: CPU count)")
     p.add_argument("--kernel", help="stepping path: compiled (numba; the default when "
                    "installed) or numpy (the reference)")
+    p.add_argument("--scheduler", help="run the chunks on Dask: 'local' (a LocalCluster of "
+                   "--workers processes) or a scheduler address, tcp://host:8786")
     p.add_argument("--figure", help="write the histogram PNG here")
     p.add_argument("--json", action="store_true")
     p = sub.add_parser("verify", help=COMMANDS["verify"][0])

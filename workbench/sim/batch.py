@@ -1,9 +1,10 @@
-"""Chunked batch execution: a local process pool, or in-process.
+"""Chunked batch execution: a local process pool, in-process, or a Dask cluster.
 
 A job is a list of plain-data payloads and a module-level worker function
 (picklable by reference); each chunk is a pure function of its payload, so
 the results do not depend on the pool, its size or the order chunks finish
-in. Nothing here knows what is simulated: the studies provide the worker,
+in, nor the machine they ran on: a chunk lost with a Dask worker is simply
+run again elsewhere (the scheduler does it). Nothing here knows what is simulated: the studies provide the worker,
 the payloads and what to make of the outputs (``collect``). Progress is a
 :func:`workbench.sim.progress.progress` bar (terminal only).
 """
@@ -51,19 +52,50 @@ class PendingBatch:
         count, rate and ETA (default: 1 per payload).
     unit : str
         What ``sizes`` count.
+    scheduler : str, optional
+        Run the chunks on a Dask distributed cluster instead (``pool`` is
+        then ignored): ``"local"`` starts a ``distributed.LocalCluster`` of
+        ``workers`` single-threaded worker processes on this machine, any
+        other value is the address of a running scheduler
+        (``tcp://host:8786``), whose workers must have this package
+        installed. Needs the ``scale`` extra (dask, distributed).
+
+    Raises
+    ------
+    OSError
+        The scheduler cannot be reached.
     """
 
     def __init__(self, worker: Callable, payloads: list, collect, workers: int, pool: bool,
-                 sizes: list | None = None, unit: str = "chunk"):
+                 sizes: list | None = None, unit: str = "chunk", scheduler: str | None = None):
         self._worker = worker
         self._sizes = [1] * len(payloads) if sizes is None else list(sizes)
         self._unit = unit
         self._payloads, self._collect, self.workers = payloads, collect, workers
         self._t0 = time.perf_counter()
-        self._pool = ProcessPoolExecutor(max_workers=min(workers, len(payloads))) if pool \
-            else None
-        self._futures = None if self._pool is None else [
-            self._pool.submit(worker, p) for p in payloads]
+        self._pool = self.client = self._cluster = None
+        self._futures = None
+        if scheduler is not None:
+            self._start_dask(scheduler)
+        elif pool:
+            self._pool = ProcessPoolExecutor(max_workers=min(workers, len(payloads)))
+            self._futures = [self._pool.submit(worker, p) for p in payloads]
+
+    def _start_dask(self, scheduler: str) -> None:
+        from distributed import Client, LocalCluster
+        try:
+            if scheduler == "local":
+                self._cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
+                                             processes=True, dashboard_address=None)
+                self.client = Client(self._cluster)
+            else:
+                self.client = Client(scheduler, timeout="10s")
+        except BaseException:
+            self.cancel()
+            raise
+        self.workers = len(self.client.scheduler_info().get("workers", {})) or self.workers
+        # pure=False: a fresh key per chunk; a chunk whose worker dies is re-run by the scheduler
+        self._futures = self.client.map(self._worker, self._payloads, pure=False)
 
     def result(self, progress: bool = False):
         """Wait for every chunk; ``progress``: a bar on stderr (terminal only)."""
@@ -71,7 +103,13 @@ class PendingBatch:
         outs = [None] * n
         bar = progress_bar(total=sum(self._sizes), unit=self._unit, enabled=progress)
         try:
-            if self._pool is None:
+            if self.client is not None:
+                from distributed import as_completed
+                index = {f.key: i for i, f in enumerate(self._futures)}
+                for f in as_completed(self._futures):
+                    outs[index[f.key]] = f.result()
+                    bar.update(self._sizes[index[f.key]])
+            elif self._pool is None:
                 for i, p in enumerate(self._payloads):
                     outs[i] = self._worker(p)
                     bar.update(self._sizes[i])
@@ -89,6 +127,15 @@ class PendingBatch:
         return self._collect(outs, time.perf_counter() - self._t0, self.workers)
 
     def cancel(self) -> None:
-        """Stop the pool (chunks not yet started are dropped)."""
+        """Stop the pool or leave the cluster (chunks not yet started are
+        dropped; a LocalCluster started here is closed)."""
         if self._pool is not None:
             self._pool.shutdown(wait=True, cancel_futures=True)
+        if self.client is not None:
+            if self._futures is not None:
+                self.client.cancel(self._futures)
+            self.client.close()
+            self.client = None
+        if self._cluster is not None:
+            self._cluster.close()
+            self._cluster = None

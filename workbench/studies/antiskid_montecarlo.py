@@ -195,13 +195,16 @@ def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]
 
 def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
                 chunk: int | None = None, pool: bool | None = None,
-                K: tuple | None = None, kernel: str | None = None) -> PendingBatch:
+                K: tuple | None = None, kernel: str | None = None,
+                scheduler: str | None = None) -> PendingBatch:
     """Draw the samples of an ``antiskid-run`` design's sweep and start its
     chunks (see :func:`sweep`); ``pool`` (default: ``workers > 1``) runs them
     in a process pool now, so the caller can work meanwhile, else in-process
     in :meth:`PendingBatch.result`. ``K``: the cruise gain if the caller has
     it (default: :func:`~workbench.studies.antiskid_run.gain_for`). ``kernel``:
-    "compiled" or "numpy" (default: compiled when numba is installed)."""
+    "compiled" or "numpy" (default: compiled when numba is installed).
+    ``scheduler``: run the chunks on Dask (``"local"`` or a scheduler's
+    address; :class:`~workbench.sim.batch.PendingBatch`)."""
     import os
 
     from .antiskid_kernel import default_kernel
@@ -211,11 +214,11 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
     chunk = chunk or max(1, math.ceil(samples / DEFAULT_CHUNKS))
     kernel = kernel or default_kernel()
     pool = workers > 1 if pool is None else pool
-    if kernel == "compiled" and pool and len(payloads) > 1:
-        from .antiskid_kernel import compile_kernel
-        compile_kernel()     # once, here: the forked workers inherit it
     payloads = [chunk_payload(inp, i0, min(i0 + chunk, samples), inp["dt"], kernel)
                 for i0 in range(0, samples, chunk)]
+    if kernel == "compiled" and pool and len(payloads) > 1 and scheduler is None:
+        from .antiskid_kernel import compile_kernel
+        compile_kernel()     # once, here: the forked workers inherit it
 
     def collect(outs: list, seconds: float, n_workers: int) -> SweepResult:
         raw = {k: np.concatenate([o["metrics"][k] for o in outs]) for k in outs[0]["metrics"]}
@@ -225,12 +228,12 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
                            {k: v.tolist() for k, v in viol.items()}, seconds, n_workers)
 
     return PendingBatch(chunk_worker, payloads, collect, workers, pool,
-                        sizes=[len(p["h"]) for p in payloads], unit="run")
+                        sizes=[len(p["h"]) for p in payloads], unit="run", scheduler=scheduler)
 
 
 def sweep(design, samples: int, seed: int, *, workers: int | None = None,
           chunk: int | None = None, progress: bool = True,
-          kernel: str | None = None) -> SweepResult:
+          kernel: str | None = None, scheduler: str | None = None) -> SweepResult:
     """Run the Monte Carlo sweep of an ``antiskid-run`` design.
 
     Parameters
@@ -248,6 +251,11 @@ def sweep(design, samples: int, seed: int, *, workers: int | None = None,
     kernel : {"compiled", "numpy"}, optional
         The stepping path (default: compiled when numba is installed); the
         results agree to rounding (``tests/test_compiled_kernel.py``).
+    scheduler : str, optional
+        Run the chunks on a Dask distributed cluster: ``"local"`` (a
+        LocalCluster of ``workers`` processes) or a scheduler address. The
+        results do not depend on the executor, the worker count or the
+        chunking (``tests/test_sweep_executors.py``).
     """
     return start_sweep(design, samples, seed, workers=workers, chunk=chunk,
-                       kernel=kernel).result(progress)
+                       kernel=kernel, scheduler=scheduler).result(progress)

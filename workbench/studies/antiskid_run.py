@@ -196,7 +196,8 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
 
 
 def sweep_command(design, *, samples: int, seed: int, workers: int | None,
-                  figure: str | None, as_json: bool, kernel: str | None = None) -> int:
+                  figure: str | None, as_json: bool, kernel: str | None = None,
+                  scheduler: str | None = None) -> int:
     """``workbench sweep`` on a loaded ``antiskid-run`` design: run, print summary statistics (and JSON), write
     the histogram figure; exit 0 (violations are reported, not failures)."""
     import json
@@ -219,7 +220,17 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     if kernel == "compiled" and not compiled_available():
         raise DesignError("<cli>", "--kernel", kernel,
                           "numpy here: numba is not installed (pip install 'workbench[fast]')")
-    res = sweep(design, samples, seed, workers=workers, kernel=kernel, progress=not as_json)
+    if scheduler is not None:
+        from importlib.util import find_spec
+        if find_spec("distributed") is None:
+            raise DesignError("<cli>", "--scheduler", scheduler, "no flag here: dask.distributed "
+                              "is not installed (pip install 'workbench[scale]')")
+    try:
+        res = sweep(design, samples, seed, workers=workers, kernel=kernel, progress=not as_json,
+                    scheduler=scheduler)
+    except OSError as e:       # the scheduler cannot be reached
+        raise DesignError("<cli>", "--scheduler", scheduler,
+                          f"'local' or the address of a running Dask scheduler ({e})") from None
     if figure:
         from ..report.figures import save_figure
         save_figure(Figure(Path(figure).stem, "Monte Carlo histograms",
