@@ -237,7 +237,8 @@ def cmd_sweep(args) -> int:
     from .studies.antiskid_run import sweep_command
     return sweep_command(_load_kind(args.design, "antiskid-run"), samples=args.samples, seed=args.seed,
                          workers=args.workers, figure=args.figure, as_json=args.json,
-                         kernel=args.kernel, scheduler=args.scheduler)
+                         kernel=args.kernel, scheduler=args.scheduler, out=args.out,
+                         resume=args.resume)
 
 
 COMMANDS: dict[str, tuple[str, Callable]] = {
@@ -292,6 +293,10 @@ def build_parser() -> argparse.ArgumentParser:
                    "installed) or numpy (the reference)")
     p.add_argument("--scheduler", help="run the chunks on Dask: 'local' (a LocalCluster of "
                    "--workers processes) or a scheduler address, tcp://host:8786")
+    p.add_argument("--out", metavar="DIR", help="write each chunk's runs to DIR/chunk-*.npz "
+                   "as it finishes; the summaries are read back from the files")
+    p.add_argument("--resume", action="store_true",
+                   help="with --out: skip the chunks already written in DIR")
     p.add_argument("--figure", help="write the histogram PNG here")
     p.add_argument("--json", action="store_true")
     p = sub.add_parser("verify", help=COMMANDS["verify"][0])

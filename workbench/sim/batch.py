@@ -19,14 +19,22 @@ import numpy as np
 from .progress import progress as progress_bar
 
 
-def uniform_draws(n: int, seed: int, ranges: dict) -> dict:
-    """n seeded uniform samples of each named range, ``{name: (lo, hi)}``.
+def uniform_draws(n: int, seed: int, ranges: dict, start: int = 0) -> dict:
+    """Seeded uniform samples ``start <= i < n`` of each named range,
+    ``{name: (lo, hi)}``.
 
     Sample i is row i of one (n, len(ranges)) draw of numpy's default
-    generator seeded by ``SeedSequence(seed)``, so the first n samples of a
-    larger draw with the same seed are the same.
+    generator (PCG64) seeded by ``SeedSequence(seed)``, so the first n
+    samples of a larger draw with the same seed are the same. Each uniform
+    takes one 64-bit output of the generator, so rows from ``start`` on are
+    drawn directly after advancing it by ``start * len(ranges)`` outputs: a
+    chunk of a sweep draws its own samples, the same as the whole draw's.
     """
-    u = np.random.default_rng(np.random.SeedSequence(seed)).uniform(size=(n, len(ranges)))
+    if not 0 <= start <= n:
+        raise ValueError(f"start = {start!r}; expected 0 <= start <= n = {n}")
+    bits = np.random.PCG64(np.random.SeedSequence(seed))
+    bits.advance(start * len(ranges))
+    u = np.random.Generator(bits).uniform(size=(n - start, len(ranges)))
     return {k: lo + (hi - lo) * u[:, j] for j, (k, (lo, hi)) in enumerate(ranges.items())}
 
 
@@ -59,6 +67,10 @@ class PendingBatch:
         other value is the address of a running scheduler
         (``tcp://host:8786``), whose workers must have this package
         installed. Needs the ``scale`` extra (dask, distributed).
+    sink : callable, optional
+        ``sink(i, output)`` is called as each chunk finishes (e.g. to write
+        it to a file); ``collect`` then receives what it returned instead of
+        the outputs, so they are not all held in memory.
 
     Raises
     ------
@@ -67,10 +79,12 @@ class PendingBatch:
     """
 
     def __init__(self, worker: Callable, payloads: list, collect, workers: int, pool: bool,
-                 sizes: list | None = None, unit: str = "chunk", scheduler: str | None = None):
+                 sizes: list | None = None, unit: str = "chunk", scheduler: str | None = None,
+                 sink: Callable | None = None):
         self._worker = worker
         self._sizes = [1] * len(payloads) if sizes is None else list(sizes)
         self._unit = unit
+        self._sink = sink or (lambda i, out: out)
         self._payloads, self._collect, self.workers = payloads, collect, workers
         self._t0 = time.perf_counter()
         self._pool = self.client = self._cluster = None
@@ -107,11 +121,11 @@ class PendingBatch:
                 from distributed import as_completed
                 index = {f.key: i for i, f in enumerate(self._futures)}
                 for f in as_completed(self._futures):
-                    outs[index[f.key]] = f.result()
+                    outs[index[f.key]] = self._sink(index[f.key], f.result())
                     bar.update(self._sizes[index[f.key]])
             elif self._pool is None:
                 for i, p in enumerate(self._payloads):
-                    outs[i] = self._worker(p)
+                    outs[i] = self._sink(i, self._worker(p))
                     bar.update(self._sizes[i])
             else:
                 index = {f: i for i, f in enumerate(self._futures)}
@@ -119,7 +133,7 @@ class PendingBatch:
                 while pending:
                     done, pending = wait(pending, return_when=FIRST_COMPLETED)
                     for f in done:
-                        outs[index[f]] = f.result()
+                        outs[index[f]] = self._sink(index[f], f.result())
                         bar.update(self._sizes[index[f]])
         finally:
             bar.close()

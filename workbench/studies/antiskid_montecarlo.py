@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -103,11 +104,11 @@ def montecarlo_quantities(res: SweepResult) -> dict:
             **{f"montecarlo.{k}": v for k, v in res.statistics().items()}}
 
 
-def draw_samples(n: int, seed: int, spec: SweepSpec) -> dict:
-    """n samples of (mass factor, adhesion s, delay h, v0), uniform, seeded;
-    sample i does not depend on n."""
+def draw_samples(n: int, seed: int, spec: SweepSpec, start: int = 0) -> dict:
+    """Samples ``start <= i < n`` of (mass factor, adhesion s, delay h, v0),
+    uniform, seeded; sample i does not depend on n or start."""
     return uniform_draws(n, seed, {"mass": spec.mass, "adhesion": spec.adhesion, "h": spec.h,
-                                   "v0": spec.v0})
+                                   "v0": spec.v0}, start)
 
 
 def chunk_worker(payload: dict) -> dict:
@@ -130,8 +131,8 @@ def chunk_worker(payload: dict) -> dict:
                                                    for k, v in vars(m).items()}}
 
 
-def sweep_inputs(design, samples: int, seed: int, K: tuple | None) -> dict:
-    """The first ``samples`` runs of the design's sweep with ``seed`` as
+def sweep_inputs(design, samples: int, seed: int, K: tuple | None, start: int = 0) -> dict:
+    """Runs ``start <= i < samples`` of the design's sweep with ``seed`` as
     plain data: ``draws``, per-run ``plant`` parameters, the nominal values
     ``base``, the ``controller`` (``asdict`` of the case's settings), the
     ``scenario`` and ``dt``; ``K``: the cruise gain if the caller has it
@@ -144,9 +145,9 @@ def sweep_inputs(design, samples: int, seed: int, K: tuple | None) -> dict:
     case = next(c for c in spec.cases if c.name == ms.case)
     K = gain_for(spec)[0] if K is None else K
     cs = controller_settings(spec, K, case)
-    draws = draw_samples(samples, seed, ms)
+    draws = draw_samples(samples, seed, ms, start)
     base = plant_values(spec)
-    plant = {k: np.full(samples, base[k], float) for k in PARAM_ORDER}
+    plant = {k: np.full(samples - start, base[k], float) for k in PARAM_ORDER}
     s = draws["adhesion"]
     for k in ("a", "b", "c"):
         plant[k] = ms.wet[k] + s * (base[k] - ms.wet[k])
@@ -166,13 +167,45 @@ def chunk_payload(inp: dict, i0: int, i1: int, dt: float, kernel: str = "numpy")
             "lambda0": sc["lambda0"], "u_init": sc["u_init"], "t_end": sc["t_end"], "dt": dt}
 
 
+@lru_cache(maxsize=1)
+def _dmu_traction():
+    """d mu / d lambda of the traction curve (eq 6), lambdified (``math``)
+    from the one sympy model, parameters as arguments (PARAM_ORDER)."""
+    import sympy as sp
+
+    from ..plants.adhesion import adhesion_model
+    from ..sim.wheel_slip import PARAM_ORDER
+    mdl = adhesion_model()
+    return sp.lambdify((mdl.lam, *[mdl.params[k] for k in PARAM_ORDER]),
+                       sp.diff(mdl.mu_traction, mdl.lam), "math")
+
+
+def lambda_opt_of(plant: dict) -> np.ndarray:
+    """lambda_opt (argmax of mu on lambda > 0) of each run's own adhesion
+    curve: the root of d mu / d lambda on (0, 1), as
+    :meth:`~workbench.plants.adhesion.NumericAdhesion.lambda_opt` (same
+    bracket and tolerances) but with one lambdified derivative for every run
+    (~0.1 ms a run instead of a sympy substitution and lambdify per run)."""
+    from scipy.optimize import brentq
+
+    from ..errors import ModelError
+    from ..sim.wheel_slip import PARAM_ORDER
+    f = _dmu_traction()
+    cols = [np.asarray(plant[k], float) for k in PARAM_ORDER]
+    out = np.empty(len(cols[0]))
+    for i in range(out.size):
+        row = tuple(float(c[i]) for c in cols)
+        g = lambda lam: f(lam, *row)     # noqa: E731
+        if not g(1e-12) > 0 or g(1.0) > 0:
+            raise ModelError(f"run {i}: adhesion curve without a peak on (0, 1) "
+                             f"(a, b, c = {row[:3]})")
+        out[i] = brentq(g, 1e-12, 1.0, xtol=1e-15, rtol=1e-14)
+    return out
+
+
 def run_lambda_opt(inp: dict) -> np.ndarray:
-    """lambda_opt of each run's own adhesion curve."""
-    from ..plants.adhesion import NumericAdhesion
-    base, plant = inp["base"], inp["plant"]
-    return np.array([NumericAdhesion.from_dict(
-        {**base, "a": plant["a"][i], "b": plant["b"][i], "c": plant["c"][i]}).lambda_opt()
-        for i in range(len(plant["a"]))])
+    """lambda_opt of each run's own adhesion curve (:func:`lambda_opt_of`)."""
+    return lambda_opt_of(inp["plant"])
 
 
 def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]:
