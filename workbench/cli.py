@@ -79,7 +79,7 @@ def cmd_verify(args) -> int:
     from .ci import run_verify, timing_table
     from .report.markdown import fmt, md_table
 
-    run = run_verify(args.designs, changed_since=args.changed_since)
+    run = run_verify(args.designs, changed_since=args.changed_since, progress=not args.json)
     evs = run.evaluations
     extra = {}
     if run.proofs:
@@ -129,8 +129,10 @@ def cmd_report(args) -> int:
     from .report.writer import check_reports, write_reports
     from .verify import evaluate_design, report_files
 
+    from .sim.progress import progress
     designs = _designs([] if args.all else args.designs)
-    files = [report_files(evaluate_design(d)) for d in designs]
+    files = [report_files(evaluate_design(d))
+             for d in progress(designs, desc="report", unit="design", enabled=len(designs) > 1)]
     index = args.all or not args.designs
     if index:
         from .prove import report_files
@@ -242,7 +244,9 @@ def cmd_simulate(args) -> int:
 def cmd_sweep(args) -> int:
     from .studies.antiskid_run import sweep_command
     return sweep_command(_load_kind(args.design, "antiskid-run"), samples=args.samples, seed=args.seed,
-                         workers=args.workers, figure=args.figure, as_json=args.json)
+                         workers=args.workers, figure=args.figure, as_json=args.json,
+                         kernel=args.kernel, scheduler=args.scheduler, out=args.out,
+                         resume=args.resume)
 
 
 COMMANDS: dict[str, tuple[str, Callable]] = {
@@ -294,6 +298,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--samples", type=int, required=True)
     p.add_argument("--seed", type=int, required=True)
     p.add_argument("--workers", type=int, help="processes (default: CPU count)")
+    p.add_argument("--kernel", help="stepping path: compiled (numba; the default when "
+                   "installed) or numpy (the reference)")
+    p.add_argument("--scheduler", help="run the chunks on Dask: 'local' (a LocalCluster of "
+                   "--workers processes) or a scheduler address, tcp://host:8786")
+    p.add_argument("--out", metavar="DIR", help="write each chunk's runs to DIR/chunk-*.npz "
+                   "as it finishes; the summaries are read back from the files")
+    p.add_argument("--resume", action="store_true",
+                   help="with --out: skip the chunks already written in DIR")
     p.add_argument("--figure", help="write the histogram PNG here")
     p.add_argument("--json", action="store_true")
     p = sub.add_parser("verify", help=COMMANDS["verify"][0])
