@@ -197,7 +197,9 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
 
 
 def sweep_command(design, *, samples: int, seed: int, workers: int | None,
-                  figure: str | None, as_json: bool) -> int:
+                  figure: str | None, as_json: bool, kernel: str | None = None,
+                  scheduler: str | None = None, out: str | None = None,
+                  resume: bool = False) -> int:
     """``workbench sweep`` on a loaded ``antiskid-run`` design: run, print summary statistics (and JSON), write
     the histogram figure; exit 0 (violations are reported, not failures)."""
     import json
@@ -214,7 +216,37 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     if design.spec.montecarlo is None:
         raise DesignError(design.path, "montecarlo", "<missing>",
                           "an antiskid-run design with a [montecarlo] table")
-    res = sweep(design, samples, seed, workers=workers)
+    from .antiskid_kernel import KERNELS, compiled_available
+    if kernel is not None and kernel not in KERNELS:
+        raise DesignError("<cli>", "--kernel", kernel, " or ".join(KERNELS))
+    if kernel == "compiled" and not compiled_available():
+        raise DesignError("<cli>", "--kernel", kernel,
+                          "numpy here: numba is not installed (pip install 'workbench[fast]')")
+    if scheduler is not None:
+        from importlib.util import find_spec
+        if find_spec("distributed") is None:
+            raise DesignError("<cli>", "--scheduler", scheduler, "no flag here: dask.distributed "
+                              "is not installed (pip install 'workbench[scale]')")
+    if resume and not out:
+        raise DesignError("<cli>", "--resume", True, "with --out DIR (the folder to resume)")
+    try:
+        if out:
+            from .antiskid_stream import start_streaming
+            try:
+                pending = start_streaming(design, samples, seed, out, resume=resume,
+                                          workers=workers, kernel=kernel, scheduler=scheduler)
+            except FileExistsError as e:
+                raise DesignError("<cli>", "--out", out, f"a new folder or --resume ({e})") \
+                    from None
+            res = pending.result(progress=not as_json)
+        else:
+            res = sweep(design, samples, seed, workers=workers, kernel=kernel,
+                        progress=not as_json, scheduler=scheduler)
+    except OSError as e:       # the scheduler cannot be reached
+        if scheduler is None:
+            raise
+        raise DesignError("<cli>", "--scheduler", scheduler,
+                          f"'local' or the address of a running Dask scheduler ({e})") from None
     if figure:
         from ..report.figures import save_figure
         save_figure(Figure(Path(figure).stem, "Monte Carlo histograms",
