@@ -30,7 +30,6 @@ of example files relative to the design). Quantities (for claims), with
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
