@@ -16,7 +16,7 @@ OTHER_KERNEL ?= Sandybridge
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -c constraints.txt -e '.[test]'
+	$(PY) -m pip install -q -c constraints.txt -e '.[test,fast,scale]'
 	touch $(STAMP)
 
 install: $(STAMP)

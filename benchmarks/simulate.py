@@ -11,9 +11,13 @@ Prints, in one process:
    an ODE) — over the first ``--ref-horizon`` seconds, and the difference in
    the time to cruise;
 3. batched Monte Carlo throughput (``workbench.studies.antiskid_montecarlo.sweep``,
-   process pool) and the projected time for 1000 runs.
+   process pool) of both stepping paths side by side, the same runs: the
+   batched numpy reference and the compiled kernel (numba; its one-off
+   compilation in each worker is included in its time, and reported apart
+   from a warm-up in this process), runs/min and their ratio, with the
+   machine's load average (the figures are only comparable within one run).
 
-Usage: .venv/bin/python benchmarks/simulate.py [--samples N] [--workers W]
+Usage: .venv/bin/python benchmarks/simulate.py [--samples N] [--workers W] [--skip-single]
 """
 from __future__ import annotations
 
@@ -61,6 +65,8 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=1000)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--ref-horizon", type=float, default=40.0, help="s; > time to cruise")
+    ap.add_argument("--skip-single", action="store_true",
+                    help="only the Monte Carlo throughput of the two paths")
     args = ap.parse_args()
     design = load_design("designs/antiskid-run-dry.toml")
     spec = design.spec
@@ -69,6 +75,13 @@ def main() -> None:
     rs = S.run_settings(spec, S.controller_settings(spec, K, case))
     dt = spec.dt
 
+    if not args.skip_single:
+        single_runs(rs, spec, dt, args.ref_horizon)
+    montecarlo(design, spec, args.samples, args.workers)
+
+
+def single_runs(rs, spec, dt: float, ref_horizon: float) -> None:
+    """Items 1 and 2 of the module docstring."""
     t0 = time.perf_counter()
     _, m = simulate_antiskid(rs, dt, record_dt=None)
     wall = time.perf_counter() - t0
@@ -77,24 +90,42 @@ def main() -> None:
           f"= {sim_s / wall:.0f}x real time (target >= 100x)")
 
     import dataclasses
-    short = dataclasses.replace(rs, t_end=args.ref_horizon)
+    short = dataclasses.replace(rs, t_end=ref_horizon)
     t0 = time.perf_counter()
     _, ms = simulate_antiskid(short, dt, record_dt=None)
     wall_ours = time.perf_counter() - t0
-    t_ref, wall_ref = reference_run(rs, dt, args.ref_horizon)
-    print(f"first {args.ref_horizon:g} s: ours {wall_ours:.2f} s wall, solve_ivp Radau "
+    t_ref, wall_ref = reference_run(rs, dt, ref_horizon)
+    print(f"first {ref_horizon:g} s: ours {wall_ours:.2f} s wall, solve_ivp Radau "
           f"method of steps {wall_ref:.2f} s wall -> ratio {wall_ref / wall_ours:.0f}x; "
           f"time to cruise ours {float(ms.t_cruise):.4f} s, reference {t_ref:.4f} s "
           f"(difference {abs(float(ms.t_cruise) - t_ref):.1e} s)")
 
-    res = sweep(design, args.samples, seed=1, workers=args.workers)
-    per_run = res.seconds / args.samples
-    mc_dt = spec.montecarlo.dt or dt
-    print(f"Monte Carlo: {args.samples} runs of up to {spec.scenario['t_end']:g} s at "
-          f"dt = {mc_dt:g} s, "
-          f"{res.workers} workers, {res.seconds:.1f} s -> {args.samples / res.seconds * 60:.0f} "
-          f"runs/min; projected 1000 runs: {1000 * per_run:.0f} s (target <= 300 s); vs the "
-          f"solve_ivp reference run sequentially: {spec.scenario['t_end'] / args.ref_horizon * wall_ref * 1000 / 60:.0f} min")
+    print(f"solve_ivp reference run, whole {spec.scenario['t_end']:g} s horizon (projected): "
+          f"{spec.scenario['t_end'] / ref_horizon * wall_ref:.0f} s per run")
+
+
+def montecarlo(design, spec, samples: int, workers: int) -> None:
+    """Item 3: the same sweep by both paths, runs/min side by side."""
+    import os
+
+    from workbench.studies.antiskid_kernel import compiled_available
+    mc_dt = spec.montecarlo.dt or spec.dt
+    print(f"Monte Carlo: {samples} runs of up to {spec.scenario['t_end']:g} s at dt = {mc_dt:g} s, "
+          f"seed 1, {workers} workers; load average before: {os.getloadavg()[0]:.2f}")
+    rates = {}
+    paths = ("numpy", "compiled") if compiled_available() else ("numpy",)
+    for kernel in paths:
+        res = sweep(design, samples, seed=1, workers=workers, kernel=kernel, progress=False)
+        rates[kernel] = samples / res.seconds * 60
+        print(f"  {kernel:>8}: {res.seconds:7.1f} s -> {rates[kernel]:6.0f} runs/min "
+              f"({rates[kernel] / 60 / res.workers:.1f} runs/s per worker); "
+              f"projected 1000 runs: {1000 / rates[kernel] * 60:.0f} s")
+    if len(rates) == 2:
+        print(f"  ratio compiled / numpy: {rates['compiled'] / rates['numpy']:.1f}x "
+              f"(target: compiled >= 3000 runs/min on 2 cores); "
+              f"load average after: {os.getloadavg()[0]:.2f}")
+    else:
+        print("  compiled: numba not installed (pip install 'workbench[fast]')")
 
 
 if __name__ == "__main__":

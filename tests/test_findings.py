@@ -51,7 +51,7 @@ def test_summary_orders_findings_most_severe_first():
     assert text.index("claim spin") < text.index("claim offset") < text.index("claim minor")
     cells = index_cells(results)
     assert cells[0] == "verified" and cells[1] == "1 of 3"
-    assert cells[3].startswith("**safety**: claim spin")
+    assert cells[3].startswith("**safety** (not reproduced: claim spin")
 
 
 def test_a_claim_that_does_not_hold_leads_the_block():

@@ -159,7 +159,8 @@ class VerifyRun:
         return all(e.ok for e in self.evaluations) and all(r.ok for _, r in self.proofs)
 
 
-def run_verify(paths: list[str], *, changed_since: str | None = None) -> VerifyRun:
+def run_verify(paths: list[str], *, changed_since: str | None = None,
+               progress: bool = False) -> VerifyRun:
     """Evaluate designs and proofs, timing each.
 
     Parameters
@@ -169,6 +170,9 @@ def run_verify(paths: list[str], *, changed_since: str | None = None) -> VerifyR
     changed_since : str, optional
         A git revision: keep only designs (and proof modules) that depend on a
         file changed since it (see :mod:`workbench.changes`).
+    progress : bool
+        A progress bar over the designs and proof modules on stderr (only
+        when stderr is a terminal: :mod:`workbench.sim.progress`).
 
     Raises
     ------
@@ -202,15 +206,23 @@ def run_verify(paths: list[str], *, changed_since: str | None = None) -> VerifyR
                   if proof_changed(project.proofs / f"{m.name}.py", changed)]
         skipped += [f"proofs/{m.name}" for m in modules if m not in keep_m]
         modules = keep_m
+    from .sim.progress import progress as progress_bar
     seconds, evaluations, proofs = [], [], []
-    for d in designs:
-        t0 = time.perf_counter()
-        evaluations.append(evaluate_design(d))
-        seconds.append((d.name, time.perf_counter() - t0))
-    for m in modules:
-        t0 = time.perf_counter()
-        proofs += run_proofs([m.name])
-        seconds.append((f"proofs/{m.name}", time.perf_counter() - t0))
+    bar = progress_bar(total=len(designs) + len(modules), desc="verify", unit="design",
+                       enabled=progress and len(designs) + len(modules) > 1)
+    with bar:
+        for d in designs:
+            bar.set_postfix_str(d.name, refresh=False)
+            t0 = time.perf_counter()
+            evaluations.append(evaluate_design(d))
+            seconds.append((d.name, time.perf_counter() - t0))
+            bar.update()
+        for m in modules:
+            bar.set_postfix_str(f"proofs/{m.name}", refresh=False)
+            t0 = time.perf_counter()
+            proofs += run_proofs([m.name])
+            seconds.append((f"proofs/{m.name}", time.perf_counter() - t0))
+            bar.update()
     return VerifyRun(tuple(evaluations), tuple(proofs), tuple(seconds), tuple(skipped))
 
 

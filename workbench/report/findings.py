@@ -105,5 +105,7 @@ def index_cells(results: tuple[ClaimResult, ...]) -> list[str]:
     worst = s.findings[0] if s.findings else None
     total = {k: n for k, n in ((sev, sum(r.claim.severity == sev for r in s.findings))
                                for sev in reversed(SEVERITIES)) if n}
+    what = "" if worst is None else ("not reproduced: " if worst.claim.origin == "paper"
+                                     else "workbench: ")
     return [verdict, f"{s.reproduced} of {s.paper}", _counts(total),
-            f"**{worst.claim.severity}**: {worst.claim.description}" if worst else "—"]
+            f"**{worst.claim.severity}** ({what}{worst.claim.description})" if worst else "—"]

@@ -50,10 +50,18 @@ def claims_table(results: tuple[ClaimResult, ...]) -> str:
 
 
 def verdict_summary(results) -> str:
+    """One line: how many claims hold as stated, and how many of those are
+    known discrepancies (FAIL as expected) rather than passes."""
     n = len(results)
     ok = sum(r.ok for r in results)
-    counts = {v: sum(r.verdict is v for r in results) for v in Verdict}
-    return (f"{ok}/{n} claims ok — " + ", ".join(f"{counts[v]} {v.value}" for v in Verdict))
+    known = sum(r.ok and r.claim.expect == "fail" for r in results)
+    passed = sum(r.ok and r.verdict is Verdict.PASS and r.claim.expect == "pass"
+                 for r in results)
+    other = ok - known - passed
+    return (f"{ok} of {n} claims hold as stated: {passed} pass, {known} known "
+            f"discrepancies fail as expected" + (f", {other} inconclusive as allowed"
+                                                   if other else "")
+            + ("" if ok == n else f"; {n - ok} do not hold"))
 
 
 def provenance(solver: str | None) -> str:

@@ -47,6 +47,7 @@ STUDIES: dict[str, str] = {
     "brake-fit": "fit000:STUDY",
     "ato-tracking": "tracking002:STUDY",
     "ntsm-platoon": "platoon001:STUDY",
+    "delay-feedback": "delay_feedback:STUDY",
 }
 
 
@@ -61,6 +62,7 @@ RENDERERS: dict[str, str] = {
     "brake-fit": "fit000:render",
     "ato-tracking": "tracking002_render:render",
     "ntsm-platoon": "platoon001_render:render",
+    "delay-feedback": "delay_feedback_render:render",
 }
 
 

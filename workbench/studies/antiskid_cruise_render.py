@@ -10,7 +10,9 @@ from ..plants.adhesion import adhesion_model
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, margin_text, md_table
 
 
-def _margin_text(dm) -> str:
+def exact_margin_text(dm) -> str:
+    """An exact delay margin as printed: 5 significant digits, ``∞``, or
+    ``0 (unstable at h = 0)``; ``—`` for None."""
     if dm is None:
         return "—"
     if dm.reason == "unstable-at-zero-delay":
@@ -83,7 +85,7 @@ def render(design, res) -> Rendered:
     for r in res.rows:
         rows.append([fmt(r.eps), fmt(r.h_certified, 5), fmt(r.h_refuted, 5),
                      _gain(r.K, st.gain_digits), fmt(r.h_gain, 4),
-                     _margin_text(r.exact), _margin_text(r.exact_siso), fmt(r.ratio, 3),
+                     exact_margin_text(r.exact), exact_margin_text(r.exact_siso), fmt(r.ratio, 3),
                      r.status.value])
     sections.append(
         "## Certified delay bounds (problem 60, cf. Table 3)\n\n"
@@ -107,7 +109,7 @@ def render(design, res) -> Rendered:
         "rounded gain certifies on its own under the same LMI with V = K L fixed. *h\\**: the "
         "exact delay margin of x' = A x + B K x(t-h) with that gain, from two independent "
         "methods.\n\n"
-        + _inf_note(res) + "\n\n" + _recheck_table(res))
+        + _inf_note(res) + "\n\n" + recheck_table(res))
     # -- published comparison -----------------------------------------------------
     if res.published:
         prow = []
@@ -116,7 +118,7 @@ def render(design, res) -> Rendered:
             prow.append([fmt(p.eps), fmt(p.h_m, 4), fmt(c.h_ours, 4),
                          "[" + ", ".join(fmt(k, 5) for k in p.K) + "]",
                          f"{fmt(c.h_paper_K, 4)}", fmt(c.eps_matching, 3),
-                         _margin_text(c.exact_paper_K), p.source])
+                         exact_margin_text(c.exact_paper_K), p.source])
         sections.append(
             "## Comparison with the printed table\n\n"
             + md_table(["eps", "printed h_m (s)", "ours h_certified (s)", "printed K",
@@ -165,8 +167,9 @@ def render(design, res) -> Rendered:
     return Rendered(tuple(sections), figs)
 
 
-def _recheck_table(res) -> str:
-    """Per-block re-check margins of every canonical certificate, as decades."""
+def recheck_table(res) -> str:
+    """Per-block re-check margins of every canonical certificate (``res.rows``,
+    :class:`workbench.synthesis.SynthesisRow`), as decades, in a <details> block."""
     rows = [r for r in res.rows if r.recheck]
     if not rows:
         return ""
@@ -275,7 +278,7 @@ def _plot_abscissa(fig, res):
     ax.legend(fontsize=8)
 
 
-def _capped(h, cap) -> str:
+def capped_text(h, cap) -> str:
     """A certified bound, marked when it is the search cap (a lower bound only)."""
     if h is None:
         return "—"
@@ -286,7 +289,7 @@ def _gain(K, digits: int = 4) -> str:
     return "—" if K is None else "[" + ", ".join(fmt(float(k), digits) for k in np.ravel(K)) + "]"
 
 
-def _closed_loop_eigs(A, B, K) -> str:
+def closed_loop_eigs_text(A, B, K) -> str:
     """Eigenvalues of A + B K (delay-free closed loop), 1/s."""
     if K is None:
         return "—"
@@ -304,33 +307,33 @@ def _tight_section(t, A, B) -> str:
     rows = []
 
     def bl(c):
-        return _capped(c.h_certified, cap) if c else "—"
+        return capped_text(c.h_certified, cap) if c else "—"
 
     def em(c):
-        return _margin_text(c.exact) if c else "—"
+        return exact_margin_text(c.exact) if c else "—"
     if t.published:
         p = t.published
         rows.append([f"paper, printed ({p.source})", fmt(p.eps), _gain(p.K),
                      fmt(p.h_m, 4) + " (printed)", bl(t.published_check), em(t.published_check),
-                     _closed_loop_eigs(A, B, p.K)])
+                     closed_loop_eigs_text(A, B, p.K)])
     r = t.reference
     rows.append(["ours: problem (60), free weighting, eps fixed", fmt(r.eps), _gain(r.K),
                  fmt(r.h_gain, 4), bl(t.reference_check), em(t.reference_check),
-                 _closed_loop_eigs(A, B, r.K)])
+                 closed_loop_eigs_text(A, B, r.K)])
     rows.append(["tight: Wirtinger synthesis, eps searched", fmt(s.eps, 3), _gain(s.K),
-                 _capped(s.gain.h_certified if s.gain else None, cap), bl(t.check), em(t.check),
-                 _closed_loop_eigs(A, B, s.K)])
+                 capped_text(s.gain.h_certified if s.gain else None, cap), bl(t.check), em(t.check),
+                 closed_loop_eigs_text(A, B, s.K)])
     table = md_table(["design", "eps", "K", "certified h with this K, own LMI (s)",
                       f"certified h, Bessel-Legendre N = {N} analysis with this K (s)",
                       "exact margin h* (s)", "eigenvalues of A + BK (1/s)"], rows, "lrlrrrl")
     tried = md_table(["eps", "certified h (s)"],
-                     [[fmt(e, 4), _capped(h, cap)] for e, h in s.eps_tried], "rr")
+                     [[fmt(e, 4), capped_text(h, cap)] for e, h in s.eps_tried], "rr")
     notes = [
         "The tight synthesis is the Wirtinger-based criterion of Seuret & Gouaisbaut (2013) with "
         "Fridman's descriptor slack P3 = eps P2, made linear by the congruence Y = P2⁻¹, V = K Y "
         "(`workbench/lmi/tight_synthesis.py`); eps is searched automatically (log grid, then "
         "golden section, stopping once the cap is reached), and each eps is a certified, "
-        f"re-checked bisection on h (best bound {_capped(s.h_certified, cap)} s). Its gain is the "
+        f"re-checked bisection on h (best bound {capped_text(s.h_certified, cap)} s). Its gain is the "
         "canonical one, as above (minimum-norm certificate at the chosen fraction of that "
         "bound, rounded), and the third column is what that gain certifies with K fixed. Every "
         "gain is then re-certified by the Bessel-Legendre *analysis* LMI (independent of the "

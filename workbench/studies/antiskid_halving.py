@@ -127,7 +127,7 @@ def _step_values(metrics: dict, viol: dict) -> dict:
 
 
 def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
-                  coarse: bool = True) -> PendingBatch:
+                  coarse: bool = True, kernel: str | None = None) -> PendingBatch:
     """Start the step-halving check of the first ``n`` runs of an
     ``antiskid-run`` design's sweep (its ``[montecarlo]`` seed and draws).
 
@@ -139,15 +139,18 @@ def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
     function of the sweep's :class:`SweepResult` (whose first n runs are the
     dt side: each run of a batch follows its single-run trajectory, whatever
     its chunk) that makes the :class:`HalvingCheck`. ``K``: as
-    :func:`~workbench.studies.antiskid_montecarlo.start_sweep`.
+    :func:`~workbench.studies.antiskid_montecarlo.start_sweep`; ``kernel``: as
+    there (default: compiled when numba is installed).
     """
+    from .antiskid_kernel import default_kernel
+    kernel = kernel or default_kernel()
     spec = design.spec
     ms: SweepSpec = spec.montecarlo
     if not n >= 1:
         raise ValueError(f"halving check of {n} runs: need at least 1")
     inp = sweep_inputs(design, n, ms.seed, K)
-    payloads = ([chunk_payload(inp, 0, n, inp["dt"])] if coarse else []) + [
-        chunk_payload(inp, 0, n, inp["dt"] / 2)]
+    payloads = ([chunk_payload(inp, 0, n, inp["dt"], kernel)] if coarse else []) + [
+        chunk_payload(inp, 0, n, inp["dt"] / 2, kernel)]
     atol = {k: spec.conv_atol.get(k, 0.0) for k in HALVING_METRICS}
 
     def check(steps: list, seconds: float, n_workers: int) -> HalvingCheck:

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -103,35 +104,35 @@ def montecarlo_quantities(res: SweepResult) -> dict:
             **{f"montecarlo.{k}": v for k, v in res.statistics().items()}}
 
 
-def draw_samples(n: int, seed: int, spec: SweepSpec) -> dict:
-    """n samples of (mass factor, adhesion s, delay h, v0), uniform, seeded;
-    sample i does not depend on n."""
+def draw_samples(n: int, seed: int, spec: SweepSpec, start: int = 0) -> dict:
+    """Samples ``start <= i < n`` of (mass factor, adhesion s, delay h, v0),
+    uniform, seeded; sample i does not depend on n or start."""
     return uniform_draws(n, seed, {"mass": spec.mass, "adhesion": spec.adhesion, "h": spec.h,
-                                   "v0": spec.v0})
+                                   "v0": spec.v0}, start)
 
 
 def chunk_worker(payload: dict) -> dict:
     """Simulate one chunk (plain data in, plain data out)."""
     from ..controllers.antiskid003_settings import ControllerSettings, CreepSpeedProfile
     from ..sim.wheel_slip import PARAM_ORDER
-    from .antiskid_scenario import RunSettings, simulate_antiskid
+    from .antiskid_kernel import simulate_batch
+    from .antiskid_scenario import RunSettings
     cs_d = dict(payload["controller"])
     cs_d["profile"] = CreepSpeedProfile(**cs_d["profile"])
     cs_d["params"] = tuple(cs_d["params"])
     cs_d["K"] = tuple(cs_d["K"])
     cs = ControllerSettings(**cs_d)
     plant = tuple(np.asarray(payload["plant"][k], float) for k in PARAM_ORDER)
-    n = len(payload["h"])
     run = RunSettings(plant, cs, np.asarray(payload["h"], float),
                       (np.asarray(payload["v0"], float), payload["lambda0"]),
                       payload["u_init"], payload["t_end"])
-    _, m = simulate_antiskid(run, payload["dt"], record_dt=None, batch=n)
+    m = simulate_batch(run, payload["dt"], payload.get("kernel", "numpy"))
     return {"index": payload["index"], "metrics": {k: np.asarray(v, float).tolist()
                                                    for k, v in vars(m).items()}}
 
 
-def sweep_inputs(design, samples: int, seed: int, K: tuple | None) -> dict:
-    """The first ``samples`` runs of the design's sweep with ``seed`` as
+def sweep_inputs(design, samples: int, seed: int, K: tuple | None, start: int = 0) -> dict:
+    """Runs ``start <= i < samples`` of the design's sweep with ``seed`` as
     plain data: ``draws``, per-run ``plant`` parameters, the nominal values
     ``base``, the ``controller`` (``asdict`` of the case's settings), the
     ``scenario`` and ``dt``; ``K``: the cruise gain if the caller has it
@@ -144,9 +145,9 @@ def sweep_inputs(design, samples: int, seed: int, K: tuple | None) -> dict:
     case = next(c for c in spec.cases if c.name == ms.case)
     K = gain_for(spec)[0] if K is None else K
     cs = controller_settings(spec, K, case)
-    draws = draw_samples(samples, seed, ms)
+    draws = draw_samples(samples, seed, ms, start)
     base = plant_values(spec)
-    plant = {k: np.full(samples, base[k], float) for k in PARAM_ORDER}
+    plant = {k: np.full(samples - start, base[k], float) for k in PARAM_ORDER}
     s = draws["adhesion"]
     for k in ("a", "b", "c"):
         plant[k] = ms.wet[k] + s * (base[k] - ms.wet[k])
@@ -155,22 +156,56 @@ def sweep_inputs(design, samples: int, seed: int, K: tuple | None) -> dict:
             "scenario": spec.scenario, "dt": ms.dt or spec.dt}
 
 
-def chunk_payload(inp: dict, i0: int, i1: int, dt: float) -> dict:
-    """The :func:`chunk_worker` payload of runs ``i0 <= i < i1`` at step ``dt``."""
+def chunk_payload(inp: dict, i0: int, i1: int, dt: float, kernel: str = "numpy") -> dict:
+    """The :func:`chunk_worker` payload of runs ``i0 <= i < i1`` at step
+    ``dt``, simulated by the ``kernel`` path
+    (:data:`~workbench.studies.antiskid_kernel.KERNELS`)."""
     sl, sc, d = slice(i0, i1), inp["scenario"], inp["draws"]
-    return {"index": i0, "controller": inp["controller"],
+    return {"index": i0, "kernel": kernel, "controller": inp["controller"],
             "plant": {k: v[sl].tolist() for k, v in inp["plant"].items()},
             "h": d["h"][sl].tolist(), "v0": d["v0"][sl].tolist(),
             "lambda0": sc["lambda0"], "u_init": sc["u_init"], "t_end": sc["t_end"], "dt": dt}
 
 
+@lru_cache(maxsize=1)
+def _dmu_traction():
+    """d mu / d lambda of the traction curve (eq 6), lambdified (``math``)
+    from the one sympy model, parameters as arguments (PARAM_ORDER)."""
+    import sympy as sp
+
+    from ..plants.adhesion import adhesion_model
+    from ..sim.wheel_slip import PARAM_ORDER
+    mdl = adhesion_model()
+    return sp.lambdify((mdl.lam, *[mdl.params[k] for k in PARAM_ORDER]),
+                       sp.diff(mdl.mu_traction, mdl.lam), "math")
+
+
+def lambda_opt_of(plant: dict) -> np.ndarray:
+    """lambda_opt (argmax of mu on lambda > 0) of each run's own adhesion
+    curve: the root of d mu / d lambda on (0, 1), as
+    :meth:`~workbench.plants.adhesion.NumericAdhesion.lambda_opt` (same
+    bracket and tolerances) but with one lambdified derivative for every run
+    (~0.1 ms a run instead of a sympy substitution and lambdify per run)."""
+    from scipy.optimize import brentq
+
+    from ..errors import ModelError
+    from ..sim.wheel_slip import PARAM_ORDER
+    f = _dmu_traction()
+    cols = [np.asarray(plant[k], float) for k in PARAM_ORDER]
+    out = np.empty(len(cols[0]))
+    for i in range(out.size):
+        row = tuple(float(c[i]) for c in cols)
+        g = lambda lam: f(lam, *row)     # noqa: E731
+        if not g(1e-12) > 0 or g(1.0) > 0:
+            raise ModelError(f"run {i}: adhesion curve without a peak on (0, 1) "
+                             f"(a, b, c = {row[:3]})")
+        out[i] = brentq(g, 1e-12, 1.0, xtol=1e-15, rtol=1e-14)
+    return out
+
+
 def run_lambda_opt(inp: dict) -> np.ndarray:
-    """lambda_opt of each run's own adhesion curve."""
-    from ..plants.adhesion import NumericAdhesion
-    base, plant = inp["base"], inp["plant"]
-    return np.array([NumericAdhesion.from_dict(
-        {**base, "a": plant["a"][i], "b": plant["b"][i], "c": plant["c"][i]}).lambda_opt()
-        for i in range(len(plant["a"]))])
+    """lambda_opt of each run's own adhesion curve (:func:`lambda_opt_of`)."""
+    return lambda_opt_of(inp["plant"])
 
 
 def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]:
@@ -193,19 +228,30 @@ def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]
 
 def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
                 chunk: int | None = None, pool: bool | None = None,
-                K: tuple | None = None) -> PendingBatch:
+                K: tuple | None = None, kernel: str | None = None,
+                scheduler: str | None = None) -> PendingBatch:
     """Draw the samples of an ``antiskid-run`` design's sweep and start its
     chunks (see :func:`sweep`); ``pool`` (default: ``workers > 1``) runs them
     in a process pool now, so the caller can work meanwhile, else in-process
     in :meth:`PendingBatch.result`. ``K``: the cruise gain if the caller has
-    it (default: :func:`~workbench.studies.antiskid_run.gain_for`)."""
+    it (default: :func:`~workbench.studies.antiskid_run.gain_for`). ``kernel``:
+    "compiled" or "numpy" (default: compiled when numba is installed).
+    ``scheduler``: run the chunks on Dask (``"local"`` or a scheduler's
+    address; :class:`~workbench.sim.batch.PendingBatch`)."""
     import os
+
+    from .antiskid_kernel import default_kernel
 
     inp = sweep_inputs(design, samples, seed, K)
     workers = max(1, workers or os.cpu_count() or 1)
     chunk = chunk or max(1, math.ceil(samples / DEFAULT_CHUNKS))
-    payloads = [chunk_payload(inp, i0, min(i0 + chunk, samples), inp["dt"])
+    kernel = kernel or default_kernel()
+    pool = workers > 1 if pool is None else pool
+    payloads = [chunk_payload(inp, i0, min(i0 + chunk, samples), inp["dt"], kernel)
                 for i0 in range(0, samples, chunk)]
+    if kernel == "compiled" and pool and len(payloads) > 1 and scheduler is None:
+        from .antiskid_kernel import compile_kernel
+        compile_kernel()     # once, here: the forked workers inherit it
 
     def collect(outs: list, seconds: float, n_workers: int) -> SweepResult:
         raw = {k: np.concatenate([o["metrics"][k] for o in outs]) for k in outs[0]["metrics"]}
@@ -214,11 +260,13 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
                            {k: v.tolist() for k, v in metrics.items()},
                            {k: v.tolist() for k, v in viol.items()}, seconds, n_workers)
 
-    return PendingBatch(chunk_worker, payloads, collect, workers, workers > 1 if pool is None else pool)
+    return PendingBatch(chunk_worker, payloads, collect, workers, pool,
+                        sizes=[len(p["h"]) for p in payloads], unit="run", scheduler=scheduler)
 
 
 def sweep(design, samples: int, seed: int, *, workers: int | None = None,
-          chunk: int | None = None, progress: bool = True) -> SweepResult:
+          chunk: int | None = None, progress: bool = True,
+          kernel: str | None = None, scheduler: str | None = None) -> SweepResult:
     """Run the Monte Carlo sweep of an ``antiskid-run`` design.
 
     Parameters
@@ -233,5 +281,14 @@ def sweep(design, samples: int, seed: int, *, workers: int | None = None,
         The results depend on it, not on ``workers``.
     progress : bool
         Progress bar on stderr.
+    kernel : {"compiled", "numpy"}, optional
+        The stepping path (default: compiled when numba is installed); the
+        results agree to rounding (``tests/test_compiled_kernel.py``).
+    scheduler : str, optional
+        Run the chunks on a Dask distributed cluster: ``"local"`` (a
+        LocalCluster of ``workers`` processes) or a scheduler address. The
+        results do not depend on the executor, the worker count or the
+        chunking (``tests/test_sweep_executors.py``).
     """
-    return start_sweep(design, samples, seed, workers=workers, chunk=chunk).result(progress)
+    return start_sweep(design, samples, seed, workers=workers, chunk=chunk,
+                       kernel=kernel, scheduler=scheduler).result(progress)

@@ -24,7 +24,7 @@ from ..sim.delay import SimResult, envelope_ratio, simulate_linear_dde, step_hal
 from ..sim.wheel_slip import PARAM_ORDER, model_functions
 from .antiskid_run_spec import (METRICS, Case, RunSpec, agree, case_mesh, case_metrics,
                                 controller_settings, gain_for, load_run_spec, nominal_cruise,
-                                run_settings)
+                                plant_values, run_settings)
 from .antiskid_scenario import simulate_antiskid
 
 @dataclass(frozen=True)
@@ -79,6 +79,7 @@ class RunResult:
     dt: float
     montecarlo: object = None   # antiskid_montecarlo.SweepResult or None
     halving: object = None      # antiskid_halving.HalvingCheck or None
+    basin: object = None        # antiskid_basin_run.BasinResult or None
 
     def case(self, name: str) -> CaseResult:
         return next(c for c in self.cases if c.case.name == name)
@@ -196,7 +197,9 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
 
 
 def sweep_command(design, *, samples: int, seed: int, workers: int | None,
-                  figure: str | None, as_json: bool) -> int:
+                  figure: str | None, as_json: bool, kernel: str | None = None,
+                  scheduler: str | None = None, out: str | None = None,
+                  resume: bool = False) -> int:
     """``workbench sweep`` on a loaded ``antiskid-run`` design: run, print summary statistics (and JSON), write
     the histogram figure; exit 0 (violations are reported, not failures)."""
     import json
@@ -213,7 +216,37 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     if design.spec.montecarlo is None:
         raise DesignError(design.path, "montecarlo", "<missing>",
                           "an antiskid-run design with a [montecarlo] table")
-    res = sweep(design, samples, seed, workers=workers)
+    from .antiskid_kernel import KERNELS, compiled_available
+    if kernel is not None and kernel not in KERNELS:
+        raise DesignError("<cli>", "--kernel", kernel, " or ".join(KERNELS))
+    if kernel == "compiled" and not compiled_available():
+        raise DesignError("<cli>", "--kernel", kernel,
+                          "numpy here: numba is not installed (pip install 'workbench[fast]')")
+    if scheduler is not None:
+        from importlib.util import find_spec
+        if find_spec("distributed") is None:
+            raise DesignError("<cli>", "--scheduler", scheduler, "no flag here: dask.distributed "
+                              "is not installed (pip install 'workbench[scale]')")
+    if resume and not out:
+        raise DesignError("<cli>", "--resume", True, "with --out DIR (the folder to resume)")
+    try:
+        if out:
+            from .antiskid_stream import start_streaming
+            try:
+                pending = start_streaming(design, samples, seed, out, resume=resume,
+                                          workers=workers, kernel=kernel, scheduler=scheduler)
+            except FileExistsError as e:
+                raise DesignError("<cli>", "--out", out, f"a new folder or --resume ({e})") \
+                    from None
+            res = pending.result(progress=not as_json)
+        else:
+            res = sweep(design, samples, seed, workers=workers, kernel=kernel,
+                        progress=not as_json, scheduler=scheduler)
+    except OSError as e:       # the scheduler cannot be reached
+        if scheduler is None:
+            raise
+        raise DesignError("<cli>", "--scheduler", scheduler,
+                          f"'local' or the address of a running Dask scheduler ({e})") from None
     if figure:
         from ..report.figures import save_figure
         save_figure(Figure(Path(figure).stem, "Monte Carlo histograms",
@@ -254,6 +287,9 @@ class AntiskidRun:
             names |= montecarlo_quantity_names()
             if spec.montecarlo.halving:
                 names |= halving_quantity_names()
+        if spec.basin is not None:
+            from .antiskid_basin_run import basin_quantity_names
+            names |= basin_quantity_names([c.name for c in spec.cases], True)
         return names
 
     def start(self, design):
@@ -294,8 +330,12 @@ class AntiskidRun:
             raise
         mc = None if pending is None else pending.result()
         hc = None if halving is None else halving.result()(mc)
+        from .antiskid_basin_run import run_basin
+        bs = None if spec.basin is None else run_basin(
+            spec.basin, plant_values(spec), spec.scenario["v_d"], K, nominal.lambda_opt(), cases,
+            spec.mass_factor)
         return RunResult(nominal.lambda_opt(), lam_d, tuple(K), how, h_cert, tuple(cases), lc,
-                         spec.dt, mc, hc)
+                         spec.dt, mc, hc, bs)
 
     def _cases(self, spec: RunSpec, K) -> list[CaseResult]:
         cases = []
@@ -342,6 +382,10 @@ class AntiskidRun:
             q.update(montecarlo_quantities(res.montecarlo))
             if res.halving is not None:
                 q.update(halving_quantities(res.halving))
+        if res.basin is not None:
+            from .antiskid_basin_run import basin_quantities
+            q.update(basin_quantities(res.basin.basin, res.basin.sweep,
+                                      [c.case.name for c in res.cases]))
         return q
 
 

@@ -77,6 +77,13 @@ def render(design, res) -> Rendered:
         Figure("adhesion", "The plant's adhesion curve with each run's operating points.",
                lambda fig, res=res, sp=spec: plot_adhesion(fig, res, sp), (9.0, 3.8)),
     )
+    if res.basin is not None:
+        from .antiskid_basin_render import plot_basin, render_basin_result
+        sections.insert(3, render_basin_result(res.basin, rail=spec.rail)
+                        + "\n![basin]({figdir}/basin.png)\n\nThe (v - v_d, lambda - lambda_d) "
+                        "plane of the delay-free cruise loop (see the section's text).\n")
+        figs += (Figure("basin", "Certified basin of the cruise law (61), switch states.",
+                        lambda fig, b=res.basin.basin: plot_basin(fig, b), (7.0, 5.0)),)
     if res.montecarlo is not None:
         from .antiskid_montecarlo_render import draw_histograms, draw_outcomes
         figs += (

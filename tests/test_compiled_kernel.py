@@ -1,0 +1,119 @@
+"""The compiled antiskid kernel (numba) against the batched numpy path, the
+reference (issue 17, item 1): every metric of every run equal to 1e-9
+relative (NaN where NaN, the same infinities), every outcome equal.
+
+The full check is the first 64 runs of the dry design's sweep (its
+``[montecarlo]`` draws, seed and step), as the issue asks; the numpy side
+takes a few minutes, so it is marked ``slow``. The fast checks cover the
+controller variants the sweep does not use (the printed cruise entry, no
+predictor, the creep braking entry, the ZOH hold) on a shortened scenario.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+pytest.importorskip("numba")
+
+from workbench.controllers.antiskid003_settings import ControllerSettings, CreepSpeedProfile  # noqa: E402
+from workbench.design import load_design  # noqa: E402
+from workbench.sim.wheel_slip import PARAM_ORDER  # noqa: E402
+from workbench.studies.antiskid_kernel import METRIC_FIELDS, simulate_batch  # noqa: E402
+from workbench.studies.antiskid_montecarlo import (chunk_payload, chunk_worker, per_run,  # noqa: E402
+                                                   run_lambda_opt, sweep_inputs)
+from workbench.studies.antiskid_run_spec import gain_for  # noqa: E402
+from workbench.studies.antiskid_scenario import RunSettings  # noqa: E402
+
+RTOL = 1e-9
+
+
+def assert_close(a: dict, b: dict, keys) -> None:
+    """Per key: NaN at the same runs, the same infinities, finite values to RTOL."""
+    for k in keys:
+        x, y = np.asarray(a[k], float), np.asarray(b[k], float)
+        assert x.shape == y.shape, k
+        np.testing.assert_array_equal(np.isnan(x), np.isnan(y), err_msg=f"{k}: NaN pattern")
+        np.testing.assert_array_equal(x[np.isinf(x)], y[np.isinf(x)], err_msg=f"{k}: infinities")
+        fin = np.isfinite(x)
+        np.testing.assert_allclose(x[fin], y[fin], rtol=RTOL, atol=0, err_msg=k)
+
+
+def _runs(design, n: int, *, t_brake=None, t_end=None, v0=None):
+    """(RunSettings of the first n runs of the design's sweep, dt)."""
+    spec = design.spec
+    if t_brake is not None:
+        spec = dataclasses.replace(spec, scenario={**spec.scenario, "t_brake": t_brake,
+                                                   "t_end": t_end})
+        design = dataclasses.replace(design, spec=spec)
+    inp = sweep_inputs(design, n, spec.montecarlo.seed, gain_for(spec)[0])
+    pl = chunk_payload(inp, 0, n, inp["dt"])
+    cs = dict(pl["controller"])
+    cs.update(profile=CreepSpeedProfile(**cs["profile"]), params=tuple(cs["params"]),
+              K=tuple(cs["K"]))
+    v = np.asarray(pl["v0"]) if v0 is None else np.full(n, v0)
+    return RunSettings(tuple(np.asarray(pl["plant"][k]) for k in PARAM_ORDER),
+                       ControllerSettings(**cs), np.asarray(pl["h"]), (v, pl["lambda0"]),
+                       pl["u_init"], pl["t_end"]), pl["dt"]
+
+
+@pytest.fixture(scope="module")
+def dry():
+    return load_design("designs/antiskid-run-dry.toml")
+
+
+VARIANTS = {
+    "printed cruise entry": dict(cruise_entry="speed"),
+    "no predictor": dict(compensate=False),
+    "creep braking entry": dict(brake_entry="creep"),
+    "zoh hold": dict(sampling="zoh"),
+    "no observer": dict(observer_tau=0.0),
+}
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_variants_agree_on_a_short_run(dry, variant):
+    # braking from 8 s, end at 16 s, v(0) near v_d: every phase is visited
+    run, dt = _runs(dry, 4, t_brake=8.0, t_end=16.0, v0=66.0)
+    run = dataclasses.replace(run, controller=dataclasses.replace(run.controller,
+                                                                  **VARIANTS[variant]))
+    a = vars(simulate_batch(run, dt, "compiled"))
+    b = vars(simulate_batch(run, dt, "numpy"))
+    assert_close(a, b, METRIC_FIELDS)
+    assert np.isfinite(b["t_cruise"]).any() and np.isfinite(b["lam_at_brake"]).any()
+
+
+def test_recursive_predictor_falls_back_to_numpy(dry):
+    run, dt = _runs(dry, 2, t_brake=1.0, t_end=1.5)
+    run = dataclasses.replace(run, controller=dataclasses.replace(run.controller,
+                                                                  predictor="recursive"))
+    a, b = simulate_batch(run, dt, "compiled"), simulate_batch(run, dt, "numpy")
+    for k in METRIC_FIELDS:
+        np.testing.assert_array_equal(getattr(a, k), getattr(b, k), err_msg=k)
+
+
+def test_unknown_kernel_is_refused(dry):
+    run, dt = _runs(dry, 1, t_brake=1.0, t_end=1.0)
+    with pytest.raises(ValueError, match="kernel = 'fortran'"):
+        simulate_batch(run, dt, "fortran")
+
+
+@pytest.mark.slow
+def test_first_64_runs_of_the_dry_sweep_agree(dry):
+    """Issue 17, item 1: the first 64 runs of the dry design's sweep (seed
+    and step of its [montecarlo] table), every metric and outcome."""
+    n = 64
+    inp = sweep_inputs(dry, n, dry.spec.montecarlo.seed, gain_for(dry.spec)[0])
+    outs = {k: chunk_worker(chunk_payload(inp, 0, n, inp["dt"], k))["metrics"]
+            for k in ("compiled", "numpy")}
+    assert_close(outs["compiled"], outs["numpy"], METRIC_FIELDS)
+    lam_opt, t_brake = run_lambda_opt(inp), inp["scenario"]["t_brake"]
+    (mc, vc), (mn, vn) = (per_run({k: np.asarray(v) for k, v in outs[p].items()}, lam_opt,
+                                  t_brake) for p in ("compiled", "numpy"))
+    assert_close(mc, mn, mc)
+    for k in vn:
+        np.testing.assert_array_equal(vc[k], vn[k], err_msg=k)
+    # the runs cover the outcomes the check is about
+    assert vn["diverged"].any() and not vn["diverged"].all()
+    assert vn["above_lambda_opt"].any()

@@ -1,0 +1,264 @@
+"""Controller (75) of paper 003, compiled (numba), one run at a time.
+
+The sample of :class:`workbench.controllers.antiskid003.Antiskid003`
+(``__call__``: phase logic, divergence events, the mismatch estimate of
+``observer_tau``, the predictor rollout of eq (2), the laws (61), (64),
+(69) and their stiff hold) written over floats with the compiled stepping
+kernel of :mod:`workbench.sim.wheel_slip_jit`, operation for operation as
+the batched numpy path (which stays the reference: the compiled and numpy
+paths are compared run by run in ``tests/test_compiled_kernel.py``).
+
+Supported: ``predictor = "rollout"`` (or ``compensate = False``), either
+``sampling``, either entry; on the fixed step (no refined mesh).
+
+State of a run, passed between calls as arrays:
+
+* ``cfg`` -- :func:`settings_array` (settings and step, read-only);
+* ``st`` -- :data:`STATE` (phase, previous sample, mismatch estimate, ...);
+* ``ubuf`` -- the controller's own input history (ring of N + 2 samples,
+  :class:`~workbench.sim.history.DelayLine` of h_model);
+* ``ev`` -- the phase events, :class:`~workbench.controllers.antiskid003.PhaseEvents`
+  field order (the first entries of the caller's metrics array).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import fields
+
+import numba
+import numpy as np
+
+from ..sim.history import split_delay
+from ..sim.wheel_slip import PARAM_ORDER
+from ..sim.wheel_slip_jit import BRAKING, TRACTION, braking, fmax, fmin, forms, phi1, \
+    stiff_step, traction, wheel_speed
+from .antiskid003 import PhaseEvents
+from .antiskid003_settings import (ACCEL, BRAKE, BRAKE_IN, CRUISE, DIVERGED, HANDOVER, STOPPED,
+                                   ControllerSettings)
+
+_JIT = dict(nogil=True, error_model="numpy")
+
+#: Entries of :func:`settings_array`.
+CFG = ("v_d", "lambda_d", "lambda_opt", "K0", "K1", "a1", "a2", "d1", "d2", "d3", "d4", "d5",
+       "d6", "k_ac", "k_de", "h_model", "t_brake", "c0", "c1", "lambda_allow", "vs_min",
+       "omega_switch", "compensate", "stiff", "cruise_creep", "brake_creep", "band", "v_stop",
+       "v_floor", "lam_diverged", "u_range", "observer_on", "alpha", "dt", "N", "f", "r")
+(V_D, LAMBDA_D, LAMBDA_OPT, K0, K1, A1, A2, D1, D2, D3, D4, D5, D6, K_AC, K_DE, H_MODEL, T_BRAKE,
+ C0, C1, LAMBDA_ALLOW, VS_MIN, OMEGA_SWITCH, COMPENSATE, STIFF, CRUISE_CREEP, BRAKE_CREEP, BAND,
+ V_STOP, V_FLOOR, LAM_DIVERGED, U_RANGE, OBSERVER_ON, ALPHA, DT, NC, FC, R_C) = range(len(CFG))
+
+#: Entries of the controller state ``st``.
+STATE = ("phase", "has_prev", "prev_v", "prev_lam", "prev_phase", "delta", "unresolved",
+         "pushed")
+PH, HAS_PREV, PV, PL, PPH, DELTA, UNRES, PUSHED = range(len(STATE))
+
+_EV = {f.name: i for i, f in enumerate(fields(PhaseEvents))}
+E_HANDOVER, E_V_HANDOVER, E_LAM_HANDOVER = (_EV["t_handover_done"], _EV["v_at_handover"],
+                                            _EV["lam_at_handover"])
+E_T_DIV, E_PH_DIV, E_HOW = _EV["t_diverged"], _EV["phase_diverged"], _EV["diverged_how"]
+
+
+def settings_array(s: ControllerSettings, dt: float) -> np.ndarray:
+    """The settings of ``s`` at step ``dt`` as the float array ``cfg`` (:data:`CFG`)."""
+    if s.compensate and s.predictor != "rollout":
+        raise ValueError(f"predictor = {s.predictor!r}; the compiled controller runs "
+                         "predictor = 'rollout' (or compensate = false)")
+    N, f = split_delay(s.h_model, dt)
+    c, pr = s.lin, s.profile
+    observer = s.sampling == "stiff" and s.observer_tau > 0
+    vals = dict(v_d=s.v_d, lambda_d=s.lambda_d, lambda_opt=s.lambda_opt, K0=s.K[0], K1=s.K[1],
+                **{k: c[k] for k in ("a1", "a2", "d1", "d2", "d3", "d4", "d5", "d6")},
+                k_ac=s.k_ac, k_de=s.k_de, h_model=s.h_model, t_brake=pr.t_brake, c0=pr.c0,
+                c1=pr.c1, lambda_allow=pr.lambda_allow, vs_min=pr.vs_min,
+                omega_switch=pr.omega_switch, compensate=float(s.compensate),
+                stiff=float(s.sampling == "stiff"), cruise_creep=float(s.cruise_entry == "creep"),
+                brake_creep=float(s.brake_entry == "creep"), band=s.handover_band,
+                v_stop=s.v_stop, v_floor=s.v_floor, lam_diverged=s.lam_diverged,
+                u_range=s.u_range, observer_on=float(observer),
+                alpha=-math.expm1(-dt / s.observer_tau) if observer else 0.0,
+                dt=dt, N=float(N), f=f, r=s.params[PARAM_ORDER.index("r")])
+    return np.array([float(vals[k]) for k in CFG])
+
+
+def initial_state(s: ControllerSettings, dt: float, u_init: float) -> tuple[np.ndarray, np.ndarray]:
+    """(``st``, ``ubuf``) of a run at t = 0."""
+    N, _ = split_delay(s.h_model, dt)
+    st = np.zeros(len(STATE))
+    st[PH] = ACCEL
+    return st, np.full(N + 2, float(u_init))
+
+
+@numba.njit(**_JIT)
+def profile(t, v, vdot, omega, cfg):
+    """(v_s*, d v_s*/dt) of eqs (76)-(78) (:class:`CreepSpeedProfile`)."""
+    root = math.sqrt(v * v + 1.0)
+    slope = cfg[C0] - cfg[C1] * (t - cfg[T_BRAKE])
+    raw = slope * cfg[LAMBDA_ALLOW] * root
+    draw = cfg[LAMBDA_ALLOW] * (-cfg[C1] * root + slope * v * vdot / root)
+    on = omega > cfg[OMEGA_SWITCH]
+    free = raw > cfg[VS_MIN]
+    vs = (raw if free else cfg[VS_MIN]) if on else 0.0
+    dvs = draw if on and free else 0.0
+    return vs, dvs
+
+
+@numba.njit(**_JIT)
+def _model_step(v, lam, u, dt, kind, cfg, p):
+    """One step of the prediction model ``kind`` (TRACTION, BRAKING, or 0:
+    the linear cruise error model, eq 62)."""
+    if kind != 0:
+        nv, nl, _ = stiff_step(v, lam, u, dt, p, cfg[V_FLOOR], kind)
+        return nv, nl
+    ve, le = v - cfg[V_D], lam - cfg[LAMBDA_D]
+    den = cfg[D4] * ve + cfg[D5] * le + cfg[D6]
+    f2 = cfg[D1] * ve + cfg[D2] * le + cfg[D3] + den * u
+    z = (cfg[D2] + cfg[D5] * u) * dt
+    return v + dt * (cfg[A1] * ve + cfg[A2] * le), lam + dt * phi1(z) * f2
+
+
+@numba.njit(**_JIT)
+def rollout(v, lam, ph, ubuf, n, cfg, p):
+    """X(t + h) of eq (2): the phase's model run from x(t) through the inputs
+    of the last h seconds (:meth:`Antiskid003._rollout`)."""
+    if ph == CRUISE:
+        kind = 0
+    elif ph < BRAKE:
+        kind = TRACTION
+    elif ph == BRAKE:
+        kind = BRAKING
+    else:
+        return v, lam
+    N, f, dt, L = int(cfg[NC]), cfg[FC], cfg[DT], ubuf.shape[0]
+    if f > 0:
+        v, lam = _model_step(v, lam, ubuf[(n - N - 1) % L], f * dt, kind, cfg, p)
+    for k in range(n - N, n):
+        v, lam = _model_step(v, lam, ubuf[k % L], dt, kind, cfg, p)
+    return v, lam
+
+
+@numba.njit(**_JIT)
+def delayed(ubuf, n, cfg):
+    """Average of u(t - h_model) over the step of the last pushed sample."""
+    N, f, L = int(cfg[NC]), cfg[FC], ubuf.shape[0]
+    a = ubuf[(n - 1 - N) % L]
+    return a if f == 0.0 else (1.0 - f) * a + f * ubuf[(n - 2 - N) % L]
+
+
+@numba.njit(**_JIT)
+def sampled(u, f20, f2u, j0, ju, delta, cfg):
+    """:meth:`Antiskid003._sampled`: the input held over one sample."""
+    if cfg[STIFF] == 0.0:
+        return u
+    dt = cfg[DT]
+    phi = phi1((j0 + ju * u) * dt)
+    d = delta
+    if cfg[COMPENSATE] != 0.0:
+        hj = fmin(fmax((j0 + ju * u) * cfg[H_MODEL], -700.0), 20.0)
+        d = d * (1.0 + math.expm1(hj))
+    return ((f20 + f2u * u) / phi + d * (1.0 / phi - 1.0) - f20) / f2u
+
+
+@numba.njit(**_JIT)
+def observe(v, lam, ph, st, ubuf, cfg, p):
+    """:meth:`Antiskid003._observe`: update the mismatch estimate ``st[DELTA]``."""
+    dt = cfg[DT]
+    if ph >= BRAKE_IN:
+        st[DELTA] = 0.0 * v
+    elif st[HAS_PREV] != 0.0 and cfg[OBSERVER_ON] != 0.0:
+        pv, pl, pph = st[PV], st[PL], st[PPH]
+        ua = delayed(ubuf, int(st[PUSHED]), cfg)
+        _, f20, f2u, j0, ju = forms(fmax(pv, cfg[V_FLOOR]), pl, p, 0)
+        if pph == CRUISE:
+            ve, le = pv - cfg[V_D], pl - cfg[LAMBDA_D]
+            den = cfg[D4] * ve + cfg[D5] * le + cfg[D6]
+            f20 = cfg[D1] * ve + cfg[D2] * le + cfg[D3]
+            f2u, j0, ju = den, cfg[D2], cfg[D5]
+        d = (lam - pl) / (dt * phi1((j0 + ju * ua) * dt)) - (f20 + f2u * ua)
+        new = st[DELTA] + cfg[ALPHA] * (d - st[DELTA])
+        st[DELTA] = 0.0 * v if not abs(new) < 1e6 else new
+    st[HAS_PREV], st[PV], st[PL], st[PPH] = 1.0, v, lam, ph
+
+
+@numba.njit(**_JIT)
+def _accel(Pv, Pl, target, delta, cfg, p):
+    y1, y2, y3, dy2, dy3 = traction(fmax(Pv, cfg[V_FLOOR]), Pl, p)
+    return sampled((-y2 - cfg[K_AC] * (Pl - target)) / y3, y2, y3, dy2, dy3, delta, cfg)
+
+
+@numba.njit(**_JIT)
+def _cruise(v, lam, Pv, Pl, delta, cfg):
+    ve, le = Pv - cfg[V_D], Pl - cfg[LAMBDA_D]
+    den = cfg[D4] * ve + cfg[D5] * le + cfg[D6]
+    u = (-cfg[D3] + cfg[K0] * (v - cfg[V_D]) + cfg[K1] * (lam - cfg[LAMBDA_D])) / den
+    return sampled(u, cfg[D1] * ve + cfg[D2] * le + cfg[D3], den, cfg[D2], cfg[D5], delta, cfg)
+
+
+@numba.njit(**_JIT)
+def _brake(t, Pv, Pl, delta, cfg, p):
+    vg = fmax(Pv, cfg[V_FLOOR])
+    z1, z2, z3, dz2, dz3 = braking(vg, Pl, p)
+    omega = wheel_speed(vg, Pl, cfg[R_C])
+    vs, dvs = profile(t + cfg[H_MODEL], vg, z1, omega, cfg)
+    u = ((-cfg[K_DE] * (vg * Pl - vs) + z1 + dvs) / vg - (1.0 + Pl) / vg * z1 - z2) / z3
+    return sampled(u, z2, z3, dz2, dz3, delta, cfg)
+
+
+@numba.njit(**_JIT)
+def law(t, v, lam, ph, st, ubuf, cfg, p):
+    """The torque the active phase's law commands (:meth:`Antiskid003._laws`)."""
+    n = int(st[PUSHED])
+    if cfg[COMPENSATE] == 0.0:
+        Pv, Pl = v, lam
+    else:
+        Pv, Pl = rollout(v, lam, ph, ubuf, n, cfg, p)
+    delta = st[DELTA]
+    if ph == ACCEL:
+        return _accel(Pv, Pl, cfg[LAMBDA_OPT], delta, cfg, p)
+    if ph == HANDOVER:
+        return _accel(Pv, Pl, cfg[LAMBDA_D], delta, cfg, p)
+    if ph == CRUISE:
+        return _cruise(v, lam, Pv, Pl, delta, cfg)
+    if ph == BRAKE_IN:
+        return _accel(Pv, Pl, -cfg[BAND], delta, cfg, p)
+    if ph == BRAKE:
+        return _brake(t, Pv, Pl, delta, cfg, p)
+    return 0.0 * v
+
+
+@numba.njit(**_JIT)
+def control(t, v, lam, st, ubuf, ev, cfg, p):
+    """One sample of controller (75) (:meth:`Antiskid003.__call__`): updates
+    ``st``, ``ubuf`` and the events ``ev``; returns (u, phase, to_cruise,
+    to_brake, to_stop) for the caller's metrics."""
+    ph = int(st[PH])
+    to_cruise = ph == ACCEL and v >= cfg[V_D]
+    if to_cruise:
+        ph = HANDOVER if cfg[CRUISE_CREEP] != 0.0 else CRUISE
+    handed = ph == HANDOVER and abs(lam - cfg[LAMBDA_D]) <= cfg[BAND]
+    if handed:
+        ph = CRUISE
+    to_brake = ph < BRAKE_IN and t >= cfg[T_BRAKE]
+    if to_brake:
+        ph = BRAKE_IN if cfg[BRAKE_CREEP] != 0.0 else BRAKE
+    if ph == BRAKE_IN and lam <= 0:
+        ph = BRAKE
+    to_stop = (ph == BRAKE_IN or ph == BRAKE) and v <= cfg[V_STOP]
+    if to_stop:
+        ph = STOPPED
+    unres = st[UNRES] != 0.0
+    bad = (not abs(lam) < cfg[LAM_DIVERGED] or unres) and ph < STOPPED
+    if bad:
+        ev[E_T_DIV], ev[E_PH_DIV], ev[E_HOW] = t, ph, 1.0 if unres else 0.0
+    if handed:
+        ev[E_HANDOVER], ev[E_V_HANDOVER], ev[E_LAM_HANDOVER] = t, v, lam
+    if bad:
+        ph = DIVERGED
+    observe(v, lam, ph, st, ubuf, cfg, p)
+    u = law(t, v, lam, ph, st, ubuf, cfg, p)
+    if not abs(u) <= cfg[U_RANGE] and ph < STOPPED:
+        ev[E_T_DIV], ev[E_PH_DIV], ev[E_HOW] = t, ph, 2.0
+        ph, u = DIVERGED, 0.0
+    n = int(st[PUSHED])
+    ubuf[n % ubuf.shape[0]] = u
+    st[PUSHED], st[PH] = n + 1, ph
+    return u, ph, to_cruise, to_brake, to_stop

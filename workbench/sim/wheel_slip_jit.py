@@ -1,0 +1,136 @@
+"""The wheel-slip stepping kernel of :mod:`workbench.sim.wheel_slip`, compiled (numba).
+
+The same step, one run at a time, as ``numba.njit`` functions: explicit Euler
+in v, exponential Euler in the stiff creep ratio, halved up to
+:data:`~workbench.sim.wheel_slip.MAX_HALVINGS` times while the creep ratio
+would move by more than :data:`~workbench.sim.wheel_slip.MAX_DLAMBDA`. The
+model functions are *not* retyped: they are the ``sympy.lambdify`` (``math``
+backend, common subexpressions eliminated) of
+:func:`workbench.plants.adhesion.adhesion_model`, exactly the functions
+:func:`~workbench.sim.wheel_slip.model_functions` builds, handed to
+``numba.njit`` (numba compiles their bytecode). Each operation is the one the
+numpy path performs, in the same order, so a compiled run follows its batched
+numpy trajectory up to the last bit of the library functions (exp, expm1).
+
+Importing this module needs numba (:func:`available` says whether it is
+installed); the functions compile at first use in each process (a few
+seconds; the lambdified model has no source file, so nothing is cached on
+disk).
+
+Parameters ``p`` are float arrays in :data:`~workbench.sim.wheel_slip.PARAM_ORDER`;
+``form`` selects the model: :data:`BY_SIGN` (eq 12 for lambda >= 0, eq 15
+otherwise: the plant), :data:`TRACTION` (eq 65) or :data:`BRAKING` (eq 70).
+"""
+from __future__ import annotations
+
+import math
+
+import numba
+
+from .wheel_slip import MAX_DLAMBDA, MAX_HALVINGS, PARAM_ORDER, model_functions
+
+#: Model forms of :func:`forms`.
+BY_SIGN, TRACTION, BRAKING = 0, 1, 2
+
+_JIT = dict(nogil=True, error_model="numpy")   # numpy's inf/nan, never ZeroDivisionError
+
+
+def _unpacked(fn):
+    """``fn(v, lam, *params)`` as a compiled ``f(v, lam, p)`` with p an array in
+    PARAM_ORDER (the wrapper's source is generated from PARAM_ORDER)."""
+    inner = numba.njit(**_JIT)(fn)
+    args = ", ".join(f"p[{i}]" for i in range(len(PARAM_ORDER)))
+    ns = {"inner": inner}
+    exec(f"def f(v, lam, p):\n    return inner(v, lam, {args})\n", ns)
+    return numba.njit(**_JIT)(ns["f"])
+
+
+_fns = model_functions("math")
+#: eq (13) (y1, y2, y3, dy2/dlambda, dy3/dlambda), compiled
+traction = _unpacked(_fns["traction"])
+#: eq (16) (z1, z2, z3, dz2/dlambda, dz3/dlambda), compiled
+braking = _unpacked(_fns["braking"])
+
+
+@numba.njit(**_JIT)
+def fmax(a, b):
+    """``numpy.maximum`` of two floats (NaN wins)."""
+    if a != a:
+        return a
+    if b != b:
+        return b
+    return a if a >= b else b
+
+
+@numba.njit(**_JIT)
+def fmin(a, b):
+    """``numpy.minimum`` of two floats (NaN wins)."""
+    if a != a:
+        return a
+    if b != b:
+        return b
+    return a if a <= b else b
+
+
+@numba.njit(**_JIT)
+def forms(v, lam, p, form):
+    """(v', lambda'_0, lambda'_u, J_0, J_u) of the model ``form`` (module
+    docstring; BY_SIGN: a NaN creep ratio takes eq 15, as the numpy path)."""
+    if form == TRACTION or (form == BY_SIGN and lam >= 0):
+        return traction(v, lam, p)
+    return braking(v, lam, p)
+
+
+@numba.njit(**_JIT)
+def phi1(z):
+    """(e^z - 1) / z (1 + z/2 near 0)."""
+    if abs(z) > 1e-8:
+        return math.expm1(z) / z
+    return 1.0 + 0.5 * z
+
+
+@numba.njit(**_JIT)
+def _halved(v, lam, u, dt, p, v_floor, form, depth):
+    """The recursion of :func:`stiff_step` (kept apart: a recursive numba
+    function is called, never inlined, and most steps need no halving)."""
+    f1, f20, f2u, j0, ju = forms(fmax(v, v_floor), lam, p, form)
+    nv = v + dt * f1
+    nl = lam + dt * phi1((j0 + ju * u) * dt) * (f20 + f2u * u)
+    big = not abs(nl - lam) <= MAX_DLAMBDA
+    if depth < MAX_HALVINGS and big:
+        hv, hl, bad1 = _halved(v, lam, u, dt / 2, p, v_floor, form, depth + 1)
+        nv2, nl2, bad2 = _halved(hv, hl, u, dt / 2, p, v_floor, form, depth + 1)
+        return nv2, nl2, bad1 or bad2
+    return nv, nl, big
+
+
+@numba.njit(**_JIT)
+def stiff_step(v, lam, u, dt, p, v_floor, form):
+    """(v, lambda, unresolved) after one step of :func:`forms` (speed
+    floored at ``v_floor`` in the model), halved recursively as
+    :func:`workbench.sim.wheel_slip.stiff_step_flagged`."""
+    f1, f20, f2u, j0, ju = forms(fmax(v, v_floor), lam, p, form)
+    nv = v + dt * f1
+    nl = lam + dt * phi1((j0 + ju * u) * dt) * (f20 + f2u * u)
+    big = not abs(nl - lam) <= MAX_DLAMBDA
+    if MAX_HALVINGS > 0 and big:
+        hv, hl, bad1 = _halved(v, lam, u, dt / 2, p, v_floor, form, 1)
+        nv2, nl2, bad2 = _halved(hv, hl, u, dt / 2, p, v_floor, form, 1)
+        return nv2, nl2, bad1 or bad2
+    return nv, nl, big
+
+
+@numba.njit(**_JIT)
+def wheel_speed(v, lam, r):
+    """omega (rad/s) from v and lambda, eqs (4)-(5)."""
+    if lam >= 0:
+        return v / (1.0 - fmin(lam, 0.999)) / r
+    return v * (1.0 + lam) / r
+
+
+@numba.njit(**_JIT)
+def creep_speed(v, lam):
+    """v_s = v_w - v (m/s)."""
+    if lam >= 0:
+        return lam * v / (1.0 - fmin(lam, 0.999))
+    return lam * v

@@ -1,0 +1,230 @@
+"""Compiled batch of antiskid runs: the closed loop of
+:func:`workbench.studies.antiskid_scenario.simulate_antiskid` (fixed step,
+no recording) with numba, one run after the other.
+
+Per run and per sample, as the batched numpy path: the controller
+(:func:`workbench.controllers.antiskid003_jit.control`: phase logic,
+predictor rollout, laws), the metrics of
+:class:`~workbench.studies.antiskid_scenario.MetricsRecorder`
+(:func:`record`), the plant's input delay line and the plant step with
+per-run adaptive halving (:func:`workbench.sim.wheel_slip_jit.stiff_step`).
+A run ends when it stops or diverges, as its lane of the batch freezes.
+
+:data:`KERNELS` names the two paths a sweep may take; :func:`compiled_available`
+says whether numba is installed (``pip install workbench[fast]``). The numpy
+path is the reference: ``tests/test_compiled_kernel.py`` compares every
+metric of the first 64 runs of the dry design's sweep.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import fields
+from importlib.util import find_spec
+from typing import Literal
+
+import numpy as np
+
+from ..controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED
+from ..sim.history import split_delay
+from .antiskid_scenario import RunMetrics, RunSettings
+
+#: The stepping paths of a sweep: "compiled" (numba, this module) or "numpy"
+#: (:func:`~workbench.studies.antiskid_scenario.simulate_antiskid` with ``batch``).
+KERNELS = ("compiled", "numpy")
+Kernel = Literal["compiled", "numpy"]
+
+#: Field order of the metrics array (RunMetrics; PhaseEvents first).
+METRIC_FIELDS = tuple(f.name for f in fields(RunMetrics))
+
+
+def compiled_available() -> bool:
+    """Whether numba is installed (the compiled kernel can run)."""
+    return find_spec("numba") is not None
+
+
+def default_kernel() -> Kernel:
+    """"compiled" when numba is installed, else "numpy"."""
+    return "compiled" if compiled_available() else "numpy"
+
+
+def compiled_covers(s) -> bool:
+    """Whether the compiled kernel covers the controller settings ``s`` (the
+    literal recursive predictor is numpy-only)."""
+    return not (s.compensate and s.predictor != "rollout")
+
+
+def _build():
+    """Compile-on-first-use: the numba functions of this kernel."""
+    import numba
+
+    from ..controllers import antiskid003_jit as C
+    from ..sim.wheel_slip_jit import BY_SIGN, creep_speed, fmax, fmin, stiff_step, wheel_speed
+
+    jit = numba.njit(nogil=True, error_model="numpy")
+    M = {k: i for i, k in enumerate(METRIC_FIELDS)}
+    T_CRUISE, V_CRUISE, L_CRUISE = M["t_cruise"], M["v_at_cruise"], M["lam_at_cruise"]
+    L_MAX, V_MAX, L_BRAKE = M["lam_max_traction"], M["v_max"], M["lam_at_brake"]
+    VE_BRAKE, LE_BRAKE, T_NEG = M["v_err_at_brake"], M["lam_err_at_brake"], M["t_lam_negative"]
+    L_MIN, T_OM3, T_STOP, T_PEAK = (M["lam_min_brake"], M["t_omega3"], M["t_stop"],
+                                    M["t_past_peak"])
+    E_LAST, E_MAX = M["evs_last"], M["evs_max_tracking"]
+    V_D, L_D, L_OPT, DT = C.V_D, C.LAMBDA_D, C.LAMBDA_OPT, C.DT
+    WS, TB = C.OMEGA_SWITCH, C.T_BRAKE
+    profile, control = C.profile, C.control
+
+    @jit
+    def clip(x):
+        return fmin(fmax(x, 0.0), 1.0)
+
+    @jit
+    def fmax_nan(a, b):      # NaN = no value yet
+        return b if a != a else fmax(a, b)
+
+    @jit
+    def record(t, v, lam, ph, to_cruise, to_brake, to_stop, m, rs, cfg, r_p, settle):
+        """:meth:`MetricsRecorder.__call__` for one run; ``rs`` = (v_prev,
+        has_track, omega_prev, e_prev, lam_prev)."""
+        dt = cfg[DT]
+        frac = (v - cfg[V_D]) / fmax(v - rs[0], 1e-12)
+        if to_cruise:
+            m[T_CRUISE] = t - dt * fmin(frac, 1.0)
+            m[V_CRUISE], m[L_CRUISE] = v, lam
+        rs[0] = v
+        if ph < BRAKE_IN:
+            m[L_MAX], m[V_MAX] = fmax(m[L_MAX], lam), fmax(m[V_MAX], v)
+        if to_brake:
+            m[L_BRAKE], m[VE_BRAKE], m[LE_BRAKE] = lam, v - cfg[V_D], lam - cfg[L_D]
+        if to_stop:
+            m[T_STOP] = t
+        if not (ph == BRAKE_IN or ph == BRAKE):
+            return
+        if lam < 0 and m[T_NEG] != m[T_NEG]:
+            m[T_NEG] = t
+        m[L_MIN] = fmin(m[L_MIN], lam)
+        omega = wheel_speed(fmax(v, cfg[C.V_FLOOR]), lam, r_p)
+        ws = cfg[WS]
+        vs_on, _ = profile(t, v, 0.0 * v, math.inf + 0.0 * v, cfg)
+        vs_star = vs_on if omega > ws else 0.0
+        vs = creep_speed(v, lam)
+        e, e_on = abs(vs - vs_star), abs(vs - vs_on)
+        m[E_LAST] = e
+        in_window = m[T_OM3] != m[T_OM3] and m[T_PEAK] != m[T_PEAK]
+        cross_w = omega <= ws and m[T_OM3] != m[T_OM3]
+        cross_l = lam < -cfg[L_OPT] and m[T_PEAK] != m[T_PEAK]
+        if rs[1] == 0.0:
+            f_w = f_l = 1.0 + 0.0 * v
+            e_prev = e_on
+        else:
+            w_prev, e_prev, l_prev = rs[2], rs[3], rs[4]
+            f_w = clip((w_prev - ws) / fmax(w_prev - omega, 1e-300))
+            f_l = clip((l_prev + cfg[L_OPT]) / fmax(l_prev - lam, 1e-300))
+        if cross_w:
+            m[T_OM3] = t - dt * (1.0 - f_w)
+        if cross_l:
+            m[T_PEAK] = t - dt * (1.0 - f_l)
+        settled = in_window and t >= cfg[TB] + settle
+        if settled and not cross_w and not cross_l:
+            m[E_MAX] = fmax_nan(m[E_MAX], e)
+        f_end = fmin(f_w if cross_w else 1.0, f_l if cross_l else 1.0)
+        e_end = e_prev + f_end * (e_on - e_prev)
+        if settled and (cross_w or cross_l):
+            m[E_MAX] = fmax_nan(m[E_MAX], e_end)
+        rs[1], rs[2], rs[3], rs[4] = 1.0, omega, e_on, lam
+
+    @jit
+    def run_batch(plant, Np, fp, v0, lam0, u_init, T_end, cfg, pc, settle, st0, ub0, m0, out):
+        """Simulate each run i (plant parameters ``plant[i]``, input delay
+        (Np[i] + fp[i]) dt, initial speed v0[i]) into ``out[i]``."""
+        dt = cfg[DT]
+        r_i = 4      # PARAM_ORDER index of r (checked by the caller)
+        for i in range(plant.shape[0]):
+            p = plant[i]
+            N, f = Np[i], fp[i]
+            L = N + 2
+            pbuf = np.full(L, u_init)
+            st, ubuf, m = st0.copy(), ub0.copy(), m0.copy()
+            rs = np.zeros(5)
+            rs[0] = v0[i]
+            v, lam = v0[i], lam0
+            T, n = 0, 0
+            while True:
+                t = T * dt
+                u, ph, tc, tb, ts = control(t, v, lam, st, ubuf, m, cfg, pc)
+                record(t, v, lam, ph, tc, tb, ts, m, rs, cfg, p[r_i], settle)
+                pbuf[n % L] = u
+                n += 1
+                a = pbuf[(n - 1 - N) % L]
+                ua = (1.0 - f) * a + f * pbuf[(n - 2 - N) % L]
+                if T >= T_end or ph >= STOPPED:
+                    break
+                v, lam, unres = stiff_step(v, lam, ua, dt, p, 1e-3, BY_SIGN)
+                st[C.UNRES] = 1.0 if unres else 0.0
+                T += 1
+            out[i] = m
+
+    return run_batch
+
+
+_KERNEL = None
+
+
+def compile_kernel() -> None:
+    """Compile the kernel in this process now (a few seconds, once). A
+    process pool started afterwards by ``fork`` inherits the compiled code,
+    so its workers do not compile it again."""
+    global _KERNEL
+    if _KERNEL is None:
+        from numba import float64, int64
+        k = _build()
+        a1, a2 = float64[::1], float64[:, ::1]
+        k.compile((a2, int64[::1], a1, a1, float64, float64, int64, a1, a1, float64, a1, a1,
+                   a1, a2))
+        _KERNEL = k
+
+
+def simulate_batch_compiled(run: RunSettings, dt: float, *,
+                            evs_settle: float = 5.0) -> RunMetrics:
+    """Compiled counterpart of ``simulate_antiskid(run, dt, record_dt=None,
+    batch=B)``: the same :class:`RunMetrics` (arrays of B runs).
+
+    Parameters
+    ----------
+    run : RunSettings
+        ``plant_params`` entries, ``h`` and ``x0[0]`` may be (B,) arrays.
+    dt : float
+        Step and sampling period (s).
+    evs_settle : float
+        As :class:`~workbench.studies.antiskid_scenario.MetricsRecorder`.
+    """
+    from ..controllers.antiskid003_jit import initial_state, settings_array
+    from ..sim.wheel_slip import PARAM_ORDER
+    if PARAM_ORDER.index("r") != 4:
+        raise RuntimeError("PARAM_ORDER changed: update run_batch's index of r")
+    compile_kernel()
+    B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))
+    plant = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(x, float), (B,))
+                                           for x in run.plant_params], axis=1))
+    parts = [split_delay(float(h), dt) for h in np.broadcast_to(run.h, (B,))]
+    Np = np.array([q[0] for q in parts], np.int64)
+    fp = np.array([q[1] for q in parts], float)
+    v0 = np.array(np.broadcast_to(np.asarray(run.x0[0], float), (B,)))
+    cs = run.controller
+    st0, ub0 = initial_state(cs, dt, run.u_init)
+    m0 = np.array([getattr(RunMetrics(), k) for k in METRIC_FIELDS], float)
+    out = np.empty((B, len(METRIC_FIELDS)))
+    _KERNEL(plant, Np, fp, v0, float(run.x0[1]), float(run.u_init),
+            int(round(run.t_end / dt)), settings_array(cs, dt),
+            np.asarray(cs.params, float), float(evs_settle), st0, ub0, m0, out)
+    return RunMetrics(**{k: out[:, j].copy() for j, k in enumerate(METRIC_FIELDS)})
+
+
+def simulate_batch(run: RunSettings, dt: float, kernel: Kernel) -> RunMetrics:
+    """A batch's :class:`RunMetrics` by the ``kernel`` path (:data:`KERNELS`;
+    "compiled" runs the numpy path where :func:`compiled_covers` says no)."""
+    if kernel not in KERNELS:
+        raise ValueError(f"kernel = {kernel!r}; expected one of {KERNELS}")
+    if kernel == "compiled" and compiled_covers(run.controller):
+        return simulate_batch_compiled(run, dt)
+    from .antiskid_scenario import simulate_antiskid
+    B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))
+    return simulate_antiskid(run, dt, record_dt=None, batch=B)[1]
