@@ -33,7 +33,7 @@ report: install
 test: install
 	@log=$$(mktemp); \
 	$(WB) check > $$log 2>&1 & check=$$!; \
-	$(PY) -m pytest; tests=$$?; \
+	$(PY) -m pytest --durations=15; tests=$$?; \
 	wait $$check; checked=$$?; \
 	echo; echo "== workbench check (verify + report --all --check)"; cat $$log; rm -f $$log; \
 	echo "pytest exit $$tests, workbench check exit $$checked"; \

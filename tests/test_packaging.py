@@ -19,5 +19,7 @@ def test_every_package_folder_is_listed_in_pyproject():
 def test_scaffold_templates_are_package_data():
     conf = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
     from workbench.scaffold import COMMON, EXAMPLE, FILES
+    from workbench.scaffold.new import KINDS
     assert conf["package-data"]["workbench.scaffold"] == ["files/*"]
-    assert sorted(p.name for p in FILES.iterdir()) == sorted({**COMMON, **EXAMPLE})
+    assert sorted(p.name for p in FILES.iterdir()) == sorted(
+        {**COMMON, **EXAMPLE} | {f"{k}.toml.tmpl": None for k in KINDS})
