@@ -201,6 +201,24 @@ def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
     return CruiseBasin(check, tuple(float(k) for k in K), q, v_d, lam_d, lam_opt, trajs)
 
 
+def _delay_free(fn, x0, lam_d: float, T: float):
+    """The delay-free loop x' = fn(x) from x0 over [0, T] (Radau, rtol 1e-8),
+    stopped when |lambda| reaches 0.9 (the wheel spins or locks); a model
+    evaluation that overflows gives NaN, which ends the step as failed."""
+    def rhs(t, x):
+        try:
+            return list(fn(x[0], x[1]))
+        except (OverflowError, ValueError, ZeroDivisionError):
+            return [math.nan, math.nan]
+
+    def spin(t, x):
+        return 0.9 - abs(x[1] + lam_d)
+    spin.terminal = True
+    with np.errstate(all="ignore"):
+        return solve_ivp(rhs, (0.0, T), np.array(x0, float), method="Radau", rtol=1e-8,
+                         atol=1e-10, events=spin, max_step=0.05)
+
+
 def _trajectories(prob, est, pts, seed, n, T, lam_d):
     """Delay-free trajectories from a seeded set of states around the basin
     and from each switch state (Radau, rtol 1e-8): "converges" when a sample
@@ -214,18 +232,7 @@ def _trajectories(prob, est, pts, seed, n, T, lam_d):
     fm = sp.lambdify(prob.states, list(prob.f), "math")
     out = []
     for x0 in starts:
-        def rhs(t, x):
-            try:
-                return list(fm(x[0], x[1]))
-            except (OverflowError, ValueError, ZeroDivisionError):
-                return [math.nan, math.nan]
-
-        def spin(t, x):
-            return 0.9 - abs(x[1] + lam_d)
-        spin.terminal = True
-        with np.errstate(all="ignore"):
-            sol = solve_ivp(rhs, (0.0, T), np.array(x0, float), method="Radau", rtol=1e-8,
-                            atol=1e-10, events=spin, max_step=0.05)
+        sol = _delay_free(fm, x0, lam_d, T)
         path = sol.y.T
         inside = prob.V(path) <= est.c_certified
         if inside.any():
@@ -290,20 +297,7 @@ def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0,
 def _fate(vals, v_d, K, x0, lam_d, sets, T) -> str:
     """Fate of the delay-free trajectory from x0 (see :class:`SwitchVerdict`)."""
     f, _, states, *_ = _loop(vals, v_d, tuple(K))
-    fn = sp.lambdify(states, f, "math")
-
-    def rhs(t, x):
-        try:
-            return list(fn(x[0], x[1]))
-        except (OverflowError, ValueError, ZeroDivisionError):
-            return [math.nan, math.nan]
-
-    def spin(t, x):
-        return 0.9 - abs(x[1] + lam_d)
-    spin.terminal = True
-    with np.errstate(all="ignore"):
-        sol = solve_ivp(rhs, (0.0, T), np.array(x0, float), method="Radau", rtol=1e-8,
-                        atol=1e-10, events=spin, max_step=0.05)
+    sol = _delay_free(sp.lambdify(states, f, "math"), x0, lam_d, T)
     path = sol.y.T
     if any(est.c_certified > 0 and np.any(prob.V(path) <= est.c_certified) for prob, est in sets):
         return "converges"
