@@ -82,6 +82,30 @@ def claims() -> list[Claim]:
                      q / beta * phi_e * (sp.Abs(d) * sp.Abs(s) + d * s)),
               sample=SAMPLE, nonzero=(ed,)),
     ]
+    # The finite-time reaching argument divides by nothing but multiplies by
+    # |e'|^(q-1): at e' = 0 the bound of eq 20 is 0, not a negative rate.
+    out += [
+        Claim("ntsm-reaching-printed", PAPER, "16, 20",
+              "eq 20 gives a reaching rate uniform in e' for every s != 0: "
+              "V' <= -(m j / 2) s^2 (as finite-time reaching needs), also near e' = 0",
+              "inequality", V_dot, -m * j * s**2 / 2, hypotheses=bounds,
+              sample=SAMPLE + ((ed, -1e-4, 1e-4),), nonzero=(ed,), expect="refuted",
+              note="Degeneracy of the reaching argument: the factor |e'|^(q-1) of eq 20 "
+                   "tends to 0 as e' -> 0, so near e' = 0 eq 20 gives no rate at all (at "
+                   "e' = 0 the bound is V' <= 0): the counterexample has a small e'."),
+        Claim("ntsm-reaching-at-rest", PAPER, "9, 13, 17",
+              "at e' = 0 the set is crossed, not a rest point: s e'' <= -(beta/q)(j s^2 + "
+              "k|s|^(p+1)) < 0 for s != 0 when |w| <= G_w, |d| <= G_d, so e' leaves 0 "
+              "in the direction that reduces |s|",
+              "inequality", s * edd.subs(ed, 0),
+              -beta / q * (j * s**2 + k * sp.Abs(s) ** (p + 1)), hypotheses=bounds,
+              terms=((Gw - sp.Abs(w)) * sp.Abs(s) / m, (sp.Abs(w) * sp.Abs(s) + w * s) / m,
+                     (Gd - sp.Abs(d)) * sp.Abs(s) / m, (sp.Abs(d) * sp.Abs(s) + d * s) / m),
+              sample=SAMPLE,
+              note="The standard repair of NTSM reaching (Feng, Yu, Man 2002): e' = 0 with "
+                   "s != 0 is not an attractor, so the reaching phase still ends in finite "
+                   "time; the paper does not make this step."),
+    ]
     # eq (21)-(22): on s = 0, e' = -(beta e)^(a/b); for e(t_e) = e0 > 0 the
     # closed form below solves it and reaches 0 at t_f of eq (22).
     t, te, e0, W = sp.symbols("t t_e e_0 W", positive=True)

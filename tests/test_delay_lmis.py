@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from workbench.cli import main
-from workbench.lmi.analysis import (BesselLegendreLMI, JensenLMI, bessel_legendre_auto,
-                                    certified_delay, legendre_derivative_coefficients,
+from workbench.lmi.analysis import (BesselLegendreLMI, JensenLMI, certified_delay, legendre_derivative_coefficients,
                                     make_criterion)
 from workbench.lmi.core import Outcome
+from workbench.lmi.hierarchy import bessel_legendre_auto
 from workbench.lmi.exact_check import exact_check, first_nonpositive_pivot, to_rational
 from workbench.margins import delay_margin_eig
 
@@ -186,21 +186,28 @@ def test_cli_benchmark_json_schema(tmp_path, capsys):
     (ex,) = data["examples"]
     assert ex["name"] == "pure" and ex["exact_margin"] == pytest.approx(math.pi / 2)
     keys = {"method", "N", "h_certified", "h_refuted", "outcome", "at_cap", "ratio", "solves",
-            "seconds"}
+            "seconds", "certified_interval", "interval_ratio", "interval_solves"}
     assert all(keys <= set(m) for m in ex["methods"])
+    # issue 13: the exact windows and an interval certificate per method
+    assert ex["stable_windows"] == [[0.0, pytest.approx(math.pi / 2)]] and ex["sound"]
+    for m in ex["methods"]:
+        lo, hi = m["certified_interval"]
+        assert lo == 0.0 and 0 < hi < math.pi / 2
     assert [(m["method"], m["N"]) for m in ex["methods"]] == [
         ("free-weighting", None), ("bessel-legendre", 0), ("bessel-legendre", 1),
         ("bessel-legendre", 2), ("bessel-legendre-auto", 2)]
     assert all(0 < m["ratio"] <= 1 and m["exact_check"] == "certified" for m in ex["methods"])
     assert set(ex) == {"name", "exact_margin", "exact_margin_sweep", "exact_agreement",
-                       "exact_methods_agree", "methods"}
+                       "exact_methods_agree", "stable_windows", "sound", "methods"}
 
 
 def test_cli_benchmark_json_exact_schema(tmp_path, capsys):
     assert main(["benchmark", "delay", str(_small_design(tmp_path)), "--json"]) == 0
     (ex,) = json.loads(capsys.readouterr().out)["examples"]
     assert all(set(m) == {"method", "N", "h_certified", "h_refuted", "outcome", "at_cap",
-                          "ratio", "solves", "seconds"} for m in ex["methods"])
+                          "ratio", "solves", "seconds", "certified_interval",
+                          "certified_intervals", "interval_ratio", "interval_solves"}
+               for m in ex["methods"])
 
 
 def test_cli_benchmark_bad_input(tmp_path, capsys):
@@ -261,6 +268,7 @@ def test_hierarchy_never_goes_backwards(monkeypatch):
     """An order whose own search fails (as after an inaccurate solve) reports
     the lower order's certificate, which proves it feasible (SG15 Thm 4)."""
     import workbench.lmi.analysis as an
+    import workbench.lmi.hierarchy as hi
     real = an.certified_delay
 
     def flaky(lmi, **kw):
@@ -269,8 +277,8 @@ def test_hierarchy_never_goes_backwards(monkeypatch):
             return an.DelayBound(b.method, 2, an.Bracket(0.0, math.inf, Outcome.INCONCLUSIVE,
                                                          None, b.bracket.steps))
         return b
-    monkeypatch.setattr(an, "certified_delay", flaky)
-    auto = an.bessel_legendre_auto(A, AD, EXACT, N_max=2, N_through=2, rel_tol=1e-3,
+    monkeypatch.setattr(hi, "certified_delay", flaky)
+    auto = hi.bessel_legendre_auto(A, AD, EXACT, N_max=2, N_through=2, rel_tol=1e-3,
                                    margin=MARGIN)
     h = [b.h_certified for b in auto.bounds]
     assert h == sorted(h) and h[2] == h[1] > 0

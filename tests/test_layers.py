@@ -27,6 +27,7 @@ ALLOWED = {
     "sim": {"sim", "plants", "errors"},
     "controllers": {"controllers", "sim", "plants", "errors"},
     "report": {"report", "claims", "errors"},
+    "roa": {"roa", "errors"},
 }
 
 #: (importer package, imported package) pairs the issue names explicitly.

@@ -135,3 +135,12 @@ def test_bad_input_is_a_design_error_naming_the_key(tmp_path, design, old, new, 
     bad.write_text(text.replace(old, new))
     with pytest.raises(DesignError, match=key):
         load_design(bad)
+
+
+def test_within_rate_is_the_wilson_interval():
+    from workbench.studies.stopping000 import within_rate
+    k, n, p, lo, hi = within_rate([40.0] * 10, 30.0)          # none within: 0 / 10
+    assert (k, n, p, lo) == (0, 10, 0.0, 0.0)
+    assert hi == pytest.approx(1.959963984540054 ** 2 / (10 + 1.959963984540054 ** 2))
+    k, n, p, lo, hi = within_rate([-10.0, 5.0, 31.0, -29.9], 30.0)
+    assert (k, n, p) == (3, 4, 0.75) and 0.3 < lo < 0.75 < hi < 1.0

@@ -9,3 +9,19 @@ user set in the environment wins.
 import os as _os
 
 _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+
+#: Public API names loaded on first use (``import workbench`` stays light).
+_API = ("delay_bound", "simulate_delay", "DelayBoundResult")
+
+
+def __getattr__(name):
+    """Lazy access to :mod:`workbench.api` (``workbench.delay_bound`` etc.)."""
+    if name in _API:
+        from . import api
+        return getattr(api, name)
+    raise AttributeError(f"module 'workbench' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(list(globals()) + list(_API))

@@ -9,9 +9,13 @@ appear only as claims of that design.
 
 For each example: the exact margin by two independent methods
 (:func:`~workbench.margins.delay_margin_eig`,
-:func:`~workbench.margins.delay_margin_sweep`), then for each method the
-certified bound by the shared bisection, its ratio to the exact margin,
-solver calls and seconds, and optionally the rational re-check of the
+:func:`~workbench.margins.delay_margin_sweep`) and the exact stability
+windows up to the search cap, then for each method two certificates, kept
+apart (issue 13): the **point** bound of the shared bisection (stable at
+that delay; its ratio to the exact margin) and the **interval** certificate
+(stable for every constant delay in [lo, hi], :mod:`workbench.lmi.interval`),
+each compared with the exact windows (:mod:`workbench.benchmark_windows`);
+solver calls and seconds, and optionally the rational re-check of the point
 certificate (:mod:`workbench.lmi.exact_check`).
 """
 from __future__ import annotations
@@ -20,14 +24,17 @@ import json
 import math
 import time
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from .benchmark_windows import (abscissa_curve, directed, exact_windows, interval_fields, middle,
+                                show_window)
 from .errors import DesignError
-from .lmi.analysis import METHODS, bessel_legendre_auto, certified_delay, make_criterion
+from .lmi.analysis import METHODS, certified_delay, make_criterion
 from .lmi.core import DEFAULT_MARGIN
+from .lmi.hierarchy import bessel_legendre_auto
 from .margins import (AGREEMENT_RTOL, Agreement, DelayMargin, compare_margins, delay_margin_eig,
                       delay_margin_sweep)
 from .reader import Reader, display_path
@@ -82,16 +89,23 @@ class BenchmarkSettings:
 
 @dataclass(frozen=True)
 class MethodRow:
-    """One method on one example.
+    """One method on one example: a point and an interval certificate.
 
-    ``h_certified`` is the largest delay certified (s; ``inf`` for a
+    ``h_certified`` is the largest delay at which the criterion certified
+    stability — a **point** certificate, "stable at h" (s; ``inf`` for a
     certified delay-independent test; ``h_max`` means "at least h_max"),
     ``ratio`` = h_certified / h* (None when h* is infinite, except 1.0 when
-    both are), ``exact_check`` the rational re-check outcome of the
+    both are), ``exact_check`` the rational re-check outcome of the point
     certificate (None when not run or nothing was certified), ``outcome`` the
     bracket's outcome (``certified`` / ``refuted`` / ``inconclusive``) and
-    ``at_cap`` whether ``h_certified`` is only the search cap (the true bound
-    is at least that).
+    ``at_cap`` whether ``h_certified`` is only the search cap. ``interval``
+    is the **interval** certificate [lo, hi] — stable for every constant
+    delay in it (:func:`~workbench.lmi.interval.certified_interval`; from 0
+    when found, else the longest window) — or None, ``intervals`` every
+    disjoint certified interval (one per window reached); ``interval_ratio`` its
+    end over h* when it starts at 0. ``point_sound`` / ``interval_sound``:
+    the point lies in an exact stable window / the interval lies inside one
+    (None when nothing was certified).
     """
 
     method: str
@@ -104,11 +118,21 @@ class MethodRow:
     exact_check: str | None
     outcome: str = "inconclusive"
     at_cap: bool = False
+    interval: tuple[float, float] | None = None
+    intervals: tuple[tuple[float, float], ...] = ()
+    interval_solves: int = 0
+    point_sound: bool | None = None
+    interval_sound: bool | None = None
+    interval_ratio: float | None = None
 
     def to_json(self, *, with_check: bool = False) -> dict:
         d = {"method": self.method, "N": self.N, "h_certified": _j(self.h_certified),
              "h_refuted": _j(self.h_refuted), "outcome": self.outcome, "at_cap": self.at_cap,
-             "ratio": _j(self.ratio), "solves": self.solves, "seconds": round(self.seconds, 4)}
+             "ratio": _j(self.ratio), "solves": self.solves, "seconds": round(self.seconds, 4),
+             "certified_interval": None if self.interval is None else
+             [_j(self.interval[0]), _j(self.interval[1])],
+             "certified_intervals": [[_j(a), _j(b)] for a, b in self.intervals],
+             "interval_ratio": _j(self.interval_ratio), "interval_solves": self.interval_solves}
         if with_check:
             d["exact_check"] = self.exact_check
         return d
@@ -130,10 +154,23 @@ def agreement_bound(rel_diff: float) -> float:
 
 @dataclass(frozen=True)
 class ExampleResult:
+    """One example: exact margins, exact stability windows within [0, h_max]
+    (``hi = inf``: stable for every larger delay), the spectral abscissa on a
+    grid (h, alpha) for the figure, and one row per method."""
+
     example: Example
     exact: DelayMargin
     exact_sweep: DelayMargin
     rows: tuple[MethodRow, ...]
+    windows: tuple[tuple[float, float], ...] = ()
+    abscissa: tuple[tuple[float, float], ...] = ()
+
+    @property
+    def sound(self) -> bool:
+        """No certified point outside, and no certified interval across, the
+        exact stability windows."""
+        return all(r.point_sound is not False and r.interval_sound is not False
+                   for r in self.rows)
 
     @property
     def agreement(self) -> float:
@@ -169,16 +206,28 @@ class BenchmarkResult:
         """``{"h_max", "exact_methods_agree", "examples": [{"name", "exact_margin",
         "exact_margin_sweep", "exact_agreement", "exact_methods_agree", "methods":
         [{"method", "N", "h_certified", "h_refuted", "outcome", "at_cap", "ratio",
-        "solves", "seconds"}]}]}`` (issues 4 and 21), plus ``exact_check`` per
+        "solves", "seconds", "certified_interval", "interval_ratio",
+        "interval_solves"}], "stable_windows", "sound"}], "sound"}`` (issues 4, 13
+        and 21): ``stable_windows`` the exact windows [lo, hi] within [0, h_max]
+        (hi ``"inf"``: stable for every larger delay), ``certified_interval``
+        [lo, hi] every constant delay certified, or null), plus ``exact_check`` per
         method when ``with_check``; infinite values are the string ``"inf"``
         (JSON has no infinity), undefined ratios ``null``."""
         return {"h_max": _j(self.settings.h_max), "exact_methods_agree": self.exact_agree,
+                "sound": self.sound,
                 "examples": [{"name": e.example.name, "exact_margin": _j(e.exact.h),
                               "exact_margin_sweep": _j(e.exact_sweep.h),
                               "exact_agreement": _j(e.agreement),
                               "exact_methods_agree": e.exact_agree,
+                              "stable_windows": [[_j(a), _j(b)] for a, b in e.windows],
+                              "sound": e.sound,
                               "methods": [r.to_json(with_check=with_check) for r in e.rows]}
                              for e in self.examples]}
+
+    @property
+    def sound(self) -> bool:
+        """Every certified point and interval lies in an exact stable window."""
+        return all(e.sound for e in self.examples)
 
     @property
     def exact_agree(self) -> bool:
@@ -186,9 +235,11 @@ class BenchmarkResult:
         return all(e.exact_agree for e in self.examples)
 
     def max_ratio(self) -> float:
-        """Largest finite ratio over examples and methods (soundness: <= 1)."""
-        rs = [r.ratio for e in self.examples for r in e.rows
-              if r.ratio is not None and math.isfinite(e.exact.h)]
+        """Largest end of a certified interval [0, hi] over the exact margin h*
+        (finite h* only; soundness: < 1). Point certificates are not margins
+        and do not count here (they may lie in a later window)."""
+        rs = [r.interval_ratio for e in self.examples for r in e.rows
+              if r.interval_ratio is not None and math.isfinite(e.exact.h)]
         return max(rs) if rs else 0.0
 
 
@@ -263,10 +314,11 @@ def load_settings(r: Reader) -> BenchmarkSettings:
 
 # -- running -------------------------------------------------------------------------
 def _row(s: BenchmarkSettings, method: str, N: int | None, b, h_star: float, solves: int,
-         seconds: float, check: str | None) -> MethodRow:
+         seconds: float, check: str | None, lmi, windows, guess=None) -> MethodRow:
     h = b.h_certified
     return MethodRow(method, N, h, b.bracket.h_refuted, _ratio(h, h_star), solves, seconds,
-                     check, b.bracket.outcome.value, bool(s.h_max <= h < math.inf))
+                     check, b.bracket.outcome.value, bool(s.h_max <= h < math.inf),
+                     **interval_fields(lmi, b, windows, h_star, s.h_max, s.rel_tol, guess))
 
 
 def _ratio(h: float, exact: float) -> float | None:
@@ -284,33 +336,50 @@ def _check(lmi, bound, enabled: bool) -> str | None:
 
 
 def run_example(ex: Example, s: BenchmarkSettings) -> ExampleResult:
-    """Exact margins and every method of ``s`` on one example."""
+    """Exact margins and windows, then every method of ``s`` on one example: its
+    point bound (:func:`~workbench.lmi.analysis.certified_delay`) and its
+    interval (:func:`~workbench.lmi.interval.certified_interval`, grown from
+    0 and from the middle of every exact window)."""
     A, Ad = np.array(ex.A), np.array(ex.Ad)
     exact, sweep = delay_margin_eig(A, Ad), delay_margin_sweep(A, Ad)
     h_star = exact.h
+    windows = exact_windows(A, Ad, s.h_max)
     rows: list[MethodRow] = []
     kw = dict(rel_tol=s.rel_tol, h_hi=s.h_max)
+    # unstable at h = 0: the point search starts inside the first window
+    guess = middle(*windows[0], s.h_max) if windows and windows[0][0] > 0 else None
     for m in s.methods:
         if m == "bessel-legendre":
             continue
         lmi = make_criterion(m, A, Ad, margin=s.margin)
-        b = certified_delay(lmi, **kw)
+        b = certified_delay(lmi, guess=guess, **kw)
         rows.append(_row(s, m, None, b, h_star, b.solves, b.seconds,
-                         _check(lmi, b, s.exact_check)))
+                         _check(lmi, b, s.exact_check), lmi, windows))
     if "bessel-legendre" in s.methods:
         auto = bessel_legendre_auto(A, Ad, h_star, gap_tol=s.gap_tol, N_max=s.N_max,
-                                    N_through=s.orders, margin=s.margin, **kw)
+                                    N_through=s.orders, margin=s.margin, guess=guess, **kw)
+        by_N = {}
         for b in auto.bounds:
             if b.N <= s.orders:
                 lmi = make_criterion("bessel-legendre", A, Ad, N=b.N, margin=s.margin)
                 rows.append(_row(s, b.method, b.N, b, h_star, b.solves, b.seconds,
-                                 _check(lmi, b, s.exact_check)))
+                                 _check(lmi, b, s.exact_check), lmi, windows))
+                by_N[b.N] = rows[-1]
         best = auto.best
         used = [b for b in auto.bounds if b.N <= best.N]
         lmi = make_criterion("bessel-legendre", A, Ad, N=best.N, margin=s.margin)
-        rows.append(_row(s, AUTO, best.N, best, h_star, sum(b.solves for b in used),
-                         sum(b.seconds for b in used), _check(lmi, best, s.exact_check)))
-    return ExampleResult(ex, exact, sweep, tuple(rows))
+        row = _row(s, AUTO, best.N, best, h_star, sum(b.solves for b in used),
+                   sum(b.seconds for b in used), _check(lmi, best, s.exact_check),
+                   lmi if best.N not in by_N else None, windows)
+        if best.N in by_N:          # the same order's interval, not searched twice
+            t = by_N[best.N]
+            row = replace(row, interval=t.interval, intervals=t.intervals,
+                          interval_solves=t.interval_solves,
+                          interval_sound=t.interval_sound, interval_ratio=t.interval_ratio)
+        rows.append(row)
+    curve = abscissa_curve(A, Ad, windows, h_star, s.h_max,
+                           [r.interval for r in rows] + [(r.h_certified,) * 2 for r in rows])
+    return ExampleResult(ex, exact, sweep, tuple(rows), windows, curve)
 
 
 def run_benchmark(examples: tuple[Example, ...], s: BenchmarkSettings) -> BenchmarkResult:
@@ -323,15 +392,17 @@ def benchmark_delay(design, *, as_json: bool = False, exact_check: bool = False,
     """``workbench benchmark delay [DESIGN] [--json] [--exact-check]``.
 
     Runs the suite of a delay-benchmark design and prints method x example:
-    certified h, ratio to the exact margin, solves, seconds. Exit 0 when every
-    run finished, the two exact methods agree on every example (relative
-    difference <= :data:`~workbench.margins.AGREEMENT_RTOL`), no certified bound
-    exceeds its exact margin (and, with ``--exact-check``, every certificate
-    passes the rational re-check); 1 otherwise. ``design`` is a loaded
-    ``delay-benchmark`` design (the CLI loads and checks its kind).
+    the point certificate (stable at h), its ratio to the exact margin, the
+    interval certificate (stable for every constant delay in [lo, hi]),
+    solves, seconds, and per example the exact stable windows. Exit 0 when
+    every run finished, the two exact methods agree on every example
+    (relative difference <= :data:`~workbench.margins.AGREEMENT_RTOL`), every
+    certified point lies in an exact stable window and every certified
+    interval inside one, no interval [0, hi] reaches h* (and, with
+    ``--exact-check``, every certificate passes the rational re-check); 1
+    otherwise. ``design`` is a loaded ``delay-benchmark`` design (the CLI
+    loads and checks its kind).
     """
-    from dataclasses import replace
-
     from .report.markdown import fmt, md_table
 
     spec = design.spec
@@ -341,7 +412,7 @@ def benchmark_delay(design, *, as_json: bool = False, exact_check: bool = False,
     res = run_benchmark(spec.examples, spec.settings)
     wall = time.perf_counter() - t0
     checks = [r.exact_check for e in res.examples for r in e.rows if r.exact_check]
-    ok = (res.max_ratio() <= 1 + spec.settings.rel_tol and all(c == "certified" for c in checks)
+    ok = (res.max_ratio() < 1 and res.sound and all(c == "certified" for c in checks)
           and res.exact_agree)
     if as_json:
         out(json.dumps(res.to_json(with_check=exact_check), indent=2))
@@ -349,15 +420,23 @@ def benchmark_delay(design, *, as_json: bool = False, exact_check: bool = False,
     for e in res.examples:
         agree = ("" if e.exact_agree else
                  f" — EXACT METHODS DISAGREE (rel. diff {fmt(e.agreement, 2)})")
+        wins = " U ".join(show_window(a, b, lambda x: fmt(x, 7)) for a, b in e.windows) or "none"
         out(f"\n{e.example.name}: h* = {fmt(e.exact.h, 7)} s (eig), {fmt(e.exact_sweep.h, 7)} "
-            f"s (phase sweep){agree} — {e.example.title}")
+            f"s (phase sweep){agree} — {e.example.title}\nexact stable windows in "
+            f"[0, {fmt(spec.settings.h_max)}] s: {wins}" + ("" if e.sound else
+                                                           " — A CERTIFICATE LIES OUTSIDE"))
         table = [[r.method, "" if r.N is None else r.N,
                   fmt(r.h_certified, 6) + (" (>= cap)" if r.at_cap else ""), fmt(r.ratio, 6),
-                  r.solves, f"{r.seconds:.2f}"] + ([r.exact_check or "—"] if exact_check else [])
-                 for r in e.rows]
-        out(md_table(["method", "N", "h certified (s)", "ratio", "solves", "s"]
+                  "—" if r.interval is None else
+                  f"[{fmt(directed(r.interval[0], up=True, sig=5), 5)}, "
+                  f"{fmt(directed(r.interval[1], up=False, sig=5), 5)}]",
+                  f"{r.solves}+{r.interval_solves}", f"{r.seconds:.2f}"]
+                 + ([r.exact_check or "—"] if exact_check else []) for r in e.rows]
+        out(md_table(["method", "N", "stable at h (point, s)", "ratio", "stable on [lo, hi] "
+                      "(interval, s)", "solves", "s"]
                      + (["exact check"] if exact_check else []), table,
-                     "lrrrrr" + ("l" if exact_check else "")))
-    out(f"\n{len(res.examples)} examples in {wall:.1f} s; largest ratio "
+                     "lrrrrrr" + ("l" if exact_check else "")))
+    out(f"\n{len(res.examples)} examples in {wall:.1f} s; point: stable at that delay; "
+        f"interval: stable for every constant delay in it; largest interval end / h* "
         f"{fmt(res.max_ratio(), 6)}" + ("" if ok else " — NOT OK"))
     return 0 if ok else 1

@@ -84,8 +84,13 @@ def design_cases(ev) -> list[Case]:
                             f"design file: {ev.design.path}"])
         note = ""
         if c.expect == "fail":
-            note = f"expected to fail (known discrepancy): {c.reason}"
-        if r.ok:
+            note = f"expected to fail (known discrepancy, severity {c.severity}): {c.reason}"
+        elif c.severity is not None:
+            note = f"workbench finding, severity {c.severity}"
+        if not r.severity_holds:
+            message = (f"severity 'rounding' does not hold (the difference is more than "
+                       f"0.1 % of the value): {facts}")
+        elif r.ok:
             message = ""
             if r.verdict.value == "INCONCLUSIVE":
                 note = "INCONCLUSIVE, allowed by allow_inconclusive = true"

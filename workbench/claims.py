@@ -15,6 +15,27 @@ A claim in a design file::
     allow_inconclusive = false
     expect = "pass"           # or "fail" with `reason`: a known, documented
     reason = "..."            #   discrepancy (like pytest's strict xfail)
+    severity = "minor"        # required with expect = "fail"; on a passing claim
+                              #   it makes the claim a workbench finding
+    origin = "paper"          # "paper" | "workbench" (default: from `source`)
+
+Severities form a closed set, mildest first (:data:`SEVERITIES`):
+
+``rounding``
+    within the precision the paper printed: checked — the claim is not ok
+    unless |got - value| <= 1e-3 |value| (the size of a paper's rounding of
+    printed intermediate values);
+``minor``
+    a difference that changes no conclusion;
+``changes-the-result``
+    a printed number or conclusion does not hold;
+``safety``
+    divergence, wheel lock or spin, instability, a string-unstable platoon.
+
+A claim with a severity is a *finding*: a paper claim that is not reproduced
+(``expect = "fail"``), or a defect the workbench shows and the paper does not
+state (a passing claim whose origin is the workbench). Each report opens with
+its findings, most severe first.
 
 Verdicts form a closed set: PASS, FAIL, INCONCLUSIVE. A claim is *ok* when it
 passes, is inconclusive and allows it, or fails and was expected to fail; a
@@ -57,6 +78,28 @@ class Claim:
     allow_inconclusive: bool
     expect: str
     reason: str
+    severity: str | None = None
+    origin: str = "paper"
+
+    @property
+    def is_finding(self) -> bool:
+        """A severity makes the claim a finding (see the module docstring)."""
+        return self.severity is not None
+
+
+#: Severities of findings, mildest first (module docstring).
+SEVERITIES = ("rounding", "minor", "changes-the-result", "safety")
+#: Where a claim comes from: a statement of a paper, or the workbench's own check.
+ORIGINS = ("paper", "workbench")
+#: Relative size of a "rounding" discrepancy.
+ROUNDING_RTOL = 1e-3
+_PAPER_SOURCE = re.compile(r"^(paper\s*)?\d{3}\b", re.I)
+
+
+def origin_of(source: str) -> str:
+    """Default origin: "paper" when ``source`` cites a paper ("003 Table 3",
+    "paper 002 §4"), else "workbench"."""
+    return "paper" if _PAPER_SOURCE.match(source.strip()) else "workbench"
 
 
 @dataclass(frozen=True)
@@ -69,8 +112,20 @@ class ClaimResult:
     note: str = ""
 
     @property
+    def severity_holds(self) -> bool:
+        """False only for a ``rounding`` finding whose measured value is not
+        within :data:`ROUNDING_RTOL` of the claimed one."""
+        c = self.claim
+        if c.severity != "rounding" or isinstance(c.value, str) or isinstance(self.got, str) \
+                or self.got is None:
+            return True
+        return abs(float(self.got) - c.value) <= ROUNDING_RTOL * abs(c.value)
+
+    @property
     def ok(self) -> bool:
         c = self.claim
+        if not self.severity_holds:
+            return False
         if c.expect == "fail":
             return self.verdict is Verdict.FAIL
         return self.verdict is Verdict.PASS or (
@@ -81,7 +136,8 @@ class ClaimResult:
         return {"id": c.id, "quantity": c.quantity, "compare": c.compare,
                 "expected": _json_value(c.value), "tolerance": c.tolerance,
                 "got": _json_value(self.got), "verdict": self.verdict.value,
-                "ok": self.ok, "expect": c.expect, "source": c.source, "note": self.note}
+                "ok": self.ok, "expect": c.expect, "source": c.source, "note": self.note,
+                "severity": c.severity, "origin": c.origin}
 
 
 def _json_value(v):
@@ -135,9 +191,17 @@ def parse_claims(root: Reader, study, spec) -> list[Claim]:
         reason = r.string("reason", default="")
         if expect == "fail" and not reason:
             raise r.fail("reason", "<missing>", 'a reason when expect = "fail"')
+        severity = r.string("severity", default=None, choices=SEVERITIES)
+        if expect == "fail" and severity is None:
+            raise r.fail("severity", "<missing>",
+                         'a severity for a known discrepancy: one of ' + ", ".join(SEVERITIES))
+        origin = r.string("origin", default=origin_of(src), choices=ORIGINS)
+        if severity is not None and expect == "pass" and origin == "paper":
+            raise r.fail("severity", severity, 'no severity on a reproduced paper claim '
+                         '(a finding is expect = "fail", or origin = "workbench")')
         r.finish()
         out.append(Claim(cid, desc, q, cmp_, value, tol, digits, rounding, src, allow,
-                         expect, reason))
+                         expect, reason, severity, origin))
     return out
 
 

@@ -42,21 +42,26 @@ def _designs(paths: list[str]) -> list:
 # -- verbs ------------------------------------------------------------------------
 def cmd_synthesize(args) -> int:
     from .design import load_design
-    from .report.markdown import fmt, md_table
+    from .report.markdown import fmt
     from .synthesis import synthesize_delay_bound
     from .studies import antiskid_cruise
+    from .studies.delay_feedback_cli import synthesis_table
 
     design = load_design(args.design)
-    if design.kind != antiskid_cruise.STUDY.kind:
+    kinds = (antiskid_cruise.STUDY.kind, "delay-feedback")
+    if design.kind not in kinds:
         raise DesignError(design.path, "design.kind", design.kind,
-                          f'a design with a delay-bound synthesis ("{antiskid_cruise.STUDY.kind}")')
-    spec = design.spec
-    eps = spec.eps
+                          "a design with a delay-bound synthesis ("
+                          + " or ".join(f'"{k}"' for k in kinds) + ")")
     if args.eps:
         for e in args.eps:
             if not (math.isfinite(e) and e > 0):
                 raise DesignError("<cli>", "--eps", e, "a positive number")
-        eps = tuple(args.eps)
+    if design.kind == "delay-feedback":
+        from .studies.delay_feedback_cli import synthesize_command
+        return synthesize_command(design, eps=args.eps, as_json=args.json)
+    spec = design.spec
+    eps = tuple(args.eps) if args.eps else spec.eps
     _, lam_solved, lam, lin = antiskid_cruise.operating_point(spec)
     rows = synthesize_delay_bound(lin.A, lin.B, eps, spec.settings)
     ok = all(r.status.value == "certified" for r in rows)
@@ -66,21 +71,7 @@ def cmd_synthesize(args) -> int:
     print(f"{design.name}: problem (60) of paper 003 at v_d = {fmt(spec.v_d.value)} m/s, "
           f"lambda_d = {fmt(lam, 5)} ({'pinned' if spec.lambda_d_pinned else 'solved'}; "
           f"solved {fmt(lam_solved, 6)})")
-    digits = spec.settings.gain_digits
-    table = [[fmt(r.eps), fmt(r.h_certified, 5), fmt(r.h_refuted, 5),
-              "—" if r.K is None else "[" + ", ".join(fmt(k, digits) for k in r.K) + "]",
-              fmt(r.h_gain, 4), fmt(r.exact.h if r.exact else None, 5),
-              fmt(r.exact_siso.h if r.exact_siso else None, 5),
-              fmt(r.ratio, 3), r.status.value] for r in rows]
-    print(md_table(["eps", "h_certified", "h_refuted", "K (canonical)", "h certified by K",
-                    "h* (eig)", "h* (pyctrl)", "ratio", "status"], table, "rrrlrrrrl"))
-    print(f"K (canonical): the minimum-norm certificate at {fmt(spec.settings.gain_fraction)} "
-          f"x h_certified, rounded to {digits} significant digits, then certified on its own "
-          "with K fixed (h certified by K).")
-    if any(r.exact and math.isinf(r.exact.h) for r in rows):
-        print("h* = inf: no characteristic root reaches the imaginary axis for any delay — the "
-              "loop is stable for every constant delay; h_certified is the limit of the LMI "
-              "criterion, not of the loop.")
+    print(synthesis_table(rows, spec.settings))
     return 0 if ok else 1
 
 
@@ -107,7 +98,9 @@ def cmd_verify(args) -> int:
         rows = []
         for e in evs:
             for c in e.claims:
-                v = c.verdict.value + (" (expected)" if c.claim.expect == "fail" and c.ok else "")
+                sev = c.claim.severity
+                v = c.verdict.value + (f" (expected; {sev})" if c.claim.expect == "fail" and c.ok
+                                       else f" ({sev})" if sev else "")
                 rows.append([e.design.name, c.claim.id, f"{c.claim.compare} {fmt(c.claim.value, 6)}",
                              fmt(c.got, 6), v if c.ok else v + " ✗", c.claim.source])
         rows += extra.get("rows", [])
@@ -222,6 +215,13 @@ def cmd_init(args) -> int:
     return 0
 
 
+def cmd_new(args) -> int:
+    from .scaffold.new import new_design
+    path = new_design(args.kind, args.name, args.dir)
+    print(f"wrote {path}; next: workbench verify {path}")
+    return 0
+
+
 def cmd_benchmark(args) -> int:
     from .benchmark import benchmark_delay
     return benchmark_delay(_load_kind(args.design, "delay-benchmark"), as_json=args.json,
@@ -229,8 +229,16 @@ def cmd_benchmark(args) -> int:
 
 
 def cmd_simulate(args) -> int:
+    from .design import load_design
+    design = load_design(args.design)
+    if design.kind == "delay-feedback":
+        from .studies.delay_feedback_cli import simulate_command as simulate_feedback
+        return simulate_feedback(design, case=args.case, dt=args.dt, as_json=args.json)
+    if design.kind != "antiskid-run":
+        raise DesignError(design.path, "design.kind", design.kind,
+                          'an "antiskid-run" or "delay-feedback" design')
     from .studies.antiskid_run import simulate_command
-    return simulate_command(_load_kind(args.design, "antiskid-run"), case=args.case, dt=args.dt, as_json=args.json)
+    return simulate_command(design, case=args.case, dt=args.dt, as_json=args.json)
 
 
 def cmd_sweep(args) -> int:
@@ -255,6 +263,7 @@ COMMANDS: dict[str, tuple[str, Callable]] = {
               cmd_check),
     "prove": ("check the claims of proofs/: PROVED / REFUTED / INCONCLUSIVE", _cmd_prove),
     "init": ("write a project skeleton: designs/, proofs/, reports/, CI files", cmd_init),
+    "new": ("write a commented template design (new delay-feedback NAME)", cmd_new),
 }
 
 
@@ -324,6 +333,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "the example")
     p.add_argument("--requirement", help="what the CI files pip-install (default: "
                    "workbench==<this version>)")
+    p = sub.add_parser("new", help=COMMANDS["new"][0])
+    p.add_argument("kind", metavar="KIND", help="design kind (delay-feedback)")
+    p.add_argument("name", metavar="NAME", help="design name (the file stem)")
+    p.add_argument("--dir", default=str(DESIGNS_DIR), help="folder (default: designs/)")
     return ap
 
 

@@ -167,6 +167,19 @@ def verification_rows(results=None) -> dict:
 
 
 # -- reports ---------------------------------------------------------------------------
+def _index_cells(pairs) -> tuple[str, ...]:
+    """The index row of a paper's proof report (see
+    :func:`workbench.report.findings.index_cells`): derivation steps refuted
+    as printed are errata; their severity is not assessed."""
+    rs = [r for _, r in pairs]
+    bad = sum(not r.ok for r in rs)
+    errata = [r for r in rs if r.verdict is Verdict.REFUTED]
+    return ("verified" if not bad else f"**NOT OK** ({bad})",
+            f"{sum(r.verdict is Verdict.PROVED for r in rs)} of {len(rs)} steps proved",
+            f"{len(errata)} refuted as printed (errata; severity not assessed)" if errata else "none",
+            f"erratum: {errata[0].claim.statement}" if errata else "—")
+
+
 def _summary(results) -> str:
     n, ok = len(results), sum(r.ok for r in results)
     counts = {v: sum(r.verdict is v for r in results) for v in Verdict}
@@ -227,12 +240,13 @@ def render_paper_report(paper: str, pairs) -> str:
 
 def report_files() -> list:
     """``ReportFiles`` of every paper: ``proofs-NNN`` (one per paper)."""
+    from .report.markdown import github_math
     from .report.writer import ReportFiles
     results = run_proofs()
     out = []
     for paper in sorted({m.paper for m, _ in results}):
         pairs = [(m, r) for m, r in results if m.paper == paper]
         rs = [r for _, r in pairs]
-        out.append(ReportFiles(f"proofs-{paper}", render_paper_report(paper, pairs), (),
-                               all(r.ok for r in rs), _summary(rs)))
+        out.append(ReportFiles(f"proofs-{paper}", github_math(render_paper_report(paper, pairs)), (),
+                               all(r.ok for r in rs), _summary(rs), _index_cells(pairs)))
     return out

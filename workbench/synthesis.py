@@ -25,7 +25,7 @@ from .lmi.core import DEFAULT_MARGIN, Bracket, Outcome, bisect_delay
 from .lmi.freeweighting003 import FreeWeighting003, FreeWeighting003FixedK
 from .lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
 from .lmi.scaling import balancing
-from .margins import DelayMargin, delay_margin_eig, delay_margin_siso
+from .margins import DelayMargin, delay_margin_eig, delay_margin_siso, stability_windows
 
 
 @dataclass(frozen=True)
@@ -72,7 +72,9 @@ class SynthesisRow:
     h_certified, h_refuted : float
         Bracket (s) of the criterion: certified by an optimal solve with a
         passing re-check / refuted by an optimal solve (``inf``: none refuted
-        in range).
+        in range). Theorem 1 of paper 003 is a delay-range criterion: the
+        gain of the certificate at h_certified is certified for every
+        constant delay in [0, h_certified] (an interval certificate).
     K : tuple[float, ...] or None
         Canonical gain (original coordinates, rounded to the settings'
         ``gain_digits``); see :mod:`workbench.lmi.gain`.
@@ -97,6 +99,9 @@ class SynthesisRow:
         coordinates, see module docstring).
     gain : CanonicalGain or None
         The canonical gain with its own certified bracket.
+    windows : tuple of (lo, hi)
+        Exact stable windows of x' = A x + B K x(t - h) (canonical K) within
+        [0, h_max] (``hi = inf``: stable for every larger delay).
     """
 
     eps: float
@@ -113,6 +118,15 @@ class SynthesisRow:
     recheck: dict = field(default_factory=dict, repr=False)
     certificate: dict = field(default_factory=dict, repr=False)
     gain: CanonicalGain | None = field(default=None, repr=False)
+    windows: tuple = ()
+
+    @property
+    def certified_interval(self) -> tuple[float, float] | None:
+        """[0, h_gain] (s): the canonical gain is certified for every constant
+        delay in it (paper 003 Theorem 1 is a delay-range criterion); None
+        without a certified gain."""
+        h = self.h_gain
+        return (0.0, h) if h else None
 
     @property
     def h_gain(self) -> float | None:
@@ -134,6 +148,9 @@ class SynthesisRow:
                 "h_gain": self.h_gain,
                 "h_design": None if self.gain is None else self.gain.h_design,
                 "exact_margin": em,
+                "stable_windows": [[a, "inf" if math.isinf(b) else b] for a, b in self.windows],
+                "certified_interval": None if self.certified_interval is None
+                else list(self.certified_interval),
                 "status": self.status.value, "solves": self.solves,
                 "seconds": round(self.seconds, 4)}
 
@@ -149,6 +166,7 @@ def _balanced(A, B):
 def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, T,
          settings: SynthesisSettings) -> SynthesisRow:
     K = exact = exact_siso = rmin = gain = None
+    windows = ()
     recheck, cert = {}, {}
     status, steps = br.outcome, list(br.steps)
     if br.certificate is not None:
@@ -168,11 +186,14 @@ def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, T,
             rmin = min(recheck.values())
             K = tuple(float(k) for k in gain.K.ravel())
             exact = delay_margin_eig(A, B @ gain.K)
+            windows = tuple((a, b if math.isinf(b) else min(b, settings.h_max))
+                            for a, b in stability_windows(A, B @ gain.K, settings.h_max))
             if B.shape[1] == 1:
                 exact_siso = delay_margin_siso(A, B, gain.K)
     return SynthesisRow(float(eps), br.h_certified, br.h_refuted, K, status, exact,
                         exact_siso, rmin, len(steps), sum(s.seconds for s in steps),
-                        tuple(s.outcome.value[0] for s in br.steps), recheck, cert, gain)
+                        tuple(s.outcome.value[0] for s in br.steps), recheck, cert, gain,
+                        windows)
 
 
 def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = SynthesisSettings()

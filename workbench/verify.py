@@ -40,5 +40,7 @@ def report_files(ev: Evaluation):
     from .lmi.core import CLARABEL_SETTINGS
     from .report.writer import build
     rendered = studies.renderer(ev.design.kind)(ev.design, ev.result)
-    solver = ", ".join(f"{k}={v}" for k, v in CLARABEL_SETTINGS.items()) or "Clarabel defaults"
+    solver = None
+    if getattr(studies.REGISTRY[ev.design.kind], "uses_solver", True):
+        solver = ", ".join(f"{k}={v}" for k, v in CLARABEL_SETTINGS.items()) or "Clarabel defaults"
     return build(ev, rendered, solver)

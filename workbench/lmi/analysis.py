@@ -1,11 +1,9 @@
 """Analysis LMIs for x'(t) = A x(t) + A_d x(t - h) with a constant delay h.
 
-Each criterion is a :class:`~workbench.lmi.core.MarginLMI`: blocks written
-once, solved as "maximise t" by Clarabel, re-checked with numpy; the largest
-certified h comes from the shared bracketed bisection
-(:func:`~workbench.lmi.core.bisect_delay`) through :func:`certified_delay`.
-Margins are relative to the largest block norm (see :mod:`workbench.lmi.core`),
-so no criterion depends on how its Lyapunov matrix is scaled.
+Each criterion is a :class:`~workbench.lmi.core.MarginLMI` (blocks written
+once, solved by Clarabel, re-checked with numpy, margins relative to the
+largest block norm); :func:`certified_delay` bisects with
+:func:`~workbench.lmi.core.bisect_delay`.
 
 Notation (block selectors on the augmented vector xi):
 ``x = x(t)``, ``x_d = x(t - h)``, and for the Bessel-Legendre hierarchy the
@@ -13,21 +11,25 @@ Legendre moments ``Omega_k = (1/h) int_{t-h}^t l_k(u(s)) x(s) ds`` with the
 shifted Legendre polynomials ``l_k(u) = P_k(2u - 1)``, ``u = (s - t + h)/h``
 (``l_k(1) = 1``, ``l_k(0) = (-1)^k``, ``int_0^1 l_j l_k = delta_jk/(2k+1)``).
 
-Criteria (weakest to tightest on the classic example):
-
-* :class:`DelayIndependentLMI` — stable for every h >= 0;
-* :class:`JensenLMI` and :class:`FreeWeightingLMI` (He et al. 2004);
-* :class:`WirtingerLMI` (Seuret & Gouaisbaut 2013) = Bessel-Legendre N = 1;
-* :class:`BesselLegendreLMI` of order N (Seuret & Gouaisbaut 2015).
+Criteria: :class:`DelayIndependentLMI` (every h >= 0), :class:`JensenLMI`,
+:class:`FreeWeightingLMI` (He et al. 2004), :class:`WirtingerLMI` (Seuret &
+Gouaisbaut 2013; Bessel-Legendre N = 1), :class:`BesselLegendreLMI` (SG15).
 
 What a CERTIFIED step proves: at the delay tested, the Lyapunov-Krasovskii
 functional of the criterion is positive definite and strictly decreasing
-along solutions, so the system is asymptotically stable for that constant
-delay (for the free-weighting criterion, whose LMI is affine in h with a
-positive semidefinite slope: for every constant delay in [0, h]). The
-bisection treats the certified set as an interval [0, h], as the literature
-does; the benchmark and the soundness suite compare every bound with the
-exact margin of :mod:`workbench.margins`.
+along solutions, so the system is asymptotically stable **at that constant
+delay** (a point certificate). Feasibility is not monotone in h: a system can
+be stable on several separate windows, and a bisection over point
+certificates can land in a later one, so :func:`certified_delay` reports a
+point, never a margin. Intervals ("stable for every constant delay in
+[h_a, h_b]") come from :mod:`workbench.lmi.interval`, which solves the
+criterion once with the decision variables shared at both ends (each class
+declares in ``h_blocks`` how its blocks depend on h). The free-weighting
+criterion is a delay-range criterion: a certificate at h bounds the
+derivative of a functional for every constant delay tau <= h (the
+free-weighting term -2 xi'N int_{t-tau}^t x' <= tau xi'N Z^{-1} N' xi +
+int_{t-tau}^t x''Z x', and tau <= h), so its point at h is the interval
+[0, h] (``range_from_zero``).
 
 References
 ----------
@@ -46,25 +48,34 @@ References
 """
 from __future__ import annotations
 
+import copy
+import dataclasses
 import math
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Literal, Mapping
 
 import cvxpy as cp
 import numpy as np
 
-from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, bisect_delay
+from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, Step, bisect_delay
+from .delay_input import check_bisection, search_range, system_matrices
+from .legendre import blockdiag_S, legendre_derivative_coefficients
+from .point_search import resumed
 
-#: Clarabel settings of the retries after an ``optimal_inaccurate`` answer,
-#: tried in order (near the bound the higher Bessel-Legendre orders are
-#: degenerate enough for the default refinement to stop short). The looser
-#: tolerances of the second retry cannot make a step CERTIFIED on their own:
-#: every certified point is re-checked with numpy against the margin.
+#: Clarabel settings of the retries after an ``optimal_inaccurate`` answer, in order
+#: (near the bound the higher Bessel-Legendre orders are degenerate); a retry certifies
+#: only through the same numpy re-check.
 RETRY_SETTINGS = (
     {"iterative_refinement_reltol": 1e-14, "iterative_refinement_abstol": 1e-14,
      "iterative_refinement_max_iter": 50},
     {"tol_gap_abs": 1e-7, "tol_gap_rel": 1e-7, "tol_feas": 1e-7, "tol_ktratio": 1e-5},
 )
+
+#: Blocks' time unit: within sqrt 2 of UNIT_SCALE / (||A||_2 + ||A_d||_2). Any fixed
+#: multiple of 1/R makes the margins independent of the unit of A; 4 keeps the classic
+#: 2 x 2 example (R = 3.4) in its published unit (u = 1), as measured in issue 4.
+UNIT_SCALE = 4.0
 
 MethodName = Literal["delay-independent", "jensen", "free-weighting", "wirtinger",
                      "bessel-legendre"]
@@ -83,12 +94,38 @@ class _DelayAnalysis(MarginLMI):
     retry_settings = RETRY_SETTINGS
 
     def __init__(self, A, Ad, **kw):
-        self.A = np.atleast_2d(np.asarray(A, float))
-        self.Ad = np.atleast_2d(np.asarray(Ad, float))
-        if self.A.shape != self.Ad.shape or self.A.shape[0] != self.A.shape[1]:
-            raise ValueError(f"A {self.A.shape}, A_d {self.Ad.shape}; expected equal square shapes")
+        self.A, self.Ad = system_matrices(A, Ad)
         self.n = self.A.shape[0]
+        R = float(np.linalg.norm(self.A, 2) + np.linalg.norm(self.Ad, 2))
+        #: time unit (s) of the blocks: the power of two nearest UNIT_SCALE / R
+        self.unit = 2.0 ** round(math.log2(UNIT_SCALE / R)) if R > 0 else 1.0
         super().__init__(**kw)
+
+    def scaled(self, p):
+        """(A u, A_d u, h / u, iota u) with u = :attr:`unit`: every block is written
+        for the system in its own time unit (exact: u is a power of two), so
+        the relative margins and the solver's scaling do not depend on the
+        unit of A (time scaling (c A, c A_d) changes u by at most a factor
+        sqrt 2). Certificates are those of the scaled system at h / u, which is
+        the same system."""
+        u = self.unit
+        if self.A.dtype == object:          # exact rational re-check
+            u = Fraction(u)
+        return self.A * u, self.Ad * u, p["h"] * (1 / u), p["iota"] * u
+
+    def solve_at(self, h: float) -> Step:
+        """:meth:`MarginLMI.solve_at`; an answer still INCONCLUSIVE after the
+        settings retries is retried once more on a twin problem with the
+        variable bound 100 times larger (another scaling of the same
+        criterion; its point passes the same re-check of the same blocks)."""
+        step = super().solve_at(h)
+        if step.outcome is not Outcome.INCONCLUSIVE:
+            return step
+        if getattr(self, "_twin_lmi", None) is None:
+            self._twin_lmi = copy.copy(self)
+            MarginLMI.__init__(self._twin_lmi, margin=self.margin, bound=100 * self.bound)
+        again = MarginLMI.solve_at(self._twin_lmi, h)
+        return dataclasses.replace(again, seconds=step.seconds + again.seconds)
 
     @property
     def N(self) -> int | None:
@@ -105,12 +142,14 @@ class DelayIndependentLMI(_DelayAnalysis):
     """
 
     method = "delay-independent"
+    h_blocks: dict[str, str] = {}
 
     def variables(self):
         return {"P": _sym(self.n, "P"), "Q": _sym(self.n, "Q")}
 
     def blocks(self, x, p, bmat):
-        P, Q, A, Ad = x["P"], x["Q"], self.A, self.Ad
+        P, Q = x["P"], x["Q"]
+        A, Ad, _, _ = self.scaled(p)
         lmi = bmat([[A.T @ P + P @ A + Q, P @ Ad], [Ad.T @ P, -Q]])
         return [Block("lmi", lmi, "nsd"), Block("P_pos", P, "psd"), Block("Q_pos", Q, "psd")]
 
@@ -129,16 +168,18 @@ class JensenLMI(_DelayAnalysis):
     """
 
     method = "jensen"
+    h_blocks = {"lmi": "h"}     # h * block = phi0 + h^2 F'RF, R >= 0
 
     def variables(self):
         return {k: _sym(self.n, k) for k in ("P", "S", "R")}
 
     def blocks(self, x, p, bmat):
-        P, S, R, A, Ad = x["P"], x["S"], x["R"], self.A, self.Ad
+        P, S, R = x["P"], x["S"], x["R"]
+        A, Ad, h, iota = self.scaled(p)
         PA, PAd = P @ A, P @ Ad
         phi0 = bmat([[PA + PA.T + S - R, PAd + R], [PAd.T + R, -S - R]])
         F = np.hstack([A, Ad])
-        lmi = p["iota"] * phi0 + p["h"] * (F.T @ R @ F)
+        lmi = iota * phi0 + h * (F.T @ R @ F)
         return [Block("lmi", lmi, "nsd")] + [Block(f"{k}_pos", x[k], "psd") for k in "PSR"]
 
 
@@ -159,6 +200,9 @@ class FreeWeightingLMI(_DelayAnalysis):
     """
 
     method = "free-weighting"
+    h_blocks = {"lmi": "1"}     # affine in h
+    #: a certificate at h proves every constant delay in [0, h] (class docstring)
+    range_from_zero = True
 
     def variables(self):
         v = {k: _sym(self.n, k) for k in ("P", "Q", "Z")}
@@ -167,8 +211,8 @@ class FreeWeightingLMI(_DelayAnalysis):
         return v
 
     def blocks(self, x, p, bmat):
-        P, Q, Zm, N1, N2, A, Ad, h = x["P"], x["Q"], x["Z"], x["N1"], x["N2"], self.A, \
-            self.Ad, p["h"]
+        P, Q, Zm, N1, N2 = x["P"], x["Q"], x["Z"], x["N1"], x["N2"]
+        A, Ad, h, _ = self.scaled(p)
         O = np.zeros((self.n, self.n), dtype=int)
         p11 = P @ A + A.T @ P + N1 + N1.T + Q
         p12 = P @ Ad - N1 + N2.T
@@ -178,18 +222,6 @@ class FreeWeightingLMI(_DelayAnalysis):
                     [h * N1.T, h * N2.T, -h * Zm, O],
                     [h * (Zm @ A), h * (Zm @ Ad), O, -h * Zm]])
         return [Block("lmi", lmi, "nsd")] + [Block(f"{k}_pos", x[k], "psd") for k in "PQZ"]
-
-
-def legendre_derivative_coefficients(N: int) -> np.ndarray:
-    """c[k, j] with l_k'(u) = sum_{j<k} c[k, j] l_j(u) on [0, 1].
-
-    For l_k(u) = P_k(2u - 1): c[k, j] = (2j + 1)(1 - (-1)^(k+j)) (SG15, eq. 4).
-    """
-    c = np.zeros((N + 1, N + 1), dtype=int)
-    for k in range(N + 1):
-        for j in range(k):
-            c[k, j] = (2 * j + 1) * (1 - (-1) ** (k + j))
-    return c
 
 
 class BesselLegendreLMI(_DelayAnalysis):
@@ -222,6 +254,7 @@ class BesselLegendreLMI(_DelayAnalysis):
     """
 
     method = "bessel-legendre"
+    h_blocks = {"phi": "h"}     # h * Phi_N = X + h He(G1' Theta H) + h^2 F'RF, R >= 0
 
     def __init__(self, A, Ad, N: int, **kw):
         if not (isinstance(N, (int, np.integer)) and N >= 0):
@@ -240,8 +273,11 @@ class BesselLegendreLMI(_DelayAnalysis):
         # positive semidefinite matrix.
         return {"Theta": _sym((N + 1) * n, "Theta"), "S": _sym(n, "S"), "R": _sym(n, "R")}
 
-    def selectors(self):
-        """(G0, G1, H, F, [Gamma_0..Gamma_N]) as numpy arrays (see class doc)."""
+    def selectors(self, A=None, Ad=None):
+        """(G0, G1, H, F, [Gamma_0..Gamma_N]) as numpy arrays (see class doc);
+        F from ``A``, ``A_d`` (default: the system's)."""
+        A = self.A if A is None else A
+        Ad = self.Ad if Ad is None else Ad
         n, N = self.n, self._N
         I = np.eye(n, dtype=int)      # integer selectors keep exact re-checks exact
         m = (N + 2) * n
@@ -257,7 +293,7 @@ class BesselLegendreLMI(_DelayAnalysis):
             for j in range(k):
                 g = g - c[k, j] * e(2 + j)
             gam.append(g)
-        F = self.A @ e(0) + self.Ad @ e(1)
+        F = A @ e(0) + Ad @ e(1)
         G0 = np.vstack([e(0)] + [np.zeros((n, m), dtype=int)] * N)
         G1 = np.vstack([np.zeros((n, m), dtype=int)] + [e(2 + k) for k in range(N)])
         H = np.vstack([F] + gam[:N])
@@ -266,15 +302,15 @@ class BesselLegendreLMI(_DelayAnalysis):
     def blocks(self, x, p, bmat):
         Th, S, R = x["Theta"], x["S"], x["R"]
         n, N = self.n, self._N
-        G0, G1, H, F, gam = self.selectors()
-        h, iota = p["h"], p["iota"]
+        A, Ad, h, iota = self.scaled(p)
+        G0, G1, H, F, gam = self.selectors(A, Ad)
         e0, e1 = G0[:n], np.eye(n, (N + 2) * n, n, dtype=int)
         # G0' D(S) = 0, so (1/h) He(G0' P H) = (1/h) He(G0' Theta H): affine in the
         # parameters (DPP); He(G1' P H) = He(G1' Theta H) - (1/h) He(G1' D(S) H).
         he0 = G0.T @ Th @ H
         he1 = G1.T @ Th @ H
         if N:
-            he1 = he1 - iota * (G1.T @ _blockdiag_S(S, N, n, bmat) @ H)
+            he1 = he1 - iota * (G1.T @ blockdiag_S(S, N, n, bmat) @ H)
         sterm = e0.T @ S @ e0 - e1.T @ S @ e1
         rsum = sum((2 * k + 1) * (g.T @ R @ g) for k, g in enumerate(gam))
         phi = iota * (he0 + he0.T + sterm - rsum) + (he1 + he1.T) + h * (F.T @ R @ F)
@@ -282,17 +318,10 @@ class BesselLegendreLMI(_DelayAnalysis):
                 Block("S_pos", S, "psd"), Block("R_pos", R, "psd")]
 
     def lyapunov_matrix(self, values: Mapping[str, np.ndarray], h: float) -> np.ndarray:
-        """P = Theta - (1/h) diag(0, S, 3S, ..., (2N-1)S) of a certificate."""
-        return values["Theta"] - _blockdiag_S(values["S"], self._N, self.n, np.block) / h
-
-
-def _blockdiag_S(S, N: int, n: int, bmat):
-    """diag(0, S, 3S, ..., (2N-1)S) as a cvxpy or numpy block matrix."""
-    Z = np.zeros((n, n), dtype=int)
-    rows = []
-    for i in range(N + 1):
-        rows.append([(2 * i - 1) * S if (i == j and i > 0) else Z for j in range(N + 1)])
-    return bmat(rows)
+        """P = Theta - (u/h) diag(0, S, 3S, ..., (2N-1)S) of a certificate (in the
+        time unit u = :attr:`unit` of the blocks)."""
+        return values["Theta"] - blockdiag_S(values["S"], self._N, self.n,
+                                              np.block) * (self.unit / h)
 
 
 class WirtingerLMI(BesselLegendreLMI):
@@ -328,7 +357,12 @@ def make_criterion(method: MethodName, A, Ad, *, N: int | None = None,
 
 @dataclass(frozen=True)
 class DelayBound:
-    """Largest delay a criterion certifies, with its bracket.
+    """Largest delay at which a criterion certifies stability, with its bracket.
+
+    A **point** certificate: stable at ``h_certified`` (the LMIs of this
+    module are not monotone in h in general; a system may be stable on
+    several windows). The interval form is
+    :func:`~workbench.lmi.interval.certified_interval`.
 
     Attributes
     ----------
@@ -351,6 +385,8 @@ class DelayBound:
     bracket: Bracket
     certified_by: int | None = None
 
+    form = "point"              # see workbench.lmi.interval.Form
+
     @property
     def h_certified(self) -> float:
         return self.bracket.h_certified
@@ -364,14 +400,43 @@ class DelayBound:
         return self.bracket.seconds
 
 
-def certified_delay(lmi: _DelayAnalysis, *, h_lo: float = 1e-3, h_hi: float = 100.0,
-                    rel_tol: float = 1e-5, guess: float | None = None,
-                    max_solves: int = 60) -> DelayBound:
-    """Largest constant delay (s) the criterion certifies, by the shared bisection.
+def certified_delay(lmi: _DelayAnalysis, *, h_lo: float | None = None,
+                    h_hi: float | None = None, rel_tol: float = 1e-5,
+                    guess: float | None = None, max_solves: int = 60) -> DelayBound:
+    """Largest constant delay (s) at which the criterion certifies stability: a
+    **point** certificate (stable at ``h_certified``; nothing is said about
+    smaller delays — see :func:`~workbench.lmi.interval.certified_interval`
+    for intervals), by the shared bisection.
 
     The delay-independent test does not depend on h: one solve decides it
-    (certified => ``h_certified = inf``).
+    (certified => ``h_certified = inf``, which is an interval [0, inf)). A
+    search ended by an inconclusive answer is resumed above it
+    (:mod:`workbench.lmi.point_search`).
+
+    Parameters
+    ----------
+    lmi : criterion of :data:`METHODS` (:func:`make_criterion`)
+    h_lo, h_hi : float, optional
+        Search range (s), 0 < h_lo < h_hi; default 1e-4 and 1e4 times the
+        system's time scale 1 / (||A||_2 + ||A_d||_2).
+    rel_tol : float
+        Relative bracket width, in (0, 1).
+    guess : float, optional
+        First delay tried (s).
+    max_solves : int
+        Solver budget.
+
+    Raises
+    ------
+    ValueError
+        h_lo >= h_hi, NaN/inf or non-positive delays, rel_tol outside (0, 1),
+        a bad budget (expected-versus-found message).
     """
+    if not isinstance(lmi, _DelayAnalysis):
+        raise ValueError(f"lmi = {type(lmi).__name__}; expected a delay criterion of "
+                         "workbench.lmi.analysis (make_criterion)")
+    h_lo, h_hi = search_range(lmi.A, lmi.Ad, h_lo, h_hi)
+    check_bisection(rel_tol, guess, max_solves)
     if isinstance(lmi, DelayIndependentLMI):
         step = lmi.solve_at(1.0)
         ok = step.outcome is Outcome.CERTIFIED
@@ -380,58 +445,5 @@ def certified_delay(lmi: _DelayAnalysis, *, h_lo: float = 1e-3, h_hi: float = 10
         return DelayBound(lmi.method, None, br)
     br = bisect_delay(lmi.solve_at, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol, guess=guess,
                       max_solves=max_solves)
+    br = resumed(lmi.solve_at, br, h_hi=h_hi, rel_tol=rel_tol, max_solves=max_solves)
     return DelayBound(lmi.method, lmi.N, br)
-
-
-@dataclass(frozen=True)
-class AutoOrder:
-    """Result of :func:`bessel_legendre_auto`: one bound per order tried.
-
-    ``N_reached`` is the first order whose gap to the exact margin is below
-    the tolerance (None when the cap was reached first).
-    """
-
-    bounds: tuple[DelayBound, ...]
-    N_reached: int | None
-
-    @property
-    def best(self) -> DelayBound:
-        """The bound at ``N_reached`` (or the largest bound when not reached)."""
-        if self.N_reached is not None:
-            return next(b for b in self.bounds if b.N == self.N_reached)
-        return max(self.bounds, key=lambda b: b.h_certified)
-
-
-def bessel_legendre_auto(A, Ad, exact: float, *, gap_tol: float = 1e-4, N_max: int = 6,
-                         N_through: int = 0, rel_tol: float = 1e-5,
-                         margin: float = DEFAULT_MARGIN, h_hi: float = 100.0) -> AutoOrder:
-    """Raise the Bessel-Legendre order N = 0, 1, ... until
-    ``1 - h_N / exact < gap_tol`` or N = ``N_max``.
-
-    Orders up to ``N_through`` are computed in any case (for tables). Each
-    order's bisection starts from the previous order's bound (the hierarchy
-    is non-decreasing in N). ``exact`` is the exact margin (s) from
-    :mod:`workbench.margins`; with ``exact = inf`` the gap never closes.
-    The hierarchy never goes backwards: when order N's own search certifies
-    less than order N - 1 (an inaccurate solve there), order N reports the
-    lower order's certificate (``certified_by``), which proves order N
-    feasible at that delay.
-    """
-    out: list[DelayBound] = []
-    guess, reached = None, None
-    for N in range(0, max(N_max, N_through) + 1):
-        if N > N_through and (reached is not None or N > N_max):
-            break
-        b = certified_delay(BesselLegendreLMI(A, Ad, N, margin=margin), rel_tol=rel_tol,
-                            guess=guess, h_hi=h_hi)
-        if out and b.h_certified < out[-1].h_certified:
-            prev = out[-1]
-            b = DelayBound(b.method, N, prev.bracket,
-                           prev.certified_by if prev.certified_by is not None else prev.N)
-        out.append(b)
-        if b.h_certified > 0:
-            guess = b.h_certified
-        if (reached is None and math.isfinite(exact) and exact > 0
-                and 1 - b.h_certified / exact < gap_tol):
-            reached = N
-    return AutoOrder(tuple(out), reached)

@@ -79,6 +79,7 @@ import numpy as np
 
 from .analysis import RETRY_SETTINGS
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, bisect_delay
+from .delay_input import time_scale
 
 
 def _check_interval(h1: float, mu: float | None) -> tuple[float, float | None]:
@@ -394,7 +395,8 @@ def certified_varying_delay(A, Ad, *, h1: float = 0.0, mu: float | None = None,
         An interval certificate [h1, h2] (see its docstring).
     """
     lmi = VaryingDelayLMI(A, Ad, h1=h1, mu=mu, windows=windows, margin=margin)
-    h_lo = h1 + max(1e-3, 1e-3 * h1)
+    tau = time_scale(lmi.A, lmi.Ad)         # scale-free: 1e-3 of h1 or of the time scale
+    h_lo = h1 + 1e-3 * max(h1, tau if math.isfinite(tau) else 1.0)
     br = bisect_delay(lmi.solve_at, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol, guess=guess,
                       max_solves=max_solves)
     return VaryingDelayBound(lmi.method, lmi.h1, lmi.mu, lmi.windows, br)

@@ -6,6 +6,7 @@ byte-identical Markdown.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
@@ -95,3 +96,42 @@ def margin_text(margin: float) -> str:
     if not (math.isfinite(margin) and margin > 0):
         return "fail"
     return f"≥ 1e{math.floor(math.log10(margin)):+03d}"
+
+
+_FENCE = re.compile(r"^(```|~~~)")
+_DISPLAY = re.compile(r"^\$\$\n(.*?)\n\$\$$", re.M | re.S)
+_CODE_SPAN = re.compile(r"(`+)(?:.*?[^`])?\1(?!`)")
+_INLINE = re.compile(r"(?<![$\\])\$(?![$\s])((?:[^$\n\\]|\\.)+?)(?<![\s\\])\$(?![$\w])")
+
+
+def github_math(markdown: str) -> str:
+    """Math in the forms GitHub renders without touching backslashes.
+
+    GitHub's Markdown applies backslash escapes inside ``$...$`` and
+    ``$$...$$`` before it renders the math, so ``\\\\``, ``\\,`` and ``\\:``
+    break (a matrix collapses to one row). Its documented safe forms are
+    code: display math as a fenced ```` ```math ```` block and inline math as
+    ``$`...`$``; the text between the delimiters is then passed verbatim.
+    Fenced code blocks and existing code spans are left alone.
+    """
+    out, fenced = [], False
+    for block in re.split(r"(^```.*?^```$)", _DISPLAY.sub(lambda m: f"```math\n{m[1]}\n```",
+                                                          markdown), flags=re.M | re.S):
+        if block.startswith("```"):
+            out.append(block)
+            continue
+        lines = []
+        for line in block.split("\n"):
+            fenced ^= bool(_FENCE.match(line))
+            if fenced:
+                lines.append(line)
+                continue
+            parts, last = [], 0
+            for m in _CODE_SPAN.finditer(line):
+                parts.append(_INLINE.sub(r"$`\1`$", line[last:m.start()]))
+                parts.append(m[0])
+                last = m.end()
+            parts.append(_INLINE.sub(r"$`\1`$", line[last:]))
+            lines.append("".join(parts))
+        out.append("\n".join(lines))
+    return "".join(out)

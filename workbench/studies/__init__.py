@@ -11,6 +11,9 @@ Each study module provides an object with
     Compute (a frozen dataclass with ``to_json()``).
 ``quantities(result) -> dict[str, float | str | None]``
     Values of the named quantities (``None``: not determined).
+``uses_solver`` (optional attribute, default True)
+    False when the study runs no convex solver (its report's provenance
+    then names none).
 and, in the study's render module (``<study>_render.py``, which imports the
 study module, never the other way round), a function
 
@@ -44,6 +47,7 @@ STUDIES: dict[str, str] = {
     "brake-fit": "fit000:STUDY",
     "ato-tracking": "tracking002:STUDY",
     "ntsm-platoon": "platoon001:STUDY",
+    "delay-feedback": "delay_feedback:STUDY",
 }
 
 
@@ -58,6 +62,7 @@ RENDERERS: dict[str, str] = {
     "brake-fit": "fit000:render",
     "ato-tracking": "tracking002_render:render",
     "ntsm-platoon": "platoon001_render:render",
+    "delay-feedback": "delay_feedback_render:render",
 }
 
 

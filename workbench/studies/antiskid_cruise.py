@@ -147,6 +147,9 @@ class CruiseResult:
     rows: tuple[SynthesisRow, ...]
     published: tuple[PublishedCheck, ...]
     tight: TightComparison | None = None
+    #: (h, spectral abscissa of x' = A x + B K x(t - h)) for the canonical gain
+    #: of the row with the largest certified bound (the figure of the loop's set)
+    abscissa_vs_h: tuple = ()
 
     def row(self, eps: float) -> SynthesisRow:
         return next(r for r in self.rows if r.eps == eps)
@@ -283,7 +286,8 @@ class AntiskidCruise:
                                       settings=spec.settings)
                 checks.append(PublishedCheck(p, ours, br.h_certified, br.h_refuted, em, match))
         tight = _run_tight(spec, lin, rows) if spec.tight else None
-        return CruiseResult(lam_opt, lam_solved, lam_used, lin, rows, tuple(checks), tight)
+        return CruiseResult(lam_opt, lam_solved, lam_used, lin, rows, tuple(checks), tight,
+                            _abscissa_vs_h(lin, rows))
 
     def quantities(self, res: CruiseResult) -> dict:
         q = {"operating_point.lambda_d": res.lambda_d_used,
@@ -321,6 +325,27 @@ class AntiskidCruise:
 TIGHT_QUANTITIES = ("eps", "h_certified", "h_analysis", "exact_margin", "exact_margin_siso",
                     "K1", "K2", "at_cap", "ratio_to_reference", "reference.h_analysis", "paper_K.h_analysis",
                     "paper_K.exact_margin")
+
+
+def _abscissa_vs_h(lin: Linearisation, rows) -> tuple:
+    """Spectral abscissa of the loop with the best row's canonical gain on a
+    log grid of delays from 1/100 to 100 times its certified bound (the exact
+    side: :func:`workbench.margins.spectral_abscissa`; a delay where the
+    adaptive collocation does not converge is left out, never guessed)."""
+    import numpy as np
+
+    from ..margins import SpectrumNotConverged, spectral_abscissa
+    best = max((r for r in rows if r.K is not None), key=lambda r: r.h_certified, default=None)
+    if best is None or not best.h_certified > 0:
+        return ()
+    Ad = lin.B @ np.array([best.K])
+    out = []
+    for h in np.geomspace(best.h_certified / 100, best.h_certified * 100, 25):
+        try:
+            out.append((float(h), float(spectral_abscissa(lin.A, Ad, h))))
+        except SpectrumNotConverged:
+            continue
+    return tuple(out)
 
 
 def _run_tight(spec: CruiseSpec, lin: Linearisation, rows) -> TightComparison:

@@ -10,7 +10,9 @@ from ..plants.adhesion import adhesion_model
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, margin_text, md_table
 
 
-def _margin_text(dm) -> str:
+def exact_margin_text(dm) -> str:
+    """An exact delay margin as printed: 5 significant digits, ``∞``, or
+    ``0 (unstable at h = 0)``; ``—`` for None."""
     if dm is None:
         return "—"
     if dm.reason == "unstable-at-zero-delay":
@@ -83,7 +85,7 @@ def render(design, res) -> Rendered:
     for r in res.rows:
         rows.append([fmt(r.eps), fmt(r.h_certified, 5), fmt(r.h_refuted, 5),
                      _gain(r.K, st.gain_digits), fmt(r.h_gain, 4),
-                     _margin_text(r.exact), _margin_text(r.exact_siso), fmt(r.ratio, 3),
+                     exact_margin_text(r.exact), exact_margin_text(r.exact_siso), fmt(r.ratio, 3),
                      r.status.value])
     sections.append(
         "## Certified delay bounds (problem 60, cf. Table 3)\n\n"
@@ -107,7 +109,7 @@ def render(design, res) -> Rendered:
         "rounded gain certifies on its own under the same LMI with V = K L fixed. *h\\**: the "
         "exact delay margin of x' = A x + B K x(t-h) with that gain, from two independent "
         "methods.\n\n"
-        + _inf_note(res) + "\n\n" + _recheck_table(res))
+        + _inf_note(res) + "\n\n" + recheck_table(res))
     # -- published comparison -----------------------------------------------------
     if res.published:
         prow = []
@@ -116,7 +118,7 @@ def render(design, res) -> Rendered:
             prow.append([fmt(p.eps), fmt(p.h_m, 4), fmt(c.h_ours, 4),
                          "[" + ", ".join(fmt(k, 5) for k in p.K) + "]",
                          f"{fmt(c.h_paper_K, 4)}", fmt(c.eps_matching, 3),
-                         _margin_text(c.exact_paper_K), p.source])
+                         exact_margin_text(c.exact_paper_K), p.source])
         sections.append(
             "## Comparison with the printed table\n\n"
             + md_table(["eps", "printed h_m (s)", "ours h_certified (s)", "printed K",
@@ -132,16 +134,42 @@ def render(design, res) -> Rendered:
         sections.append(_tight_section(res.tight, res.lin.A, res.lin.B))
     figs = (Figure("delay-bound-vs-eps",
                    "Certified bound and refuted bound against eps; printed values for comparison.",
-                   lambda fig, res=res: _plot_bounds(fig, res)),)
-    sections.append("## Figure\n\n![Certified bound vs eps](" + "{figdir}/delay-bound-vs-eps.png)\n\n"
-                    "Certified bound (filled) and refuted bound (open) per eps, with the printed "
-                    "values (crosses). " + ("The exact margin is infinite for every row, so it "
-                                           "does not appear on the axis." if _all_inf(res) else ""))
+                   lambda fig, res=res: _plot_bounds(fig, res)),
+            Figure("loop", "Loop L(s) = -K (sI - A)^-1 B: Bode and Nyquist.",
+                   lambda fig, res=res: _plot_loop(fig, res), (9.0, 3.6)))
+    best = max((r for r in res.rows if r.K is not None), key=lambda r: r.h_certified,
+               default=None)
+    text = ("## Figures\n\n![Certified bound vs eps](" + "{figdir}/delay-bound-vs-eps.png)\n\n"
+            "Certified bound (filled) and refuted bound (open) per eps, with the printed "
+            "values (crosses). " + ("The exact margin is infinite for every row, so it "
+                                   "does not appear on the axis." if _all_inf(res) else ""))
+    if best is not None:
+        text += ("\n\n![Loop](" + "{figdir}/loop.png)\n\n"
+                 f"Bode and Nyquist plots of L(s) = -K (sI - A)⁻¹ B with the canonical gain of "
+                 f"eps = {fmt(best.eps)} (K = {_gain(best.K)}): a delay e^(-sh) only rotates "
+                 "L(jω) by -ωh, so the loop can lose stability only at a frequency where "
+                 "|L(jω)| = 1; "
+                 + _gain_crossing_text(res.lin.A, res.lin.B, np.array([best.K]),
+                                       best.exact is not None and math.isinf(best.exact.h)))
+    if res.abscissa_vs_h:
+        figs += (Figure("abscissa-vs-h", "Rightmost characteristic root against the delay.",
+                        lambda fig, res=res: _plot_abscissa(fig, res)),)
+        worst = max(a for _, a in res.abscissa_vs_h)
+        text += ("\n\n![Spectral abscissa vs h](" + "{figdir}/abscissa-vs-h.png)\n\n"
+                 "Spectral abscissa (real part of the rightmost root) of x' = A x + B K "
+                 f"x(t − h) with the same gain, for h from {fmt(res.abscissa_vs_h[0][0], 3)} to "
+                 f"{fmt(res.abscissa_vs_h[-1][0], 3)} s; largest value {fmt(worst, 3)} 1/s. "
+                 + ("It stays negative: the loop is stable for every delay shown, as the "
+                    "infinite exact margin says (no root ever reaches the imaginary axis)."
+                    if worst < 0 and _all_inf(res) else
+                    "A positive value is a delay at which the loop is unstable."))
+    sections.append(text)
     return Rendered(tuple(sections), figs)
 
 
-def _recheck_table(res) -> str:
-    """Per-block re-check margins of every canonical certificate, as decades."""
+def recheck_table(res) -> str:
+    """Per-block re-check margins of every canonical certificate (``res.rows``,
+    :class:`workbench.synthesis.SynthesisRow`), as decades, in a <details> block."""
     rows = [r for r in res.rows if r.recheck]
     if not rows:
         return ""
@@ -198,7 +226,59 @@ def _plot_bounds(fig, res):
     ax.legend()
 
 
-def _capped(h, cap) -> str:
+def _loop_response(A, B, K, w):
+    """L(jω) = -K (jωI - A)^-1 B at the frequencies ``w`` (single input)."""
+    n = A.shape[0]
+    return np.array([-(np.atleast_2d(K) @ np.linalg.solve(1j * x * np.eye(n) - A, B))[0, 0]
+                     for x in w])
+
+
+def _gain_crossing_text(A, B, K, infinite: bool) -> str:
+    """The largest |L(jω)| on the plotted grid (ω = 0 and 1e-4..1e3 rad/s)."""
+    w = np.concatenate([[0.0], np.geomspace(1e-4, 1e3, 600)])
+    peak = float(np.max(np.abs(_loop_response(A, B, K, w))))
+    text = f"on the plotted frequencies max |L(jω)| = {fmt(peak, 3)}"
+    if peak < 1 and infinite:
+        return text + (", below 1, as the infinite exact margin (no gain crossing at all, "
+                       "computed without this grid) requires.")
+    return text + "."
+
+
+def _plot_loop(fig, res):
+    best = max((r for r in res.rows if r.K is not None), key=lambda r: r.h_certified)
+    A, B = res.lin.A, res.lin.B
+    w = np.geomspace(1e-4, 1e3, 600)
+    L = _loop_response(A, B, np.array([best.K]), w)
+    ax_m, ax_p, ax_n = fig.subplots(1, 3)
+    ax_m.loglog(w, np.abs(L), color="C0")
+    ax_m.axhline(1.0, color="k", lw=0.8, ls="--")
+    ax_m.set_xlabel("ω (rad/s)")
+    ax_m.set_ylabel("|L(jω)|")
+    ax_p.semilogx(w, np.degrees(np.unwrap(np.angle(L))), color="C0")
+    ax_p.set_xlabel("ω (rad/s)")
+    ax_p.set_ylabel("arg L(jω) (deg)")
+    ax_n.plot(L.real, L.imag, color="C0", label="ω > 0")
+    ax_n.plot(L.real, -L.imag, color="C0", ls=":", label="ω < 0")
+    ax_n.plot([-1], [0], "rx", label="-1")
+    ax_n.set_xlabel("Re L")
+    ax_n.set_ylabel("Im L")
+    ax_n.legend(fontsize=7)
+    fig.suptitle(f"Loop with the canonical gain of eps = {fmt(best.eps)}", fontsize=9)
+
+
+def _plot_abscissa(fig, res):
+    h, a = zip(*res.abscissa_vs_h)
+    ax = fig.add_subplot(111)
+    ax.semilogx(h, a, "o-", ms=3, color="C0", label="spectral abscissa")
+    ax.axhline(0.0, color="k", lw=0.8)
+    best = max((r for r in res.rows if r.K is not None), key=lambda r: r.h_certified)
+    ax.axvline(best.h_certified, color="C1", ls="--", label="h certified (LMI)")
+    ax.set_xlabel("constant delay h (s)")
+    ax.set_ylabel("max Re s (1/s)")
+    ax.legend(fontsize=8)
+
+
+def capped_text(h, cap) -> str:
     """A certified bound, marked when it is the search cap (a lower bound only)."""
     if h is None:
         return "—"
@@ -209,7 +289,7 @@ def _gain(K, digits: int = 4) -> str:
     return "—" if K is None else "[" + ", ".join(fmt(float(k), digits) for k in np.ravel(K)) + "]"
 
 
-def _closed_loop_eigs(A, B, K) -> str:
+def closed_loop_eigs_text(A, B, K) -> str:
     """Eigenvalues of A + B K (delay-free closed loop), 1/s."""
     if K is None:
         return "—"
@@ -227,33 +307,33 @@ def _tight_section(t, A, B) -> str:
     rows = []
 
     def bl(c):
-        return _capped(c.h_certified, cap) if c else "—"
+        return capped_text(c.h_certified, cap) if c else "—"
 
     def em(c):
-        return _margin_text(c.exact) if c else "—"
+        return exact_margin_text(c.exact) if c else "—"
     if t.published:
         p = t.published
         rows.append([f"paper, printed ({p.source})", fmt(p.eps), _gain(p.K),
                      fmt(p.h_m, 4) + " (printed)", bl(t.published_check), em(t.published_check),
-                     _closed_loop_eigs(A, B, p.K)])
+                     closed_loop_eigs_text(A, B, p.K)])
     r = t.reference
     rows.append(["ours: problem (60), free weighting, eps fixed", fmt(r.eps), _gain(r.K),
                  fmt(r.h_gain, 4), bl(t.reference_check), em(t.reference_check),
-                 _closed_loop_eigs(A, B, r.K)])
+                 closed_loop_eigs_text(A, B, r.K)])
     rows.append(["tight: Wirtinger synthesis, eps searched", fmt(s.eps, 3), _gain(s.K),
-                 _capped(s.gain.h_certified if s.gain else None, cap), bl(t.check), em(t.check),
-                 _closed_loop_eigs(A, B, s.K)])
+                 capped_text(s.gain.h_certified if s.gain else None, cap), bl(t.check), em(t.check),
+                 closed_loop_eigs_text(A, B, s.K)])
     table = md_table(["design", "eps", "K", "certified h with this K, own LMI (s)",
                       f"certified h, Bessel-Legendre N = {N} analysis with this K (s)",
                       "exact margin h* (s)", "eigenvalues of A + BK (1/s)"], rows, "lrlrrrl")
     tried = md_table(["eps", "certified h (s)"],
-                     [[fmt(e, 4), _capped(h, cap)] for e, h in s.eps_tried], "rr")
+                     [[fmt(e, 4), capped_text(h, cap)] for e, h in s.eps_tried], "rr")
     notes = [
         "The tight synthesis is the Wirtinger-based criterion of Seuret & Gouaisbaut (2013) with "
         "Fridman's descriptor slack P3 = eps P2, made linear by the congruence Y = P2⁻¹, V = K Y "
         "(`workbench/lmi/tight_synthesis.py`); eps is searched automatically (log grid, then "
         "golden section, stopping once the cap is reached), and each eps is a certified, "
-        f"re-checked bisection on h (best bound {_capped(s.h_certified, cap)} s). Its gain is the "
+        f"re-checked bisection on h (best bound {capped_text(s.h_certified, cap)} s). Its gain is the "
         "canonical one, as above (minimum-norm certificate at the chosen fraction of that "
         "bound, rounded), and the third column is what that gain certifies with K fixed. Every "
         "gain is then re-certified by the Bessel-Legendre *analysis* LMI (independent of the "

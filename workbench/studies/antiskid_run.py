@@ -24,7 +24,7 @@ from ..sim.delay import SimResult, envelope_ratio, simulate_linear_dde, step_hal
 from ..sim.wheel_slip import PARAM_ORDER, model_functions
 from .antiskid_run_spec import (METRICS, Case, RunSpec, agree, case_mesh, case_metrics,
                                 controller_settings, gain_for, load_run_spec, nominal_cruise,
-                                run_settings)
+                                plant_values, run_settings)
 from .antiskid_scenario import simulate_antiskid
 
 @dataclass(frozen=True)
@@ -79,6 +79,7 @@ class RunResult:
     dt: float
     montecarlo: object = None   # antiskid_montecarlo.SweepResult or None
     halving: object = None      # antiskid_halving.HalvingCheck or None
+    basin: object = None        # antiskid_basin_run.BasinResult or None
 
     def case(self, name: str) -> CaseResult:
         return next(c for c in self.cases if c.case.name == name)
@@ -286,6 +287,9 @@ class AntiskidRun:
             names |= montecarlo_quantity_names()
             if spec.montecarlo.halving:
                 names |= halving_quantity_names()
+        if spec.basin is not None:
+            from .antiskid_basin_run import basin_quantity_names
+            names |= basin_quantity_names([c.name for c in spec.cases], True)
         return names
 
     def start(self, design):
@@ -326,8 +330,12 @@ class AntiskidRun:
             raise
         mc = None if pending is None else pending.result()
         hc = None if halving is None else halving.result()(mc)
+        from .antiskid_basin_run import run_basin
+        bs = None if spec.basin is None else run_basin(
+            spec.basin, plant_values(spec), spec.scenario["v_d"], K, nominal.lambda_opt(), cases,
+            spec.mass_factor)
         return RunResult(nominal.lambda_opt(), lam_d, tuple(K), how, h_cert, tuple(cases), lc,
-                         spec.dt, mc, hc)
+                         spec.dt, mc, hc, bs)
 
     def _cases(self, spec: RunSpec, K) -> list[CaseResult]:
         cases = []
@@ -374,6 +382,10 @@ class AntiskidRun:
             q.update(montecarlo_quantities(res.montecarlo))
             if res.halving is not None:
                 q.update(halving_quantities(res.halving))
+        if res.basin is not None:
+            from .antiskid_basin_run import basin_quantities
+            q.update(basin_quantities(res.basin.basin, res.basin.sweep,
+                                      [c.case.name for c in res.cases]))
         return q
 
 

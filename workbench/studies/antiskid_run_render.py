@@ -5,13 +5,11 @@ import math
 
 import numpy as np
 
-from ..controllers.antiskid003_settings import (BRAKE, BRAKE_IN, DIVERGED_HOW, PHASE_NAMES,
-                                                CreepSpeedProfile)
+from ..controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
-from ..sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
+from .antiskid_run_figures import (plot_adhesion, plot_creep, plot_evs, plot_linear,
+                                   plot_speed, plot_torque)
 
-_COLORS = {"paper": "tab:red", "compensated": "tab:blue", "uncompensated": "tab:orange",
-           "recursive": "tab:purple"}
 _LABELS = {  # metric -> (label, unit, sig)
     "t_cruise": ("time to reach v_d", "s", 4),
     "lam_max_traction": ("max creep ratio, traction", "-", 4),
@@ -26,10 +24,6 @@ _LABELS = {  # metric -> (label, unit, sig)
     "evs_last": ("creep-speed error at the stop", "m/s", 2),
     "t_diverged": ("diverged at", "s", 4),
 }
-
-
-def _color(name):
-    return _COLORS.get(name, "tab:green")
 
 
 def _diverged_text(c) -> str:
@@ -69,19 +63,27 @@ def render(design, res) -> Rendered:
     sections.append(_linear_section(res))
     if res.montecarlo is not None:
         sections.append(_montecarlo_section(design, res.montecarlo, res.halving))
-    sections.append(_numerics_section(res.montecarlo is not None))
     figs = (
         Figure("speed", "Train speed v and wheel speed v_w = omega r.",
-               lambda fig, res=res: _plot_speed(fig, res), (7.0, 4.0)),
+               lambda fig, res=res: plot_speed(fig, res), (7.0, 4.0)),
         Figure("creep-ratio", "Creep ratio against lambda_opt and lambda_d.",
-               lambda fig, res=res: _plot_creep(fig, res), (7.0, 5.5)),
+               lambda fig, res=res: plot_creep(fig, res), (7.0, 5.5)),
         Figure("torque", "Wheel torque u(t) of the controller.",
-               lambda fig, res=res: _plot_torque(fig, res), (7.0, 4.0)),
+               lambda fig, res=res: plot_torque(fig, res), (7.0, 4.0)),
         Figure("creep-speed-error", "Creep-speed tracking error in braking.",
-               lambda fig, res=res, sp=spec: _plot_evs(fig, res, sp), (7.0, 4.0)),
+               lambda fig, res=res, sp=spec: plot_evs(fig, res, sp), (7.0, 4.0)),
         Figure("linear-checks", "Linear error system E' = A E + B K E(t-h).",
-               lambda fig, res=res: _plot_linear(fig, res), (7.0, 4.0)),
+               lambda fig, res=res: plot_linear(fig, res), (7.0, 4.0)),
+        Figure("adhesion", "The plant's adhesion curve with each run's operating points.",
+               lambda fig, res=res, sp=spec: plot_adhesion(fig, res, sp), (9.0, 3.8)),
     )
+    if res.basin is not None:
+        from .antiskid_basin_render import plot_basin, render_basin_result
+        sections.insert(3, render_basin_result(res.basin, rail=spec.rail)
+                        + "\n![basin]({figdir}/basin.png)\n\nThe (v - v_d, lambda - lambda_d) "
+                        "plane of the delay-free cruise loop (see the section's text).\n")
+        figs += (Figure("basin", "Certified basin of the cruise law (61), switch states.",
+                        lambda fig, b=res.basin.basin: plot_basin(fig, b), (7.0, 5.0)),)
     if res.montecarlo is not None:
         from .antiskid_montecarlo_render import draw_histograms, draw_outcomes
         figs += (
@@ -99,7 +101,12 @@ def render(design, res) -> Rendered:
         "later).\n\n![creep speed error]({figdir}/creep-speed-error.png)\n\nCreep-speed error "
         "e_vs = v_s - v_s*(t) in braking (Theorem 3, cf. Fig. 4 of the paper).\n\n"
         "![linear checks]({figdir}/linear-checks.png)\n\n|E| of the linear error system with "
-        "the finite-margin gain at the multiples of its exact margin h*.")
+        "the finite-margin gain at the multiples of its exact margin h*.\n\n"
+        "![adhesion]({figdir}/adhesion.png)\n\nLeft: the plant's adhesion curve mu(lambda) "
+        "(eq 6, the plant's own parameters) with the (lambda, mu) each run visits; past the "
+        "peak at lambda_opt the wheel loses adhesion (spin in traction, lock in braking). "
+        "Right: the same runs in the (v, lambda) plane, from the start (o) to the end (x).")
+    sections.append(_numerics_section(res.montecarlo is not None, spec.rail))
     return Rendered(tuple(sections), figs)
 
 
@@ -164,10 +171,7 @@ def _switch_section(res) -> str:
         "abscissa and exact delay margin (Chen-Gu-Nett).\n\n"
         + md_table(["case", "v (m/s)", "lambda", "d mu/d lambda", "A_loc", "abscissa (1/s)",
                     "exact margin"], rows, "lrrrlrl")
-        + "\n\nAt lambda = lambda_opt the adhesion slope d mu/d lambda is zero: the restoring "
-        "term d2 of the cruise linearisation, which the synthesised K (k2 > 0, positive "
-        "feedback on lambda_e) relies on, has vanished, so the frozen loop is unstable "
-        "before any delay is added. Eq (75) as printed switches exactly there.\n\n"
+        + "\n\n" + _switch_note(res) + "\n\n"
         "**Cruise → braking.** Law (69) is built on the braking form (eq 15, lambda <= 0). "
         "State at t_brake:\n\n"
         + md_table(["case", "lambda at t_brake", "in the braking form's domain?", "then"],
@@ -178,6 +182,25 @@ def _switch_section(res) -> str:
         "0.75 s.\n\n"
         "**omega <= 3 rad/s.** v_s* jumps to 0 (eq 76): the creep-speed error jumps and decays "
         "at rate k_de; the train then coasts on running resistance to v_stop.")
+
+
+def _switch_note(res) -> str:
+    """What the slope at the printed switch means, from the measured d mu/d lambda."""
+    paper = next((c.switch for c in res.cases if c.case.name == "paper" and c.switch), None)
+    if paper is None:
+        return ""
+    slope = fmt(paper.dmu_dlam, 3)
+    where = ("zero there (the peak of the plant's curve)" if abs(paper.dmu_dlam) < 1e-6 else
+             f"{slope} on this plant's curve (the controller's lambda_opt is the nominal "
+             "model's peak, not this plant's)")
+    stable = ("unstable before any delay is added" if paper.abscissa > 0 else
+              "stable without delay")
+    return (f"Eq (75) as printed switches to the cruise law at lambda = lambda_opt of the "
+            f"controller's model, where the adhesion slope d mu/d lambda is {where}. The "
+            "synthesised K (k2 > 0, positive feedback on lambda_e) relies on the restoring "
+            "term d2 of the cruise linearisation at lambda_d, which the slope there sets; "
+            f"the frozen loop at the switch has delay-free spectral abscissa "
+            f"{fmt(paper.abscissa, 3)} 1/s: {stable}.")
 
 
 def _convergence_section(res, spec) -> str:
@@ -254,7 +277,7 @@ def _montecarlo_section(design, mc, halving=None) -> str:
         "that study; each run of a batch follows its single-run trajectory). The claims "
         "`mc-*-vs-full` compare "
         "these fractions with the full 1000-run sweep. Draws, uniform and independent; the "
-        "controller keeps the nominal dry model and the design's h:\n\n"
+        f"controller keeps the nominal {design.spec.rail}-rail model and the design's h:\n\n"
         + md_table(["parameter", "range"], rows, "ll")
         + "\n\nSummary statistics (3 significant digits; `lam_max_over_opt` is the max creep "
         "ratio in traction over the sample's own lambda_opt, not given for a run that diverged "
@@ -278,9 +301,12 @@ def _montecarlo_section(design, mc, halving=None) -> str:
            + halving_section(halving, design.spec)))
 
 
-def _numerics_section(with_montecarlo: bool = False) -> str:
+def _numerics_section(with_montecarlo: bool, rail: str) -> str:
+    """Appendix: how the runs are integrated. Measurements behind these
+    choices are re-run by ``benchmarks/mesh.py`` and ``benchmarks/simulate.py``,
+    not typed here."""
     return (
-        "## Numerics\n\n"
+        "## Appendix: numerics\n\n"
         "* Plant: v by explicit Euler; the creep ratio, stiff at low speed "
         "(d lambda'/d lambda ~ -m g r^2 mu'/(J v), time constant ~ v/4000 s), by the "
         "exponential Euler step with the sympy Jacobian, stable for any step; a step that "
@@ -297,16 +323,15 @@ def _numerics_section(with_montecarlo: bool = False) -> str:
         "stiff creep ratio to its quasi-steady value, so the printed law held constant "
         "realises its rate only for dt |J| << 1 (at 3 m/s, |J| ~ 1000/s). Each law is held "
         "as the torque that moves the exponential-Euler creep ratio by dt times the rate "
-        "the continuous law asks for; it equals the printed law when dt |J| -> 0. With the "
-        "printed value held, the time to cruise moved by 0.08 s per 5 ms of step.\n"
+        "the continuous law asks for; it equals the printed law when dt |J| -> 0 (with the "
+        "printed value held, the time to cruise moves with the step).\n"
         "* Model mismatch in the hold: the plant's creep-ratio rate is the model's plus a "
         "mismatch delta (mass, adhesion, true delay). Scaling only the model's rate by "
         "1/phi1(dt J) leaves delta scaled by phi1(dt J) = 1 + dt J/2 + ..., which moves the "
-        "loop's fixed points by O(dt): with the plant mass +5 %, v - v_d at t_brake (the end "
-        "of a ~270 s slow transient set by where lambda settles) was -3.133 / -3.220 / "
-        "-3.264 m/s at dt = 10 / 5 / 2.5 ms. The hold therefore also realises an estimate of "
+        "loop's fixed points by O(dt) (with a mismatched plant mass, v - v_d at t_brake "
+        "then moved with each halving of the step). The hold therefore also realises an estimate of "
         "delta from the last step (the measured lambda against the model's step under the "
-        "input the controller believes applied, filtered over 0.2 s), carried to t + h for "
+        "input the controller believes applied, filtered over `observer_tau`), carried to t + h for "
         "the predictor (delta e^{hJ}); its fixed points are the continuous loop's. It is not "
         "used in braking.\n"
         "* Phase switches use measured states; stops at v <= v_stop. A run ends as diverged "
@@ -321,95 +346,20 @@ def _numerics_section(with_montecarlo: bool = False) -> str:
         "* Refined mesh for the cases without the predictor (`mesh_courant`, `mesh_levels` "
         "in `[numerics]`): the step is dt / 2^k, k <= mesh_levels the smallest level with "
         "step x S/v <= mesh_courant, S/v = m g r^2 mu'(0) / (J v) the fastest creep-ratio "
-        "rate (~3800/v 1/s on dry rail); dt/2 halves every step of the mesh. Why: without "
+        "rate; dt/2 halves every step of the mesh. Why: without "
         "the predictor the loop at low speed is close to neutral (lambda' ~ J lambda - "
-        "(J + k_ac) lambda(t - h): roots decay at only (1/h) ln(|J|/|J + k_ac|), ~0.2/s at "
-        "3 m/s), so features of width ~1/|J| ~ 1 ms set at the start persist for seconds; the "
-        "exponential step keeps them stable but does not resolve them. On the fixed step the "
-        "mass -5 % run's max creep ratio in traction converged only at first order (0.216 / "
-        "0.205 / 0.198 / 0.194 / 0.192 / 0.1905 / 0.1898 at dt = 10 ms down to 0.16 ms). "
+        "(J + k_ac) lambda(t - h): roots decay at only (1/h) ln(|J|/|J + k_ac|) at "
+        "low speed), so features of width ~1/|J| set at the start persist for seconds; the "
+        "exponential step keeps them stable but does not resolve them, and on the fixed step "
+        "such a run's max creep ratio in traction converges only at first order. "
         "With the predictor, plant and rollout share one discretisation and the fixed step "
-        "converges: a refined mesh (rollout on the mesh too) gave the same dry-rail metrics "
-        "(time to cruise 31.042 / 31.043 s, braking 86.29 / 86.35 s) at 15-100 times the cost "
-        "(`benchmarks/mesh.py` re-runs both comparisons); "
-        "refining the plant but not the rollout is inconsistent and stops the train 35 s "
-        "early (the predictor's error then keeps lambda at -0.03 after omega <= 3 rad/s).\n"
-        "* Monte Carlo robustness (mass, adhesion between the wet and dry curves, true delay, "
-        "initial speed; the controller keeps the nominal dry model) is run by "
+        "converges: a refined mesh (rollout on the mesh too) gives the same metrics at many "
+        "times the cost, while refining the plant but not the rollout is inconsistent "
+        "(`benchmarks/mesh.py` re-runs these comparisons and prints them).\n"
+        f"* Monte Carlo robustness (mass, adhesion between the wet and dry curves, true delay, "
+        "initial speed; the controller keeps the nominal {rail}-rail model) is run by "
         "`workbench sweep DESIGN --samples N --seed S --figure PNG`"
         + (", the runs of a chunk as one batch (arrays) at the `[montecarlo]` step; the "
            "reduced sample above is run with this report, and its first runs again at that "
            "step and its half (the step-size check of the Monte Carlo section)."
            if with_montecarlo else ", outside this report."))
-
-
-# -- figures ---------------------------------------------------------------------
-def _plot_speed(fig, res):
-    ax = fig.add_subplot(111)
-    for c in res.cases:
-        r = c.run
-        v, lam = r.x
-        vw = np.where(lam >= 0, v / (1 - np.minimum(lam, 0.999)), v * (1 + lam))
-        ax.plot(r.t, v, color=_color(c.case.name), label=f"{c.case.name}: v")
-        ax.plot(r.t, vw, color=_color(c.case.name), ls=":", label=f"{c.case.name}: v_w")
-    vmax = max(float(np.nanmax(c.run.x[0])) for c in res.cases)
-    ax.set_ylim(-5.0, 1.3 * vmax)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("speed (m/s), clipped")
-    ax.legend(fontsize=7, ncol=2)
-
-
-def _plot_creep(fig, res):
-    ax1, ax2 = fig.subplots(2, 1)
-    for ax in (ax1, ax2):
-        for c in res.cases:
-            r = c.run
-            ax.plot(r.t, np.clip(r.x[1], -1, 1), color=_color(c.case.name), label=c.case.name)
-        ax.axhline(res.lambda_opt, color="k", ls="--", lw=0.8, label="lambda_opt")
-        ax.axhline(res.lambda_d, color="gray", ls=":", lw=0.8, label="lambda_d")
-        ax.set_ylabel("creep ratio")
-    t_c = min((c.metrics["t_cruise"] for c in res.cases
-               if not math.isnan(c.metrics["t_cruise"])), default=0.0)
-    ax1.set_ylim(-0.2, 0.3)
-    ax2.set_xlim(t_c - 1.0, t_c + 3.0)
-    ax2.set_ylim(-0.1, 1.0)
-    ax2.set_xlabel("t (s)")
-    ax1.legend(fontsize=7, ncol=3)
-
-
-def _plot_torque(fig, res):
-    ax = fig.add_subplot(111)
-    for c in res.cases:
-        ax.plot(c.run.t, np.clip(c.run.u[0], -4e4, 4e4), color=_color(c.case.name),
-                label=c.case.name, lw=0.8)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("u (N m), clipped to ±4e4")
-    ax.legend(fontsize=7)
-
-
-def _plot_evs(fig, res, spec):
-    ax = fig.add_subplot(111)
-    prof = CreepSpeedProfile(t_brake=spec.scenario["t_brake"], **spec.profile)
-    r_wheel = spec.params["r"].value
-    for c in res.cases:
-        r = c.run
-        sel = (r.phase == BRAKE) | (r.phase == BRAKE_IN)
-        if not sel.any():
-            continue
-        t, v, lam = r.t[sel], r.x[0][sel], r.x[1][sel]
-        om = wheel_speed(np.maximum(v, 1e-3), lam, r_wheel, ArrayOps)
-        vs, _ = prof(t, v, 0 * v, om, ArrayOps)
-        ax.plot(t, creep_speed(v, lam, ArrayOps) - vs, color=_color(c.case.name), label=c.case.name)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("e_vs = v_s - v_s* (m/s)")
-    ax.set_ylim(-0.3, 0.3)
-    ax.legend(fontsize=7)
-
-
-def _plot_linear(fig, res):
-    ax = fig.add_subplot(111)
-    for (fac, h, _), r in zip(res.linear.ratios_finite, res.linear.runs):
-        ax.semilogy(r.t, np.linalg.norm(r.x, axis=0) + 1e-300, label=f"h = {fac:g} h*")
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("|E|")
-    ax.legend(fontsize=7)

@@ -69,6 +69,7 @@ class RunSpec:
     far_delays: tuple
     periods: float
     montecarlo: object = None      # antiskid_montecarlo.SweepSpec or None
+    basin: object = None           # antiskid_basin_run.BasinSettings or None ([basin] table)
 
 
 @dataclass(frozen=True)
@@ -308,6 +309,7 @@ def load_run_spec(root: Reader) -> RunSpec:
             raise mt.fail("halving_samples", mc.halving,
                           f"at most samples = {mc.samples} (the check re-runs the first runs)")
         mt.finish()
+    from .antiskid_basin_run import load_basin_settings
     vals = {k: q.value for k, q in params.items()}
     try:
         NumericAdhesion.from_dict(vals).cruise_lambda(scen["v_d"])
@@ -316,4 +318,4 @@ def load_run_spec(root: Reader) -> RunSpec:
                           f"a speed with a creep-region equilibrium ({exc})") from None
     return RunSpec(rail, params, mass_factor, scen, gain, eps, K_table, K_source, k_ac, k_de,
                    profile, dt, v_stop, band, torque_range, mesh_courant, mesh_levels, rtol, atol, tuple(cases), tuple(fg),
-                   factors, far, periods, mc)
+                   factors, far, periods, mc, load_basin_settings(root))

@@ -309,6 +309,7 @@ def _key(x: float) -> str:
 
 class ClosedLoopBrake:
     kind = "closed-loop-brake"
+    uses_solver = False    # no convex solver runs: the report says so
 
     def load(self, root: Reader) -> Spec004:
         return _load(root)

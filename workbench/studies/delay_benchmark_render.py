@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from ..benchmark import AUTO, BenchmarkResult, agreement_bound
+from ..benchmark_windows import directed, show_window
 from ..margins import AGREEMENT_RTOL
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
 
@@ -28,6 +29,12 @@ def _ratio(r) -> str:
     return f"{math.floor(r * 1e5) / 1e5:.5f}"   # truncated: never rounds up to 1
 
 
+def _ratio4(r) -> str:
+    """Truncated to 4 decimals: interval ends come from chains of solves whose
+    last digits differ between CPUs."""
+    return f"{math.floor(r * 1e4) / 1e4:.4f}"
+
+
 def _label(r) -> str:
     if r.method == "bessel-legendre":
         return f"bessel-legendre N={r.N}"
@@ -36,11 +43,27 @@ def _label(r) -> str:
     return r.method
 
 
+def _windows(e) -> str:
+    if not e.windows:
+        return "none (unstable for every h ≤ h_max)"
+    return " ∪ ".join(show_window(a, b, lambda x: fmt(x, 7)) for a, b in e.windows)
+
+
+def _interval(r) -> str:
+    if r.interval is None:
+        return "—"
+    parts = []
+    for lo, hi in r.intervals or (r.interval,):
+        cap = " (≥ cap)" if math.isfinite(hi) and r.at_cap and hi >= r.h_certified else ""
+        parts.append(f"[{fmt(directed(lo, up=True))}, {fmt(directed(hi, up=False))}]{cap}")
+    return " ∪ ".join(parts)
+
+
 def render(design, res: BenchmarkResult) -> Rendered:
     s = res.settings
     ex_rows = [[f"`{e.example.name}`", e.example.title, len(e.example.A),
                 fmt(e.exact.h, 7), fmt(e.exact_sweep.h, 7), "≤ " + fmt(agreement_bound(e.agreement)),
-                e.example.source] for e in res.examples]
+                _windows(e), e.example.source] for e in res.examples]
     intro = ("## Examples\n\nx'(t) = A x(t) + A_d x(t - h), constant delay. Exact margin h* "
              "by two independent methods: Chen-Gu-Nett (Kronecker-sum eigenproblem, "
              "`delay_margin_eig`) and a sweep of the delay phase theta following every "
@@ -49,9 +72,14 @@ def render(design, res: BenchmarkResult) -> Rendered:
              f"{fmt(AGREEMENT_RTOL)} (claim `exact-methods-agree`). Example files: "
              f"`{s.examples}/` next to this design.\n\n"
              + md_table(["example", "system", "n", "h* eig (s)", "h* sweep (s)",
-                         "rel. diff", "source"], ex_rows, "llrrrrl")
+                         "rel. diff", f"stable windows in [0, {fmt(s.h_max)}] s (exact)",
+                         "source"], ex_rows, "llrrrrll")
              + "\n\nThe relative difference is shown as the power of ten it stays below, "
-               "floored at 1e-12: below that it is rounding, which differs between CPUs.")
+               "floored at 1e-12: below that it is rounding, which differs between CPUs. "
+               "h* is the end of the window that starts at 0 (0 when the system is "
+               "unstable without delay); the stable windows are the whole exact stability "
+               "set up to the search cap, from every crossing delay and its direction "
+               "(`stability_windows`).")
     mats = "\n\n".join(f"`{e.example.name}`: $A = {latex_matrix(e.example.A)},\\ "
                        f"A_d = {latex_matrix(e.example.Ad)}$" for e in res.examples)
     names = [e.example.name for e in res.examples]
@@ -65,8 +93,14 @@ def render(design, res: BenchmarkResult) -> Rendered:
             cap = " (≥ cap)" if s.h_max <= r.h_certified < math.inf else ""
             row.append(f"{fmt(r.h_certified, 5)}{cap} / {_ratio(r.ratio)}{n_txt}")
         table.append(row)
-    bounds = ("## Certified bounds\n\nEach cell: largest certified delay (s) / ratio to h* "
-              "(truncated to 5 decimals; — when h* is infinite). Bracketed bisection "
+    bounds = ("## Certified bounds\n\nTwo kinds of numbers. A **point** certificate "
+              "h: the LMI holds at that one delay, so the system is stable *at h* — nothing "
+              "is said about other delays, and h may lie in a later window. An **interval** "
+              "certificate [lo, hi]: the system is stable *for every constant delay* in it "
+              "(next section). Only an interval from 0 is compared with the exact margin.\n\n"
+              "### Point certificates (stable at h)\n\nEach cell: largest delay at which "
+              "the criterion certified stability (s) / ratio to h* "
+              "(truncated to 5 decimals; — when h* is 0 or infinite). Bracketed bisection "
               f"(`bisect_delay`) to a relative bracket width of {fmt(s.rel_tol)}, definiteness "
               f"margin {fmt(s.margin)} (relative to the largest block size), search cap h <= {fmt(s.h_max)} s; "
               "every certified step re-checked with numpy"
@@ -81,29 +115,93 @@ def render(design, res: BenchmarkResult) -> Rendered:
                          "l" + "r" * len(names))
               + "\n\nMethods: " + "; ".join(f"**{k}**: {v}" for k, v in METHOD_DOC.items())
               + ".\n\n" + mats)
+    ivs = [[_label(e0r)] + [_interval(e.rows[i]) + (
+        f" / {_ratio4(e.rows[i].interval_ratio)}" if e.rows[i].interval_ratio is not None
+        and math.isfinite(e.exact.h) else "") for e in res.examples]
+        for i, e0r in enumerate(res.examples[0].rows)]
+    intervals = ("### Interval certificates (stable for every constant delay in [lo, hi])"
+                 "\n\nEach cell: the certified intervals [lo, hi] (s; lo rounded up and hi "
+                 "down to 4 digits) / hi over h* when the first starts at 0 and h* is finite "
+                 "(truncated to 4 decimals). How "
+                 "(`workbench.lmi.interval`): the criterion's LMIs at both ends of [lo, hi] "
+                 "with the same decision variables. Times a positive weight (h or 1), every "
+                 "block is affine in h or quadratic with a positive semidefinite h^2 "
+                 "coefficient (F'RF, R ≥ 0), hence convex in h: one solution holds at every "
+                 "delay in between. From 0 the lower block is the limit h → 0, which also "
+                 "proves A + A_d Hurwitz. An interval is extended by links [hi, hi'] with "
+                 "fresh variables (at most 32 links; a union of certified intervals is "
+                 "certified), so an interval can end below the point bound. The "
+                 "free-weighting criterion is a delay-range criterion (a certificate at h "
+                 "covers [0, h]). When the system is unstable at h = 0, or has a later "
+                 "window, the search starts in the middle of each exact window and grows "
+                 "both ends (one interval per window reached). Every certified point lies in an exact stable window and every "
+                 "certified interval inside one: "
+                 f"**{'yes' if res.sound else 'NO'}** (claim `suite-sound`).\n\n"
+                 + md_table(["method"] + [f"`{n}`" for n in names], ivs,
+                            "l" + "r" * len(names)))
     solves = [[_label(e0r)] + [e.rows[i].solves for e in res.examples]
               for i, e0r in enumerate(res.examples[0].rows)]
     checks = [[_label(e0r)] + [e.rows[i].exact_check or "—" for e in res.examples]
               for i, e0r in enumerate(res.examples[0].rows)]
-    cost = ("## Solver calls and exact re-check\n\n"
+    cost = ("## Solver calls and exact re-check\n\nSolves of the point search (the interval "
+            "searches' counts depend on the last digits of chained solves, which differ "
+            "between CPUs: `--json` gives them as `interval_solves`).\n\n"
             + md_table(["method"] + [f"`{n}`" for n in names], solves, "l" + "r" * len(names))
             + ("\n\nRational re-check of the certificate at each bound (strict definiteness "
                "of every block, exact LDL^T, `workbench.lmi.exact_check`):\n\n"
                + md_table(["method"] + [f"`{n}`" for n in names], checks,
                           "l" + "l" * len(names)) if s.exact_check else "")
-            + f"\n\nLargest ratio h_certified / h* over the suite: "
-              f"**{_ratio(res.max_ratio())}** (a sound criterion never exceeds 1).")
+            + f"\n\nLargest ratio hi / h* of a certified interval [0, hi] over the suite: "
+              f"**{_ratio(res.max_ratio())}** (a sound criterion stays below 1).")
     fig = Figure("bessel-legendre-gap", "Gap 1 - h_N/h* of the Bessel-Legendre hierarchy "
-                 "against the order N (finite h* only).", lambda f: _draw_gap(f, res))
-    return Rendered((intro, bounds, cost,
-                     f"## Bessel-Legendre hierarchy\n\n![gap]({{figdir}}/{fig.name}.png)"),
-                    (fig,))
+                 "(point certificates) against the order N (finite h* only).",
+                 lambda f: _draw_gap(f, res))
+    sets = [Figure(f"stability-set-{e.example.name}",
+                   f"{e.example.name}: spectral abscissa against h (top; exact windows "
+                   "shaded) and each method's certified interval (bars) and point (x).",
+                   lambda f, e=e: _draw_set(f, e), size=(6.4, 5.6)) for e in res.examples]
+    figs = "\n\n".join(f"![{g.name}]({{figdir}}/{g.name}.png)\n\n*{g.caption}*" for g in sets)
+    return Rendered((intro, bounds + "\n\n" + intervals, cost,
+                     f"## Bessel-Legendre hierarchy\n\n![gap]({{figdir}}/{fig.name}.png)",
+                     "## Stability sets\n\nSpectral abscissa (rightmost characteristic root, "
+                     "adaptive Chebyshev collocation with Newton polishing, "
+                     "`spectral_abscissa`) on a uniform grid; shaded: the exact stable "
+                     "windows. Bars: certified intervals; x: the point certificate.\n\n"
+                     + figs), (fig, *sets))
+
+
+def _draw_set(fig, e) -> None:
+    ax, bx = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [1, 1.3]})
+    hs = np.array([p[0] for p in e.abscissa])
+    al = np.array([p[1] for p in e.abscissa])
+    H = float(hs[-1]) if len(hs) else 1.0
+    for a, b in e.windows:
+        for axis in (ax, bx):
+            axis.axvspan(a, min(b, H), color="tab:green", alpha=0.15, lw=0)
+    ax.plot(hs, al, "k-", lw=1)
+    ax.axhline(0, color="k", lw=0.6)
+    ax.set_ylabel("spectral abscissa (1/s)")
+    ax.grid(True, alpha=0.3)
+    for i, r in enumerate(e.rows):
+        if r.interval is not None:
+            lo, hi = r.interval
+            bx.plot([lo, min(hi, H)], [i, i], "-", color="tab:blue", lw=4,
+                    solid_capstyle="butt")
+        if 0 < r.h_certified <= H:
+            bx.plot([r.h_certified], [i], "x", color="tab:red", ms=6)
+    bx.set_yticks(range(len(e.rows)))
+    bx.set_yticklabels([_label(r) for r in e.rows], fontsize=7)
+    bx.invert_yaxis()
+    bx.set_xlim(0, H)
+    bx.set_xlabel("constant delay h (s)")
+    bx.grid(True, axis="x", alpha=0.3)
+    fig.tight_layout()
 
 
 def _draw_gap(fig, res: BenchmarkResult) -> None:
     ax = fig.add_subplot(111)
     for e in res.examples:
-        if not math.isfinite(e.exact.h):
+        if not 0 < e.exact.h < math.inf:
             continue
         rows = [r for r in e.rows if r.method == "bessel-legendre"]
         gaps = [max(1 - r.h_certified / e.exact.h, 1e-8) for r in rows]

@@ -93,6 +93,7 @@ def _load(root: Reader) -> FitSpec:
 
 class BrakeFit:
     kind = "brake-fit"
+    uses_solver = False    # no convex solver runs: the report says so
 
     def load(self, root: Reader) -> FitSpec:
         return _load(root)

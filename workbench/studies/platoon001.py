@@ -174,6 +174,7 @@ def _odd(r: Reader, name: str) -> int:
 
 class NTSMPlatoon:
     kind = "ntsm-platoon"
+    uses_solver = False    # no convex solver runs: the report says so
 
     def load(self, root: Reader) -> PlatoonSpec:
         pl = root.table("plant")

@@ -266,8 +266,26 @@ def _collect(spec: StopSpec, blocks) -> StopResult:
                       stats, example, (float(np.min(th)), float(np.max(th))))
 
 
+def within_rate(errors, tol: float, z: float = 1.959963984540054):
+    """(k, n, k/n, lo, hi): stops with |error| <= ``tol`` and the Wilson score
+    interval of that proportion (95 % for the default z). Wilson's interval
+    stays inside [0, 1] and is sound at k = 0 or k = n, where the normal
+    approximation collapses to a point."""
+    import math
+    e = [abs(x) for x in errors]
+    n, k = len(e), sum(x <= tol for x in e)
+    if n == 0:
+        return 0, 0, math.nan, math.nan, math.nan
+    p = k / n
+    den = 1 + z * z / n
+    mid = (p + z * z / (2 * n)) / den
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return k, n, p, max(0.0, mid - half), min(1.0, mid + half)
+
+
 class StationStopping:
     kind = "station-stopping"
+    uses_solver = False    # no convex solver runs: the report says so
 
     def load(self, root: Reader) -> StopSpec:
         return load_stop_spec(root)

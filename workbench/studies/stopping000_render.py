@@ -6,7 +6,7 @@ import sympy as sp
 
 from ..plants.brake000 import brake_model
 from ..report.markdown import Figure, Rendered, fmt, md_table
-from .stopping000 import CONTROLLERS, UNCERTAIN
+from .stopping000 import CONTROLLERS, UNCERTAIN, within_rate
 
 LABEL = {"pid": "PID", "smc": "SMC", "smarc": "SMARC", "smarc-sgn": "SMARC (sgn)"}
 
@@ -101,7 +101,8 @@ def render(design, res) -> Rendered:
         + f"\n\nFinal SMARC mass estimates theta_hat span [{fmt(res.theta_hat_final[0], 3)}, "
         f"{fmt(res.theta_hat_final[1], 3)}] (per unit of the nominal mass; > 1 absorbs the "
         "brake's under-delivery, P1 and the air gain).\n\n"
-        "![stop errors]({figdir}/stop-errors.png)\n\n![curves]({figdir}/stop-curves.png)")
+        "![stop errors]({figdir}/stop-errors.png)\n\n![curves]({figdir}/stop-curves.png)"
+        + "\n\n" + _within_section(res))
     if spec.published:
         prow = []
         for k, smarc, smc, pid, m4, v4, src in spec.published:
@@ -122,8 +123,42 @@ def render(design, res) -> Rendered:
     figs = (Figure("stop-errors", "Stop-error distribution per controller and section.",
                    lambda fig, res=res: _plot_errors(fig, res), size=(7.0, 4.0)),
             Figure("stop-curves", "Speed against distance to the stopping point, section 1.",
-                   lambda fig, res=res: _plot_curves(fig, res), size=(7.0, 4.0)))
+                   lambda fig, res=res: _plot_curves(fig, res), size=(7.0, 4.0)),
+            Figure("stop-error-cdf", "Distribution of |stop error| per controller.",
+                   lambda fig, res=res: _plot_cdf(fig, res), size=(7.0, 4.0)))
     return Rendered(tuple(sections), figs)
+
+
+def _errors(res, c: str) -> list[float]:
+    """Every stop error of controller ``c`` over all sections (cm)."""
+    return [e for i in range(len(res.sections)) for e in res.stats[c, i].errors]
+
+
+def _within_section(res) -> str:
+    """P(|e| <= 30 cm) per controller over all sections, Wilson 95 % interval."""
+    rows = []
+    for c in CONTROLLERS:
+        k, n, p, lo, hi = within_rate(_errors(res, c), 30.0)
+        rows.append([LABEL[c], f"{k} / {n}", fmt(p, 3), f"[{fmt(lo, 3)}, {fmt(hi, 3)}]",
+                     fmt(float(np.percentile(np.abs(_errors(res, c)), 95)), 3)])
+    return ("**Stops within ±0.3 m** (the usual platform-screen-door tolerance), over all "
+            "sections and repeats, with the Wilson 95 % interval of the proportion:\n\n"
+            + md_table(["controller", "stops within 0.3 m", "P(|e| <= 0.3 m)", "95 % interval",
+                        "95th percentile of |e| (cm)"], rows, "lrrrr")
+            + "\n\n![stop error distribution]({figdir}/stop-error-cdf.png)")
+
+
+def _plot_cdf(fig, res):
+    ax = fig.add_subplot(111)
+    for k, c in enumerate(CONTROLLERS):
+        e = np.sort(np.abs(_errors(res, c)))
+        ax.step(e, np.arange(1, len(e) + 1) / len(e), where="post", color=f"C{k}",
+                label=LABEL[c])
+    ax.axvline(30.0, color="k", ls="--", lw=0.8, label="0.3 m")
+    ax.set_xscale("symlog", linthresh=1.0)
+    ax.set_xlabel("|stop error| (cm)")
+    ax.set_ylabel("fraction of stops")
+    ax.legend(fontsize=8)
 
 
 def _overshoot_share(res, c: str, ns: int) -> float:

@@ -126,6 +126,7 @@ def _section(r: Reader, *, with_source: bool) -> Section:
 
 class ATOTracking:
     kind = "ato-tracking"
+    uses_solver = False    # no convex solver runs: the report says so
 
     # -- load ----------------------------------------------------------------
     def load(self, root: Reader) -> TrackingSpec:

@@ -1,0 +1,95 @@
+"""Invariance of the LMI bisection's outcome (issue 21 item 2).
+
+In exact arithmetic every criterion's certificate transforms with the system:
+
+* time scaling (A, A_d) -> (c A, c A_d) is the same system in another time unit,
+  so the certified delay becomes h / c (c in [1e-6, 1e6]); the search range
+  and the first trial are relative to the system's time scale, so the
+  bisection visits the same points divided by c;
+* a similarity T A T^-1, T A_d T^-1 maps every certificate by congruence
+  (P -> T^-T P T^-1 blockwise), and a state permutation is a special case.
+
+So the bisection's bound may only move by its own bracket width (plus solver
+noise near the boundary). Hypothesis is derandomized and seeded (no database).
+Systems: Gaussian 2 x 2 with A + A_d Hurwitz and a finite delay margin of
+moderate size in the system's own time unit (rejection), and the
+pocket system (stable only on a window) for the interval search.
+"""
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import strategies as st
+
+from workbench.lmi.analysis import certified_delay, make_criterion
+from workbench.lmi.interval import certified_interval
+from workbench.margins import delay_margin_sweep
+
+EXAMPLES = 6
+RUN = settings(derandomize=True, database=None, max_examples=EXAMPLES, deadline=None,
+               phases=[Phase.explicit, Phase.generate],
+               suppress_health_check=[HealthCheck.too_slow])
+SEEDS = st.integers(min_value=0, max_value=2**32 - 1)
+REL_TOL = 1e-4
+#: Bracket width twice (one per search) plus solver noise at the boundary.
+SLACK = 5 * REL_TOL
+POCKET = (np.array([[0.0, 1.0], [-2.0, 0.1]]), np.array([[0.0, 0.0], [1.0, 0.0]]))
+
+
+def system(seed: int):
+    """A 2 x 2 system with A + A_d Hurwitz and an exact margin between 0.2 and 5
+    time scales 1 / (||A|| + ||A_d||) (deterministic in ``seed``; rejection)."""
+    rng = np.random.default_rng(np.random.SeedSequence([21, 13, seed]))
+    while True:
+        A, Ad = rng.normal(size=(2, 2)), rng.normal(size=(2, 2))
+        A -= (np.max(np.linalg.eigvals(A + Ad).real) + rng.uniform(0.1, 0.5)) * np.eye(2)
+        R = np.linalg.norm(A, 2) + np.linalg.norm(Ad, 2)
+        if 0.2 < delay_margin_sweep(A, Ad).h * R < 5:
+            return A, Ad
+
+
+def bound(A, Ad, method="wirtinger", N=None) -> float:
+    return certified_delay(make_criterion(method, A, Ad, N=N), rel_tol=REL_TOL).h_certified
+
+
+def _close(a: float, b: float) -> bool:
+    if a == b:
+        return True
+    return math.isfinite(a) and math.isfinite(b) and abs(a - b) <= SLACK * max(a, b)
+
+
+@RUN
+@given(seed=SEEDS, log_c=st.floats(min_value=-6.0, max_value=6.0))
+def test_time_scaling_divides_the_bound(seed, log_c):
+    A, Ad = system(seed)
+    c = 10.0 ** log_c
+    h, hc = bound(A, Ad), bound(c * A, c * Ad)
+    assert h > 0
+    assert _close(h, c * hc), (h, c * hc)
+
+
+@RUN
+@given(seed=SEEDS)
+def test_similarity_and_permutation_leave_the_bound(seed):
+    A, Ad = system(seed)
+    rng = np.random.default_rng(np.random.SeedSequence([13, 21, seed]))
+    q, r = np.linalg.qr(rng.normal(size=(2, 2)))
+    T = (q * np.sign(np.diag(r))) @ np.diag(rng.uniform(0.5, 2.0, 2))
+    Ti = np.linalg.inv(T)
+    Pm = np.eye(2)[[1, 0]]
+    h = bound(A, Ad)
+    assert _close(h, bound(T @ A @ Ti, T @ Ad @ Ti))
+    assert _close(h, bound(Pm @ A @ Pm.T, Pm @ Ad @ Pm.T))
+
+
+@pytest.mark.parametrize("c", [1e-6, 1e-3, 1e3, 1e6])
+def test_interval_search_scales_with_time(c):
+    """The pocket's certified window is found in any time unit, divided by c."""
+    def window(A, Ad, scale):
+        res = certified_interval(make_criterion("bessel-legendre", A, Ad, N=2),
+                                 h_hi=10.0 / scale, rel_tol=1e-3, max_solves=80)
+        return res.bounds
+    lo, hi = window(*POCKET, 1.0)
+    lo_c, hi_c = window(c * POCKET[0], c * POCKET[1], c)
+    assert abs(lo_c * c / lo - 1) <= 3e-3 and abs(hi_c * c / hi - 1) <= 3e-3

@@ -1,0 +1,86 @@
+"""Basin of paper 003's cruise law (61): the printed switch at lambda_opt is
+outside every certified basin and diverges; the workbench's handover state is
+inside; a small k2 makes the printed switch safe (workbench.studies.antiskid_basin)."""
+import numpy as np
+import pytest
+
+from workbench.plants.adhesion import NumericAdhesion
+from workbench.roa import LevelOutcome
+from workbench.studies import antiskid_basin as AB
+
+# 003 Tables 1-2 (dry rail); the gain is the workbench's certified synthesis at
+# eps = 0.35 (reports/antiskid-run-dry.md: K = [-0.004575, 10.27])
+DRY = dict(a=0.3315, b=40.19, c=5.392, J=80.0, r=0.445, m=12000.0, zeta=0.01, c0=180.9,
+           c1=112.2, c2=2.6, g=9.8)
+K = (-0.004575, 10.27)
+
+
+@pytest.fixture(scope="module")
+def lam_opt():
+    return NumericAdhesion.from_dict(DRY).lambda_opt()
+
+
+def test_printed_switch_is_refuted_and_diverges(lam_opt):
+    v = AB.switch_in_basin(DRY, 70.0, K, (70.0, lam_opt))
+    assert v.outcome is LevelOutcome.REFUTED and v.hurwitz
+    assert v.fate == "diverges"
+
+
+def test_handover_state_is_certified_and_converges():
+    # the compensated variant's handover state (reports/antiskid-run-dry.md)
+    v = AB.switch_in_basin(DRY, 70.0, K, (70.29, 0.02145))
+    assert v.outcome is LevelOutcome.CERTIFIED and v.fate == "converges"
+
+
+def test_small_k2_makes_the_printed_switch_safe(lam_opt):
+    v = AB.switch_in_basin(DRY, 70.0, (K[0], 0.0), (70.0, lam_opt))
+    assert v.outcome is LevelOutcome.CERTIFIED and v.fate == "converges"
+
+
+def test_cruise_loop_linearisation_matches_A_plus_BK():
+    vals = tuple(sorted(DRY.items()))
+    f, _, states, A_cl, lam_d, _ = AB._loop(vals, 70.0, K)
+    import sympy as sp
+    fn = sp.lambdify(states, f, "math")
+    assert max(abs(c) for c in fn(0.0, 0.0)) < 1e-12          # equilibrium at E = 0
+    h = np.array([1e-5, 1e-8])
+    J = np.column_stack([(np.array(fn(*(h[j] * np.eye(2)[j]))) -
+                          np.array(fn(*(-h[j] * np.eye(2)[j])))) / (2 * h[j]) for j in range(2)])
+    assert np.allclose(J, A_cl, rtol=1e-5, atol=1e-9)
+
+
+def test_certified_cruise_level_holds_no_sampled_point_with_vdot_nonnegative(lam_opt):
+    vals = tuple(sorted(DRY.items()))
+    lam_d = AB.cruise_lambda_d(vals, 70.0)
+    prob, est = AB.estimate_cruise(vals, 70.0, K, [(0.0, lam_opt - lam_d)], 100.0)
+    assert 0 < est.c_certified < est.c_refuted < prob.V(np.array([[0.0, lam_opt - lam_d]]))[0]
+    rng = np.random.default_rng(5)
+    u = rng.standard_normal((100_000, 2))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    u *= np.sqrt(rng.random((100_000, 1)) * est.c_certified * (1 - 1e-9))
+    X = u @ np.linalg.inv(np.linalg.cholesky(prob.P).T).T
+    V = prob.V(X)
+    keep = V > 1e-12 * est.c_certified
+    assert np.all(prob.vdot_numeric(X[keep]) < 0)
+    # the counterexample really has V' >= 0 below the switch state's level
+    cx = np.array([est.counterexample])
+    assert prob.vdot_numeric(cx)[0] >= 0
+
+
+@pytest.mark.parametrize("old, new, key", [
+    ("bisect = 4", "bisect = 2.5", "basin.bisect"),
+    ("compare_gains = [[-0.0049, 10.5080],", "compare_gains = [[-0.0049],", "basin.compare_gains[0]"),
+    ("k2_grid = [-40.0,", 'k2_grid = ["a",', "basin.k2_grid[0]"),
+])
+def test_bad_basin_table_is_exit_2(tmp_path, capsys, old, new, key):
+    from pathlib import Path
+
+    from workbench.cli import main
+    src = Path(__file__).resolve().parents[1] / "designs" / "antiskid-run-dry.toml"
+    bad = tmp_path / "antiskid-run-dry.toml"
+    text = src.read_text()
+    assert old in text
+    bad.write_text(text.replace(old, new, 1))
+    assert main(["verify", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert key in err and "Traceback" not in err

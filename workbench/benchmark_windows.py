@@ -1,0 +1,116 @@
+"""Exact stability windows against LMI certificates, for the delay benchmark
+(the only place where :mod:`workbench.lmi` and :mod:`workbench.margins` meet).
+
+A certified point must lie in an exact stable window; a certified interval
+must lie inside one (issue 13). The spectral abscissa on a grid is the
+independent picture of the figure.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .lmi.interval import certified_interval
+from .margins import SpectrumNotConverged, spectral_abscissa, stability_windows
+
+#: Relative slack of the window tests for the exact windows' rounding.
+WINDOW_RTOL = 1e-9
+#: Grid points of the spectral-abscissa curve.
+CURVE_POINTS = 161
+
+
+def directed(x: float, *, up: bool, sig: int = 4) -> float:
+    """x to ``sig`` significant digits, rounded up (a lower end) or down (an upper
+    end): an interval quantity never claims more than was certified, and its
+    last digits, which differ between CPUs, are dropped."""
+    if x == 0 or math.isinf(x):
+        return x
+    q = 10.0 ** (math.floor(math.log10(abs(x))) - sig + 1)
+    return float(f"{(math.ceil(x / q) if up else math.floor(x / q)) * q:.{sig}g}")
+
+
+def show_window(a: float, b: float, fmt) -> str:
+    """A window as text: closed at 0, open at a crossing delay."""
+    return ("[0" if a == 0 else f"({fmt(a)}") + f", {fmt(b)})"
+
+
+def exact_windows(A, Ad, h_max: float) -> tuple[tuple[float, float], ...]:
+    """Exact stability windows intersected with [0, h_max] (s); a window that
+    never closes keeps ``hi = inf`` (stable for every larger delay)."""
+    out = []
+    for a, b in stability_windows(A, Ad, h_max):
+        if a <= h_max:
+            out.append((a, b if math.isinf(b) else min(b, h_max)))
+    return tuple(out)
+
+
+def in_window(h: float, windows, rtol: float = WINDOW_RTOL) -> bool:
+    """The delay h (s) lies in an exact stable window (open at crossing delays,
+    closed at 0; ``rtol`` relative slack)."""
+    return any((a == 0 and h == 0) or (a * (1 - rtol) < h < b * (1 + rtol))
+               for a, b in windows)
+
+
+def interval_inside(lo: float, hi: float, windows, rtol: float = WINDOW_RTOL) -> bool:
+    """[lo, hi] lies inside one exact stable window (see :func:`in_window`)."""
+    return any((lo >= a if a == 0 else lo > a * (1 - rtol))
+               and (hi == b == math.inf or hi < b * (1 + rtol)) for a, b in windows)
+
+
+def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: float,
+                    guess=None) -> dict:
+    """Interval search of one criterion and its comparison with the exact windows:
+    ``interval``, ``intervals``, ``interval_solves``, ``interval_ratio``, ``point_sound``,
+    ``interval_sound`` (keyword fields of a benchmark row). ``lmi`` None: the
+    point comparison only."""
+    h = bound.h_certified
+    point = None if not h > 0 else (
+        windows == ((0.0, math.inf),) if math.isinf(h) else in_window(h, windows))
+    out = dict(point_sound=point)
+    if lmi is None:
+        return out
+    starts = [middle(a, b, h_max) for a, b in windows if a > 0]
+    search = certified_interval(lmi, h_hi=h_max, starts=starts, rel_tol=rel_tol,
+                                guess=guess or (h if 0 < h < h_max else None),
+                                max_solves=260)
+    iv = search.bounds
+    out.update(interval=iv, interval_solves=search.solves,
+               intervals=tuple((c.lo, c.hi) for c in search.intervals))
+    if iv is not None:
+        out["interval_sound"] = all(interval_inside(c.lo, c.hi, windows)
+                                    for c in search.intervals)
+        if iv[0] == 0:
+            out["interval_ratio"] = (iv[1] / h_star if 0 < h_star < math.inf else
+                                     (1.0 if math.isinf(iv[1]) and math.isinf(h_star)
+                                      else None))
+    return out
+
+
+def middle(a: float, b: float, h_max: float) -> float:
+    """Geometric middle (s) of the window (a, b) cut at h_max."""
+    b = min(b, h_max)
+    return math.sqrt(a * b) if b > a else a
+
+
+def abscissa_curve(A, Ad, windows, h_star: float, h_max: float, intervals
+                   ) -> tuple[tuple[float, float], ...]:
+    """(h, spectral abscissa) on a uniform grid over [0, H] with H the plot
+    horizon: 1.3 times the largest finite window end, certified end or h*
+    (capped at h_max); NaN where the collocation did not converge."""
+    ends = [x for w in windows for x in w] + [h_star]
+    ends += [x for iv in intervals if iv is not None for x in iv]
+    finite = [x for x in ends if math.isfinite(x) and x > 0]
+    if finite:
+        H = min(h_max, 1.3 * max(finite))
+    else:
+        R = float(np.linalg.norm(A, 2) + np.linalg.norm(Ad, 2))
+        H = min(h_max, 20.0 / R if R > 0 else h_max)
+    out = []
+    for h in np.linspace(0.0, H, CURVE_POINTS):
+        try:
+            alpha = spectral_abscissa(A, Ad, float(h))
+        except SpectrumNotConverged:
+            alpha = math.nan
+        out.append((float(h), float(alpha)))
+    return tuple(out)

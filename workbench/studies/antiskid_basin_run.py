@@ -1,0 +1,145 @@
+"""The basin check inside the ``antiskid-run`` study: the design's ``[basin]``
+table, and the check run on the study's results.
+
+Design table (optional; absent: no basin section)::
+
+    [basin]
+    enabled = true                     # false: the section is left out
+    k2_grid = [-40.0, -10.0, 0.0, 2.0, 4.0, 6.0, 8.0, 10.0]
+    compare_gains = [[-0.0049, 10.5080], ...]   # [k1, k2] rows judged at the printed switch
+    compare_labels = ["eps = 0.35", ...]        # one per row
+    compare_source = "003 Table 3 (dry rail, v_d = 70 m/s)"
+    bisect = 4                         # bisection steps on the edge of the safe k2 range
+    seed = 0                           # falsifier seed
+
+The switch states are the simulated states where law (61) takes over in each
+case (``v_at_cruise`` / ``lam_at_cruise`` for ``cruise_entry = "speed"``,
+the handover state for ``"creep"``); the k2 rule is judged at the printed
+switch state (v_d, lambda_opt). The basin uses the controller's nominal
+model (a design's plant mass factor is not in it; the report says so).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .antiskid_basin import CruiseBasin, cruise_basin
+from .antiskid_basin_k2 import K2Sweep, safe_k2_range
+
+
+@dataclass(frozen=True)
+class BasinSettings:
+    """The design's ``[basin]`` table."""
+
+    k2_grid: tuple
+    compare: tuple            # ((label, (k1, k2)), ...)
+    compare_source: str
+    bisect: int
+    seed: int
+
+
+@dataclass(frozen=True)
+class BasinResult:
+    """Basin of the cruise law at the design's gain and the k2 rule."""
+
+    basin: CruiseBasin
+    sweep: K2Sweep
+    compare_source: str
+    mass_factor: float
+
+
+def load_basin_settings(root) -> BasinSettings | None:
+    """Read ``[basin]`` from a design (a :class:`workbench.reader.Reader`);
+    None when the table is absent or ``enabled = false``."""
+    if not root.has("basin"):
+        return None
+    b = root.table("basin")
+    enabled = b.boolean("enabled", default=True)
+    grid = b.numbers("k2_grid", min_len=2, what="cruise gains k2")
+    gains = b.raw("compare_gains", default=[])
+    if not isinstance(gains, list):
+        raise b.fail("compare_gains", gains, "a list of [k1, k2] pairs")
+    rows = []
+    for i, g in enumerate(gains):
+        ok = (isinstance(g, list) and len(g) == 2 and all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+            for x in g))
+        if not ok:
+            raise b.fail(f"compare_gains[{i}]", g, "a pair [k1, k2] of finite numbers")
+        rows.append((float(g[0]), float(g[1])))
+    labels = b.raw("compare_labels", default=[f"row {i + 1}" for i in range(len(rows))])
+    if (not isinstance(labels, list) or len(labels) != len(rows)
+            or not all(isinstance(x, str) and x.strip() for x in labels)):
+        raise b.fail("compare_labels", labels, f"{len(rows)} non-empty strings, one per gain")
+    source = b.string("compare_source", default="—")
+    bisect = b.number("bisect", integer=True, default=4, lo=0, hi=12, what="integer")
+    seed = b.number("seed", integer=True, default=0, nonneg=True, what="integer")
+    b.finish()
+    if not enabled:
+        return None
+    return BasinSettings(tuple(sorted(grid)), tuple(zip(labels, rows)), source, bisect, seed)
+
+
+def switch_points(cases) -> list:
+    """(case name, (v, lambda)) where law (61) took over, per case (cases whose
+    cruise law never started are left out)."""
+    out = []
+    for c in cases:
+        key = "handover" if c.case.cruise_entry == "creep" else "cruise"
+        v, lam = c.metrics.get(f"v_at_{key}", math.nan), c.metrics.get(f"lam_at_{key}", math.nan)
+        if math.isfinite(v) and math.isfinite(lam):
+            out.append((c.case.name, (float(v), float(lam))))
+    return out
+
+
+def run_basin(settings: BasinSettings, values: dict, v_d: float, K, lambda_opt: float, cases,
+              mass_factor: float = 1.0) -> BasinResult:
+    """The basin check of one antiskid-run design.
+
+    Parameters
+    ----------
+    settings : BasinSettings
+    values : dict
+        Nominal plant constants (SI) the controller is built on.
+    v_d : float
+        Cruise speed (m/s).
+    K : (k1, k2)
+        The design's cruise gain.
+    lambda_opt : float
+        Creep ratio of peak adhesion (the printed switch: lambda = lambda_opt).
+    cases : sequence of CaseResult
+        The study's cases (their switch states).
+    mass_factor : float
+        Plant mass / nominal (reported: the basin uses the nominal model).
+    """
+    basin = cruise_basin(values, v_d, K, switch_points(cases), seed=settings.seed)
+    sweep = safe_k2_range(values, v_d, float(K[0]), (v_d, lambda_opt), grid=settings.k2_grid,
+                          compare=settings.compare, bisect=settings.bisect, seed=settings.seed)
+    return BasinResult(basin, sweep, settings.compare_source, mass_factor)
+
+
+def basin_quantities(basin, sweep, labels=()) -> dict:
+    """Claim quantities of the basin check (``labels``: every case; a case
+    whose cruise law never started gets None)."""
+    est = basin.check.estimate
+    q = {"basin.c_certified": est.c_certified, "basin.c_refuted": est.c_refuted}
+    for lab in labels:
+        q[f"switch.cruise[{lab}].in_basin"] = q[f"switch.cruise[{lab}].fate"] = None
+    for p, tr in zip(basin.check.points, basin.trajectories):
+        q[f"switch.cruise[{p.label}].in_basin"] = p.verdict.outcome.value
+        q[f"switch.cruise[{p.label}].fate"] = tr.fate
+    if sweep is not None:
+        q["basin.k2_safe_max"] = None if sweep.edge is None else sweep.edge[0]
+        q["basin.k2_unsafe_min"] = None if sweep.edge is None else sweep.edge[1]
+        q["basin.compared_certified"] = sum(r.verdict.outcome.value == "CERTIFIED"
+                                            for r in sweep.compared)
+    return q
+
+
+def basin_quantity_names(labels, with_sweep: bool) -> set:
+    names = {"basin.c_certified", "basin.c_refuted"}
+    for lab in labels:
+        names |= {f"switch.cruise[{lab}].in_basin", f"switch.cruise[{lab}].fate"}
+    if with_sweep:
+        names |= {"basin.k2_safe_max", "basin.k2_unsafe_min", "basin.compared_certified"}
+    return names

@@ -1,0 +1,146 @@
+"""``workbench synthesize delay-bound`` and ``workbench simulate`` for
+``delay-feedback`` designs (printing only; the computing is
+:mod:`.delay_feedback_run`)."""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+
+import numpy as np
+
+
+def synthesis_table(rows, settings) -> str:
+    """The printed table of a problem (60) eps sweep (``workbench synthesize
+    delay-bound``), with its notes; one function for every design kind, so
+    the same rows print the same digits."""
+    from ..report.markdown import fmt, md_table
+    digits = settings.gain_digits
+    table = [[fmt(r.eps), fmt(r.h_certified, 5), fmt(r.h_refuted, 5),
+              "—" if r.K is None else "[" + ", ".join(fmt(k, digits) for k in r.K) + "]",
+              fmt(r.h_gain, 4), fmt(r.exact.h if r.exact else None, 5),
+              fmt(r.exact_siso.h if r.exact_siso else None, 5),
+              fmt(r.ratio, 3), r.status.value] for r in rows]
+    out = [md_table(["eps", "h_certified: on [0, h] (s)", "h_refuted", "K (canonical)",
+                     "K certified on [0, h] (s)", "h* (eig)", "h* (pyctrl)", "ratio", "status"],
+                    table, "rrrlrrrrl"),
+           "Interval certificates: Theorem 1 of paper 003 proves stability for every constant "
+           "delay in [0, h] (h* = end of the exact stable window from 0).",
+           f"K (canonical): the minimum-norm certificate at {fmt(settings.gain_fraction)} "
+           f"x h_certified, rounded to {digits} significant digits, then certified on its own "
+           "with K fixed (h certified by K)."]
+    if any(r.exact and math.isinf(r.exact.h) for r in rows):
+        out.append("h* = inf: no characteristic root reaches the imaginary axis for any delay "
+                   "— the loop is stable for every constant delay; h_certified is the limit "
+                   "of the LMI criterion, not of the loop.")
+    return "\n".join(out)
+
+
+def _op_text(spec, op) -> str:
+    from ..report.markdown import fmt
+    vals = op.as_dict(spec.plant)
+    return ", ".join(f"{k} = {fmt(v, 6)}" + (" (solved)" if k in op.solved else "")
+                     for k, v in vals.items())
+
+
+def gain_text(K, digits: int) -> str:
+    """A gain matrix as printed: rows in brackets, ``digits`` significant digits."""
+    from ..report.markdown import fmt
+    if K is None:
+        return "—"
+    K = np.atleast_2d(K)
+    rows = ["[" + ", ".join(fmt(float(k), digits) for k in row) + "]" for row in K]
+    return rows[0] if len(rows) == 1 else "[" + ", ".join(rows) + "]"
+
+
+def synthesize_command(design, *, eps=None, as_json: bool = False) -> int:
+    """Print the synthesis of a ``delay-feedback`` design; exit 0 if certified, else 1."""
+    from ..report.markdown import fmt, md_table
+    from .delay_feedback_run import nominal_point, synthesise
+    spec = design.spec
+    if eps:
+        if spec.synthesis.method != "free-weighting-003":
+            from ..errors import DesignError
+            raise DesignError("<cli>", "--eps", list(eps), "no --eps: the design's method "
+                              f"{spec.synthesis.method!r} searches eps itself")
+        spec = replace(spec, synthesis=replace(spec.synthesis, eps=tuple(eps)))
+    _, _, op, A, B = nominal_point(spec)
+    points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
+    s = synthesise(spec, A, B, points)
+    st = spec.synthesis.settings
+    if spec.synthesis.method == "free-weighting-003":
+        ok = all(r.status.value == "certified" for r in s.rows)
+        if as_json:
+            print(json.dumps({"design": design.name, "rows": [r.to_json() for r in s.rows]},
+                             indent=2))
+            return 0 if ok else 1
+        print(f"{design.name}: problem (60) of paper 003 on the linearisation at "
+              f"{_op_text(spec, op)}")
+        print(synthesis_table(s.rows, st))
+        return 0 if ok else 1
+    from ..margins import exact_margin
+    ex = exact_margin(A, B @ s.K) if s.K is not None else None
+    ok = s.status == "certified"
+    if as_json:
+        inf = lambda x: "inf" if isinstance(x, float) and math.isinf(x) else x
+        print(json.dumps({"design": design.name, "method": s.method, "eps": s.eps,
+                          "h_certified": s.h_certified, "h_refuted": inf(s.h_refuted),
+                          "K": None if s.K is None else s.K.tolist(), "h_gain": s.h_gain,
+                          "h_analysis": s.h_analysis, "status": s.status,
+                          "exact_margin": None if ex is None else inf(ex.h)}, indent=2))
+        return 0 if ok else 1
+    what = {"wirtinger": "Wirtinger synthesis (Seuret & Gouaisbaut 2013), eps searched",
+            "bessel-legendre": "Wirtinger synthesis, gain certified by the Bessel-Legendre "
+                               f"analysis of order N = {spec.synthesis.order}",
+            "robust-descriptor": f"one gain over {len(points)} vertices (Jensen/descriptor "
+                                 "synthesis), eps searched"}[s.method]
+    print(f"{design.name}: {what}, at {_op_text(spec, op)}")
+    cap = lambda h: "—" if h is None else (f">= {fmt(st.h_max, 4)} (cap)" if h >= st.h_max
+                                           else fmt(h, 4))
+    print(md_table(["method", "eps", "h_certified", "h_refuted", "K (canonical)",
+                    "h certified by K", f"h, Bessel-Legendre N = {spec.synthesis.order}",
+                    "h* (exact)", "status"],
+                   [[s.method, fmt(s.eps, 3), cap(s.h_certified), fmt(s.h_refuted, 4),
+                     gain_text(s.K, st.gain_digits), cap(s.h_gain), cap(s.h_analysis),
+                     fmt(None if ex is None else ex.h, 4), s.status]], "lrrrlrrrl"))
+    print("Certificate: " + ("for every constant delay in [0, h]" if s.all_delays else
+                             "at the delay h (not for smaller delays; see the exact windows)")
+          + ". K: canonical gain (minimum-norm certificate at "
+          f"{fmt(st.gain_fraction)} x h_certified, {st.gain_digits} significant digits).")
+    return 0 if ok else 1
+
+
+def simulate_command(design, *, case: str | None, dt: float | None, as_json: bool) -> int:
+    """``workbench simulate`` of one scenario: its metrics; exit 0."""
+    import time
+
+    from ..errors import DesignError
+    from ..report.markdown import fmt, md_table
+    from .delay_feedback_run import metrics, nominal_point, simulate, synthesise
+    spec = design.spec
+    if not spec.scenarios:
+        raise DesignError(design.path, "scenarios", "<missing>", "at least one [[scenarios]]")
+    names = [s.name for s in spec.scenarios]
+    if case is not None and case not in names:
+        raise DesignError("<cli>", "--case", case, "one of " + ", ".join(names))
+    sc = spec.scenarios[names.index(case) if case else 0]
+    if dt is not None and not (math.isfinite(dt) and 0 < dt <= sc.t_end / 10):
+        raise DesignError("<cli>", "--dt", dt, f"a step in (0, {sc.t_end / 10:g}] s")
+    model, values, op, A, B = nominal_point(spec)
+    points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
+    s = synthesise(spec, A, B, points)
+    if s.K is None:
+        print(f"{design.name}: no gain was certified; nothing to simulate")
+        return 1
+    t0 = time.perf_counter()
+    r = simulate(spec, model, values, op, s.K, sc, dt or sc.dt)
+    wall = time.perf_counter() - t0
+    m = metrics(spec, op, sc, r)
+    if as_json:
+        print(json.dumps({"design": design.name, "case": sc.name, "dt": dt or sc.dt,
+                          "metrics": m, "wall_s": round(wall, 3)}, indent=2))
+        return 0
+    print(f"{design.name}: scenario {sc.name}, h = {fmt(sc.h)} s, dt = {fmt(dt or sc.dt)} s, "
+          f"K = {gain_text(s.K, spec.synthesis.settings.gain_digits)}")
+    print(md_table(["metric", "value"], [[k, fmt(v, 6)] for k, v in m.items()], "lr"))
+    return 0
