@@ -115,12 +115,17 @@ def montecarlo(design, spec, samples: int, workers: int) -> None:
           f"seed 1, {workers} workers; load average before: {os.getloadavg()[0]:.2f}")
     rates = {}
     paths = ("numpy", "compiled") if compiled_available() else ("numpy",)
+    import resource
     for kernel in paths:
+        cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime
         res = sweep(design, samples, seed=1, workers=workers, kernel=kernel, progress=False)
+        cpu = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime - cpu0   # the pool's workers
         rates[kernel] = samples / res.seconds * 60
         print(f"  {kernel:>8}: {res.seconds:7.1f} s -> {rates[kernel]:6.0f} runs/min "
               f"({rates[kernel] / 60 / res.workers:.1f} runs/s per worker); "
-              f"projected 1000 runs: {1000 / rates[kernel] * 60:.0f} s")
+              f"projected 1000 runs: {1000 / rates[kernel] * 60:.0f} s; workers' CPU "
+              f"{cpu:.1f} s = {samples / cpu:.1f} runs per CPU-second (on {workers} idle cores: "
+              f"{samples / cpu * 60 * workers:.0f} runs/min)")
     if len(rates) == 2:
         print(f"  ratio compiled / numpy: {rates['compiled'] / rates['numpy']:.1f}x "
               f"(target: compiled >= 3000 runs/min on 2 cores); "
