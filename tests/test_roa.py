@@ -56,6 +56,7 @@ def vdp_exact_level(P):
     sp.Piecewise((sp.exp(x) - 1, x >= 0), (-x**2 + x, True)) * (y - sp.pi),
     sp.log(x + 4) * sp.sqrt(y + 3) + sp.Abs(x - y) + sp.Max(x, y),
     (x + 2.5) ** sp.Rational(3, 2) - 0.1 * (y + 3) ** 0.7,
+    sp.tanh(3 * x) * sp.atan(y) + sp.sinh(x - y) - sp.asinh(2 * y),
 ])
 def test_interval_encloses_high_precision_values(expr):
     rng = np.random.default_rng(7)

@@ -30,6 +30,19 @@ def directed(x: float, *, up: bool, sig: int = 4) -> float:
     return float(f"{(math.ceil(x / q) if up else math.floor(x / q)) * q:.{sig}g}")
 
 
+def printed_ratio(r) -> float | None:
+    """hi / h* of a row's interval from 0, from hi rounded down to 4 digits
+    (:func:`directed`) and truncated to 4 decimals: the digits a second CPU
+    reproduces (the chained solves' last digits differ between CPUs)."""
+    if r.interval_ratio is None or r.interval is None:
+        return None
+    hi = r.interval[1]
+    if math.isinf(hi):
+        return r.interval_ratio
+    h_star = hi / r.interval_ratio
+    return math.floor(directed(hi, up=False) / h_star * 1e4) / 1e4
+
+
 def show_window(a: float, b: float, fmt) -> str:
     """A window as text: closed at 0, open at a crossing delay."""
     return ("[0" if a == 0 else f"({fmt(a)}") + f", {fmt(b)})"

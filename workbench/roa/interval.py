@@ -10,7 +10,8 @@ interval *encloses* the expression's range on the box:
   one step of ``np.nextafter`` outwards after each operation is enough;
 * ``exp`` and ``log`` are not correctly rounded: numpy documents an error
   below 1 ulp for its float64 ``exp`` / ``log``; the result is widened by
-  two ulps outwards;
+  two ulps outwards (``tanh``, ``atan``, ``sinh``, ``asinh``: increasing,
+  widened by four ulps);
 * a constant that is not exactly a float (a Rational, a Float of higher
   precision, ``pi``) is enclosed by the floats on either side of it;
 * an operation outside its domain (a division by an interval holding 0, a
@@ -118,6 +119,21 @@ def iexp(a: Interval) -> Interval:
     return _fix(np.maximum(_down(_down(lo)), 0.0), _up(_up(hi)))
 
 
+def _widen(x, k: int, direction):
+    for _ in range(k):
+        x = np.nextafter(x, direction)
+    return x
+
+
+def imonotone(fn, a: Interval, lo_bound: float = -_INF, hi_bound: float = _INF) -> Interval:
+    """An increasing libm function (tanh, atan, sinh, asinh) on an interval,
+    widened by 4 ulps each way (their libm error is below that) and clipped
+    to the function's range."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        lo, hi = _widen(fn(a.lo), 4, -_INF), _widen(fn(a.hi), 4, _INF)
+    return _fix(np.maximum(lo, lo_bound), np.minimum(hi, hi_bound))
+
+
 def ilog(a: Interval) -> Interval:
     with np.errstate(divide="ignore", invalid="ignore"):
         lo = np.where(a.lo > 0, _down(_down(np.log(np.maximum(a.lo, 0.0)))), -_INF)
@@ -164,7 +180,7 @@ class IntervalFunction:
     ------
     UnsupportedExpression
         For a function without an interval rule (supported: +, *, integer,
-        rational and real powers, exp, log, Abs, Max, Min, Piecewise with
+        rational and real powers, exp, log, tanh, atan, sinh, asinh, Abs, Max, Min, Piecewise with
         relational conditions, and/or).
     """
 
@@ -227,6 +243,14 @@ class IntervalFunction:
             return lambda env, st, f=args[0]: iexp(f(env, st))
         if isinstance(e, sp.log) and len(e.args) == 1:
             return lambda env, st, f=args[0]: ilog(f(env, st))
+        if isinstance(e, sp.tanh):
+            return lambda env, st, f=args[0]: imonotone(np.tanh, f(env, st), -1.0, 1.0)
+        if isinstance(e, sp.atan):
+            return lambda env, st, f=args[0]: imonotone(np.arctan, f(env, st), -2.0, 2.0)
+        if isinstance(e, sp.sinh):
+            return lambda env, st, f=args[0]: imonotone(np.sinh, f(env, st))
+        if isinstance(e, sp.asinh):
+            return lambda env, st, f=args[0]: imonotone(np.arcsinh, f(env, st))
         if isinstance(e, sp.Abs):
             return lambda env, st, f=args[0]: iabs(f(env, st))
         if isinstance(e, (sp.Max, sp.Min)):

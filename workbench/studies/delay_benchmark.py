@@ -13,7 +13,8 @@ of example files relative to the design). Quantities (for claims), with
   **point** certificate: stable at h_certified), ``.interval_lo`` /
   ``.interval_hi`` / ``.interval_ratio`` (the **interval** certificate:
   stable for every constant delay in [lo, hi]; None when none; ends to 4
-  significant digits rounded inwards, ratio truncated to 4 decimals), with
+  significant digits rounded inwards, ratio of the rounded end truncated to
+  4 decimals), with
   ``<m>`` one of the methods, ``bessel-legendre[N=k]`` or
   ``bessel-legendre-auto`` (plus ``.N`` for the order reached);
 * ``examples[<ex>].windows`` (number of exact stable windows in [0, h_max]),
@@ -29,13 +30,12 @@ of example files relative to the design). Quantities (for claims), with
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..benchmark import (AUTO, BenchmarkResult, BenchmarkSettings, Example, agreement_bound,
                          load_examples, load_settings, run_benchmark)
-from ..benchmark_windows import directed
+from ..benchmark_windows import directed, printed_ratio
 from ..reader import Reader
 
 FIELDS = ("h_certified", "ratio", "exact_check", "interval_lo", "interval_hi",
@@ -106,8 +106,7 @@ class DelayBenchmark:
                 lo, hi = r.interval or (None, None)      # printed digits (see module doc)
                 q[f"{base}.{k}.interval_lo"] = None if lo is None else directed(lo, up=True)
                 q[f"{base}.{k}.interval_hi"] = None if hi is None else directed(hi, up=False)
-                q[f"{base}.{k}.interval_ratio"] = (None if r.interval_ratio is None else
-                                                   math.floor(r.interval_ratio * 1e4) / 1e4)
+                q[f"{base}.{k}.interval_ratio"] = printed_ratio(r)
                 if r.method == AUTO:
                     q[f"{base}.{AUTO}.N"] = float(r.N)
         return q

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from ..benchmark import AUTO, BenchmarkResult, agreement_bound
-from ..benchmark_windows import directed, show_window
+from ..benchmark_windows import directed, printed_ratio, show_window
 from ..margins import AGREEMENT_RTOL
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
 
@@ -27,12 +27,6 @@ def _ratio(r) -> str:
     if r is None:
         return "—"
     return f"{math.floor(r * 1e5) / 1e5:.5f}"   # truncated: never rounds up to 1
-
-
-def _ratio4(r) -> str:
-    """Truncated to 4 decimals: interval ends come from chains of solves whose
-    last digits differ between CPUs."""
-    return f"{math.floor(r * 1e4) / 1e4:.4f}"
 
 
 def _label(r) -> str:
@@ -91,7 +85,8 @@ def render(design, res: BenchmarkResult) -> Rendered:
             r = e.rows[i]
             n_txt = f" [N={r.N}]" if r.method == AUTO else ""
             cap = " (≥ cap)" if s.h_max <= r.h_certified < math.inf else ""
-            row.append(f"{fmt(r.h_certified, 5)}{cap} / {_ratio(r.ratio)}{n_txt}")
+            h = fmt(directed(r.h_certified, up=False, sig=5), 5)   # never rounded up
+            row.append(f"{h}{cap} / {_ratio(r.ratio)}{n_txt}")
         table.append(row)
     bounds = ("## Certified bounds\n\nTwo kinds of numbers. A **point** certificate "
               "h: the LMI holds at that one delay, so the system is stable *at h* — nothing "
@@ -99,7 +94,7 @@ def render(design, res: BenchmarkResult) -> Rendered:
               "certificate [lo, hi]: the system is stable *for every constant delay* in it "
               "(next section). Only an interval from 0 is compared with the exact margin.\n\n"
               "### Point certificates (stable at h)\n\nEach cell: largest delay at which "
-              "the criterion certified stability (s) / ratio to h* "
+              "the criterion certified stability (s, rounded down to 5 digits) / ratio to h* "
               "(truncated to 5 decimals; — when h* is 0 or infinite). Bracketed bisection "
               f"(`bisect_delay`) to a relative bracket width of {fmt(s.rel_tol)}, definiteness "
               f"margin {fmt(s.margin)} (relative to the largest block size), search cap h <= {fmt(s.h_max)} s; "
@@ -116,13 +111,13 @@ def render(design, res: BenchmarkResult) -> Rendered:
               + "\n\nMethods: " + "; ".join(f"**{k}**: {v}" for k, v in METHOD_DOC.items())
               + ".\n\n" + mats)
     ivs = [[_label(e0r)] + [_interval(e.rows[i]) + (
-        f" / {_ratio4(e.rows[i].interval_ratio)}" if e.rows[i].interval_ratio is not None
+        f" / {printed_ratio(e.rows[i]):.4f}" if e.rows[i].interval_ratio is not None
         and math.isfinite(e.exact.h) else "") for e in res.examples]
         for i, e0r in enumerate(res.examples[0].rows)]
     intervals = ("### Interval certificates (stable for every constant delay in [lo, hi])"
                  "\n\nEach cell: the certified intervals [lo, hi] (s; lo rounded up and hi "
-                 "down to 4 digits) / hi over h* when the first starts at 0 and h* is finite "
-                 "(truncated to 4 decimals). How "
+                 "down to 4 digits) / that hi over h* when the first starts at 0 and h* is "
+                 "finite (truncated to 4 decimals). How "
                  "(`workbench.lmi.interval`): the criterion's LMIs at both ends of [lo, hi] "
                  "with the same decision variables. Times a positive weight (h or 1), every "
                  "block is affine in h or quadratic with a positive semidefinite h^2 "
