@@ -12,10 +12,10 @@ Prints, in one process:
    the time to cruise;
 3. batched Monte Carlo throughput (``workbench.studies.antiskid_montecarlo.sweep``,
    process pool) of both stepping paths side by side, the same runs: the
-   batched numpy reference and the compiled kernel (numba; its one-off
-   compilation in each worker is included in its time, and reported apart
-   from a warm-up in this process), runs/min and their ratio, with the
-   machine's load average (the figures are only comparable within one run).
+   batched numpy reference and the compiled kernel (numba; compiled once in
+   this process before the pool forks, which is not in its time), runs/min
+   and their ratio, with the machine's load average (the figures are only
+   comparable within one run).
 
 Usage: .venv/bin/python benchmarks/simulate.py [--samples N] [--workers W] [--skip-single]
 """
@@ -31,17 +31,18 @@ from scipy.integrate import solve_ivp
 from workbench.controllers.antiskid003 import Antiskid003
 from workbench.design import load_design
 from workbench.sim.history import DelayLine
-from workbench.sim.wheel_slip import ScalarOps, model_functions, plant_forms
+from workbench.sim.wheel_slip import PARAM_ORDER, ScalarOps, model_functions, plant_forms
 from workbench.studies import antiskid_run_spec as S
 from workbench.studies.antiskid_montecarlo import sweep
-from workbench.studies.antiskid_scenario import simulate_antiskid
+from workbench.studies.antiskid_scenario import MetricsRecorder, simulate_antiskid
 
 
 def reference_run(rs, dt: float, t_end: float) -> tuple[float, float]:
     """(time to cruise, wall s): sampled controller, solve_ivp plant."""
     fns = model_functions("math")
     p = rs.plant_params
-    ctrl = Antiskid003(rs.controller, rs.x0, rs.u_init, dt, None)
+    rec = MetricsRecorder(rs.controller, rs.x0, None, p[PARAM_ORDER.index("r")])
+    ctrl = Antiskid003(rs.controller, rs.x0, rs.u_init, dt, None, recorder=rec)
     line = DelayLine(rs.h, dt, rs.u_init)
     x = np.array(rs.x0, float)
 
@@ -57,7 +58,7 @@ def reference_run(rs, dt: float, t_end: float) -> tuple[float, float]:
         sol = solve_ivp(rhs, (t, t + dt), x, method="Radau", rtol=1e-8, atol=1e-11,
                         args=(line.delayed(),))
         x = sol.y[:, -1]
-    return float(ctrl.m.t_cruise), time.perf_counter() - t0
+    return float(rec.m.t_cruise), time.perf_counter() - t0
 
 
 def main() -> None:
@@ -114,12 +115,17 @@ def montecarlo(design, spec, samples: int, workers: int) -> None:
           f"seed 1, {workers} workers; load average before: {os.getloadavg()[0]:.2f}")
     rates = {}
     paths = ("numpy", "compiled") if compiled_available() else ("numpy",)
+    import resource
     for kernel in paths:
+        cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime
         res = sweep(design, samples, seed=1, workers=workers, kernel=kernel, progress=False)
+        cpu = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime - cpu0   # the pool's workers
         rates[kernel] = samples / res.seconds * 60
         print(f"  {kernel:>8}: {res.seconds:7.1f} s -> {rates[kernel]:6.0f} runs/min "
               f"({rates[kernel] / 60 / res.workers:.1f} runs/s per worker); "
-              f"projected 1000 runs: {1000 / rates[kernel] * 60:.0f} s")
+              f"projected 1000 runs: {1000 / rates[kernel] * 60:.0f} s; workers' CPU "
+              f"{cpu:.1f} s = {samples / cpu:.1f} runs per CPU-second (on {workers} idle cores: "
+              f"{samples / cpu * 60 * workers:.0f} runs/min)")
     if len(rates) == 2:
         print(f"  ratio compiled / numpy: {rates['compiled'] / rates['numpy']:.1f}x "
               f"(target: compiled >= 3000 runs/min on 2 cores); "

@@ -72,6 +72,12 @@ def test_stream_resume_and_refusals(short, in_memory, tmp_path, monkeypatch):
     res = S.start_streaming(short, N, 5, out, resume=True, workers=1, chunk=CHUNK).result()
     assert ran == [CHUNK]
     assert_identical(res, in_memory)
+    # every chunk written: nothing runs, the summaries come from the files (pool or not)
+    for workers in (1, 2):
+        res = S.start_streaming(short, N, 5, out, resume=True, workers=workers,
+                                chunk=CHUNK).result()
+        assert ran == [CHUNK]
+        assert_identical(res, in_memory)
 
 
 def test_cli_resume_needs_out(capsys):

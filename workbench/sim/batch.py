@@ -91,7 +91,7 @@ class PendingBatch:
         self._futures = None
         if scheduler is not None:
             self._start_dask(scheduler)
-        elif pool:
+        elif pool and payloads:
             self._pool = ProcessPoolExecutor(max_workers=min(workers, len(payloads)))
             self._futures = [self._pool.submit(worker, p) for p in payloads]
 
