@@ -79,7 +79,7 @@ import numpy as np
 
 from .analysis import RETRY_SETTINGS
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, bisect_delay
-from .delay_input import time_scale
+from .delay_input import H_HI_SCALE, time_scale
 
 
 def _check_interval(h1: float, mu: float | None) -> tuple[float, float | None]:
@@ -366,7 +366,7 @@ class VaryingDelayBound:
 
 
 def certified_varying_delay(A, Ad, *, h1: float = 0.0, mu: float | None = None,
-                            windows: Windows | None = None, h_hi: float = 100.0,
+                            windows: Windows | None = None, h_hi: float | None = None,
                             rel_tol: float = 1e-4, guess: float | None = None,
                             max_solves: int = 60,
                             margin: float = DEFAULT_MARGIN) -> VaryingDelayBound:
@@ -382,10 +382,12 @@ def certified_varying_delay(A, Ad, *, h1: float = 0.0, mu: float | None = None,
         Bound on |h'(t)| (dimensionless); None = unknown derivative.
     windows : {"delay", "fixed"}, optional
         See :class:`VaryingDelayLMI`.
-    h_hi : float
+    h_hi : float, optional
         Search cap on h2 (s); a result at the cap means "at least h_hi".
+        Default ``H_HI_SCALE`` times the time scale 1 / (||A|| + ||A_d||).
     rel_tol, guess, max_solves
-        Bisection settings (:func:`~workbench.lmi.core.bisect_delay`).
+        Bisection settings (:func:`~workbench.lmi.core.bisect_delay`); the
+        search starts at h1 + 1e-3 max(h1, min(tau, h_hi)) (relative).
     margin : float
         Relative LMI margin.
 
@@ -396,7 +398,11 @@ def certified_varying_delay(A, Ad, *, h1: float = 0.0, mu: float | None = None,
     """
     lmi = VaryingDelayLMI(A, Ad, h1=h1, mu=mu, windows=windows, margin=margin)
     tau = time_scale(lmi.A, lmi.Ad)         # scale-free: 1e-3 of h1 or of the time scale
-    h_lo = h1 + 1e-3 * max(h1, tau if math.isfinite(tau) else 1.0)
+    if h_hi is None:
+        if not math.isfinite(tau):
+            raise ValueError("A = A_d = 0 has no time scale; expected h_hi (s)")
+        h_hi = H_HI_SCALE * tau
+    h_lo = lmi.h1 + 1e-3 * max(lmi.h1, min(tau, h_hi))
     br = bisect_delay(lmi.solve_at, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol, guess=guess,
                       max_solves=max_solves)
     return VaryingDelayBound(lmi.method, lmi.h1, lmi.mu, lmi.windows, br)
