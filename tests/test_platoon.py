@@ -10,7 +10,8 @@ from workbench.controllers.ntsm import (NTSMGains, convergence_time, ntsm_force,
 from workbench.design import load_design
 from workbench.errors import DesignError
 from workbench.plants.platoon001 import TrainParams, external_force, perturbed
-from workbench.sim.tracking import Route, simulate_platoon
+from workbench.sim.platoon import simulate_platoon
+from workbench.sim.tracking import Route
 
 DESIGN = Path("designs/platoon-ntsm-001.toml")
 G = NTSMGains(beta=0.2, a=5, b=7, j=3.0, k=3.0, alpha=3, xi=5)

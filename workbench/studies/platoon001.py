@@ -22,7 +22,8 @@ from ..controllers.ntsm import NTSMGains, convergence_time, ntsm_force, pd_force
 from ..plants.platoon001 import PARAMETER_UNITS, TrainParams, external_force, perturbed
 from ..profiles import Profile, build_profile, spec_for_cruise
 from ..reader import Quantity, Reader
-from ..sim.tracking import PlatoonRun, Route, simulate_platoon
+from ..sim.platoon import PlatoonRun, simulate_platoon
+from ..sim.tracking import Route
 from .tracking002 import read_gradients
 
 
