@@ -19,7 +19,8 @@ from ..plants.platoon001 import TrainParams, external_force, perturbed
 from ..profiles import Profile, build_profile, spec_for_cruise
 from ..reader import Reader
 from ..sim.platoon import PlatoonRun, simulate_platoon
-from .platoon001_realism import Realism, realism_quantities, realism_quantity_names, run_realism
+from .platoon001_realism import (Realism, accel_end, realism_quantities, realism_quantity_names,
+                                 run_realism)
 from .platoon001_spec import PlatoonSpec, load_spec
 
 #: The followers' laws of :meth:`Scenario.law`.
@@ -183,14 +184,14 @@ class NTSMPlatoon:
         prof = sc.profile
         bound = spec.G_w + spec.G_d
         nom = sc.nominal
-        t_acc_end = float(prof.t[np.nonzero(prof.a > 0)[0][-1]])
+        t_acc_end = accel_end(prof)
         t_brk = float(prof.t[np.nonzero(prof.a < 0)[0][0]])
         window = (t_acc_end + 10.0, t_brk)     # settled cruise
         metrics = {k: _metrics(r, window, nom.m, bound) for k, r in runs.items()}
         conv = tuple(_convergence(runs["ntsm_offset"], i, e0, spec)
                      for i, e0 in enumerate(spec.initial_errors))
         return PlatoonResult(prof, window, runs, metrics, conv,
-                             run_realism(sc, t_acc_end, window))
+                             run_realism(sc))
 
     def quantities(self, res: PlatoonResult) -> dict:
         q = {"leader.v_cruise": res.profile.v_cruise}

@@ -31,12 +31,13 @@ force):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..controllers.ntsm import linear_member
-from ..margins import DelayMargin, delay_margin_eig, delay_margin_siso, relative_difference
+from ..margins import (Agreement, DelayMargin, compare_margins, delay_margin_eig,
+                       delay_margin_siso)
 from ..sim.platoon import Actuator, Link, PlatoonRun, packet_delays, received_steps
 
 CASES = ("constant", "random")
@@ -95,9 +96,9 @@ class SweepRow:
     ----------
     law : str
     factor : float or None
-        h / h* (None: the design's V2V delay).
+        Asked delay / h* (None: the design's V2V delay).
     h : float
-        Delay (s).
+        Simulated delay (s): the asked one rounded to whole steps.
     amp_first, amp_worst : float
         Largest |e| (m) in the window: first follower; any follower.
     saturated : float
@@ -111,6 +112,7 @@ class SweepRow:
     amp_first: float
     amp_worst: float
     saturated: float
+    trace: np.ndarray = field(compare=False, repr=False)   # (t (s), e (m)) of the first follower
 
 
 @dataclass(frozen=True)
@@ -159,12 +161,14 @@ class DelayMarginStudy:
         return self.lowest_power >= 1.0 and self.switching == 0.0
 
     @property
-    def rel_diff(self) -> float:
-        return relative_difference(self.eig.h, self.siso.h)
+    def agreement(self) -> tuple[Agreement, float | None]:
+        """The two exact methods' agreement and relative difference."""
+        return compare_margins(self.eig, self.siso)
 
 
 @dataclass(frozen=True)
 class Realism:
+    delay: float           # the design's V2V delay (s)
     t_emergency: float
     horizon: float
     links: dict            # case -> LinkStats
@@ -208,9 +212,26 @@ def envelope(v_f, v_p, *, reaction: float, brake: float, margin: float):
     return margin + v_f * reaction + np.maximum(0.0, (v_f ** 2 - v_p ** 2) / (2.0 * brake))
 
 
-def _emergency(sc, run: PlatoonRun, t_e: float, cruise_from: float) -> EmergencyRun:
+def accel_end(profile) -> float:
+    """Time (s) the leader's profile stops accelerating."""
+    return float(profile.t[np.nonzero(profile.a > 0)[0][-1]])
+
+
+def emergency_horizon(spec) -> float:
+    """End (s) of an emergency run: the brake time plus twice the time to stop
+    from cruise at the brake limit plus 20 s, within the design's horizon."""
+    return min(spec.horizon, spec.emergency.time.value
+               + 2.0 * spec.v_cruise.value / spec.actuator.brake.value + 20.0)
+
+
+def emergency_run(sc, law: str, lk: Link) -> EmergencyRun:
+    """The law ``law`` with the link ``lk`` under the leader's emergency brake,
+    judged against the envelope (module docstring)."""
     spec = sc.spec
-    em = spec.emergency
+    act, em = actuator(spec), spec.emergency
+    t_e = em.time.value
+    run = sc.simulate(law, horizon=emergency_horizon(spec), link=lk, actuator=act,
+                      leader_brake=(t_e, act.f_min))
     env = envelope(run.v[:, 1:], run.v[:, :-1], reaction=em.reaction.value,
                    brake=spec.actuator.brake.value, margin=em.margin.value)
     after = run.t >= t_e - 1e-9
@@ -219,7 +240,7 @@ def _emergency(sc, run: PlatoonRun, t_e: float, cruise_from: float) -> Emergency
     kg = np.unravel_index(np.argmin(gap), gap.shape)
     km = np.unravel_index(np.argmin(margin), margin.shape)
     t_after = run.t[after]
-    cw = (run.t >= cruise_from) & (run.t < t_e)
+    cw = (run.t >= accel_end(sc.profile) + 10.0) & (run.t < t_e)
     return EmergencyRun(run, env, float(gap[kg]), float(t_after[kg[0]]), float(margin[km]),
                         float(t_after[km[0]]), int(km[1]) + 2,
                         float(np.abs(run.e[cw]).max()) if cw.any() else math.nan,
@@ -247,7 +268,8 @@ def _sweep_row(sc, law: str, factor, h: float, act: Actuator, window, K: int) ->
     e = np.abs(run.e[w])
     u = run.u[w, 1]
     sat = ((u < act.f_min) | (u > act.f_max)).mean()
-    return SweepRow(law, factor, h, float(e[:, 0].max()), float(e.max()), float(sat))
+    return SweepRow(law, factor, h, float(e[:, 0].max()), float(e.max()), float(sat),
+                    np.stack([run.t[w], run.e[w, 0]], axis=1))
 
 
 def delay_margin_study(sc, act: Actuator, t_acc_end: float) -> DelayMarginStudy:
@@ -261,8 +283,10 @@ def delay_margin_study(sc, act: Actuator, t_acc_end: float) -> DelayMarginStudy:
     current = delay_margin_eig(A + B @ K, np.zeros_like(A))
     window = (t_acc_end + 10.0, t_acc_end + 30.0)
     n_steps = int(round(window[1] / spec.T)) + 1
-    hs = [(f, f * eig.h) for f in SWEEP_FACTORS] if math.isfinite(eig.h) and eig.h > 0 else []
-    hs.append((None, spec.link.delay.value))
+    steps = lambda h: round(h / spec.T) * spec.T        # whole steps, nearest
+    hs = ([(f, steps(f * eig.h)) for f in SWEEP_FACTORS]
+          if math.isfinite(eig.h) and eig.h > 0 else [])
+    hs.append((None, math.ceil(round(spec.link.delay.value / spec.T, 9)) * spec.T))
     rows = tuple(_sweep_row(sc, law, f, h, act, window, n_steps)
                  for law in SWEEP_LAWS for f, h in hs)
     return DelayMarginStudy(min(2.0 - g.b / g.a, g.alpha / g.xi), spec.G_w + spec.G_d,
@@ -270,23 +294,18 @@ def delay_margin_study(sc, act: Actuator, t_acc_end: float) -> DelayMarginStudy:
                             k_e, k_d, A, B, K, eig, siso, current, rows, window)
 
 
-def run_realism(sc, t_acc_end: float, cruise_window) -> Realism:
+def run_realism(sc) -> Realism:
     """Every run of the realistic scenario (module docstring)."""
     spec = sc.spec
-    act = actuator(spec)
-    t_e = spec.emergency.time.value
-    horizon = min(spec.horizon, t_e + 2.0 * spec.v_cruise.value / spec.actuator.brake.value
-                  + 20.0)
-    K = int(round(horizon / spec.T))
-    brake = (t_e, act.f_min)
+    K = int(round(emergency_horizon(spec) / spec.T))
     links, runs = {}, {}
     for case in CASES:
         lk, lost = link(spec, case, K)
         links[case] = _stats(lk, spec.T, lost)
         for law in CONTROLLERS:
-            run = sc.simulate(law, horizon=horizon, link=lk, actuator=act, leader_brake=brake)
-            runs[case, law] = _emergency(sc, run, t_e, cruise_window[0])
-    return Realism(t_e, horizon, links, runs, delay_margin_study(sc, act, t_acc_end))
+            runs[case, law] = emergency_run(sc, law, lk)
+    return Realism(spec.link.delay.value, spec.emergency.time.value, K * spec.T, links, runs,
+                   delay_margin_study(sc, actuator(spec), accel_end(sc.profile)))
 
 
 def realism_quantity_names() -> set[str]:
@@ -302,7 +321,7 @@ def realism_quantity_names() -> set[str]:
               for k in ("min_gap", "min_margin")}
     names |= {f"delay_margin.{k}" for k in ("linearisable", "lowest_power", "spring", "k_e",
                                              "k_d", "h_eig",
-                                             "h_siso", "omega", "rel_diff", "h_over_delay",
+                                             "h_siso", "omega", "agreement", "h_over_delay",
                                              "current_h")}
     names |= {f"delay_sweep.{law}.{k}" for law in SWEEP_LAWS
               for k in ("amp_ratio", "amp_at_delay", "saturated_at_delay")}
@@ -335,10 +354,11 @@ def realism_quantities(r: Realism) -> dict:
               "delay_margin.lowest_power": m.lowest_power, "delay_margin.spring": m.spring,
               "delay_margin.k_e": m.k_e, "delay_margin.k_d": m.k_d,
               "delay_margin.h_eig": m.eig.h, "delay_margin.h_siso": m.siso.h,
-              "delay_margin.omega": m.eig.omega, "delay_margin.rel_diff": m.rel_diff,
+              "delay_margin.omega": m.eig.omega,
+              "delay_margin.agreement": m.agreement[0].value,
               "delay_margin.current_h": m.current.h})
-    at = _amp(m.sweep, "ntsm", None)
-    q["delay_margin.h_over_delay"] = m.eig.h / at.h if at.h > 0 else math.inf
+    delay = r.delay
+    q["delay_margin.h_over_delay"] = m.eig.h / delay if delay > 0 else math.inf
     for law in SWEEP_LAWS:
         lo, hi, d = _amp(m.sweep, law, 0.9), _amp(m.sweep, law, 1.1), _amp(m.sweep, law, None)
         q[f"delay_sweep.{law}.amp_ratio"] = (hi.amp_first / lo.amp_first
