@@ -87,6 +87,10 @@ def test_received_steps_holds_the_newest_packet():
     # packet 0 (sent 0) at 1; packet 2 (sent 4) at 5 before packet 1 (sent 2) at 6,
     # which is older and ignored; packet 3 lost; packet 4 (sent 8) at 9
     assert src.tolist() == [0, 0, 0, 0, 0, 4, 4, 4, 4, 8]
+    with pytest.raises(ValueError, match="multiple of T"):
+        received_steps(10, T=T, period=0.15, delays=delays, lost=lost)
+    with pytest.raises(ValueError, match="one row per packet"):
+        received_steps(12, T=T, period=0.2, delays=delays, lost=lost)
 
 
 def test_packet_delays_are_seeded_and_shaped():
@@ -136,7 +140,8 @@ def test_actuator_lag_and_limits():
     from workbench.sim.platoon import simulate_platoon
     from workbench.sim.tracking import Route
     T, lag, K = 0.01, 0.65, 300
-    one, two = TrainParams(5e5, 0.0, 0.0, 0.0, 9.8), TrainParams(np.array([5e5, 5e5]), 0.0, 0.0, 0.0, 9.8)
+    one = TrainParams(5e5, 0.0, 0.0, 0.0, 9.8)                     # nominal
+    two = TrainParams(np.array([5e5, 5e5]), 0.0, 0.0, 0.0, 9.8)     # true, per train
     ref = lambda t: (np.zeros_like(t), np.zeros_like(t))
     for cmd, limit in ((2e5, 1e6), (2e6, 5e5)):
         law = lambda e, de, u1, ap: (np.full_like(e, cmd), np.zeros_like(e))

@@ -152,18 +152,20 @@ def received_steps(K: int, *, T: float, period: float, delays: np.ndarray,
     Parameters
     ----------
     delays : numpy.ndarray
-        Per-packet delays (s), shape (n_packets, n_links), n_packets = ceil(K / P).
+        Per-packet delays (s), shape (n_packets, n_links), n_packets = ceil(K / P);
+        a negative delay counts as 0.
     lost : numpy.ndarray
         Boolean, same shape: packets that never arrive.
     """
     P = int(round(period / T))
     if P < 1 or not math.isclose(P * T, period, rel_tol=1e-9):
         raise ValueError(f"period = {period} s; expected a positive multiple of T = {T} s")
-    sent = np.arange(delays.shape[0]) * P
-    if delays.shape != lost.shape or sent.size and sent[-1] >= K + P:
+    n_packets = -(-K // P)
+    if delays.shape != lost.shape or delays.ndim != 2 or delays.shape[0] != n_packets:
         raise ValueError(f"delays {delays.shape}, lost {lost.shape}; expected equal shapes "
-                         f"with ceil({K} / {P}) rows")
-    arrive = sent[:, None] + np.ceil(np.round(delays / T, 9)).astype(np.int64)
+                         f"({n_packets}, n_links): one row per packet sent in {K} steps")
+    sent = np.arange(n_packets) * P
+    arrive = sent[:, None] + np.maximum(np.ceil(np.round(delays / T, 9)), 0).astype(np.int64)
     best = np.full((K, delays.shape[1]), -1, dtype=np.int64)
     for i in range(delays.shape[1]):
         ok = ~lost[:, i] & (arrive[:, i] < K)
