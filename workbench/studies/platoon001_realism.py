@@ -315,8 +315,8 @@ def realism_quantity_names() -> set[str]:
         names |= {f"emergency.{case}.{law}.{k}" for law in CONTROLLERS for k in
                   ("min_gap", "t_min_gap", "min_margin", "t_min_margin", "cruise_abs_e",
                    "stopped")}
-        names |= {f"emergency.{case}.ntsm_minus_pd_ff.min_gap",
-                  f"emergency.{case}.pd_ff_minus_pd.min_gap"}
+        names |= {f"emergency.{case}.{d}.{k}" for d in ("ntsm_minus_pd_ff", "pd_ff_minus_pd")
+                  for k in ("min_gap", "min_margin")}
     names |= {f"emergency.{who}.{k}" for who in CONTROLLERS + ("worst",)
               for k in ("min_gap", "min_margin")}
     names |= {f"delay_margin.{k}" for k in ("linearisable", "lowest_power", "spring", "k_e",
@@ -342,9 +342,10 @@ def realism_quantities(r: Realism) -> dict:
             q[f"emergency.{case}.{law}.{k}"] = getattr(e, k)
         q[f"emergency.{case}.{law}.stopped"] = "yes" if e.stopped else "no"
     for case in CASES:
-        gap = {law: r.emergency[case, law].min_gap for law in CONTROLLERS}
-        q[f"emergency.{case}.ntsm_minus_pd_ff.min_gap"] = gap["ntsm"] - gap["pd_ff"]
-        q[f"emergency.{case}.pd_ff_minus_pd.min_gap"] = gap["pd_ff"] - gap["pd"]
+        for k in ("min_gap", "min_margin"):
+            x = {law: getattr(r.emergency[case, law], k) for law in CONTROLLERS}
+            q[f"emergency.{case}.ntsm_minus_pd_ff.{k}"] = x["ntsm"] - x["pd_ff"]
+            q[f"emergency.{case}.pd_ff_minus_pd.{k}"] = x["pd_ff"] - x["pd"]
     for who in CONTROLLERS + ("worst",):
         runs = [e for (case, law), e in r.emergency.items() if who in (law, "worst")]
         q[f"emergency.{who}.min_gap"] = min(e.min_gap for e in runs)
