@@ -180,3 +180,16 @@ def test_robust_synthesis_scales_with_time(c):
     assert r1.K is not None and rc.K is not None
     assert abs(r1.bracket.h_certified / (c * rc.bracket.h_certified) - 1) <= 3e-3
     assert np.allclose(rc.K, r1.K, rtol=5e-3)
+
+
+@pytest.mark.parametrize("c", [1e-4, 1e4])
+def test_varying_delay_certificate_scales_with_time(c):
+    """The interval certificate for a time-varying delay (h in [0, h2],
+    |h'| <= 0.3): (c A, c A_d) gives h2 / c. Before its blocks were written in
+    the system's own time unit, c = 1e-4 certified 17 times less."""
+    from workbench.lmi.varying import certified_varying_delay
+    A = np.array([[-2.0, 0.0], [0.0, -0.9]])
+    Ad = np.array([[-1.0, 0.0], [-1.0, -1.0]])
+    h = certified_varying_delay(A, Ad, mu=0.3, rel_tol=REL_TOL, h_hi=20.0).h2
+    hc = certified_varying_delay(c * A, c * Ad, mu=0.3, rel_tol=REL_TOL, h_hi=20.0 / c).h2
+    assert h > 0 and _close(h, c * hc), (h, c * hc)
