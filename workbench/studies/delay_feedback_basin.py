@@ -129,7 +129,9 @@ class DelayFeedbackBasin:
     plane : tuple of int
         State indices of the figure.
     box : (lo, hi)
-        Box of the sampled starts and of "leaves the domain".
+        Box of the sampled starts: the domain, and x* +- 1.5 x the half-width of
+        {V <= c_search} in the coordinates it leaves unbounded (there a trajectory
+        "leaves the domain" beyond 100 x that half-width).
     sampled, inside : tuple of Trajectory
         Seeded starts in the box (and the scenarios' initial states); starts
         on the certified level's boundary {V = 0.999 c_certified}.
@@ -224,6 +226,8 @@ def run_basin(settings: BasinSettings, spec, model, values: dict, op, K) -> Dela
     half = np.sqrt(est.c_search * np.diag(np.linalg.inv(P)))
     box = (np.where(np.isfinite(lo), lo, x_eq - 1.5 * half),
            np.where(np.isfinite(hi), hi, x_eq + 1.5 * half))
+    escape = (np.where(np.isfinite(lo), lo, x_eq - 100 * half),
+              np.where(np.isfinite(hi), hi, x_eq + 100 * half))
     fn = sp.lambdify(states, fcl, "math")
     V = lambda X: np.einsum("ni,ij,nj->n", X - x_eq, P, X - x_eq)
     plane = tuple(names.index(k) for k in settings.plane)
@@ -234,14 +238,15 @@ def run_basin(settings: BasinSettings, spec, model, values: dict, op, K) -> Dela
         x0[list(plane)] = rng.uniform(box[0][list(plane)], box[1][list(plane)])
         starts.append(tuple(x0))
     c_cert = est.c_certified
-    sampled = tuple(_trajectory(fn, x0, V, c_cert, box, horizon) for x0 in starts)
+    sampled = tuple(_trajectory(fn, x0, V, c_cert, escape, horizon) for x0 in starts)
     inside, ok = (), None
     if c_cert > 0:
         L = np.linalg.cholesky(P)
         dirs = rng.standard_normal((N_INSIDE, n))
         dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
         X0 = x_eq + np.sqrt(0.999 * c_cert) * dirs @ np.linalg.inv(L.T).T
-        inside = tuple(_trajectory(fn, x0, V, c_cert, box, horizon, full=True) for x0 in X0)
+        inside = tuple(_trajectory(fn, x0, V, c_cert, escape, horizon, full=True)
+                       for x0 in X0)
         ok = all(_decays(tr.path, V) for tr in inside)
     return DelayFeedbackBasin(chk, outcome.value, plane, (tuple(box[0]), tuple(box[1])), sampled,
                               inside, ok, horizon, dict(settings.domain), tuple(names))
@@ -249,7 +254,7 @@ def run_basin(settings: BasinSettings, spec, model, values: dict, op, K) -> Dela
 
 def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False) -> Trajectory:
     """The delay-free loop from x0 over [0, T] (Radau, rtol 1e-8). Ends when it
-    leaves ``box`` (fate "leaves the domain"), or, unless ``full``, when V falls
+    leaves ``box`` (fate "leaves the domain": the domain, or far away), or, unless ``full``, when V falls
     below 1e-3 c_certified; "converges" when it entered {V <= c_certified}."""
     import numpy as np
     from scipy.integrate import solve_ivp

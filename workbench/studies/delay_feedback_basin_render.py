@@ -77,8 +77,10 @@ def render_basin_section(spec, res, basin) -> tuple[str, tuple]:
     text = (head + body + "\n" + inside + "\n\n"
             f"![basin]({{figdir}}/basin.png)\n\nThe figure shows {plane}: the certified level "
             "set (solid), the refuted level (dashed) and its counterexample (*), delay-free "
-            "trajectories from seeded starts in the domain box (green: converge, i.e. enter "
-            "the certified set; red: leave the box; grey: neither within the horizon), and "
+            "trajectories from seeded starts in the plotted box (green: converge, i.e. enter "
+            "the certified set; red: leave the domain, or go 100 times the searched "
+            "ellipsoid's half-width away where no domain bounds a state; grey: neither "
+            "within the horizon), and "
             "each scenario's initial state marked by its verdict (o CERTIFIED, s "
             "INCONCLUSIVE, X REFUTED).\n")
     return text, (fig,)
