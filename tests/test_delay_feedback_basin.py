@@ -131,7 +131,8 @@ def test_certified_level_agrees_with_simulation(evaluated):
     rng = np.random.default_rng(7)
     g = rng.standard_normal((400, 2))
     g /= np.linalg.norm(g, axis=1, keepdims=True)
-    E = g * np.sqrt(rng.random((400, 1)) * est.c_certified) @ np.linalg.inv(np.linalg.cholesky(P).T).T
+    E = g * np.sqrt(rng.random((400, 1)) * est.c_certified)
+    E = E @ np.linalg.inv(np.linalg.cholesky(P).T).T
     X = x_eq + E
     Fx = np.array(fn(*X.T), float).T
     vdot = 2 * np.einsum("ni,ij,nj->n", E, P, Fx)
