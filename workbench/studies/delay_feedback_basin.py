@@ -255,7 +255,8 @@ def run_basin(settings: BasinSettings, spec, model, values: dict, op, K) -> Dela
 def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False) -> Trajectory:
     """The delay-free loop from x0 over [0, T] (Radau, rtol 1e-8). Ends when it
     leaves ``box`` (fate "leaves the domain": the domain, or far away), or,
-    unless ``full``, when V falls below 1e-3 c_certified; "converges" when it entered {V <= c_certified}."""
+    unless ``full``, when V falls below 1e-3 c_certified; "converges" when it
+    entered {V <= c_certified}."""
     import numpy as np
     from scipy.integrate import solve_ivp
     lo, hi = (np.asarray(b, float) for b in box)
