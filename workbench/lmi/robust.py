@@ -42,7 +42,7 @@ from .analysis import BesselLegendreLMI, certified_delay
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, bisect_delay
 from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
 from .delay_input import H_HI_SCALE, H_LO_SCALE
-from .scaling import balance_points, check_unit, time_unit
+from .scaling import balance_points, check_unit
 
 #: The eps-search bisections of a synthesis stop going down at this fraction
 #: of the search cap (relative: the search is the same in any time unit).
@@ -266,13 +266,13 @@ def synthesize_robust(points, *, h_hi: float, alpha: float = 0.0,
 
     ``h_hi`` (the search cap, s) is required: it states the delay range of
     interest in the system's own time unit. ``eps_grid`` defaults to
-    :data:`ROBUST_EPS_GRID` times ``h_hi``, so (c A_i, c B_i) with cap h_hi / c
-    gives the same gain and h / c.
+    :data:`ROBUST_EPS_GRID` times ``h_hi``. The blocks are written in seconds
+    (``unit`` = 1): in exact arithmetic (c A_i, c B_i) with cap h_hi / c gives
+    the same gain and h / c, numerically not yet (issue 21).
     """
     eps_grid = eps_grid_for(eps_grid, ROBUST_EPS_GRID, h_hi)
-    u = time_unit(h_hi)
     T, Tinv, pts = balance_points(points)
-    lmi = DescriptorSynthesis(pts, eps_grid[0], alpha, margin=margin, unit=u)
+    lmi = DescriptorSynthesis(pts, eps_grid[0], alpha, margin=margin)
     best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_hi,
                                    rel_tol=rel_tol)
     br = tried[best]
@@ -281,8 +281,7 @@ def synthesize_robust(points, *, h_hi: float, alpha: float = 0.0,
         lmi.set_eps(best)
         gain = canonical_gain(
             lmi, br.h_certified,
-            lambda Kt: DescriptorSynthesisFixedK(pts, best, alpha, K=Kt, margin=margin,
-                                                 unit=u), T,
+            lambda Kt: DescriptorSynthesisFixedK(pts, best, alpha, K=Kt, margin=margin), T,
             fraction=gain_fraction, digits=gain_digits, h_hi=h_hi, rel_tol=rel_tol)
     pairs = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
     return RobustSynthesis(best, br, None if gain is None else gain.K, pairs, gain)

@@ -43,7 +43,7 @@ import numpy as np
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI
 from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
 from .robust import DescriptorSynthesis, best_eps_bracket, eps_grid_for
-from .scaling import balance_points, check_unit, time_unit
+from .scaling import balance_points, check_unit
 
 
 class WirtingerSynthesis(MarginLMI):
@@ -201,8 +201,10 @@ def synthesize_tight(A, B, *, h_max: float, eps_grid: Sequence[float] | None = N
         system's own time unit (no absolute default).
     eps_grid : sequence of float, optional
         Log grid of the descriptor scalar (s), refined by golden section;
-        default :data:`TIGHT_EPS_GRID` times ``h_max`` (so (c A, c B) with cap
-        h_max / c gives the same gain and h / c).
+        default :data:`TIGHT_EPS_GRID` times ``h_max``. In exact arithmetic
+        (c A, c B) with cap h_max / c then gives the same gain and h / c; the
+        blocks are still written in seconds (``unit`` = 1), and numerically a
+        model in milliseconds certifies less (issue 21, open).
     golden_steps : int
     rel_tol : float
         Relative bracket width of the delay bisection.
@@ -221,8 +223,7 @@ def synthesize_tight(A, B, *, h_max: float, eps_grid: Sequence[float] | None = N
     A = np.atleast_2d(np.asarray(A, float))
     B = np.asarray(B, float).reshape(A.shape[0], -1)
     T, Tinv, ((At, Bt),) = balance_points([(A, B)])
-    u = time_unit(h_max)
-    lmi = WirtingerSynthesis(At, Bt, eps_grid[0], margin=margin, unit=u)
+    lmi = WirtingerSynthesis(At, Bt, eps_grid[0], margin=margin)
     best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_max,
                                    rel_tol=rel_tol, stop_at=h_max)   # nothing beyond the cap
     br = tried[best]
@@ -231,7 +232,7 @@ def synthesize_tight(A, B, *, h_max: float, eps_grid: Sequence[float] | None = N
         lmi.set_eps(best)
         gain = canonical_gain(
             lmi, br.h_certified,
-            lambda Kt: WirtingerSynthesisFixedK(At, Bt, best, K=Kt, margin=margin, unit=u), T,
+            lambda Kt: WirtingerSynthesisFixedK(At, Bt, best, K=Kt, margin=margin), T,
             fraction=gain_fraction, digits=gain_digits, h_hi=h_max, rel_tol=rel_tol)
         K = gain.K
     tried_h = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
@@ -259,8 +260,7 @@ def recheck_tight(A, B, result: TightSynthesis,
     A = np.atleast_2d(np.asarray(A, float))
     B = np.asarray(B, float).reshape(A.shape[0], -1)
     Tinv = np.diag(1.0 / np.diag(result.T))
-    lmi = WirtingerSynthesis(Tinv @ A @ result.T, Tinv @ B, result.eps,
-                             unit=time_unit(result.h_max))
+    lmi = WirtingerSynthesis(Tinv @ A @ result.T, Tinv @ B, result.eps)
     cert = result.bracket.certificate.certificate if certificate is None else certificate
     return lmi.recheck(cert, result.bracket.h_certified)
 
