@@ -34,10 +34,23 @@ class Figure:
 
 @dataclass(frozen=True)
 class Rendered:
-    """Markdown sections (each starting with a ``## `` heading) and figures."""
+    """Markdown sections (each starting with a ``## `` heading) and figures.
+
+    ``anchors``: (quantity prefix, section heading) pairs; a finding whose
+    claim names a quantity with that prefix links to that section.
+    """
 
     sections: tuple[str, ...]
     figures: tuple[Figure, ...] = ()
+    anchors: tuple[tuple[str, str], ...] = ()
+
+
+def slug(heading: str) -> str:
+    """The anchor GitHub gives a heading: lower case, every character but
+    letters, digits, spaces, ``-`` and ``_`` dropped, spaces made ``-``."""
+    text = heading.strip().lower()
+    return "".join("-" if ch == " " else ch for ch in text
+                   if ch.isalnum() or ch in " -_")
 
 
 def fmt(x, sig: int = 4) -> str:

@@ -101,7 +101,7 @@ def render_report(ev, rendered: Rendered, figdir: str, solver: str | None
     d = ev.design
     head = f"# {d.title}\n\nDesign `{d.path}` (kind `{d.kind}`), from {d.source}."
     body = [s.replace("{figdir}", figdir) for s in rendered.sections]
-    parts = [head, findings_section(ev.claims), *body,
+    parts = [head, findings_section(ev.claims, rendered.anchors), *body,
              "## Claims\n\n" + verdict_summary(ev.claims) + ".\n\n" + claims_table(ev.claims),
              provenance(solver)]
     return github_math("\n\n".join(parts).rstrip() + "\n"), rendered.figures
