@@ -41,6 +41,8 @@ class Finding:
         The statement.
     evidence : str
         One line of evidence (Markdown), with a link to where it is shown.
+    why : str
+        Why the severity (shown in the report's table, not in the index).
     """
 
     id: str
@@ -49,6 +51,7 @@ class Finding:
     label: str
     what: str
     evidence: str
+    why: str = ""
 
 
 @dataclass(frozen=True)
@@ -146,9 +149,9 @@ def _counts(d: dict[str, int]) -> str:
     return ", ".join(f"{n} {s}" for s, n in d.items()) or "none"
 
 
-def render_findings(s: Summary, labels: Labels = DESIGN) -> str:
-    """``## Findings``: the verdict, the counts and every finding (most
-    severe first) with one line of evidence."""
+def render_findings(s: Summary, labels: Labels = DESIGN, notes: tuple[str, ...] = ()) -> str:
+    """``## Findings``: the verdict, the counts (and ``notes``, more bullet
+    lines) and every finding (most severe first) with one line of evidence."""
     if not s.claims:
         return f"## Findings\n\n_This design states no {labels.items}._"
     if s.not_ok:
@@ -161,9 +164,11 @@ def render_findings(s: Summary, labels: Labels = DESIGN) -> str:
              f"{_counts(s.by_severity('paper'))}."]
     if labels.workbench:
         lines.append(f"- {labels.workbench}: {_counts(s.by_severity('workbench'))}.")
+    lines += notes
     body = "\n".join(lines)
     if s.findings:
-        rows = [[f"**{f.severity or NOT_ASSESSED}**", f"{f.label}: {f.what}", f.evidence]
+        rows = [[f"**{f.severity or NOT_ASSESSED}**",
+                 f"{f.label}: {f.what}" + (f" {f.why}" if f.why else ""), f.evidence]
                 for f in s.findings]
         body += ("\n\n" + md_table(["severity", "finding", f"evidence (see {labels.details})"],
                                    rows, "lll"))
