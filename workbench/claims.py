@@ -20,9 +20,11 @@ A claim in a design file::
     origin = "paper"          # "paper" | "workbench" (default: from `source`)
 
 A ``description`` or ``reason`` never types a measured number: it names it,
-``{quantity}`` or ``{quantity:N}`` (N significant digits, default 4), and
-the field is filled from the design's results when the claim is evaluated
-(:func:`fill_claim`); a field naming no quantity of the design is bad input.
+``{quantity}`` or ``{quantity:N}`` (N significant digits, default 4;
+``{quantity:N%}`` prints 100 x the value, for a fraction written in per
+cent), and the field is filled from the design's results when the claim is
+evaluated (:func:`fill_claim`); a field naming no quantity of the design is
+bad input. ``tests/test_typed_numbers.py`` states what a text may type.
 
 Severities form a closed set, mildest first (:data:`SEVERITIES`):
 
@@ -152,14 +154,19 @@ def _json_value(v):
 
 
 _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.=+-]*$")
-#: A template field of a claim's text: ``{quantity}`` or ``{quantity:N}``.
-TEMPLATE_FIELD = re.compile(r"\{([^{}:]+)(?::(\d+))?\}")
+#: A template field of a claim's text: ``{quantity}``, ``{quantity:N}`` or ``{quantity:N%}``.
+TEMPLATE_FIELD = re.compile(r"\{([^{}:]+)(?::(\d+)?(%)?)?\}")
 
 
 def fill_text(text: str, quantities: dict, fmt) -> str:
-    """``text`` with each ``{quantity:N}`` replaced by ``fmt(value, N)``."""
-    return TEMPLATE_FIELD.sub(
-        lambda m: fmt(quantities.get(m[1].strip()), int(m[2] or 4)), text)
+    """``text`` with each ``{quantity:N}`` replaced by ``fmt(value, N)``
+    (``{quantity:N%}``: by ``fmt(100 value, N)``)."""
+    def one(m):
+        v = quantities.get(m[1].strip())
+        if m[3] and isinstance(v, (int, float)) and not isinstance(v, bool):
+            v = 100 * v
+        return fmt(v, int(m[2] or 4))
+    return TEMPLATE_FIELD.sub(one, text)
 
 
 def fill_claim(claim: Claim, quantities: dict, fmt) -> Claim:
@@ -173,12 +180,13 @@ def fill_claim(claim: Claim, quantities: dict, fmt) -> Claim:
 def _check_fields(r: Reader, key: str, text: str, names: set[str]) -> None:
     for m in TEMPLATE_FIELD.finditer(text):
         if m[1].strip() not in names:
-            raise r.fail(key, m[0], "template fields {quantity} or {quantity:N} naming a "
-                         "quantity this design computes")
+            raise r.fail(key, m[0], "template fields {quantity}, {quantity:N} or "
+                         "{quantity:N%} naming a quantity this design computes")
         if m[2] is not None and not 1 <= int(m[2]) <= 12:
             raise r.fail(key, m[0], "N from 1 to 12 significant digits in {quantity:N}")
     if "{" in TEMPLATE_FIELD.sub("", text) or "}" in TEMPLATE_FIELD.sub("", text):
-        raise r.fail(key, text, "braces only around template fields {quantity} or {quantity:N}")
+        raise r.fail(key, text, "braces only around template fields {quantity}, "
+                     "{quantity:N} or {quantity:N%}")
 
 
 def parse_claims(root: Reader, study, spec) -> list[Claim]:

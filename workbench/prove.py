@@ -19,6 +19,7 @@ from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
 
+from .claims import ROUNDING_RTOL
 from .errors import DesignError
 from .report.findings import Finding, Labels, Summary, index_row, ordered, render_findings
 from .report.markdown import fmt, md_table, slug
@@ -145,7 +146,6 @@ def rounding_holds(r: ProofResult) -> bool:
     """A ``rounding`` erratum is checked as on a design claim: the exact
     value lies within :data:`workbench.claims.ROUNDING_RTOL` of the printed
     one (every other severity, or none, is not checked: True)."""
-    from .claims import ROUNDING_RTOL
     c = r.claim
     if c.severity != "rounding" or r.counterexample is None:
         return True
@@ -276,7 +276,8 @@ def _claim_section(module: ProofModule, r: ProofResult) -> str:
         lines += ["", f"**Severity: {c.severity}** — {c.severity_reason}" if c.severity else
                   "**Severity: not assessed.**"]
         if not r.severity_holds:
-            lines[-1] += " **Not a rounding: more than 0.1 % off.**"
+            lines[-1] += (f" **Not a rounding: more than {fmt(100 * ROUNDING_RTOL)} % "
+                          "off.**")
     if c.note:
         lines += ["", f"> {c.note}"]
     marks = {True: "✓", False: "✗", None: "—"}

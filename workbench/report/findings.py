@@ -12,6 +12,7 @@ are the two for a design's claims.
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 from ..claims import SEVERITIES, ClaimResult, Verdict
@@ -114,10 +115,11 @@ def ordered(findings) -> tuple[Finding, ...]:
 
 
 def section_link(quantity: str, anchors) -> str:
-    """``[heading](#slug)`` of the first section whose quantity prefix starts
-    ``quantity`` (``anchors``: (prefix, heading) pairs), or "" for none."""
-    for prefix, heading in anchors:
-        if quantity.startswith(prefix):
+    """``[heading](#slug)`` of the first section whose pattern matches the
+    start of ``quantity`` (``anchors``: (regular expression, heading)
+    pairs; a plain prefix is a pattern too), or "" for none."""
+    for pattern, heading in anchors:
+        if re.match(pattern, quantity):
             return f"[{heading}](#{slug(heading)})"
     return ""
 

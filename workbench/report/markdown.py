@@ -36,8 +36,9 @@ class Figure:
 class Rendered:
     """Markdown sections (each starting with a ``## `` heading) and figures.
 
-    ``anchors``: (quantity prefix, section heading) pairs; a finding whose
-    claim names a quantity with that prefix links to that section.
+    ``anchors``: (pattern, section heading) pairs; a finding whose claim
+    names a quantity whose start matches the pattern (a regular expression,
+    :func:`re.match`) links to that section.
     """
 
     sections: tuple[str, ...]

@@ -7,6 +7,7 @@ import numpy as np
 
 from ..report.markdown import fmt, md_table
 from ..roa.render import fmt_level, render_basin_markdown
+from .antiskid_basin import LAM_DIVERGED
 
 _FATE_COLOR = {"converges": "tab:green", "diverges": "tab:red", "undecided": "0.6"}
 _SWITCH_MARK = {"CERTIFIED": "o", "REFUTED": "X", "INCONCLUSIVE": "s"}
@@ -23,12 +24,16 @@ def render_basin_result(res, *, rail: str) -> str:
     return text
 
 
+#: Heading of the basin section (findings on switch and basin quantities link here).
+HEADING = ("Regions of attraction: does each switch land in the basin of the law that "
+           "takes over?")
+
+
 def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—") -> str:
     """The report section: loop, certified bracket, switch verdicts, k2 rule."""
     K = "[" + ", ".join(fmt(k, 4) for k in basin.K) + "]"
     head = (
-        "## Regions of attraction: does each switch land in the basin of the law that "
-        "takes over?\n\n"
+        f"## {HEADING}\n\n"
         f"Cruise law (61) with K = {K} on {rail} rail, at (v_d, lambda_d) = "
         f"({fmt(basin.v_d)} m/s, {fmt(basin.lambda_d, 4)}). The loop is the **delay-free** "
         "loop under exact prediction (as paper 003's Theorems 2-3 argue for laws (64) and "
@@ -49,8 +54,8 @@ def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—"
           + "\n\nCERTIFIED: V at the state is below c_certified, so the delay-free loop "
             "converges from it. REFUTED: its level holds a point with V' >= 0, so this V "
             "cannot certify it; the last column says what the delay-free trajectory does "
-            "(\"diverges\": lambda reaches 0.9, the wheel spins). The cruise → braking switch "
-            "hands over to law (69), which tracks a time-varying creep speed: it has no "
+            f"(\"diverges\": |lambda| reaches {fmt(LAM_DIVERGED)}, the wheel spins). The "
+            "cruise → braking switch hands over to law (69), which tracks a time-varying creep speed: it has no "
             "equilibrium basin; see the phase-switch section for its domain check.\n")
     return head + body + sw + (_k2_text(sweep, compare_source) if sweep is not None else "")
 

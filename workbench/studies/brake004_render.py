@@ -17,7 +17,7 @@ def _worked_section(res, spec) -> str:
     _, distance, degraded, share = worked_formulas()
     w = res.worked
     rows = [["d1: 50 km/h at a_full, v as printed", fmt(w["d1"], 8), "m"],
-            ["d1 from exact 50 km/h (13.889 m/s)", fmt(w["d1_exact_speed"], 8), "m"],
+            [f"d1 from exact 50 km/h ({fmt(50 / 3.6, 5)} m/s)", fmt(w["d1_exact_speed"], 8), "m"],
             ["a2: -15 % force, 15 ‰ down-grade", fmt(w["a2"], 6), "m/s²"],
             ["d2 at a2", fmt(w["d2"], 8), "m"],
             ["d2 − d1", fmt(w["delta"], 6), "m"],
@@ -68,7 +68,7 @@ def render(design, res) -> Rendered:
                 if r.mode == "closed" and r.channel == "analogue" and r.fault == "healthy"
                 and r.electric) // max(len(res.distance), 1)
     sections.append(
-        "## Error grid: stop error against the ±0.3 m window\n\n"
+        f"## Error grid: stop error against the ±{fmt(res.tolerance)} m window\n\n"
         + md_table(["km/h", "mode", "channel", "max |error| (m)", "corners outside ±"
                     f"{fmt(res.tolerance)} m", "of them feasible"], rows, "rllrrr")
         + f"\n\n*Feasible*: full service applied from the first instant stops at least "

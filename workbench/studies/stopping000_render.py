@@ -11,6 +11,9 @@ from .stopping000 import CONTROLLERS, UNCERTAIN, within_rate
 LABEL = {"pid": "PID", "smc": "SMC", "smarc": "SMARC", "smarc-sgn": "SMARC (sgn)"}
 
 
+#: Stop window of the accuracy table and figure (m): the usual platform-screen-door tolerance.
+STOP_WINDOW_M = 0.3
+
 def model_section() -> str:
     """The brake model of paper 000 rendered from the sympy source."""
     m = brake_model()
@@ -138,12 +141,13 @@ def _within_section(res) -> str:
     """P(|e| <= 30 cm) per controller over all sections, Wilson 95 % interval."""
     rows = []
     for c in CONTROLLERS:
-        k, n, p, lo, hi = within_rate(_errors(res, c), 30.0)
+        k, n, p, lo, hi = within_rate(_errors(res, c), 100 * STOP_WINDOW_M)
         rows.append([LABEL[c], f"{k} / {n}", fmt(p, 3), f"[{fmt(lo, 3)}, {fmt(hi, 3)}]",
                      fmt(float(np.percentile(np.abs(_errors(res, c)), 95)), 3)])
-    return ("**Stops within ±0.3 m** (the usual platform-screen-door tolerance), over all "
+    w = fmt(STOP_WINDOW_M)
+    return (f"**Stops within ±{w} m** (the usual platform-screen-door tolerance), over all "
             "sections and repeats, with the Wilson 95 % interval of the proportion:\n\n"
-            + md_table(["controller", "stops within 0.3 m", "P(|e| <= 0.3 m)", "95 % interval",
+            + md_table(["controller", f"stops within {w} m", f"P(|e| <= {w} m)", "95 % interval",
                         "95th percentile of |e| (cm)"], rows, "lrrrr")
             + "\n\n![stop error distribution]({figdir}/stop-error-cdf.png)")
 
@@ -154,7 +158,7 @@ def _plot_cdf(fig, res):
         e = np.sort(np.abs(_errors(res, c)))
         ax.step(e, np.arange(1, len(e) + 1) / len(e), where="post", color=f"C{k}",
                 label=LABEL[c])
-    ax.axvline(30.0, color="k", ls="--", lw=0.8, label="0.3 m")
+    ax.axvline(100 * STOP_WINDOW_M, color="k", ls="--", lw=0.8, label=f"{fmt(STOP_WINDOW_M)} m")
     ax.set_xscale("symlog", linthresh=1.0)
     ax.set_xlabel("|stop error| (cm)")
     ax.set_ylabel("fraction of stops")
