@@ -6,8 +6,11 @@ boxes of the interval cover and the time of the falsifier + verifier
 interval functions). Target (issue 15): a 2-state model within 30 s on 2 cores.
 
 Models: x' = -x + x^3, y' = -y (basin |x| < 1); Van der Pol in reversed
-time; paper 003's cruise loop (law 61, dry and wet designs) when the study
-module is present.
+time; paper 003's cruise loop (law 61, dry and wet designs); the delay-free
+loop of the delay-feedback design wheel-slip-burckhardt (2 states, Burckhardt
+adhesion; its report's canonical gain), the certificate alone and the whole
+basin section (certificate, sampled trajectories and the check from the
+certified level's boundary).
 
 Usage: .venv/bin/python benchmarks/basin.py
 """
@@ -56,6 +59,39 @@ def main() -> None:
             wall, cpu = time.perf_counter() - t0, time.process_time() - c0
             print(f"| 003 cruise law (61), {rail}, w = 100, {label} | {est.c_certified:.6g} | "
                   f"{est.c_refuted:.6g} | {est.boxes} | {est.samples} | {wall:.2f} | {cpu:.2f} |")
+    _delay_feedback()
+
+
+def _delay_feedback() -> None:
+    """wheel-slip-burckhardt-delay-feedback: certificate and basin section."""
+    from pathlib import Path
+
+    from workbench.design import load_design
+    from workbench.studies.delay_feedback_basin import delay_feedback_basin, run_basin
+    from workbench.studies.delay_feedback_model import PlantModel, solve_operating_point
+    path = (Path(__file__).resolve().parents[1] / "designs"
+            / "wheel-slip-burckhardt-delay-feedback.toml")
+    spec = load_design(path).spec
+    K = [[-0.03668, 0.00772]]          # reports/wheel-slip-burckhardt-delay-feedback.md
+    values = spec.plant.values()
+    dom = spec.basin.domain
+    box = ([dom["omega"][0], dom["T"][0]], [dom["omega"][1], dom["T"][1]])
+    for label in ("first (model built)", "second (model built again)"):
+        t0, c0 = time.perf_counter(), time.process_time()
+        model = PlantModel(spec.plant)
+        op = solve_operating_point(model, values)
+        est = delay_feedback_basin(model, values, op, K, c_search=float("inf"), domain=box).estimate
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+        print(f"| wheel-slip delay-free loop, certificate, {label} | {est.c_certified:.6g} | "
+              f"{est.c_refuted:.6g} | {est.boxes} | {est.samples} | {wall:.2f} | {cpu:.2f} |")
+    t0, c0 = time.perf_counter(), time.process_time()
+    b = run_basin(spec.basin, spec, model, values, op, K)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    est = b.check.estimate
+    print(f"| wheel-slip, whole basin section (+ {len(b.sampled) + len(b.inside)} trajectories) | "
+          f"{est.c_certified:.6g} | {est.c_refuted:.6g} | {est.boxes} | {est.samples} | "
+          f"{wall:.2f} | {cpu:.2f} |")
+
 
 if __name__ == "__main__":
     main()

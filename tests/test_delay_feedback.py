@@ -121,7 +121,7 @@ def test_template_runs_as_written(tmp_path, monkeypatch, capsys):
     capsys.readouterr()
     assert main(["verify", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "3 of 3 claims ok" in out
+    assert "4 of 4 claims ok" in out
     assert main(["simulate", str(path), "--dt", "0.1"]) == 0
     out = capsys.readouterr().out
     assert "final_error.x1" in out

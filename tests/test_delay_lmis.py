@@ -222,7 +222,8 @@ def test_robust_synthesis_is_sound_at_every_point():
     from workbench.lmi.robust import synthesize_robust
     # two double-integrator-like points with different input gains (synthetic)
     pts = [(np.array([[0.0, 1.0], [0.0, -0.5]]), np.array([[0.0], [b]])) for b in (0.8, 1.2)]
-    syn = synthesize_robust(pts, eps_grid=(0.3, 1.0, 3.0), golden_steps=1, rel_tol=1e-2)
+    syn = synthesize_robust(pts, eps_grid=(0.3, 1.0, 3.0), golden_steps=1, rel_tol=1e-2,
+                            h_hi=10.0)
     assert syn.bracket.outcome is Outcome.CERTIFIED and syn.K is not None
     for c in check_gain(pts, syn.K, N=2):
         assert c.stable_at_zero

@@ -23,6 +23,7 @@ from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 from workbench.lmi.analysis import certified_delay, make_criterion
+from workbench.lmi.core import Outcome
 from workbench.lmi.interval import certified_interval
 from workbench.margins import delay_margin_sweep
 
@@ -93,3 +94,106 @@ def test_interval_search_scales_with_time(c):
     lo, hi = window(*POCKET, 1.0)
     lo_c, hi_c = window(c * POCKET[0], c * POCKET[1], c)
     assert abs(lo_c * c / lo - 1) <= 3e-3 and abs(hi_c * c / hi - 1) <= 3e-3
+
+
+#: Search settings an LMI function may not default to a number of seconds: the
+#: range of a delay search and the descriptor method's eps grid are times, so a
+#: numeric default would make the answer depend on the caller's time unit.
+TIME_PARAMETERS = {"h_lo", "h_hi", "h_max", "h_min", "eps_grid"}
+
+
+def _public_functions():
+    import importlib
+    import inspect
+    import pkgutil
+
+    import workbench.lmi
+    names = ["workbench.crosscheck"] + [
+        f"workbench.lmi.{m.name}" for m in pkgutil.iter_modules(workbench.lmi.__path__)]
+    for name in names:
+        mod = importlib.import_module(name)
+        for fname, f in vars(mod).items():
+            if inspect.isfunction(f) and f.__module__ == name and not fname.startswith("_"):
+                yield f"{name}.{fname}", f
+            if inspect.isclass(f) and f.__module__ == name:
+                for mname, m in vars(f).items():
+                    if inspect.isfunction(m) and not mname.startswith("_"):
+                        yield f"{name}.{fname}.{mname}", m
+
+
+def test_no_absolute_time_defaults_in_lmi():
+    """No public LMI function defaults a delay range or eps grid to seconds
+    (issue 21: "no tolerance in margins.py or lmi/ is absolute"); they are
+    required, None (derived from the system's time scale or the cap), or
+    relative. The check sees every public function and method of ``lmi/``."""
+    import inspect
+    seen, bad = 0, []
+    for name, f in _public_functions():
+        for p in inspect.signature(f).parameters.values():
+            if p.name in TIME_PARAMETERS:
+                seen += 1
+                if p.default is not inspect.Parameter.empty and p.default is not None:
+                    bad.append(f"{name}({p.name}={p.default!r})")
+    assert seen >= 10            # the scan does see the search functions
+    assert not bad, bad
+
+
+def test_absolute_default_scan_can_fail():
+    import inspect
+
+    def searcher(A, *, h_hi: float = 100.0):
+        return A
+    p = inspect.signature(searcher).parameters["h_hi"]
+    assert p.name in TIME_PARAMETERS and p.default not in (inspect.Parameter.empty, None)
+
+
+#: Known defect (issue 21, open): the Wirtinger synthesis of x' = x + u(t - h)
+#: written in milliseconds (c = 1e-3, cap 1e4) certifies 336 instead of 996 ms.
+#: Writing its blocks in a power-of-two time unit taken from the cap fixes
+#: that, but then the minimum-norm canonical point of the shipped
+#: train-brake-lag design fails its re-check at every fraction tried; the
+#: unit is used for the time-varying-delay LMIs only, until that is solved.
+SYNTHESIS_UNIT_DEFECT = pytest.mark.xfail(
+    strict=True, reason="synthesis LMIs are not yet written in the system's time unit")
+
+
+@pytest.mark.parametrize("c", [pytest.param(c, marks=SYNTHESIS_UNIT_DEFECT) for c in (1e-3, 1e3)])
+def test_synthesis_scales_with_time(c):
+    """Wirtinger synthesis of x' = x + u(t - h) in another time unit: (c A, c B)
+    with the cap h_max / c (the default eps grid follows the cap) gives the
+    same gain K (u = K x(t - h) is dimensionless here) and h / c."""
+    from workbench.lmi.tight_synthesis import synthesize_tight
+    A, B = np.array([[1.0]]), np.array([[1.0]])
+    r1 = synthesize_tight(A, B, h_max=10.0)
+    rc = synthesize_tight(c * A, c * B, h_max=10.0 / c)
+    assert _close(r1.bracket.h_certified, c * rc.bracket.h_certified)
+    assert r1.K is not None and rc.K is not None
+    assert np.allclose(rc.K, r1.K, rtol=2e-3)
+    assert _close(r1.gain.h_certified, c * rc.gain.h_certified)
+
+
+@pytest.mark.parametrize("c", [pytest.param(c, marks=SYNTHESIS_UNIT_DEFECT) for c in (1e-4, 1e4)])
+def test_robust_synthesis_scales_with_time(c):
+    """The polytopic (descriptor) synthesis with a decay rate: (c A_i, c B_i),
+    cap h_hi / c and rate c alpha give the same K and h / c."""
+    from workbench.lmi.robust import synthesize_robust
+    pts = [(np.array([[0.0, 1.0], [0.0, -0.5]]), np.array([[0.0], [b]])) for b in (0.8, 1.2)]
+    kw = dict(golden_steps=1, rel_tol=1e-3)
+    r1 = synthesize_robust(pts, h_hi=10.0, alpha=0.05, **kw)
+    rc = synthesize_robust([(c * A, c * B) for A, B in pts], h_hi=10.0 / c, alpha=0.05 * c, **kw)
+    assert r1.K is not None and rc.K is not None
+    assert abs(r1.bracket.h_certified / (c * rc.bracket.h_certified) - 1) <= 3e-3
+    assert np.allclose(rc.K, r1.K, rtol=5e-3)
+
+
+@pytest.mark.parametrize("c", [1e-4, 1e4])
+def test_varying_delay_certificate_scales_with_time(c):
+    """The interval certificate for a time-varying delay (h in [0, h2],
+    |h'| <= 0.3): (c A, c A_d) gives h2 / c. Before its blocks were written in
+    the system's own time unit, c = 1e-4 certified 17 times less."""
+    from workbench.lmi.varying import certified_varying_delay
+    A = np.array([[-2.0, 0.0], [0.0, -0.9]])
+    Ad = np.array([[-1.0, 0.0], [-1.0, -1.0]])
+    h = certified_varying_delay(A, Ad, mu=0.3, rel_tol=REL_TOL, h_hi=20.0).h2
+    hc = certified_varying_delay(c * A, c * Ad, mu=0.3, rel_tol=REL_TOL, h_hi=20.0 / c).h2
+    assert h > 0 and _close(h, c * hc), (h, c * hc)

@@ -10,7 +10,8 @@ from workbench.controllers.ntsm import (NTSMGains, convergence_time, ntsm_force,
 from workbench.design import load_design
 from workbench.errors import DesignError
 from workbench.plants.platoon001 import TrainParams, external_force, perturbed
-from workbench.sim.tracking import Route, simulate_platoon
+from workbench.sim.platoon import simulate_platoon
+from workbench.sim.tracking import Route
 
 DESIGN = Path("designs/platoon-ntsm-001.toml")
 G = NTSMGains(beta=0.2, a=5, b=7, j=3.0, k=3.0, alpha=3, xi=5)
@@ -114,6 +115,23 @@ def test_platoon_initial_error_converges_near_eq22():
     ("initial_errors = [3.0, 2.0, 1.0]", "initial_errors = [3.0, 2.0]",
      "convergence.initial_errors"),
     ('T = { value = 0.01, unit = "s"', 'T = { value = 0.5, unit = "s"', "platoon.T.value"),
+    # the realistic scenario (tests/test_platoon_realism.py)
+    ('jitter = "exponential"', 'jitter = "gaussian"', "v2v.jitter"),
+    ("loss = 0.05 ", "loss = 1.5 ", "v2v.loss"),
+    ('period = { value = 0.1,', 'period = { value = 0.015,', "v2v.period"),
+    ('own_state = "current"', 'own_state = "later"', "v2v.own_state"),
+    ("seed = 2\n", "seed = 2.5\n", "v2v.seed"),
+    ('lag = { value = 0.65, unit = "s"', 'lag = { value = -0.65, unit = "s"',
+     "actuator.lag.value"),
+    ('brake = { value = 1.2, unit = "m/s^2"', 'brake = { value = 1.2, unit = "m/s2"',
+     "actuator.brake.unit"),
+    ("[actuator]   # every train, the leader included\n",
+     "[actuator]   # every train, the leader included\nlagg = 1.0\n", "actuator.lagg"),
+    ('time = { value = 100.0, unit = "s"', 'time = { value = 500.0, unit = "s"',
+     "emergency.time"),
+    ('margin = { value = 10.0, unit = "m"', 'margin = { value = "ten", unit = "m"',
+     "emergency.margin.value"),
+    ("[pd_ff]  #", "[pd_ff_gains]  #", "pd_ff"),
 ])
 def test_bad_designs_name_the_key(tmp_path, old, new, key):
     text = DESIGN.read_text()

@@ -103,3 +103,39 @@ def test_delay_feedback_design_gets_a_basin():
     est = chk.estimate
     assert 0 < est.c_certified <= est.c_refuted
     assert chk.points[0].verdict.outcome is LevelOutcome.CERTIFIED
+
+
+def test_brake_switch_at_lambda_d_is_in_no_basin_and_spins():
+    """Cruise -> braking (law 69) at t_brake, dry rail: the state (v_d, lambda_d)
+    of the compensated run (reports/antiskid-run-dry.md) lies in the basin of
+    no equilibrium of the frozen loop (lambda' > 0 proven up to 0.9), and the
+    time-varying delay-free loop spins the wheel too."""
+    from workbench.controllers.antiskid003_settings import CreepSpeedProfile
+    from workbench.studies.antiskid_basin_brake import brake_switch
+    from workbench.studies.antiskid_basin_render import brake_text
+    b = brake_switch(DRY, "compensated", (70.0126, 0.01954),
+                     profile=CreepSpeedProfile(t_brake=300.0), k_de=10.0)
+    assert b.outcome is LevelOutcome.REFUTED and b.why == "no equilibrium up to spin"
+    assert b.rate > 0 and b.fate == "diverges" and 0 < b.t_fate < 0.1
+    text = brake_text([b])
+    assert "frozen at the switch instant" in text and "| REFUTED |" in text
+
+
+def test_brake_switch_on_the_braking_side_is_certified():
+    """Frozen 1 s after t_brake (v_s* < 0: equilibrium on the braking side), a
+    state at lambda = -0.01 reaches the certified level set of the equilibrium;
+    the time-varying delay-free loop (no frozen assumption) tracks."""
+    from workbench.controllers.antiskid003_settings import CreepSpeedProfile
+    from workbench.studies.antiskid_basin_brake import brake_switch
+    b = brake_switch(DRY, "later", (69.0, -0.01), profile=CreepSpeedProfile(t_brake=300.0),
+                     k_de=10.0, t=301.0)
+    assert b.outcome is LevelOutcome.CERTIFIED and b.lam_star < 0 and b.fate == "tracks"
+    # the frozen equilibrium is the law's own: k_de (v lambda - v_s*) = -lambda z1
+    assert abs(b.lam_star - b.vs_frozen / b.v) < 0.1 * abs(b.lam_star)
+
+
+def test_brake_switch_claims_are_known_quantities():
+    from workbench.design import load_design
+    d = load_design("designs/antiskid-run-dry.toml")
+    ids = {c.id: c for c in d.claims}
+    assert ids["switch-brake-outside-basin"].quantity == "switch.brake[compensated].in_basin"

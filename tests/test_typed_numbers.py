@@ -163,6 +163,8 @@ RENDERER_CONSTANTS = {
         "the deceleration paper 004 printed (its rounding is the finding)",
     ("stopping000_render.py", "3.2"): "section number of paper 000",
     ("stopping000_render.py", "85.16"): "K1/K2 as paper 000's Table 1 prints it",
+    ("delay_feedback_basin_render.py", "0.6"): "a matplotlib grey level, not text",
+    ("platoon001_realism_render.py", "1e-9"): "display floor of a printed relative difference",
 }
 
 
@@ -198,3 +200,12 @@ def test_the_prose_rule_fails_on_a_typed_number(tmp_path):
     f.write_text('"""Doc 0.5 is fine."""\ntext = "the dip decays with time constant 84.2 s"\n'
                  'ok = f"rate {fmt(x)} s"\n')
     assert renderer_numbers(f) == [("84.2", 2)]
+
+
+def test_template_fields_fill_and_escape():
+    from workbench.claims import fill_text
+    from workbench.report.markdown import fmt
+    q = {"cases[paper].t_diverged": 31.4372, "sensitivity.oat.rho": 0.0779, "none": None}
+    text = ("at t = {cases[paper].t_diverged:4} s, rho {sensitivity.oat.rho:2%} %, "
+            "{none}, the ellipsoid {{V <= c}}")
+    assert fill_text(text, q, fmt) == "at t = 31.44 s, rho 7.8 %, —, the ellipsoid {V <= c}"

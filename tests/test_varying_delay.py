@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from workbench.lmi.core import Outcome
+from workbench.lmi.scaling import time_unit
 from workbench.lmi.varying import VaryingDelayLMI, certified_varying_delay
 from workbench.margins import delay_margin_eig
 from workbench.sim.varying_delay import (simulate_varying_delay, switching_delay,
@@ -273,7 +274,8 @@ def test_synthesis_refuted_side(scalar_synthesis):
     from workbench.lmi.varying_synthesis import VaryingDelaySynthesis
     r = scalar_synthesis
     Tinv = np.diag(1.0 / np.diag(r.T))
-    lmi = VaryingDelaySynthesis(Tinv @ SCALAR[0] @ r.T, Tinv @ SCALAR[1], r.eps, mu=r.mu)
+    lmi = VaryingDelaySynthesis(Tinv @ SCALAR[0] @ r.T, Tinv @ SCALAR[1], r.eps, mu=r.mu,
+                                unit=time_unit(r.h_max))
     assert lmi.solve_at(r.h2).outcome is Outcome.CERTIFIED
     assert lmi.solve_at(r.bracket.h_refuted).outcome is Outcome.REFUTED
 

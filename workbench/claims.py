@@ -24,7 +24,7 @@ A ``description`` or ``reason`` never types a measured number: it names it,
 ``{quantity:N%}`` prints 100 x the value, for a fraction written in per
 cent), and the field is filled from the design's results when the claim is
 evaluated (:func:`fill_claim`); a field naming no quantity of the design is
-bad input. ``tests/test_typed_numbers.py`` states what a text may type.
+bad input. ``{{`` and ``}}`` write a brace (``{{V <= c}}``). ``tests/test_typed_numbers.py`` states what a text may type.
 
 Severities form a closed set, mildest first (:data:`SEVERITIES`):
 
@@ -154,14 +154,17 @@ def _json_value(v):
 
 
 _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.=+-]*$")
-#: A template field of a claim's text: ``{quantity}``, ``{quantity:N}`` or ``{quantity:N%}``.
-TEMPLATE_FIELD = re.compile(r"\{([^{}:]+)(?::(\d+)?(%)?)?\}")
+#: A template field of a claim's text: ``{quantity}``, ``{quantity:N}`` or ``{quantity:N%}``;
+#: ``{{`` and ``}}`` are escaped braces (no group matched).
+TEMPLATE_FIELD = re.compile(r"\{\{|\}\}|\{([^{}:]+)(?::(\d+)?(%)?)?\}")
 
 
 def fill_text(text: str, quantities: dict, fmt) -> str:
     """``text`` with each ``{quantity:N}`` replaced by ``fmt(value, N)``
     (``{quantity:N%}``: by ``fmt(100 value, N)``)."""
     def one(m):
+        if m[1] is None:
+            return m[0][0]
         v = quantities.get(m[1].strip())
         if m[3] and isinstance(v, (int, float)) and not isinstance(v, bool):
             v = 100 * v
@@ -179,6 +182,8 @@ def fill_claim(claim: Claim, quantities: dict, fmt) -> Claim:
 
 def _check_fields(r: Reader, key: str, text: str, names: set[str]) -> None:
     for m in TEMPLATE_FIELD.finditer(text):
+        if m[1] is None:
+            continue
         if m[1].strip() not in names:
             raise r.fail(key, m[0], "template fields {quantity}, {quantity:N} or "
                          "{quantity:N%} naming a quantity this design computes")
@@ -186,7 +191,7 @@ def _check_fields(r: Reader, key: str, text: str, names: set[str]) -> None:
             raise r.fail(key, m[0], "N from 1 to 12 significant digits in {quantity:N}")
     if "{" in TEMPLATE_FIELD.sub("", text) or "}" in TEMPLATE_FIELD.sub("", text):
         raise r.fail(key, text, "braces only around template fields {quantity}, "
-                     "{quantity:N} or {quantity:N%}")
+                     "{quantity:N} or {quantity:N%} ({{ and }} for a brace)")
 
 
 def parse_claims(root: Reader, study, spec) -> list[Claim]:

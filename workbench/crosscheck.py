@@ -48,7 +48,7 @@ class PointCheck:
 
 
 def check_gain(points, K, *, N: int = 2, margin: float = DEFAULT_MARGIN,
-               rel_tol: float = 1e-4, h_hi: float = 100.0) -> tuple[PointCheck, ...]:
+               rel_tol: float = 1e-4, h_hi: float | None = None) -> tuple[PointCheck, ...]:
     """Check a given K at every point: exact margin and certified BL bound.
 
     Parameters
@@ -99,7 +99,7 @@ class TightCheck:
 
 
 def check_tight(A, B, K, *, N: int = 2, margin: float = DEFAULT_MARGIN,
-                h_hi: float = 10.0) -> TightCheck:
+                h_hi: float | None = None) -> TightCheck:
     """:func:`check_gain` at one point plus the single-input exact margin."""
     B = np.asarray(B, float).reshape(np.shape(A)[0], -1)
     (check,) = check_gain([(A, B)], K, N=N, margin=margin, h_hi=h_hi)
@@ -122,7 +122,7 @@ class DecayRate:
 
 
 def decay_rate_bound(A, Ad, alpha: float, *, N: int = 2, margin: float = DEFAULT_MARGIN,
-                     rel_tol: float = 1e-4, h_hi: float = 10.0) -> DecayRate:
+                     rel_tol: float = 1e-4, h_hi: float | None = None) -> DecayRate:
     """Decay-rate certificate (:func:`~workbench.lmi.robust.decay_rate_bracket`)
     and the spectral abscissa of x' = A x + A_d x(t - h) at its delay."""
     br = decay_rate_bracket(A, Ad, alpha, N=N, margin=margin, rel_tol=rel_tol, h_hi=h_hi)

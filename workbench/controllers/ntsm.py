@@ -126,3 +126,26 @@ def pd_force(e, de, resist, m: float, kp: float, kd: float):
     the textbook string-unstable case for constant spacing.
     """
     return resist + m * (kp * e + kd * de)
+
+
+def pd_ff_force(e, de, resist, m: float, a_pred, kp: float, kd: float):
+    """PD with acceleration feed-forward u = u1 + m (kp e + kd e' + v'_{i-1}) (N).
+
+    The fair baseline for eq 13: the same information as the NTSM law (the
+    predecessor's communicated acceleration ``a_pred``, m/s^2, fed forward
+    as in u4), but linear feedback and no switching term.
+    """
+    return pd_force(e, de, resist, m, kp, kd) + m * a_pred
+
+
+def linear_member(g: NTSMGains) -> tuple[float, float]:
+    """Gains (k_e (1/s^2), k_d (1/s)) of the NTSM family's linear member.
+
+    With b = a and alpha = xi (every power 1) and without the switching term,
+    eqs 10-13 become the linear sliding-mode law on s = e + e'/beta with
+    s' = -(j + k) s, i.e. (u - u1)/m = v'_{i-1} + k_e e + k_d e' with
+    k_e = beta (j + k), k_d = beta + j + k. It is the surrogate the exact
+    delay margin is computed on: the law itself has no linearisation at
+    e = e' = 0 (powers 2 - b/a and alpha/xi below 1, and sign(s)).
+    """
+    return g.beta * (g.j + g.k), g.beta + g.j + g.k

@@ -322,7 +322,7 @@ class MarginLMI:
         return dataclasses.replace(step, t_opt=min(step.recheck.values()))
 
 
-def bisect_delay(decide: Callable[[float], Step], *, h_lo: float = 1e-4, h_hi: float = 100.0,
+def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
                  rel_tol: float = 1e-4, max_solves: int = 60, guess: float | None = None,
                  secant: bool = True) -> Bracket:
     """Bracketed bisection of a delay criterion (cf. cvxpy's ``bisection.py``).
@@ -343,8 +343,11 @@ def bisect_delay(decide: Callable[[float], Step], *, h_lo: float = 1e-4, h_hi: f
     decide : callable
         ``decide(h) -> Step``, e.g. :meth:`MarginLMI.solve_at`.
     h_lo, h_hi : float
-        Search range (s); ``h_hi`` certified means the bound is at least
-        ``h_hi`` (reported as the bracket ``[h_hi, inf]``).
+        Search range (s), 0 < h_lo < h_hi, required: the range is in the
+        system's own time unit, so there is no absolute default (callers derive
+        it from the system's time scale or from a design's cap). ``h_hi``
+        certified means the bound is at least ``h_hi`` (reported as the
+        bracket ``[h_hi, inf]``).
     rel_tol : float
         Relative width of the final bracket.
     max_solves : int
@@ -358,6 +361,8 @@ def bisect_delay(decide: Callable[[float], Step], *, h_lo: float = 1e-4, h_hi: f
     -------
     Bracket
     """
+    if not (0 < h_lo < h_hi < math.inf):
+        raise ValueError(f"h_lo = {h_lo!r} s, h_hi = {h_hi!r} s; expected 0 < h_lo < h_hi < inf")
     steps: list[Step] = []
     cert: Step | None = None
     lo, hi = 0.0, math.inf          # certified / first not-certified (for search)

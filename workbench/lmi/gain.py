@@ -40,6 +40,9 @@ from .core import Bracket, MarginLMI, Outcome, Step, bisect_delay
 DEFAULT_FRACTION = 0.99
 #: Significant digits of a canonical gain.
 DEFAULT_DIGITS = 4
+#: Lower end of the rounded gain's own bisection, as a fraction of the design
+#: delay (relative, so the search is the same in any time unit).
+ANALYSIS_FLOOR = 1e-4
 
 
 def round_significant(x: np.ndarray, digits: int) -> np.ndarray:
@@ -90,7 +93,7 @@ class CanonicalGain:
 
 def canonical_gain(lmi: MarginLMI, h_certified: float, fixed: Callable[[np.ndarray], MarginLMI],
                    T: np.ndarray, *, fraction: float = DEFAULT_FRACTION,
-                   digits: int = DEFAULT_DIGITS, h_lo: float = 1e-4, h_hi: float = 100.0,
+                   digits: int = DEFAULT_DIGITS, h_hi: float, h_lo: float | None = None,
                    rel_tol: float = 1e-4, max_solves: int = 60) -> CanonicalGain:
     """The well-posed gain of a synthesis LMI (see the module docstring).
 
@@ -111,7 +114,12 @@ def canonical_gain(lmi: MarginLMI, h_certified: float, fixed: Callable[[np.ndarr
         ``h_design = fraction * h_certified``, in (0, 1].
     digits : int
         Significant digits of K.
-    h_lo, h_hi, rel_tol, max_solves
+    h_hi : float
+        Search cap (s) of the fixed-gain analysis (the synthesis's own cap).
+    h_lo : float, optional
+        Lower end of that search (s); default :data:`ANALYSIS_FLOOR` times
+        the design delay (relative: no absolute default).
+    rel_tol, max_solves
         Bisection settings of the fixed-gain analysis.
 
     Returns
@@ -123,6 +131,7 @@ def canonical_gain(lmi: MarginLMI, h_certified: float, fixed: Callable[[np.ndarr
     if not h_certified > 0:
         raise ValueError(f"h_certified = {h_certified!r}; expected a positive delay (s)")
     h = fraction * h_certified
+    h_lo = ANALYSIS_FLOOR * h if h_lo is None else h_lo
     point = lmi.canonical_point(h)
     if point.outcome is not Outcome.CERTIFIED:
         return CanonicalGain(None, digits, h, point, None)

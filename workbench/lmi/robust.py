@@ -41,7 +41,29 @@ import numpy as np
 from .analysis import BesselLegendreLMI, certified_delay
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, bisect_delay
 from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
-from .scaling import balance_points
+from .delay_input import H_HI_SCALE, H_LO_SCALE
+from .scaling import balance_points, check_unit
+
+#: The eps-search bisections of a synthesis stop going down at this fraction
+#: of the search cap (relative: the search is the same in any time unit).
+SYNTHESIS_FLOOR = 1e-5
+#: Default eps grid of :func:`synthesize_robust`, in units of the cap ``h_hi``
+#: (eps of the descriptor method is a time: it scales with the delay range).
+ROBUST_EPS_GRID = (0.003, 0.01, 0.03, 0.1, 0.3)
+
+
+def eps_grid_for(grid: Sequence[float] | None, default: Sequence[float], h_cap: float
+                 ) -> tuple[float, ...]:
+    """The eps grid (s) of a synthesis: the given one, or ``default`` (in units
+    of the search cap) times ``h_cap``; ValueError on a non-positive entry."""
+    if isinstance(h_cap, bool) or not (isinstance(h_cap, (int, float, np.floating))
+                                       and 0 < h_cap < math.inf):
+        raise ValueError(f"h_max = {h_cap!r}; expected a positive finite delay cap (s)")
+    out = tuple(float(e) for e in grid) if grid is not None else tuple(
+        float(e) * float(h_cap) for e in default)
+    if not out or not all(0 < e < math.inf for e in out):
+        raise ValueError(f"eps_grid = {grid!r}; expected positive finite values (s)")
+    return out
 
 
 class DescriptorSynthesis(MarginLMI):
@@ -70,7 +92,8 @@ class DescriptorSynthesis(MarginLMI):
 
 
     def __init__(self, points: Sequence[tuple[np.ndarray, np.ndarray]], eps: float,
-                 alpha: float = 0.0, **kw):
+                 alpha: float = 0.0, *, unit: float = 1.0, **kw):
+        self.unit = check_unit(unit)
         if not alpha >= 0:
             raise ValueError(f"alpha = {alpha!r}; expected a non-negative rate (1/s)")
         self.alpha = float(alpha)
@@ -105,9 +128,11 @@ class DescriptorSynthesis(MarginLMI):
         return v
 
     def blocks(self, x, p, bmat):
-        Y, V, eps, h, iota = x["Y"], x["V"], p["eps"], p["h"], p["iota"]
+        u = self.unit                    # blocks in the time unit u (exact, see time_unit)
+        Y, V, eps, h, iota = x["Y"], x["V"], p["eps"] * (1 / u), p["h"] * (1 / u), p["iota"] * u
         out = []
         for i, (A, B) in enumerate(self.points):
+            A, B = A * u, B * u
             P, S, R = x[f"P{i}"], x[f"S{i}"], x[f"R{i}"]
             AY, BV = A @ Y, p["ealpha"] * (B @ V)
             lmi = bmat([[AY + AY.T + S - iota * R, P - Y + eps * AY.T, BV + iota * R],
@@ -216,7 +241,8 @@ def best_eps_bracket(lmi, eps_grid: Sequence[float], *, golden_steps: int, h_hi:
     def h_of(eps: float) -> float:
         lmi.set_eps(eps)
         guess = max((b.h_certified for b in tried.values()), default=0.0) or h_hi / 4
-        tried[eps] = bisect_delay(lmi.solve_at, h_lo=1e-4, h_hi=h_hi, rel_tol=rel_tol,
+        tried[eps] = bisect_delay(lmi.solve_at, h_lo=SYNTHESIS_FLOOR * h_hi, h_hi=h_hi,
+                                  rel_tol=rel_tol,
                                   guess=guess)
         return tried[eps].h_certified
 
@@ -224,10 +250,10 @@ def best_eps_bracket(lmi, eps_grid: Sequence[float], *, golden_steps: int, h_hi:
     return best, tried
 
 
-def synthesize_robust(points, *, alpha: float = 0.0,
-                      eps_grid: Sequence[float] = (0.03, 0.1, 0.3, 1.0, 3.0),
+def synthesize_robust(points, *, h_hi: float, alpha: float = 0.0,
+                      eps_grid: Sequence[float] | None = None,
                       golden_steps: int = 6, rel_tol: float = 1e-3,
-                      margin: float = DEFAULT_MARGIN, h_hi: float = 10.0,
+                      margin: float = DEFAULT_MARGIN,
                       gain_fraction: float = DEFAULT_FRACTION,
                       gain_digits: int = DEFAULT_DIGITS) -> RobustSynthesis:
     """Largest h with one gain certified at every point, eps searched automatically.
@@ -237,7 +263,14 @@ def synthesize_robust(points, *, alpha: float = 0.0,
     (shared :func:`~workbench.lmi.core.bisect_delay`). Coordinates are
     balanced by a common power-of-two diagonal T (exact), K is mapped back.
     K is the canonical gain (:func:`~workbench.lmi.gain.canonical_gain`).
+
+    ``h_hi`` (the search cap, s) is required: it states the delay range of
+    interest in the system's own time unit. ``eps_grid`` defaults to
+    :data:`ROBUST_EPS_GRID` times ``h_hi``. The blocks are written in seconds
+    (``unit`` = 1): in exact arithmetic (c A_i, c B_i) with cap h_hi / c gives
+    the same gain and h / c, numerically not yet (issue 21).
     """
+    eps_grid = eps_grid_for(eps_grid, ROBUST_EPS_GRID, h_hi)
     T, Tinv, pts = balance_points(points)
     lmi = DescriptorSynthesis(pts, eps_grid[0], alpha, margin=margin)
     best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_hi,
@@ -255,12 +288,14 @@ def synthesize_robust(points, *, alpha: float = 0.0,
 
 
 def gain_delay_bound(A, B, K, *, N: int = 2, margin: float = DEFAULT_MARGIN,
-                     rel_tol: float = 1e-4, h_hi: float = 100.0) -> Bracket:
+                     rel_tol: float = 1e-4, h_hi: float | None = None) -> Bracket:
     """Bessel-Legendre (order N) certified bound of x' = A x + B K x(t - h).
 
     The LMI side of a gain check: it knows nothing of the exact margin
     (:func:`workbench.crosscheck.check_gain` puts the two side by side).
     The point certificate holds at ``h_certified``; see :class:`Bracket`.
+    ``h_hi`` defaults to the loop's own time scale times ``H_HI_SCALE``
+    (:func:`~workbench.lmi.analysis.certified_delay`).
     """
     A = np.atleast_2d(np.asarray(A, float))
     Ad = np.asarray(B, float).reshape(A.shape[0], -1) @ np.atleast_2d(np.asarray(K, float))
@@ -270,14 +305,15 @@ def gain_delay_bound(A, B, K, *, N: int = 2, margin: float = DEFAULT_MARGIN,
 
 
 def decay_rate_bracket(A, Ad, alpha: float, *, N: int = 2, margin: float = DEFAULT_MARGIN,
-                       rel_tol: float = 1e-4, h_hi: float = 10.0) -> Bracket:
+                       rel_tol: float = 1e-4, h_hi: float | None = None) -> Bracket:
     """Bessel-Legendre bound for z' = (A + alpha I) z + e^{alpha h} A_d z(t-h).
 
     A certificate at h proves exponential stability with rate alpha of
     x' = A x + A_d x(t-h) at that delay. The delayed matrix depends on h,
     so each step builds its own criterion (no DPP re-use); the shared
-    bisection decides. The first trial delay is relative to the system's
-    time scale (1e-4 / ||A|| + ||A_d||), not an absolute number of seconds.
+    bisection decides. The search range is relative to the system's time
+    scale tau = 1 / (||A|| + ||A_d|| + alpha): ``H_LO_SCALE`` tau up to
+    ``h_hi`` (default ``H_HI_SCALE`` tau), not an absolute number of seconds.
     """
     if not alpha >= 0:
         raise ValueError(f"alpha = {alpha!r}; expected a non-negative rate (1/s)")
@@ -290,5 +326,9 @@ def decay_rate_bracket(A, Ad, alpha: float, *, N: int = 2, margin: float = DEFAU
         return BesselLegendreLMI(Aa, math.exp(alpha * h) * Adt, N, margin=margin).solve_at(h)
 
     rate = np.linalg.norm(A, 2) + np.linalg.norm(Ad, 2) + alpha
-    h_lo = min(1e-4 / rate, h_hi / 2) if rate > 0 else 1e-4 * h_hi
+    if h_hi is None:
+        if not rate > 0:
+            raise ValueError("A = A_d = 0 and alpha = 0 have no time scale; expected h_hi (s)")
+        h_hi = H_HI_SCALE / rate
+    h_lo = min(H_LO_SCALE / rate, h_hi / 2) if rate > 0 else H_LO_SCALE * h_hi
     return bisect_delay(decide, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol)

@@ -8,10 +8,41 @@ K~ maps back as K = K~ T^{-1} without rounding.
 
 from __future__ import annotations
 
+import math
 from typing import Sequence
 
 import numpy as np
 import scipy.linalg as sl
+
+
+#: A synthesis LMI's blocks are written in the time unit that makes its delay
+#: cap about this many units (the power of two nearest h_cap / CAP_IN_UNITS).
+CAP_IN_UNITS = 10.0
+
+
+def time_unit(h_cap: float) -> float:
+    """Time unit (s) of a synthesis LMI's blocks: the power of two nearest
+    ``h_cap / CAP_IN_UNITS``.
+
+    The blocks are written for (u A, u B) at delay h / u and descriptor
+    scalar eps / u: the same system in the unit u, so a certificate there is
+    one in seconds, and the change is exact (u is a power of two). The
+    solver then sees the same numbers whatever unit the caller's model uses
+    (time scaling (c A, c B) with cap h_cap / c changes u by at most a factor
+    sqrt 2), and relative margins do not depend on the unit. Caps within
+    sqrt 2 of ``CAP_IN_UNITS`` s give u = 1.
+    """
+    if not (isinstance(h_cap, (int, float, np.floating)) and 0 < h_cap < math.inf):
+        raise ValueError(f"h_max = {h_cap!r}; expected a positive finite delay cap (s)")
+    return 2.0 ** round(math.log2(h_cap / CAP_IN_UNITS))
+
+
+def check_unit(unit: float) -> float:
+    """``unit`` if it is a power of two (so scaling by it is exact), else ValueError."""
+    if not (isinstance(unit, (int, float, np.floating)) and 0 < unit < math.inf
+            and math.frexp(unit)[0] == 0.5):
+        raise ValueError(f"unit = {unit!r}; expected a power of two (s)")
+    return float(unit)
 
 
 def balancing(A) -> np.ndarray:

@@ -42,8 +42,8 @@ import numpy as np
 
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI
 from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
-from .robust import DescriptorSynthesis, best_eps_bracket
-from .scaling import balance_points
+from .robust import DescriptorSynthesis, best_eps_bracket, eps_grid_for
+from .scaling import balance_points, check_unit
 
 
 class WirtingerSynthesis(MarginLMI):
@@ -83,7 +83,8 @@ class WirtingerSynthesis(MarginLMI):
     """
 
 
-    def __init__(self, A, B, eps: float, **kw):
+    def __init__(self, A, B, eps: float, *, unit: float = 1.0, **kw):
+        self.unit = check_unit(unit)
         self.A = np.atleast_2d(np.asarray(A, float))
         self.B = np.asarray(B, float).reshape(self.A.shape[0], -1)
         self.n, self.m = self.B.shape
@@ -119,14 +120,15 @@ class WirtingerSynthesis(MarginLMI):
 
     def blocks(self, v: Mapping[str, object], p, bmat) -> list[Block]:
         Th, S, R, Y, V = v["Theta"], v["S"], v["R"], v["Y"], v["V"]
-        h, iota, eps = p["h"], p["iota"], p["eps"]
+        u = self.unit                    # blocks in the time unit u (exact, see time_unit)
+        h, iota, eps = p["h"] * (1 / u), p["iota"] * u, p["eps"] * (1 / u)
         x, dx, xd, om, G0, G1, Gd = self._selectors()
         n = self.n
         Z = np.zeros((n, n), dtype=int)
         DS = bmat([[Z, Z], [Z, S]])
         chi0, chi1 = x - xd, x + xd - 2 * om
         he = G0.T @ Th @ Gd + h * (G1.T @ Th @ Gd) - G1.T @ DS @ Gd
-        row = bmat([[self.A @ Y, -Y, self.B @ V, Z]])           # -x' + A x + B K x_d, times Y
+        row = bmat([[(self.A * u) @ Y, -Y, (self.B * u) @ V, Z]])           # -x' + A x + B K x_d, times Y
         desc = x.T @ row + eps * (dx.T @ row)
         psi = (he + he.T + x.T @ S @ x - xd.T @ S @ xd + h * (dx.T @ R @ dx)
                - iota * (chi0.T @ R @ chi0 + 3 * (chi1.T @ R @ chi1)) + desc + desc.T)
@@ -177,8 +179,12 @@ class TightSynthesis:
         return self.bracket.h_certified >= self.h_max
 
 
-def synthesize_tight(A, B, *, eps_grid: Sequence[float] = (0.01, 0.1, 1.0, 10.0, 100.0),
-                     golden_steps: int = 6, h_max: float = 10.0, rel_tol: float = 1e-3,
+#: Default eps grid of :func:`synthesize_tight`, in units of the cap ``h_max``.
+TIGHT_EPS_GRID = (1e-3, 1e-2, 0.1, 1.0, 10.0)
+
+
+def synthesize_tight(A, B, *, h_max: float, eps_grid: Sequence[float] | None = None,
+                     golden_steps: int = 6, rel_tol: float = 1e-3,
                      margin: float = DEFAULT_MARGIN,
                      gain_fraction: float = DEFAULT_FRACTION,
                      gain_digits: int = DEFAULT_DIGITS) -> TightSynthesis:
@@ -190,11 +196,16 @@ def synthesize_tight(A, B, *, eps_grid: Sequence[float] = (0.01, 0.1, 1.0, 10.0,
         Open-loop matrix.
     B : (n, m) array_like
         Input matrix; the closed loop is x' = A x + B K x(t - h).
-    eps_grid : sequence of float
-        Log grid of the descriptor scalar, refined by golden section.
-    golden_steps : int
     h_max : float
-        Delay search cap (s).
+        Delay search cap (s), required: the delay range of interest in the
+        system's own time unit (no absolute default).
+    eps_grid : sequence of float, optional
+        Log grid of the descriptor scalar (s), refined by golden section;
+        default :data:`TIGHT_EPS_GRID` times ``h_max``. In exact arithmetic
+        (c A, c B) with cap h_max / c then gives the same gain and h / c; the
+        blocks are still written in seconds (``unit`` = 1), and numerically a
+        model in milliseconds certifies less (issue 21, open).
+    golden_steps : int
     rel_tol : float
         Relative bracket width of the delay bisection.
     margin : float
@@ -208,6 +219,7 @@ def synthesize_tight(A, B, *, eps_grid: Sequence[float] = (0.01, 0.1, 1.0, 10.0,
         The LMI is solved in balanced coordinates (exact power-of-two
         scaling, :func:`workbench.lmi.scaling.balancing`); K is mapped back.
     """
+    eps_grid = eps_grid_for(eps_grid, TIGHT_EPS_GRID, h_max)
     A = np.atleast_2d(np.asarray(A, float))
     B = np.asarray(B, float).reshape(A.shape[0], -1)
     T, Tinv, ((At, Bt),) = balance_points([(A, B)])

@@ -77,9 +77,9 @@ from typing import Literal
 import cvxpy as cp
 import numpy as np
 
-from .analysis import RETRY_SETTINGS
+from .analysis import RETRY_SETTINGS, UNIT_SCALE
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, bisect_delay
-from .delay_input import time_scale
+from .delay_input import H_HI_SCALE, time_scale
 
 
 def _check_interval(h1: float, mu: float | None) -> tuple[float, float | None]:
@@ -126,6 +126,15 @@ class _VaryingTerms:
     mu: float | None
     windows: str
     n: int
+    #: Time unit (s) of the blocks (a power of two): they are written for the
+    #: same system in that unit (A u, A_d u, h1 / u, h2 / u, eps / u), exact,
+    #: so the solver sees the same numbers in any time unit of the model.
+    unit: float = 1.0
+
+    def _times(self, p):
+        """(h1, h12, h12^2) in the blocks' time unit."""
+        u = self.unit
+        return self.h1 / u, p["h12"] * (1 / u), p["h12sq"] * (1 / (u * u))
 
     @property
     def with_h1(self) -> bool:
@@ -194,11 +203,12 @@ class _VaryingTerms:
         on xi) and the Wirtinger / reciprocally convex lower bounds."""
         e = self._e
         x, xh, x2, x1 = e("x"), e("xh"), e("x2"), e("x1")
-        out = x1.T @ v["S2"] @ x1 - x2.T @ v["S2"] @ x2 + p["h12sq"] * dx_form(v["R2"])
+        h1, _, h12sq = self._times(p)
+        out = x1.T @ v["S2"] @ x1 - x2.T @ v["S2"] @ x2 + h12sq * dx_form(v["R2"])
         if self.with_h1:
             S1, R1 = v["S1"], v["R1"]
             c0, c1 = x - x1, x + x1 - 2 * e("nu1")
-            out = (out + x.T @ S1 @ x - x1.T @ S1 @ x1 + self.h1 ** 2 * dx_form(R1)
+            out = (out + x.T @ S1 @ x - x1.T @ S1 @ x1 + h1 ** 2 * dx_form(R1)
                    - c0.T @ R1 @ c0 - 3 * (c1.T @ R1 @ c1))
         gam = np.vstack([x1 - xh, x1 + xh - 2 * e("nu2"), xh - x2, xh + x2 - 2 * e("nu3")])
         return out - gam.T @ self._rcc(v, bmat) @ gam
@@ -222,8 +232,9 @@ class _VaryingTerms:
         (``dx`` is the row block of x')."""
         e = self._e
         x, x1, xh, x2 = e("x"), e("x1"), e("xh"), e("x2")
-        c2, c3 = (0, p["h12"]) if vertex == "h1" else (p["h12"], 0)
-        head_G = [x] + ([self.h1 * e("nu1")] if self.with_h1 else [])
+        h1, h12, _ = self._times(p)
+        c2, c3 = (0, h12) if vertex == "h1" else (h12, 0)
+        head_G = [x] + ([h1 * e("nu1")] if self.with_h1 else [])
         head_H = [dx] + ([x - x1] if self.with_h1 else [])
         if self.windows == "delay":     # [int_{t-h(t)}^{t-h1} x; int_{t-h2}^{t-h(t)} x]
             return (head_G + [c2 * e("nu2"), c3 * e("nu3")],
@@ -302,6 +313,9 @@ class VaryingDelayLMI(_VaryingTerms, MarginLMI):
             raise ValueError(f"A {self.A.shape}, A_d {self.Ad.shape}; expected equal square "
                              "shapes")
         self._init_terms(h1, mu, windows, self.A.shape[0])
+        R = float(np.linalg.norm(self.A, 2) + np.linalg.norm(self.Ad, 2))
+        #: as the constant-delay criteria (:data:`~workbench.lmi.analysis.UNIT_SCALE`)
+        self.unit = 2.0 ** round(math.log2(UNIT_SCALE / R)) if R > 0 else 1.0
         super().__init__(**kw)
 
     def variables(self):
@@ -309,7 +323,7 @@ class VaryingDelayLMI(_VaryingTerms, MarginLMI):
 
     def blocks(self, v, p, bmat):
         e = self._e
-        F = self.A @ e("x") + self.Ad @ e("xh")
+        F = (self.A * self.unit) @ e("x") + (self.Ad * self.unit) @ e("xh")
         return (self._phi_blocks(v, p, bmat, F, lambda W: F.T @ W @ F)
                 + self._positive_blocks(v, bmat))
 
@@ -366,7 +380,7 @@ class VaryingDelayBound:
 
 
 def certified_varying_delay(A, Ad, *, h1: float = 0.0, mu: float | None = None,
-                            windows: Windows | None = None, h_hi: float = 100.0,
+                            windows: Windows | None = None, h_hi: float | None = None,
                             rel_tol: float = 1e-4, guess: float | None = None,
                             max_solves: int = 60,
                             margin: float = DEFAULT_MARGIN) -> VaryingDelayBound:
@@ -382,10 +396,12 @@ def certified_varying_delay(A, Ad, *, h1: float = 0.0, mu: float | None = None,
         Bound on |h'(t)| (dimensionless); None = unknown derivative.
     windows : {"delay", "fixed"}, optional
         See :class:`VaryingDelayLMI`.
-    h_hi : float
+    h_hi : float, optional
         Search cap on h2 (s); a result at the cap means "at least h_hi".
+        Default ``H_HI_SCALE`` times the time scale 1 / (||A|| + ||A_d||).
     rel_tol, guess, max_solves
-        Bisection settings (:func:`~workbench.lmi.core.bisect_delay`).
+        Bisection settings (:func:`~workbench.lmi.core.bisect_delay`); the
+        search starts at h1 + 1e-3 max(h1, min(tau, h_hi)) (relative).
     margin : float
         Relative LMI margin.
 
@@ -396,7 +412,11 @@ def certified_varying_delay(A, Ad, *, h1: float = 0.0, mu: float | None = None,
     """
     lmi = VaryingDelayLMI(A, Ad, h1=h1, mu=mu, windows=windows, margin=margin)
     tau = time_scale(lmi.A, lmi.Ad)         # scale-free: 1e-3 of h1 or of the time scale
-    h_lo = h1 + 1e-3 * max(h1, tau if math.isfinite(tau) else 1.0)
+    if h_hi is None:
+        if not math.isfinite(tau):
+            raise ValueError("A = A_d = 0 has no time scale; expected h_hi (s)")
+        h_hi = H_HI_SCALE * tau
+    h_lo = lmi.h1 + 1e-3 * max(lmi.h1, min(tau, h_hi))
     br = bisect_delay(lmi.solve_at, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol, guess=guess,
                       max_solves=max_solves)
     return VaryingDelayBound(lmi.method, lmi.h1, lmi.mu, lmi.windows, br)

@@ -53,8 +53,8 @@ from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, ca
 
 #: Fractions of the certified h2 at which the canonical gain is tried, in order.
 GAIN_FRACTIONS = (DEFAULT_FRACTION, 0.95, 0.9, 0.8, 0.6)
-from .robust import DescriptorSynthesis, maximise_log_scalar
-from .scaling import balance_points
+from .robust import DescriptorSynthesis, eps_grid_for, maximise_log_scalar
+from .scaling import balance_points, check_unit, time_unit
 from .varying import (RETRY_SETTINGS, VaryingDelayBound, Windows, _VaryingTerms,
                       certified_varying_delay)
 
@@ -86,7 +86,8 @@ class VaryingDelaySynthesis(_VaryingTerms, MarginLMI):
     gain = DescriptorSynthesis.gain
 
     def __init__(self, A, B, eps: float, *, h1: float = 0.0, mu: float | None = None,
-                 windows: Windows | None = None, **kw):
+                 windows: Windows | None = None, unit: float = 1.0, **kw):
+        self.unit = check_unit(unit)
         self.A = np.atleast_2d(np.asarray(A, float))
         self.B = np.asarray(B, float).reshape(self.A.shape[0], -1)
         self.m = self.B.shape[1]
@@ -108,8 +109,9 @@ class VaryingDelaySynthesis(_VaryingTerms, MarginLMI):
         x, xh, dx = e("x"), e("xh"), e("dx")
         Y = v["Y"]
         # Y'P2'(-x' + A x + B K x_h) Y with P2 Y = I, V = K Y:
-        row = self.A @ Y @ x + self.B @ v["V"] @ xh - Y @ dx
-        desc = (x + p["eps"] * dx).T @ row
+        u = self.unit                    # blocks in the time unit u (exact)
+        row = (self.A * u) @ Y @ x + (self.B * u) @ v["V"] @ xh - Y @ dx
+        desc = (x + p["eps"] * (1 / u) * dx).T @ row
         return (self._phi_blocks(v, p, bmat, dx, lambda W: dx.T @ W @ dx, desc + desc.T)
                 + self._positive_blocks(v, bmat))
 
@@ -172,10 +174,14 @@ class VaryingSynthesis:
         return self.bracket.h_certified
 
 
-def synthesize_varying(A, B, *, h1: float = 0.0, mu: float | None = None,
+#: Default eps grid of :func:`synthesize_varying`, in units of the cap ``h_max``.
+VARYING_EPS_GRID = (0.01, 0.03, 0.1, 0.3, 1.0, 3.0)
+
+
+def synthesize_varying(A, B, *, h_max: float, h1: float = 0.0, mu: float | None = None,
                        windows: Windows | None = None,
-                       eps_grid: Sequence[float] = (0.1, 0.3, 1.0, 3.0, 10.0, 30.0),
-                       golden_steps: int = 4, h_max: float = 10.0, rel_tol: float = 1e-3,
+                       eps_grid: Sequence[float] | None = None,
+                       golden_steps: int = 4, rel_tol: float = 1e-3,
                        margin: float = DEFAULT_MARGIN,
                        gain_fractions: Sequence[float] = GAIN_FRACTIONS,
                        gain_digits: int = DEFAULT_DIGITS) -> VaryingSynthesis:
@@ -192,12 +198,13 @@ def synthesize_varying(A, B, *, h1: float = 0.0, mu: float | None = None,
         Bound on |h'(t)|; None = unknown.
     windows : {"delay", "fixed"}, optional
         See :class:`~workbench.lmi.varying.VaryingDelayLMI`.
-    eps_grid : sequence of float
-        Log grid of the descriptor scalar, refined by ``golden_steps``
+    eps_grid : sequence of float, optional
+        Log grid of the descriptor scalar (s), refined by ``golden_steps``
         golden-section steps (a fixed eps: a one-element grid and
-        ``golden_steps=0``).
+        ``golden_steps=0``); default :data:`VARYING_EPS_GRID` times ``h_max``.
     h_max : float
-        Search cap on h2 (s).
+        Search cap on h2 (s), required (no absolute default); the search
+        starts at h1 + 1e-3 max(h1, h_max / 10).
     rel_tol : float
         Relative bracket width of each bisection.
     margin : float
@@ -216,12 +223,14 @@ def synthesize_varying(A, B, *, h1: float = 0.0, mu: float | None = None,
         Solved in balanced coordinates (exact power-of-two scaling); K is
         mapped back.
     """
+    eps_grid = eps_grid_for(eps_grid, VARYING_EPS_GRID, h_max)
     A = np.atleast_2d(np.asarray(A, float))
     B = np.asarray(B, float).reshape(A.shape[0], -1)
     T, Tinv, ((At, Bt),) = balance_points([(A, B)])
+    u = time_unit(h_max)
     lmi = VaryingDelaySynthesis(At, Bt, eps_grid[0], h1=h1, mu=mu, windows=windows,
-                                margin=margin)
-    h_lo = lmi.h1 + max(1e-3, 1e-3 * lmi.h1)
+                                margin=margin, unit=u)
+    h_lo = lmi.h1 + 1e-3 * max(lmi.h1, h_max / 10)
     tried: dict[float, Bracket] = {}
 
     def h_of(eps: float) -> float:
@@ -244,7 +253,7 @@ def synthesize_varying(A, B, *, h1: float = 0.0, mu: float | None = None,
                 lmi, br.h_certified,
                 lambda Kt: VaryingDelaySynthesisFixedK(At, Bt, best, K=Kt, h1=lmi.h1,
                                                        mu=lmi.mu, windows=lmi.windows,
-                                                       margin=margin),
+                                                       margin=margin, unit=u),
                 T, fraction=fraction, digits=gain_digits, h_lo=h_lo, h_hi=h_max,
                 rel_tol=rel_tol)
             if gain.outcome is Outcome.CERTIFIED:
@@ -282,7 +291,8 @@ def recheck_varying(A, B, result: VaryingSynthesis,
     B = np.asarray(B, float).reshape(A.shape[0], -1)
     Tinv = np.diag(1.0 / np.diag(result.T))
     lmi = VaryingDelaySynthesis(Tinv @ A @ result.T, Tinv @ B, result.eps, h1=result.h1,
-                                mu=result.mu, windows=result.windows)
+                                mu=result.mu, windows=result.windows,
+                                unit=time_unit(result.h_max))
     cert = result.bracket.certificate.certificate if certificate is None else certificate
     return lmi.recheck(cert, result.bracket.h_certified)
 

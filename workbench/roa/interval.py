@@ -11,6 +11,7 @@ interval *encloses* the expression's range on the box:
 * ``exp`` and ``log`` are not correctly rounded: numpy documents an error
   below 1 ulp for its float64 ``exp`` / ``log``; the result is widened by
   two ulps outwards (``tanh``, ``atan``, ``sinh``, ``asinh``: increasing,
+  ``sin``, ``cos``: their extrema added where the interval may hold one,
   widened by four ulps);
 * a constant that is not exactly a float (a Rational, a Float of higher
   precision, ``pi``) is enclosed by the floats on either side of it;
@@ -134,6 +135,42 @@ def imonotone(fn, a: Interval, lo_bound: float = -_INF, hi_bound: float = _INF) 
     return _fix(np.maximum(lo, lo_bound), np.minimum(hi, hi_bound))
 
 
+def _holds(a: Interval, c: float, period: float) -> np.ndarray:
+    """Whether [a.lo, a.hi] may hold a point c + k period (k integer); errs
+    towards True (then the caller widens to the extremum, which is sound)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        k = np.ceil((a.lo - c) / period - 1e-9)
+        near = c + k * period <= a.hi + 1e-9 * (1.0 + np.abs(a.hi))
+    return near | ~np.isfinite(a.lo) | ~np.isfinite(a.hi)
+
+
+def isincos(a: Interval, phase: float) -> Interval:
+    """sin (phase 0) or cos (phase pi/2: cos x = sin(x + pi/2)) on an interval:
+    the end values widened by 4 ulps (libm's error is below 1 ulp), and +-1
+    where the interval may hold a maximum / minimum (tested with a margin, so
+    a near miss gives the wider, still enclosing, interval)."""
+    fn = np.sin if phase == 0 else np.cos
+    with np.errstate(invalid="ignore"):
+        e1, e2 = fn(a.lo), fn(a.hi)
+    lo = _widen(np.minimum(e1, e2), 4, -_INF)
+    hi = _widen(np.maximum(e1, e2), 4, _INF)
+    two_pi = 2.0 * np.pi
+    top = _holds(a, np.pi / 2 - phase, two_pi)
+    bottom = _holds(a, -np.pi / 2 - phase, two_pi)
+    lo = np.where(bottom | np.isnan(lo), -1.0, np.maximum(lo, -1.0))
+    hi = np.where(top | np.isnan(hi), 1.0, np.minimum(hi, 1.0))
+    return Interval(lo, hi)
+
+
+def istep(a: Interval, below: float, above: float, at: tuple[float, float]) -> Interval:
+    """A step function: ``below`` for x < 0, ``above`` for x > 0, within
+    ``at`` at 0 (sign: -1, 1, (0, 0); Heaviside: 0, 1, (0, 1); DiracDelta's
+    support: 0, 0, (0, inf))."""
+    lo = np.where(a.lo > 0, above, np.where(a.hi < 0, below, min(below, above, at[0])))
+    hi = np.where(a.lo > 0, above, np.where(a.hi < 0, below, max(below, above, at[1])))
+    return Interval(lo.astype(float), hi.astype(float))
+
+
 def ilog(a: Interval) -> Interval:
     with np.errstate(divide="ignore", invalid="ignore"):
         lo = np.where(a.lo > 0, _down(_down(np.log(np.maximum(a.lo, 0.0)))), -_INF)
@@ -180,7 +217,8 @@ class IntervalFunction:
     ------
     UnsupportedExpression
         For a function without an interval rule (supported: +, *, integer,
-        rational and real powers, exp, log, tanh, atan, sinh, asinh, Abs, Max, Min, Piecewise with
+        rational and real powers, exp, log, sin, cos, tanh, atan, sinh, asinh, Abs, sign,
+        Heaviside, DiracDelta, Max, Min, Piecewise with
         relational conditions, and/or).
     """
 
@@ -251,6 +289,17 @@ class IntervalFunction:
             return lambda env, st, f=args[0]: imonotone(np.sinh, f(env, st))
         if isinstance(e, sp.asinh):
             return lambda env, st, f=args[0]: imonotone(np.arcsinh, f(env, st))
+        if isinstance(e, (sp.sin, sp.cos)):
+            ph = 0.0 if isinstance(e, sp.sin) else np.pi / 2
+            return lambda env, st, f=args[0], ph=ph: isincos(f(env, st), ph)
+        if isinstance(e, sp.sign):
+            return lambda env, st, f=args[0]: istep(f(env, st), -1.0, 1.0, (0.0, 0.0))
+        if isinstance(e, sp.Heaviside):           # Heaviside(x, H0): H0 at x = 0
+            h0 = constant(e.args[1]) if len(e.args) > 1 else (0.0, 1.0)
+            at = (min(0.0, h0[0]), max(1.0, h0[1]))
+            return lambda env, st, f=args[0], at=at: istep(f(env, st), 0.0, 1.0, at)
+        if isinstance(e, sp.DiracDelta) and len(e.args) == 1:
+            return lambda env, st, f=args[0]: istep(f(env, st), 0.0, 0.0, (0.0, _INF))
         if isinstance(e, sp.Abs):
             return lambda env, st, f=args[0]: iabs(f(env, st))
         if isinstance(e, (sp.Max, sp.Min)):

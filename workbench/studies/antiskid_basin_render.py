@@ -3,6 +3,8 @@
 :class:`~workbench.studies.antiskid_basin_k2.K2Sweep`)."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..report.markdown import fmt, md_table
@@ -16,7 +18,7 @@ _SWITCH_MARK = {"CERTIFIED": "o", "REFUTED": "X", "INCONCLUSIVE": "s"}
 def render_basin_result(res, *, rail: str) -> str:
     """Section of a :class:`~workbench.studies.antiskid_basin_run.BasinResult`."""
     text = render_basin_section(res.basin, res.sweep, rail=rail,
-                                compare_source=res.compare_source)
+                                compare_source=res.compare_source, brake=res.brake)
     if res.mass_factor != 1.0:
         text += (f"\nThe plant of this design has {fmt(res.mass_factor, 3)} x the nominal mass; "
                  "the basin is that of the controller's nominal model (the switch states are "
@@ -29,7 +31,8 @@ HEADING = ("Regions of attraction: does each switch land in the basin of the law
            "takes over?")
 
 
-def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—") -> str:
+def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—",
+                         brake=()) -> str:
     """The report section: loop, certified bracket, switch verdicts, k2 rule."""
     K = "[" + ", ".join(fmt(k, 4) for k in basin.K) + "]"
     head = (
@@ -54,10 +57,75 @@ def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—"
           + "\n\nCERTIFIED: V at the state is below c_certified, so the delay-free loop "
             "converges from it. REFUTED: its level holds a point with V' >= 0, so this V "
             "cannot certify it; the last column says what the delay-free trajectory does "
-            f"(\"diverges\": |lambda| reaches {fmt(LAM_DIVERGED)}, the wheel spins). The "
-            "cruise → braking switch hands over to law (69), which tracks a time-varying creep speed: it has no "
-            "equilibrium basin; see the phase-switch section for its domain check.\n")
-    return head + body + sw + (_k2_text(sweep, compare_source) if sweep is not None else "")
+            f"(\"diverges\": |lambda| reaches {fmt(LAM_DIVERGED)}, the wheel spins).\n")
+    return (head + body + sw + brake_text(brake)
+            + (_k2_text(sweep, compare_source) if sweep is not None else ""))
+
+
+def _floor(x: float, digits: int = 2) -> str:
+    e = math.floor(math.log10(x)) - digits + 1
+    return fmt(math.floor(x / 10.0**e) * 10.0**e, digits)
+
+
+def _ceil(x: float, digits: int = 2) -> str:
+    e = math.floor(math.log10(x)) - digits + 1
+    return fmt(math.ceil(x / 10.0**e) * 10.0**e, digits)
+
+
+def brake_text(brake) -> str:
+    """Subsection of the cruise -> braking switch (:mod:`.antiskid_basin_brake`)."""
+    from .antiskid_basin_brake import FATE_RTOL, LAM_LIMIT, T_FATE, TRACK_TOL
+    rows = []
+    for b in brake:
+        if b.why.startswith("no equilibrium"):
+            side = "up to" if b.why.endswith("spin") else "down to"
+            frozen = (f"no equilibrium from the state {side} lambda = "
+                      f"{'' if side == 'up to' else '−'}{fmt(LAM_LIMIT)}: |lambda'| >= "
+                      f"{_floor(b.rate)} 1/s proven, so it gets there within "
+                      f"{_ceil((LAM_LIMIT - abs(b.lam)) / b.rate)} s")
+        elif b.lam_star is not None:
+            frozen = (f"equilibrium lambda* = {fmt(b.lam_star, 4)} ({b.why}"
+                      + (f"; V = {fmt_level(b.level[0], 'up')}, c_certified = "
+                         f"{fmt_level(b.level[1])}" if b.level else "") + ")")
+        else:
+            frozen = b.why
+        fate = (f"diverges: |lambda| = {fmt(LAM_LIMIT)} at t_brake + {fmt(b.t_fate, 2)} s"
+                if b.fate == "diverges" else b.fate)
+        rows.append([f"`{b.label}`", fmt(b.v, 4), fmt(b.lam, 4), fmt(b.vs_frozen, 4), frozen,
+                     b.outcome.value, fate])
+    if not rows:
+        return ("\n### Switch states (cruise → braking)\n\nNo case reached the braking "
+                "phase.\n")
+    return (
+        "\n### Switch states (cruise → braking)\n\n"
+        "Law (69) takes over at t_brake. It tracks the time-varying creep speed v_s*(t) of "
+        "eq (76), so it has no fixed equilibrium: a basin exists only for the loop **frozen "
+        "at the switch instant**. Assumptions: exact prediction (the delay-free loop, as "
+        "Theorem 3 argues); the speed v frozen at its value at t_brake (the creep ratio "
+        "moves on a time scale of about v / 4000 s, the speed by about 1 % a second); "
+        "v_s* frozen at v_s*(t_brake), with d v_s*/dt = 0; the controller's nominal model, "
+        "traction form (eq 12) for lambda >= 0 and braking form (eq 15) below, as the "
+        "plant; law (69) computed on the braking form (eq 16) whatever the sign of lambda, "
+        "as printed. The frozen loop has one state, lambda' = g(lambda), so its trajectory "
+        "moves monotonically to the nearest equilibrium in the direction of g: the verdict "
+        "is REFUTED when no equilibrium lies between the state and |lambda| = "
+        f"{fmt(LAM_LIMIT)} (the sign of g proven by interval arithmetic on the whole "
+        "interval), CERTIFIED when the state reaches a certified level set of a stable "
+        "equilibrium (a level set of `workbench/roa`, with the sign of g proven on the "
+        "way to it). The last column drops the frozen assumptions: the delay-free loop with "
+        "v and lambda integrated and v_s*(t), d v_s*/dt of eq (76) as printed (Radau, rtol "
+        f"{fmt(FATE_RTOL)}, over {fmt(T_FATE)} s; \"tracks\": lambda < 0 and |v lambda - "
+        f"v_s*| < {fmt(TRACK_TOL)} m/s at the end).\n\n"
+        + md_table(["case", "v (m/s)", "lambda", "v_s* frozen (m/s)", "frozen loop",
+                    "in a basin of law (69)?", "delay-free loop, time-varying"], rows,
+                   "lrrrlll")
+        + "\n\nREFUTED here means that the state lies in the basin of no equilibrium of the "
+          "frozen loop: on the traction side the braking form that law (69) is built on "
+          "(its adhesion branch grows like e^{b lambda} for lambda > 0) is not the plant, "
+          "and the law raises lambda further. The simulated runs are not this loop (their "
+          "predictor integrates the braking form, eq (70), which is not the plant there "
+          "either, and the law is held over each sample): what they do after t_brake is in "
+          "the phase-switch section.\n")
 
 
 def _k2_text(sweep, compare_source) -> str:

@@ -15,7 +15,9 @@ Design table (optional; absent: no basin section)::
 The switch states are the simulated states where law (61) takes over in each
 case (``v_at_cruise`` / ``lam_at_cruise`` for ``cruise_entry = "speed"``,
 the handover state for ``"creep"``); the k2 rule is judged at the printed
-switch state (v_d, lambda_opt). The basin uses the controller's nominal
+switch state (v_d, lambda_opt). The cruise -> braking switch is judged at
+each case's state at t_brake against the braking law (69) frozen at that
+instant (:mod:`.antiskid_basin_brake`). The basin uses the controller's nominal
 model (a design's plant mass factor is not in it; the report says so).
 """
 from __future__ import annotations
@@ -46,6 +48,7 @@ class BasinResult:
     sweep: K2Sweep
     compare_source: str
     mass_factor: float
+    brake: tuple = ()          # antiskid_basin_brake.BrakeSwitch per case that braked
 
 
 def load_basin_settings(root) -> BasinSettings | None:
@@ -92,8 +95,19 @@ def switch_points(cases) -> list:
     return out
 
 
+def brake_points(cases, v_d: float) -> list:
+    """(case name, (v, lambda)) at t_brake, per case that reached braking."""
+    out = []
+    for c in cases:
+        dv, lam = c.metrics.get("v_err_at_brake", math.nan), c.metrics.get("lam_at_brake", math.nan)
+        if math.isfinite(dv) and math.isfinite(lam):
+            out.append((c.case.name, (v_d + float(dv), float(lam))))
+    return out
+
+
 def run_basin(settings: BasinSettings, values: dict, v_d: float, K, lambda_opt: float, cases,
-              mass_factor: float = 1.0) -> BasinResult:
+              mass_factor: float = 1.0, *, profile=None, k_de: float | None = None
+              ) -> BasinResult:
     """The basin check of one antiskid-run design.
 
     Parameters
@@ -111,20 +125,33 @@ def run_basin(settings: BasinSettings, values: dict, v_d: float, K, lambda_opt: 
         The study's cases (their switch states).
     mass_factor : float
         Plant mass / nominal (reported: the basin uses the nominal model).
+    profile : CreepSpeedProfile, optional
+        Eq (76); with ``k_de``, the cruise -> braking switch is judged too.
+    k_de : float, optional
+        Gain of the braking law (69) (1/s).
     """
     basin = cruise_basin(values, v_d, K, switch_points(cases), seed=settings.seed)
     sweep = safe_k2_range(values, v_d, float(K[0]), (v_d, lambda_opt), grid=settings.k2_grid,
                           compare=settings.compare, bisect=settings.bisect, seed=settings.seed)
-    return BasinResult(basin, sweep, settings.compare_source, mass_factor)
+    brake = ()
+    if profile is not None and k_de is not None:
+        from .antiskid_basin_brake import brake_switch
+        brake = tuple(brake_switch(values, lab, pt, profile=profile, k_de=k_de,
+                                   seed=settings.seed) for lab, pt in brake_points(cases, v_d))
+    return BasinResult(basin, sweep, settings.compare_source, mass_factor, brake)
 
 
-def basin_quantities(basin, sweep, labels=()) -> dict:
+def basin_quantities(basin, sweep, labels=(), brake=()) -> dict:
     """Claim quantities of the basin check (``labels``: every case; a case
-    whose cruise law never started gets None)."""
+    whose cruise law never started, or that never braked, gets None)."""
     est = basin.check.estimate
     q = {"basin.c_certified": est.c_certified, "basin.c_refuted": est.c_refuted}
     for lab in labels:
         q[f"switch.cruise[{lab}].in_basin"] = q[f"switch.cruise[{lab}].fate"] = None
+        q[f"switch.brake[{lab}].in_basin"] = q[f"switch.brake[{lab}].fate"] = None
+    for b in brake:
+        q[f"switch.brake[{b.label}].in_basin"] = b.outcome.value
+        q[f"switch.brake[{b.label}].fate"] = b.fate
     for p, tr in zip(basin.check.points, basin.trajectories):
         q[f"switch.cruise[{p.label}].in_basin"] = p.verdict.outcome.value
         q[f"switch.cruise[{p.label}].fate"] = tr.fate
@@ -139,7 +166,8 @@ def basin_quantities(basin, sweep, labels=()) -> dict:
 def basin_quantity_names(labels, with_sweep: bool) -> set:
     names = {"basin.c_certified", "basin.c_refuted"}
     for lab in labels:
-        names |= {f"switch.cruise[{lab}].in_basin", f"switch.cruise[{lab}].fate"}
+        names |= {f"switch.cruise[{lab}].in_basin", f"switch.cruise[{lab}].fate",
+                  f"switch.brake[{lab}].in_basin", f"switch.brake[{lab}].fate"}
     if with_sweep:
         names |= {"basin.k2_safe_max", "basin.k2_unsafe_min", "basin.compared_certified"}
     return names

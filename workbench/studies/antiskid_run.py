@@ -343,7 +343,8 @@ class AntiskidRun:
         from .antiskid_basin_run import run_basin
         bs = None if spec.basin is None else run_basin(
             spec.basin, plant_values(spec), spec.scenario["v_d"], K, nominal.lambda_opt(), cases,
-            spec.mass_factor)
+            spec.mass_factor, profile=controller_settings(spec, K, spec.cases[0]).profile,
+            k_de=spec.k_de)
         return RunResult(nominal.lambda_opt(), lam_d, tuple(K), how, h_cert, tuple(cases), lc,
                          spec.dt, mc, hc, bs)
 
@@ -404,7 +405,7 @@ class AntiskidRun:
         if res.basin is not None:
             from .antiskid_basin_run import basin_quantities
             q.update(basin_quantities(res.basin.basin, res.basin.sweep,
-                                      [c.case.name for c in res.cases]))
+                                      [c.case.name for c in res.cases], res.basin.brake))
         return q
 
 

@@ -25,6 +25,8 @@ Tables (see ``designs/antiskid-cruise-dry-generic.toml`` for a full file)::
     [synthesis]    method = "free-weighting-003" | "wirtinger" | "bessel-legendre"
     [[vertices]]   name, source, parameter = value ...   (optional: robust gain)
     [[scenarios]]  name, t_end, dt, x0 = {...}, setpoint = {...}, h, rtol, predictor
+    [basin]        enabled, domain = {...}, plane, seed     (optional: region of attraction,
+                   :mod:`.delay_feedback_basin`)
 
 The design tables are read here (light: no sympy until the operating point
 is solved); :mod:`.delay_feedback_run` computes, :mod:`.delay_feedback_render`
@@ -101,6 +103,7 @@ class DelayFeedbackSpec:
     vertices: tuple[Vertex, ...]
     scenarios: tuple[Scenario, ...]
     window_horizon: float
+    basin: object = None     # delay_feedback_basin.BasinSettings or None ([basin] table)
 
 
 def _variables(root: Reader, table: str, taken: set[str], min_len: int = 1
@@ -324,11 +327,15 @@ class DelayFeedback:
         horizon = ex.number("window_horizon", default=max(4 * delay.h_max, 1.0),
                             positive=True, hi=1e4, what="number (s)")
         ex.finish()
-        spec = DelayFeedbackSpec(plant, delay, syn, vertices, scenarios, horizon)
+        from .delay_feedback_basin import check_domain, load_basin_settings
+        basin = load_basin_settings(root, plant, len(scenarios))
+        spec = DelayFeedbackSpec(plant, delay, syn, vertices, scenarios, horizon, basin)
         from .delay_feedback_run import nominal_point
-        nominal_point(spec)          # no operating point in range is bad input: fail now
+        op = nominal_point(spec)[2]  # no operating point in range is bad input: fail now
         for v in vertices:
             nominal_point(spec, v)
+        if basin is not None:
+            check_domain(basin, root.path, plant.state_names, op.x, scenarios)
         return spec
 
     def quantity_names(self, spec: DelayFeedbackSpec) -> set[str]:
@@ -355,6 +362,9 @@ class DelayFeedback:
             names |= {f"{b}.peak_error.{k}" for k in p.state_names}
             names |= {f"{b}.final_error.{k}" for k in p.state_names}
             names |= {f"{b}.peak_input_dev.{k}" for k in p.input_names}
+        if spec.basin is not None:
+            from .delay_feedback_basin import basin_quantity_names
+            names |= basin_quantity_names(spec)
         return names
 
     def run(self, design):

@@ -109,6 +109,11 @@ def render(design, res) -> Rendered:
     if res.scenarios:
         sec, figs = _simulation_section(spec, res)
         sections.append(sec)
+    if res.basin is not None:
+        from .delay_feedback_basin_render import render_basin_section
+        sec, bfigs = render_basin_section(spec, res, res.basin)
+        sections.append(sec)
+        figs = [*figs, *bfigs]
     return Rendered(tuple(sections), tuple(figs))
 
 

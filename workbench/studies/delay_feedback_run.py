@@ -99,6 +99,7 @@ class DelayFeedbackResult:
     vertex_points: tuple = ()
     delay: object = None       # DelaySpec of the design
     names: tuple = ()          # state names, then input names
+    basin: object = None       # delay_feedback_basin.DelayFeedbackBasin or None
 
     def to_json(self) -> dict:
         s = self.synthesis
@@ -186,9 +187,13 @@ def run(spec) -> DelayFeedbackResult:
             checks = tuple(zip(spec.vertices, syn.robust[1], ab))
     scen = tuple(simulate_scenario(spec, model, values, op, syn.K, s)
                  for s in spec.scenarios) if syn.K is not None else ()
+    basin = None
+    if spec.basin is not None and syn.K is not None:
+        from .delay_feedback_basin import run_basin
+        basin = run_basin(spec.basin, spec, model, values, op, syn.K)
     return DelayFeedbackResult(op, A, B, syn, exact, tuple(windows), stable, checks, scen,
                                points, spec.delay,
-                               spec.plant.state_names + spec.plant.input_names)
+                               spec.plant.state_names + spec.plant.input_names, basin)
 
 
 # -- simulation -----------------------------------------------------------------------
@@ -363,6 +368,9 @@ def quantities(res: DelayFeedbackResult) -> dict:
         q[f"{b}.diverged"] = "yes" if sr.metrics["diverged"] else "no"
         q[f"{b}.converged"] = "yes" if sr.converged else "no"
     q["certificate.covers_delay_range"] = covers(res)
+    if res.basin is not None:
+        from .delay_feedback_basin import basin_quantities
+        q.update(basin_quantities(res.basin))
     return q
 
 

@@ -1,16 +1,11 @@
 """Study ``ntsm-platoon``: paper 001's virtual-coupling platoon under the NTSM law
-(eq 13), with a constant-spacing PD baseline.
+(eq 13), against a constant-spacing PD and a PD with acceleration feed-forward.
 
-Design tables read here: ``[plant]`` (nominal train, Table 1), ``[uncertainty]``
-(seeded parameter spread and external force, bounds G_w, G_d of eq 6),
-``[leader]`` (accelerate - cruise - brake), ``[platoon]`` (n, D, T, horizon),
-``[route]`` (gradients), ``[ntsm]`` (eqs 10-13 parameters), ``[pd]`` and
-``[convergence]`` (initial spacing errors for the eq 22 check and the bands
-that define "reached" and "converged").
-
-Three runs: NTSM from exact spacing (the paper's set-up), NTSM from the
-initial errors (reaching and sliding times against eq 22), PD from exact
-spacing.
+The design is read by :mod:`.platoon001_spec`. Four runs in the paper's
+(ideal) set-up — NTSM from exact spacing, NTSM from the initial errors
+(reaching and sliding times against eq 22), PD, PD + feed-forward — and the
+realistic scenario of :mod:`.platoon001_realism` (V2V link, actuator lag and
+limits, the leader's emergency brake, the exact delay margin).
 """
 from __future__ import annotations
 
@@ -18,44 +13,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..controllers.ntsm import NTSMGains, convergence_time, ntsm_force, pd_force, surface
-from ..plants.platoon001 import PARAMETER_UNITS, TrainParams, external_force, perturbed
+from ..controllers.ntsm import (convergence_time, linear_member, ntsm_force, pd_ff_force,
+                                pd_force, surface)
+from ..plants.platoon001 import TrainParams, external_force, perturbed
 from ..profiles import Profile, build_profile, spec_for_cruise
-from ..reader import Quantity, Reader
-from ..sim.tracking import PlatoonRun, Route, simulate_platoon
-from .tracking002 import read_gradients
+from ..reader import Reader
+from ..sim.platoon import PlatoonRun, simulate_platoon
+from .platoon001_realism import (Realism, accel_end, realism_quantities, realism_quantity_names,
+                                 run_realism)
+from .platoon001_spec import PlatoonSpec, load_spec
 
-
-@dataclass(frozen=True)
-class PlatoonSpec:
-    plant: dict                 # Quantity per PARAMETER_UNITS key
-    mass_spread: float
-    davis_spread: float
-    G_w: float
-    G_d: float
-    hold: float
-    seed: int
-    v_cruise: Quantity
-    cruise_time: float
-    accel: float
-    brake: float
-    jerk: float
-    leader_gain: float
-    n: int
-    D: Quantity
-    T: float
-    horizon: float
-    route: Route
-    gains: NTSMGains
-    kp: float
-    kd: float
-    initial_errors: tuple[float, ...]
-    reach_band: float
-    converge_band: float
-
-    def nominal(self) -> TrainParams:
-        p = {k: q.value for k, q in self.plant.items()}
-        return TrainParams(p["m"], p["c0"], p["c1"], p["c2"], p["g"])
+#: The followers' laws of :meth:`Scenario.law`.
+LAWS = ("ntsm", "pd", "pd_ff", "linear")
 
 
 @dataclass(frozen=True)
@@ -113,6 +82,7 @@ class PlatoonResult:
     runs: dict                        # name -> PlatoonRun
     metrics: dict                     # name -> RunMetrics
     convergence: tuple[Convergence, ...]
+    realism: Realism
 
 
 @dataclass(frozen=True)
@@ -132,9 +102,11 @@ class Scenario:
         return np.interp(t, p.t, p.v, right=0.0), np.interp(t, p.t, p.a, right=0.0)
 
     def law(self, name: str):
-        """The followers' law ``law(e, de, u1, a_pred) -> (u, s)``: "ntsm" or "pd"."""
+        """The followers' law ``law(e, de, u1, a_pred) -> (u, s)``, one of :data:`LAWS`:
+        eq 13, the PD, the PD + acceleration feed-forward, the NTSM's linear member."""
         spec, m = self.spec, self.nominal.m
         g, bound = spec.gains, spec.G_w + spec.G_d
+        k_e, k_d = linear_member(g)
 
         def ntsm(e, de, u1, a_pred):
             s = surface(e, de, g)
@@ -143,16 +115,28 @@ class Scenario:
         def pd(e, de, u1, a_pred):
             return pd_force(e, de, u1, m, spec.kp, spec.kd), np.zeros_like(e)
 
-        return {"ntsm": ntsm, "pd": pd}[name]
+        def pd_ff(e, de, u1, a_pred):
+            return pd_ff_force(e, de, u1, m, a_pred, spec.kp_ff, spec.kd_ff), np.zeros_like(e)
+
+        def linear(e, de, u1, a_pred):
+            return pd_ff_force(e, de, u1, m, a_pred, k_e, k_d), np.zeros_like(e)
+
+        return {"ntsm": ntsm, "pd": pd, "pd_ff": pd_ff, "linear": linear}[name]
 
     def common(self) -> dict:
         spec = self.spec
         return dict(n=spec.n, spacing=spec.D.value, T=spec.T, horizon=spec.horizon, w=self.w,
                     leader_gain=spec.leader_gain, route=spec.route)
 
-    def simulate(self, law: str, initial_errors=None) -> PlatoonRun:
+    def simulate(self, law: str, initial_errors=None, *, horizon: float | None = None,
+                 **realism) -> PlatoonRun:
+        """One run of the law ``law``; ``realism``: ``link``, ``actuator``,
+        ``leader_brake`` of :func:`~workbench.sim.platoon.simulate_platoon`."""
+        common = self.common()
+        if horizon is not None:
+            common["horizon"] = horizon
         return simulate_platoon(self.nominal, self.true, self.law(law), self.leader_ref,
-                                **self.common(), initial_errors=initial_errors)
+                                **common, initial_errors=initial_errors, **realism)
 
 
 def scenario(spec: PlatoonSpec) -> Scenario:
@@ -168,82 +152,27 @@ def scenario(spec: PlatoonSpec) -> Scenario:
     return Scenario(spec, nom, true, w, prof)
 
 
-def _odd(r: Reader, name: str) -> int:
-    return int(r.number(name, integer=True, positive=True, what="positive odd integer"))
-
-
 class NTSMPlatoon:
     kind = "ntsm-platoon"
     uses_solver = False    # no convex solver runs: the report says so
 
     def load(self, root: Reader) -> PlatoonSpec:
-        pl = root.table("plant")
-        pl.string("model", choices=("davis-001",))
-        plant = {k: pl.quantity(k, u, positive=True) for k, u in PARAMETER_UNITS.items()}
-        pl.finish()
-        un = root.table("uncertainty")
-        ms = un.number("mass_spread", nonneg=True, hi=0.5)
-        ds = un.number("davis_spread", nonneg=True, hi=0.5)
-        G_w = un.quantity("G_w", "N", nonneg=True).value
-        G_d = un.quantity("G_d", "N", nonneg=True).value
-        hold = un.quantity("hold", "s", positive=True).value
-        seed = int(un.number("seed", integer=True, nonneg=True, what="integer seed"))
-        un.finish()
-        le = root.table("leader")
-        vc = le.quantity("cruise_speed", "m/s", positive=True, hi=100.0)
-        ct = le.quantity("cruise_time", "s", positive=True).value
-        acc = le.quantity("accel", "m/s^2", positive=True, hi=2.0).value
-        brk = le.quantity("brake", "m/s^2", positive=True, hi=2.0).value
-        jerk = le.quantity("jerk", "m/s^3", positive=True, hi=5.0).value
-        lg = le.quantity("gain", "1/s", positive=True).value
-        le.finish()
-        pt = root.table("platoon")
-        n = int(pt.number("trains", integer=True, lo=2, hi=20, what="number of trains"))
-        D = pt.quantity("spacing", "m", positive=True)
-        T = pt.quantity("T", "s", positive=True, hi=0.1).value
-        horizon = pt.quantity("horizon", "s", positive=True, hi=3600.0).value
-        pt.finish()
-        ro = root.table("route")
-        g_from, grade = read_gradients(ro)
-        ro.finish()
-        nt = root.table("ntsm")
-        gains = NTSMGains(nt.number("beta", positive=True), _odd(nt, "a"), _odd(nt, "b"),
-                          nt.number("j", positive=True), nt.number("k", positive=True),
-                          _odd(nt, "alpha"), _odd(nt, "xi"))
-        bad = gains.problems()
-        if bad:
-            raise nt.fail(*bad[0])
-        nt.finish()
-        pd = root.table("pd")
-        kp, kd = pd.number("kp", positive=True), pd.number("kd", positive=True)
-        pd.finish()
-        cv = root.table("convergence")
-        e0 = cv.numbers("initial_errors", what="spacing errors (m)")
-        if len(e0) != n - 1 or min(e0) < 0:
-            raise cv.fail("initial_errors", list(e0), f"{n - 1} non-negative errors (m), one per "
-                          "follower (a follower too close would have to reverse)")
-        rb = cv.quantity("reach_band", "m", positive=True).value
-        cb = cv.quantity("converge_band", "m", positive=True).value
-        cv.finish()
-        spec = PlatoonSpec(plant, ms, ds, G_w, G_d, hold, seed, vc, ct, acc, brk, jerk, lg, n, D,
-                           T, horizon, Route(1e9, g_from, grade), gains, kp, kd, e0, rb, cb)
-        if spec_for_cruise(vc.value, ct, acc, brk, jerk).run_time > horizon:
-            raise pt.fail("horizon", horizon, "a horizon longer than the leader's run")
-        return spec
+        return load_spec(root)
 
     def quantity_names(self, spec: PlatoonSpec) -> set[str]:
         names = set()
-        for r in ("ntsm", "ntsm_offset", "pd"):
+        for r in ("ntsm", "ntsm_offset", "pd", "pd_ff"):
             names |= {f"{r}.{k}" for k in ("max_abs_e", "cruise_abs_e", "cruise_abs_de",
                                             "chatter", "sign_rate", "lumped_ratio",
                                             "string_ratio", "max_speed")}
-        names |= {"pd_over_ntsm.max_abs_e", "convergence.max_reaching_time",
+        names |= {"pd_over_ntsm.max_abs_e", "pd_ff_over_ntsm.max_abs_e",
+                  "pd_over_pd_ff.max_abs_e", "convergence.max_reaching_time",
                   "convergence.max_rel_error_band", "convergence.max_ratio_eq22",
                   "leader.v_cruise"}
         for i in range(2, spec.n + 1):
             names |= {f"convergence.train{i}.{k}" for k in
                       ("t_reach", "e_reach", "slide_eq22", "slide_band", "slide_measured")}
-        return names
+        return names | realism_quantity_names()
 
     # -- run -------------------------------------------------------------------
     def run(self, design) -> PlatoonResult:
@@ -251,17 +180,18 @@ class NTSMPlatoon:
         sc = scenario(spec)
         runs = {"ntsm": sc.simulate("ntsm"),
                 "ntsm_offset": sc.simulate("ntsm", np.array(spec.initial_errors)),
-                "pd": sc.simulate("pd")}
+                "pd": sc.simulate("pd"), "pd_ff": sc.simulate("pd_ff")}
         prof = sc.profile
         bound = spec.G_w + spec.G_d
         nom = sc.nominal
-        t_acc_end = float(prof.t[np.nonzero(prof.a > 0)[0][-1]])
+        t_acc_end = accel_end(prof)
         t_brk = float(prof.t[np.nonzero(prof.a < 0)[0][0]])
         window = (t_acc_end + 10.0, t_brk)     # settled cruise
         metrics = {k: _metrics(r, window, nom.m, bound) for k, r in runs.items()}
         conv = tuple(_convergence(runs["ntsm_offset"], i, e0, spec)
                      for i, e0 in enumerate(spec.initial_errors))
-        return PlatoonResult(prof, window, runs, metrics, conv)
+        return PlatoonResult(prof, window, runs, metrics, conv,
+                             run_realism(sc))
 
     def quantities(self, res: PlatoonResult) -> dict:
         q = {"leader.v_cruise": res.profile.v_cruise}
@@ -275,6 +205,8 @@ class NTSMPlatoon:
             q[f"{name}.string_ratio"] = m.string_ratio
             q[f"{name}.max_speed"] = max(m.max_speed)
         q["pd_over_ntsm.max_abs_e"] = q["pd.max_abs_e"] / q["ntsm.max_abs_e"]
+        q["pd_ff_over_ntsm.max_abs_e"] = q["pd_ff.max_abs_e"] / q["ntsm.max_abs_e"]
+        q["pd_over_pd_ff.max_abs_e"] = q["pd.max_abs_e"] / q["pd_ff.max_abs_e"]
         for i, c in enumerate(res.convergence):
             for k in ("t_reach", "e_reach", "slide_eq22", "slide_band", "slide_measured"):
                 q[f"convergence.train{i + 2}.{k}"] = getattr(c, k)
@@ -285,6 +217,7 @@ class NTSMPlatoon:
             abs(c.slide_measured / c.slide_band - 1.0) for c in done) if ok else None
         q["convergence.max_ratio_eq22"] = max(
             c.slide_measured / c.slide_eq22 for c in done) if ok else None
+        q.update(realism_quantities(res.realism))
         return q
 
 
