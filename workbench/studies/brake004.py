@@ -36,7 +36,7 @@ from ..controllers.fuzzy import FuzzyIncrement
 from ..controllers.pid import PID
 from ..reader import Quantity, Reader
 from ..sim.stopping import batch_params, simulate
-from .stopping000 import load_plant
+from .stopping000_spec import load_plant
 
 MODES = ("open", "ato-open", "closed")
 #: not a control mode: full service from t = 0, to test each corner's feasibility
