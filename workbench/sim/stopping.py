@@ -198,10 +198,11 @@ def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 
         v_new = np.maximum(v + dt * a, 0.0)
         x_new = x + 0.5 * (v + v_new) * dt
         hit = ~stopped & (v_new <= 0.0) & (t + dt > t_arm)
-        x_hit, t_hit = standstill(x, v, a, x_new, dt)
-        x_new = np.where(hit, x_hit, x_new)
-        t_stop = np.where(hit, t + t_hit, t_stop)
-        x_stop = np.where(hit, x_new, x_stop)
+        if hit.any():
+            x_hit, t_hit = standstill(x, v, a, x_new, dt)
+            x_new = np.where(hit, x_hit, x_new)
+            t_stop = np.where(hit, t + t_hit, t_stop)
+            x_stop = np.where(hit, x_new, x_stop)
         stopped |= hit
         x = np.where(stopped, x_stop, x_new)
         v = np.where(stopped, 0.0, v_new)

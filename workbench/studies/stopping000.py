@@ -16,7 +16,7 @@ from .stopping000_run import (CellStats, StopResult, draw_plants, loop_dead_time
 from .stopping000_spec import (ABLATION_LAWS, COMPENSATED, CONTROLLERS, DAMPING, MC_CONTROLLERS,
                                MC_FACTORS, PAPER_CONTROLLERS, UNCERTAIN, UNCOMPENSATED, VARIANTS,
                                StopSpec, load_plant, load_stop_spec)
-from .stopping_mc import within_rate
+from .stopping_mc import MC_QUANTITIES, within_rate
 
 __all__ = ["ABLATION_LAWS", "CONTROLLERS", "COMPENSATED", "CellStats", "DAMPING",
            "MC_CONTROLLERS", "MC_FACTORS", "PAPER_CONTROLLERS",
@@ -24,9 +24,6 @@ __all__ = ["ABLATION_LAWS", "CONTROLLERS", "COMPENSATED", "CellStats", "DAMPING"
            "load_plant", "load_stop_spec", "loop_dead_time", "run_station_stops",
            "within_rate"]
 
-#: Monte Carlo statistics a claim may name: quantity suffix -> StopStatistics attribute.
-MC_QUANTITIES = {"p_within": "p", "within_lo": "lo", "within_hi": "hi", "p95_abs_m": "p95",
-                 "mean_m": "mean", "overshoot_share": "overshoot"}
 
 
 class StationStopping:

@@ -167,6 +167,11 @@ def within_rate(errors, tol: float, z: float = Z95):
     return k, n, p, max(0.0, mid - half), min(1.0, mid + half)
 
 
+#: Statistics a claim may name: quantity suffix -> :class:`StopStatistics` attribute.
+MC_QUANTITIES = {"p_within": "p", "within_lo": "lo", "within_hi": "hi", "p95_abs_m": "p95",
+                 "mean_m": "mean", "overshoot_share": "overshoot"}
+
+
 @dataclass(frozen=True)
 class StopStatistics:
     """Stop errors of one controller (or mode) over a Monte Carlo, in metres.
