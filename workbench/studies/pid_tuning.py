@@ -21,9 +21,9 @@ neglected):
   filter f' = (b - f) / tau, e = a_req - f, c = kp e + ki int e. States
   (b, f, int e).
 
-:func:`tune_pid` searches a fixed log-spaced (kp, ki) grid (kd = 0) for the
-largest decay rate -alpha subject to zeta >= zeta_min: deterministic, no
-random numbers.
+:func:`tune_pid` searches a fixed log-spaced (kp, ki) grid (kd = 0), then
+refines it around its best point, for the largest decay rate -alpha subject
+to zeta >= zeta_min: deterministic, no random numbers.
 """
 from __future__ import annotations
 
@@ -85,8 +85,12 @@ def damping(A, Ad, h: float) -> Damping:
 
 
 def tune_pid(loop, h: float, *, zeta_min: float, kp=(0.05, 3.0), ki=(0.005, 3.0),
-             points: int = 25) -> tuple[float, float, Damping]:
+             points: int = 25, refine: int = 3) -> tuple[float, float, Damping]:
     """(kp, ki, damping) with the largest decay rate and zeta >= ``zeta_min``.
+
+    A log-spaced grid of ``points`` x ``points`` gains, then ``refine`` rounds
+    of a 9 x 9 log grid spanning one step of the previous grid on each side
+    of its best point (the step shrinks by 4 each round); deterministic.
 
     Parameters
     ----------
@@ -97,19 +101,28 @@ def tune_pid(loop, h: float, *, zeta_min: float, kp=(0.05, 3.0), ki=(0.005, 3.0)
     zeta_min : float
         Required damping ratio of the dominant roots.
     kp, ki : (float, float)
-        Ranges of the log-spaced grid (``points`` values each).
+        Ranges of the first grid.
 
     Raises
     ------
     ValueError
         No grid point meets the damping requirement.
     """
-    best = None
-    for p in np.geomspace(*kp, points):
-        for i in np.geomspace(*ki, points):
-            d = damping(*loop(float(p), float(i)), h)
-            if d.zeta >= zeta_min and (best is None or d.alpha < best[2].alpha):
-                best = (float(p), float(i), d)
+    def search(kps, kis, best):
+        for p in kps:
+            for i in kis:
+                d = damping(*loop(float(p), float(i)), h)
+                if d.zeta >= zeta_min and (best is None or d.alpha < best[2].alpha):
+                    best = (float(p), float(i), d)
+        return best
+
+    best = search(np.geomspace(*kp, points), np.geomspace(*ki, points), None)
     if best is None:
         raise ValueError(f"no (kp, ki) on the grid reaches zeta >= {zeta_min}")
+    step = np.array([np.log(kp[1] / kp[0]), np.log(ki[1] / ki[0])]) / (points - 1)
+    for _ in range(refine):
+        centre = np.log([best[0], best[1]])
+        grids = [np.exp(np.linspace(c - s, c + s, 9)) for c, s in zip(centre, step)]
+        best = search(*grids, best)
+        step = step / 4
     return best

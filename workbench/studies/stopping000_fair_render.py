@@ -74,16 +74,19 @@ def _pid_part(spec, res) -> str:
         "target deceleration as feed-forward; its roots are the exact ones of the delay "
         "equation (`workbench/margins`, no Padé approximation). Tuning "
         "(`workbench/studies/pid_tuning.py`, `tune_pid`): the largest decay rate −α meeting "
-        "the criterion on a fixed 25 × 25 log grid of (kp, ki), kd = 0; deterministic. The "
+        "the criterion on a fixed 25 × 25 log grid of (kp, ki), kd = 0, refined three times "
+        "around its best point; deterministic; rounded to 2 digits. The "
         "grid-tuned gains of the paper rows (best mean |stop error| on a small grid) do not "
         "meet it: their loop rings. Time-domain check: sign changes of the speed error of the "
         "nominal stop while tracking (|error| below 5 cm/s ignored).\n\n"
         + md_table(["PID", "kp", "ki", "kd", "dead time in the loop (s)", "dominant ζ",
                     "period of the least damped root (s)", "decay rate −α (1/s)",
                     "sign changes of the speed error"], rows, "lrrrrrrrr")
-        + "\n\nBehind the predictor the same gains see only the sample-and-hold delay (nominal "
-        "model exact), hence the higher damping of the last row. The damped PID no longer "
-        "rings, but it regulates speed only: the position error it accumulates while the brake "
+        + "\n\nBehind the predictor the nominal loop keeps only the sample-and-hold delay, so "
+        "the compensated PID is tuned on that loop (the design procedure a Smith predictor "
+        "allows): the same criterion, faster gains. Each PID's tuning is the one of the loop it "
+        "runs in (also in the ablation below: the predictor rows use the compensated gains). "
+        "The damped PID no longer rings, but it regulates speed only: the position error it accumulates while the brake "
         "comes in is never fed back, so without compensation its stops are worse, not better "
         "(rows below). In the figure the compensated run is in its terminal phase over the last "
         "seconds, where v_d is no longer what it follows.\n\n"
@@ -147,7 +150,7 @@ def figures(res) -> tuple[Figure, ...]:
 
 def _plot_pid(fig, res):
     ax = fig.add_subplot(111)
-    for k, c in enumerate(DAMPING + ("pid-comp",)):
+    for k, c in enumerate(DAMPING):
         n = res.nominal[c]
         moving = np.concatenate(([True], n.v[1:] > 0))
         ax.plot(n.t[moving], 100 * (n.v - n.v_d)[moving], color=f"C{k}", label=VARIANTS[c].label)

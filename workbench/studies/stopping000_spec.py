@@ -73,7 +73,7 @@ class Variant:
     Attributes
     ----------
     law : {"pid", "smc", "smarc", "smarc-sgn"}
-    gains : {"pid", "pid_damped", ""}
+    gains : {"pid", "pid_damped", "pid_compensated", ""}
         PID gain table of the design ("" for the sliding laws).
     predictor : bool
         The law acts on the state one dead time ahead (Smith predictor).
@@ -98,13 +98,14 @@ VARIANTS = {
     "smarc": Variant("smarc", "", False, False, "SMARC"),
     "smarc-sgn": Variant("smarc-sgn", "", False, False, "SMARC (sgn)"),
     "pid-damped": Variant("pid", "pid_damped", False, False, "PID, ζ ≥ 0.7"),
-    "pid-comp": Variant("pid", "pid_damped", True, True, "PID, ζ ≥ 0.7 + compensation"),
+    "pid-comp": Variant("pid", "pid_compensated", True, True, "PID, ζ ≥ 0.7 + compensation"),
     "smc-comp": Variant("smc", "", True, True, "SMC + compensation"),
     "smarc-comp": Variant("smarc", "", True, True, "SMARC + compensation"),
     "smarc-comp-nogain": Variant("smarc", "", True, True,
                                  "SMARC + compensation, no gain correction", False),
     # nominal-plant ablation: one part of the compensation at a time
-    "pid-damped+predictor": Variant("pid", "pid_damped", True, False, "PID, ζ ≥ 0.7 + predictor"),
+    "pid-damped+predictor": Variant("pid", "pid_compensated", True, False,
+                                    "PID, ζ ≥ 0.7 + predictor"),
     "pid-damped+terminal": Variant("pid", "pid_damped", False, True, "PID, ζ ≥ 0.7 + terminal"),
     "smc+predictor": Variant("smc", "", True, False, "SMC + predictor"),
     "smc+terminal": Variant("smc", "", False, True, "SMC + terminal"),
@@ -174,14 +175,16 @@ class StopSpec:
     c_min: float
     published: tuple = ()   # (section, smarc, smc, pid, smarc mean, smarc var, source): data
     pid_damped: dict | None = None       # kp, ki, kd of the damped PID
+    pid_compensated: dict | None = None  # ... and of the damped PID behind the predictor
     zeta_min: float = 0.7                # its damping requirement
     tolerance: Quantity | None = None    # platform tolerance (m)
     compensation: Compensation | None = None
     montecarlo: MonteCarloSpec | None = None
 
     def gains(self, name: str) -> dict:
-        """PID gain table ``name`` ("pid" or "pid_damped")."""
-        return self.pid if name == "pid" else self.pid_damped
+        """PID gain table ``name`` ("pid", "pid_damped" or "pid_compensated")."""
+        return {"pid": self.pid, "pid_damped": self.pid_damped,
+                "pid_compensated": self.pid_compensated}[name]
 
 
 def load_plant(root: Reader) -> dict:
@@ -227,6 +230,9 @@ def load_stop_spec(root: Reader) -> StopSpec:
     pid_damped = {k: p.number(k, nonneg=True) for k in ("kp", "ki", "kd")}
     zeta_min = p.number("zeta_min", positive=True, hi=1.0)
     p.finish()
+    p = ctl.table("pid_compensated")
+    pid_comp = {k: p.number(k, nonneg=True) for k in ("kp", "ki", "kd")}
+    p.finish()
     s = ctl.table("sliding")
     sliding = SlidingGains(c=s.number("c", positive=True), k_s=s.number("k_s", positive=True),
                            eta=s.number("eta", nonneg=True), phi=s.number("phi", nonneg=True))
@@ -264,5 +270,6 @@ def load_stop_spec(root: Reader) -> StopSpec:
                r.string("source"))
         pub.append(row)
         r.finish()
-    return replace(spec, published=tuple(pub), pid_damped=pid_damped, zeta_min=zeta_min,
+    return replace(spec, published=tuple(pub), pid_damped=pid_damped, pid_compensated=pid_comp,
+                   zeta_min=zeta_min,
                    tolerance=tol, compensation=comp, montecarlo=mc)

@@ -187,7 +187,8 @@ class StopStatistics:
     mean : float
         Signed mean error (m, + = overshoot).
     overshoot : float
-        Share of stops beyond the stopping point.
+        Share of stops beyond the stopping point (a run that never stopped counts
+        as beyond; its error is nan, so is the mean).
     errors : tuple[float, ...]
     """
 
@@ -208,5 +209,18 @@ def stop_statistics(errors, tol: float) -> StopStatistics:
     e = np.asarray(errors, float)
     e_in = np.where(np.isfinite(e), e, np.inf)
     k, n, p, lo, hi = within_rate(e_in, tol)
-    return StopStatistics(k, n, p, lo, hi, float(np.percentile(np.abs(e_in), 95)),
+    return StopStatistics(k, n, p, lo, hi, percentile(np.abs(e_in), 95.0),
                           float(np.mean(e)), float(np.mean(e_in > 0)), tuple(float(x) for x in e))
+
+
+def percentile(x, q: float) -> float:
+    """The q-th percentile of ``x`` by linear interpolation between order
+    statistics (numpy's default), inf when an infinite value takes part."""
+    s = np.sort(np.asarray(x, float))
+    if np.all(np.isfinite(s)):
+        return float(np.percentile(s, q))
+    pos = q / 100 * (len(s) - 1)
+    i, j = int(np.floor(pos)), int(np.ceil(pos))
+    if i == j or not np.isfinite(s[j]):
+        return float(s[j])
+    return float(s[i] + (pos - i) * (s[j] - s[i]))
