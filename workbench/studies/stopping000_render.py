@@ -148,7 +148,9 @@ def _within_section(res) -> str:
             "sections and repeats, with the Wilson 95 % interval of the proportion:\n\n"
             + md_table(["controller", "stops within 0.3 m", "P(|e| <= 0.3 m)", "95 % interval",
                         "95th percentile of |e| (cm)"], rows, "lrrrr")
-            + "\n\n![stop error distribution]({figdir}/stop-error-cdf.png)")
+            + "\n\n![stop error distribution]({figdir}/stop-error-cdf.png)\n\nThese are the paper "
+            "rows over the repeats' uniform ranges; the Monte Carlo over continuous distributions, "
+            "the nominal row and the rows with known-delay compensation follow.")
 
 
 def _plot_cdf(fig, res):
