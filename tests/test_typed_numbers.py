@@ -165,6 +165,11 @@ RENDERER_CONSTANTS = {
     ("stopping000_render.py", "85.16"): "K1/K2 as paper 000's Table 1 prints it",
     ("delay_feedback_basin_render.py", "0.6"): "a matplotlib grey level, not text",
     ("platoon001_realism_render.py", "1e-9"): "display floor of a printed relative difference",
+    ("brake004_fair_render.py", "0.5"): "the horizon before the retuning (a t_predict_sweep value)",
+    ("brake004_fair_render.py", "0.7"): "paper 000's damping criterion of its PID",
+    ("brake004_fair_render.py", "0.9"): "a matplotlib grey level, not text",
+    ("stopping000_fair_render.py", "0.0"): "how a zero is printed, not a number in prose",
+    ("stopping000_fair_render.py", "-0.0"): "how a zero is printed, not a number in prose",
 }
 
 

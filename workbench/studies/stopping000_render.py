@@ -6,7 +6,9 @@ import sympy as sp
 
 from ..plants.brake000 import brake_model
 from ..report.markdown import Figure, Rendered, fmt, md_table
-from .stopping000 import CONTROLLERS, UNCERTAIN, within_rate
+from .stopping000 import CONTROLLERS, UNCERTAIN
+from .stopping000_fair_render import fair_section, figures
+from .stopping_mc import within_rate
 
 LABEL = {"pid": "PID", "smc": "SMC", "smarc": "SMARC", "smarc-sgn": "SMARC (sgn)"}
 
@@ -106,6 +108,7 @@ def render(design, res) -> Rendered:
         "brake's under-delivery, P1 and the air gain).\n\n"
         "![stop errors]({figdir}/stop-errors.png)\n\n![curves]({figdir}/stop-curves.png)"
         + "\n\n" + _within_section(res))
+    sections.append(fair_section(spec, res))
     if spec.published:
         prow = []
         for k, smarc, smc, pid, m4, v4, src in spec.published:
@@ -128,7 +131,7 @@ def render(design, res) -> Rendered:
             Figure("stop-curves", "Speed against distance to the stopping point, section 1.",
                    lambda fig, res=res: _plot_curves(fig, res), size=(7.0, 4.0)),
             Figure("stop-error-cdf", "Distribution of |stop error| per controller.",
-                   lambda fig, res=res: _plot_cdf(fig, res), size=(7.0, 4.0)))
+                   lambda fig, res=res: _plot_cdf(fig, res), size=(7.0, 4.0))) + figures(res)
     return Rendered(tuple(sections), figs)
 
 
@@ -149,7 +152,9 @@ def _within_section(res) -> str:
             "sections and repeats, with the Wilson 95 % interval of the proportion:\n\n"
             + md_table(["controller", f"stops within {w} m", f"P(|e| <= {w} m)", "95 % interval",
                         "95th percentile of |e| (cm)"], rows, "lrrrr")
-            + "\n\n![stop error distribution]({figdir}/stop-error-cdf.png)")
+            + "\n\n![stop error distribution]({figdir}/stop-error-cdf.png)\n\nThese are the paper "
+            "rows over the repeats' uniform ranges; the Monte Carlo over continuous distributions, "
+            "the nominal row and the rows with known-delay compensation follow.")
 
 
 def _plot_cdf(fig, res):
