@@ -54,6 +54,15 @@ def slug(heading: str) -> str:
                    if ch.isalnum() or ch in " -_")
 
 
+def fmt_floor(x: float, sig: int = 2) -> str:
+    """A positive finite lower bound rounded *down* to ``sig`` significant
+    digits (a lower bound may only be rounded down). For LMI bounds of a given
+    gain, whose last digits depend on the bisection's path and hence on the
+    CPU's BLAS kernels."""
+    q = 10.0 ** (math.floor(math.log10(x)) - (sig - 1))
+    return fmt(math.floor(x / q + 1e-12) * q, sig)
+
+
 def fmt(x, sig: int = 4) -> str:
     """A number with ``sig`` significant digits (solver noise below them does
     not change the text); ``inf``, ``nan``, ``None`` and words pass through."""
