@@ -172,7 +172,9 @@ def test_synthesis_scales_with_time(c):
     assert _close(r1.gain.h_certified, c * rc.gain.h_certified)
 
 
-@pytest.mark.parametrize("c", [pytest.param(c, marks=SYNTHESIS_UNIT_DEFECT) for c in (1e-4, 1e4)])
+# c = 1e4 shows the same defect and took 105 s (of a 15 min suite): the defect is
+# pinned by c = 1e-4 here and by both directions in test_synthesis_scales_with_time.
+@pytest.mark.parametrize("c", [pytest.param(1e-4, marks=SYNTHESIS_UNIT_DEFECT)])
 def test_robust_synthesis_scales_with_time(c):
     """The polytopic (descriptor) synthesis with a decay rate: (c A_i, c B_i),
     cap h_hi / c and rate c alpha give the same K and h / c."""
