@@ -15,3 +15,27 @@ def _repo_cwd(monkeypatch):
 def pytest_addoption(parser):
     parser.addoption("--regen-golden", action="store_true",
                      help="rewrite golden files instead of comparing with them")
+
+
+# A timeline for CI logs: with WORKBENCH_TEST_TIMELINE=1 (set by .ci/run) each
+# test file's start is written to stderr with the seconds since the session
+# began, so a run cut short by a time limit still shows where the time went.
+_T0 = [None, None]
+
+
+def pytest_sessionstart(session):
+    import time
+    _T0[0] = time.monotonic()
+
+
+def pytest_runtest_logstart(nodeid, location):
+    import os
+    import sys
+    import time
+    if not os.environ.get("WORKBENCH_TEST_TIMELINE"):
+        return
+    path = nodeid.split("::")[0]
+    if path != _T0[1]:
+        _T0[1] = path
+        sys.stderr.write(f"\n[{time.monotonic() - (_T0[0] or 0):7.1f} s] {path}\n")
+        sys.stderr.flush()
