@@ -17,25 +17,25 @@ def pytest_addoption(parser):
                      help="rewrite golden files instead of comparing with them")
 
 
-# A timeline for CI logs: with WORKBENCH_TEST_TIMELINE=1 (set by .ci/run) each
-# test file's start is written to stderr with the seconds since the session
-# began, so a run cut short by a time limit still shows where the time went.
-_T0 = [None, None]
+# A timeline for CI logs: with WORKBENCH_TEST_TIMELINE=1 (set by .ci/run) the
+# first start of each test file is written to stderr with the seconds since the
+# session began (under xdist this runs in the controller, as workers report), so
+# a run cut short by a time limit still shows where the time went.
+_TIMELINE = {"t0": 0.0, "seen": set()}
 
 
 def pytest_sessionstart(session):
     import time
-    _T0[0] = time.monotonic()
+    _TIMELINE["t0"] = time.monotonic()
 
 
 def pytest_runtest_logstart(nodeid, location):
     import os
     import sys
     import time
-    if not os.environ.get("WORKBENCH_TEST_TIMELINE"):
-        return
     path = nodeid.split("::")[0]
-    if path != _T0[1]:
-        _T0[1] = path
-        sys.stderr.write(f"\n[{time.monotonic() - (_T0[0] or 0):7.1f} s] {path}\n")
-        sys.stderr.flush()
+    if not os.environ.get("WORKBENCH_TEST_TIMELINE") or path in _TIMELINE["seen"]:
+        return
+    _TIMELINE["seen"].add(path)
+    sys.stderr.write(f"\n[{time.monotonic() - _TIMELINE['t0']:7.1f} s] {path}\n")
+    sys.stderr.flush()
