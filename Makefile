@@ -10,8 +10,6 @@ STAMP  := $(VENV)/.installed
 export OPENBLAS_NUM_THREADS ?= 1
 # A second CPU's BLAS kernels (no FMA): the report check must hold under it too.
 OTHER_KERNEL ?= Sandybridge
-# pytest workers (pytest-xdist, one test file at a time each)
-TEST_WORKERS ?= 2
 
 .PHONY: install report test test-wheel bench clean
 
@@ -28,7 +26,7 @@ report: install
 	$(WB) report --all
 
 ## tests, every claim (designs and proofs) and report freshness, on two CPUs' BLAS
-## kernels. Four processes share the two cores: pytest's two workers; `workbench check`
+## kernels. Three processes share the two cores: pytest; `workbench check`
 ## (`workbench verify` + `workbench report --all --check` in one process, each
 ## study computed once; its output ends with the time each design's study took);
 ## and the report check again under another CPU's kernels (OTHER_KERNEL). Their
@@ -37,7 +35,7 @@ test: install
 	@t0=$$(date +%s); log=$$(mktemp); other=$$(mktemp); \
 	$(WB) check > $$log 2>&1 & check=$$!; \
 	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(WB) report --all --check > $$other 2>&1 & second=$$!; \
-	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile --durations=15; tests=$$?; \
+	$(PY) -m pytest --durations=15; tests=$$?; \
 	echo "== pytest done after $$(( $$(date +%s) - t0 )) s"; \
 	wait $$check; checked=$$?; wait $$second; seconded=$$?; \
 	echo; echo "== workbench check (verify + report --all --check)"; cat $$log; \

@@ -34,7 +34,8 @@ def pytest_runtest_logstart(nodeid, location):
     import sys
     import time
     path = nodeid.split("::")[0]
-    if not os.environ.get("WORKBENCH_TEST_TIMELINE") or path in _TIMELINE["seen"]:
+    if (not os.environ.get("WORKBENCH_TEST_TIMELINE") or os.environ.get("PYTEST_XDIST_WORKER")
+            or path in _TIMELINE["seen"]):
         return
     _TIMELINE["seen"].add(path)
     sys.stderr.write(f"\n[{time.monotonic() - _TIMELINE['t0']:7.1f} s] {path}\n")
