@@ -72,11 +72,13 @@ def iadd(a: Interval, b: Interval) -> Interval:
 
 
 def imul(a: Interval, b: Interval) -> Interval:
+    # The hull of the four end-point products. np.minimum / np.maximum
+    # propagate a NaN product (0 * inf), which _fix turns into the infinite
+    # bound on its side: the whole real line, as for any undefined product.
     with np.errstate(invalid="ignore", over="ignore"):
-        p = np.stack([a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi])
-    nan = np.isnan(p)
-    lo = np.where(nan, -_INF, p).min(axis=0)
-    hi = np.where(nan, _INF, p).max(axis=0)
+        p1, p2, p3, p4 = a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi
+    lo = np.minimum(np.minimum(p1, p2), np.minimum(p3, p4))
+    hi = np.maximum(np.maximum(p1, p2), np.maximum(p3, p4))
     return _fix(_down(lo), _up(hi))
 
 
