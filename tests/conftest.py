@@ -19,8 +19,7 @@ def pytest_addoption(parser):
 
 # A timeline for CI logs: with WORKBENCH_TEST_TIMELINE=1 (set by .ci/run) the
 # first start of each test file is written to stderr with the seconds since the
-# session began (under xdist this runs in the controller, as workers report), so
-# a run cut short by a time limit still shows where the time went.
+# session began, so a run cut short by a time limit still shows where the time went.
 _TIMELINE = {"t0": 0.0, "seen": set()}
 
 
@@ -34,8 +33,7 @@ def pytest_runtest_logstart(nodeid, location):
     import sys
     import time
     path = nodeid.split("::")[0]
-    if (not os.environ.get("WORKBENCH_TEST_TIMELINE") or os.environ.get("PYTEST_XDIST_WORKER")
-            or path in _TIMELINE["seen"]):
+    if not os.environ.get("WORKBENCH_TEST_TIMELINE") or path in _TIMELINE["seen"]:
         return
     _TIMELINE["seen"].add(path)
     sys.stderr.write(f"\n[{time.monotonic() - _TIMELINE['t0']:7.1f} s] {path}\n")
