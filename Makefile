@@ -25,23 +25,29 @@ install: $(STAMP)
 report: install
 	$(WB) report --all
 
-## tests, every claim (designs and proofs) and report freshness. `workbench check`
-## is `workbench verify` + `workbench report --all --check` in one process (each
-## study computed once); it runs next to pytest (two cores), its output is shown
-## after pytest's and ends with the time each design's study took. Then the
-## report check and the golden report again under another CPU's BLAS kernels.
+## tests, every claim (designs and proofs) and report freshness, on two CPUs' BLAS
+## kernels. Three processes share the two cores: pytest; `workbench check`
+## (`workbench verify` + `workbench report --all --check` in one process, each
+## study computed once; its output ends with the time each design's study took);
+## and the report check again under another CPU's kernels (OTHER_KERNEL). Their
+## outputs are shown after pytest's, then the golden report runs under OTHER_KERNEL.
 test: install
-	@log=$$(mktemp); \
+	@t0=$$(date +%s); log=$$(mktemp); other=$$(mktemp); \
 	$(WB) check > $$log 2>&1 & check=$$!; \
+	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(WB) report --all --check > $$other 2>&1 & second=$$!; \
 	$(PY) -m pytest --durations=15; tests=$$?; \
-	wait $$check; checked=$$?; \
-	echo; echo "== workbench check (verify + report --all --check)"; cat $$log; rm -f $$log; \
-	echo "pytest exit $$tests, workbench check exit $$checked"; \
-	test $$tests -eq 0 && test $$checked -eq 0
-	@echo "== report check and golden report under OPENBLAS_CORETYPE=$(OTHER_KERNEL)"
-	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(WB) report --all --check
+	echo "== pytest done after $$(( $$(date +%s) - t0 )) s"; \
+	wait $$check; checked=$$?; wait $$second; seconded=$$?; \
+	echo; echo "== workbench check (verify + report --all --check)"; cat $$log; \
+	echo; echo "== report --all --check under OPENBLAS_CORETYPE=$(OTHER_KERNEL)"; cat $$other; \
+	rm -f $$log $$other; \
+	echo "== golden report under OPENBLAS_CORETYPE=$(OTHER_KERNEL)"; \
 	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(PY) -m pytest -q -p no:cacheprovider \
-	  tests/test_cli_and_reports.py::test_golden_report
+	  tests/test_cli_and_reports.py::test_golden_report; golden=$$?; \
+	echo "pytest exit $$tests, workbench check exit $$checked," \
+	     "$(OTHER_KERNEL) report check exit $$seconded, golden exit $$golden;" \
+	     "$$(( $$(date +%s) - t0 )) s"; \
+	test $$tests -eq 0 && test $$checked -eq 0 && test $$seconded -eq 0 && test $$golden -eq 0
 
 ## the wheel in a fresh venv outside the checkout: init, verify --junit-xml,
 ## pytest --workbench (needs PyPI for the dependencies; run by .ci/run)

@@ -20,6 +20,7 @@ import time
 from pathlib import Path
 
 from workbench.design import load_design
+from workbench.sim.progress import progress
 from workbench.studies import antiskid_run_spec as S
 from workbench.studies.antiskid_scenario import Mesh, simulate_antiskid
 
@@ -49,9 +50,10 @@ def main() -> None:
     if not args.skip_compensated:
         spec, cs, rs = _settings(ROOT / "designs/antiskid-run-dry.toml", "compensated")
         t_b = spec.scenario["t_brake"]
-        rows = [("fixed dt", *_timed(rs, spec.dt)), ("fixed dt/2", *_timed(rs, spec.dt / 2)),
-                ("mesh dt", *_timed(rs, spec.dt, Mesh(spec.dt, spec.mesh_courant,
-                                                      spec.mesh_levels)))]
+        runs = (("fixed dt", spec.dt, None), ("fixed dt/2", spec.dt / 2, None),
+                ("mesh dt", spec.dt, Mesh(spec.dt, spec.mesh_courant, spec.mesh_levels)))
+        rows = [(name, *_timed(rs, dt, mesh)) for name, dt, mesh in
+                progress(runs, desc="dry, compensated", unit="run")]
         base = rows[0][2]
         print(f"dry, compensated (dt = {spec.dt:g} s; mesh courant {spec.mesh_courant:g}, "
               f"{spec.mesh_levels} levels)")
@@ -64,11 +66,12 @@ def main() -> None:
     spec, cs, rs = _settings(ROOT / "designs/antiskid-run-dry-mass-minus5.toml",
                              "uncompensated", 6.0)
     print("dry, mass -5 %, without the predictor, max creep ratio over the first 6 s:")
-    for dt in (0.01, 0.005, 0.0025, 0.00125, 0.000625):
+    for dt in progress((0.01, 0.005, 0.0025, 0.00125, 0.000625), desc="fixed-step runs",
+                       unit="run"):
         m, wall = _timed(rs, dt)
         print(f"  fixed dt = {dt * 1e3:6.3f} ms: {m.lam_max_traction:.5f}  (wall {wall:.2f} s)")
     mesh = Mesh(spec.dt, spec.mesh_courant, spec.mesh_levels)
-    for dt in (spec.dt, spec.dt / 2):
+    for dt in progress((spec.dt, spec.dt / 2), desc="mesh runs", unit="run"):
         m, wall = _timed(rs, dt, mesh)
         print(f"  mesh  dt = {dt * 1e3:6.3f} ms: {m.lam_max_traction:.5f}  (wall {wall:.2f} s)")
 

@@ -21,14 +21,14 @@ REPEATS = int(sys.argv[1]) if len(sys.argv) > 1 else 50
 
 def main() -> None:
     spec = replace(load_design("designs/stopping-line5.toml").spec, repeats=REPEATS)
-    run_station_stops(replace(spec, repeats=2))                  # warm lambdify caches
+    run_station_stops(replace(spec, repeats=2), extras=False)    # warm lambdify caches
     n = len(spec.sections) * len(CONTROLLERS) * REPEATS
 
     t0 = time.perf_counter()
-    batched = run_station_stops(spec)
+    batched = run_station_stops(spec, extras=False)
     t_batched = time.perf_counter() - t0
     t0 = time.perf_counter()
-    per_section = run_station_stops(spec, batch="per-section")
+    per_section = run_station_stops(spec, batch="per-section", extras=False)
     t_sections = time.perf_counter() - t0
 
     same = all(np.allclose(batched.stats[k].errors, per_section.stats[k].errors, atol=1e-9)

@@ -48,6 +48,20 @@ def _projection(x, upper_strict: bool):
     return sp.Piecewise((0, up & (x > 0)), (0, lo & (x < 0)), (x, True))
 
 
+#: Severity of the as-printed projection (eq 27), upper and lower bound alike.
+_PROJ_SEVERITY = dict(
+    severity="minor",
+    severity_reason="the strict form fails only on the boundary itself, where theta_hat can "
+                    "pass the bound by the one update that reaches it; the bounds the proof "
+                    "uses hold with >= / <=")
+#: Severity of eq 1 as printed (branch t > T2).
+_EQ1_SEVERITY = dict(
+    severity="minor",
+    severity_reason="with Table 1's T2 < T1 the printed branch differs only for T2 < t < T1, "
+                    "where the lag term is still small; the workbench's brake model "
+                    "(workbench/plants/brake000.py) starts it at T1")
+
+
 def claims() -> list[Claim]:
     good, printed = closed_loop(xd2), closed_loop(xd1)
     zd, thd, tau = sp.symbols(r"\dot{z} \dot{\hat{\theta}} tau", real=True)
@@ -58,25 +72,37 @@ def claims() -> list[Claim]:
               "With V as printed (theta_tilde z^2/(2 lambda)), law (22) and adaptation (24) "
               "give V' = -k_s z^2 - eta|z| + Delta z", "identity",
               time_derivative(V_PRINTED, good), TARGET, expect="refuted",
-              note="Erratum: eq 19 writes theta_tilde z^2 where theta_tilde^2 is meant."),
+              note="Erratum: eq 19 writes theta_tilde z^2 where theta_tilde^2 is meant.",
+              severity="minor",
+              severity_reason="a typo in V: the law and adaptation as printed are unchanged and "
+                              "with theta_tilde^2 they give eq 25 (smarc-eq19-corrected)"),
         Claim("smarc-eq19-corrected", PAPER, "19-25",
               "With V = theta z^2/2 + theta_tilde^2/(2 lambda), x_d'' in (21)-(24): "
               "V' = -k_s z^2 - eta|z| + Delta z", "identity",
-              time_derivative(V, good), TARGET),
+              time_derivative(V, good), TARGET, origin="workbench"),
         Claim("smarc-eq20-printed", PAPER, "20",
               "dV/dt = theta z z' + theta_tilde theta_hat' z / lambda (as printed, stray z)",
               "identity", time_derivative(V, flows_generic),
               theta * z * zd + th_tilde * thd * z / lam, expect="refuted",
-              note="Erratum: the factor z of the last term of eq 20 is stray."),
+              note="Erratum: the factor z of the last term of eq 20 is stray.",
+              severity="minor",
+              severity_reason="a stray factor in an intermediate line; the derivative without "
+                              "it (smarc-eq20-corrected) leads to eq 25"),
         Claim("smarc-eq20-corrected", PAPER, "20",
               "dV/dt = theta z z' + theta_tilde theta_hat' / lambda", "identity",
-              time_derivative(V, flows_generic), theta * z * zd + th_tilde * thd / lam),
+              time_derivative(V, flows_generic), theta * z * zd + th_tilde * thd / lam,
+              origin="workbench"),
         Claim("smarc-eq21-24-printed", PAPER, "21-24",
               "With x_d' (as printed) in the law and the adaptation: "
               "V' = -k_s z^2 - eta|z| + Delta z", "identity",
               time_derivative(V, printed), TARGET, expect="refuted",
               note="Erratum: eqs 20-24 write x_d' where x_d'' is meant; "
-                   "the corrected form is smarc-eq19-corrected."),
+                   "the corrected form is smarc-eq19-corrected.",
+              severity="changes-the-result",
+              severity_reason="the law and adaptation as printed are not those the proof "
+                              "covers: their V' gains theta z (x_d' - x_d''), a speed-sized term "
+                              "the robust term eta|z| does not dominate, so eq 25 and the "
+                              "stability conclusion do not follow for them"),
         Claim("smarc-eq25", PAPER, "16, 22, 25",
               "-k_s z^2 - eta|z| + Delta z <= -k_s z^2 when |Delta| <= D < eta",
               "inequality", TARGET, -k_s * z**2,
@@ -92,15 +118,17 @@ def claims() -> list[Claim]:
             f"Proj with '{rel}': at theta_hat = theta_max the rate Proj(tau) is <= 0 "
             "(theta_hat stays <= theta_max)", "inequality", _projection(tau, strict), 0,
             given=((th_hat, th_max),), hypotheses=(hyp(th_max, ">", th_min),),
-            sample=box, expect=exp,
+            sample=box, expect=exp, origin="paper" if strict else "workbench",
             note="" if not strict else "Eq 27's strict inequalities let the rate point "
-            "outwards on the boundary itself; with >= / <= the interval is invariant."))
+            "outwards on the boundary itself; with >= / <= the interval is invariant.",
+            **(_PROJ_SEVERITY if strict else {})))
         out.append(Claim(
             f"smarc-eq27-lower-{tag}", PAPER, "26-27",
             f"Proj with '{rel.replace('>', '<')}': at theta_hat = theta_min the rate "
             "Proj(tau) is >= 0", "inequality", 0, _projection(tau, strict),
             given=((th_hat, th_min),), hypotheses=(hyp(th_max, ">", th_min),),
-            sample=box, expect=exp))
+            sample=box, expect=exp, origin="paper" if strict else "workbench",
+            **(_PROJ_SEVERITY if strict else {})))
     # eq (27) keeps eq (25): the extra term theta_tilde (Proj(tau) - tau)/lambda <= 0
     proj = _projection(tau, False)
     extra = th_tilde * (proj - tau) / lam
@@ -132,6 +160,8 @@ def claims() -> list[Claim]:
             f"on the branch t > {start} of eq 1, a_real = a_bra (1 - exp(-(t - T1)/T2)) "
             "has the sign of a_bra (a_real / a_bra >= 0)", "inequality", 0, lag,
             hypotheses=(hyp(t, ">", start),), expect=exp,
+            origin="workbench" if exp == "proved" else "paper",
             note="" if exp == "proved" else "Eq 1 writes t > T2 for the branch that starts "
-            "after the delay T1: for T2 < t < T1 the response has the wrong sign."))
+            "after the delay T1: for T2 < t < T1 the response has the wrong sign.",
+            **({} if exp == "proved" else _EQ1_SEVERITY)))
     return out

@@ -57,10 +57,14 @@ def claims() -> list[Claim]:
               "identity", m * v_dot9 + c0 + c1 * v + c2 * v_dot9**2,
               u_i - m * g * sp.sin(phi) + w + d, expect="refuted",
               note="Erratum: eqs 2, 4, 5 write c2 x''^2 for the Davis term c2 v^2 "
-                   "that eq 9 uses."),
+                   "that eq 9 uses.",
+              severity="minor",
+              severity_reason="a typo in the resistance term: eq 9 and every later step use "
+                              "c2 v^2 (ntsm-eq5-corrected)"),
         Claim("ntsm-eq5-corrected", PAPER, "2, 5, 9",
               "eq 9's v_i' solves eq 5 with f_u = c0 + c1 v + c2 v^2", "identity",
-              m * v_dot9 + c0 + c1 * v + c2 * v**2, u_i - m * g * sp.sin(phi) + w + d),
+              m * v_dot9 + c0 + c1 * v + c2 * v**2, u_i - m * g * sp.sin(phi) + w + d,
+              origin="workbench"),
         Claim("ntsm-eq17", PAPER, "5, 9, 13, 17",
               "Under law (13), the spacing error obeys eq 17", "identity", edd, eq17,
               sample=SAMPLE),
@@ -68,11 +72,13 @@ def claims() -> list[Claim]:
               "V' = m s s' equals eq 15 as printed (reaching term without m)", "identity",
               V_dot, -reach - dist, sample=SAMPLE, expect="refuted", nonzero=(ed,),
               note="Eq 15 drops the mass m_i from the reaching term; eq 20 has it. "
-                   "(Eq 16 as printed still follows when m >= 1, as for a train.)"),
+                   "(Eq 16 as printed still follows when m >= 1, as for a train.)",
+              severity="minor",
+              severity_reason="eq 20 has the mass again and eq 16 still follows for m >= 1 kg"),
         Claim("ntsm-eq15-corrected", PAPER, "14-15, 20",
               "V' = -m (j s^2 + k|s|^(p+1)) |e'|^(q-1) - (q/beta)|e'|^(q-1) s "
               "((G_w + G_d) sign(s) + d + w), for e' != 0 (as the paper argues)", "identity",
-              V_dot, -m * reach - dist, sample=SAMPLE, nonzero=(ed,)),
+              V_dot, -m * reach - dist, sample=SAMPLE, nonzero=(ed,), origin="workbench"),
         Claim("ntsm-eq20", PAPER, "6, 16, 20",
               "V' <= -m (j s^2 + k|s|^(p+1)) |e'|^(q-1) when |w| <= G_w, |d| <= G_d (e' != 0)",
               "inequality", -m * reach - dist, -m * reach, hypotheses=bounds,
@@ -92,7 +98,11 @@ def claims() -> list[Claim]:
               sample=SAMPLE + ((ed, -1e-4, 1e-4),), nonzero=(ed,), expect="refuted",
               note="Degeneracy of the reaching argument: the factor |e'|^(q-1) of eq 20 "
                    "tends to 0 as e' -> 0, so near e' = 0 eq 20 gives no rate at all (at "
-                   "e' = 0 the bound is V' <= 0): the counterexample has a small e'."),
+                   "e' = 0 the bound is V' <= 0): the counterexample has a small e'.",
+              severity="minor",
+              severity_reason="a gap in the argument, not in the conclusion: finite-time "
+                              "reaching still holds by the standard repair "
+                              "(ntsm-reaching-at-rest, proved)"),
         Claim("ntsm-reaching-at-rest", PAPER, "9, 13, 17",
               "at e' = 0 the set is crossed, not a rest point: s e'' <= -(beta/q)(j s^2 + "
               "k|s|^(p+1)) < 0 for s != 0 when |w| <= G_w, |d| <= G_d, so e' leaves 0 "
@@ -101,7 +111,7 @@ def claims() -> list[Claim]:
               -beta / q * (j * s**2 + k * sp.Abs(s) ** (p + 1)), hypotheses=bounds,
               terms=((Gw - sp.Abs(w)) * sp.Abs(s) / m, (sp.Abs(w) * sp.Abs(s) + w * s) / m,
                      (Gd - sp.Abs(d)) * sp.Abs(s) / m, (sp.Abs(d) * sp.Abs(s) + d * s) / m),
-              sample=SAMPLE,
+              sample=SAMPLE, origin="workbench",
               note="The standard repair of NTSM reaching (Feng, Yu, Man 2002): e' = 0 with "
                    "s != 0 is not an attractor, so the reaching phase still ends in finite "
                    "time; the paper does not make this step."),

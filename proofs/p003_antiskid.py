@@ -100,11 +100,15 @@ def _linearisation_claims() -> list[Claim]:
               "a1 v_d + a2 lambda_d + a3 = 0 at any linearisation point (eq 25 as stated)",
               "identity", affine[0], 0, sample=box, expect="refuted",
               note="Eq 25 holds only where y1(v_d, lambda_d) = 0: that condition is what "
-                   "fixes lambda_d (digest: 'eq 25 relies on y1(v_d, lambda_d) = 0')."),
+                   "fixes lambda_d (digest: 'eq 25 relies on y1(v_d, lambda_d) = 0').",
+              severity="minor",
+              severity_reason="a missing hypothesis: the paper uses eq 25 only at the cruise "
+                              "equilibrium y1(v_d, lambda_d) = 0, where it holds "
+                              "(lin-eq25-corrected)"),
         Claim("lin-eq25-corrected", PAPER, "24-25",
               "a1 v_d + a2 lambda_d + a3 = 0 at a cruise equilibrium y1(v_d, lambda_d) = 0 "
               "(used as c0 = m(mu g) - c1 v_d - c2 v_d^2)", "identity", affine[0], 0,
-              given=((P["c0"], y1_zero_c0[0]),), sample=box),
+              given=((P["c0"], y1_zero_c0[0]),), sample=box, origin="workbench"),
         Claim("lin-eq61", PAPER, "27, 29, 61",
               "under exact prediction, the cruise law (61) makes the virtual input (27) "
               "equal to K E (eq 29)", "identity", u_virtual, k1 * ve + k2 * le),

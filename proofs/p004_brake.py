@@ -47,18 +47,24 @@ def claims() -> list[Claim]:
               "deceleration 0.703 m/s^2", a2, 0.703, 3),
         value("brake-case1-distance-corrected", "sec. 2.3",
               "with the rounded speed 13.89 m/s, 1 m/s^2 stops in 96.466 m",
-              s1, 96.466, 3),
+              s1, 96.466, 3, origin="workbench"),
         value("brake-case1-distance-printed", "sec. 2.3",
               "50 km/h (exactly 125/9 m/s) at 1 m/s^2 stops in 96.466 m", v_exact**2 / 2,
               96.466, 3, expect="refuted",
               note="96.466 m holds only for the rounded speed 13.89 m/s; exactly 50 km/h "
-                   "gives 96.451 m (the paper's inputs, not an error of method)."),
+                   "gives 96.451 m (the paper's inputs, not an error of method).",
+              severity="rounding",
+              severity_reason="the paper's own rounding of 50 km/h to 13.89 m/s (checked: "
+                              "within 0.1 % of the exact value)"),
         value("brake-case2-distance", "sec. 2.3", "13.89 m/s at 0.703 m/s^2 stops in 137.22 m",
               s2, 137.22, 2),
         value("brake-difference-printed", "sec. 2.3", "the two distances differ by 40.754 m",
               s2 - s1, 40.754, 3, expect="refuted",
               note="40.754 is 137.22 - 96.466, the difference of the rounded distances; "
-                   "the distances themselves (96.466 m, 137.2175 m) differ by 40.751 m."),
+                   "the distances themselves (96.466 m, 137.2175 m) differ by 40.751 m.",
+              severity="rounding",
+              severity_reason="a difference of two rounded distances (checked: within 0.1 % "
+                              "of the exact difference)"),
         value("brake-difference-corrected", "sec. 2.3", "the two distances differ by 40.751 m",
-              s2 - s1, 40.751, 3),
+              s2 - s1, 40.751, 3, origin="workbench"),
     ]

@@ -110,3 +110,59 @@ def test_proofs_never_parse_strings():
         text = p.read_text()
         for banned in ("eval(", "exec(", "sympify(", "parse_expr", "S(\""):
             assert banned not in text, f"{p}: {banned}"
+
+
+# -- severities of errata and the Findings block (issue 19) ------------------------------
+def test_errata_carry_a_severity_with_a_reason():
+    from workbench.claims import SEVERITIES
+    for cid, c in IDS.items():
+        assert c.severity in (*SEVERITIES, None), cid
+        assert bool(c.severity) == bool(c.severity_reason.strip()), cid
+        if c.severity:
+            assert c.expect == "refuted" and "\n" not in c.severity_reason, cid
+        # a corrected form is the workbench's, never a step the paper printed
+        assert ("corrected" in cid) <= (c.origin == "workbench"), cid
+
+
+def test_a_rounding_erratum_is_checked(results):
+    from dataclasses import replace
+
+    from workbench.prove import rounding_holds
+    r = results["brake-difference-printed"]       # 004 sec. 2.3: 40.754 printed, 40.751 exact
+    assert r.claim.severity == "rounding" and rounding_holds(r) and r.ok
+    # 2 % off is not a rounding
+    far = replace(r, counterexample=(("computed", 41.6),))
+    assert not rounding_holds(far)
+    assert not replace(far, severity_holds=rounding_holds(far)).ok
+
+
+@pytest.mark.parametrize("severity, expect, kind, reason, key", [
+    ("huge", "refuted", "value", "why", "severity"),
+    ("minor", "proved", "value", "why", "severity"),
+    ("rounding", "refuted", "identity", "why", "severity"),
+    ("minor", "refuted", "value", "", "severity_reason"),
+])
+def test_a_bad_proof_severity_is_bad_input(severity, expect, kind, reason, key):
+    from workbench.errors import DesignError
+    from workbench.prove import check_proof_severity
+    from workbench.symbolic.proof import Claim
+    c = Claim("x-printed", "004", "1", "s", kind, sp.Integer(1), 1.0, digits=1, expect=expect,
+              severity=severity, severity_reason=reason)
+    with pytest.raises(DesignError) as e:
+        check_proof_severity(Path("proofs/p.py"), c)
+    msg = str(e.value)
+    assert len(msg.splitlines()) == 1 and f"claims()[x-printed].{key}" in msg and "expected" in msg
+
+
+def test_proof_reports_open_with_findings():
+    for f in report_files():
+        md = f.markdown
+        assert re.search(r"^## .*$", md, re.M)[0] == "## Findings", f.name
+        findings = md.split("## Findings")[1].split("\n## ")[0]
+        errata = [c for m in proof_modules() if f"proofs-{m.paper}" == f.name
+                  for c in m.claims if c.expect == "refuted"]
+        for c in errata:   # each erratum a row with its severity and a link to its section
+            row = next(line for line in findings.splitlines() if f"`{c.id}`" in line)
+            assert f"**{c.severity or 'not assessed'}**" in row
+            assert f"(#{c.id}--refuted)" in row
+        assert f.index[2] != "none" or not errata

@@ -195,3 +195,24 @@ def test_modal_P_rejects_unstable_and_bad_weights():
         modal_P(np.array([[0.1, 0.0], [0.0, -1.0]]))
     with pytest.raises(ModelError, match="positive weights"):
         modal_P(-np.eye(2) - np.diag([0, 1.0]), [1.0, -2.0])
+
+
+def test_imul_is_the_rounded_hull_of_the_four_products():
+    """imul against the hull taken directly (NaN products, as 0 * inf, give the
+    whole line), on special values: signed zeros, infinities, subnormals."""
+    from workbench.roa.interval import Interval, imul
+    rng = np.random.default_rng(0)
+    special = np.array([0.0, -0.0, np.inf, -np.inf, 1e308, -1e308, 1e-320, -1e-320, 1.0, -2.5])
+    for _ in range(200):
+        x = [np.where(rng.random(40) < 0.4, rng.choice(special, 40), rng.normal(size=40))
+             for _ in range(4)]
+        a = Interval(np.minimum(x[0], x[1]), np.maximum(x[0], x[1]))
+        b = Interval(np.minimum(x[2], x[3]), np.maximum(x[2], x[3]))
+        with np.errstate(invalid="ignore", over="ignore"):
+            p = np.stack([a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi])
+        nan = np.isnan(p).any(axis=0)
+        lo = np.where(nan, -np.inf, np.nextafter(p.min(axis=0), -np.inf))
+        hi = np.where(nan, np.inf, np.nextafter(p.max(axis=0), np.inf))
+        r = imul(a, b)
+        np.testing.assert_array_equal(r.lo, lo)
+        np.testing.assert_array_equal(r.hi, hi)

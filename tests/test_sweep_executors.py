@@ -92,3 +92,14 @@ def test_unknown_kernel_is_a_cli_error(capsys):
                  "--kernel", "fortran"])
     err = capsys.readouterr().err
     assert code == 2 and "--kernel = 'fortran'; expected compiled or numpy" in err
+
+
+def test_default_workers_are_the_cpus_granted(short, monkeypatch):
+    """The pool's default size is the CPUs this process may use (cgroup quota,
+    affinity; LOKY_MAX_CPU_COUNT caps it), not os.cpu_count(): on a CI runner
+    that shows the host's CPUs, a pool that large starved the other processes."""
+    from workbench.sim.batch import available_cpus
+    monkeypatch.setenv("LOKY_MAX_CPU_COUNT", "1")
+    assert available_cpus() == 1
+    pending = start_sweep(short, 4, 0, chunk=1)
+    assert pending.workers == 1 and pending.result().n == 4

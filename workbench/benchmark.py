@@ -382,8 +382,13 @@ def run_example(ex: Example, s: BenchmarkSettings) -> ExampleResult:
     return ExampleResult(ex, exact, sweep, tuple(rows), windows, curve)
 
 
-def run_benchmark(examples: tuple[Example, ...], s: BenchmarkSettings) -> BenchmarkResult:
-    return BenchmarkResult(s, tuple(run_example(e, s) for e in examples))
+def run_benchmark(examples: tuple[Example, ...], s: BenchmarkSettings, *,
+                  progress: bool = False) -> BenchmarkResult:
+    """Every example under every method; ``progress``: a bar over the examples
+    on stderr (terminal only, :mod:`workbench.sim.progress`)."""
+    from .sim.progress import progress as progress_bar
+    return BenchmarkResult(s, tuple(run_example(e, s) for e in progress_bar(
+        examples, desc="benchmark", unit="example", enabled=progress and len(examples) > 1)))
 
 
 # -- CLI -------------------------------------------------------------------------------
@@ -409,7 +414,7 @@ def benchmark_delay(design, *, as_json: bool = False, exact_check: bool = False,
     if exact_check:
         spec = replace(spec, settings=replace(spec.settings, exact_check=True))
     t0 = time.perf_counter()
-    res = run_benchmark(spec.examples, spec.settings)
+    res = run_benchmark(spec.examples, spec.settings, progress=not as_json)
     wall = time.perf_counter() - t0
     checks = [r.exact_check for e in res.examples for r in e.rows if r.exact_check]
     ok = (res.max_ratio() < 1 and res.sound and all(c == "certified" for c in checks)

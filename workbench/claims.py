@@ -19,6 +19,13 @@ A claim in a design file::
                               #   it makes the claim a workbench finding
     origin = "paper"          # "paper" | "workbench" (default: from `source`)
 
+A ``description`` or ``reason`` never types a measured number: it names it,
+``{quantity}`` or ``{quantity:N}`` (N significant digits, default 4;
+``{quantity:N%}`` prints 100 x the value, for a fraction written in per
+cent), and the field is filled from the design's results when the claim is
+evaluated (:func:`fill_claim`); a field naming no quantity of the design is
+bad input. ``{{`` and ``}}`` write a brace (``{{V <= c}}``). ``tests/test_typed_numbers.py`` states what a text may type.
+
 Severities form a closed set, mildest first (:data:`SEVERITIES`):
 
 ``rounding``
@@ -147,6 +154,44 @@ def _json_value(v):
 
 
 _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.=+-]*$")
+#: A template field of a claim's text: ``{quantity}``, ``{quantity:N}`` or ``{quantity:N%}``;
+#: ``{{`` and ``}}`` are escaped braces (no group matched).
+TEMPLATE_FIELD = re.compile(r"\{\{|\}\}|\{([^{}:]+)(?::(\d+)?(%)?)?\}")
+
+
+def fill_text(text: str, quantities: dict, fmt) -> str:
+    """``text`` with each ``{quantity:N}`` replaced by ``fmt(value, N)``
+    (``{quantity:N%}``: by ``fmt(100 value, N)``)."""
+    def one(m):
+        if m[1] is None:
+            return m[0][0]
+        v = quantities.get(m[1].strip())
+        if m[3] and isinstance(v, (int, float)) and not isinstance(v, bool):
+            v = 100 * v
+        return fmt(v, int(m[2] or 4))
+    return TEMPLATE_FIELD.sub(one, text)
+
+
+def fill_claim(claim: Claim, quantities: dict, fmt) -> Claim:
+    """The claim with its description and reason filled from ``quantities``
+    (``fmt(value, digits) -> str`` prints a value)."""
+    from dataclasses import replace
+    return replace(claim, description=fill_text(claim.description, quantities, fmt),
+                   reason=fill_text(claim.reason, quantities, fmt))
+
+
+def _check_fields(r: Reader, key: str, text: str, names: set[str]) -> None:
+    for m in TEMPLATE_FIELD.finditer(text):
+        if m[1] is None:
+            continue
+        if m[1].strip() not in names:
+            raise r.fail(key, m[0], "template fields {quantity}, {quantity:N} or "
+                         "{quantity:N%} naming a quantity this design computes")
+        if m[2] is not None and not 1 <= int(m[2]) <= 12:
+            raise r.fail(key, m[0], "N from 1 to 12 significant digits in {quantity:N}")
+    if "{" in TEMPLATE_FIELD.sub("", text) or "}" in TEMPLATE_FIELD.sub("", text):
+        raise r.fail(key, text, "braces only around template fields {quantity}, "
+                     "{quantity:N} or {quantity:N%} ({{ and }} for a brace)")
 
 
 def parse_claims(root: Reader, study, spec) -> list[Claim]:
@@ -191,6 +236,8 @@ def parse_claims(root: Reader, study, spec) -> list[Claim]:
         reason = r.string("reason", default="")
         if expect == "fail" and not reason:
             raise r.fail("reason", "<missing>", 'a reason when expect = "fail"')
+        for key, text in (("description", desc), ("reason", reason)):
+            _check_fields(r, key, text, names)
         severity = r.string("severity", default=None, choices=SEVERITIES)
         if expect == "fail" and severity is None:
             raise r.fail("severity", "<missing>",

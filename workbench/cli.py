@@ -297,7 +297,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("design")
     p.add_argument("--samples", type=int, required=True)
     p.add_argument("--seed", type=int, required=True)
-    p.add_argument("--workers", type=int, help="processes (default: CPU count)")
+    p.add_argument("--workers", type=int, help="processes (default: the CPUs granted to this process)")
     p.add_argument("--kernel", help="stepping path: compiled (numba; the default when "
                    "installed) or numpy (the reference)")
     p.add_argument("--scheduler", help="run the chunks on Dask: 'local' (a LocalCluster of "

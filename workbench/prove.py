@@ -14,13 +14,15 @@ import json
 import pkgutil
 import sys
 import types
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
 
+from .claims import ROUNDING_RTOL
 from .errors import DesignError
-from .report.markdown import fmt, md_table
+from .report.findings import Finding, Labels, Summary, index_row, ordered, render_findings
+from .report.markdown import fmt, md_table, slug
 from .symbolic.proof import ProofResult, Verdict, check_claim
 
 
@@ -76,8 +78,31 @@ def _modules_in(folder: Path) -> tuple[ProofModule, ...]:
             if not hasattr(m, attr):
                 raise DesignError(str(folder / f"{name}.py"), attr, "<missing>",
                                   "PAPER, TITLE and claims() in every proof module")
-        out.append(ProofModule(name, m.PAPER, m.TITLE, tuple(m.claims())))
+        claims = tuple(m.claims())
+        for c in claims:
+            check_proof_severity(folder / f"{name}.py", c)
+        out.append(ProofModule(name, m.PAPER, m.TITLE, claims))
     return tuple(out)
+
+
+def check_proof_severity(path: Path, c) -> None:
+    """A proof claim's severity: one of SEVERITIES, on an erratum
+    (``expect = "refuted"``), with a one-line reason (else exit 2)."""
+    from .claims import SEVERITIES
+    key = f"claims()[{c.id}].severity"
+    if c.severity is None:
+        return
+    if c.severity not in SEVERITIES:
+        raise DesignError(str(path), key, c.severity, "one of " + ", ".join(SEVERITIES))
+    if c.expect != "refuted":
+        raise DesignError(str(path), key, c.severity, 'a severity only on an erratum '
+                          '(expect = "refuted")')
+    if c.severity == "rounding" and c.kind != "value":
+        raise DesignError(str(path), key, c.severity, '"rounding" only on a value claim '
+                          "(where it is checked against the printed value)")
+    if not c.severity_reason.strip() or "\n" in c.severity_reason:
+        raise DesignError(str(path), f"claims()[{c.id}].severity_reason",
+                          c.severity_reason, "one line saying why")
 
 
 def proof_modules(folder: str | Path | None = None) -> tuple[ProofModule, ...]:
@@ -113,7 +138,19 @@ def check_proof_claim(folder: Path, module: str, claim_id: str) -> ProofResult:
     """Check one claim of a ``proofs/`` module (once per process)."""
     claim = next(c for m in proof_modules(folder) if m.name == module for c in m.claims
                  if c.id == claim_id)
-    return check_claim(claim)
+    r = check_claim(claim)
+    return replace(r, severity_holds=rounding_holds(r))
+
+
+def rounding_holds(r: ProofResult) -> bool:
+    """A ``rounding`` erratum is checked as on a design claim: the exact
+    value lies within :data:`workbench.claims.ROUNDING_RTOL` of the printed
+    one (every other severity, or none, is not checked: True)."""
+    c = r.claim
+    if c.severity != "rounding" or r.counterexample is None:
+        return True
+    computed = dict(r.counterexample).get("computed")
+    return computed is not None and abs(computed - float(c.rhs)) <= ROUNDING_RTOL * abs(float(c.rhs))
 
 
 def run_proofs(names=()) -> list[tuple[ProofModule, ProofResult]]:
@@ -167,17 +204,56 @@ def verification_rows(results=None) -> dict:
 
 
 # -- reports ---------------------------------------------------------------------------
-def _index_cells(pairs) -> tuple[str, ...]:
-    """The index row of a paper's proof report (see
-    :func:`workbench.report.findings.index_cells`): derivation steps refuted
-    as printed are errata; their severity is not assessed."""
-    rs = [r for _, r in pairs]
-    bad = sum(not r.ok for r in rs)
-    errata = [r for r in rs if r.verdict is Verdict.REFUTED]
-    return ("verified" if not bad else f"**NOT OK** ({bad})",
-            f"{sum(r.verdict is Verdict.PROVED for r in rs)} of {len(rs)} steps proved",
-            f"{len(errata)} refuted as printed (errata; severity not assessed)" if errata else "none",
-            f"erratum: {errata[0].claim.statement}" if errata else "—")
+#: The words of a proof report's Findings block (:mod:`workbench.report.findings`).
+PROOF_LABELS = Labels(
+    items="proof claims",
+    holds="hold as stated (PROVED, or REFUTED where the claim is the paper's printed form "
+          "of an erratum)",
+    reproduced="Paper steps proved as printed", not_reproduced="refuted as printed (errata)",
+    workbench=None, details="[Checked steps](#checked-steps)", index_reproduced=" steps as printed")
+
+
+def _eqs(equations: str) -> str:
+    if not equations[:1].isdigit():
+        return equations
+    return ("eq " if equations.isdigit() else "eqs ") + equations
+
+
+def _heading(r: ProofResult) -> str:
+    return f"`{r.claim.id}` — {r.verdict.value}" + ("" if r.ok else " — **NOT OK**")
+
+
+def proof_summary(results) -> Summary:
+    """The Findings counts of a paper's proof claims: paper steps proved as
+    printed, and each erratum (refuted as printed) a finding with its
+    severity (None: not assessed)."""
+    findings = []
+    for r in results:
+        c = r.claim
+        if c.expect != "refuted":
+            continue
+        why = f"— why `{c.severity}`: {c.severity_reason}." if c.severity else ""
+        if r.counterexample is None:
+            detail = r.verdict.value
+        elif c.kind == "value":
+            detail = (f"{r.verdict.value}: exact value {fmt(dict(r.counterexample)['computed'], 6)}"
+                      f", printed {c.rhs}")
+        else:
+            detail = (f"{r.verdict.value}: a counterexample, re-checked with 30 digits, fails "
+                      f"by {fmt(r.violation, 3)}")
+        findings.append(Finding(
+            c.id, c.severity, "paper", "erratum", f"{c.statement} ({_eqs(c.equations)})",
+            f"{detail}; claim `{c.id}`; shown in [its section](#{slug(_heading(r))})", why))
+    paper = [r for r in results if r.claim.origin == "paper"]
+    return Summary(len(results), tuple(r.claim.id for r in results if not r.ok), len(paper),
+                   sum(r.verdict is Verdict.PROVED for r in paper), ordered(findings))
+
+
+def _findings(results) -> str:
+    own = [r for r in results if r.claim.origin == "workbench"]
+    note = (f"- Corrected forms and repairs the workbench adds: {len(own)}, "
+            f"{sum(r.verdict is Verdict.PROVED for r in own)} proved." if own else "")
+    return render_findings(proof_summary(results), PROOF_LABELS, notes=(note,) if note else ())
 
 
 def _summary(results) -> str:
@@ -191,10 +267,17 @@ def _summary(results) -> str:
 
 def _claim_section(module: ProofModule, r: ProofResult) -> str:
     c = r.claim
-    mark = "" if r.ok else " — **NOT OK**"
-    lines = [f"### `{c.id}` — {r.verdict.value}{mark}", "",
+    lines = [f"### {_heading(r)}", "",
              f"{c.statement}. Paper {c.paper}, eqs {c.equations}; kind `{c.kind}`; "
-             f"expected {expected_verdict(r)}; module `proofs/{module.name}.py`."]
+             f"expected {expected_verdict(r)}; "
+             + ("a corrected form or repair the workbench adds; " if c.origin == "workbench"
+                else "") + f"module `proofs/{module.name}.py`."]
+    if c.expect == "refuted":
+        lines += ["", f"**Severity: {c.severity}** — {c.severity_reason}" if c.severity else
+                  "**Severity: not assessed.**"]
+        if not r.severity_holds:
+            lines[-1] += (f" **Not a rounding: more than {fmt(100 * ROUNDING_RTOL)} % "
+                          "off.**")
     if c.note:
         lines += ["", f"> {c.note}"]
     marks = {True: "✓", False: "✗", None: "—"}
@@ -220,8 +303,8 @@ def render_paper_report(paper: str, pairs) -> str:
                      [[f"`{r.claim.id}`", r.claim.equations, r.claim.statement, expected_verdict(r),
                        f"**{r.verdict.value}**" + ("" if r.ok else " ✗")] for r in results],
                      "llllr")
-    head = (f"# Proofs for paper {paper}\n\n" + "; ".join(titles) + ".\n\n"
-            f"**{_summary(results)}.**\n\n"
+    head = f"# Proofs for paper {paper}\n\n" + "; ".join(titles) + "."
+    how = (f"**{_summary(results)}.**\n\n"
             "Each claim is built as sympy objects in `proofs/` and checked by "
             "`workbench.symbolic.proof`: identities by simplification (split into sign cases "
             "where `Abs`/`sign` occur), inequalities by a decomposition into terms shown "
@@ -235,7 +318,8 @@ def render_paper_report(paper: str, pairs) -> str:
             f"{metadata.version('numpy')}; falsification seed fixed in "
             "`workbench/symbolic/falsify.py`. Generated by `workbench report`; do not edit "
             "by hand.")
-    return "\n\n".join([head, "## Claims\n\n" + table, "## Checked steps", *body, prov]) + "\n"
+    return "\n\n".join([head, _findings(results), "## Claims\n\n" + how + "\n\n" + table,
+                        "## Checked steps", *body, prov]) + "\n"
 
 
 def report_files() -> list:
@@ -248,5 +332,6 @@ def report_files() -> list:
         pairs = [(m, r) for m, r in results if m.paper == paper]
         rs = [r for _, r in pairs]
         out.append(ReportFiles(f"proofs-{paper}", github_math(render_paper_report(paper, pairs)), (),
-                               all(r.ok for r in rs), _summary(rs), _index_cells(pairs)))
+                               all(r.ok for r in rs), _summary(rs),
+                               tuple(index_row(proof_summary(rs), PROOF_LABELS))))
     return out

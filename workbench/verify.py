@@ -5,9 +5,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from . import studies
-from .claims import ClaimResult, check_claim
+from .claims import ClaimResult, check_claim, fill_claim
 from .design import Design
 from .memo import run_study
+from .report.markdown import fmt
 
 
 @dataclass(frozen=True)
@@ -29,7 +30,7 @@ def evaluate_design(design: Design) -> Evaluation:
     study = studies.REGISTRY[design.kind]
     result = run_study(design, study.run)
     q = study.quantities(result)
-    return Evaluation(design, result, tuple(check_claim(c, q.get(c.quantity))
+    return Evaluation(design, result, tuple(check_claim(fill_claim(c, q, fmt), q.get(c.quantity))
                                             for c in design.claims))
 
 

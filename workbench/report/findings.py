@@ -1,17 +1,75 @@
 """The verdict-first summary of a report: what holds, what does not, how badly.
 
-:func:`summarise` counts a design's evaluated claims (paper claims
-reproduced or not, workbench findings, each finding with its severity from
-:data:`workbench.claims.SEVERITIES`); :func:`findings_section` renders the
-``## Findings`` block every report opens with, and :func:`index_cells` the
-columns of ``reports/README.md``. Pure functions of the claim results.
+One renderer for every report. A :class:`Summary` holds a report's counts
+and its findings (each a :class:`Finding` with its severity from
+:data:`workbench.claims.SEVERITIES`, or None: not assessed);
+:func:`summarise` builds it from a design's evaluated claims, and
+:mod:`workbench.prove` from a paper's proof claims. :func:`render_findings`
+writes the ``## Findings`` block every report opens with and
+:func:`index_row` the columns of ``reports/README.md``; both are pure
+functions of the summary. :func:`findings_section` and :func:`index_cells`
+are the two for a design's claims.
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 from ..claims import SEVERITIES, ClaimResult, Verdict
-from .markdown import fmt, md_table
+from .markdown import fmt, md_table, slug
+
+#: Label of a finding whose severity nobody assessed (listed after the others).
+NOT_ASSESSED = "not assessed"
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One finding: a paper statement that does not hold, or a defect the
+    workbench shows.
+
+    Attributes
+    ----------
+    id : str
+        The claim's id.
+    severity : str or None
+        One of :data:`workbench.claims.SEVERITIES`; None when not assessed.
+    origin : str
+        "paper" or "workbench".
+    label : str
+        What kind of finding, as the table prints it ("paper claim not
+        reproduced", "workbench", "erratum").
+    what : str
+        The statement.
+    evidence : str
+        One line of evidence (Markdown), with a link to where it is shown.
+    why : str
+        Why the severity (shown in the report's table, not in the index).
+    """
+
+    id: str
+    severity: str | None
+    origin: str
+    label: str
+    what: str
+    evidence: str
+    why: str = ""
+
+
+@dataclass(frozen=True)
+class Labels:
+    """The words of a Findings block: what is counted and where the
+    details are (designs: claims; proofs: steps)."""
+
+    items: str = "claims"
+    holds: str = "hold as the design states them"
+    reproduced: str = "Paper claims reproduced"
+    not_reproduced: str = "not reproduced"
+    workbench: str | None = "Findings of the workbench that the paper does not state"
+    details: str = "[Claims](#claims)"
+    index_reproduced: str = ""
+
+
+DESIGN = Labels()
 
 
 @dataclass(frozen=True)
@@ -22,74 +80,99 @@ class Summary:
     ----------
     claims : int
     not_ok : tuple[str, ...]
-        Ids of claims that do not hold as the design states them.
+        Ids of claims that do not hold as stated.
     paper : int
-        Claims that cite a paper.
+        Claims that state the paper's own results.
     reproduced : int
-        Paper claims that pass (and are not findings).
-    findings : tuple[ClaimResult, ...]
-        Claims with a severity, most severe first (paper claims not
-        reproduced, then workbench findings, each by severity).
+        Paper claims that hold as printed (and are not findings).
+    findings : tuple[Finding, ...]
+        Most severe first (paper findings before workbench ones within a
+        severity; those not assessed last).
     """
 
     claims: int
     not_ok: tuple[str, ...]
     paper: int
     reproduced: int
-    findings: tuple[ClaimResult, ...]
+    findings: tuple[Finding, ...]
 
-    def by_severity(self, origin: str) -> dict[str, int]:
-        """Findings of one origin per severity, most severe first (zeros left out)."""
-        out = {s: sum(r.claim.severity == s and r.claim.origin == origin for r in self.findings)
-               for s in reversed(SEVERITIES)}
+    def by_severity(self, origin: str | None = None) -> dict[str, int]:
+        """Findings (of one origin, or all) per severity, most severe first,
+        then those not assessed (zeros left out)."""
+        keys = (*reversed(SEVERITIES), None)
+        out = {NOT_ASSESSED if s is None else s:
+               sum(f.severity == s and origin in (None, f.origin) for f in self.findings)
+               for s in keys}
         return {s: n for s, n in out.items() if n}
 
 
-def summarise(results: tuple[ClaimResult, ...]) -> Summary:
-    """Count a report's claims; findings sorted most severe first."""
+def ordered(findings) -> tuple[Finding, ...]:
+    """Most severe first; within a severity paper findings first; not assessed last."""
     rank = {s: i for i, s in enumerate(SEVERITIES)}
-    findings = sorted((r for r in results if r.claim.is_finding),
-                      key=lambda r: (-rank[r.claim.severity], r.claim.origin != "paper"))
+    return tuple(sorted(findings, key=lambda f: (f.severity is None,
+                                                 -rank.get(f.severity, -1),
+                                                 f.origin != "paper")))
+
+
+def section_link(quantity: str, anchors) -> str:
+    """``[heading](#slug)`` of the first section whose pattern matches the
+    start of ``quantity`` (``anchors``: (regular expression, heading)
+    pairs; a plain prefix is a pattern too), or "" for none."""
+    for pattern, heading in anchors:
+        if re.match(pattern, quantity):
+            return f"[{heading}](#{slug(heading)})"
+    return ""
+
+
+def _evidence(r: ClaimResult, anchors) -> str:
+    c = r.claim
+    want = f"{c.compare} {fmt(c.value, 6)}"
+    if c.compare == "within" or (c.compare != "==" and c.tolerance):
+        want += f" ± {fmt(c.tolerance)}"
+    link = section_link(c.quantity, anchors)
+    return (f"expected {want}, got {fmt(r.got, 5)} ({r.verdict.value}); claim `{c.id}`"
+            + (f"; shown in {link}" if link else ""))
+
+
+def summarise(results: tuple[ClaimResult, ...], anchors=()) -> Summary:
+    """A design's counts; findings sorted most severe first (``anchors``:
+    (quantity prefix, section heading) pairs the evidence links to)."""
+    findings = [Finding(r.claim.id, r.claim.severity, r.claim.origin,
+                        "paper claim not reproduced" if r.claim.origin == "paper"
+                        else "workbench", r.claim.description, _evidence(r, anchors))
+                for r in results if r.claim.is_finding]
     paper = [r for r in results if r.claim.origin == "paper"]
     reproduced = sum(r.verdict is Verdict.PASS and not r.claim.is_finding for r in paper)
     return Summary(len(results), tuple(r.claim.id for r in results if not r.ok), len(paper),
-                   reproduced, tuple(findings))
+                   reproduced, ordered(findings))
 
 
 def _counts(d: dict[str, int]) -> str:
     return ", ".join(f"{n} {s}" for s, n in d.items()) or "none"
 
 
-def _evidence(r: ClaimResult) -> str:
-    c = r.claim
-    want = f"{c.compare} {fmt(c.value, 6)}"
-    if c.compare == "within" or (c.compare != "==" and c.tolerance):
-        want += f" ± {fmt(c.tolerance)}"
-    return f"expected {want}, got {fmt(r.got, 5)} ({r.verdict.value}); claim `{c.id}`"
-
-
-def findings_section(results: tuple[ClaimResult, ...]) -> str:
-    """``## Findings``: the verdict, the counts and every finding (most
-    severe first) with one line of evidence; details in ``## Claims``."""
-    s = summarise(results)
-    if not results:
-        return "## Findings\n\n_This design states no claims._"
+def render_findings(s: Summary, labels: Labels = DESIGN, notes: tuple[str, ...] = ()) -> str:
+    """``## Findings``: the verdict, the counts (and ``notes``, more bullet
+    lines) and every finding (most severe first) with one line of evidence."""
+    if not s.claims:
+        return f"## Findings\n\n_This design states no {labels.items}._"
     if s.not_ok:
-        head = (f"**NOT OK: {len(s.not_ok)} of {s.claims} claims do not hold as the design "
-                f"states them** (" + ", ".join(f"`{i}`" for i in s.not_ok) + ").")
+        head = (f"**NOT OK: {len(s.not_ok)} of {s.claims} {labels.items} do not "
+                f"{labels.holds}** (" + ", ".join(f"`{i}`" for i in s.not_ok) + ").")
     else:
-        head = f"**Verified: all {s.claims} claims hold as the design states them.**"
+        head = f"**Verified: all {s.claims} {labels.items} {labels.holds}.**"
     lines = [head, "",
-             f"- Paper claims reproduced: {s.reproduced} of {s.paper}; not reproduced: "
-             f"{_counts(s.by_severity('paper'))}.",
-             f"- Findings of the workbench that the paper does not state: "
-             f"{_counts(s.by_severity('workbench'))}."]
+             f"- {labels.reproduced}: {s.reproduced} of {s.paper}; {labels.not_reproduced}: "
+             f"{_counts(s.by_severity('paper'))}."]
+    if labels.workbench:
+        lines.append(f"- {labels.workbench}: {_counts(s.by_severity('workbench'))}.")
+    lines += notes
     body = "\n".join(lines)
     if s.findings:
-        rows = [[f"**{r.claim.severity}**",
-                 ("paper claim not reproduced: " if r.claim.origin == "paper" else
-                  "workbench: ") + r.claim.description, _evidence(r)] for r in s.findings]
-        body += ("\n\n" + md_table(["severity", "finding", "evidence (see [Claims](#claims))"],
+        rows = [[f"**{f.severity or NOT_ASSESSED}**",
+                 f"{f.label}: {f.what}" + (f" {f.why}" if f.why else ""), f.evidence]
+                for f in s.findings]
+        body += ("\n\n" + md_table(["severity", "finding", f"evidence (see {labels.details})"],
                                    rows, "lll"))
     body += ("\n\nSeverities, mildest first: `rounding` (within the paper's printed "
              "precision), `minor` (no conclusion changes), `changes-the-result`, `safety` "
@@ -97,15 +180,25 @@ def findings_section(results: tuple[ClaimResult, ...]) -> str:
     return "## Findings\n\n" + body
 
 
-def index_cells(results: tuple[ClaimResult, ...]) -> list[str]:
+def findings_section(results: tuple[ClaimResult, ...], anchors=()) -> str:
+    """``## Findings`` of a design report (details in ``## Claims``)."""
+    return render_findings(summarise(results, anchors))
+
+
+def index_row(s: Summary, labels: Labels = DESIGN) -> list[str]:
     """Cells of the index row: verdict, paper claims reproduced, findings by
     severity, the most severe finding."""
-    s = summarise(results)
     verdict = "verified" if not s.not_ok else f"**NOT OK** ({len(s.not_ok)})"
     worst = s.findings[0] if s.findings else None
-    total = {k: n for k, n in ((sev, sum(r.claim.severity == sev for r in s.findings))
-                               for sev in reversed(SEVERITIES)) if n}
-    what = "" if worst is None else ("not reproduced: " if worst.claim.origin == "paper"
-                                     else "workbench: ")
-    return [verdict, f"{s.reproduced} of {s.paper}", _counts(total),
-            f"**{worst.claim.severity}** ({what}{worst.claim.description})" if worst else "—"]
+    if worst is None:
+        last = "—"
+    else:
+        what = {"paper claim not reproduced": "not reproduced"}.get(worst.label, worst.label)
+        last = f"**{worst.severity or NOT_ASSESSED}** ({what}: {worst.what})"
+    return [verdict, f"{s.reproduced} of {s.paper}{labels.index_reproduced}",
+            _counts(s.by_severity()), last]
+
+
+def index_cells(results: tuple[ClaimResult, ...]) -> list[str]:
+    """The index row of a design's report (see :func:`index_row`)."""
+    return index_row(summarise(results))

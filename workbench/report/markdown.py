@@ -34,10 +34,33 @@ class Figure:
 
 @dataclass(frozen=True)
 class Rendered:
-    """Markdown sections (each starting with a ``## `` heading) and figures."""
+    """Markdown sections (each starting with a ``## `` heading) and figures.
+
+    ``anchors``: (pattern, section heading) pairs; a finding whose claim
+    names a quantity whose start matches the pattern (a regular expression,
+    :func:`re.match`) links to that section.
+    """
 
     sections: tuple[str, ...]
     figures: tuple[Figure, ...] = ()
+    anchors: tuple[tuple[str, str], ...] = ()
+
+
+def slug(heading: str) -> str:
+    """The anchor GitHub gives a heading: lower case, every character but
+    letters, digits, spaces, ``-`` and ``_`` dropped, spaces made ``-``."""
+    text = heading.strip().lower()
+    return "".join("-" if ch == " " else ch for ch in text
+                   if ch.isalnum() or ch in " -_")
+
+
+def fmt_floor(x: float, sig: int = 2) -> str:
+    """A positive finite lower bound rounded *down* to ``sig`` significant
+    digits (a lower bound may only be rounded down). For LMI bounds of a given
+    gain, whose last digits depend on the bisection's path and hence on the
+    CPU's BLAS kernels."""
+    q = 10.0 ** (math.floor(math.log10(x)) - (sig - 1))
+    return fmt(math.floor(x / q + 1e-12) * q, sig)
 
 
 def fmt(x, sig: int = 4) -> str:

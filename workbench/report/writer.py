@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 
-from ..claims import ClaimResult, Verdict
+from ..claims import ROUNDING_RTOL, ClaimResult, Verdict
 from .findings import findings_section, index_cells
 from .markdown import Figure, Rendered, fmt, github_math, md_table
 
@@ -35,7 +35,7 @@ def claims_table(results: tuple[ClaimResult, ...]) -> str:
             exp += f" ({c.digits} decimals, {'truncated' if c.rounding == 'truncate' else 'rounded'})"
         verdict = r.verdict.value
         if not r.severity_holds:
-            verdict += " (not a rounding: more than 0.1 % off)"
+            verdict += f" (not a rounding: more than {fmt(100 * ROUNDING_RTOL)} % off)"
         elif c.expect == "fail":
             verdict += " (expected)" if r.ok else " (expected FAIL, now passes: update the design)"
         elif r.verdict is Verdict.INCONCLUSIVE and c.allow_inconclusive:
@@ -101,7 +101,7 @@ def render_report(ev, rendered: Rendered, figdir: str, solver: str | None
     d = ev.design
     head = f"# {d.title}\n\nDesign `{d.path}` (kind `{d.kind}`), from {d.source}."
     body = [s.replace("{figdir}", figdir) for s in rendered.sections]
-    parts = [head, findings_section(ev.claims), *body,
+    parts = [head, findings_section(ev.claims, rendered.anchors), *body,
              "## Claims\n\n" + verdict_summary(ev.claims) + ".\n\n" + claims_table(ev.claims),
              provenance(solver)]
     return github_math("\n\n".join(parts).rstrip() + "\n"), rendered.figures

@@ -31,12 +31,16 @@ References
 """
 from __future__ import annotations
 
+from collections import OrderedDict
 from typing import Callable, NamedTuple, Sequence
 
 import numpy as np
 import sympy as sp
 
 _INF = np.inf
+#: Compiled stages of :class:`IntervalFunction`, least recently used dropped first.
+_STAGE_CACHE: OrderedDict = OrderedDict()
+_STAGE_CACHE_SIZE = 256
 
 
 class Interval(NamedTuple):
@@ -68,11 +72,13 @@ def iadd(a: Interval, b: Interval) -> Interval:
 
 
 def imul(a: Interval, b: Interval) -> Interval:
+    # The hull of the four end-point products. np.minimum / np.maximum
+    # propagate a NaN product (0 * inf), which _fix turns into the infinite
+    # bound on its side: the whole real line, as for any undefined product.
     with np.errstate(invalid="ignore", over="ignore"):
-        p = np.stack([a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi])
-    nan = np.isnan(p)
-    lo = np.where(nan, -_INF, p).min(axis=0)
-    hi = np.where(nan, _INF, p).max(axis=0)
+        p1, p2, p3, p4 = a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi
+    lo = np.minimum(np.minimum(p1, p2), np.minimum(p3, p4))
+    hi = np.maximum(np.maximum(p1, p2), np.maximum(p3, p4))
     return _fix(_down(lo), _up(hi))
 
 
@@ -234,10 +240,8 @@ class IntervalFunction:
                 raise UnsupportedExpression(
                     f"expressions depend on {sorted(map(str, free))}, not only on "
                     f"{[str(s) for s in self.symbols]}")
-            repl, reduced = sp.cse([e for _, e in stage], optimizations=None,
-                                   symbols=sp.numbered_symbols(f"_cse{len(self._steps)}_"))
-            self._steps += [(s, self._compile(e)) for s, e in repl]
-            outs = [(s, self._compile(e)) for (s, _), e in zip(stage, reduced)]
+            steps, outs = self._compile_stage(stage, len(self._steps))
+            self._steps += steps
             if stage and stage[0][0] is None:
                 self._outs = [fn for _, fn in outs]
             else:
@@ -261,6 +265,28 @@ class IntervalFunction:
         return [fn(env, state) for fn in self._outs], state["amb"]
 
     # --- compilation -----------------------------------------------------------------------
+    def _compile_stage(self, stage: list, at: int) -> tuple[list, list]:
+        """(cse steps, outputs) of one stage, each a list of (Symbol, closure).
+
+        The closures depend on the stage's expressions only (no instance
+        state), so a stage met again, such as the model stage of a basin
+        problem tried with several Lyapunov matrices, is compiled once per
+        process (:data:`_STAGE_CACHE`, keyed by the expressions and the
+        position that names the cse symbols)."""
+        key = (at, tuple(stage))
+        hit = _STAGE_CACHE.get(key)
+        if hit is not None:
+            _STAGE_CACHE.move_to_end(key)
+            return hit
+        repl, reduced = sp.cse([e for _, e in stage], optimizations=None,
+                               symbols=sp.numbered_symbols(f"_cse{at}_"))
+        out = ([(s, self._compile(e)) for s, e in repl],
+               [(s, self._compile(e)) for (s, _), e in zip(stage, reduced)])
+        _STAGE_CACHE[key] = out
+        if len(_STAGE_CACHE) > _STAGE_CACHE_SIZE:
+            _STAGE_CACHE.popitem(last=False)
+        return out
+
     def _compile(self, e) -> Callable:
         if isinstance(e, sp.Symbol):
             return lambda env, st, s=e: env[s]

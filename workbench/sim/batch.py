@@ -19,6 +19,20 @@ import numpy as np
 from .progress import progress as progress_bar
 
 
+def available_cpus() -> int:
+    """CPUs this process may use, the default number of pool workers.
+
+    ``os.cpu_count()`` counts the host's CPUs; in a container or a CI runner
+    limited by a cgroup CPU quota or an affinity mask that can be many times
+    the CPUs actually granted, and a pool that large only multiplies the
+    start-up cost and starves the other processes. joblib's count (loky's)
+    takes the affinity mask, the cgroup quota (v1 and v2) and the
+    ``LOKY_MAX_CPU_COUNT`` override into account.
+    """
+    from joblib import cpu_count
+    return max(1, int(cpu_count(only_physical_cores=False)))
+
+
 def uniform_draws(n: int, seed: int, ranges: dict, start: int = 0) -> dict:
     """Seeded uniform samples ``start <= i < n`` of each named range,
     ``{name: (lo, hi)}``.

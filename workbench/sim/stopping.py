@@ -75,6 +75,53 @@ def batch_params(base: dict, n: int, overrides: dict | None = None) -> dict:
     return out
 
 
+def brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params: dict, dt: float, on_air):
+    """One explicit-Euler step of the brake stages with the hand-over of eq 8.
+
+    Parameters
+    ----------
+    v : ndarray
+        Speed (m/s) at the start of the step.
+    b_e, b_a : ndarray
+        Achieved electric and air brake (m/s^2).
+    cap : ndarray
+        Electric cap (m/s^2): ``inf`` above the hand-over, then falling at
+        ``k_bra`` from the electric brake achieved at the hand-over.
+    ce, ca : ndarray
+        Command as it reaches the electric stage (after T1) and the air stage
+        (after T3), m/s^2.
+    theta, kappa : ndarray or float
+        Gradient (permille) and load-weighing gain.
+    params : dict
+        Brake parameters (floats or arrays that broadcast).
+    dt : float
+        Step (s).
+    on_air : ndarray of bool
+        Runs with an air stage (v_ho > 0).
+
+    Returns
+    -------
+    dv, b_e, b_a, cap
+        Acceleration over the step (m/s^2, from eqs 5, 10) and the stepped
+        brake states and cap.
+    """
+    fading = on_air & (v < params["v_ho"]) & np.isinf(cap)
+    cap = np.where(fading, np.maximum(b_e, 0.0), cap)
+    cap = np.where(np.isinf(cap), cap, np.maximum(cap - params["k_bra"] * dt, 0.0))
+    e_in = np.minimum(ce, cap)
+    air_in = np.where(on_air, np.maximum(ca - np.minimum(ca, cap), 0.0), 0.0)
+    dv, dbe, dba = brake_rhs(v, b_e, b_a, e_in, air_in, theta, kappa, params)
+    return dv, b_e + dt * dbe, b_a + dt * dba, cap
+
+
+def standstill(x, v, a, x_new, dt: float):
+    """Exact standstill within a step of constant deceleration ``a``: position
+    (m; ``x_new`` where the run does not brake) and time into the step (s)."""
+    braking = a < 0
+    x_hit = np.where(braking, x - v * v / (2 * np.where(braking, a, -1.0)), x_new)
+    return x_hit, np.where(braking, v / np.maximum(-a, 1e-12), dt)
+
+
 def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 0.01,
              dt_ctrl: float = 0.1, dt_rec: float = 0.1, v0=0.0, x0=0.0,
              theta=0.0, kappa=1.0, c_init=0.0, t_arm: float = 0.0,
@@ -145,23 +192,17 @@ def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 
                 rec[key].append(val.copy())
         if k == steps or stopped.all():
             break
-        ce, ca = delayed(d1, k), delayed(d3, k)
-        fading = on_air & (v < params["v_ho"]) & np.isinf(cap)
-        cap = np.where(fading, np.maximum(b_e, 0.0), cap)
-        cap = np.where(np.isinf(cap), cap, np.maximum(cap - params["k_bra"] * dt, 0.0))
-        e_in = np.minimum(ce, cap)
-        air_in = np.where(on_air, np.maximum(ca - np.minimum(ca, cap), 0.0), 0.0)
-        dv, dbe, dba = brake_rhs(v, b_e, b_a, e_in, air_in, theta, kappa, params)
+        dv, b_e, b_a, cap = brake_step(v, b_e, b_a, cap, delayed(d1, k), delayed(d3, k), theta,
+                                       kappa, params, dt, on_air)
         a = np.where(stopped, 0.0, dv)
         v_new = np.maximum(v + dt * a, 0.0)
         x_new = x + 0.5 * (v + v_new) * dt
-        b_e, b_a = b_e + dt * dbe, b_a + dt * dba
         hit = ~stopped & (v_new <= 0.0) & (t + dt > t_arm)
-        # exact standstill position within the step (constant deceleration)
-        x_hit = np.where(a < 0, x - v * v / (2 * np.where(a < 0, a, -1.0)), x_new)
-        x_new = np.where(hit, x_hit, x_new)
-        t_stop = np.where(hit, t + np.where(a < 0, v / np.maximum(-a, 1e-12), dt), t_stop)
-        x_stop = np.where(hit, x_new, x_stop)
+        if hit.any():
+            x_hit, t_hit = standstill(x, v, a, x_new, dt)
+            x_new = np.where(hit, x_hit, x_new)
+            t_stop = np.where(hit, t + t_hit, t_stop)
+            x_stop = np.where(hit, x_new, x_stop)
         stopped |= hit
         x = np.where(stopped, x_stop, x_new)
         v = np.where(stopped, 0.0, v_new)

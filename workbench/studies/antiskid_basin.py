@@ -39,6 +39,7 @@ import numpy as np
 import sympy as sp
 from scipy.integrate import solve_ivp
 
+from ..controllers.antiskid003_settings import ControllerSettings
 from ..errors import ModelError
 from ..plants.adhesion import NumericAdhesion, adhesion_model
 from ..roa import BasinEstimate, BasinProblem, LevelOutcome, estimate_basin, modal_P
@@ -201,6 +202,10 @@ def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
     return CruiseBasin(check, tuple(float(k) for k in K), q, v_d, lam_d, lam_opt, trajs)
 
 
+#: |lambda| at which a delay-free trajectory has diverged (the runs' own test).
+LAM_DIVERGED = ControllerSettings.lam_diverged
+
+
 def _delay_free(fn, x0, lam_d: float, T: float):
     """The delay-free loop x' = fn(x) from x0 over [0, T] (Radau, rtol 1e-8),
     stopped when |lambda| reaches 0.9 (the wheel spins or locks); a model
@@ -212,7 +217,7 @@ def _delay_free(fn, x0, lam_d: float, T: float):
             return [math.nan, math.nan]
 
     def spin(t, x):
-        return 0.9 - abs(x[1] + lam_d)
+        return LAM_DIVERGED - abs(x[1] + lam_d)
     spin.terminal = True
     with np.errstate(all="ignore"):
         return solve_ivp(rhs, (0.0, T), np.array(x0, float), method="Radau", rtol=1e-8,

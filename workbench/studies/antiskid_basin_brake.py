@@ -55,6 +55,10 @@ from ..sim.wheel_slip import ScalarOps, wheel_speed
 LAM_LIMIT = 0.9
 #: Horizon (s) of the time-varying delay-free loop from the switch state.
 T_FATE = 5.0
+#: Relative tolerance of its Radau integration.
+FATE_RTOL = 1e-8
+#: |v lambda - v_s*| (m/s) under which the loop "tracks" at T_FATE.
+TRACK_TOL = 0.01
 
 
 @dataclass(frozen=True)
@@ -250,9 +254,9 @@ def time_varying_fate(values: dict, x0, profile, k_de: float) -> tuple[str, floa
     t0 = profile.t_brake
     with np.errstate(all="ignore"):
         sol = solve_ivp(rhs, (t0, t0 + T_FATE), np.array(x0, float), method="Radau",
-                        rtol=1e-8, atol=1e-10, events=spin, max_step=0.05)
+                        rtol=FATE_RTOL, atol=1e-10, events=spin, max_step=0.05)
     if len(sol.t_events[0]) or sol.status != 0 or not np.all(np.isfinite(sol.y)):
         return "diverges", float(sol.t[-1] - t0)
     v, la = sol.y[:, -1]
     _, vs = law(sol.t[-1], v, la)
-    return ("tracks" if la < 0 and abs(v * la - vs) < 0.01 else "undecided"), None
+    return ("tracks" if la < 0 and abs(v * la - vs) < TRACK_TOL else "undecided"), None

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..report.markdown import fmt, md_table
 from ..roa.render import fmt_level, render_basin_markdown
+from .antiskid_basin import LAM_DIVERGED
 
 _FATE_COLOR = {"converges": "tab:green", "diverges": "tab:red", "undecided": "0.6"}
 _SWITCH_MARK = {"CERTIFIED": "o", "REFUTED": "X", "INCONCLUSIVE": "s"}
@@ -25,13 +26,17 @@ def render_basin_result(res, *, rail: str) -> str:
     return text
 
 
+#: Heading of the basin section (findings on switch and basin quantities link here).
+HEADING = ("Regions of attraction: does each switch land in the basin of the law that "
+           "takes over?")
+
+
 def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—",
                          brake=()) -> str:
     """The report section: loop, certified bracket, switch verdicts, k2 rule."""
     K = "[" + ", ".join(fmt(k, 4) for k in basin.K) + "]"
     head = (
-        "## Regions of attraction: does each switch land in the basin of the law that "
-        "takes over?\n\n"
+        f"## {HEADING}\n\n"
         f"Cruise law (61) with K = {K} on {rail} rail, at (v_d, lambda_d) = "
         f"({fmt(basin.v_d)} m/s, {fmt(basin.lambda_d, 4)}). The loop is the **delay-free** "
         "loop under exact prediction (as paper 003's Theorems 2-3 argue for laws (64) and "
@@ -52,7 +57,7 @@ def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—"
           + "\n\nCERTIFIED: V at the state is below c_certified, so the delay-free loop "
             "converges from it. REFUTED: its level holds a point with V' >= 0, so this V "
             "cannot certify it; the last column says what the delay-free trajectory does "
-            "(\"diverges\": lambda reaches 0.9, the wheel spins).\n")
+            f"(\"diverges\": |lambda| reaches {fmt(LAM_DIVERGED)}, the wheel spins).\n")
     return (head + body + sw + brake_text(brake)
             + (_k2_text(sweep, compare_source) if sweep is not None else ""))
 
@@ -69,7 +74,7 @@ def _ceil(x: float, digits: int = 2) -> str:
 
 def brake_text(brake) -> str:
     """Subsection of the cruise -> braking switch (:mod:`.antiskid_basin_brake`)."""
-    from .antiskid_basin_brake import LAM_LIMIT, T_FATE
+    from .antiskid_basin_brake import FATE_RTOL, LAM_LIMIT, T_FATE, TRACK_TOL
     rows = []
     for b in brake:
         if b.why.startswith("no equilibrium"):
@@ -109,8 +114,8 @@ def brake_text(brake) -> str:
         "equilibrium (a level set of `workbench/roa`, with the sign of g proven on the "
         "way to it). The last column drops the frozen assumptions: the delay-free loop with "
         "v and lambda integrated and v_s*(t), d v_s*/dt of eq (76) as printed (Radau, rtol "
-        f"1e-8, over {fmt(T_FATE)} s; \"tracks\": lambda < 0 and |v lambda - v_s*| < "
-        "0.01 m/s at the end).\n\n"
+        f"{fmt(FATE_RTOL)}, over {fmt(T_FATE)} s; \"tracks\": lambda < 0 and |v lambda - "
+        f"v_s*| < {fmt(TRACK_TOL)} m/s at the end).\n\n"
         + md_table(["case", "v (m/s)", "lambda", "v_s* frozen (m/s)", "frozen loop",
                     "in a basin of law (69)?", "delay-free loop, time-varying"], rows,
                    "lrrrlll")

@@ -7,7 +7,9 @@ Design tables read here: ``[plant]`` (parameters with units and sources),
 paper printed, compared with what we compute — data, never used as inputs
 to the synthesis itself) and the optional ``[tight]`` (Wirtinger-based
 synthesis with its scalar searched automatically,
-:mod:`workbench.lmi.tight_synthesis`, shown next to the paper's row).
+:mod:`workbench.lmi.tight_synthesis`, shown next to the paper's row) and
+``[[other_gains]]`` (gains designed elsewhere, checked on this loop:
+:mod:`workbench.studies.antiskid_cruise_gains`).
 """
 from __future__ import annotations
 
@@ -17,6 +19,9 @@ from typing import TYPE_CHECKING
 from ..errors import DesignError, ModelError
 from ..plants.units import ADHESION_003 as PARAMETER_UNITS
 from ..reader import Quantity, Reader
+from .antiskid_cruise_gains import (GainCheck, OtherGain, check_other_gains, load_other_gains,
+                                    other_gain_quantities)
+from .antiskid_cruise_gains import quantity_names as other_gain_names
 
 if TYPE_CHECKING:   # the solvers and the symbolic model load when a design runs
     from ..crosscheck import PointCheck
@@ -76,6 +81,7 @@ class CruiseSpec:
     published: tuple[Published, ...]
     compare_published: bool
     tight: TightSettings | None = None
+    other_gains: tuple[OtherGain, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -150,6 +156,8 @@ class CruiseResult:
     #: (h, spectral abscissa of x' = A x + B K x(t - h)) for the canonical gain
     #: of the row with the largest certified bound (the figure of the loop's set)
     abscissa_vs_h: tuple = ()
+    #: gains of ``[[other_gains]]`` on this loop (:mod:`.antiskid_cruise_gains`)
+    other_gains: tuple[GainCheck, ...] = ()
 
     def row(self, eps: float) -> SynthesisRow:
         return next(r for r in self.rows if r.eps == eps)
@@ -221,6 +229,7 @@ class AntiskidCruise:
         compare = syn.boolean("compare_published", default=True)
         syn.finish()
         tight = self._load_tight(root, eps) if root.has("tight") else None
+        other = load_other_gains(root)
         from ..plants.adhesion import NumericAdhesion
         plant_values = {k: q.value for k, q in params.items()}
         try:  # an impossible operating point is bad input, found at load time
@@ -229,7 +238,7 @@ class AntiskidCruise:
             raise DesignError(root.path, "operating_point.v_d", v_d.value,
                               f"a speed with a creep-region equilibrium ({exc})") from None
         return CruiseSpec(rail, params, v_d, pinned, eps, settings, tuple(published), compare,
-                          tight)
+                          tight, other)
 
     @staticmethod
     def _load_tight(root: Reader, eps: tuple[float, ...]) -> TightSettings | None:
@@ -263,7 +272,7 @@ class AntiskidCruise:
                 names.add(f"published[eps={_eps_key(p.eps)}].{f}")
         if spec.tight:
             names |= {f"tight.{k}" for k in TIGHT_QUANTITIES}
-        return names
+        return names | other_gain_names(spec.other_gains)
 
     # -- run -------------------------------------------------------------------
     def run(self, design) -> CruiseResult:
@@ -287,7 +296,8 @@ class AntiskidCruise:
                 checks.append(PublishedCheck(p, ours, br.h_certified, br.h_refuted, em, match))
         tight = _run_tight(spec, lin, rows) if spec.tight else None
         return CruiseResult(lam_opt, lam_solved, lam_used, lin, rows, tuple(checks), tight,
-                            _abscissa_vs_h(lin, rows))
+                            _abscissa_vs_h(lin, rows),
+                            check_other_gains(lin.A, lin.B, spec.other_gains))
 
     def quantities(self, res: CruiseResult) -> dict:
         q = {"operating_point.lambda_d": res.lambda_d_used,
@@ -316,6 +326,7 @@ class AntiskidCruise:
             q[f"{base}.eps_matching"] = c.eps_matching
         if res.tight:
             q.update(_tight_quantities(res.tight))
+        q.update(other_gain_quantities(res.other_gains))
         return q
 
     # -- render ----------------------------------------------------------------

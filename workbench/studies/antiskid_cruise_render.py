@@ -132,6 +132,8 @@ def render(design, res) -> Rendered:
             "printed row, not of a looser criterion.")
     if res.tight:
         sections.append(_tight_section(res.tight, res.lin.A, res.lin.B))
+    if res.other_gains:
+        sections.append(other_gains_section(res.other_gains, spec, res.lin.A, res.lin.B))
     figs = (Figure("delay-bound-vs-eps",
                    "Certified bound and refuted bound against eps; printed values for comparison.",
                    lambda fig, res=res: _plot_bounds(fig, res)),
@@ -164,7 +166,46 @@ def render(design, res) -> Rendered:
                     if worst < 0 and _all_inf(res) else
                     "A positive value is a delay at which the loop is unstable."))
     sections.append(text)
-    return Rendered(tuple(sections), figs)
+    return Rendered(tuple(sections), figs, ((OTHER_GAINS_QUANTITY, OTHER_GAINS_HEADING),))
+
+
+OTHER_GAINS_HEADING = "Gains designed elsewhere, on this loop"
+OTHER_GAINS_QUANTITY = "other_gains"
+
+
+def other_gains_section(checks, spec, A, B) -> str:
+    """``## Gains designed elsewhere, on this loop``: the ``[[other_gains]]``
+    of a design (:mod:`workbench.studies.antiskid_cruise_gains`) closed
+    around this design's A, B."""
+    k2_max = -(A[0, 0] + A[1, 1])     # with B = [0, 1]^T, trace(A + B K) < 0 is necessary
+    above = sum(c.gain.K[1] >= k2_max for c in checks)
+    trace = ("With B = [0, 1]ᵀ the gain adds to the second row of A, so stability needs "
+             "trace(A + B K) = a11 + a22 + k2 < 0, i.e. k2 < "
+             f"{fmt(k2_max, 3)} on this loop; {above} of the {len(checks)} gains have a "
+             "larger k2. " if np.array_equal(np.ravel(B), [0.0, 1.0]) else "")
+    rows = [[f"`{c.gain.name}`", _gain(c.gain.K, 5), c.gain.source,
+             ", ".join(_eig_text(e) for e in c.eigenvalues if e.imag >= 0), fmt(c.abscissa, 3),
+             "yes" if c.stable else "**no**", exact_margin_text(c.exact)] for c in checks]
+    n_bad = sum(not c.stable for c in checks)
+    verdict = (f"**{n_bad} of {len(checks)} gains leave this loop unstable even without "
+               "delay**" if n_bad else f"All {len(checks)} gains stabilise this loop at h = 0")
+    return (f"## {OTHER_GAINS_HEADING}\n\nGains designed for another loop (their source says "
+            f"where), closed around this design's linearisation ({spec.rail} rail, v_d = "
+            f"{fmt(spec.v_d.value)} m/s): eigenvalues of A + B K (the loop at h = 0) and the "
+            "exact delay margin of x' = A x + B K x(t - h), computed without any LMI. "
+            + verdict + ".\n\n"
+            + md_table(["gain", "K", "source", "eigenvalues of A + B K (1/s)",
+                        "rightmost real part (1/s)", "stable at h = 0", "exact margin h* (s)"],
+                       rows, "lllllll")
+            + "\n\n" + trace + "A gain with a positive rightmost root is no design for this loop: the error grows "
+            "like e^(t Re s) from the moment the cruise law takes over, whatever the delay, so "
+            "no delay bound of any criterion applies to it.")
+
+
+def _eig_text(e: complex) -> str:
+    if abs(e.imag) < 1e-9 * max(1.0, abs(e.real)):
+        return fmt(e.real, 3)
+    return f"{fmt(e.real, 3)} ± {fmt(abs(e.imag), 3)}j"
 
 
 def recheck_table(res) -> str:

@@ -29,7 +29,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..sim.batch import PendingBatch, uniform_draws
+from ..sim.batch import PendingBatch, available_cpus, uniform_draws
 from .antiskid_run_spec import SweepSpec
 
 #: Summary statistics reported per metric. The time to the stop (v <= v_stop)
@@ -237,13 +237,12 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
     it (default: :func:`~workbench.studies.antiskid_run.gain_for`). ``kernel``:
     "compiled" or "numpy" (default: compiled when numba is installed).
     ``scheduler``: run the chunks on Dask (``"local"`` or a scheduler's
-    address; :class:`~workbench.sim.batch.PendingBatch`)."""
-    import os
-
+    address; :class:`~workbench.sim.batch.PendingBatch`). ``workers``
+    defaults to the CPUs granted (:func:`~workbench.sim.batch.available_cpus`)."""
     from .antiskid_kernel import default_kernel
 
     inp = sweep_inputs(design, samples, seed, K)
-    workers = max(1, workers or os.cpu_count() or 1)
+    workers = max(1, workers or available_cpus())
     chunk = chunk or max(1, math.ceil(samples / DEFAULT_CHUNKS))
     kernel = kernel or default_kernel()
     pool = workers > 1 if pool is None else pool

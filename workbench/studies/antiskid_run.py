@@ -27,6 +27,11 @@ from .antiskid_run_spec import (METRICS, Case, RunSpec, agree, case_mesh, case_m
                                 plant_values, run_settings)
 from .antiskid_scenario import simulate_antiskid
 
+#: Record step (s) of the runs (figures, comfort) at dt and dt / 2.
+RECORD_DT = 0.05
+#: (a, h, t_end) of the step-halving check x' = -a x(t - h), x = 1 on [-h, 0], over t_end s.
+HALVING_PROBLEM = (1.0, 0.7, 10.0)
+
 @dataclass(frozen=True)
 class SwitchCheck:
     """Frozen linearisation of the cruise loop at the state where cruise starts.
@@ -51,6 +56,8 @@ class CaseResult:
     converged: dict          # metric -> bool
     run: SimResult           # recorded at dt / 2
     switch: SwitchCheck | None
+    comfort: object = None         # antiskid_comfort.Comfort at dt / 2 (design with [comfort])
+    comfort_coarse: object = None  # the same at dt
 
 
 @dataclass(frozen=True)
@@ -145,7 +152,7 @@ def linear_check(spec: RunSpec, A, B, K) -> LinearCheck:
         window = max(10 * h, 3 / slow)
         r = simulate_linear_dde(A, B @ Kp, h, E0, 3 * window, min(h, 1 / rate) / 5)
         ratios_p.append((h, envelope_ratio(r, window)))
-    halving = step_halving(1.0, 0.7, 10.0, (0.1, 0.05, 0.025, 0.0125))
+    halving = step_halving(*HALVING_PROBLEM, (0.1, 0.05, 0.025, 0.0125))
     return LinearCheck(A, B, tuple(K), tuple(spec.finite_gain), fin, tuple(ratios_f), pm,
                        tuple(ratios_p), tuple(runs), halving)
 
@@ -281,6 +288,9 @@ class AntiskidRun:
             names |= {f"{b}.{m}" for m in METRICS}
             names |= {f"{b}.diverged", f"{b}.stopped", f"{b}.converged",
                       f"{b}.switch.abscissa", f"{b}.switch.margin", f"{b}.switch.dmu_dlam"}
+            if spec.comfort is not None:
+                from .antiskid_comfort import COMFORT_QUANTITIES
+                names |= {f"{b}.{k}" for k in COMFORT_QUANTITIES}
         if spec.montecarlo is not None:
             from .antiskid_halving import halving_quantity_names
             from .antiskid_montecarlo import montecarlo_quantity_names
@@ -345,8 +355,8 @@ class AntiskidRun:
             rs = run_settings(spec, cs)
             t_b = spec.scenario["t_brake"]
             mesh = case_mesh(spec, case)
-            _, m1 = simulate_antiskid(rs, spec.dt, record_dt=None, mesh=mesh)
-            run2, m2 = simulate_antiskid(rs, spec.dt / 2, record_dt=0.05, mesh=mesh)
+            run1, m1 = simulate_antiskid(rs, spec.dt, record_dt=RECORD_DT, mesh=mesh)
+            run2, m2 = simulate_antiskid(rs, spec.dt / 2, record_dt=RECORD_DT, mesh=mesh)
             coarse, fine = case_metrics(m1, cs, t_b), case_metrics(m2, cs, t_b)
             conv = {k: agree(coarse[k], fine[k], spec.conv_rtol, spec.conv_atol.get(k, 0.0))
                     for k in METRICS}
@@ -354,7 +364,13 @@ class AntiskidRun:
             key = "handover" if case.cruise_entry == "creep" else "cruise"
             if math.isfinite(fine[f"lam_at_{key}"]):
                 sw = switch_check(cs, fine[f"v_at_{key}"], fine[f"lam_at_{key}"])
-            cases.append(CaseResult(case, fine, coarse, conv, run2, sw))
+            comfort = (None, None)
+            if spec.comfort is not None:
+                from .antiskid_comfort import comfort_of
+                u_peak = cs.u_range / spec.torque_range
+                comfort = tuple(comfort_of(r, spec.comfort, u_peak, RECORD_DT)
+                                for r in (run2, run1))
+            cases.append(CaseResult(case, fine, coarse, conv, run2, sw, *comfort))
         return cases
 
     def quantities(self, res: RunResult) -> dict:
@@ -377,6 +393,9 @@ class AntiskidRun:
             q[f"{b}.switch.abscissa"] = None if sw is None else sw.abscissa
             q[f"{b}.switch.margin"] = None if sw is None else sw.margin.h
             q[f"{b}.switch.dmu_dlam"] = None if sw is None else sw.dmu_dlam
+            if c.comfort is not None:
+                from .antiskid_comfort import comfort_quantities
+                q.update(comfort_quantities(c.case.name, c.comfort, c.comfort_coarse))
         if res.montecarlo is not None:
             from .antiskid_halving import halving_quantities
             from .antiskid_montecarlo import montecarlo_quantities

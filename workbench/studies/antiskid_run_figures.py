@@ -77,16 +77,6 @@ def plot_adhesion(fig, res, spec):
     ax_pp.set_ylabel("lambda (clipped to ±1)")
 
 
-def plot_torque(fig, res):
-    ax = fig.add_subplot(111)
-    for c in res.cases:
-        ax.plot(c.run.t, np.clip(c.run.u[0], -4e4, 4e4), color=color_of(c.case.name),
-                label=c.case.name, lw=0.8)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("u (N m), clipped to ±4e4")
-    ax.legend(fontsize=7)
-
-
 def plot_evs(fig, res, spec):
     ax = fig.add_subplot(111)
     prof = CreepSpeedProfile(t_brake=spec.scenario["t_brake"], **spec.profile)

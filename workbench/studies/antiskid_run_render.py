@@ -5,10 +5,14 @@ import math
 
 import numpy as np
 
-from ..controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES
+from ..controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
-from .antiskid_run_figures import (plot_adhesion, plot_creep, plot_evs, plot_linear,
-                                   plot_speed, plot_torque)
+from ..sim.wheel_slip import MAX_DLAMBDA, MAX_HALVINGS
+from .antiskid_basin_render import HEADING as BASIN_HEADING
+from .antiskid_comfort_render import (HEADING, PATTERN, TORQUE_CAPTION, comfort_figure,
+                                      comfort_section, torque_figure)
+from .antiskid_run import HALVING_PROBLEM
+from .antiskid_run_figures import plot_adhesion, plot_creep, plot_evs, plot_linear, plot_speed
 
 _LABELS = {  # metric -> (label, unit, sig)
     "t_cruise": ("time to reach v_d", "s", 4),
@@ -58,9 +62,18 @@ def render(design, res) -> Rendered:
         "of eq (76); the predictor X(t+h) of Lemma 1, eq (2).\n\n"
         + md_table(["item", "value"], rows, "ll") + "\n\n" + _cases_text(spec))
     sections.append(_results_section(res))
-    sections.append(_switch_section(res))
+    sections.append(_switch_section(res, spec))
     sections.append(_convergence_section(res, spec))
     sections.append(_linear_section(res))
+    anchors = [(r"cases\[[^\]]+\]\.(diverged|stopped|t_|braking|lam_|evs|omega3|v_)",
+                "What happens"),
+               (r"switch\.|basin\.", BASIN_HEADING),
+               (r"montecarlo\.", "Monte Carlo robustness (reduced sample)")]
+    extra_figs = (torque_figure(res, spec),)
+    if spec.comfort is not None:
+        sections.append(comfort_section(res, spec))
+        extra_figs += (comfort_figure(res, spec),)
+        anchors.insert(0, (PATTERN, HEADING))
     if res.montecarlo is not None:
         sections.append(_montecarlo_section(design, res.montecarlo, res.halving))
     figs = (
@@ -68,8 +81,7 @@ def render(design, res) -> Rendered:
                lambda fig, res=res: plot_speed(fig, res), (7.0, 4.0)),
         Figure("creep-ratio", "Creep ratio against lambda_opt and lambda_d.",
                lambda fig, res=res: plot_creep(fig, res), (7.0, 5.5)),
-        Figure("torque", "Wheel torque u(t) of the controller.",
-               lambda fig, res=res: plot_torque(fig, res), (7.0, 4.0)),
+        *extra_figs,
         Figure("creep-speed-error", "Creep-speed tracking error in braking.",
                lambda fig, res=res, sp=spec: plot_evs(fig, res, sp), (7.0, 4.0)),
         Figure("linear-checks", "Linear error system E' = A E + B K E(t-h).",
@@ -97,8 +109,9 @@ def render(design, res) -> Rendered:
         "that diverges ends where it is declared diverged).\n\n"
         "![creep ratio]({figdir}/creep-ratio.png)\n\nCreep ratio: whole run (top) and the "
         "end of acceleration (bottom), with lambda_opt and lambda_d.\n\n"
-        "![torque]({figdir}/torque.png)\n\nTorque u(t) computed by the controller (it acts h "
-        "later).\n\n![creep speed error]({figdir}/creep-speed-error.png)\n\nCreep-speed error "
+        + ("" if spec.comfort is not None else
+           "![torque]({figdir}/torque.png)\n\n" + TORQUE_CAPTION + "\n\n")
+        + "![creep speed error]({figdir}/creep-speed-error.png)\n\nCreep-speed error "
         "e_vs = v_s - v_s*(t) in braking (Theorem 3, cf. Fig. 4 of the paper).\n\n"
         "![linear checks]({figdir}/linear-checks.png)\n\n|E| of the linear error system with "
         "the finite-margin gain at the multiples of its exact margin h*.\n\n"
@@ -107,7 +120,7 @@ def render(design, res) -> Rendered:
         "peak at lambda_opt the wheel loses adhesion (spin in traction, lock in braking). "
         "Right: the same runs in the (v, lambda) plane, from the start (o) to the end (x).")
     sections.append(_numerics_section(res.montecarlo is not None, spec.rail))
-    return Rendered(tuple(sections), figs)
+    return Rendered(tuple(sections), figs, tuple(anchors))
 
 
 def _cases_text(spec) -> str:
@@ -138,7 +151,7 @@ def _results_section(res) -> str:
             "ended before).")
 
 
-def _switch_section(res) -> str:
+def _switch_section(res, spec) -> str:
     rows = []
     for c in res.cases:
         sw = c.switch
@@ -178,10 +191,19 @@ def _switch_section(res) -> str:
                    brows, "lrll")
         + "\n\nThe braking law starts on the traction side (lambda = lambda_d > 0), where its "
         "model (the braking form, whose adhesion branch grows like e^{b lambda} for lambda > 0) "
-        "does not hold; eq (76) even asks for a *positive* creep speed during the first "
-        "0.75 s.\n\n"
+        "does not hold" + _positive_creep_text(spec.profile) + ".\n\n"
         "**omega <= 3 rad/s.** v_s* jumps to 0 (eq 76): the creep-speed error jumps and decays "
         "at rate k_de; the train then coasts on running resistance to v_stop.")
+
+
+def _positive_creep_text(profile: dict) -> str:
+    """When eq (76) asks for a positive creep speed after t_brake: while
+    c0 - c1 (t - t_brake) > 0, i.e. for c0 / c1 seconds."""
+    c0, c1 = profile["c0"], profile["c1"]
+    if not (c0 > 0 and c1 > 0):
+        return ""
+    return (f"; eq (76) even asks for a *positive* creep speed during the first c0 / c1 = "
+            f"{fmt(c0 / c1, 3)} s")
 
 
 def _switch_note(res) -> str:
@@ -226,12 +248,14 @@ def _linear_section(res) -> str:
             for f, h, r in lc.ratios_finite]
     prow = [[fmt(h, 3), fmt(r, 3), "decays" if r < 1 else "grows"] for h, r in lc.ratios_paper]
     pm = lc.paper_margin
+    ha, hh, ht = HALVING_PROBLEM
     ptxt = "∞ (no crossing: stable for every constant delay)" if math.isinf(pm.h) else fmt(pm.h, 4)
     return (
         "## Linear cross-checks of the delay bound\n\n"
         "E' = A E + B K E(t - h) on the cruise linearisation, simulated by Heun's method on "
         "a grid with h = N dt. Accuracy, by step halving against the exact method-of-steps "
-        "solution of x' = -x(t - 0.7), x = 1 on [-0.7, 0], over 10 s:\n\n"
+        f"solution of x' = -{'' if ha == 1 else fmt(ha) + ' '}x(t - {fmt(hh)}), x = 1 on "
+        f"[-{fmt(hh)}, 0], over {fmt(ht)} s:\n\n"
         + md_table(["dt (s)", "max error", "observed order"],
                    [[fmt(r.dt, 3), fmt(r.error, 3), fmt(r.order, 3)] for r in lc.halving],
                    "rrr")
@@ -310,7 +334,8 @@ def _numerics_section(with_montecarlo: bool, rail: str) -> str:
         "* Plant: v by explicit Euler; the creep ratio, stiff at low speed "
         "(d lambda'/d lambda ~ -m g r^2 mu'/(J v), time constant ~ v/4000 s), by the "
         "exponential Euler step with the sympy Jacobian, stable for any step; a step that "
-        "would move the creep ratio by more than 0.02 is halved (up to 8 times), since the "
+        f"would move the creep ratio by more than {fmt(MAX_DLAMBDA)} is halved (up to "
+        f"{MAX_HALVINGS} times), since the "
         "adhesion curve is far from linear over such a change.\n"
         "* Delay: exact average of the delayed zero-order-hold input over each step "
         "(`workbench/sim/history.py`).\n"
@@ -335,14 +360,16 @@ def _numerics_section(with_montecarlo: bool, rail: str) -> str:
         "the predictor (delta e^{hJ}); its fixed points are the continuous loop's. It is not "
         "used in braking.\n"
         "* Phase switches use measured states; stops at v <= v_stop. A run ends as diverged "
-        "when |lambda| >= 0.9 (spin or lock), when a law commands more than `torque_range` "
+        f"when |lambda| >= {fmt(ControllerSettings.lam_diverged)} (spin or lock), when a law "
+        "commands more than `torque_range` "
         "times the peak adhesion torque mu(lambda_opt) m g r (no drive or brake delivers it; "
         "e.g. law (69) on the traction side, whose e^{b lambda} terms blow up: without this "
-        "test the next steps apply torques of 1e8 N m and more and the creep ratio jumps "
+        "test the next steps apply torques orders of magnitude beyond any drive or brake and "
+        "the creep ratio jumps "
         "to whichever side the overflow throws it, a different side for each step size), "
-        "or when a plant step cannot be resolved (a sub-step of dt/256 still moves lambda "
-        "by more than 0.02). The extremum of lambda over the phase a run diverged in is "
-        "where the test fired, not a property of the run: the tables show '—' for it.\n"
+        f"or when a plant step cannot be resolved (a sub-step of dt/{2 ** MAX_HALVINGS} still "
+        f"moves lambda by more than {fmt(MAX_DLAMBDA)}). The extremum of lambda over the phase "
+        "a run diverged in is where the test fired, not a property of the run: the tables show '—' for it.\n"
         "* Refined mesh for the cases without the predictor (`mesh_courant`, `mesh_levels` "
         "in `[numerics]`): the step is dt / 2^k, k <= mesh_levels the smallest level with "
         "step x S/v <= mesh_courant, S/v = m g r^2 mu'(0) / (J v) the fastest creep-ratio "
@@ -356,8 +383,8 @@ def _numerics_section(with_montecarlo: bool, rail: str) -> str:
         "converges: a refined mesh (rollout on the mesh too) gives the same metrics at many "
         "times the cost, while refining the plant but not the rollout is inconsistent "
         "(`benchmarks/mesh.py` re-runs these comparisons and prints them).\n"
-        f"* Monte Carlo robustness (mass, adhesion between the wet and dry curves, true delay, "
-        "initial speed; the controller keeps the nominal {rail}-rail model) is run by "
+        "* Monte Carlo robustness (mass, adhesion between the wet and dry curves, true delay, "
+        f"initial speed; the controller keeps the nominal {rail}-rail model) is run by "
         "`workbench sweep DESIGN --samples N --seed S --figure PNG`"
         + (", the runs of a chunk as one batch (arrays) at the `[montecarlo]` step; the "
            "reduced sample above is run with this report, and its first runs again at that "

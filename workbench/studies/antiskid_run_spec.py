@@ -70,6 +70,7 @@ class RunSpec:
     periods: float
     montecarlo: object = None      # antiskid_montecarlo.SweepSpec or None
     basin: object = None           # antiskid_basin_run.BasinSettings or None ([basin] table)
+    comfort: object = None         # antiskid_comfort.ComfortSpec or None ([comfort] table)
 
 
 @dataclass(frozen=True)
@@ -107,6 +108,14 @@ def nominal_cruise(spec: RunSpec):
     return nominal, lam_d, linearise_cruise(nominal, v_d, lam_d)
 
 
+def peak_adhesion_torque(spec: RunSpec) -> float:
+    """mu(lambda_opt) m g r of the nominal model (N m): the most torque the
+    rail transmits in steady state; ``torque_range`` counts in it."""
+    nominal = nominal_cruise(spec)[0]
+    vals = plant_values(spec)
+    return float(nominal.mu(nominal.lambda_opt())) * vals["m"] * vals["g"] * vals["r"]
+
+
 def controller_settings(spec: RunSpec, K, case: Case) -> ControllerSettings:
     """Controller (75) data for one case (plain data: picklable)."""
     nominal, lam_d, lin = nominal_cruise(spec)
@@ -114,7 +123,7 @@ def controller_settings(spec: RunSpec, K, case: Case) -> ControllerSettings:
     prof = CreepSpeedProfile(t_brake=spec.scenario["t_brake"], **spec.profile)
     lam_opt = nominal.lambda_opt()
     vals = plant_values(spec)
-    u_peak = float(nominal.mu(lam_opt)) * vals["m"] * vals["g"] * vals["r"]
+    u_peak = peak_adhesion_torque(spec)
     return ControllerSettings(
         params=tuple(vals[k] for k in PARAM_ORDER), v_d=v_d, lambda_d=lam_d,
         lambda_opt=lam_opt, K=tuple(K), lin=dict(lin.coefficients),
@@ -310,6 +319,7 @@ def load_run_spec(root: Reader) -> RunSpec:
                           f"at most samples = {mc.samples} (the check re-runs the first runs)")
         mt.finish()
     from .antiskid_basin_run import load_basin_settings
+    from .antiskid_comfort import load_comfort
     vals = {k: q.value for k, q in params.items()}
     try:
         NumericAdhesion.from_dict(vals).cruise_lambda(scen["v_d"])
@@ -318,4 +328,4 @@ def load_run_spec(root: Reader) -> RunSpec:
                           f"a speed with a creep-region equilibrium ({exc})") from None
     return RunSpec(rail, params, mass_factor, scen, gain, eps, K_table, K_source, k_ac, k_de,
                    profile, dt, v_stop, band, torque_range, mesh_courant, mesh_levels, rtol, atol, tuple(cases), tuple(fg),
-                   factors, far, periods, mc, load_basin_settings(root))
+                   factors, far, periods, mc, load_basin_settings(root), load_comfort(root))

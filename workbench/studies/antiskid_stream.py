@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..sim.batch import PendingBatch
+from ..sim.batch import PendingBatch, available_cpus
 from .antiskid_montecarlo import (DEFAULT_CHUNKS, SweepResult, chunk_payload, chunk_worker,
                                   lambda_opt_of, per_run, sweep_inputs)
 
@@ -93,7 +93,7 @@ def start_streaming(design, samples: int, seed: int, out, *, resume: bool = Fals
     from .antiskid_kernel import compile_kernel, default_kernel
     from .antiskid_run_spec import gain_for
     out = Path(out)
-    workers = max(1, workers or os.cpu_count() or 1)
+    workers = max(1, workers or available_cpus())
     chunk = chunk or max(1, math.ceil(samples / DEFAULT_CHUNKS))
     kernel = kernel or default_kernel()
     K = tuple(gain_for(design.spec)[0] if K is None else K)

@@ -33,18 +33,16 @@ import numpy as np
 import sympy as sp
 
 from ..controllers.fuzzy import FuzzyIncrement
-from ..controllers.pid import PID
 from ..reader import Quantity, Reader
 from ..sim.stopping import batch_params, simulate
-from .stopping000 import load_plant
+from .brake004_run import (CHANNELS, FAULTS, FULL, MC_FACTORS, MC_MODES, MODES,
+                           run_horizon_sweep, run_montecarlo, simulate_brake)
+from .pid_tuning import Damping, damping, deceleration_loop
+from .stopping000_spec import load_plant
+from .stopping_mc import MC_QUANTITIES, MonteCarloSpec, load_montecarlo
 
-MODES = ("open", "ato-open", "closed")
-#: not a control mode: full service from t = 0, to test each corner's feasibility
-FULL = "full-service"
-CHANNELS = ("analogue", "3bit")
-#: axle-sensor cases at the nominal corner: name -> states of the 4 axles
-FAULTS = {"healthy": "oooo", "1 sliding": "sooo", "3 failed": "fffo",
-          "2 sliding + 1 failed": "ssfo", "all 4 failed": "ffff", "all 4 sliding": "ssss"}
+__all__ = ["CHANNELS", "FAULTS", "FULL", "MC_FACTORS", "MC_MODES", "MODES", "STUDY", "Result004",
+           "Run", "Spec004", "compute_worked", "decel_damping", "run_grid", "worked_formulas"]
 
 
 @lru_cache(maxsize=1)
@@ -90,6 +88,9 @@ class Spec004:
     t_predict: float
     dt: float
     dt_ctrl: float
+    high_ratio: float = 1.1                   # a sensor reading high reads this x the speed
+    montecarlo: MonteCarloSpec | None = None
+    t_predict_sweep: tuple = ()               # ATO horizons (s) of the retuning sweep
 
 
 def _load(root: Reader) -> Spec004:
@@ -130,11 +131,17 @@ def _load(root: Reader) -> Spec004:
                    tau_filter=ct.number("tau_filter", nonneg=True),
                    slide=ct.number("slide_ratio", positive=True, hi=1.0),
                    d_min=ct.number("d_min", positive=True),
-                   t_predict=ct.number("t_predict", nonneg=True, hi=5.0), dt=0.0, dt_ctrl=0.0)
+                   t_predict=ct.number("t_predict", nonneg=True, hi=5.0), dt=0.0, dt_ctrl=0.0,
+                   high_ratio=ct.number("high_ratio", lo=1.0, hi=2.0,
+                                        what="ratio >= 1 (a sensor reading high)"),
+                   t_predict_sweep=ct.numbers("t_predict_sweep", what="horizons (s)"))
+    if not all(0 <= x <= 5.0 for x in spec.t_predict_sweep):
+        raise ct.fail("t_predict_sweep", list(spec.t_predict_sweep), "horizons in [0, 5] s")
     ct.finish()
+    mc = load_montecarlo(root, {k: v[2] for k, v in MC_FACTORS.items()})
     sim = root.table("sim")
     spec = Spec004(**{**spec.__dict__, "dt": sim.number("dt", positive=True, hi=0.05),
-                      "dt_ctrl": sim.number("dt_ctrl", positive=True, hi=1.0)})
+                      "dt_ctrl": sim.number("dt_ctrl", positive=True, hi=1.0), "montecarlo": mc})
     sim.finish()
     return spec
 
@@ -162,6 +169,9 @@ class Result004:
     tolerance: float        # m, platform-door tolerance
     feasible: tuple         # per run: full service can hold a_target on that corner
     curves: tuple = ()      # (Run, position - D (m), speed (m/s)) of the curve corners
+    mc: dict | None = None  # (speed km/h, mode) -> StopStatistics of the Monte Carlo
+    damping: Damping | None = None   # of the linearised deceleration PID loop
+    sweep: tuple = ()       # (ATO horizon s, speed km/h, nominal closed-loop stop error m)
 
     def failing(self, **kw) -> list[tuple[Run, float]]:
         """Runs (with errors) outside the tolerance among those selected."""
@@ -219,75 +229,24 @@ def stopping_point(spec: Spec004, v0: float) -> float:
     return float(tr.x_stop[0])
 
 
-def run_grid(spec: Spec004, *, debug: dict | None = None) -> Result004:
+def run_grid(spec: Spec004, *, debug: dict | None = None,
+             montecarlo: bool = True) -> Result004:
+    """The error grid, the sensor faults, the electric-brake loss; with
+    ``montecarlo`` also the Monte Carlo and the horizon sweep."""
     runs = _cases(spec)
     n = len(runs)
     D = {s: stopping_point(spec, s / 3.6) for s in spec.speeds_kmh}
     arr = lambda f: np.array([f(r) for r in runs], float)
     base = {k: q.value for k, q in spec.params.items()}
-    p = batch_params(base, n, {"K1": base["K1"] * arr(lambda r: r.friction),
-                               "v_ho": np.where(arr(lambda r: r.electric) > 0, base["v_ho"], 1e3)})
     dist = arr(lambda r: D[r.speed_kmh])
-    mode = np.array([(*MODES, FULL).index(r.mode) for r in runs])
-    bits = np.array([r.channel == "3bit" for r in runs])
-    states = np.array([list(FAULTS[r.fault]) for r in runs])           # (n, 4)
-    fallback = np.all(states != "o", axis=1)
-    closed = (mode == 2) & ~fallback
-    idx_closed = np.flatnonzero(closed)
-    pids = {j: PID(**spec.pid, dt=spec.dt_ctrl) for j in idx_closed}
-    st = {"c": np.zeros(n), "a_f": np.zeros(n), "v_prev": None, "e_prev": np.zeros(n),
-          "anchor": np.zeros(n), "in_pid": np.zeros(n, bool)}
-
-    def policy(t, o):
-        a_now = np.maximum(-o.a, 0.0)
-        tp = spec.t_predict       # ATO predicts over the brake's dead time
-        v_p = np.maximum(o.v - a_now * tp, 0.0)
-        d_go = dist - o.x - 0.5 * (o.v + v_p) * tp
-        a_req = np.where(d_go > 0, v_p**2 / (2 * np.maximum(d_go, spec.d_min)), spec.c_full)
-        axles = np.where(states == "o", o.v[:, None],
-                         np.where(states == "s", o.v[:, None] * (1 - spec.slide), 0.0))
-        v_m = axles.max(axis=1)
-        if st["v_prev"] is None:
-            st["v_prev"] = v_m.copy()
-        raw = (st["v_prev"] - v_m) / spec.dt_ctrl
-        st["v_prev"] = v_m
-        k = spec.dt_ctrl / (spec.tau_filter + spec.dt_ctrl)
-        st["a_f"] = st["a_f"] + k * (raw - st["a_f"])
-        e = a_req - st["a_f"]
-        de = (e - st["e_prev"]) / spec.dt_ctrl
-        st["e_prev"] = e
-        # closed loop: command = a_req (feed-forward) + correction; the correction is
-        # integrated by the fuzzy increments, or set by PID around its value at the switch
-        corr = st["c"]
-        small = np.abs(e) <= spec.e_switch
-        enter = small & ~st["in_pid"]
-        st["anchor"] = np.where(enter, corr, st["anchor"])
-        for j in idx_closed:
-            if enter[j]:
-                pids[j].reset()
-        fz = corr + spec.fuzzy.increment(e, de)
-        pid_out = st["anchor"].copy()
-        for j in idx_closed:
-            if small[j]:
-                pid_out[j] += pids[j].step(float(e[j]))
-        corr = np.clip(np.where(small, pid_out, fz), -spec.c_full, spec.c_full)
-        st["in_pid"] = small
-        st["c"] = np.where(closed, corr, 0.0)
-        c_closed = a_req + corr
-        c_new = np.where(mode == 0, spec.a_target, np.where(closed, c_closed, a_req))
-        c_new = np.where(mode == 3, spec.c_full, c_new)
-        if debug is not None:
-            debug.setdefault("rows", []).append((t, a_req.copy(), st["a_f"].copy(), c_new.copy(),
-                                                 d_go.copy(), o.v.copy()))
-        c_new = np.clip(c_new, 0.0, spec.c_full)
-        q = np.round(c_new / spec.c_full * 7) / 7 * spec.c_full
-        return np.where(bits, q, c_new)
-
-    v0 = arr(lambda r: r.speed_kmh / 3.6)
-    tr = simulate(p, policy, n=n, t_end=float(2 * (v0 / spec.a_target).max() + 60), dt=spec.dt,
-                  dt_ctrl=spec.dt_ctrl, dt_rec=0.5, v0=v0,
-                  theta=arr(lambda r: r.gradient), kappa=1 + arr(lambda r: r.force_error),
-                  c_min=0.0, c_max=spec.c_full)
+    tr = simulate_brake(
+        spec, v0=arr(lambda r: r.speed_kmh / 3.6), dist=dist,
+        mode=np.array([(*MODES, FULL).index(r.mode) for r in runs]),
+        bits=np.array([r.channel == "3bit" for r in runs]),
+        states=np.array([list(FAULTS[r.fault]) for r in runs]),
+        overrides={"K1": base["K1"] * arr(lambda r: r.friction),
+                   "v_ho": np.where(arr(lambda r: r.electric) > 0, base["v_ho"], 1e3)},
+        theta=arr(lambda r: r.gradient), kappa=1 + arr(lambda r: r.force_error), debug=debug)
     err = tr.x_stop - dist
     full = {(r.speed_kmh, r.force_error, r.gradient, r.friction): e
             for r, e in zip(runs, err) if r.mode == FULL}
@@ -300,7 +259,18 @@ def run_grid(spec: Spec004, *, debug: dict | None = None) -> Result004:
                    and (r.force_error, r.gradient, r.friction) in corners and r.mode != FULL)
     return Result004(compute_worked(spec.worked), D, tuple(runs[k] for k in keep),
                      tuple(float(err[k]) for k in keep), spec.tolerance,
-                     tuple(feasible[k] for k in keep), curves)
+                     tuple(feasible[k] for k in keep), curves,
+                     run_montecarlo(spec, D) if montecarlo else None, decel_damping(spec),
+                     run_horizon_sweep(spec, D) if montecarlo else ())
+
+
+def decel_damping(spec: Spec004) -> Damping:
+    """Damping of the linearised deceleration PID loop (electric stage, dead
+    time T1 plus one control period: sample and hold, and the backward
+    difference of the measured speed)."""
+    p = {k: q.value for k, q in spec.params.items()}
+    return damping(*deceleration_loop(spec.pid["kp"], spec.pid["ki"], P1=p["P1"], T2=p["T2"],
+                                      tau=spec.tau_filter), p["T1"] + spec.dt_ctrl)
 
 
 def _key(x: float) -> str:
@@ -326,10 +296,13 @@ class ClosedLoopBrake:
                       f"{b}.closed.analogue.feasible_max_abs_m",
                       f"{b}.closed.3bit.feasible_max_abs_m",
                       f"{b}.electric_loss.closed.abs_m", f"{b}.electric_loss.ato-open.abs_m"}
-            names |= {f"{b}.fault[{f}].abs_m" for f in FAULTS if f != "healthy"}
-            names |= {f"{b}.fault[{f}].change_vs_healthy_m" for f in FAULTS if f != "healthy"}
-            names.add(f"{b}.closed.3bit_minus_analogue_m")
-        return names
+            names |= {f"{b}.fault[{f}].{k}" for f in FAULTS if f != "healthy"
+                      for k in ("abs_m", "error_m", "change_vs_healthy_m")}
+            names |= {f"{b}.closed.3bit_minus_analogue_m", f"{b}.nominal.closed.analogue.abs_m",
+                      f"{b}.nominal.closed.3bit.abs_m", f"{b}.nominal.ato-open.abs_m"}
+            names |= {f"{b}.mc.{m}.{k}" for m in MC_MODES for k in MC_QUANTITIES}
+            names.add(f"{b}.mc.closed_minus_ato-open_p")
+        return names | {"pid.damping_zeta"}
 
     def run(self, design) -> Result004:
         return run_grid(design.spec)
@@ -359,11 +332,22 @@ class ClosedLoopBrake:
             for f in FAULTS:
                 if f != "healthy":
                     q[f"{b}.fault[{f}].abs_m"] = res.max_abs(speed_kmh=s, fault=f)
+                    q[f"{b}.fault[{f}].error_m"] = res.select(fault=f, **nominal)[0][1]
                     q[f"{b}.fault[{f}].change_vs_healthy_m"] = abs(
                         res.select(fault=f, **nominal)[0][1] - healthy)
+            q[f"{b}.nominal.closed.analogue.abs_m"] = abs(healthy)
+            q[f"{b}.nominal.closed.3bit.abs_m"] = abs(res.select(
+                fault="healthy", **{**nominal, "channel": "3bit"})[0][1])
+            q[f"{b}.nominal.ato-open.abs_m"] = abs(res.select(
+                fault="healthy", **{**nominal, "mode": "ato-open"})[0][1])
             for mode in ("closed", "ato-open"):
                 q[f"{b}.electric_loss.{mode}.abs_m"] = res.max_abs(speed_kmh=s, mode=mode,
                                                                    electric=False)
+            for m in MC_MODES:
+                st = res.mc[s, m]
+                q |= {f"{b}.mc.{m}.{k}": getattr(st, a) for k, a in MC_QUANTITIES.items()}
+            q[f"{b}.mc.closed_minus_ato-open_p"] = res.mc[s, "closed"].p - res.mc[s, "ato-open"].p
+        q["pid.damping_zeta"] = res.damping.zeta
         return q
 
 

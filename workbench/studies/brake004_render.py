@@ -6,6 +6,7 @@ import sympy as sp
 
 from ..report.markdown import Figure, Rendered, fmt, md_table
 from .brake004 import CHANNELS, FAULTS, MODES, worked_formulas
+from .brake004_fair_render import fault_text, figures, mc_section, retune_section
 
 MODE_TEXT = {"open": "open loop, single command",
              "ato-open": "open loop + ATO re-commands (a_req sent as the brake demand: no "
@@ -17,7 +18,7 @@ def _worked_section(res, spec) -> str:
     _, distance, degraded, share = worked_formulas()
     w = res.worked
     rows = [["d1: 50 km/h at a_full, v as printed", fmt(w["d1"], 8), "m"],
-            ["d1 from exact 50 km/h (13.889 m/s)", fmt(w["d1_exact_speed"], 8), "m"],
+            [f"d1 from exact 50 km/h ({fmt(50 / 3.6, 5)} m/s)", fmt(w["d1_exact_speed"], 8), "m"],
             ["a2: -15 % force, 15 ‰ down-grade", fmt(w["a2"], 6), "m/s²"],
             ["d2 at a2", fmt(w["d2"], 8), "m"],
             ["d2 − d1", fmt(w["delta"], 6), "m"],
@@ -53,6 +54,7 @@ def render(design, res) -> Rendered:
         f"3-bit channel sends round(7 c / {fmt(spec.c_full)}) levels.\n\n"
         + md_table(["parameter", "value", "unit", "source"], prow, "lrll"),
         _worked_section(res, spec),
+        retune_section(spec, res),
     ]
     rows = []
     for s in res.distance:
@@ -68,7 +70,7 @@ def render(design, res) -> Rendered:
                 if r.mode == "closed" and r.channel == "analogue" and r.fault == "healthy"
                 and r.electric) // max(len(res.distance), 1)
     sections.append(
-        "## Error grid: stop error against the ±0.3 m window\n\n"
+        f"## Error grid: stop error against the ±{fmt(res.tolerance)} m window\n\n"
         + md_table(["km/h", "mode", "channel", "max |error| (m)", "corners outside ±"
                     f"{fmt(res.tolerance)} m", "of them feasible"], rows, "rllrrr")
         + f"\n\n*Feasible*: full service applied from the first instant stops at least "
@@ -82,23 +84,26 @@ def render(design, res) -> Rendered:
             sel = res.select(speed_kmh=s, fault=f, mode="closed", channel="analogue",
                              force_error=0.0, gradient=0.0, friction=1.0, electric=True)
             frows.append([fmt(s), f, FAULTS[f], fmt(sel[0][1], 3) if sel else "—",
-                          "fallback (ATO open loop)" if all(c != "o" for c in FAULTS[f])
+                          "fallback (ATO open loop)" if all(c in "sf" for c in FAULTS[f])
+                          else "closed, fault undetected" if set(FAULTS[f]) & set("hz")
                           else "closed"])
         for m in ("ato-open", "closed"):
             sel = res.select(speed_kmh=s, mode=m, electric=False)
             frows.append([fmt(s), f"electric brake lost ({m})", "oooo", fmt(sel[0][1], 3), m])
     sections.append(
-        "## Sensor faults and electric-brake loss (nominal corner)\n\nAxle states: o = healthy, "
-        "s = sliding (reads 20 % low), f = failed (reads 0). Train speed = max of the four.\n\n"
-        + md_table(["km/h", "case", "axles", "stop error (m)", "loop"], frows, "rllrl"))
+        "## Sensor faults and electric-brake loss (nominal corner)\n\n"
+        + md_table(["km/h", "case", "axles", "stop error (m)", "loop"], frows, "rllrl")
+        + "\n\n" + fault_text(spec))
     sections.append("## Speed against distance\n\nFrom " + fmt(spec.speeds_kmh[0]) + " km/h at "
                     "the nominal corner and with the lowest force error (gradient 0, friction ×1)."
                     "\n\n![curves]({figdir}/speed-distance.png)")
+    sections.append(mc_section(spec, res))
     figs = (Figure("speed-distance", "Speed against position relative to the stopping point.",
                    lambda fig, res=res: _plot_curves(fig, res), size=(7.0, 4.0)),
             Figure("error-grid", "Closed-loop stop error per grid corner (analogue channel), "
                    "with the open loop for contrast.",
-                   lambda fig, res=res, spec=spec: _plot_grid(fig, res, spec), size=(8.0, 5.5)),)
+                   lambda fig, res=res, spec=spec: _plot_grid(fig, res, spec), size=(8.0, 5.5)),
+            ) + figures(spec, res)
     return Rendered(tuple(sections), figs)
 
 

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..benchmark import AUTO, BenchmarkResult, agreement_bound
 from ..benchmark_windows import directed, printed_ratio, show_window
+from ..lmi.analysis import RETRY_SETTINGS
 from ..margins import AGREEMENT_RTOL
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
 
@@ -101,7 +102,8 @@ def render(design, res: BenchmarkResult) -> Rendered:
               "every certified step re-checked with numpy"
               + (" and in exact rational arithmetic (LDL^T)" if s.exact_check else "")
               + ". A solve answered `optimal_inaccurate` is retried with Clarabel's iterative "
-              "refinement tightened, then with its tolerances at 1e-7 "
+              "refinement tightened, then with its tolerances at "
+              f"{fmt(RETRY_SETTINGS[1]['tol_feas'])} "
               "(`workbench.lmi.analysis.RETRY_SETTINGS`); a retry can only certify through "
               f"the same numpy re-check. Automatic mode: N = 0, 1, ... until 1 - h_N/h* < "
               f"{fmt(s.gap_tol)} or "

@@ -39,6 +39,8 @@ LOOP = ("delay-free closed loop x' = f(x, u* + K (x - x*)), the predictor loop f
         "under exact prediction (scope: see the section's first paragraph)")
 #: Trajectories sampled for the figure, and started on the certified level's boundary.
 N_SAMPLED, N_INSIDE = 16, 8
+#: The inside check starts on {V = BOUNDARY c_certified}; trajectories are Radau with RADAU_RTOL.
+BOUNDARY, RADAU_RTOL = 0.999, 1e-8
 
 
 @dataclass(frozen=True)
@@ -244,7 +246,7 @@ def run_basin(settings: BasinSettings, spec, model, values: dict, op, K) -> Dela
         L = np.linalg.cholesky(P)
         dirs = rng.standard_normal((N_INSIDE, n))
         dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
-        X0 = x_eq + np.sqrt(0.999 * c_cert) * dirs @ np.linalg.inv(L.T).T
+        X0 = x_eq + np.sqrt(BOUNDARY * c_cert) * dirs @ np.linalg.inv(L.T).T
         inside = tuple(_trajectory(fn, x0, V, c_cert, escape, horizon, full=True)
                        for x0 in X0)
         ok = all(_decays(tr.path, V) for tr in inside)
@@ -276,7 +278,7 @@ def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False) -> Trajectory:
     near.terminal = True
     events = [out] if full or not c_cert > 0 else [out, near]
     with np.errstate(all="ignore"):
-        sol = solve_ivp(rhs, (0.0, T), np.asarray(x0, float), method="Radau", rtol=1e-8,
+        sol = solve_ivp(rhs, (0.0, T), np.asarray(x0, float), method="Radau", rtol=RADAU_RTOL,
                         atol=1e-10, events=events)
     path = sol.y.T
     if c_cert > 0 and np.any(V(path) <= c_cert):

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..report.markdown import Figure, fmt
 from ..roa.render import fmt_level, render_basin_markdown
-from .delay_feedback_basin import N_INSIDE
+from .delay_feedback_basin import BOUNDARY, N_INSIDE, RADAU_RTOL
 
 _FATE_COLOR = {"converges": "tab:green", "leaves the domain": "tab:red", "undecided": "0.6"}
 _MARK = {"CERTIFIED": "o", "REFUTED": "X", "INCONCLUSIVE": "s"}
@@ -57,8 +57,9 @@ def render_basin_section(spec, res, basin) -> tuple[str, tuple]:
         inside = "Nothing is certified: no trajectory is started on a certified level."
     else:
         inside = (f"**Check independent of the falsifier**: {N_INSIDE} delay-free trajectories "
-                  "started on the boundary of the certified level set, {V = 0.999 c_certified} "
-                  f"(seeded directions; Radau, rtol 1e-8, over {fmt(basin.horizon, 3)} s = "
+                  "started on the boundary of the certified level set, {V = "
+                  f"{fmt(BOUNDARY)} c_certified}} (seeded directions; Radau, rtol "
+                  f"{fmt(RADAU_RTOL)}, over {fmt(basin.horizon, 3)} s = "
                   "10 / |slowest eigenvalue of A + BK|): V never rises along any of them and "
                   "each ends below 1 % of its start: "
                   + ("**yes**." if basin.inside_ok else "**no** (see the claims)."))

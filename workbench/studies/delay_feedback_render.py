@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
+from ..report.markdown import Figure, Rendered, fmt, fmt_floor, latex_matrix, md_table
 from .antiskid_cruise_render import (capped_text, closed_loop_eigs_text, exact_margin_text,
                                      recheck_table)
 from .delay_feedback_cli import gain_text
@@ -258,5 +258,4 @@ def _floor2(h, cap) -> str:
     import math
     if h is None or not math.isfinite(h) or h >= cap or h <= 0:
         return capped_text(h, cap)
-    q = 10.0 ** (math.floor(math.log10(h)) - 1)
-    return fmt(math.floor(h / q + 1e-12) * q, 2)
+    return fmt_floor(h, 2)

@@ -14,7 +14,7 @@ import numpy as np
 from ..fit import FITTED, FitResult, existing_rmse, fit, model_speeds, synthetic_log
 from ..reader import Reader
 from ..report.markdown import Figure, Rendered, fmt, md_table
-from .stopping000 import load_plant
+from .stopping000_spec import load_plant
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..report.markdown import Figure, fmt, latex_matrix, md_table
-from .platoon001_realism import CASES, CONTROLLERS
+from .platoon001_realism import CASES, CONTROLLERS, SWEEP_FACTORS
 
 LABEL = {"ntsm": "NTSM (eq 13)", "pd": "PD", "pd_ff": "PD + feed-forward",
          "linear": "NTSM's linear member"}
@@ -160,7 +160,8 @@ def margin_section(spec, rz) -> str:
                     "first follower max |e| (m)", "any follower max |e| (m)",
                     "first follower saturated (% of steps)"], srows, "llrrrrr")
         + "\n\nThe linear member loses stability where the exact margin says (its first "
-        "follower's oscillation jumps between 0.9 h* and 1.1 h*; the actuator limits then "
+        f"follower's oscillation jumps between {fmt(SWEEP_FACTORS[1])} h* and "
+        f"{fmt(SWEEP_FACTORS[2])} h*; the actuator limits then "
         "bound it). The NTSM has no threshold: its gain at ė = 0 is infinite, so with any "
         "delay in the loop it settles into an oscillation whose size grows with the delay. "
         "Followers further back oscillate more (their predecessor's oscillating acceleration "

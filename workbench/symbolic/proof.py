@@ -140,6 +140,15 @@ class Claim:
         matrices; display only, never parsed).
     note : str
         Erratum / remark shown in the report.
+    origin : "paper" | "workbench"
+        "paper": a step as the paper states it (or the printed half of an
+        erratum); "workbench": a corrected form or a repair the workbench adds.
+    severity : str, optional
+        How much an erratum (``expect = "refuted"``) matters, one of
+        :data:`workbench.claims.SEVERITIES` (checked by :mod:`workbench.prove`);
+        None: not assessed.
+    severity_reason : str
+        One line saying why (required with a severity).
     """
 
     id: str
@@ -162,12 +171,17 @@ class Claim:
     display: str = ""
     expect: Literal["proved", "refuted"] = "proved"
     note: str = ""
+    origin: Literal["paper", "workbench"] = "paper"
+    severity: str | None = None
+    severity_reason: str = ""
 
     def __post_init__(self):
         if self.kind not in KINDS:
             raise ValueError(f"claim {self.id}: kind = {self.kind!r}; expected one of {KINDS}")
         if self.expect not in ("proved", "refuted"):
             raise ValueError(f"claim {self.id}: expect = {self.expect!r}")
+        if self.origin not in ("paper", "workbench"):
+            raise ValueError(f"claim {self.id}: origin = {self.origin!r}")
 
 
 @dataclass(frozen=True)
@@ -194,6 +208,10 @@ class ProofResult:
         What is left to show (INCONCLUSIVE only).
     samples : int
         Points of the falsification search that satisfied the hypotheses.
+    severity_holds : bool
+        False when the claim's severity was checked against the result and
+        does not hold (:func:`workbench.prove.check_proof_claim`: a
+        ``rounding`` erratum more than a rounding off); the claim is then not ok.
     """
 
     claim: Claim
@@ -203,17 +221,20 @@ class ProofResult:
     violation: float | None = None
     remaining: str = ""
     samples: int = 0
+    severity_holds: bool = True
 
     @property
     def ok(self) -> bool:
-        """PROVED, or REFUTED for a claim declared expected-refuted."""
+        """PROVED, or REFUTED for a claim declared expected-refuted (and its
+        severity, where checked, holds)."""
         want = Verdict.REFUTED if self.claim.expect == "refuted" else Verdict.PROVED
-        return self.verdict is want
+        return self.verdict is want and self.severity_holds
 
     def to_json(self) -> dict:
         c = self.claim
         return {"id": c.id, "paper": c.paper, "equations": c.equations,
                 "statement": c.statement, "kind": c.kind, "expect": c.expect,
+                "origin": c.origin, "severity": c.severity,
                 "verdict": self.verdict.value, "ok": self.ok,
                 "counterexample": (None if self.counterexample is None
                                    else dict(self.counterexample)),
