@@ -147,7 +147,7 @@ def test_absolute_default_scan_can_fail():
     assert p.name in TIME_PARAMETERS and p.default not in (inspect.Parameter.empty, None)
 
 
-@pytest.mark.parametrize("c", [1e-3, 1e3])
+@pytest.mark.parametrize("c", [1e-6, 1e-3, 1e3, 1e6])
 def test_synthesis_scales_with_time(c):
     """Wirtinger synthesis of x' = x + u(t - h) in another time unit: (c A, c B)
     with the cap h_max / c (the default eps grid follows the cap) gives the
