@@ -72,7 +72,7 @@ def _delay_feedback() -> None:
     path = (Path(__file__).resolve().parents[1] / "designs"
             / "wheel-slip-burckhardt-delay-feedback.toml")
     spec = load_design(path).spec
-    K = [[-0.03668, 0.00772]]          # reports/wheel-slip-burckhardt-delay-feedback.md
+    K = [[-0.03662, 0.007732]]         # reports/wheel-slip-burckhardt-delay-feedback.md
     values = spec.plant.values()
     dom = spec.basin.domain
     box = ([dom["omega"][0], dom["T"][0]], [dom["omega"][1], dom["T"][1]])

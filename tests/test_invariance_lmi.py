@@ -147,17 +147,7 @@ def test_absolute_default_scan_can_fail():
     assert p.name in TIME_PARAMETERS and p.default not in (inspect.Parameter.empty, None)
 
 
-#: Known defect (issue 21, open): the Wirtinger synthesis of x' = x + u(t - h)
-#: written in milliseconds (c = 1e-3, cap 1e4) certifies 336 instead of 996 ms.
-#: Writing its blocks in a power-of-two time unit taken from the cap fixes
-#: that, but then the minimum-norm canonical point of the shipped
-#: train-brake-lag design fails its re-check at every fraction tried; the
-#: unit is used for the time-varying-delay LMIs only, until that is solved.
-SYNTHESIS_UNIT_DEFECT = pytest.mark.xfail(
-    strict=True, reason="synthesis LMIs are not yet written in the system's time unit")
-
-
-@pytest.mark.parametrize("c", [pytest.param(c, marks=SYNTHESIS_UNIT_DEFECT) for c in (1e-3, 1e3)])
+@pytest.mark.parametrize("c", [1e-6, 1e-3, 1e3, 1e6])
 def test_synthesis_scales_with_time(c):
     """Wirtinger synthesis of x' = x + u(t - h) in another time unit: (c A, c B)
     with the cap h_max / c (the default eps grid follows the cap) gives the
@@ -172,9 +162,7 @@ def test_synthesis_scales_with_time(c):
     assert _close(r1.gain.h_certified, c * rc.gain.h_certified)
 
 
-# c = 1e4 shows the same defect and took 105 s (of a 15 min suite): the defect is
-# pinned by c = 1e-4 here and by both directions in test_synthesis_scales_with_time.
-@pytest.mark.parametrize("c", [pytest.param(1e-4, marks=SYNTHESIS_UNIT_DEFECT)])
+@pytest.mark.parametrize("c", [1e-4, 1e4])
 def test_robust_synthesis_scales_with_time(c):
     """The polytopic (descriptor) synthesis with a decay rate: (c A_i, c B_i),
     cap h_hi / c and rate c alpha give the same K and h / c."""

@@ -174,6 +174,9 @@ class MarginLMI:
     #: (each on top of :data:`CLARABEL_SETTINGS`); a retry can only certify
     #: through the same numpy re-check.
     retry_settings: tuple[dict, ...] = ()
+    #: The same for the minimum-norm :meth:`canonical_point` after an answer
+    #: other than ``optimal`` (None: :attr:`retry_settings`).
+    canonical_retry_settings: tuple[dict, ...] | None = None
 
     def __init__(self, *, margin: float = DEFAULT_MARGIN, bound: float = DEFAULT_BOUND):
         if not 0 < margin < 1:
@@ -294,9 +297,9 @@ class MarginLMI:
         projection of 0 onto a closed convex set, unique whenever the
         criterion holds at ``h`` with a positive margin (written as a
         second-order cone, which Clarabel solves more reliably here than the
-        equivalent quadratic objective). After an inaccurate answer it is
-        retried with :attr:`retry_settings`. The point is re-checked like
-        any other (relative margins >= ``margin``).
+        equivalent quadratic objective). After an answer other than
+        ``optimal`` it is retried with :attr:`canonical_retry_settings`. The
+        point is re-checked like any other (relative margins >= ``margin``).
 
         Returns
         -------
@@ -311,7 +314,9 @@ class MarginLMI:
             size = cp.norm(cp.hstack([cp.vec(v, order="F") for v in self._vars.values()]), 2)
             self._canonical = cp.Problem(cp.Minimize(size), cons)
         status, seconds = self._run(self._canonical, h, CLARABEL_SETTINGS)
-        for extra in self.retry_settings:
+        retries = (self.retry_settings if self.canonical_retry_settings is None
+                   else self.canonical_retry_settings)
+        for extra in retries:
             if status == cp.OPTIMAL:
                 break
             status, more = self._run(self._canonical, h, {**CLARABEL_SETTINGS, **extra})

@@ -38,11 +38,11 @@ from typing import Callable, Sequence
 import cvxpy as cp
 import numpy as np
 
-from .analysis import BesselLegendreLMI, certified_delay
+from .analysis import RETRY_SETTINGS, BesselLegendreLMI, certified_delay
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, bisect_delay
 from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
 from .delay_input import H_HI_SCALE, H_LO_SCALE
-from .scaling import balance_points, check_unit
+from .scaling import SYNTHESIS_CAP_IN_UNITS, balance_points, check_unit, time_unit
 
 #: The eps-search bisections of a synthesis stop going down at this fraction
 #: of the search cap (relative: the search is the same in any time unit).
@@ -89,6 +89,11 @@ class DescriptorSynthesis(MarginLMI):
     z' = (A_i + alpha I) z + e^{alpha h} B_i K z(t-h) (x = e^{-alpha t} z):
     feasible => exponentially stable with rate alpha at delay h.
     """
+
+    #: The minimum-norm canonical point is retried like the analysis LMIs'
+    #: solves (the bisection's steps are not: an inaccurate step stays
+    #: inconclusive).
+    canonical_retry_settings = RETRY_SETTINGS
 
 
     def __init__(self, points: Sequence[tuple[np.ndarray, np.ndarray]], eps: float,
@@ -266,13 +271,16 @@ def synthesize_robust(points, *, h_hi: float, alpha: float = 0.0,
 
     ``h_hi`` (the search cap, s) is required: it states the delay range of
     interest in the system's own time unit. ``eps_grid`` defaults to
-    :data:`ROBUST_EPS_GRID` times ``h_hi``. The blocks are written in seconds
-    (``unit`` = 1): in exact arithmetic (c A_i, c B_i) with cap h_hi / c gives
-    the same gain and h / c, numerically not yet (issue 21).
+    :data:`ROBUST_EPS_GRID` times ``h_hi``. The blocks (and the fixed-gain
+    analysis's) are written in the time unit
+    u = ``time_unit(h_hi, SYNTHESIS_CAP_IN_UNITS)`` (:mod:`workbench.lmi.scaling`,
+    exact), so (c A_i, c B_i) with cap h_hi / c and rate c alpha gives the same
+    gain and h / c, numerically too (issue 21).
     """
     eps_grid = eps_grid_for(eps_grid, ROBUST_EPS_GRID, h_hi)
     T, Tinv, pts = balance_points(points)
-    lmi = DescriptorSynthesis(pts, eps_grid[0], alpha, margin=margin)
+    u = time_unit(h_hi, SYNTHESIS_CAP_IN_UNITS)
+    lmi = DescriptorSynthesis(pts, eps_grid[0], alpha, margin=margin, unit=u)
     best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_hi,
                                    rel_tol=rel_tol)
     br = tried[best]
@@ -281,7 +289,8 @@ def synthesize_robust(points, *, h_hi: float, alpha: float = 0.0,
         lmi.set_eps(best)
         gain = canonical_gain(
             lmi, br.h_certified,
-            lambda Kt: DescriptorSynthesisFixedK(pts, best, alpha, K=Kt, margin=margin), T,
+            lambda Kt: DescriptorSynthesisFixedK(pts, best, alpha, K=Kt, margin=margin,
+                                                 unit=u), T,
             fraction=gain_fraction, digits=gain_digits, h_hi=h_hi, rel_tol=rel_tol)
     pairs = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
     return RobustSynthesis(best, br, None if gain is None else gain.K, pairs, gain)

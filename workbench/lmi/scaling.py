@@ -15,14 +15,29 @@ import numpy as np
 import scipy.linalg as sl
 
 
-#: A synthesis LMI's blocks are written in the time unit that makes its delay
-#: cap about this many units (the power of two nearest h_cap / CAP_IN_UNITS).
+#: A time-varying-delay synthesis LMI's blocks are written in the time unit
+#: that makes its delay cap about this many units (the power of two nearest
+#: h_cap / CAP_IN_UNITS).
 CAP_IN_UNITS = 10.0
+#: The same for the constant-delay syntheses (Wirtinger and descriptor,
+#: :mod:`workbench.lmi.tight_synthesis`, :mod:`workbench.lmi.robust`): the cap is
+#: about 4 units (2.8 to 5.7). Their canonical gain (the minimum-norm
+#: certificate, :mod:`workbench.lmi.gain`) depends on the unit, and this is the
+#: ratio that suits every shipped design (issue 21, measured): about 10 units
+#: fail the canonical point of train-brake-lag (cap 1.5 s, unit 1/8 s: relative
+#: margin 4.5e-8 < 1e-7; 1/4 s: solver error), about 1.4 to 2.8 units leave the
+#: antiskid-cruise gains (cap 10 s, unit 4 or 8 s) with an entry 2e-5 of the
+#: other, whose fourth digit then depends on the BLAS kernels; at 4 units
+#: (train 1/2 s, wheel-slip 1/4 s, antiskid 2 s) every shipped synthesis
+#: certifies its cap or more, canonical gain included (default and
+#: Sandybridge OpenBLAS kernels give the same reports).
+SYNTHESIS_CAP_IN_UNITS = 4.0
 
 
-def time_unit(h_cap: float) -> float:
+def time_unit(h_cap: float, cap_in_units: float = CAP_IN_UNITS) -> float:
     """Time unit (s) of a synthesis LMI's blocks: the power of two nearest
-    ``h_cap / CAP_IN_UNITS``.
+    ``h_cap / cap_in_units`` (default :data:`CAP_IN_UNITS`; the constant-delay
+    syntheses pass :data:`SYNTHESIS_CAP_IN_UNITS`).
 
     The blocks are written for (u A, u B) at delay h / u and descriptor
     scalar eps / u: the same system in the unit u, so a certificate there is
@@ -30,11 +45,11 @@ def time_unit(h_cap: float) -> float:
     solver then sees the same numbers whatever unit the caller's model uses
     (time scaling (c A, c B) with cap h_cap / c changes u by at most a factor
     sqrt 2), and relative margins do not depend on the unit. Caps within
-    sqrt 2 of ``CAP_IN_UNITS`` s give u = 1.
+    sqrt 2 of ``cap_in_units`` s give u = 1.
     """
     if not (isinstance(h_cap, (int, float, np.floating)) and 0 < h_cap < math.inf):
         raise ValueError(f"h_max = {h_cap!r}; expected a positive finite delay cap (s)")
-    return 2.0 ** round(math.log2(h_cap / CAP_IN_UNITS))
+    return 2.0 ** round(math.log2(h_cap / cap_in_units))
 
 
 def check_unit(unit: float) -> float:

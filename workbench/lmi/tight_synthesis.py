@@ -43,7 +43,7 @@ import numpy as np
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI
 from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
 from .robust import DescriptorSynthesis, best_eps_bracket, eps_grid_for
-from .scaling import balance_points, check_unit
+from .scaling import SYNTHESIS_CAP_IN_UNITS, balance_points, check_unit, time_unit
 
 
 class WirtingerSynthesis(MarginLMI):
@@ -98,6 +98,7 @@ class WirtingerSynthesis(MarginLMI):
     #: Jensen descriptor synthesis of :mod:`workbench.lmi.robust`.
     set_eps = DescriptorSynthesis.set_eps
     gain = DescriptorSynthesis.gain
+    canonical_retry_settings = DescriptorSynthesis.canonical_retry_settings
 
     def variables(self) -> dict[str, cp.Variable]:
         n = self.n
@@ -158,6 +159,9 @@ class TightSynthesis:
         Balancing T (x = T x~) of the certificate's coordinates.
     gain : CanonicalGain or None
         How K was chosen, and the delay it certifies on its own.
+    unit : float
+        Time unit (s, a power of two) the blocks were written in
+        (:func:`~workbench.lmi.scaling.time_unit` of the cap).
     """
 
     eps: float
@@ -167,6 +171,7 @@ class TightSynthesis:
     h_max: float
     T: np.ndarray = field(repr=False)
     gain: CanonicalGain | None = field(default=None, repr=False)
+    unit: float = 1.0
 
     @property
     def h_certified(self) -> float:
@@ -201,10 +206,10 @@ def synthesize_tight(A, B, *, h_max: float, eps_grid: Sequence[float] | None = N
         system's own time unit (no absolute default).
     eps_grid : sequence of float, optional
         Log grid of the descriptor scalar (s), refined by golden section;
-        default :data:`TIGHT_EPS_GRID` times ``h_max``. In exact arithmetic
-        (c A, c B) with cap h_max / c then gives the same gain and h / c; the
-        blocks are still written in seconds (``unit`` = 1), and numerically a
-        model in milliseconds certifies less (issue 21, open).
+        default :data:`TIGHT_EPS_GRID` times ``h_max``. The blocks are written
+        in the time unit u = ``time_unit(h_max, SYNTHESIS_CAP_IN_UNITS)``
+        (:mod:`workbench.lmi.scaling`, exact), so (c A, c B) with cap h_max / c
+        gives the same gain and h / c, numerically too (issue 21).
     golden_steps : int
     rel_tol : float
         Relative bracket width of the delay bisection.
@@ -223,7 +228,8 @@ def synthesize_tight(A, B, *, h_max: float, eps_grid: Sequence[float] | None = N
     A = np.atleast_2d(np.asarray(A, float))
     B = np.asarray(B, float).reshape(A.shape[0], -1)
     T, Tinv, ((At, Bt),) = balance_points([(A, B)])
-    lmi = WirtingerSynthesis(At, Bt, eps_grid[0], margin=margin)
+    u = time_unit(h_max, SYNTHESIS_CAP_IN_UNITS)
+    lmi = WirtingerSynthesis(At, Bt, eps_grid[0], margin=margin, unit=u)
     best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_max,
                                    rel_tol=rel_tol, stop_at=h_max)   # nothing beyond the cap
     br = tried[best]
@@ -232,11 +238,11 @@ def synthesize_tight(A, B, *, h_max: float, eps_grid: Sequence[float] | None = N
         lmi.set_eps(best)
         gain = canonical_gain(
             lmi, br.h_certified,
-            lambda Kt: WirtingerSynthesisFixedK(At, Bt, best, K=Kt, margin=margin), T,
+            lambda Kt: WirtingerSynthesisFixedK(At, Bt, best, K=Kt, margin=margin, unit=u), T,
             fraction=gain_fraction, digits=gain_digits, h_hi=h_max, rel_tol=rel_tol)
         K = gain.K
     tried_h = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
-    return TightSynthesis(best, br, K, tried_h, float(h_max), T, gain)
+    return TightSynthesis(best, br, K, tried_h, float(h_max), T, gain, u)
 
 
 def recheck_tight(A, B, result: TightSynthesis,
@@ -260,7 +266,7 @@ def recheck_tight(A, B, result: TightSynthesis,
     A = np.atleast_2d(np.asarray(A, float))
     B = np.asarray(B, float).reshape(A.shape[0], -1)
     Tinv = np.diag(1.0 / np.diag(result.T))
-    lmi = WirtingerSynthesis(Tinv @ A @ result.T, Tinv @ B, result.eps)
+    lmi = WirtingerSynthesis(Tinv @ A @ result.T, Tinv @ B, result.eps, unit=result.unit)
     cert = result.bracket.certificate.certificate if certificate is None else certificate
     return lmi.recheck(cert, result.bracket.h_certified)
 
