@@ -85,3 +85,13 @@ def test_cli_resume_needs_out(capsys):
                  "--resume"])
     err = capsys.readouterr().err
     assert code == 2 and "--resume = True; expected with --out DIR" in err
+
+
+def test_default_chunk_is_bounded():
+    """A large sweep is cut into chunks of at most MAX_CHUNK runs (streaming,
+    resume and progress at a fine grain); a small one into DEFAULT_CHUNKS."""
+    from workbench.studies.antiskid_montecarlo import DEFAULT_CHUNKS, MAX_CHUNK, default_chunk
+    assert default_chunk(1) == 1
+    assert default_chunk(64) == 64 // DEFAULT_CHUNKS
+    assert default_chunk(10**6) == MAX_CHUNK
+    assert all(1 <= default_chunk(n) <= MAX_CHUNK for n in range(1, 5000, 37))

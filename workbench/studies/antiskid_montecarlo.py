@@ -51,8 +51,19 @@ VIOLATIONS = {"above_lambda_opt": "creep ratio above the sample's lambda_opt in 
               "diverged": "diverged (|lambda| >= 0.9, torque out of range, or step not resolved)",
               "not_stopped": "not stopped by t_end"}
 
-#: Default number of chunks a sweep is cut into (independent of the workers).
+#: Default number of chunks a sweep is cut into (independent of the workers)...
 DEFAULT_CHUNKS = 4
+#: ... unless a chunk would hold more runs than this: a large sweep streams,
+#: resumes and reports progress in chunks of at most MAX_CHUNK runs (about a
+#: minute of one core with the compiled kernel), and a worker's memory does
+#: not grow with the sweep.
+MAX_CHUNK = 500
+
+
+def default_chunk(samples: int) -> int:
+    """Runs per chunk when the caller gives none: samples / DEFAULT_CHUNKS,
+    at most MAX_CHUNK, at least 1 (the results do not depend on it)."""
+    return max(1, min(math.ceil(samples / DEFAULT_CHUNKS), MAX_CHUNK))
 
 
 @dataclass(frozen=True)
@@ -243,7 +254,7 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
 
     inp = sweep_inputs(design, samples, seed, K)
     workers = max(1, workers or available_cpus())
-    chunk = chunk or max(1, math.ceil(samples / DEFAULT_CHUNKS))
+    chunk = chunk or default_chunk(samples)
     kernel = kernel or default_kernel()
     pool = workers > 1 if pool is None else pool
     payloads = [chunk_payload(inp, i0, min(i0 + chunk, samples), inp["dt"], kernel)
@@ -276,7 +287,7 @@ def sweep(design, samples: int, seed: int, *, workers: int | None = None,
     workers : int, optional
         Process count (default: CPU count); 1 runs in-process.
     chunk : int, optional
-        Samples per batch (default: samples / DEFAULT_CHUNKS, at least 1).
+        Samples per batch (default: :func:`default_chunk`).
         The results depend on it, not on ``workers``.
     progress : bool
         Progress bar on stderr.

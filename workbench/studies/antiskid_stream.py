@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..sim.batch import PendingBatch, available_cpus
-from .antiskid_montecarlo import (DEFAULT_CHUNKS, SweepResult, chunk_payload, chunk_worker,
+from .antiskid_montecarlo import (SweepResult, chunk_payload, chunk_worker, default_chunk,
                                   lambda_opt_of, per_run, sweep_inputs)
 
 MANIFEST = "sweep.json"
@@ -94,7 +94,7 @@ def start_streaming(design, samples: int, seed: int, out, *, resume: bool = Fals
     from .antiskid_run_spec import gain_for
     out = Path(out)
     workers = max(1, workers or available_cpus())
-    chunk = chunk or max(1, math.ceil(samples / DEFAULT_CHUNKS))
+    chunk = chunk or default_chunk(samples)
     kernel = kernel or default_kernel()
     K = tuple(gain_for(design.spec)[0] if K is None else K)
     man = _manifest(design, samples, seed, chunk, kernel, K)
