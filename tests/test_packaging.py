@@ -23,3 +23,14 @@ def test_scaffold_templates_are_package_data():
     assert conf["package-data"]["workbench.scaffold"] == ["files/*"]
     assert sorted(p.name for p in FILES.iterdir()) == sorted(
         {**COMMON, **EXAMPLE} | {f"{k}.toml.tmpl": None for k in KINDS})
+
+
+def test_python_m_workbench_is_the_cli():
+    """``python -m workbench`` runs the same CLI: a bad design path exits 2 with
+    one line naming the file, no traceback."""
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, "-m", "workbench", "verify", "no-such-design.toml"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2
+    assert "no-such-design.toml" in r.stderr and "Traceback" not in r.stderr
