@@ -11,7 +11,7 @@ from workbench.design import load_design
 from workbench.errors import DesignError, ModelError
 from workbench.plants.train002 import Train002, davis
 from workbench.profiles import ProfileSpec, build_profile, cruise_speed, run_time
-from workbench.sim.tracking import Route, TrackingRun, quality_indices, simulate_tracking
+from workbench.sim.tracking import Route, TrackingRun, objectives, simulate_tracking
 
 DESIGN = Path("designs/ato-mfac-pid-002.toml")
 # paper 002 §4: Macun - Nanhu 1657.8 m, 114.9 s planned, 80 km/h
@@ -71,8 +71,8 @@ def test_davis_matches_formula_and_train_holds_at_rest():
 
 
 # -- MFAC -------------------------------------------------------------------------------
-def test_mfac_control_law_minimises_eq8_criterion():
-    """With rho = 1 the increment minimises |y* - y - phi du|^2 + lambda du^2."""
+def test_mfac_control_law_minimises_eq6_criterion():
+    """With rho = 1 the increment of eq 7 minimises eq 6, |y* - y - phi du|^2 + lambda du^2."""
     g = MFACGains(lam=0.3, rho=1.0, eta=0.5, mu=1.0, phi1=0.7)
     c = MFAC(g, 1)
     u = c.step(np.array([1.0]), np.array([2.5]))[0]
@@ -80,7 +80,7 @@ def test_mfac_control_law_minimises_eq8_criterion():
     assert u == pytest.approx(minimize_scalar(J).x, rel=1e-6)
 
 
-def test_mfac_ppd_update_minimises_eq6_criterion_and_resets():
+def test_mfac_ppd_update_minimises_eq8_criterion_and_resets():
     g = MFACGains(lam=1.0, rho=0.5, eta=1.0, mu=0.2, phi1=0.5)
     c = MFAC(g, 1)
     c.step(np.array([0.0]), np.array([1.0]))
@@ -104,18 +104,19 @@ def test_frozen_ppd_loop_is_undamped_then_unstable():
 
 
 # -- indices -----------------------------------------------------------------------------
-def test_quality_indices_on_a_known_history():
+def test_objectives_on_a_known_history():
     t = np.arange(5) * 1.0
     a = np.array([[0.0, 1.0, 0.0, -1.0, 0.0]])
     run = TrackingRun(t, np.ones((1, 5)), np.zeros((1, 5)), a, np.zeros((1, 5)),
                       np.ones((1, 5)) * 1.5, np.array([4.5]), np.array([99.0]),
                       np.array([20.0]))
-    q = quality_indices(run, distance=100.0, run_time=5.0)
+    q = objectives(run, distance=100.0, run_time=5.0)
     assert q.stop_error[0] == pytest.approx(1.0)
-    assert q.punctuality[0] == pytest.approx(0.1)
-    assert q.comfort[0] == pytest.approx(4.0 / 4.5)   # |1|+|1|+|1|+|1| over 4.5 s
-    assert q.energy[0] == pytest.approx(0.2)
+    assert q.punctuality[0] == pytest.approx(0.5)                 # |4.5 - 5| s
+    assert q.comfort[0] == pytest.approx(1.0)                     # jerks +-1 m/s^3, RMS 1
+    assert q.energy[0] == pytest.approx(20.0)                     # J/kg, not per metre
     assert q.rms_speed_error[0] == pytest.approx(0.5)
+    assert q.matrix().shape == (1, 4)
 
 
 # -- design ---------------------------------------------------------------------------------
@@ -129,7 +130,9 @@ def _bad(tmp_path, old, new):
 
 @pytest.mark.parametrize("old, new, key", [
     ('Ts = { value = 0.1,', 'Ts = { value = 0.105,', "simulation.Ts"),
-    ("rho = [0.2, 0.5, 1.0]", "rho = [0.2, 0.5, 1.5]", "mfac.rho"),
+    ("rho = [0.2, 0.5, 1.0]", "rho = [0.2, 0.5, 1.5]", "plant_readings[0].mfac.rho"),
+    ('name = "first-order"', 'name = "integrating"', "plant_readings"),
+    ("weights = [1.0, 1.0, 1.0, 1.0]", "weights = [1.0, 1.0, 1.0]", "tuning.weights"),
     ('run_time = { value = 114.9, unit = "s", source = "paper 002 §4 (planned)" }',
      'run_time = { value = 60.0, unit = "s", source = "x" }', "route.run_time"),
     ('delay = { value = 0.3, unit = "s"', 'delay = { value = 0.3, unit = "ms"', "train.delay.unit"),
@@ -147,11 +150,18 @@ def evaluation():
 
 
 def test_study_runs_and_claims_are_ok(evaluation):
+    from workbench.studies.tracking002_run import study_quantities
     assert evaluation.ok
-    q = __import__("workbench.studies.tracking002", fromlist=["STUDY"]).STUDY.quantities(
-        evaluation.result)
-    # both controllers stop on every section (no undetermined index)
-    assert all(np.isfinite(c.value(k, "stop_error")) for c in
-               (evaluation.result.main, *evaluation.result.line) for k in ("MFAC", "PID"))
-    assert q["main.pid.rms_speed_error"] < q["main.mfac.rms_speed_error"]
-    assert math.isclose(q["profile.v_cruise"], evaluation.result.main.profile.v_cruise)
+    res = evaluation.result
+    q = study_quantities(res)
+    assert [r.reading.name for r in res.readings] == ["integrating", "first-order"]
+    for r in res.readings:
+        # both chosen controllers stop on the main pair, and each chosen point is on its front
+        assert all(np.isfinite(r.main.value(k, "stop_error")) for k in ("MFAC", "PID"))
+        assert r.mfac.front[r.mfac.chosen] and r.pid.front[r.pid.chosen]
+        # the grid row of the chosen point and its re-run agree (same batch arithmetic)
+        row = r.mfac.objectives[r.mfac.chosen]
+        assert row[0] == pytest.approx(r.main.value("MFAC", "stop_error"), rel=1e-9)
+        assert r.mfac.reset_rate[r.mfac.chosen] == pytest.approx(r.ppd.reset_rate, rel=1e-12)
+    assert math.isclose(q["profile.v_cruise"], res.profile.v_cruise)
+    assert res.to_json()["readings"][1]["name"] == "first-order"

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 
 @dataclass
 class PID:
@@ -57,4 +59,43 @@ class PID:
         saturating = (u_free > self.u_max and error > 0) or (u_free < self.u_min and error < 0)
         if not saturating:
             self._integral += error * self.dt
+        return u
+
+
+class BatchPID:
+    """:class:`PID` (error form, no derivative on measurement) for a batch of
+    independent loops, one gain set each: the same arithmetic, elementwise.
+
+    Parameters
+    ----------
+    kp, ki, kd : array_like
+        Gains, one per loop (broadcast to ``n``).
+    n : int
+        Batch size.
+    dt, u_min, u_max : float
+        As for :class:`PID`.
+    """
+
+    def __init__(self, kp, ki, kd, n: int, *, dt: float, u_min: float = float("-inf"),
+                 u_max: float = float("inf")):
+        if not dt > 0:
+            raise ValueError(f"dt = {dt!r}; expected a positive sampling period (s)")
+        if not u_min < u_max:
+            raise ValueError(f"u_min = {u_min!r}, u_max = {u_max!r}; expected u_min < u_max")
+        shape = (n,)
+        self.kp, self.ki, self.kd = (np.broadcast_to(np.asarray(x, float), shape)
+                                     for x in (kp, ki, kd))
+        self.dt, self.u_min, self.u_max = dt, u_min, u_max
+        self.integral = np.zeros(shape)
+        self.prev: np.ndarray | None = None
+
+    def step(self, error) -> np.ndarray:
+        """One sample: the saturated outputs for these errors."""
+        error = np.asarray(error, float)
+        deriv = np.zeros_like(error) if self.prev is None else (error - self.prev) / self.dt
+        self.prev = error
+        u_free = self.kp * error + self.ki * (self.integral + error * self.dt) + self.kd * deriv
+        u = np.minimum(np.maximum(u_free, self.u_min), self.u_max)
+        saturating = ((u_free > self.u_max) & (error > 0)) | ((u_free < self.u_min) & (error < 0))
+        self.integral = np.where(saturating, self.integral, self.integral + error * self.dt)
         return u

@@ -3,7 +3,9 @@ paper 001 is in :mod:`workbench.sim.platoon`.
 
 The plants here are discrete-time / non-stiff: the 002 train is stepped at a
 fine plant step ``dt`` (the lag integrated exactly for a demand held over the
-step, the pure delay as a FIFO of whole steps) and the controller runs every
+step, the pure delay as a FIFO of whole steps; in the first-order reading the
+lag acts on speed and its exact increment is limited to the acceleration
+limits times ``dt``) and the controller runs every
 ``Ts = n_sub dt`` with zero-order hold. Every state is an array over a batch
 of independent runs (controllers, parameter sets, stations), so a whole
 parameter study is one loop over time.
@@ -20,7 +22,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..plants.train002 import Train002
+from ..plants.train002 import FirstOrderTrain002, Train002
 
 
 @dataclass(frozen=True)
@@ -61,7 +63,9 @@ class TrackingRun:
         Time (s) and position (m) of the stop; nan when the train did not stop
         within the horizon. Shape (N,).
     traction_work : numpy.ndarray
-        Integral of max(a_applied, 0) v dt up to the stop (J/kg), shape (N,).
+        Integral of max(a_applied, 0) v dt up to the stop (J/kg), shape (N,);
+        a_applied is the lag's output (integrating reading) or the realised
+        traction/brake acceleration (first-order reading), before resistance.
     """
 
     t: np.ndarray
@@ -115,6 +119,7 @@ def simulate_tracking(train: Train002, route: Route, target: Callable[[np.ndarra
                                                             abs_tol=1e-12):
         raise ValueError(f"Ts = {Ts} and delay = {train.delay} must be multiples of dt = {dt}")
     K = int(math.ceil(horizon / Ts))
+    first_order = isinstance(train, FirstOrderTrain002)
     decay = math.exp(-dt / train.lag)
     gain_int = train.lag * (1.0 - decay)          # integral of (1 - e^{-t/T}) weight
     fifo = np.zeros((n_delay + 1, n))              # demands of the last n_delay steps
@@ -138,9 +143,11 @@ def simulate_tracking(train: Train002, route: Route, target: Callable[[np.ndarra
             fifo[head] = demand
             head = (head + 1) % (n_delay + 1)
             A = fifo[head]                          # demand of n_delay steps ago
-            # exact lag over the step with A held: a(t+dt) and its integral
-            a_int = A * dt + (a - A) * gain_int
-            a = A + (a - A) * decay
+            if first_order:     # exact lag increment of v, within the acceleration limits
+                a_int = np.clip((A - v) * (1.0 - decay), train.a_min * dt, train.a_max * dt)
+            else:               # exact lag over the step with A held: a(t+dt) and its integral
+                a_int = A * dt + (a - A) * gain_int
+                a = A + (a - A) * decay
             acc_ext = train.resistance(v) + grade_acc[np.searchsorted(edges, s, side="right")]
             v_new = np.maximum(v + a_int - acc_ext * dt, 0.0)   # no rolling back
             work += np.where(stopped, 0.0, np.maximum(a_int, 0.0) * v)
@@ -161,22 +168,29 @@ def simulate_tracking(train: Train002, route: Route, target: Callable[[np.ndarra
 
 
 @dataclass(frozen=True)
-class QualityIndices:
-    """ATO quality indices of paper 002 (eqs 10-13, reconstructed); arrays over the batch.
+class Objectives:
+    """The four objectives of the multi-objective tuning (arrays over the batch;
+    smaller is better; nan when the train did not stop).
+
+    Paper 002's quality indices (eqs 10-13, formulas lost) are K_s, K_t, K_c,
+    K_e; these are the same quantities in absolute units (K_t = punctuality /
+    T_o, K_e = energy / S) except comfort, an RMS jerk instead of a mean
+    absolute one.
 
     Attributes
     ----------
     stop_error : numpy.ndarray
-        K_s = |s_t - s_o| (m).
+        |s_t - S| (m).
     punctuality : numpy.ndarray
-        K_t = |T_t - T_o| / T_o (-).
+        |T_t - T_o| (s).
     comfort : numpy.ndarray
-        K_c = (1 / T_t) sum_k |a(k+1) - a(k)| (m/s^3): mean absolute jerk.
+        RMS jerk (m/s^3) up to the stop, jerk(k) = (a(k+1) - a(k)) / Ts with
+        a(k) = (v(k+1) - v(k)) / Ts.
     energy : numpy.ndarray
-        K_e = (1 / S) integral max(a_applied, 0) v dt (J/(kg m) = m/s^2):
-        traction work per unit mass and metre.
+        Integral of max(a_applied, 0) v dt up to the stop (J/kg): positive
+        traction power per unit mass.
     rms_speed_error : numpy.ndarray
-        sqrt(mean (v - v*)^2) over the planned run time (m/s); the tuning criterion.
+        sqrt(mean (v - v*)^2) over the planned run time (m/s); shown, not an objective.
     """
 
     stop_error: np.ndarray
@@ -187,13 +201,25 @@ class QualityIndices:
 
     NAMES = ("stop_error", "punctuality", "comfort", "energy")
 
+    def matrix(self) -> np.ndarray:
+        """The four objectives as columns, shape (N, 4)."""
+        return np.column_stack([getattr(self, k) for k in self.NAMES])
 
-def quality_indices(run: TrackingRun, distance: float, run_time: float) -> QualityIndices:
-    """The four indices (and the RMS speed error) of every run of a batch."""
+    def row(self, i: int) -> "Objectives":
+        """Batch element ``i`` as a batch of one."""
+        return Objectives(*(np.asarray(getattr(self, f))[i:i + 1] for f in
+                            (*self.NAMES, "rms_speed_error")))
+
+
+def objectives(run: TrackingRun, distance: float, run_time: float) -> Objectives:
+    """The four objectives (and the RMS speed error) of every run of a batch."""
     t_stop = run.stop_time
-    jerk_sum = np.array([np.abs(np.diff(a[run.t < ts])).sum() if np.isfinite(ts) else np.nan
+    dt = run.t[1] - run.t[0] if len(run.t) > 1 else 1.0
+    rms_jerk = np.array([np.sqrt(np.mean((np.diff(a[run.t < ts]) / dt) ** 2))
+                         if np.isfinite(ts) and np.sum(run.t < ts) > 1 else np.nan
                          for a, ts in zip(run.a, t_stop)])
     planned = run.t <= run_time
     rms = np.sqrt(np.mean((run.v[:, planned] - run.target[:, planned]) ** 2, axis=1))
-    return QualityIndices(np.abs(run.stop_pos - distance), np.abs(t_stop - run_time) / run_time,
-                          jerk_sum / t_stop, run.traction_work / distance, rms)
+    energy = np.where(np.isfinite(t_stop), run.traction_work, np.nan)
+    return Objectives(np.abs(run.stop_pos - distance), np.abs(t_stop - run_time), rms_jerk,
+                      energy, rms)

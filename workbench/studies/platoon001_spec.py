@@ -20,7 +20,7 @@ from ..profiles import phase_time, spec_for_cruise
 from ..reader import Quantity, Reader
 from ..sim.platoon import JITTER, OWN_STATE
 from ..sim.tracking import Route
-from .tracking002 import read_gradients
+from .tracking002_spec import read_gradients
 
 
 @dataclass(frozen=True)
