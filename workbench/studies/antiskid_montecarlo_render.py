@@ -1,6 +1,8 @@
 """Rendering of the Monte Carlo sweep and its step-halving check (pure)."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..report.markdown import fmt, md_table
@@ -81,8 +83,10 @@ def draw_outcomes(fig, res: SweepResult) -> None:
     groups = (("stopped", ~div & ~stuck, "tab:blue", "o"),
               ("diverged", div, "tab:red", "x"),
               ("not stopped, not diverged", stuck, "tab:gray", "s"))
+    delay = (("delay_period", "period of the varying delay h(t) (s)") if "delay_period" in d
+             else ("h", "true input delay h (s)"))
     for ax, (kx, ky, lx, ly) in zip(fig.subplots(1, 2), (
-            ("adhesion", "h", "adhesion s (0 wet, 1 dry)", "true input delay h (s)"),
+            ("adhesion", delay[0], "adhesion s (0 wet, 1 dry)", delay[1]),
             ("mass", "v0", "plant mass / nominal", "v(0) (m/s)"))):
         for label, sel, color, marker in groups:
             if sel.any():
@@ -99,7 +103,16 @@ def summary_tables(res: SweepResult, sig: int) -> str:
     stats = md_table(["metric", "n finite", "min", "median", "95 %", "max"],
                      [[f"`{r[0]}`", r[1]] + [fmt(x, sig) for x in r[2:]]
                       for r in res.summary_rows()], "lrrrrr")
-    viol = md_table(["violation", "runs", "fraction"],
-                    [[VIOLATIONS[k], sum(v), fmt(sum(v) / res.n, 3)]
-                     for k, v in res.violations.items()], "lrr")
+    label = {**VIOLATIONS, "ok": "ok: none of the above"}
+    viol = md_table(["outcome", "runs", "fraction", "rate [Wilson 95 % interval]"],
+                    [[label[o], k, fmt(p, 3), rate_text(k, n, lo, hi)]
+                     for o, k, n, p, lo, hi in res.outcome_rates()], "lrrr")
     return stats + "\n\n" + viol
+
+
+def rate_text(k: int, n: int, lo: float, hi: float) -> str:
+    """"k / n = p % [lo, hi] %" (one decimal; the interval's ends rounded
+    outwards, so the printed interval contains the computed one)."""
+    down = math.floor(1000 * lo) / 10
+    up = math.ceil(1000 * hi) / 10
+    return f"{k} / {n} = {100 * k / n:.1f} % [{down:.1f}, {up:.1f}] %"
