@@ -74,6 +74,21 @@ def draw_histograms(fig, res: SweepResult) -> None:
         ax.set_xlabel(k + {"lam_max_over_opt": " (-)"}.get(k, " (s)"))
 
 
+def draw_rates(fig, res: SweepResult) -> None:
+    """Each outcome's rate (percent of the runs) with its Wilson 95 %
+    interval (pure)."""
+    ax = fig.subplots()
+    rows = res.outcome_rates()
+    y = np.arange(len(rows))[::-1]
+    p = np.array([100 * r[3] for r in rows])
+    lo, hi = np.array([100 * r[4] for r in rows]), np.array([100 * r[5] for r in rows])
+    ax.errorbar(p, y, xerr=[p - lo, hi - p], fmt="o", color="tab:blue", capsize=4)
+    ax.set_yticks(y, [r[0] for r in rows], fontsize=8)
+    ax.set_xlim(-2, 102)
+    ax.set_xlabel(f"runs with the outcome (%) of {res.n}, Wilson 95 % interval")
+    ax.grid(alpha=0.3)
+
+
 def draw_outcomes(fig, res: SweepResult) -> None:
     """Each run at its (adhesion s, true delay h) and (mass factor, v0),
     marked by its outcome: stopped, diverged, or neither (pure)."""

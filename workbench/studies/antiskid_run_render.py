@@ -97,10 +97,12 @@ def render(design, res) -> Rendered:
         figs += (Figure("basin", "Certified basin of the cruise law (61), switch states.",
                         lambda fig, b=res.basin.basin: plot_basin(fig, b), (7.0, 5.0)),)
     if res.montecarlo is not None:
-        from .antiskid_montecarlo_render import draw_histograms, draw_outcomes
+        from .antiskid_montecarlo_render import draw_histograms, draw_outcomes, draw_rates
         figs += (
             Figure("montecarlo-histograms", "Monte Carlo: histograms of the summary metrics.",
                    lambda fig, mc=res.montecarlo: draw_histograms(fig, mc), (9.0, 3.2)),
+            Figure("montecarlo-rates", "Monte Carlo: outcome rates, Wilson 95 % intervals.",
+                   lambda fig, mc=res.montecarlo: draw_rates(fig, mc), (6.0, 2.8)),
             Figure("montecarlo-outcomes", "Monte Carlo: outcome of each run against its draws.",
                    lambda fig, mc=res.montecarlo: draw_outcomes(fig, mc), (9.0, 3.8)))
     sections.append(
@@ -318,7 +320,10 @@ def _montecarlo_section(design, mc, halving=None) -> str:
         "`not stopped` row):\n\n"
         + summary_tables(mc, 3)
         + "\n\nEach outcome's rate is given with its Wilson 95 % score interval (the "
-        f"{mc.n} runs as independent trials; the interval's ends rounded outwards)."
+        f"{mc.n} runs as independent trials; the interval's ends rounded outwards).\n\n"
+        "![Monte Carlo rates]({figdir}/montecarlo-rates.png)\n\n"
+        "The rates of the table with their intervals (the claims `mc-*-vs-full` and "
+        "`mc-perturbations-raise-divergence` compare these intervals with full sweeps)."
         + "\n\nBy adhesion (s = 0 wet, s = 1 dry):\n\n"
         + md_table(["adhesion s", "runs", "fraction diverged", "fraction above lambda_opt"],
                    brows, "lrrr")
