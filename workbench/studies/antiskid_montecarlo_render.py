@@ -48,13 +48,15 @@ def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
         ["outcome", "runs at dt", "runs at dt / 2", f"agree (of {n})"],
         [[f"`{o}`", sum(hc.coarse[o]), sum(hc.fine[o]), sum(hc.agree[o])]
          for o in HALVING_OUTCOMES], "lrrr")
-    bad = [[i] + [fmt(hc.draws[d][i], 4) for d, _ in _DRAW_LABELS]
+    labels = tuple(("delay_period", "h(t) period (s)") if d == "h" and "delay_period" in hc.draws
+                   else (d, lab) for d, lab in _DRAW_LABELS)    # the h draw unused then
+    bad = [[i] + [fmt(hc.draws[d][i], 4) for d, _ in labels]
            + [f"`{key}`", fmt(hc.coarse[key][i], sig), fmt(hc.fine[key][i], sig)]
            for i in range(n) for key in hc.agree if not hc.agree[key][i]]
     text += "\n\nRuns that disagree:"
     if not bad:
         return text + " none."
-    return text + "\n\n" + md_table(["run"] + [lab for _, lab in _DRAW_LABELS]
+    return text + "\n\n" + md_table(["run"] + [lab for _, lab in labels]
                                     + ["metric or outcome", "at dt", "at dt / 2"],
                                     bad, "rrrrrlrr")
 
