@@ -117,4 +117,5 @@ def test_sweep_is_seeded(tmp_path, capsys):
     fig = tmp_path / "hist.png"
     assert main(["sweep", str(short), "--samples", "2", "--seed", "1", "--workers", "1",
                  "--figure", str(fig)]) == 0
-    assert fig.exists() and "violation" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert fig.exists() and "outcome" in out and "Wilson 95 % interval" in out

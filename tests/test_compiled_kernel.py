@@ -102,8 +102,13 @@ def test_unknown_kernel_is_refused(dry):
 @pytest.mark.slow
 def test_first_64_runs_of_the_dry_sweep_agree(dry):
     """Issue 17, item 1: the first 64 runs of the dry design's sweep (seed
-    and step of its [montecarlo] table), every metric and outcome."""
+    and step of its [montecarlo] table), every metric and outcome, without
+    the sampled perturbations of item 6 (with them every run diverges; they
+    are compared in ``tests/test_sweep_perturbations.py``)."""
     n = 64
+    spec = dataclasses.replace(dry.spec, montecarlo=dataclasses.replace(dry.spec.montecarlo,
+                                                                        perturb=None))
+    dry = dataclasses.replace(dry, spec=spec)
     inp = sweep_inputs(dry, n, dry.spec.montecarlo.seed, gain_for(dry.spec)[0])
     outs = {k: chunk_worker(chunk_payload(inp, 0, n, inp["dt"], k))["metrics"]
             for k in ("compiled", "numpy")}

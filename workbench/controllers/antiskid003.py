@@ -148,6 +148,11 @@ class Antiskid003:
         #: set by the plant step: the last step could not be resolved (see
         #: ControllerSettings.lam_diverged)
         self.unresolved = False if batch is None else np.zeros(batch, bool)
+        #: None, or ``measure(v, lambda) -> (v_m, lambda_m)``: what the
+        #: controller sees of the true state at each sample (measurement
+        #: noise, :func:`workbench.sim.perturb.measured_state`); the
+        #: divergence test and the recorder keep the true state
+        self.measure = None
 
     def set_step(self, ticks: int, tick: float) -> None:
         """The step about to start lasts ``ticks`` ticks of ``tick`` s (refined mesh)."""
@@ -277,7 +282,8 @@ class Antiskid003:
     # -- one sample -----------------------------------------------------------------
     def __call__(self, t, x, inputs):
         s, xp = self.s, self.xp
-        v, lam = x
+        v_true, lam_true = x
+        v, lam = x if self.measure is None else self.measure(v_true, lam_true)
         ph, B = self.phase, xp.batch
         after = HANDOVER if s.cruise_entry == "creep" else CRUISE
         to_cruise = (ph == ACCEL) & (v >= s.v_d) if B else (ph == ACCEL and v >= s.v_d)
@@ -294,8 +300,8 @@ class Antiskid003:
         to_stop = in_brake & (v <= s.v_stop) if B else (in_brake and v <= s.v_stop)
         ph = xp.where(to_stop, STOPPED, ph)
         unres = self.unresolved
-        bad = (~(xp.abs(lam) < s.lam_diverged) | unres) & (ph < STOPPED) if B else (
-            (not abs(lam) < s.lam_diverged or unres) and ph < STOPPED)
+        bad = (~(xp.abs(lam_true) < s.lam_diverged) | unres) & (ph < STOPPED) if B else (
+            (not abs(lam_true) < s.lam_diverged or unres) and ph < STOPPED)
         self.events.t_diverged = xp.where(bad, t, self.events.t_diverged)
         self.events.phase_diverged = xp.where(bad, ph, self.events.phase_diverged)
         self.events.diverged_how = xp.where(bad, xp.where(unres, 1.0, 0.0), self.events.diverged_how)
@@ -327,7 +333,7 @@ class Antiskid003:
         self.fl.push(fl, self._ticks)
         self.uline.push(u, self._ticks)
         if self.recorder is not None:
-            self.recorder(t, v, lam, ph, to_cruise, to_brake, to_stop, self._dt_prev)
+            self.recorder(t, v_true, lam_true, ph, to_cruise, to_brake, to_stop, self._dt_prev)
         self._dt_prev = self.dt
         return u, ph
 

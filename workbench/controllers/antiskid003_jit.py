@@ -226,10 +226,11 @@ def law(t, v, lam, ph, st, ubuf, cfg, p):
 
 
 @numba.njit(**_JIT)
-def control(t, v, lam, st, ubuf, ev, cfg, p):
-    """One sample of controller (75) (:meth:`Antiskid003.__call__`): updates
-    ``st``, ``ubuf`` and the events ``ev``; returns (u, phase, to_cruise,
-    to_brake, to_stop) for the caller's metrics."""
+def control(t, lam_true, v, lam, st, ubuf, ev, cfg, p):
+    """One sample of controller (75) (:meth:`Antiskid003.__call__`) seeing
+    (v, lam) (measured), the divergence test on the true ``lam_true``:
+    updates ``st``, ``ubuf`` and the events ``ev``; returns (u, phase,
+    to_cruise, to_brake, to_stop) for the caller's metrics."""
     ph = int(st[PH])
     to_cruise = ph == ACCEL and v >= cfg[V_D]
     if to_cruise:
@@ -246,7 +247,7 @@ def control(t, v, lam, st, ubuf, ev, cfg, p):
     if to_stop:
         ph = STOPPED
     unres = st[UNRES] != 0.0
-    bad = (not abs(lam) < cfg[LAM_DIVERGED] or unres) and ph < STOPPED
+    bad = (not abs(lam_true) < cfg[LAM_DIVERGED] or unres) and ph < STOPPED
     if bad:
         ev[E_T_DIV], ev[E_PH_DIV], ev[E_HOW] = t, ph, 1.0 if unres else 0.0
     if handed:

@@ -54,6 +54,11 @@ class AdhesionModel:
     def params(self) -> dict[str, sp.Symbol]:
         return {k: sp.Symbol(k, positive=True) for k in PARAMETER_UNITS}
 
+    @cached_property
+    def grade(self) -> sp.Symbol:
+        """Track slope (dimensionless, uphill positive; small-angle sin)."""
+        return sp.Symbol("grade", real=True)
+
     # --- eq (6): adhesion coefficient -------------------------------------
     @cached_property
     def mu_traction(self) -> sp.Expr:
@@ -78,14 +83,29 @@ class AdhesionModel:
         p = self.params
         return p["c0"] + p["c1"] * self.v + p["c2"] * self.v**2
 
+    @cached_property
+    def f_graded(self) -> sp.Expr:
+        """Running resistance plus the gradient force m g grade (N): the
+        resistance of eq (9) on a slope (issue 17, item 6)."""
+        p = self.params
+        return self.f_r + p["m"] * p["g"] * self.grade
+
     # --- eqs (12)-(13): traction form, v_w > v ------------------------------
     @cached_property
     def traction(self) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
         """(y1, y2, y3) of eq (13): v' = y1, lambda' = y2 + y3 u(t-h)."""
+        return self._traction(self.f_r)
+
+    @cached_property
+    def traction_graded(self) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
+        """:attr:`traction` with the resistance :attr:`f_graded` (free symbol :attr:`grade`)."""
+        return self._traction(self.f_graded)
+
+    def _traction(self, f_r: sp.Expr) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
         p, v, lam, mu = self.params, self.v, self.lam, self.mu_traction
-        y1 = mu * p["g"] - self.f_r / p["m"]
+        y1 = mu * p["g"] - f_r / p["m"]
         y2 = (mu * (lam - 1) * p["g"] / v - p["zeta"] * (1 - lam) / p["J"]
-              - (lam - 1) * self.f_r / (p["m"] * v)
+              - (lam - 1) * f_r / (p["m"] * v)
               - (1 - lam) ** 2 * mu * p["m"] * p["g"] * p["r"] ** 2 / (p["J"] * v))
         y3 = (1 - lam) ** 2 * p["r"] / (p["J"] * v)
         return y1, y2, y3
@@ -94,10 +114,18 @@ class AdhesionModel:
     @cached_property
     def braking(self) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
         """(z1, z2, z3) of eq (16): v' = z1, lambda' = z2 + z3 u(t-h)."""
+        return self._braking(self.f_r)
+
+    @cached_property
+    def braking_graded(self) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
+        """:attr:`braking` with the resistance :attr:`f_graded`."""
+        return self._braking(self.f_graded)
+
+    def _braking(self, f_r: sp.Expr) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
         p, v, lam, mu = self.params, self.v, self.lam, self.mu_braking
-        z1 = mu * p["g"] - self.f_r / p["m"]
+        z1 = mu * p["g"] - f_r / p["m"]
         z2 = (-mu * (lam + 1) * p["g"] / v - p["zeta"] * (1 + lam) / p["J"]
-              + (lam + 1) * self.f_r / (p["m"] * v)
+              + (lam + 1) * f_r / (p["m"] * v)
               - mu * p["m"] * p["g"] * p["r"] ** 2 / (p["J"] * v))
         z3 = p["r"] / (p["J"] * v)
         return z1, z2, z3

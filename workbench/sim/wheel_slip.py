@@ -34,15 +34,43 @@ PARAM_ORDER = tuple(PARAMETER_UNITS)
 
 
 @lru_cache(maxsize=4)
-def model_functions(backend: Literal["math", "numpy"]) -> dict:
+def model_functions(backend: Literal["math", "numpy"], graded: bool = False) -> dict:
     """Lambdified (y1, y2, y3, dy2/dlambda, dy3/dlambda) of eq (13) and the
     (z...) of eq (16), each as one function of (v, lambda, *params) with
-    params in :data:`PARAM_ORDER`."""
+    params in :data:`PARAM_ORDER`; ``graded``: the forms on a slope
+    (:attr:`~workbench.plants.adhesion.AdhesionModel.traction_graded`), the
+    slope an extra last parameter (``params = (*params, grade)``), evaluated
+    as the level forms plus :func:`grade_terms` (so a zero slope gives the
+    level forms' values bit for bit)."""
     mdl = adhesion_model()
     args = (mdl.v, mdl.lam, *[mdl.params[k] for k in PARAM_ORDER])
     out = {}
     for name, (f1, f2, f3) in (("traction", mdl.traction), ("braking", mdl.braking)):
         exprs = (f1, f2, f3, sp.diff(f2, mdl.lam), sp.diff(f3, mdl.lam))
+        out[name] = sp.lambdify(args, exprs, modules=backend, cse=True)
+    if not graded:
+        return out
+    level, terms = out, grade_terms(backend)
+
+    def on_slope(name):
+        f, g = level[name], terms[name]
+        return lambda v, lam, *p: tuple(a + b for a, b in zip(f(v, lam, *p[:-1]), g(v, lam, *p)))
+    return {name: on_slope(name) for name in level}
+
+
+@lru_cache(maxsize=4)
+def grade_terms(backend: Literal["math", "numpy"]) -> dict:
+    """The slope's terms of each form, (graded form) - (level form) of
+    :class:`~workbench.plants.adhesion.AdhesionModel` simplified by sympy
+    (-g grade in v', -(lambda - 1) g grade / v in lambda' of eq 13, ...), as
+    functions of (v, lambda, *params, grade)."""
+    mdl = adhesion_model()
+    args = (mdl.v, mdl.lam, *[mdl.params[k] for k in PARAM_ORDER], mdl.grade)
+    out = {}
+    for name, lev, gr in (("traction", mdl.traction, mdl.traction_graded),
+                          ("braking", mdl.braking, mdl.braking_graded)):
+        d = [sp.simplify(a - b) for a, b in zip(gr, lev)]
+        exprs = (d[0], d[1], d[2], sp.diff(d[1], mdl.lam), sp.diff(d[2], mdl.lam))
         out[name] = sp.lambdify(args, exprs, modules=backend, cse=True)
     return out
 

@@ -19,7 +19,9 @@ disk).
 
 Parameters ``p`` are float arrays in :data:`~workbench.sim.wheel_slip.PARAM_ORDER`;
 ``form`` selects the model: :data:`BY_SIGN` (eq 12 for lambda >= 0, eq 15
-otherwise: the plant), :data:`TRACTION` (eq 65) or :data:`BRAKING` (eq 70).
+otherwise: the plant), :data:`TRACTION` (eq 65) or :data:`BRAKING` (eq 70),
+:data:`GRADED` (the plant on a slope). The perturbations of
+:mod:`workbench.sim.perturb` are at the end, written as there.
 """
 from __future__ import annotations
 
@@ -27,19 +29,20 @@ import math
 
 import numba
 
-from .wheel_slip import MAX_DLAMBDA, MAX_HALVINGS, PARAM_ORDER, model_functions
+from .wheel_slip import MAX_DLAMBDA, MAX_HALVINGS, PARAM_ORDER, grade_terms, model_functions
 
-#: Model forms of :func:`forms`.
-BY_SIGN, TRACTION, BRAKING = 0, 1, 2
+#: Model forms of :func:`forms` (GRADED: as BY_SIGN on a slope, p = (*params, grade)).
+BY_SIGN, TRACTION, BRAKING, GRADED = 0, 1, 2, 3
 
 _JIT = dict(nogil=True, error_model="numpy")   # numpy's inf/nan, never ZeroDivisionError
 
 
-def _unpacked(fn):
+def _unpacked(fn, extra: int = 0):
     """``fn(v, lam, *params)`` as a compiled ``f(v, lam, p)`` with p an array in
-    PARAM_ORDER (the wrapper's source is generated from PARAM_ORDER)."""
+    PARAM_ORDER (plus ``extra`` entries: the slope of the graded forms; the
+    wrapper's source is generated from PARAM_ORDER)."""
     inner = numba.njit(**_JIT)(fn)
-    args = ", ".join(f"p[{i}]" for i in range(len(PARAM_ORDER)))
+    args = ", ".join(f"p[{i}]" for i in range(len(PARAM_ORDER) + extra))
     ns = {"inner": inner}
     exec(f"def f(v, lam, p):\n    return inner(v, lam, {args})\n", ns)
     return numba.njit(**_JIT)(ns["f"])
@@ -50,6 +53,24 @@ _fns = model_functions("math")
 traction = _unpacked(_fns["traction"])
 #: eq (16) (z1, z2, z3, dz2/dlambda, dz3/dlambda), compiled
 braking = _unpacked(_fns["braking"])
+_terms = grade_terms("math")
+_traction_slope = _unpacked(_terms["traction"], 1)
+_braking_slope = _unpacked(_terms["braking"], 1)
+
+
+@numba.njit(**_JIT)
+def traction_graded(v, lam, p):
+    """eq (13) on a slope, p = (*params, grade): the level form plus the
+    slope's terms (:func:`~workbench.sim.wheel_slip.model_functions`, ``graded``)."""
+    a, b = traction(v, lam, p), _traction_slope(v, lam, p)
+    return a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3], a[4] + b[4]
+
+
+@numba.njit(**_JIT)
+def braking_graded(v, lam, p):
+    """eq (16) on a slope (as :func:`traction_graded`)."""
+    a, b = braking(v, lam, p), _braking_slope(v, lam, p)
+    return a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3], a[4] + b[4]
 
 
 @numba.njit(**_JIT)
@@ -76,6 +97,8 @@ def fmin(a, b):
 def forms(v, lam, p, form):
     """(v', lambda'_0, lambda'_u, J_0, J_u) of the model ``form`` (module
     docstring; BY_SIGN: a NaN creep ratio takes eq 15, as the numpy path)."""
+    if form == GRADED:
+        return traction_graded(v, lam, p) if lam >= 0 else braking_graded(v, lam, p)
     if form == TRACTION or (form == BY_SIGN and lam >= 0):
         return traction(v, lam, p)
     return braking(v, lam, p)
@@ -134,3 +157,33 @@ def creep_speed(v, lam):
     if lam >= 0:
         return lam * v / (1.0 - fmin(lam, 0.999))
     return lam * v
+
+
+@numba.njit(**_JIT)
+def measured_state(v, lam, zv, zw, sv, sw, r_plant, r_ctrl, v_floor):
+    """:func:`workbench.sim.perturb.measured_state` for one run."""
+    omega = wheel_speed(v, lam, r_plant)
+    vm = fmax(v + sv * zv, v_floor)
+    vw = fmax((omega + sw * zw) * r_ctrl, 0.0)
+    if vw >= vm:
+        return vm, 1.0 - vm / vw
+    return vm, vw / vm - 1.0
+
+
+@numba.njit(**_JIT)
+def delay_at(t, lo, hi, period, phase):
+    """:func:`workbench.sim.perturb.delay_at` for one run."""
+    x = t / period + phase
+    tri = abs(2.0 * (x - math.floor(x)) - 1.0)
+    return fmin(fmax(lo + (hi - lo) * tri, lo), hi)
+
+
+@numba.njit(**_JIT)
+def split_delay(h, dt):
+    """:func:`workbench.sim.perturb.split_delays` for one run."""
+    q = h / dt
+    n = math.floor(q + 0.5)
+    if abs(q - n) < 1e-9:
+        return int(n), 0.0
+    fl = math.floor(q)
+    return int(fl), q - fl

@@ -58,7 +58,11 @@ def _build():
     import numba
 
     from ..controllers import antiskid003_jit as C
-    from ..sim.wheel_slip_jit import BY_SIGN, creep_speed, fmax, fmin, stiff_step, wheel_speed
+    from ..sim.counter_rng import jit_functions
+    from ..sim.wheel_slip_jit import (BY_SIGN, GRADED, creep_speed, delay_at, fmax, fmin,
+                                      measured_state, split_delay, stiff_step, wheel_speed)
+
+    _, uniform, normal4 = jit_functions()
 
     jit = numba.njit(nogil=True, error_model="numpy")
     M = {k: i for i, k in enumerate(METRIC_FIELDS)}
@@ -132,32 +136,53 @@ def _build():
         rs[1], rs[2], rs[3], rs[4] = 1.0, omega, e_on, lam
 
     @jit
-    def run_batch(plant, Np, fp, v0, lam0, u_init, T_end, cfg, pc, settle, st0, ub0, m0, out):
+    def run_batch(plant, Np, fp, v0, lam0, u_init, T_end, cfg, pc, settle, st0, ub0, m0,
+                  keys, pert, period, phase, out):
         """Simulate each run i (plant parameters ``plant[i]``, input delay
-        (Np[i] + fp[i]) dt, initial speed v0[i]) into ``out[i]``."""
+        (Np[i] + fp[i]) dt, initial speed v0[i]) into ``out[i]``; ``keys[i]``
+        (v, omega, grade streams), ``pert`` (:data:`PERT`), ``period[i]``,
+        ``phase[i]``: the perturbations of :mod:`workbench.sim.perturb`."""
         dt = cfg[DT]
         r_i = 4      # PARAM_ORDER index of r (checked by the caller)
+        sv, sw, every = pert[0], pert[1], int(pert[2])
+        noisy, graded, varying = sv > 0 or sw > 0, pert[3] != 0.0, pert[7] != 0.0
         for i in range(plant.shape[0]):
             p = plant[i]
+            pg = np.empty(p.shape[0] + 1)
+            pg[:p.shape[0]] = p
             N, f = Np[i], fp[i]
             L = N + 2
             pbuf = np.full(L, u_init)
             st, ubuf, m = st0.copy(), ub0.copy(), m0.copy()
             rs = np.zeros(5)
             rs[0] = v0[i]
-            v, lam = v0[i], lam0
+            v, lam, pos = v0[i], lam0, 0.0
             T, n = 0, 0
             while True:
                 t = T * dt
-                u, ph, tc, tb, ts = control(t, v, lam, st, ubuf, m, cfg, pc)
+                vm, lm = v, lam
+                if noisy:
+                    k = np.uint64(T // every)
+                    vm, lm = measured_state(v, lam, normal4(keys[i, 0], k),
+                                            normal4(keys[i, 1], k), sv, sw, p[r_i],
+                                            cfg[C.R_C], cfg[C.V_FLOOR])
+                u, ph, tc, tb, ts = control(t, lam, vm, lm, st, ubuf, m, cfg, pc)
                 record(t, v, lam, ph, tc, tb, ts, m, rs, cfg, p[r_i], settle)
                 pbuf[n % L] = u
                 n += 1
+                if varying:
+                    N, f = split_delay(delay_at(t, pert[8], pert[9], period[i], phase[i]), dt)
                 a = pbuf[(n - 1 - N) % L]
                 ua = (1.0 - f) * a + f * pbuf[(n - 2 - N) % L]
                 if T >= T_end or ph >= STOPPED:
                     break
-                v, lam, unres = stiff_step(v, lam, ua, dt, p, 1e-3, BY_SIGN)
+                if graded:
+                    j = np.uint64(math.floor(fmax(pos, 0.0) / pert[6]))
+                    pg[p.shape[0]] = pert[4] + (pert[5] - pert[4]) * uniform(keys[i, 2], j)
+                    pos = pos + dt * v
+                    v, lam, unres = stiff_step(v, lam, ua, dt, pg, 1e-3, GRADED)
+                else:
+                    v, lam, unres = stiff_step(v, lam, ua, dt, p, 1e-3, BY_SIGN)
                 st[C.UNRES] = 1.0 if unres else 0.0
                 T += 1
             out[i] = m
@@ -174,11 +199,11 @@ def compile_kernel() -> None:
     so its workers do not compile it again."""
     global _KERNEL
     if _KERNEL is None:
-        from numba import float64, int64
+        from numba import float64, int64, uint64
         k = _build()
         a1, a2 = float64[::1], float64[:, ::1]
         k.compile((a2, int64[::1], a1, a1, float64, float64, int64, a1, a1, float64, a1, a1,
-                   a1, a2))
+                   a1, uint64[:, ::1], a1, a1, a1, a2))
         _KERNEL = k
 
 
@@ -212,10 +237,38 @@ def simulate_batch_compiled(run: RunSettings, dt: float, *,
     st0, ub0 = initial_state(cs, dt, run.u_init)
     m0 = np.array([getattr(RunMetrics(), k) for k in METRIC_FIELDS], float)
     out = np.empty((B, len(METRIC_FIELDS)))
+    keys, pert, period, phase = perturbation_arrays(run.perturb, B)
+    if run.perturb is not None and run.perturb.delay is not None:
+        Np[:] = split_delay(run.perturb.delay[1], dt)[0]     # the ring holds the longest delay
     _KERNEL(plant, Np, fp, v0, float(run.x0[1]), float(run.u_init),
             int(round(run.t_end / dt)), settings_array(cs, dt),
-            np.asarray(cs.params, float), float(evs_settle), st0, ub0, m0, out)
+            np.asarray(cs.params, float), float(evs_settle), st0, ub0, m0,
+            keys, pert, period, phase, out)
     return RunMetrics(**{k: out[:, j].copy() for j, k in enumerate(METRIC_FIELDS)})
+
+
+#: Entries of the kernel's ``pert`` array (:func:`perturbation_arrays`).
+PERT = ("noise_v", "noise_omega", "noise_every", "graded", "grade_lo", "grade_hi", "segment",
+        "varying", "h_lo", "h_hi")
+
+
+def perturbation_arrays(pt, B: int):
+    """(keys (B, 3) uint64, pert (:data:`PERT`), period (B,), phase (B,)) of
+    the :class:`~workbench.sim.perturb.Perturbations` ``pt`` (None: none)."""
+    keys = np.zeros((B, 3), np.uint64)
+    period, phase = np.ones(B), np.zeros(B)
+    if pt is None:
+        return keys, np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]), period, phase
+    for j, c in enumerate(("v", "omega", "grade")):
+        if c in pt.keys:
+            keys[:, j] = np.asarray(pt.keys[c], np.uint64)
+    g, d = pt.grade or (0.0, 0.0), pt.delay or (0.0, 0.0)
+    if pt.delay is not None:
+        period, phase = np.asarray(pt.period, float), np.asarray(pt.phase, float)
+    pert = np.array([pt.noise_v, pt.noise_omega, float(pt.noise_every),
+                     float(pt.grade is not None), g[0], g[1], pt.segment,
+                     float(pt.delay is not None), d[0], d[1]])
+    return keys, pert, period, phase
 
 
 def simulate_batch(run: RunSettings, dt: float, kernel: Kernel) -> RunMetrics:

@@ -51,6 +51,10 @@ VIOLATIONS = {"above_lambda_opt": "creep ratio above the sample's lambda_opt in 
               "diverged": "diverged (|lambda| >= 0.9, torque out of range, or step not resolved)",
               "not_stopped": "not stopped by t_end"}
 
+#: Outcomes reported as rates with their Wilson 95 % interval: the checks of
+#: :data:`VIOLATIONS` and "ok" (none of them).
+OUTCOMES = (*VIOLATIONS, "ok")
+
 #: Default number of chunks a sweep is cut into (independent of the workers)...
 DEFAULT_CHUNKS = 4
 #: ... unless a chunk would hold more runs than this: a large sweep streams,
@@ -93,20 +97,33 @@ class SweepResult:
         return rows
 
     def statistics(self) -> dict:
-        """``{"<metric>.<statistic>": value}`` from :meth:`summary_rows` and
-        ``{"fraction.<violation>": value}`` (fraction of all runs)."""
+        """``{"<metric>.<statistic>": value}`` from :meth:`summary_rows`,
+        ``{"fraction.<violation>": value}`` (fraction of all runs) and
+        ``{"wilson.<outcome>.lo" | ".hi": bound}`` (:meth:`outcome_rates`)."""
         out = {f"{r[0]}.{s}": x for r in self.summary_rows() for s, x in zip(STATISTICS, r[1:])}
         out.update({f"fraction.{k}": sum(v) / self.n for k, v in self.violations.items()})
+        for o, _, _, _, lo, hi in self.outcome_rates():
+            out[f"wilson.{o}.lo"], out[f"wilson.{o}.hi"] = lo, hi
         return out
+
+    def outcome_rates(self) -> list[tuple]:
+        """(outcome, k, n, k / n, lo, hi) per :data:`OUTCOMES`: runs with the
+        outcome and the Wilson 95 % score interval of its rate."""
+        from .stopping_mc import wilson_interval
+        flags = {k: np.asarray(v, bool) for k, v in self.violations.items()}
+        flags["ok"] = ~np.logical_or.reduce(list(flags.values()))
+        return [(o, *wilson_interval(int(flags[o].sum()), self.n)) for o in OUTCOMES]
 
 
 def montecarlo_quantity_names() -> set[str]:
     """Quantities of a sweep run by the ``antiskid-run`` study:
-    ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>`` and
-    ``montecarlo.fraction.<violation>``."""
+    ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
+    ``montecarlo.fraction.<violation>`` and ``montecarlo.wilson.<outcome>.lo``
+    / ``.hi`` (the Wilson 95 % interval of an outcome's rate)."""
     return ({"montecarlo.samples"}
             | {f"montecarlo.{m}.{s}" for m in SUMMARY_METRICS for s in STATISTICS}
-            | {f"montecarlo.fraction.{k}" for k in VIOLATIONS})
+            | {f"montecarlo.fraction.{k}" for k in VIOLATIONS}
+            | {f"montecarlo.wilson.{o}.{b}" for o in OUTCOMES for b in ("lo", "hi")})
 
 
 def montecarlo_quantities(res: SweepResult) -> dict:
@@ -117,9 +134,36 @@ def montecarlo_quantities(res: SweepResult) -> dict:
 
 def draw_samples(n: int, seed: int, spec: SweepSpec, start: int = 0) -> dict:
     """Samples ``start <= i < n`` of (mass factor, adhesion s, delay h, v0),
-    uniform, seeded; sample i does not depend on n or start."""
-    return uniform_draws(n, seed, {"mass": spec.mass, "adhesion": spec.adhesion, "h": spec.h,
-                                   "v0": spec.v0}, start)
+    uniform, seeded; sample i does not depend on n or start. With a varying
+    delay (``delay_variation``), also its period and phase (fraction of a
+    period) per run, uniform, from the counter-based generator of
+    (seed, run) (:mod:`workbench.sim.counter_rng`): the first four draws
+    are those of the same design without perturbations."""
+    out = uniform_draws(n, seed, {"mass": spec.mass, "adhesion": spec.adhesion, "h": spec.h,
+                                  "v0": spec.v0}, start)
+    pt = spec.perturb
+    if pt is not None and pt.delay_period is not None:
+        from ..sim.counter_rng import DELAY_PERIOD, DELAY_PHASE, run_key, uniform
+        runs = np.arange(start, n)
+        lo, hi = pt.delay_period
+        out["delay_period"] = lo + (hi - lo) * uniform(run_key(seed, DELAY_PERIOD, runs), 0)
+        out["delay_phase"] = uniform(run_key(seed, DELAY_PHASE, runs), 0)
+    return out
+
+
+def perturbations(p: dict | None, sl: slice):
+    """The :class:`~workbench.sim.perturb.Perturbations` of a payload's
+    ``perturb`` entry (None: none)."""
+    if p is None:
+        return None
+    from ..sim.counter_rng import GRADE, NOISE_OMEGA, NOISE_V, run_key
+    from ..sim.perturb import Perturbations
+    run = np.asarray(p["run"], np.int64)[sl]
+    keys = {c: tuple(run_key(p["seed"], k, run).tolist())
+            for c, k in (("v", NOISE_V), ("omega", NOISE_OMEGA), ("grade", GRADE))}
+    return Perturbations(tuple(run.tolist()), keys, p["noise_v"], p["noise_omega"],
+                         p["noise_every"], p["grade"], p["segment"], p["delay"],
+                         tuple(p["period"][sl]), tuple(p["phase"][sl]))
 
 
 def chunk_worker(payload: dict) -> dict:
@@ -136,7 +180,8 @@ def chunk_worker(payload: dict) -> dict:
     plant = tuple(np.asarray(payload["plant"][k], float) for k in PARAM_ORDER)
     run = RunSettings(plant, cs, np.asarray(payload["h"], float),
                       (np.asarray(payload["v0"], float), payload["lambda0"]),
-                      payload["u_init"], payload["t_end"])
+                      payload["u_init"], payload["t_end"],
+                      perturbations(payload.get("perturb"), slice(None)))
     m = simulate_batch(run, payload["dt"], payload.get("kernel", "numpy"))
     return {"index": payload["index"], "metrics": {k: np.asarray(v, float).tolist()
                                                    for k, v in vars(m).items()}}
@@ -164,7 +209,8 @@ def sweep_inputs(design, samples: int, seed: int, K: tuple | None, start: int = 
         plant[k] = ms.wet[k] + s * (base[k] - ms.wet[k])
     plant["m"] = base["m"] * draws["mass"]
     return {"draws": draws, "plant": plant, "base": base, "controller": asdict(cs),
-            "scenario": spec.scenario, "dt": ms.dt or spec.dt}
+            "scenario": spec.scenario, "dt": ms.dt or spec.dt, "seed": seed,
+            "run": np.arange(start, samples), "perturb": ms.perturb, "h_range": ms.h}
 
 
 def chunk_payload(inp: dict, i0: int, i1: int, dt: float, kernel: str = "numpy") -> dict:
@@ -172,10 +218,25 @@ def chunk_payload(inp: dict, i0: int, i1: int, dt: float, kernel: str = "numpy")
     ``dt``, simulated by the ``kernel`` path
     (:data:`~workbench.studies.antiskid_kernel.KERNELS`)."""
     sl, sc, d = slice(i0, i1), inp["scenario"], inp["draws"]
-    return {"index": i0, "kernel": kernel, "controller": inp["controller"],
-            "plant": {k: v[sl].tolist() for k, v in inp["plant"].items()},
-            "h": d["h"][sl].tolist(), "v0": d["v0"][sl].tolist(),
-            "lambda0": sc["lambda0"], "u_init": sc["u_init"], "t_end": sc["t_end"], "dt": dt}
+    out = {"index": i0, "kernel": kernel, "controller": inp["controller"],
+           "plant": {k: v[sl].tolist() for k, v in inp["plant"].items()},
+           "h": d["h"][sl].tolist(), "v0": d["v0"][sl].tolist(),
+           "lambda0": sc["lambda0"], "u_init": sc["u_init"], "t_end": sc["t_end"], "dt": dt}
+    pt = inp.get("perturb")
+    if pt is not None:
+        # the noise is held over the sweep's step: a run at dt / 2 sees the same noise
+        every = round(inp["dt"] / dt)
+        if not abs(every * dt - inp["dt"]) <= 1e-12 * inp["dt"]:
+            raise ValueError(f"dt = {dt!r}: the noise needs a step that divides {inp['dt']!r}")
+        varying = pt.delay_period is not None
+        out["perturb"] = {
+            "seed": inp["seed"], "run": inp["run"][sl].tolist(), "noise_v": pt.noise_v,
+            "noise_omega": pt.noise_omega, "noise_every": every,
+            "grade": None if pt.gradient is None else tuple(g / 1000 for g in pt.gradient),
+            "segment": pt.segment, "delay": tuple(inp["h_range"]) if varying else None,
+            "period": d["delay_period"][sl].tolist() if varying else [],
+            "phase": d["delay_phase"][sl].tolist() if varying else []}
+    return out
 
 
 @lru_cache(maxsize=1)

@@ -1,6 +1,8 @@
 """Rendering of the Monte Carlo sweep and its step-halving check (pure)."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..report.markdown import fmt, md_table
@@ -46,13 +48,15 @@ def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
         ["outcome", "runs at dt", "runs at dt / 2", f"agree (of {n})"],
         [[f"`{o}`", sum(hc.coarse[o]), sum(hc.fine[o]), sum(hc.agree[o])]
          for o in HALVING_OUTCOMES], "lrrr")
-    bad = [[i] + [fmt(hc.draws[d][i], 4) for d, _ in _DRAW_LABELS]
+    labels = tuple(("delay_period", "h(t) period (s)") if d == "h" and "delay_period" in hc.draws
+                   else (d, lab) for d, lab in _DRAW_LABELS)    # the h draw unused then
+    bad = [[i] + [fmt(hc.draws[d][i], 4) for d, _ in labels]
            + [f"`{key}`", fmt(hc.coarse[key][i], sig), fmt(hc.fine[key][i], sig)]
            for i in range(n) for key in hc.agree if not hc.agree[key][i]]
     text += "\n\nRuns that disagree:"
     if not bad:
         return text + " none."
-    return text + "\n\n" + md_table(["run"] + [lab for _, lab in _DRAW_LABELS]
+    return text + "\n\n" + md_table(["run"] + [lab for _, lab in labels]
                                     + ["metric or outcome", "at dt", "at dt / 2"],
                                     bad, "rrrrrlrr")
 
@@ -72,6 +76,21 @@ def draw_histograms(fig, res: SweepResult) -> None:
         ax.set_xlabel(k + {"lam_max_over_opt": " (-)"}.get(k, " (s)"))
 
 
+def draw_rates(fig, res: SweepResult) -> None:
+    """Each outcome's rate (percent of the runs) with its Wilson 95 %
+    interval (pure)."""
+    ax = fig.subplots()
+    rows = res.outcome_rates()
+    y = np.arange(len(rows))[::-1]
+    p = np.array([100 * r[3] for r in rows])
+    lo, hi = np.array([100 * r[4] for r in rows]), np.array([100 * r[5] for r in rows])
+    ax.errorbar(p, y, xerr=[p - lo, hi - p], fmt="o", color="tab:blue", capsize=4)
+    ax.set_yticks(y, [r[0] for r in rows], fontsize=8)
+    ax.set_xlim(-2, 102)
+    ax.set_xlabel(f"runs with the outcome (%) of {res.n}, Wilson 95 % interval")
+    ax.grid(alpha=0.3)
+
+
 def draw_outcomes(fig, res: SweepResult) -> None:
     """Each run at its (adhesion s, true delay h) and (mass factor, v0),
     marked by its outcome: stopped, diverged, or neither (pure)."""
@@ -81,8 +100,10 @@ def draw_outcomes(fig, res: SweepResult) -> None:
     groups = (("stopped", ~div & ~stuck, "tab:blue", "o"),
               ("diverged", div, "tab:red", "x"),
               ("not stopped, not diverged", stuck, "tab:gray", "s"))
+    delay = (("delay_period", "period of the varying delay h(t) (s)") if "delay_period" in d
+             else ("h", "true input delay h (s)"))
     for ax, (kx, ky, lx, ly) in zip(fig.subplots(1, 2), (
-            ("adhesion", "h", "adhesion s (0 wet, 1 dry)", "true input delay h (s)"),
+            ("adhesion", delay[0], "adhesion s (0 wet, 1 dry)", delay[1]),
             ("mass", "v0", "plant mass / nominal", "v(0) (m/s)"))):
         for label, sel, color, marker in groups:
             if sel.any():
@@ -99,7 +120,16 @@ def summary_tables(res: SweepResult, sig: int) -> str:
     stats = md_table(["metric", "n finite", "min", "median", "95 %", "max"],
                      [[f"`{r[0]}`", r[1]] + [fmt(x, sig) for x in r[2:]]
                       for r in res.summary_rows()], "lrrrrr")
-    viol = md_table(["violation", "runs", "fraction"],
-                    [[VIOLATIONS[k], sum(v), fmt(sum(v) / res.n, 3)]
-                     for k, v in res.violations.items()], "lrr")
+    label = {**VIOLATIONS, "ok": "ok: none of the above"}
+    viol = md_table(["outcome", "runs", "fraction", "rate [Wilson 95 % interval]"],
+                    [[label[o], k, fmt(p, 3), rate_text(k, n, lo, hi)]
+                     for o, k, n, p, lo, hi in res.outcome_rates()], "lrrr")
     return stats + "\n\n" + viol
+
+
+def rate_text(k: int, n: int, lo: float, hi: float) -> str:
+    """"k / n = p % [lo, hi] %" (one decimal; the interval's ends rounded
+    outwards, so the printed interval contains the computed one)."""
+    down = math.floor(1000 * lo) / 10
+    up = math.ceil(1000 * hi) / 10
+    return f"{k} / {n} = {100 * k / n:.1f} % [{down:.1f}, {up:.1f}] %"

@@ -97,10 +97,12 @@ def render(design, res) -> Rendered:
         figs += (Figure("basin", "Certified basin of the cruise law (61), switch states.",
                         lambda fig, b=res.basin.basin: plot_basin(fig, b), (7.0, 5.0)),)
     if res.montecarlo is not None:
-        from .antiskid_montecarlo_render import draw_histograms, draw_outcomes
+        from .antiskid_montecarlo_render import draw_histograms, draw_outcomes, draw_rates
         figs += (
             Figure("montecarlo-histograms", "Monte Carlo: histograms of the summary metrics.",
                    lambda fig, mc=res.montecarlo: draw_histograms(fig, mc), (9.0, 3.2)),
+            Figure("montecarlo-rates", "Monte Carlo: outcome rates, Wilson 95 % intervals.",
+                   lambda fig, mc=res.montecarlo: draw_rates(fig, mc), (6.0, 2.8)),
             Figure("montecarlo-outcomes", "Monte Carlo: outcome of each run against its draws.",
                    lambda fig, mc=res.montecarlo: draw_outcomes(fig, mc), (9.0, 3.8)))
     sections.append(
@@ -280,7 +282,7 @@ def _montecarlo_section(design, mc, halving=None) -> str:
              + f"; wet a, b, c = {fmt(ms.wet['a'])}, {fmt(ms.wet['b'])}, {fmt(ms.wet['c'])}"],
             ["true input delay h (s)", rng(ms.h, 4) + " (the predictor keeps "
              + fmt(design.spec.scenario["h"], 4) + " s)"],
-            ["v(0) (m/s)", rng(ms.v0)]]
+            ["v(0) (m/s)", rng(ms.v0)]] + _perturbation_rows(ms, rng)
     s = np.asarray(mc.samples["adhesion"], float)
     div = np.asarray(mc.violations["diverged"], bool)
     above = np.asarray(mc.violations["above_lambda_opt"], bool)
@@ -301,7 +303,10 @@ def _montecarlo_section(design, mc, halving=None) -> str:
         "that study; each run of a batch follows its single-run trajectory). The claims "
         "`mc-*-vs-full` compare "
         "these fractions with the full 1000-run sweep. Draws, uniform and independent; the "
-        f"controller keeps the nominal {design.spec.rail}-rail model and the design's h:\n\n"
+        f"controller keeps the nominal {design.spec.rail}-rail model and the design's h"
+        + (":" if ms.perturb is None else ". Perturbations sampled as well (`[montecarlo]`; "
+           "each a function of (seed, run index) only, by the counter-based generator of "
+           "`workbench/sim/counter_rng.py`):") + "\n\n"
         + md_table(["parameter", "range"], rows, "ll")
         + "\n\nSummary statistics (3 significant digits; `lam_max_over_opt` is the max creep "
         "ratio in traction over the sample's own lambda_opt, not given for a run that diverged "
@@ -314,6 +319,11 @@ def _montecarlo_section(design, mc, halving=None) -> str:
         "(in the halving check dt/2 moved it by up to 13 s); whether a run stops is the "
         "`not stopped` row):\n\n"
         + summary_tables(mc, 3)
+        + "\n\nEach outcome's rate is given with its Wilson 95 % score interval (the "
+        f"{mc.n} runs as independent trials; the interval's ends rounded outwards).\n\n"
+        "![Monte Carlo rates]({figdir}/montecarlo-rates.png)\n\n"
+        "The rates of the table with their intervals (the claims `mc-*-vs-full` and "
+        "`mc-perturbations-raise-divergence` compare these intervals with full sweeps)."
         + "\n\nBy adhesion (s = 0 wet, s = 1 dry):\n\n"
         + md_table(["adhesion s", "runs", "fraction diverged", "fraction above lambda_opt"],
                    brows, "lrrr")
@@ -323,6 +333,33 @@ def _montecarlo_section(design, mc, halving=None) -> str:
         "Each run at its draws, marked by its outcome."
         + ("" if halving is None else "\n\n### Step-size check of the Monte Carlo runs\n\n"
            + halving_section(halving, design.spec)))
+
+
+def _perturbation_rows(ms, rng) -> list[list[str]]:
+    """Rows of the Monte Carlo table for the sampled perturbations (none when
+    the design samples none)."""
+    pt = ms.perturb
+    if pt is None:
+        return []
+    src, rows = dict(pt.sources), []
+    if pt.noisy:
+        rows.append(["measurement noise on v, omega (the controller's inputs; its lambda is "
+                     "computed from them; the plant is unaffected)",
+                     f"sd {fmt(pt.noise_v)} m/s, {fmt(pt.noise_omega)} rad/s, new values every "
+                     f"dt = {fmt(ms.dt)} s (sum of four uniforms, unit variance) — "
+                     + "; ".join(src[k] for k in ("noise_v", "noise_omega") if k in src)])
+    if pt.gradient is not None:
+        rows.append(["gradient profile (per mille, uphill positive; a force m g grade on the "
+                     "train in the sympy model's v' and lambda')",
+                     f"{rng(pt.gradient)}, uniform per {fmt(pt.segment)} m segment of the "
+                     f"distance run — {src['gradient']}"])
+    if pt.delay_period is not None:
+        rows.append(["true input delay h(t) (s), varying",
+                     f"triangle wave over the `h` range {rng(ms.h, 4)}, inside the interval "
+                     "[0, h_certified] the cruise synthesis certifies (scenario table); "
+                     f"period {rng(pt.delay_period)} s and phase uniform per run (the constant "
+                     f"h draw above is not used) — {src['delay_variation']}"])
+    return rows
 
 
 def _numerics_section(with_montecarlo: bool, rail: str) -> str:

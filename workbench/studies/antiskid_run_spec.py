@@ -91,6 +91,55 @@ class SweepSpec:
     chunk: int | None = None
     halving: int = 0        # first runs re-checked at dt and dt / 2 (:func:`start_halving`)
     dt: float | None = None  # step of the sweep's runs (None: the design's [numerics] dt)
+    perturb: SweepPerturbations | None = None   # noise, gradient, varying delay (opt-in)
+
+
+@dataclass(frozen=True)
+class SweepPerturbations:
+    """The optional perturbations of ``[montecarlo]`` (issue 17, item 6; see
+    :mod:`workbench.sim.perturb`): measurement noise (standard deviations),
+    a gradient profile (slope range in per mille, segment length), a delay
+    varying inside the ``h`` range (range of the triangle wave's period).
+    Each ``None`` or 0 when its key is absent; ``sources``: key -> source."""
+
+    noise_v: float = 0.0            # m/s
+    noise_omega: float = 0.0        # rad/s
+    gradient: tuple | None = None   # per mille, uphill positive
+    segment: float = 1000.0         # m
+    delay_period: tuple | None = None   # s
+    sources: tuple = ()
+
+    @property
+    def noisy(self) -> bool:
+        return self.noise_v > 0 or self.noise_omega > 0
+
+
+def load_perturbations(mt: Reader) -> SweepPerturbations | None:
+    """The ``noise_v``, ``noise_omega``, ``gradient`` and ``delay_variation``
+    entries of a ``[montecarlo]`` table (None when none is given)."""
+    if not any(mt.has(k) for k in ("noise_v", "noise_omega", "gradient", "delay_variation")):
+        return None
+    src, out = {}, {}
+    for k, unit in (("noise_v", "m/s"), ("noise_omega", "rad/s")):
+        if mt.has(k):
+            q = mt.quantity(k, unit, nonneg=True, hi=10.0)
+            out[k], src[k] = q.value, q.source
+    if mt.has("gradient"):
+        g = mt.table("gradient")
+        out["gradient"] = _range(g, "range", lo=-100.0, hi=100.0)
+        if g.string("unit") != "per mille":
+            raise g.fail("unit", g.raw("unit"), '"per mille"')
+        out["segment"] = g.number("segment", positive=True, what="number (m)")
+        src["gradient"] = g.string("source")
+        g.finish()
+    if mt.has("delay_variation"):
+        d = mt.table("delay_variation")
+        out["delay_period"] = _range(d, "period", positive=True)
+        if d.string("unit") != "s":
+            raise d.fail("unit", d.raw("unit"), '"s"')
+        src["delay_variation"] = d.string("source")
+        d.finish()
+    return SweepPerturbations(**out, sources=tuple(src.items()))
 
 
 def plant_values(spec: RunSpec, mass_factor: float = 1.0) -> dict:
@@ -313,7 +362,8 @@ def load_run_spec(root: Reader) -> RunSpec:
                        count("workers", lo=1, hi=256),
                        count("chunk", default=None, lo=1, hi=10**5),
                        count("halving_samples", default=0, lo=0, hi=10**5),
-                       mt.number("dt", default=None, positive=True, hi=0.05))
+                       mt.number("dt", default=None, positive=True, hi=0.05),
+                       load_perturbations(mt))
         if mc.halving > mc.samples:
             raise mt.fail("halving_samples", mc.halving,
                           f"at most samples = {mc.samples} (the check re-runs the first runs)")

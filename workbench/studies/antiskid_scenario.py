@@ -19,7 +19,9 @@ import numpy as np
 from ..controllers.antiskid003 import Antiskid003, PhaseEvents
 from ..controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED, ControllerSettings
 from ..sim.delay import SimResult, simulate_closed_loop
+from ..sim.counter_rng import normal4
 from ..sim.history import BatchDelayLine
+from ..sim.perturb import Perturbations, VaryingDelayLine, grade_at, measured_state
 from ..sim.wheel_slip import (PARAM_ORDER, ArrayOps, ScalarOps, creep_rate_coefficient,
                               creep_speed, model_functions, plant_step, wheel_speed)
 
@@ -151,6 +153,7 @@ class RunSettings:
     x0: tuple = (3.0, 0.001)
     u_init: float = 100.0
     t_end: float = 400.0
+    perturb: Perturbations | None = None    # batches only: noise, gradient, varying delay
 
 
 @dataclass(frozen=True)
@@ -212,13 +215,30 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     ctrl = Antiskid003(run.controller, run.x0, run.u_init, dt, batch, recorder=rec,
                        k_max=None if mesh is None else mesh.k_max)
     zero = 0.0 if batch is None else np.zeros(batch)
+    pt = run.perturb
+    if pt is not None and (batch is None or mesh is not None):
+        raise ValueError("perturbations are for batches on the fixed step")
+    if pt is not None and pt.noisy:
+        ctrl.measure = _measure(pt, p, run.controller)
+    pos, plant_fns = [zero], fns
+    if pt is not None and pt.grade is not None:
+        plant_fns = model_functions("numpy", graded=True)
+
+    def plant_params():
+        """The plant's parameters this step (a slope appended on a gradient)."""
+        if pt is None or pt.grade is None:
+            return p
+        g = grade_at(pos[0], np.asarray(pt.keys["grade"], np.uint64), *pt.grade, pt.segment)
+        return (*p, g)
 
     def step(x, u, t, dt_):
         if batch is None:
             *nx, ctrl.unresolved = plant_step(x, u, p, dt_, fns, xp, with_flag=True)
             return tuple(nx)
         stop = ctrl.phase >= STOPPED
-        *nx, unres = plant_step(x, u, p, dt_, fns, xp, mask=~stop, with_flag=True)
+        pp = plant_params()
+        pos[0] = pos[0] + dt_ * x[0]
+        *nx, unres = plant_step(x, u, pp, dt_, plant_fns, xp, mask=~stop, with_flag=True)
         ctrl.unresolved = unres & ~stop
         return (np.where(stop, x[0], nx[0]), np.where(stop, x[1], nx[1]))
 
@@ -229,6 +249,8 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     x0 = (run.x0[0] + zero, run.x0[1] + zero)
     line = None if batch is None else BatchDelayLine(np.broadcast_to(run.h, (batch,)), dt,
                                                       run.u_init)
+    if pt is not None and pt.delay is not None:
+        line = VaryingDelayLine(*pt.delay, pt.period, pt.phase, dt, run.u_init)
     level = None
     if mesh is not None:
         S = creep_rate_coefficient()(*p)
@@ -246,3 +268,18 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     for k, v in vars(ctrl.events).items():      # the phase logic's events
         setattr(rec.m, k, v)
     return res, rec.m
+
+
+def _measure(pt: Perturbations, p: tuple, cs: ControllerSettings):
+    """The controller's ``measure`` of a batch with measurement noise: sample k
+    sees noise number k // noise_every of each run's streams."""
+    kv, kw = (np.asarray(pt.keys[c], np.uint64) for c in ("v", "omega"))
+    r_p, r_c = p[PARAM_ORDER.index("r")], cs.params[PARAM_ORDER.index("r")]
+    count = [0]
+
+    def measure(v, lam):
+        k = count[0] // pt.noise_every
+        count[0] += 1
+        return measured_state(v, lam, normal4(kv, k), normal4(kw, k), pt.noise_v,
+                              pt.noise_omega, r_p, r_c, cs.v_floor)
+    return measure

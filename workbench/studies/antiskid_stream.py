@@ -63,6 +63,8 @@ def _manifest(design, samples: int, seed: int, chunk: int, kernel: str, K) -> di
     inp = sweep_inputs(design, 1, seed, K)      # the data every run shares
     shared = {k: inp[k] for k in ("base", "controller", "scenario", "dt")}
     shared["ranges"] = [ms.mass, ms.adhesion, ms.h, ms.v0, sorted(ms.wet.items())]
+    if ms.perturb is not None:      # absent: the digest of a sweep without perturbations
+        shared["perturb"] = ms.perturb
     digest = hashlib.sha256(json.dumps(shared, sort_keys=True, default=repr).encode())
     return {"design": design.name, "samples": samples, "seed": seed, "chunk": chunk,
             "kernel": kernel, "t_brake": inp["scenario"]["t_brake"],

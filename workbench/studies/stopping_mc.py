@@ -157,7 +157,18 @@ def within_rate(errors, tol: float, z: float = Z95):
     stays inside [0, 1] and is sound at k = 0 or k = n, where the normal
     approximation collapses to a point."""
     e = [abs(x) for x in errors]
-    n, k = len(e), sum(x <= tol for x in e)
+    return wilson_interval(sum(x <= tol for x in e), len(e), z)
+
+
+def wilson_interval(k: int, n: int, z: float = Z95):
+    """(k, n, k/n, lo, hi): the proportion of k successes in n trials and its
+    Wilson score interval (95 % for the default z); NaNs for n = 0.
+
+    References
+    ----------
+    .. [W27] Wilson E. B., "Probable inference, the law of succession, and
+       statistical inference", J. Am. Stat. Assoc. 22(158):209-212, 1927.
+    """
     if n == 0:
         return 0, 0, math.nan, math.nan, math.nan
     p = k / n

@@ -1,0 +1,157 @@
+"""Sampled perturbations of an antiskid run (issue 17, item 6): measurement
+noise on v and omega, a gradient profile over distance, a time-varying
+input delay.
+
+Each is a pure function of (seed, run index, time or position) through the
+counter-based generator of :mod:`workbench.sim.counter_rng`, written here
+for numpy (a batch of runs, arrays) and, operation for operation, in
+:mod:`workbench.sim.wheel_slip_jit` for the compiled kernel:
+
+* noise -- the controller sees v_m = max(v + sigma_v z_v, v_floor) and
+  omega_m = omega + sigma_omega z_omega, z of :func:`~workbench.sim.counter_rng.normal4`
+  (unit variance), held over ``every`` samples (the noise is a function of
+  time on the sweep's step grid, so a run at dt / 2 sees the same noise);
+  its creep ratio is that of (v_m, omega_m), eqs (4)-(5) inverted
+  (:func:`measured_state`); the plant is unaffected;
+* gradient -- a piecewise-constant slope over distance: segment j (positions
+  [j L, (j + 1) L)) has the slope g_lo + (g_hi - g_lo) u_j, u_j uniform of
+  (seed, run, j) (:func:`grade_at`); the position integrates v;
+* delay -- h(t) = h_lo + (h_hi - h_lo) tri(t / P + phi), tri(x) = |2 frac(x) - 1|
+  a triangle wave (period P and phase phi per run), clipped to [h_lo, h_hi]
+  (:func:`delay_at`); the applied input is the exact ZOH average of
+  u(t - h(t_n)) over step n (:func:`split_delays`, as
+  :func:`~workbench.sim.history.split_delay`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .counter_rng import uniform
+from .wheel_slip import ArrayOps, wheel_speed
+
+
+@dataclass(frozen=True)
+class Perturbations:
+    """The perturbations of a batch of runs (plain data; per-run arrays).
+
+    Attributes
+    ----------
+    run : tuple[int, ...]
+        Global run index of each run of the batch (the generator's counter).
+    keys : dict[str, tuple[int, ...]]
+        ``uint64`` keys per run of the streams used (``"v"``, ``"omega"``, ``"grade"``).
+    noise_v, noise_omega : float
+        Standard deviations of the measurement noise (m/s, rad/s); 0 = none.
+    noise_every : int
+        Samples each noise value is held (noise period / step).
+    grade : tuple[float, float] or None
+        Slope range (dimensionless, uphill positive) of the gradient profile.
+    segment : float
+        Length of a gradient segment (m).
+    delay : tuple[float, float] or None
+        [h_lo, h_hi] of the time-varying delay (s); None: constant per run.
+    period, phase : tuple[float, ...]
+        Per run: period (s) and phase (fraction of a period) of h(t).
+    """
+
+    run: tuple
+    keys: dict
+    noise_v: float = 0.0
+    noise_omega: float = 0.0
+    noise_every: int = 1
+    grade: tuple | None = None
+    segment: float = 1000.0
+    delay: tuple | None = None
+    period: tuple = ()
+    phase: tuple = ()
+
+    @property
+    def noisy(self) -> bool:
+        return self.noise_v > 0 or self.noise_omega > 0
+
+
+def measured_state(v, lam, zv, zw, sv, sw, r_plant, r_ctrl, v_floor):
+    """(v_m, lambda_m) the controller sees (module docstring), arrays.
+
+    Parameters
+    ----------
+    v, lam : array
+        True speed (m/s) and creep ratio.
+    zv, zw : array
+        Unit-variance noise values.
+    sv, sw : float
+        Noise standard deviations (m/s, rad/s).
+    r_plant, r_ctrl : float or array
+        Wheel radius of the plant (omega) and of the controller's model (m).
+    v_floor : float
+        Floor of the measured speed (m/s).
+    """
+    omega = wheel_speed(v, lam, r_plant, ArrayOps)
+    vm = np.maximum(v + sv * zv, v_floor)
+    vw = np.maximum((omega + sw * zw) * r_ctrl, 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lm = np.where(vw >= vm, 1.0 - vm / vw, vw / vm - 1.0)
+    return vm, lm
+
+
+def grade_at(pos, key, lo: float, hi: float, segment: float):
+    """Slope at positions ``pos`` (m, arrays) of the runs with gradient keys ``key``."""
+    j = np.floor(np.maximum(pos, 0.0) / segment).astype(np.int64)
+    return lo + (hi - lo) * uniform(key, j)
+
+
+def delay_at(t: float, lo: float, hi: float, period, phase):
+    """h(t) of each run (s): the clipped triangle wave of the module docstring."""
+    x = t / period + phase
+    tri = np.abs(2.0 * (x - np.floor(x)) - 1.0)
+    return np.minimum(np.maximum(lo + (hi - lo) * tri, lo), hi)
+
+
+def split_delays(h, dt: float):
+    """(N, f) of ``h = (N + f) dt`` per run, snapped within 1e-9 of a whole
+    step (as :func:`~workbench.sim.history.split_delay`)."""
+    q = h / dt
+    n = np.floor(q + 0.5)
+    snap = np.abs(q - n) < 1e-9
+    fl = np.floor(q)
+    return np.where(snap, n, fl).astype(np.int64), np.where(snap, 0.0, q - fl)
+
+
+class VaryingDelayLine:
+    """Input delay line of a batch whose delay varies in time
+    (:func:`delay_at`): the interface of
+    :class:`~workbench.sim.history.BatchDelayLine`, the delay of step n
+    taken at t_n = n dt.
+
+    Parameters
+    ----------
+    lo, hi : float
+        Delay range (s).
+    period, phase : (B,) array
+    dt : float
+    initial : float
+        Input before t = 0.
+    """
+
+    def __init__(self, lo: float, hi: float, period, phase, dt: float, initial: float):
+        self.lo, self.hi, self.dt = lo, hi, dt
+        self.period, self.phase = np.asarray(period, float), np.asarray(phase, float)
+        N_max = int(split_delays(np.array([hi]), dt)[0][0])
+        self._L = N_max + 2
+        self._buf = np.full((self._L, self.period.size), float(initial))
+        self._cols = np.arange(self.period.size)
+        self._n = 0
+
+    def push(self, value, ticks=None) -> None:
+        self._buf[self._n % self._L] = value
+        self._n += 1
+
+    def delayed(self):
+        n = self._n - 1
+        N, f = split_delays(delay_at(n * self.dt, self.lo, self.hi, self.period, self.phase),
+                            self.dt)
+        a = self._buf[(n - N) % self._L, self._cols]
+        b = self._buf[(n - N - 1) % self._L, self._cols]
+        return (1.0 - f) * a + f * b
