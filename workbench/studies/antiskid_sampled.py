@@ -5,7 +5,7 @@ Design table (optional; absent: no sampled section)::
 
     [sampled]
     case = "compensated"          # the [[cases]] entry whose controller is sampled
-    rates_hz = [10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0]
+    rates_hz = [5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0]
     creep_margin = 0.001          # traction requirement lambda <= lambda_opt (1 + creep_margin)
     plant_step = 1e-4             # s, largest plant sub-step (mesh checked at its half)
     predictor_step = 1e-3         # s, the predictor steps over >= this many held samples

@@ -1,5 +1,9 @@
 """Compiled sampled-data loop of paper 003's antiskid controller (issue 20).
 
+Paper 003: Cai, Yue, Huang, "Antiskid control of high-speed trains with
+input delay": controller (75) (laws (61), (64), (69), predictor of Lemma 1,
+eq (2)) on the adhesion plant of eqs (12)-(16), scenario of section 4.
+
 A real traction controller samples the measured state at t_k = t0 + k T_c
 (T_c = 1 / f_c), possibly ``tau_m`` old, evaluates its law once, quantises
 the torque and holds it (zero-order hold, ZOH) until the next sample; the
@@ -16,14 +20,16 @@ plant receives the held torque h later (the input delay). Here:
   at most ``dt_p``, each an exponential-Euler step of
   :func:`workbench.sim.wheel_slip_jit.stiff_step` (the lambdified sympy model,
   never retyped) under a torque that is constant on it. When T_c and h are
-  multiples of ``dt_p`` the mesh is the fixed grid k dt_p for every rate.
+  multiples of ``dt_p`` (and ``tau_m``) the mesh is the fixed grid k dt_p for
+  every rate.
   Metrics are taken on that mesh, between samples too.
 
-Why not :func:`scipy.integrate.solve_ivp` for the whole grid: a 5 kHz run is
-5000 restarts a second of simulated time, each with a fast creep-ratio
-transient (time constant ~ v/4000 s) to resolve; scipy's Python-level Radau
-costs about a millisecond per restart, minutes per run. Radau is kept as the
-independent check of this mesh (:mod:`workbench.studies.antiskid_sampled`).
+Why not :func:`scipy.integrate.solve_ivp` for the whole grid: a 5 kHz run
+restarts the integration 10 000 times a second of simulated time (each sample,
+each arriving command), each time with a fast creep-ratio transient (time
+constant ~ v/4000 s) to resolve; scipy's Radau, restarted from Python, costs
+about a millisecond per restart, a quarter of an hour per 5 kHz run. Radau is
+kept as the independent check of this mesh (:mod:`.antiskid_sampled_check`).
 
 :func:`kernel` is the loop, :func:`run_once` runs one scenario with it;
 :data:`OUT` names its results.
@@ -39,7 +45,7 @@ import numpy as np
 from ..controllers.antiskid003_settings import CRUISE
 from ..sim.wheel_slip import PARAM_ORDER, model_functions
 
-#: Entries of the result array of :func:`run_sampled` (NaN: did not happen).
+#: Entries of the result array of the loop (:func:`kernel`; NaN: did not happen).
 OUT = ("t_end", "lam_max", "lam_min", "time_above", "time_past_peak", "t_cruise",
        "t_handover", "t_stop", "stop_distance", "t_omega3", "evs_max", "t_diverged",
        "u_max_abs", "samples", "plant_steps", "unresolved", "v_end", "lam_end")
