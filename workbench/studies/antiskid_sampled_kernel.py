@@ -209,6 +209,11 @@ def kernel():
     stopping distance from ``t_brake``. Results in ``out`` (:data:`OUT`)."""
     global _KERNEL
     if _KERNEL is None:
+        from importlib.util import find_spec
+        if find_spec("numba") is None:
+            from ..errors import ModelError
+            raise ModelError("a design's [sampled] table runs a compiled loop, which needs "
+                             "numba: pip install 'workbench[fast]'")
         _KERNEL = _build()
     return _KERNEL
 
