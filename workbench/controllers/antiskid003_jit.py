@@ -42,10 +42,12 @@ _JIT = dict(nogil=True, error_model="numpy")
 CFG = ("v_d", "lambda_d", "lambda_opt", "K0", "K1", "a1", "a2", "d1", "d2", "d3", "d4", "d5",
        "d6", "k_ac", "k_de", "h_model", "t_brake", "c0", "c1", "lambda_allow", "vs_min",
        "omega_switch", "compensate", "stiff", "cruise_creep", "brake_creep", "band", "v_stop",
-       "v_floor", "lam_diverged", "u_range", "observer_on", "alpha", "dt", "N", "f", "r")
+       "v_floor", "lam_diverged", "u_range", "observer_on", "alpha", "dt", "N", "f", "r",
+       "group")
 (V_D, LAMBDA_D, LAMBDA_OPT, K0, K1, A1, A2, D1, D2, D3, D4, D5, D6, K_AC, K_DE, H_MODEL, T_BRAKE,
  C0, C1, LAMBDA_ALLOW, VS_MIN, OMEGA_SWITCH, COMPENSATE, STIFF, CRUISE_CREEP, BRAKE_CREEP, BAND,
- V_STOP, V_FLOOR, LAM_DIVERGED, U_RANGE, OBSERVER_ON, ALPHA, DT, NC, FC, R_C) = range(len(CFG))
+ V_STOP, V_FLOOR, LAM_DIVERGED, U_RANGE, OBSERVER_ON, ALPHA, DT, NC, FC, R_C,
+ GROUP) = range(len(CFG))
 
 #: Entries of the controller state ``st``.
 STATE = ("phase", "has_prev", "prev_v", "prev_lam", "prev_phase", "delta", "unresolved",
@@ -58,8 +60,14 @@ E_HANDOVER, E_V_HANDOVER, E_LAM_HANDOVER = (_EV["t_handover_done"], _EV["v_at_ha
 E_T_DIV, E_PH_DIV, E_HOW = _EV["t_diverged"], _EV["phase_diverged"], _EV["diverged_how"]
 
 
-def settings_array(s: ControllerSettings, dt: float) -> np.ndarray:
-    """The settings of ``s`` at step ``dt`` as the float array ``cfg`` (:data:`CFG`)."""
+def settings_array(s: ControllerSettings, dt: float, group: int = 1) -> np.ndarray:
+    """The settings of ``s`` at step ``dt`` as the float array ``cfg`` (:data:`CFG`);
+    ``group``: the predictor's rollout steps over ``group`` held samples at a
+    time, with their exact average (1: every sample, as
+    :meth:`Antiskid003._rollout`; a fast sampled controller's choice, see
+    :mod:`workbench.studies.antiskid_sampled`)."""
+    if not (isinstance(group, int) and group >= 1):
+        raise ValueError(f"group = {group!r}; expected an integer >= 1")
     if s.compensate and s.predictor != "rollout":
         raise ValueError(f"predictor = {s.predictor!r}; the compiled controller runs "
                          "predictor = 'rollout' (or compensate = false)")
@@ -76,7 +84,7 @@ def settings_array(s: ControllerSettings, dt: float) -> np.ndarray:
                 v_stop=s.v_stop, v_floor=s.v_floor, lam_diverged=s.lam_diverged,
                 u_range=s.u_range, observer_on=float(observer),
                 alpha=-math.expm1(-dt / s.observer_tau) if observer else 0.0,
-                dt=dt, N=float(N), f=f, r=s.params[PARAM_ORDER.index("r")])
+                dt=dt, N=float(N), f=f, r=s.params[PARAM_ORDER.index("r")], group=float(group))
     return np.array([float(vals[k]) for k in CFG])
 
 
@@ -128,11 +136,21 @@ def rollout(v, lam, ph, ubuf, n, cfg, p):
         kind = BRAKING
     else:
         return v, lam
-    N, f, dt, L = int(cfg[NC]), cfg[FC], cfg[DT], ubuf.shape[0]
+    N, f, dt, L, G = int(cfg[NC]), cfg[FC], cfg[DT], ubuf.shape[0], int(cfg[GROUP])
     if f > 0:
         v, lam = _model_step(v, lam, ubuf[(n - N - 1) % L], f * dt, kind, cfg, p)
-    for k in range(n - N, n):
-        v, lam = _model_step(v, lam, ubuf[k % L], dt, kind, cfg, p)
+    if G == 1:
+        for k in range(n - N, n):
+            v, lam = _model_step(v, lam, ubuf[k % L], dt, kind, cfg, p)
+        return v, lam
+    k = n - N
+    while k < n:       # pieces of G held samples, each with their average input
+        m = min(G, n - k)
+        total = 0.0
+        for j in range(k, k + m):
+            total += ubuf[j % L]
+        v, lam = _model_step(v, lam, total / m, m * dt, kind, cfg, p)
+        k += m
     return v, lam
 
 

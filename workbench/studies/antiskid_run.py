@@ -87,13 +87,17 @@ class RunResult:
     montecarlo: object = None   # antiskid_montecarlo.SweepResult or None
     halving: object = None      # antiskid_halving.HalvingCheck or None
     basin: object = None        # antiskid_basin_run.BasinResult or None
+    sampled: object = None      # antiskid_sampled.SampledResult or None
 
     def case(self, name: str) -> CaseResult:
         return next(c for c in self.cases if c.case.name == name)
 
     def to_json(self) -> dict:
-        return {"lambda_opt": self.lambda_opt, "lambda_d": self.lambda_d, "K": list(self.K),
-                "cases": {c.case.name: c.metrics for c in self.cases}}
+        out = {"lambda_opt": self.lambda_opt, "lambda_d": self.lambda_d, "K": list(self.K),
+               "cases": {c.case.name: c.metrics for c in self.cases}}
+        if self.sampled is not None:
+            out["sampled"] = self.sampled.to_json()
+        return out
 
 
 def switch_check(cs: ControllerSettings, v: float, lam: float) -> SwitchCheck:
@@ -300,6 +304,9 @@ class AntiskidRun:
         if spec.basin is not None:
             from .antiskid_basin_run import basin_quantity_names
             names |= basin_quantity_names([c.name for c in spec.cases], True)
+        if spec.sampled is not None:
+            from .antiskid_sampled import sampled_quantity_names
+            names |= sampled_quantity_names(spec.sampled)
         return names
 
     def start(self, design):
@@ -333,6 +340,11 @@ class AntiskidRun:
         try:
             cases = self._cases(spec, K)
             lc = linear_check(spec, lin.A, lin.B, K)
+            sampled = None
+            if spec.sampled is not None:
+                from .antiskid_run_spec import sampled_context
+                from .antiskid_sampled import run_sampled
+                sampled = run_sampled(spec.sampled, sampled_context(spec, K), spec.dt)
         except BaseException:
             for p in (pending, halving):
                 if p is not None:
@@ -346,7 +358,7 @@ class AntiskidRun:
             spec.mass_factor, profile=controller_settings(spec, K, spec.cases[0]).profile,
             k_de=spec.k_de)
         return RunResult(nominal.lambda_opt(), lam_d, tuple(K), how, h_cert, tuple(cases), lc,
-                         spec.dt, mc, hc, bs)
+                         spec.dt, mc, hc, bs, sampled)
 
     def _cases(self, spec: RunSpec, K) -> list[CaseResult]:
         cases = []
@@ -406,6 +418,9 @@ class AntiskidRun:
             from .antiskid_basin_run import basin_quantities
             q.update(basin_quantities(res.basin.basin, res.basin.sweep,
                                       [c.case.name for c in res.cases], res.basin.brake))
+        if res.sampled is not None:
+            from .antiskid_sampled import sampled_quantities
+            q.update(sampled_quantities(res.sampled))
         return q
 
 

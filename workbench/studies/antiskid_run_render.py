@@ -74,6 +74,12 @@ def render(design, res) -> Rendered:
         sections.append(comfort_section(res, spec))
         extra_figs += (comfort_figure(res, spec),)
         anchors.insert(0, (PATTERN, HEADING))
+    if res.sampled is not None:
+        from .antiskid_sampled_render import (HEADING as SAMPLED_HEADING, PATTERN as SAMPLED,
+                                              sampled_figure, sampled_section, trace_figure)
+        sections.append(sampled_section(res.sampled, spec.rail))
+        extra_figs += (sampled_figure(res.sampled), trace_figure(res.sampled))
+        anchors.insert(0, (SAMPLED, SAMPLED_HEADING))
     if res.montecarlo is not None:
         sections.append(_montecarlo_section(design, res.montecarlo, res.halving))
     figs = (

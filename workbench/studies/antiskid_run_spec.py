@@ -11,7 +11,9 @@ applied to the plant only: the controller keeps the nominal model),
 ``[linear_check]`` and, optionally, ``[montecarlo]``: the ranges of the
 ``workbench sweep`` robustness study plus ``samples``, ``seed``, ``workers``
 and ``chunk`` of a reduced sample that the study runs (in a process pool,
-while the cases run) and reports as ``montecarlo.*`` quantities.
+while the cases run) and reports as ``montecarlo.*`` quantities;
+``[basin]``, ``[comfort]`` and ``[sampled]`` (the case's laws as a
+sampled-data controller, :mod:`workbench.studies.antiskid_sampled`).
 """
 from __future__ import annotations
 
@@ -71,6 +73,7 @@ class RunSpec:
     montecarlo: object = None      # antiskid_montecarlo.SweepSpec or None
     basin: object = None           # antiskid_basin_run.BasinSettings or None ([basin] table)
     comfort: object = None         # antiskid_comfort.ComfortSpec or None ([comfort] table)
+    sampled: object = None         # antiskid_sampled.SampledSpec or None ([sampled] table)
 
 
 @dataclass(frozen=True)
@@ -200,6 +203,20 @@ def run_settings(spec: RunSpec, cs: ControllerSettings) -> RunSettings:
     sc = spec.scenario
     plant = tuple(plant_values(spec, spec.mass_factor)[k] for k in PARAM_ORDER)
     return RunSettings(plant, cs, sc["h"], (sc["v0"], sc["lambda0"]), sc["u_init"], sc["t_end"])
+
+
+def sampled_context(spec: RunSpec, K):
+    """The :class:`~workbench.studies.antiskid_sampled_kernel.Context` of a
+    design's ``[sampled]`` runs: its case's controller with gain ``K``, the
+    (mass-scaled) plant, the scenario."""
+    import numpy as np
+
+    from .antiskid_sampled_kernel import Context
+    case = next(c for c in spec.cases if c.name == spec.sampled.case)
+    rs = run_settings(spec, controller_settings(spec, K, case))
+    return Context(rs.controller, np.asarray(rs.plant_params, float), rs.h, rs.x0, rs.u_init,
+                   spec.scenario["t_brake"], spec.scenario["t_end"], peak_adhesion_torque(spec),
+                   spec.sampled.creep_margin)
 
 
 def case_metrics(m, cs: ControllerSettings, t_brake: float) -> dict:
@@ -370,6 +387,7 @@ def load_run_spec(root: Reader) -> RunSpec:
         mt.finish()
     from .antiskid_basin_run import load_basin_settings
     from .antiskid_comfort import load_comfort
+    from .antiskid_sampled import load_sampled
     vals = {k: q.value for k, q in params.items()}
     try:
         NumericAdhesion.from_dict(vals).cruise_lambda(scen["v_d"])
@@ -378,4 +396,5 @@ def load_run_spec(root: Reader) -> RunSpec:
                           f"a speed with a creep-region equilibrium ({exc})") from None
     return RunSpec(rail, params, mass_factor, scen, gain, eps, K_table, K_source, k_ac, k_de,
                    profile, dt, v_stop, band, torque_range, mesh_courant, mesh_levels, rtol, atol, tuple(cases), tuple(fg),
-                   factors, far, periods, mc, load_basin_settings(root), load_comfort(root))
+                   factors, far, periods, mc, load_basin_settings(root), load_comfort(root),
+                   load_sampled(root, names))
