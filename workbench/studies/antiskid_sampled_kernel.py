@@ -108,7 +108,7 @@ def _build():
             if t0 + ks * Tc <= t + eps:
                 tk = t0 + ks * Tc
                 mv, ml = mq[ks % Lq, 0], mq[ks % Lq, 1]
-                u, ph, tc, tb, ts = control(tk, mv, ml, st, ubuf, ev, cfg, pc)
+                u, ph, tc, tb, ts = control(tk, ml, mv, ml, st, ubuf, ev, cfg, pc)   # divergence on the sampled lambda
                 if q > 0:
                     u = q * math.floor(u / q + 0.5)
                     ubuf[(int(st[PUSHED]) - 1) % ubuf.shape[0]] = u
