@@ -15,7 +15,8 @@ Prints, in one process:
    batched numpy reference and the compiled kernel (numba; compiled once in
    this process before the pool forks, which is not in its time), runs/min
    and their ratio, with the machine's load average (the figures are only
-   comparable within one run).
+   comparable within one run); for the design as shipped and for the same
+   sweep without its perturbations (longer runs: the issue's workload).
 
 Usage: .venv/bin/python benchmarks/simulate.py [--samples N] [--workers W] [--skip-single]
 """
@@ -105,33 +106,48 @@ def single_runs(rs, spec, dt: float, ref_horizon: float) -> None:
           f"{spec.scenario['t_end'] / ref_horizon * wall_ref:.0f} s per run")
 
 
-def montecarlo(design, spec, samples: int, workers: int) -> None:
-    """Item 3: the same sweep by both paths, runs/min side by side."""
-    import os
+def unperturbed(design):
+    """The design without its sweep's perturbations (noise, gradient, varying
+    delay): the workload of issue 17's figures (1000 runs at dt = 0.005 s in
+    166 s), whose runs are longer (fewer diverge early)."""
+    import dataclasses
+    ms = dataclasses.replace(design.spec.montecarlo, perturb=None)
+    return dataclasses.replace(design, spec=dataclasses.replace(design.spec, montecarlo=ms))
 
-    from workbench.studies.antiskid_kernel import compiled_available
+
+def montecarlo(design, spec, samples: int, workers: int) -> None:
+    """Item 3: the same sweep by both paths, runs/min side by side, for the
+    design as shipped and without its perturbations."""
+    import os
+    import resource
+
+    from workbench.studies.antiskid_kernel import LANES, compiled_available
     mc_dt = spec.montecarlo.dt or spec.dt
     print(f"Monte Carlo: {samples} runs of up to {spec.scenario['t_end']:g} s at dt = {mc_dt:g} s, "
-          f"seed 1, {workers} workers; load average before: {os.getloadavg()[0]:.2f}")
-    rates = {}
+          f"seed 1, {workers} workers; compiled batches keep {LANES} runs in flight")
     paths = ("numpy", "compiled") if compiled_available() else ("numpy",)
-    import resource
-    for kernel in paths:
-        cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime
-        res = sweep(design, samples, seed=1, workers=workers, kernel=kernel, progress=False)
-        cpu = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime - cpu0   # the pool's workers
-        rates[kernel] = samples / res.seconds * 60
-        print(f"  {kernel:>8}: {res.seconds:7.1f} s -> {rates[kernel]:6.0f} runs/min "
-              f"({rates[kernel] / 60 / res.workers:.1f} runs/s per worker); "
-              f"projected 1000 runs: {1000 / rates[kernel] * 60:.0f} s; workers' CPU "
-              f"{cpu:.1f} s = {samples / cpu:.1f} runs per CPU-second (on {workers} idle cores: "
-              f"{samples / cpu * 60 * workers:.0f} runs/min)")
-    if len(rates) == 2:
-        print(f"  ratio compiled / numpy: {rates['compiled'] / rates['numpy']:.1f}x "
-              f"(target: compiled >= 3000 runs/min on 2 cores); "
-              f"load average after: {os.getloadavg()[0]:.2f}")
-    else:
-        print("  compiled: numba not installed (pip install 'workbench[fast]')")
+    workloads = [("as shipped (perturbations on)", design)]
+    if spec.montecarlo.perturb is not None:
+        workloads.append(("without perturbations", unperturbed(design)))
+    for label, d in workloads:
+        print(f" {label}; load average before: {os.getloadavg()[0]:.2f}")
+        rates = {}
+        for kernel in paths:
+            cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime
+            res = sweep(d, samples, seed=1, workers=workers, kernel=kernel, progress=False)
+            cpu = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime - cpu0   # the workers
+            rates[kernel] = samples / res.seconds * 60
+            print(f"  {kernel:>8}: {res.seconds:7.1f} s -> {rates[kernel]:6.0f} runs/min "
+                  f"({rates[kernel] / 60 / res.workers:.1f} runs/s per worker); "
+                  f"projected 1000 runs: {1000 / rates[kernel] * 60:.0f} s; workers' CPU "
+                  f"{cpu:.1f} s = {samples / cpu:.1f} runs per CPU-second (on {workers} idle "
+                  f"cores: {samples / cpu * 60 * workers:.0f} runs/min)")
+        if len(rates) == 2:
+            print(f"  ratio compiled / numpy: {rates['compiled'] / rates['numpy']:.1f}x "
+                  f"(target: compiled >= 3000 runs/min on 2 cores); "
+                  f"load average after: {os.getloadavg()[0]:.2f}")
+        else:
+            print("  compiled: numba not installed (pip install 'workbench[fast]')")
 
 
 if __name__ == "__main__":

@@ -20,7 +20,7 @@ pytest.importorskip("numba")
 from workbench.controllers.antiskid003_settings import ControllerSettings, CreepSpeedProfile  # noqa: E402
 from workbench.design import load_design  # noqa: E402
 from workbench.sim.wheel_slip import PARAM_ORDER  # noqa: E402
-from workbench.studies.antiskid_kernel import METRIC_FIELDS, simulate_batch  # noqa: E402
+from workbench.studies.antiskid_kernel import LANES, METRIC_FIELDS, simulate_batch  # noqa: E402
 from workbench.studies.antiskid_montecarlo import (chunk_payload, chunk_worker, per_run,  # noqa: E402
                                                    run_lambda_opt, sweep_inputs)
 from workbench.studies.antiskid_run_spec import gain_for  # noqa: E402
@@ -97,6 +97,26 @@ def test_unknown_kernel_is_refused(dry):
     run, dt = _runs(dry, 1, t_brake=1.0, t_end=1.0)
     with pytest.raises(ValueError, match="kernel = 'fortran'"):
         simulate_batch(run, dt, "fortran")
+
+
+def test_runs_in_flight_together_equal_runs_alone(dry):
+    """A batch keeps LANES runs in flight and refills a lane when its run
+    ends: each run's metrics are bit for bit those of the run simulated
+    alone (a batch of one), with the design's perturbations (noise, slopes,
+    varying delay: keyed by run index) on a shortened scenario."""
+    n = LANES + 3                         # lanes refilled, some more than once
+    spec = dataclasses.replace(dry.spec, scenario={**dry.spec.scenario, "t_brake": 8.0,
+                                                   "t_end": 16.0})
+    assert spec.montecarlo.perturb is not None
+    d = dataclasses.replace(dry, spec=spec)
+    inp = sweep_inputs(d, n, spec.montecarlo.seed, gain_for(spec)[0])
+    together = chunk_worker(chunk_payload(inp, 0, n, inp["dt"], "compiled"))["metrics"]
+    for i in range(n):
+        alone = chunk_worker(chunk_payload(inp, i, i + 1, inp["dt"], "compiled"))["metrics"]
+        for k in METRIC_FIELDS:
+            np.testing.assert_array_equal(together[k][i], alone[k][0], err_msg=f"run {i}: {k}")
+    ends = np.array(together["t_diverged"])
+    assert np.isfinite(ends).any() and not np.isfinite(ends).all()   # lanes end apart
 
 
 @pytest.mark.slow

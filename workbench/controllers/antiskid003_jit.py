@@ -37,6 +37,7 @@ from .antiskid003_settings import (ACCEL, BRAKE, BRAKE_IN, CRUISE, DIVERGED, HAN
                                    ControllerSettings)
 
 _JIT = dict(nogil=True, error_model="numpy")
+_JITI = dict(_JIT, inline="always")
 
 #: Entries of :func:`settings_array`.
 CFG = ("v_d", "lambda_d", "lambda_opt", "K0", "K1", "a1", "a2", "d1", "d2", "d3", "d4", "d5",
@@ -96,7 +97,7 @@ def initial_state(s: ControllerSettings, dt: float, u_init: float) -> tuple[np.n
     return st, np.full(N + 2, float(u_init))
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def profile(t, v, vdot, omega, cfg):
     """(v_s*, d v_s*/dt) of eqs (76)-(78) (:class:`CreepSpeedProfile`)."""
     root = math.sqrt(v * v + 1.0)
@@ -110,7 +111,7 @@ def profile(t, v, vdot, omega, cfg):
     return vs, dvs
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def _model_step(v, lam, u, dt, kind, cfg, p):
     """One step of the prediction model ``kind`` (TRACTION, BRAKING, or 0:
     the linear cruise error model, eq 62)."""
@@ -140,8 +141,10 @@ def rollout(v, lam, ph, ubuf, n, cfg, p):
     if f > 0:
         v, lam = _model_step(v, lam, ubuf[(n - N - 1) % L], f * dt, kind, cfg, p)
     if G == 1:
-        for k in range(n - N, n):
-            v, lam = _model_step(v, lam, ubuf[k % L], dt, kind, cfg, p)
+        j = (n - N) % L      # ring index of sample k = n - N, ..., n - 1 (no division per step)
+        for _ in range(N):
+            v, lam = _model_step(v, lam, ubuf[j], dt, kind, cfg, p)
+            j = j + 1 if j + 1 < L else 0
         return v, lam
     k = n - N
     while k < n:       # pieces of G held samples, each with their average input
@@ -154,7 +157,7 @@ def rollout(v, lam, ph, ubuf, n, cfg, p):
     return v, lam
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def delayed(ubuf, n, cfg):
     """Average of u(t - h_model) over the step of the last pushed sample."""
     N, f, L = int(cfg[NC]), cfg[FC], ubuf.shape[0]
@@ -162,7 +165,7 @@ def delayed(ubuf, n, cfg):
     return a if f == 0.0 else (1.0 - f) * a + f * ubuf[(n - 2 - N) % L]
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def sampled(u, f20, f2u, j0, ju, delta, cfg):
     """:meth:`Antiskid003._sampled`: the input held over one sample."""
     if cfg[STIFF] == 0.0:
@@ -197,13 +200,13 @@ def observe(v, lam, ph, st, ubuf, cfg, p):
     st[HAS_PREV], st[PV], st[PL], st[PPH] = 1.0, v, lam, ph
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def _accel(Pv, Pl, target, delta, cfg, p):
     y1, y2, y3, dy2, dy3 = traction(fmax(Pv, cfg[V_FLOOR]), Pl, p)
     return sampled((-y2 - cfg[K_AC] * (Pl - target)) / y3, y2, y3, dy2, dy3, delta, cfg)
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def _cruise(v, lam, Pv, Pl, delta, cfg):
     ve, le = Pv - cfg[V_D], Pl - cfg[LAMBDA_D]
     den = cfg[D4] * ve + cfg[D5] * le + cfg[D6]
@@ -211,7 +214,7 @@ def _cruise(v, lam, Pv, Pl, delta, cfg):
     return sampled(u, cfg[D1] * ve + cfg[D2] * le + cfg[D3], den, cfg[D2], cfg[D5], delta, cfg)
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def _brake(t, Pv, Pl, delta, cfg, p):
     vg = fmax(Pv, cfg[V_FLOOR])
     z1, z2, z3, dz2, dz3 = braking(vg, Pl, p)
@@ -221,14 +224,21 @@ def _brake(t, Pv, Pl, delta, cfg, p):
     return sampled(u, z2, z3, dz2, dz3, delta, cfg)
 
 
-@numba.njit(**_JIT)
-def law(t, v, lam, ph, st, ubuf, cfg, p):
-    """The torque the active phase's law commands (:meth:`Antiskid003._laws`)."""
-    n = int(st[PUSHED])
-    if cfg[COMPENSATE] == 0.0:
-        Pv, Pl = v, lam
-    else:
-        Pv, Pl = rollout(v, lam, ph, ubuf, n, cfg, p)
+@numba.njit(**_JITI)
+def kind_of(ph, cfg):
+    """The rollout's model for phase ``ph`` (:func:`_model_step`'s ``kind``),
+    or -1: no rollout (no predictor, or the phase has no law)."""
+    if cfg[COMPENSATE] == 0.0 or ph > BRAKE:
+        return -1
+    if ph == CRUISE:
+        return 0
+    return TRACTION if ph < BRAKE else BRAKING
+
+
+@numba.njit(**_JITI)
+def law_at(t, v, lam, Pv, Pl, ph, st, cfg, p):
+    """The torque of the active phase's law at the prediction (Pv, Pl)
+    (:meth:`Antiskid003._laws`)."""
     delta = st[DELTA]
     if ph == ACCEL:
         return _accel(Pv, Pl, cfg[LAMBDA_OPT], delta, cfg, p)
@@ -244,11 +254,20 @@ def law(t, v, lam, ph, st, ubuf, cfg, p):
 
 
 @numba.njit(**_JIT)
-def control(t, lam_true, v, lam, st, ubuf, ev, cfg, p):
-    """One sample of controller (75) (:meth:`Antiskid003.__call__`) seeing
-    (v, lam) (measured), the divergence test on the true ``lam_true``:
-    updates ``st``, ``ubuf`` and the events ``ev``; returns (u, phase,
-    to_cruise, to_brake, to_stop) for the caller's metrics."""
+def law(t, v, lam, ph, st, ubuf, cfg, p):
+    """The torque the active phase's law commands (:meth:`Antiskid003._laws`)."""
+    n = int(st[PUSHED])
+    if cfg[COMPENSATE] == 0.0:
+        Pv, Pl = v, lam
+    else:
+        Pv, Pl = rollout(v, lam, ph, ubuf, n, cfg, p)
+    return law_at(t, v, lam, Pv, Pl, ph, st, cfg, p)
+
+
+@numba.njit(**_JITI)
+def control_pre(t, lam_true, v, lam, st, ubuf, ev, cfg, p):
+    """The first part of :func:`control`: phase logic, divergence events and
+    the mismatch estimate; returns (phase, to_cruise, to_brake, to_stop)."""
     ph = int(st[PH])
     to_cruise = ph == ACCEL and v >= cfg[V_D]
     if to_cruise:
@@ -273,11 +292,62 @@ def control(t, lam_true, v, lam, st, ubuf, ev, cfg, p):
     if bad:
         ph = DIVERGED
     observe(v, lam, ph, st, ubuf, cfg, p)
-    u = law(t, v, lam, ph, st, ubuf, cfg, p)
+    return ph, to_cruise, to_brake, to_stop
+
+
+@numba.njit(**_JITI)
+def control_post(t, v, lam, Pv, Pl, ph, st, ubuf, ev, cfg, p):
+    """The last part of :func:`control`: the law at the prediction (Pv, Pl),
+    the range test, the push into the input history; returns (u, phase)."""
+    u = law_at(t, v, lam, Pv, Pl, ph, st, cfg, p)
     if not abs(u) <= cfg[U_RANGE] and ph < STOPPED:
         ev[E_T_DIV], ev[E_PH_DIV], ev[E_HOW] = t, ph, 2.0
         ph, u = DIVERGED, 0.0
     n = int(st[PUSHED])
     ubuf[n % ubuf.shape[0]] = u
     st[PUSHED], st[PH] = n + 1, ph
+    return u, ph
+
+
+@numba.njit(**_JIT)
+def control(t, lam_true, v, lam, st, ubuf, ev, cfg, p):
+    """One sample of controller (75) (:meth:`Antiskid003.__call__`) seeing
+    (v, lam) (measured), the divergence test on the true ``lam_true``:
+    updates ``st``, ``ubuf`` and the events ``ev``; returns (u, phase,
+    to_cruise, to_brake, to_stop) for the caller's metrics.
+
+    :func:`control_pre`, the predictor (:func:`rollout`) and
+    :func:`control_post`; a batch of runs may interleave the predictors of
+    several runs between the two parts (:func:`rollout_lanes`)."""
+    ph, to_cruise, to_brake, to_stop = control_pre(t, lam_true, v, lam, st, ubuf, ev, cfg, p)
+    if cfg[COMPENSATE] == 0.0:
+        Pv, Pl = v, lam
+    else:
+        Pv, Pl = rollout(v, lam, ph, ubuf, int(st[PUSHED]), cfg, p)
+    u, ph = control_post(t, v, lam, Pv, Pl, ph, st, ubuf, ev, cfg, p)
     return u, ph, to_cruise, to_brake, to_stop
+
+
+@numba.njit(**_JITI)
+def rollout_lanes(Pv, Pl, kind, ubuf, n, active, cfg, p):
+    """:func:`rollout` of several runs ("lanes") at once, in place on
+    (Pv[j], Pl[j]) for the lanes with ``active[j]`` and ``kind[j] >= 0``
+    (:func:`kind_of`): the same operations per run as :func:`rollout`
+    (predictor group 1), their steps interleaved, so that the processor
+    overlaps the runs' dependency chains (a rollout step of one run is a
+    chain of about 100 dependent operations). ``n[j]``: the lane's pushed
+    sample count, overwritten (scratch)."""
+    N, f, dt, L = int(cfg[NC]), cfg[FC], cfg[DT], ubuf.shape[1]
+    K = Pv.shape[0]
+    if f > 0:
+        for j in range(K):
+            if active[j] and kind[j] >= 0:
+                Pv[j], Pl[j] = _model_step(Pv[j], Pl[j], ubuf[j, (n[j] - N - 1) % L], f * dt,
+                                           kind[j], cfg, p)
+    for j in range(K):
+        n[j] = (n[j] - N) % L            # ring index of the first of the N samples
+    for _ in range(N):
+        for j in range(K):
+            if active[j] and kind[j] >= 0:
+                Pv[j], Pl[j] = _model_step(Pv[j], Pl[j], ubuf[j, n[j]], dt, kind[j], cfg, p)
+            n[j] = n[j] + 1 if n[j] + 1 < L else 0

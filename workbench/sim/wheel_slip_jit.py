@@ -35,17 +35,21 @@ from .wheel_slip import MAX_DLAMBDA, MAX_HALVINGS, PARAM_ORDER, grade_terms, mod
 BY_SIGN, TRACTION, BRAKING, GRADED = 0, 1, 2, 3
 
 _JIT = dict(nogil=True, error_model="numpy")   # numpy's inf/nan, never ZeroDivisionError
+#: The small hot functions are inlined into their callers (numba IR): a call
+#: costs as much as the arithmetic, and inlined steps of independent runs
+#: overlap in the processor (:mod:`workbench.studies.antiskid_kernel`).
+_JITI = dict(_JIT, inline="always")
 
 
 def _unpacked(fn, extra: int = 0):
     """``fn(v, lam, *params)`` as a compiled ``f(v, lam, p)`` with p an array in
     PARAM_ORDER (plus ``extra`` entries: the slope of the graded forms; the
     wrapper's source is generated from PARAM_ORDER)."""
-    inner = numba.njit(**_JIT)(fn)
+    inner = numba.njit(**_JITI)(fn)
     args = ", ".join(f"p[{i}]" for i in range(len(PARAM_ORDER) + extra))
     ns = {"inner": inner}
     exec(f"def f(v, lam, p):\n    return inner(v, lam, {args})\n", ns)
-    return numba.njit(**_JIT)(ns["f"])
+    return numba.njit(**_JITI)(ns["f"])
 
 
 _fns = model_functions("math")
@@ -58,7 +62,7 @@ _traction_slope = _unpacked(_terms["traction"], 1)
 _braking_slope = _unpacked(_terms["braking"], 1)
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def traction_graded(v, lam, p):
     """eq (13) on a slope, p = (*params, grade): the level form plus the
     slope's terms (:func:`~workbench.sim.wheel_slip.model_functions`, ``graded``)."""
@@ -66,14 +70,14 @@ def traction_graded(v, lam, p):
     return a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3], a[4] + b[4]
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def braking_graded(v, lam, p):
     """eq (16) on a slope (as :func:`traction_graded`)."""
     a, b = braking(v, lam, p), _braking_slope(v, lam, p)
     return a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3], a[4] + b[4]
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def fmax(a, b):
     """``numpy.maximum`` of two floats (NaN wins)."""
     if a != a:
@@ -83,7 +87,7 @@ def fmax(a, b):
     return a if a >= b else b
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def fmin(a, b):
     """``numpy.minimum`` of two floats (NaN wins)."""
     if a != a:
@@ -93,7 +97,7 @@ def fmin(a, b):
     return a if a <= b else b
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def forms(v, lam, p, form):
     """(v', lambda'_0, lambda'_u, J_0, J_u) of the model ``form`` (module
     docstring; BY_SIGN: a NaN creep ratio takes eq 15, as the numpy path)."""
@@ -104,7 +108,7 @@ def forms(v, lam, p, form):
     return braking(v, lam, p)
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def phi1(z):
     """(e^z - 1) / z (1 + z/2 near 0)."""
     if abs(z) > 1e-8:
@@ -127,7 +131,7 @@ def _halved(v, lam, u, dt, p, v_floor, form, depth):
     return nv, nl, big
 
 
-@numba.njit(**_JIT)
+@numba.njit(**_JITI)
 def stiff_step(v, lam, u, dt, p, v_floor, form):
     """(v, lambda, unresolved) after one step of :func:`forms` (speed
     floored at ``v_floor`` in the model), halved recursively as

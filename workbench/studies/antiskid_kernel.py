@@ -1,6 +1,6 @@
 """Compiled batch of antiskid runs: the closed loop of
 :func:`workbench.studies.antiskid_scenario.simulate_antiskid` (fixed step,
-no recording) with numba, one run after the other.
+no recording) with numba, :data:`LANES` runs in flight at a time.
 
 Per run and per sample, as the batched numpy path: the controller
 (:func:`workbench.controllers.antiskid003_jit.control`: phase logic,
@@ -9,6 +9,14 @@ predictor rollout, laws), the metrics of
 (:func:`record`), the plant's input delay line and the plant step with
 per-run adaptive halving (:func:`workbench.sim.wheel_slip_jit.stiff_step`).
 A run ends when it stops or diverges, as its lane of the batch freezes.
+
+Speed without changing a bit: the small model and controller functions are
+inlined into the loop (``inline="always"``), and the predictor rollouts of
+the runs in flight are interleaved step by step. A rollout step is a chain
+of dependent operations (an ``exp``, an ``expm1``, four divisions); a second
+independent chain fills the processor's idle units. Each run performs
+exactly the operations it performs alone (a test compares runs in flight
+together with runs alone, bit for bit).
 
 :data:`KERNELS` names the two paths a sweep may take; :func:`compiled_available`
 says whether numba is installed (``pip install workbench[fast]``). The numpy
@@ -32,6 +40,11 @@ from .antiskid_scenario import RunMetrics, RunSettings
 #: (:func:`~workbench.studies.antiskid_scenario.simulate_antiskid` with ``batch``).
 KERNELS = ("compiled", "numpy")
 Kernel = Literal["compiled", "numpy"]
+
+#: Runs a compiled batch keeps in flight at a time (their predictor rollouts
+#: interleaved: two dependency chains keep the processor busy, more add nothing
+#: measurable; ``benchmarks/simulate.py``).
+LANES = 4
 
 #: Field order of the metrics array (RunMetrics; PhaseEvents first).
 METRIC_FIELDS = tuple(f.name for f in fields(RunMetrics))
@@ -74,7 +87,19 @@ def _build():
     E_LAST, E_MAX = M["evs_last"], M["evs_max_tracking"]
     V_D, L_D, L_OPT, DT = C.V_D, C.LAMBDA_D, C.LAMBDA_OPT, C.DT
     WS, TB = C.OMEGA_SWITCH, C.T_BRAKE
-    profile, control = C.profile, C.control
+    profile, control_pre, control_post = C.profile, C.control_pre, C.control_post
+
+    @jit
+    def load(j, i, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf, st, ubuf, m, rs,
+             v, lam, pos, f, Lp, N, T, n, run, active):
+        """Put run i, at t = 0, into lane j of :func:`run_batch`."""
+        pg[j, :plant.shape[1]] = plant[i]
+        N[j], f[j], Lp[j] = Np[i], fp[i], Np[i] + 2
+        pbuf[j, :Lp[j]] = u_init
+        st[j], ubuf[j], m[j] = st0, ub0, m0
+        rs[j] = 0.0
+        rs[j, 0] = v0[i]
+        v[j], lam[j], pos[j], T[j], n[j], run[j], active[j] = v0[i], lam0, 0.0, 0, 0, i, True
 
     @jit
     def clip(x):
@@ -141,51 +166,92 @@ def _build():
         """Simulate each run i (plant parameters ``plant[i]``, input delay
         (Np[i] + fp[i]) dt, initial speed v0[i]) into ``out[i]``; ``keys[i]``
         (v, omega, grade streams), ``pert`` (:data:`PERT`), ``period[i]``,
-        ``phase[i]``: the perturbations of :mod:`workbench.sim.perturb`."""
+        ``phase[i]``: the perturbations of :mod:`workbench.sim.perturb`.
+
+        :data:`LANES` runs are in flight at a time, each with its own state and
+        clock; a lane that ends takes the next run. Per sample, the lanes'
+        predictor rollouts are interleaved (:func:`~workbench.controllers.antiskid003_jit.rollout_lanes`);
+        every run performs the operations of a run simulated alone."""
         dt = cfg[DT]
         r_i = 4      # PARAM_ORDER index of r (checked by the caller)
         sv, sw, every = pert[0], pert[1], int(pert[2])
         noisy, graded, varying = sv > 0 or sw > 0, pert[3] != 0.0, pert[7] != 0.0
-        for i in range(plant.shape[0]):
-            p = plant[i]
-            pg = np.empty(p.shape[0] + 1)
-            pg[:p.shape[0]] = p
-            N, f = Np[i], fp[i]
-            L = N + 2
-            pbuf = np.full(L, u_init)
-            st, ubuf, m = st0.copy(), ub0.copy(), m0.copy()
-            rs = np.zeros(5)
-            rs[0] = v0[i]
-            v, lam, pos = v0[i], lam0, 0.0
-            T, n = 0, 0
-            while True:
-                t = T * dt
-                vm, lm = v, lam
+        B, P, K = plant.shape[0], plant.shape[1], LANES
+        Lmax = 2
+        for i in range(B):
+            Lmax = max(Lmax, Np[i] + 2)
+        pg = np.zeros((K, P + 1))                 # plant parameters (+ the slope)
+        pbuf = np.empty((K, Lmax))                # plant input delay line
+        st, ubuf = np.empty((K, st0.shape[0])), np.empty((K, ub0.shape[0]))
+        m, rs = np.empty((K, m0.shape[0])), np.zeros((K, 5))
+        v, lam, pos = np.zeros(K), np.zeros(K), np.zeros(K)
+        vm, lm, Pv, Pl = np.zeros(K), np.zeros(K), np.zeros(K), np.zeros(K)
+        f, Lp, N, T, n = (np.zeros(K), np.zeros(K, np.int64), np.zeros(K, np.int64),
+                          np.zeros(K, np.int64), np.zeros(K, np.int64))
+        run, kind, ncs = np.full(K, -1), np.zeros(K, np.int64), np.zeros(K, np.int64)
+        phs, tcs, tbs, tss = (np.zeros(K, np.int64), np.zeros(K, np.bool_),
+                              np.zeros(K, np.bool_), np.zeros(K, np.bool_))
+        active = np.zeros(K, np.bool_)
+        nxt = 0
+        for j in range(K):
+            if nxt < B:
+                load(j, nxt, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf, st, ubuf,
+                     m, rs, v, lam, pos, f, Lp, N, T, n, run, active)
+                nxt += 1
+        while True:
+            busy = False
+            for j in range(K):
+                if not active[j]:
+                    continue
+                busy = True
+                i, t = run[j], T[j] * dt
+                vm[j], lm[j] = v[j], lam[j]
                 if noisy:
-                    k = np.uint64(T // every)
-                    vm, lm = measured_state(v, lam, normal4(keys[i, 0], k),
-                                            normal4(keys[i, 1], k), sv, sw, p[r_i],
-                                            cfg[C.R_C], cfg[C.V_FLOOR])
-                u, ph, tc, tb, ts = control(t, lam, vm, lm, st, ubuf, m, cfg, pc)
-                record(t, v, lam, ph, tc, tb, ts, m, rs, cfg, p[r_i], settle)
-                pbuf[n % L] = u
-                n += 1
+                    k = np.uint64(T[j] // every)
+                    vm[j], lm[j] = measured_state(v[j], lam[j], normal4(keys[i, 0], k),
+                                                  normal4(keys[i, 1], k), sv, sw, pg[j, r_i],
+                                                  cfg[C.R_C], cfg[C.V_FLOOR])
+                phs[j], tcs[j], tbs[j], tss[j] = control_pre(t, lam[j], vm[j], lm[j], st[j],
+                                                             ubuf[j], m[j], cfg, pc)
+                kind[j], ncs[j] = C.kind_of(phs[j], cfg), int(st[j, C.PUSHED])
+                Pv[j], Pl[j] = vm[j], lm[j]
+            if not busy:
+                break
+            C.rollout_lanes(Pv, Pl, kind, ubuf, ncs, active, cfg, pc)
+            for j in range(K):
+                if not active[j]:
+                    continue
+                t = T[j] * dt
+                u, ph = control_post(t, vm[j], lm[j], Pv[j], Pl[j], phs[j], st[j], ubuf[j],
+                                     m[j], cfg, pc)
+                record(t, v[j], lam[j], ph, tcs[j], tbs[j], tss[j], m[j], rs[j], cfg,
+                       pg[j, r_i], settle)
+                L = Lp[j]
+                pbuf[j, n[j] % L] = u
+                n[j] += 1
                 if varying:
-                    N, f = split_delay(delay_at(t, pert[8], pert[9], period[i], phase[i]), dt)
-                a = pbuf[(n - 1 - N) % L]
-                ua = (1.0 - f) * a + f * pbuf[(n - 2 - N) % L]
-                if T >= T_end or ph >= STOPPED:
-                    break
+                    N[j], f[j] = split_delay(delay_at(t, pert[8], pert[9], period[run[j]],
+                                                      phase[run[j]]), dt)
+                a = pbuf[j, (n[j] - 1 - N[j]) % L]
+                ua = (1.0 - f[j]) * a + f[j] * pbuf[j, (n[j] - 2 - N[j]) % L]
+                if T[j] >= T_end or ph >= STOPPED:
+                    out[run[j]] = m[j]
+                    active[j] = False
+                    if nxt < B:
+                        load(j, nxt, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf,
+                             st, ubuf, m, rs, v, lam, pos, f, Lp, N, T, n, run, active)
+                        nxt += 1
+                    continue
                 if graded:
-                    j = np.uint64(math.floor(fmax(pos, 0.0) / pert[6]))
-                    pg[p.shape[0]] = pert[4] + (pert[5] - pert[4]) * uniform(keys[i, 2], j)
-                    pos = pos + dt * v
-                    v, lam, unres = stiff_step(v, lam, ua, dt, pg, 1e-3, GRADED)
+                    jj = np.uint64(math.floor(fmax(pos[j], 0.0) / pert[6]))
+                    pg[j, P] = pert[4] + (pert[5] - pert[4]) * uniform(keys[run[j], 2], jj)
+                    pos[j] = pos[j] + dt * v[j]
+                    v[j], lam[j], unres = stiff_step(v[j], lam[j], ua, dt, pg[j], 1e-3, GRADED)
                 else:
-                    v, lam, unres = stiff_step(v, lam, ua, dt, p, 1e-3, BY_SIGN)
-                st[C.UNRES] = 1.0 if unres else 0.0
-                T += 1
-            out[i] = m
+                    v[j], lam[j], unres = stiff_step(v[j], lam[j], ua, dt, pg[j, :P], 1e-3,
+                                                     BY_SIGN)
+                st[j, C.UNRES] = 1.0 if unres else 0.0
+                T[j] += 1
 
     return run_batch
 
