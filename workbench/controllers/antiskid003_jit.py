@@ -200,13 +200,13 @@ def observe(v, lam, ph, st, ubuf, cfg, p):
     st[HAS_PREV], st[PV], st[PL], st[PPH] = 1.0, v, lam, ph
 
 
-@numba.njit(**_JITI)
+@numba.njit(**_JIT)
 def _accel(Pv, Pl, target, delta, cfg, p):
     y1, y2, y3, dy2, dy3 = traction(fmax(Pv, cfg[V_FLOOR]), Pl, p)
     return sampled((-y2 - cfg[K_AC] * (Pl - target)) / y3, y2, y3, dy2, dy3, delta, cfg)
 
 
-@numba.njit(**_JITI)
+@numba.njit(**_JIT)
 def _cruise(v, lam, Pv, Pl, delta, cfg):
     ve, le = Pv - cfg[V_D], Pl - cfg[LAMBDA_D]
     den = cfg[D4] * ve + cfg[D5] * le + cfg[D6]
@@ -214,7 +214,7 @@ def _cruise(v, lam, Pv, Pl, delta, cfg):
     return sampled(u, cfg[D1] * ve + cfg[D2] * le + cfg[D3], den, cfg[D2], cfg[D5], delta, cfg)
 
 
-@numba.njit(**_JITI)
+@numba.njit(**_JIT)
 def _brake(t, Pv, Pl, delta, cfg, p):
     vg = fmax(Pv, cfg[V_FLOOR])
     z1, z2, z3, dz2, dz3 = braking(vg, Pl, p)
@@ -339,15 +339,12 @@ def rollout_lanes(Pv, Pl, kind, ubuf, n, active, cfg, p):
     sample count, overwritten (scratch)."""
     N, f, dt, L = int(cfg[NC]), cfg[FC], cfg[DT], ubuf.shape[1]
     K = Pv.shape[0]
-    if f > 0:
-        for j in range(K):
-            if active[j] and kind[j] >= 0:
-                Pv[j], Pl[j] = _model_step(Pv[j], Pl[j], ubuf[j, (n[j] - N - 1) % L], f * dt,
-                                           kind[j], cfg, p)
+    first = -1 if f > 0 else 0           # -1: the fraction f of the oldest sample's step
     for j in range(K):
-        n[j] = (n[j] - N) % L            # ring index of the first of the N samples
-    for _ in range(N):
+        n[j] = (n[j] - N + first) % L    # ring index of the first sample stepped
+    for i in range(first, N):
+        step = f * dt if i < 0 else dt
         for j in range(K):
             if active[j] and kind[j] >= 0:
-                Pv[j], Pl[j] = _model_step(Pv[j], Pl[j], ubuf[j, n[j]], dt, kind[j], cfg, p)
+                Pv[j], Pl[j] = _model_step(Pv[j], Pl[j], ubuf[j, n[j]], step, kind[j], cfg, p)
             n[j] = n[j] + 1 if n[j] + 1 < L else 0

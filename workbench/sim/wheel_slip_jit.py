@@ -37,19 +37,22 @@ BY_SIGN, TRACTION, BRAKING, GRADED = 0, 1, 2, 3
 _JIT = dict(nogil=True, error_model="numpy")   # numpy's inf/nan, never ZeroDivisionError
 #: The small hot functions are inlined into their callers (numba IR): a call
 #: costs as much as the arithmetic, and inlined steps of independent runs
-#: overlap in the processor (:mod:`workbench.studies.antiskid_kernel`).
+#: overlap in the processor (:mod:`workbench.studies.antiskid_kernel`). numba
+#: types an inlined body again at every call site, so the rarely taken ones
+#: (the graded forms) stay calls: compiling the sweep kernel takes ~16 s
+#: instead of ~40 s with everything inlined, at the same speed.
 _JITI = dict(_JIT, inline="always")
 
 
-def _unpacked(fn, extra: int = 0):
+def _unpacked(fn, extra: int = 0, inline: bool = True):
     """``fn(v, lam, *params)`` as a compiled ``f(v, lam, p)`` with p an array in
     PARAM_ORDER (plus ``extra`` entries: the slope of the graded forms; the
     wrapper's source is generated from PARAM_ORDER)."""
-    inner = numba.njit(**_JITI)(fn)
+    inner = numba.njit(**(_JITI if inline else _JIT))(fn)
     args = ", ".join(f"p[{i}]" for i in range(len(PARAM_ORDER) + extra))
     ns = {"inner": inner}
     exec(f"def f(v, lam, p):\n    return inner(v, lam, {args})\n", ns)
-    return numba.njit(**_JITI)(ns["f"])
+    return numba.njit(**(_JITI if inline else _JIT))(ns["f"])
 
 
 _fns = model_functions("math")
@@ -58,11 +61,11 @@ traction = _unpacked(_fns["traction"])
 #: eq (16) (z1, z2, z3, dz2/dlambda, dz3/dlambda), compiled
 braking = _unpacked(_fns["braking"])
 _terms = grade_terms("math")
-_traction_slope = _unpacked(_terms["traction"], 1)
-_braking_slope = _unpacked(_terms["braking"], 1)
+_traction_slope = _unpacked(_terms["traction"], 1, inline=False)
+_braking_slope = _unpacked(_terms["braking"], 1, inline=False)
 
 
-@numba.njit(**_JITI)
+@numba.njit(**_JIT)
 def traction_graded(v, lam, p):
     """eq (13) on a slope, p = (*params, grade): the level form plus the
     slope's terms (:func:`~workbench.sim.wheel_slip.model_functions`, ``graded``)."""
@@ -70,7 +73,7 @@ def traction_graded(v, lam, p):
     return a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3], a[4] + b[4]
 
 
-@numba.njit(**_JITI)
+@numba.njit(**_JIT)
 def braking_graded(v, lam, p):
     """eq (16) on a slope (as :func:`traction_graded`)."""
     a, b = braking(v, lam, p), _braking_slope(v, lam, p)

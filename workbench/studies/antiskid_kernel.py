@@ -246,10 +246,9 @@ def _build():
                     jj = np.uint64(math.floor(fmax(pos[j], 0.0) / pert[6]))
                     pg[j, P] = pert[4] + (pert[5] - pert[4]) * uniform(keys[run[j], 2], jj)
                     pos[j] = pos[j] + dt * v[j]
-                    v[j], lam[j], unres = stiff_step(v[j], lam[j], ua, dt, pg[j], 1e-3, GRADED)
-                else:
-                    v[j], lam[j], unres = stiff_step(v[j], lam[j], ua, dt, pg[j, :P], 1e-3,
-                                                     BY_SIGN)
+                # BY_SIGN reads the first P entries only
+                v[j], lam[j], unres = stiff_step(v[j], lam[j], ua, dt, pg[j], 1e-3,
+                                                 GRADED if graded else BY_SIGN)
                 st[j, C.UNRES] = 1.0 if unres else 0.0
                 T[j] += 1
 
