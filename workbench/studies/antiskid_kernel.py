@@ -14,9 +14,13 @@ Speed without changing a bit: the small model and controller functions are
 inlined into the loop (``inline="always"``), and the predictor rollouts of
 the runs in flight are interleaved step by step. A rollout step is a chain
 of dependent operations (an ``exp``, an ``expm1``, four divisions); a second
-independent chain fills the processor's idle units. Each run performs
-exactly the operations it performs alone (a test compares runs in flight
-together with runs alone, bit for bit).
+independent chain fills the processor's idle units. Nothing in the loop
+makes an array view (a view costs two atomic reference-count updates): the
+lanes' state is read by row index, and the settings and the model
+parameters are tuples of floats (values the compiler keeps in registers and
+hoists: 1/c, 1/J of the controller's model are computed once). Each run
+performs exactly the operations it performs alone (a test compares runs in
+flight together with runs alone, bit for bit).
 
 :data:`KERNELS` names the two paths a sweep may take; :func:`compiled_available`
 says whether numba is installed (``pip install workbench[fast]``). The numpy
@@ -90,7 +94,7 @@ def _build():
     V_D, L_D, L_OPT, DT = C.V_D, C.LAMBDA_D, C.LAMBDA_OPT, C.DT
     WS, TB = C.OMEGA_SWITCH, C.T_BRAKE
     profile, control_pre, control_post = C.profile, C.control_pre, C.control_post
-    params_tuple, row_tuple = _tuples(jit)
+    params_tuple, row_tuple, cfg_tuple = _tuples(jit)
 
     @jit
     def load(j, i, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf, st, ubuf, m, rs,
@@ -196,6 +200,7 @@ def _build():
                               np.zeros(K, np.bool_), np.zeros(K, np.bool_))
         active = np.zeros(K, np.bool_)
         pc = params_tuple(pc)     # the controller's model: constants the compiler hoists
+        cfg = cfg_tuple(cfg)      # the settings (:data:`~workbench.controllers.antiskid003_jit.CFG`)
         nxt = 0
         for j in range(K):
             if nxt < B:
@@ -264,13 +269,15 @@ def _tuples(jit):
     then the slope) as a tuple of floats, from an array ``p`` (slope 0) or
     from row ``j`` of a 2-D array. Tuple entries are values: a loop over
     them reloads nothing and creates no array view (no reference counting)."""
+    from ..controllers import antiskid003_jit as C
     from ..sim.wheel_slip import PARAM_ORDER
     n = len(PARAM_ORDER)
     ns = {}
     exec(f"def params_tuple(p):\n    return ({', '.join(f'p[{i}]' for i in range(n))}, 0.0)\n"
-         f"def row_tuple(a, j):\n    return ({', '.join(f'a[j, {i}]' for i in range(n + 1))})\n",
+         f"def row_tuple(a, j):\n    return ({', '.join(f'a[j, {i}]' for i in range(n + 1))})\n"
+         f"def cfg_tuple(c):\n    return ({', '.join(f'c[{i}]' for i in range(len(C.CFG)))})\n",
          ns)
-    return jit(ns["params_tuple"]), jit(ns["row_tuple"])
+    return jit(ns["params_tuple"]), jit(ns["row_tuple"]), jit(ns["cfg_tuple"])
 
 
 _KERNEL = None
