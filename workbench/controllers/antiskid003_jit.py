@@ -158,11 +158,12 @@ def rollout(v, lam, ph, ubuf, n, cfg, p):
 
 
 @numba.njit(**_JITI)
-def delayed(ubuf, n, cfg):
-    """Average of u(t - h_model) over the step of the last pushed sample."""
-    N, f, L = int(cfg[NC]), cfg[FC], ubuf.shape[0]
-    a = ubuf[(n - 1 - N) % L]
-    return a if f == 0.0 else (1.0 - f) * a + f * ubuf[(n - 2 - N) % L]
+def delayed(ubuf, j, n, cfg):
+    """Average of u(t - h_model) over the step of the last pushed sample (run
+    ``j``'s input history ``ubuf[j]``)."""
+    N, f, L = int(cfg[NC]), cfg[FC], ubuf.shape[1]
+    a = ubuf[j, (n - 1 - N) % L]
+    return a if f == 0.0 else (1.0 - f) * a + f * ubuf[j, (n - 2 - N) % L]
 
 
 @numba.njit(**_JITI)
@@ -179,25 +180,26 @@ def sampled(u, f20, f2u, j0, ju, delta, cfg):
     return ((f20 + f2u * u) / phi + d * (1.0 / phi - 1.0) - f20) / f2u
 
 
-@numba.njit(**_JIT)
-def observe(v, lam, ph, st, ubuf, cfg, p):
-    """:meth:`Antiskid003._observe`: update the mismatch estimate ``st[DELTA]``."""
+@numba.njit(**_JITI)
+def observe(v, lam, ph, st, ubuf, j, cfg, p):
+    """:meth:`Antiskid003._observe`: update run ``j``'s mismatch estimate ``st[j, DELTA]``."""
     dt = cfg[DT]
     if ph >= BRAKE_IN:
-        st[DELTA] = 0.0 * v
-    elif st[HAS_PREV] != 0.0 and cfg[OBSERVER_ON] != 0.0:
-        pv, pl, pph = st[PV], st[PL], st[PPH]
-        ua = delayed(ubuf, int(st[PUSHED]), cfg)
-        _, f20, f2u, j0, ju = forms(fmax(pv, cfg[V_FLOOR]), pl, p, 0)
-        if pph == CRUISE:
+        st[j, DELTA] = 0.0 * v
+    elif st[j, HAS_PREV] != 0.0 and cfg[OBSERVER_ON] != 0.0:
+        pv, pl, pph = st[j, PV], st[j, PL], st[j, PPH]
+        ua = delayed(ubuf, j, int(st[j, PUSHED]), cfg)
+        if pph == CRUISE:       # the linear cruise model (eq 62); the plant's forms otherwise
             ve, le = pv - cfg[V_D], pl - cfg[LAMBDA_D]
             den = cfg[D4] * ve + cfg[D5] * le + cfg[D6]
             f20 = cfg[D1] * ve + cfg[D2] * le + cfg[D3]
             f2u, j0, ju = den, cfg[D2], cfg[D5]
+        else:
+            _, f20, f2u, j0, ju = forms(fmax(pv, cfg[V_FLOOR]), pl, p, 0)
         d = (lam - pl) / (dt * phi1((j0 + ju * ua) * dt)) - (f20 + f2u * ua)
-        new = st[DELTA] + cfg[ALPHA] * (d - st[DELTA])
-        st[DELTA] = 0.0 * v if not abs(new) < 1e6 else new
-    st[HAS_PREV], st[PV], st[PL], st[PPH] = 1.0, v, lam, ph
+        new = st[j, DELTA] + cfg[ALPHA] * (d - st[j, DELTA])
+        st[j, DELTA] = 0.0 * v if not abs(new) < 1e6 else new
+    st[j, HAS_PREV], st[j, PV], st[j, PL], st[j, PPH] = 1.0, v, lam, ph
 
 
 @numba.njit(**_JIT)
@@ -236,10 +238,9 @@ def kind_of(ph, cfg):
 
 
 @numba.njit(**_JITI)
-def law_at(t, v, lam, Pv, Pl, ph, st, cfg, p):
-    """The torque of the active phase's law at the prediction (Pv, Pl)
-    (:meth:`Antiskid003._laws`)."""
-    delta = st[DELTA]
+def law_at(t, v, lam, Pv, Pl, ph, delta, cfg, p):
+    """The torque of the active phase's law at the prediction (Pv, Pl), with
+    the mismatch estimate ``delta`` (:meth:`Antiskid003._laws`)."""
     if ph == ACCEL:
         return _accel(Pv, Pl, cfg[LAMBDA_OPT], delta, cfg, p)
     if ph == HANDOVER:
@@ -261,14 +262,16 @@ def law(t, v, lam, ph, st, ubuf, cfg, p):
         Pv, Pl = v, lam
     else:
         Pv, Pl = rollout(v, lam, ph, ubuf, n, cfg, p)
-    return law_at(t, v, lam, Pv, Pl, ph, st, cfg, p)
+    return law_at(t, v, lam, Pv, Pl, ph, st[DELTA], cfg, p)
 
 
 @numba.njit(**_JITI)
-def control_pre(t, lam_true, v, lam, st, ubuf, ev, cfg, p):
-    """The first part of :func:`control`: phase logic, divergence events and
-    the mismatch estimate; returns (phase, to_cruise, to_brake, to_stop)."""
-    ph = int(st[PH])
+def control_pre(t, lam_true, v, lam, st, ubuf, ev, j, cfg, p):
+    """The first part of :func:`control` for run ``j`` (row ``j`` of ``st``,
+    ``ubuf`` and ``ev``: rows, not views, so no reference counting per
+    sample): phase logic, divergence events and the mismatch estimate;
+    returns (phase, to_cruise, to_brake, to_stop)."""
+    ph = int(st[j, PH])
     to_cruise = ph == ACCEL and v >= cfg[V_D]
     if to_cruise:
         ph = HANDOVER if cfg[CRUISE_CREEP] != 0.0 else CRUISE
@@ -283,29 +286,30 @@ def control_pre(t, lam_true, v, lam, st, ubuf, ev, cfg, p):
     to_stop = (ph == BRAKE_IN or ph == BRAKE) and v <= cfg[V_STOP]
     if to_stop:
         ph = STOPPED
-    unres = st[UNRES] != 0.0
+    unres = st[j, UNRES] != 0.0
     bad = (not abs(lam_true) < cfg[LAM_DIVERGED] or unres) and ph < STOPPED
     if bad:
-        ev[E_T_DIV], ev[E_PH_DIV], ev[E_HOW] = t, ph, 1.0 if unres else 0.0
+        ev[j, E_T_DIV], ev[j, E_PH_DIV], ev[j, E_HOW] = t, ph, 1.0 if unres else 0.0
     if handed:
-        ev[E_HANDOVER], ev[E_V_HANDOVER], ev[E_LAM_HANDOVER] = t, v, lam
+        ev[j, E_HANDOVER], ev[j, E_V_HANDOVER], ev[j, E_LAM_HANDOVER] = t, v, lam
     if bad:
         ph = DIVERGED
-    observe(v, lam, ph, st, ubuf, cfg, p)
+    observe(v, lam, ph, st, ubuf, j, cfg, p)
     return ph, to_cruise, to_brake, to_stop
 
 
 @numba.njit(**_JITI)
-def control_post(t, v, lam, Pv, Pl, ph, st, ubuf, ev, cfg, p):
-    """The last part of :func:`control`: the law at the prediction (Pv, Pl),
-    the range test, the push into the input history; returns (u, phase)."""
-    u = law_at(t, v, lam, Pv, Pl, ph, st, cfg, p)
+def control_post(t, v, lam, Pv, Pl, ph, st, ubuf, ev, j, cfg, p):
+    """The last part of :func:`control` for run ``j`` (as :func:`control_pre`):
+    the law at the prediction (Pv, Pl), the range test, the push into the
+    input history; returns (u, phase)."""
+    u = law_at(t, v, lam, Pv, Pl, ph, st[j, DELTA], cfg, p)
     if not abs(u) <= cfg[U_RANGE] and ph < STOPPED:
-        ev[E_T_DIV], ev[E_PH_DIV], ev[E_HOW] = t, ph, 2.0
+        ev[j, E_T_DIV], ev[j, E_PH_DIV], ev[j, E_HOW] = t, ph, 2.0
         ph, u = DIVERGED, 0.0
-    n = int(st[PUSHED])
-    ubuf[n % ubuf.shape[0]] = u
-    st[PUSHED], st[PH] = n + 1, ph
+    n = int(st[j, PUSHED])
+    ubuf[j, n % ubuf.shape[1]] = u
+    st[j, PUSHED], st[j, PH] = n + 1, ph
     return u, ph
 
 
@@ -319,12 +323,14 @@ def control(t, lam_true, v, lam, st, ubuf, ev, cfg, p):
     :func:`control_pre`, the predictor (:func:`rollout`) and
     :func:`control_post`; a batch of runs may interleave the predictors of
     several runs between the two parts (:func:`rollout_lanes`)."""
-    ph, to_cruise, to_brake, to_stop = control_pre(t, lam_true, v, lam, st, ubuf, ev, cfg, p)
+    S, U, E = (st.reshape((1, st.shape[0])), ubuf.reshape((1, ubuf.shape[0])),
+               ev.reshape((1, ev.shape[0])))
+    ph, to_cruise, to_brake, to_stop = control_pre(t, lam_true, v, lam, S, U, E, 0, cfg, p)
     if cfg[COMPENSATE] == 0.0:
         Pv, Pl = v, lam
     else:
         Pv, Pl = rollout(v, lam, ph, ubuf, int(st[PUSHED]), cfg, p)
-    u, ph = control_post(t, v, lam, Pv, Pl, ph, st, ubuf, ev, cfg, p)
+    u, ph = control_post(t, v, lam, Pv, Pl, ph, S, U, E, 0, cfg, p)
     return u, ph, to_cruise, to_brake, to_stop
 
 

@@ -14,9 +14,13 @@ Speed without changing a bit: the small model and controller functions are
 inlined into the loop (``inline="always"``), and the predictor rollouts of
 the runs in flight are interleaved step by step. A rollout step is a chain
 of dependent operations (an ``exp``, an ``expm1``, four divisions); a second
-independent chain fills the processor's idle units. Each run performs
-exactly the operations it performs alone (a test compares runs in flight
-together with runs alone, bit for bit).
+independent chain fills the processor's idle units. Nothing in the loop
+makes an array view (a view costs two atomic reference-count updates): the
+lanes' state is read by row index, and the settings and the model
+parameters are tuples of floats (values the compiler keeps in registers and
+hoists: 1/c, 1/J of the controller's model are computed once). Each run
+performs exactly the operations it performs alone (a test compares runs in
+flight together with runs alone, bit for bit).
 
 :data:`KERNELS` names the two paths a sweep may take; :func:`compiled_available`
 says whether numba is installed (``pip install workbench[fast]``). The numpy
@@ -79,6 +83,7 @@ def _build():
     _, uniform, normal4 = jit_functions()
 
     jit = numba.njit(nogil=True, error_model="numpy")
+    jiti = numba.njit(nogil=True, error_model="numpy", inline="always")
     M = {k: i for i, k in enumerate(METRIC_FIELDS)}
     T_CRUISE, V_CRUISE, L_CRUISE = M["t_cruise"], M["v_at_cruise"], M["lam_at_cruise"]
     L_MAX, V_MAX, L_BRAKE = M["lam_max_traction"], M["v_max"], M["lam_at_brake"]
@@ -89,6 +94,7 @@ def _build():
     V_D, L_D, L_OPT, DT = C.V_D, C.LAMBDA_D, C.LAMBDA_OPT, C.DT
     WS, TB = C.OMEGA_SWITCH, C.T_BRAKE
     profile, control_pre, control_post = C.profile, C.control_pre, C.control_post
+    params_tuple, row_tuple, cfg_tuple = _tuples(jit)
 
     @jit
     def load(j, i, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf, st, ubuf, m, rs,
@@ -110,56 +116,56 @@ def _build():
     def fmax_nan(a, b):      # NaN = no value yet
         return b if a != a else fmax(a, b)
 
-    @jit
-    def record(t, v, lam, ph, to_cruise, to_brake, to_stop, m, rs, cfg, r_p, settle):
-        """:meth:`MetricsRecorder.__call__` for one run; ``rs`` = (v_prev,
-        has_track, omega_prev, e_prev, lam_prev)."""
+    @jiti
+    def record(t, v, lam, ph, to_cruise, to_brake, to_stop, M, RS, j, cfg, r_p, settle):
+        """:meth:`MetricsRecorder.__call__` for run ``j`` (metrics ``M[j]``,
+        ``RS[j]`` = (v_prev, has_track, omega_prev, e_prev, lam_prev))."""
         dt = cfg[DT]
-        frac = (v - cfg[V_D]) / fmax(v - rs[0], 1e-12)
+        frac = (v - cfg[V_D]) / fmax(v - RS[j, 0], 1e-12)
         if to_cruise:
-            m[T_CRUISE] = t - dt * fmin(frac, 1.0)
-            m[V_CRUISE], m[L_CRUISE] = v, lam
-        rs[0] = v
+            M[j, T_CRUISE] = t - dt * fmin(frac, 1.0)
+            M[j, V_CRUISE], M[j, L_CRUISE] = v, lam
+        RS[j, 0] = v
         if ph < BRAKE_IN:
-            m[L_MAX], m[V_MAX] = fmax(m[L_MAX], lam), fmax(m[V_MAX], v)
+            M[j, L_MAX], M[j, V_MAX] = fmax(M[j, L_MAX], lam), fmax(M[j, V_MAX], v)
         if to_brake:
-            m[L_BRAKE], m[VE_BRAKE], m[LE_BRAKE] = lam, v - cfg[V_D], lam - cfg[L_D]
+            M[j, L_BRAKE], M[j, VE_BRAKE], M[j, LE_BRAKE] = lam, v - cfg[V_D], lam - cfg[L_D]
         if to_stop:
-            m[T_STOP] = t
+            M[j, T_STOP] = t
         if not (ph == BRAKE_IN or ph == BRAKE):
             return
-        if lam < 0 and m[T_NEG] != m[T_NEG]:
-            m[T_NEG] = t
-        m[L_MIN] = fmin(m[L_MIN], lam)
+        if lam < 0 and M[j, T_NEG] != M[j, T_NEG]:
+            M[j, T_NEG] = t
+        M[j, L_MIN] = fmin(M[j, L_MIN], lam)
         omega = wheel_speed(fmax(v, cfg[C.V_FLOOR]), lam, r_p)
         ws = cfg[WS]
         vs_on, _ = profile(t, v, 0.0 * v, math.inf + 0.0 * v, cfg)
         vs_star = vs_on if omega > ws else 0.0
         vs = creep_speed(v, lam)
         e, e_on = abs(vs - vs_star), abs(vs - vs_on)
-        m[E_LAST] = e
-        in_window = m[T_OM3] != m[T_OM3] and m[T_PEAK] != m[T_PEAK]
-        cross_w = omega <= ws and m[T_OM3] != m[T_OM3]
-        cross_l = lam < -cfg[L_OPT] and m[T_PEAK] != m[T_PEAK]
-        if rs[1] == 0.0:
+        M[j, E_LAST] = e
+        in_window = M[j, T_OM3] != M[j, T_OM3] and M[j, T_PEAK] != M[j, T_PEAK]
+        cross_w = omega <= ws and M[j, T_OM3] != M[j, T_OM3]
+        cross_l = lam < -cfg[L_OPT] and M[j, T_PEAK] != M[j, T_PEAK]
+        if RS[j, 1] == 0.0:
             f_w = f_l = 1.0 + 0.0 * v
             e_prev = e_on
         else:
-            w_prev, e_prev, l_prev = rs[2], rs[3], rs[4]
+            w_prev, e_prev, l_prev = RS[j, 2], RS[j, 3], RS[j, 4]
             f_w = clip((w_prev - ws) / fmax(w_prev - omega, 1e-300))
             f_l = clip((l_prev + cfg[L_OPT]) / fmax(l_prev - lam, 1e-300))
         if cross_w:
-            m[T_OM3] = t - dt * (1.0 - f_w)
+            M[j, T_OM3] = t - dt * (1.0 - f_w)
         if cross_l:
-            m[T_PEAK] = t - dt * (1.0 - f_l)
+            M[j, T_PEAK] = t - dt * (1.0 - f_l)
         settled = in_window and t >= cfg[TB] + settle
         if settled and not cross_w and not cross_l:
-            m[E_MAX] = fmax_nan(m[E_MAX], e)
+            M[j, E_MAX] = fmax_nan(M[j, E_MAX], e)
         f_end = fmin(f_w if cross_w else 1.0, f_l if cross_l else 1.0)
         e_end = e_prev + f_end * (e_on - e_prev)
         if settled and (cross_w or cross_l):
-            m[E_MAX] = fmax_nan(m[E_MAX], e_end)
-        rs[1], rs[2], rs[3], rs[4] = 1.0, omega, e_on, lam
+            M[j, E_MAX] = fmax_nan(M[j, E_MAX], e_end)
+        RS[j, 1], RS[j, 2], RS[j, 3], RS[j, 4] = 1.0, omega, e_on, lam
 
     @jit
     def run_batch(plant, Np, fp, v0, lam0, u_init, T_end, cfg, pc, settle, st0, ub0, m0,
@@ -193,6 +199,8 @@ def _build():
         phs, tcs, tbs, tss = (np.zeros(K, np.int64), np.zeros(K, np.bool_),
                               np.zeros(K, np.bool_), np.zeros(K, np.bool_))
         active = np.zeros(K, np.bool_)
+        pc = params_tuple(pc)     # the controller's model: constants the compiler hoists
+        cfg = cfg_tuple(cfg)      # the settings (:data:`~workbench.controllers.antiskid003_jit.CFG`)
         nxt = 0
         for j in range(K):
             if nxt < B:
@@ -212,8 +220,8 @@ def _build():
                     vm[j], lm[j] = measured_state(v[j], lam[j], normal4(keys[i, 0], k),
                                                   normal4(keys[i, 1], k), sv, sw, pg[j, r_i],
                                                   cfg[C.R_C], cfg[C.V_FLOOR])
-                phs[j], tcs[j], tbs[j], tss[j] = control_pre(t, lam[j], vm[j], lm[j], st[j],
-                                                             ubuf[j], m[j], cfg, pc)
+                phs[j], tcs[j], tbs[j], tss[j] = control_pre(t, lam[j], vm[j], lm[j], st, ubuf,
+                                                             m, j, cfg, pc)
                 kind[j], ncs[j] = C.kind_of(phs[j], cfg), int(st[j, C.PUSHED])
                 Pv[j], Pl[j] = vm[j], lm[j]
             if not busy:
@@ -223,9 +231,9 @@ def _build():
                 if not active[j]:
                     continue
                 t = T[j] * dt
-                u, ph = control_post(t, vm[j], lm[j], Pv[j], Pl[j], phs[j], st[j], ubuf[j],
-                                     m[j], cfg, pc)
-                record(t, v[j], lam[j], ph, tcs[j], tbs[j], tss[j], m[j], rs[j], cfg,
+                u, ph = control_post(t, vm[j], lm[j], Pv[j], Pl[j], phs[j], st, ubuf, m, j,
+                                     cfg, pc)
+                record(t, v[j], lam[j], ph, tcs[j], tbs[j], tss[j], m, rs, j, cfg,
                        pg[j, r_i], settle)
                 L = Lp[j]
                 pbuf[j, n[j] % L] = u
@@ -248,12 +256,28 @@ def _build():
                     pg[j, P] = pert[4] + (pert[5] - pert[4]) * uniform(keys[run[j], 2], jj)
                     pos[j] = pos[j] + dt * v[j]
                 # BY_SIGN reads the first P entries only
-                v[j], lam[j], unres = stiff_step(v[j], lam[j], ua, dt, pg[j], 1e-3,
+                v[j], lam[j], unres = stiff_step(v[j], lam[j], ua, dt, row_tuple(pg, j), 1e-3,
                                                  GRADED if graded else BY_SIGN)
                 st[j, C.UNRES] = 1.0 if unres else 0.0
                 T[j] += 1
 
     return run_batch
+
+
+def _tuples(jit):
+    """(params_tuple(p), row_tuple(a, j)): the model parameters (PARAM_ORDER,
+    then the slope) as a tuple of floats, from an array ``p`` (slope 0) or
+    from row ``j`` of a 2-D array. Tuple entries are values: a loop over
+    them reloads nothing and creates no array view (no reference counting)."""
+    from ..controllers import antiskid003_jit as C
+    from ..sim.wheel_slip import PARAM_ORDER
+    n = len(PARAM_ORDER)
+    ns = {}
+    exec(f"def params_tuple(p):\n    return ({', '.join(f'p[{i}]' for i in range(n))}, 0.0)\n"
+         f"def row_tuple(a, j):\n    return ({', '.join(f'a[j, {i}]' for i in range(n + 1))})\n"
+         f"def cfg_tuple(c):\n    return ({', '.join(f'c[{i}]' for i in range(len(C.CFG)))})\n",
+         ns)
+    return jit(ns["params_tuple"]), jit(ns["row_tuple"]), jit(ns["cfg_tuple"])
 
 
 _KERNEL = None
