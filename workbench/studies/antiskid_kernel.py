@@ -265,10 +265,13 @@ def _build():
 
 
 def _tuples(jit):
-    """(params_tuple(p), row_tuple(a, j)): the model parameters (PARAM_ORDER,
-    then the slope) as a tuple of floats, from an array ``p`` (slope 0) or
-    from row ``j`` of a 2-D array. Tuple entries are values: a loop over
-    them reloads nothing and creates no array view (no reference counting)."""
+    """(params_tuple(p), row_tuple(a, j), cfg_tuple(c)), compiled: the model
+    parameters (PARAM_ORDER, then the slope) as a tuple of floats, from an
+    array ``p`` (slope 0) or from row ``j`` of a 2-D array; the settings
+    array ``c`` (:data:`~workbench.controllers.antiskid003_jit.CFG`) as a
+    tuple. Tuple entries are values: a loop over them reloads nothing and
+    creates no array view (no reference counting). The source is generated
+    from the two name lists, as :func:`workbench.sim.wheel_slip_jit._unpacked`."""
     from ..controllers import antiskid003_jit as C
     from ..sim.wheel_slip import PARAM_ORDER
     n = len(PARAM_ORDER)
