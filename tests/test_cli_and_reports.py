@@ -117,7 +117,11 @@ def test_report_check_detects_stale_and_missing(tmp_path, capsys):
     md.write_text(md.read_text() + "edited\n")
     assert main(["report", src, "--out", str(tmp_path), "--check"]) == 1
     assert main(["report", src, "--out", str(tmp_path)]) == 0
-    (tmp_path / "small-cruise" / "delay-bound-vs-eps.png").unlink()
+    png = tmp_path / "small-cruise" / "delay-bound-vs-eps.png"
+    png.write_bytes(png.read_bytes() + b"\0")      # a figure is compared byte for byte
+    assert main(["report", src, "--out", str(tmp_path), "--check"]) == 1
+    assert "stale figure" in capsys.readouterr().out
+    png.unlink()
     assert main(["report", src, "--out", str(tmp_path), "--check"]) == 1
     assert "missing figure" in capsys.readouterr().out
 

@@ -158,7 +158,10 @@ def write_reports(files: list[ReportFiles], outdir: Path, *, index: bool) -> lis
 
 
 def check_reports(files: list[ReportFiles], outdir: Path, *, index: bool) -> list[str]:
-    """Problems with the committed reports: stale Markdown, missing figures."""
+    """Problems with the committed reports: stale Markdown, missing or stale
+    figures (each figure is drawn again and compared byte for byte:
+    :func:`workbench.report.figures.figure_png`)."""
+    from .figures import figure_png
     problems = []
     for f in files:
         p = outdir / f"{f.name}.md"
@@ -170,6 +173,8 @@ def check_reports(files: list[ReportFiles], outdir: Path, *, index: bool) -> lis
             fp = outdir / f.name / f"{fig.name}.png"
             if not fp.is_file():
                 problems.append(f"{fp}: missing figure linked from {p.name}")
+            elif fp.read_bytes() != figure_png(fig):
+                problems.append(f"{fp}: stale figure (regenerate with `workbench report`)")
     if index:
         p = outdir / "README.md"
         if not p.is_file() or p.read_text(encoding="utf-8") != index_markdown(files):

@@ -24,6 +24,10 @@ METHOD_DOC = {
 }
 
 
+#: Floor of the gap figure: the resolution of the printed ratio h_N / h*.
+GAP_FLOOR = 1e-5
+
+
 def _ratio(r) -> str:
     if r is None:
         return "—"
@@ -151,7 +155,8 @@ def render(design, res: BenchmarkResult) -> Rendered:
             + f"\n\nLargest ratio hi / h* of a certified interval [0, hi] over the suite: "
               f"**{_ratio(res.max_ratio())}** (a sound criterion stays below 1).")
     fig = Figure("bessel-legendre-gap", "Gap 1 - h_N/h* of the Bessel-Legendre hierarchy "
-                 "(point certificates) against the order N (finite h* only).",
+                 "(point certificates, from the ratio as printed, floored at "
+                 f"{fmt(GAP_FLOOR)}) against the order N (finite h* only).",
                  lambda f: _draw_gap(f, res))
     sets = [Figure(f"stability-set-{e.example.name}",
                    f"{e.example.name}: spectral abscissa against h (top; exact windows "
@@ -179,13 +184,14 @@ def _draw_set(fig, e) -> None:
     ax.axhline(0, color="k", lw=0.6)
     ax.set_ylabel("spectral abscissa (1/s)")
     ax.grid(True, alpha=0.3)
-    for i, r in enumerate(e.rows):
+    for i, r in enumerate(e.rows):      # the values the tables print (they reproduce)
         if r.interval is not None:
-            lo, hi = r.interval
+            lo, hi = directed(r.interval[0], up=True), directed(r.interval[1], up=False)
             bx.plot([lo, min(hi, H)], [i, i], "-", color="tab:blue", lw=4,
                     solid_capstyle="butt")
-        if 0 < r.h_certified <= H:
-            bx.plot([r.h_certified], [i], "x", color="tab:red", ms=6)
+        h = directed(r.h_certified, up=False, sig=5)
+        if 0 < h <= H:
+            bx.plot([h], [i], "x", color="tab:red", ms=6)
     bx.set_yticks(range(len(e.rows)))
     bx.set_yticklabels([_label(r) for r in e.rows], fontsize=7)
     bx.invert_yaxis()
@@ -200,8 +206,9 @@ def _draw_gap(fig, res: BenchmarkResult) -> None:
     for e in res.examples:
         if not 0 < e.exact.h < math.inf:
             continue
-        rows = [r for r in e.rows if r.method == "bessel-legendre"]
-        gaps = [max(1 - r.h_certified / e.exact.h, 1e-8) for r in rows]
+        rows = [r for r in e.rows if r.method == "bessel-legendre" and r.ratio is not None]
+        # from the printed ratio (truncated to 5 decimals: the digits that reproduce)
+        gaps = [max(1 - float(_ratio(r.ratio)), GAP_FLOOR) for r in rows]
         ax.semilogy([r.N for r in rows], gaps, "o-", label=e.example.name)
     ax.axhline(res.settings.gap_tol, color="k", ls="--", lw=0.8, label="gap tolerance")
     ax.set_xlabel("order N")

@@ -1,0 +1,88 @@
+"""Figures that do not depend on the last digits of their data (issue 12):
+:func:`workbench.report.figures.snap_figure` before the PNG is written."""
+import numpy as np
+
+from workbench.report import figures
+from workbench.report.figures import SNAP_CELLS, figure_png
+from workbench.report.markdown import Figure
+
+RNG = np.random.default_rng(12)
+X = np.linspace(0.0, 3.0, 400)
+Y = np.sin(3 * X) * 1e3 + RNG.normal(size=X.size)
+
+
+def _draw(fig, eps):
+    """Every kind of artist the reports draw, the data scaled by 1 + eps."""
+    s = 1.0 + eps
+    ax, bx = fig.subplots(1, 2)
+    ax.plot(X, Y * s, "o-", ms=2)
+    ax.step(X, 0.5 * Y * s, where="post")
+    ax.axhline(0.0)
+    ax.axvline(1.5 * s)
+    ax.axvspan(1.0, 2.0 * s, alpha=0.2)
+    ax.axhspan(100.0, 200.0 * s, alpha=0.2)
+    ax.fill_between(X, Y * s, 0.0, alpha=0.2)
+    ax.text(1.5 * s, 200.0, "label")
+    bx.semilogy(X, np.exp(5 * X) * s)
+    bx.scatter(X[::10], np.exp(X[::10]) * s)
+    bx.bar([1.0, 2.0], [10.0 * s, 20.0], 0.3)
+    bx.errorbar([1.5], [30.0 * s], yerr=[5.0])
+    bx.imshow([[0.0, 1.0], [1.0, 0.0]], extent=(0.2, 0.8 * s, 1.0, 2.0 * s), aspect="auto")
+
+
+def _png(eps):
+    return figure_png(Figure("t", "test", lambda f: _draw(f, eps)))
+
+
+def test_last_digits_of_the_data_do_not_change_the_png():
+    assert _png(0.0) == _png(1e-10) == _png(-3e-9)
+
+
+def test_a_visible_change_changes_the_png():
+    assert _png(0.0) != _png(1e-3)
+
+
+def test_without_snapping_the_last_digits_change_the_png(monkeypatch):
+    # the property above is the snapping's, not the renderer's
+    monkeypatch.setattr(figures, "snap_figure", lambda fig: None)
+    assert _png(0.0) != _png(1e-10)
+
+
+def test_grid_is_a_power_of_two_below_span_over_cells():
+    import matplotlib.pyplot as plt
+    fig = plt.figure()
+    try:
+        ax = fig.add_subplot(111)
+        ax.plot([0.0, 0.3], [1.0, 1e4])
+        ax.set_yscale("log")
+        xs = figures._AxisGrid(ax.xaxis, ax.get_xlim())
+        ys = figures._AxisGrid(ax.yaxis, ax.get_ylim())
+        for g, span in ((xs, np.ptp(ax.get_xlim())), (ys, np.ptp(np.log10(ax.get_ylim())))):
+            k = np.log2(g.step)
+            assert k == np.floor(k) and g.step <= span / SNAP_CELLS < 2 * g.step
+        # log axes round in log10 space; values stay positive, NaN stays NaN
+        out = ys(np.array([1.0, 123.456, np.nan]))
+        assert out[0] == 1.0 and abs(np.log10(out[1] / 123.456)) <= ys.step / 2
+        assert np.isnan(out[2])
+    finally:
+        plt.close(fig)
+
+
+def test_axes_coordinates_are_left_alone():
+    import matplotlib.pyplot as plt
+    fig = plt.figure()
+    try:
+        ax = fig.add_subplot(111)
+        ax.plot([0.1, 0.7], [0.2, 0.9])
+        line = ax.axhline(0.123456789)
+        figures.snap_figure(fig)
+        assert list(line.get_xdata()) == [0, 1]              # axes fraction: untouched
+        assert line.get_ydata()[0] != 0.123456789             # data: rounded
+        assert not ax.get_autoscalex_on()                     # limits now fixed
+    finally:
+        plt.close(fig)
+
+
+def test_png_has_no_metadata_that_changes():
+    png = _png(0.0)
+    assert png.startswith(b"\x89PNG") and b"Software" not in png and b"Creation" not in png
