@@ -63,3 +63,38 @@ def test_run_study_once_per_equal_spec():
         assert [t.design for t in memo.study_times()] == ["small-cruise", "small-cruise"]
     finally:
         memo.clear()
+
+
+def test_study_times_count_the_run_and_the_pool_apart():
+    """A study with nothing to start is timed from its run; one whose pool
+    started early also gets the wall time since that start."""
+    import time
+    from types import SimpleNamespace
+
+    from workbench import memo
+
+    class Study:
+        def __init__(self, handle):
+            self.handle = handle
+
+        def start(self, design):
+            return self.handle
+
+    class Handle(tuple):
+        def __new__(cls):
+            return super().__new__(cls, ())
+
+    quiet = SimpleNamespace(kind="quiet", spec=("q",), name="quiet")
+    pooled = SimpleNamespace(kind="pooled", spec=("p",), name="pooled")
+    registry = {"quiet": Study(None), "pooled": Study(Handle())}
+    memo.clear()
+    try:
+        memo.start_studies([quiet, pooled], registry)
+        time.sleep(0.2)                       # the other designs' work, in between
+        memo.run_study(quiet, lambda d: 1)
+        memo.run_study(pooled, lambda d, started=None: started)
+        t = {x.design: x for x in memo.study_times()}
+        assert t["quiet"].since_start is None and t["quiet"].wall < 0.1
+        assert t["pooled"].wall < 0.1 and t["pooled"].since_start >= 0.2
+    finally:
+        memo.clear()

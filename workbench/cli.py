@@ -177,14 +177,17 @@ def cmd_check(args) -> int:
 def study_times_table(times) -> str:
     """Markdown table of :func:`workbench.memo.study_times`, slowest first."""
     from .report.markdown import md_table
-    rows = [[t.design, t.kind, f"{t.wall:.1f}", f"{t.cpu:.1f}"]
+    rows = [[t.design, t.kind, f"{t.wall:.1f}", f"{t.cpu:.1f}",
+             "" if t.since_start is None else f"{t.since_start:.1f}"]
             for t in sorted(times, key=lambda t: -t.wall)]
     total = [["total", "", f"{sum(t.wall for t in times):.1f}",
-              f"{sum(t.cpu for t in times):.1f}"]]
-    return ("\nper-design study time (each computed once; wall from the study's start, which "
-            "for a Monte Carlo design is the start of `check`; cpu: this process, not the "
-            "pool workers):\n"
-            + md_table(["design", "kind", "wall s", "cpu s"], rows + total, "llrr"))
+              f"{sum(t.cpu for t in times):.1f}", ""]]
+    return ("\nper-design study time (each computed once; wall and cpu: the study's run in this "
+            "process, not its pool workers; a Monte Carlo design's pool starts with `check` and "
+            "runs beside the other designs: its wall from that start to its result is the last "
+            "column):\n"
+            + md_table(["design", "kind", "wall s", "cpu s", "pool: wall s since start"],
+                       rows + total, "llrrr"))
 
 
 def _cmd_prove(args) -> int:

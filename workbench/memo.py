@@ -40,16 +40,20 @@ class StudyTime:
     kind : str
         Study kind.
     wall, cpu : float
-        Seconds from the study's start to its result; ``cpu`` is user +
+        Seconds of the study's ``run`` in this process; ``cpu`` is user +
         system time of this process only (the Monte Carlo pools' workers
-        are not in it). For a study started early (:func:`start_studies`)
-        both include whatever this process did in between.
+        are not in it).
+    since_start : float or None
+        For a study whose worker processes :func:`start_studies` started
+        early: wall seconds from that start to its result (they include
+        whatever this process did in between); None otherwise.
     """
 
     design: str
     kind: str
     wall: float
     cpu: float
+    since_start: float | None = None
 
 
 _RESULTS: dict[tuple, Any] = {}
@@ -120,14 +124,16 @@ def start_studies(designs, registry) -> None:
         key, study = _design_key(d), registry[d.kind]
         if key is None or key in _RESULTS or key in _STARTED or not hasattr(study, "start"):
             continue
-        w0, c0 = time.perf_counter(), _cpu()
-        _STARTED[key] = (study, study.start(d), w0, c0)
+        w0 = time.perf_counter()
+        handle = study.start(d)
+        if handle is not None:           # nothing started: timed from its run, as any other
+            _STARTED[key] = (study, handle, w0)
 
 
 def cancel_started() -> None:
     """Stop the worker processes of started studies that never ran."""
     while _STARTED:
-        _, (_, handle, _, _) = _STARTED.popitem()
+        _, (_, handle, _) = _STARTED.popitem()
         for p in handle or ():
             if p is not None:
                 p.cancel()
@@ -146,13 +152,15 @@ def run_study(design, run: Callable[..., Any]) -> Any:
     key = _design_key(design)
     if key is not None and key in _RESULTS:
         return _RESULTS[key]
-    w0, c0 = time.perf_counter(), _cpu()
+    w0, c0, started = time.perf_counter(), _cpu(), None
     if key is not None and key in _STARTED:
-        _, handle, w0, c0 = _STARTED.pop(key)
+        _, handle, started = _STARTED.pop(key)
         result = run(design, started=handle)
     else:
         result = run(design)
-    _TIMES.append(StudyTime(design.name, design.kind, time.perf_counter() - w0, _cpu() - c0))
+    w1 = time.perf_counter()
+    _TIMES.append(StudyTime(design.name, design.kind, w1 - w0, _cpu() - c0,
+                            None if started is None else w1 - started))
     if key is not None:
         _RESULTS[key] = result
     return result
