@@ -164,7 +164,8 @@ def render(design, res: BenchmarkResult) -> Rendered:
                    lambda f, e=e: _draw_set(f, e), size=(6.4, 5.6)) for e in res.examples]
     figs = "\n\n".join(f"![{g.name}]({{figdir}}/{g.name}.png)\n\n*{g.caption}*" for g in sets)
     return Rendered((intro, bounds + "\n\n" + intervals, cost,
-                     f"## Bessel-Legendre hierarchy\n\n![gap]({{figdir}}/{fig.name}.png)",
+                     f"## Bessel-Legendre hierarchy\n\n![gap]({{figdir}}/{fig.name}.png)\n\n"
+                     f"Figure: {fig.caption}",
                      "## Stability sets\n\nSpectral abscissa (rightmost characteristic root, "
                      "adaptive Chebyshev collocation with Newton polishing, "
                      "`spectral_abscissa`) on a uniform grid; shaded: the exact stable "
