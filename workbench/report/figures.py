@@ -160,9 +160,6 @@ def figure_png(fig_spec: Figure) -> bytes:
 
 
 def save_figure(fig_spec: Figure, path: Path) -> None:
-    """Write :func:`figure_png` of ``fig_spec`` to ``path``."""
-    data = figure_png(fig_spec)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_bytes(data)
-    tmp.replace(path)
+    """Write :func:`figure_png` of ``fig_spec`` to ``path`` (atomically)."""
+    from .writer import atomic_write
+    atomic_write(path, figure_png(fig_spec))

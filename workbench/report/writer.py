@@ -143,17 +143,15 @@ def index_markdown(files: list[ReportFiles]) -> str:
 
 def write_reports(files: list[ReportFiles], outdir: Path, *, index: bool) -> list[Path]:
     """Write Markdown (atomically) and figures; returns the paths written."""
-    from .figures import save_figure
+    from .figures import figure_png
     written = []
     outdir.mkdir(parents=True, exist_ok=True)
     for f in files:
         for fig in f.figures:
-            p = outdir / f.name / f"{fig.name}.png"
-            save_figure(fig, p)
-            written.append(p)
-        written.append(_atomic_write(outdir / f"{f.name}.md", f.markdown))
+            written.append(atomic_write(outdir / f.name / f"{fig.name}.png", figure_png(fig)))
+        written.append(atomic_write(outdir / f"{f.name}.md", f.markdown))
     if index:
-        written.append(_atomic_write(outdir / "README.md", index_markdown(files)))
+        written.append(atomic_write(outdir / "README.md", index_markdown(files)))
     return written
 
 
@@ -182,8 +180,14 @@ def check_reports(files: list[ReportFiles], outdir: Path, *, index: bool) -> lis
     return problems
 
 
-def _atomic_write(path: Path, text: str) -> Path:
+def atomic_write(path: Path, data: str | bytes) -> Path:
+    """Write text (UTF-8) or bytes to ``path`` through a temporary file, so a
+    reader never sees it half-written; returns ``path``."""
+    path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
+    if isinstance(data, bytes):
+        tmp.write_bytes(data)
+    else:
+        tmp.write_text(data, encoding="utf-8")
     tmp.replace(path)
     return path

@@ -28,10 +28,13 @@ METHOD_DOC = {
 GAP_FLOOR = 1e-5
 
 
+def _truncated(r: float) -> float:
+    """r truncated to 5 decimals (never rounds up to 1): the digits printed."""
+    return math.floor(r * 1e5) / 1e5
+
+
 def _ratio(r) -> str:
-    if r is None:
-        return "—"
-    return f"{math.floor(r * 1e5) / 1e5:.5f}"   # truncated: never rounds up to 1
+    return "—" if r is None else f"{_truncated(r):.5f}"
 
 
 def _label(r) -> str:
@@ -209,7 +212,7 @@ def _draw_gap(fig, res: BenchmarkResult) -> None:
             continue
         rows = [r for r in e.rows if r.method == "bessel-legendre" and r.ratio is not None]
         # from the printed ratio (truncated to 5 decimals: the digits that reproduce)
-        gaps = [max(1 - float(_ratio(r.ratio)), GAP_FLOOR) for r in rows]
+        gaps = [max(1 - _truncated(r.ratio), GAP_FLOOR) for r in rows]
         ax.semilogy([r.N for r in rows], gaps, "o-", label=e.example.name)
     ax.axhline(res.settings.gap_tol, color="k", ls="--", lw=0.8, label="gap tolerance")
     ax.set_xlabel("order N")
