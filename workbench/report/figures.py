@@ -34,6 +34,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Polygon, Rectangle  # noqa: E402
 from matplotlib.text import Text  # noqa: E402
 
+from .files import atomic_write  # noqa: E402
 from .markdown import Figure  # noqa: E402
 
 _RC = {"svg.hashsalt": "workbench", "figure.dpi": 100, "savefig.dpi": 100,
@@ -161,5 +162,4 @@ def figure_png(fig_spec: Figure) -> bytes:
 
 def save_figure(fig_spec: Figure, path: Path) -> None:
     """Write :func:`figure_png` of ``fig_spec`` to ``path`` (atomically)."""
-    from .writer import atomic_write
     atomic_write(path, figure_png(fig_spec))

@@ -14,6 +14,7 @@ from importlib import metadata
 from pathlib import Path
 
 from ..claims import ROUNDING_RTOL, ClaimResult, Verdict
+from .files import atomic_write
 from .findings import findings_section, index_cells
 from .markdown import Figure, Rendered, fmt, github_math, md_table
 
@@ -178,16 +179,3 @@ def check_reports(files: list[ReportFiles], outdir: Path, *, index: bool) -> lis
         if not p.is_file() or p.read_text(encoding="utf-8") != index_markdown(files):
             problems.append(f"{p}: stale or missing index")
     return problems
-
-
-def atomic_write(path: Path, data: str | bytes) -> Path:
-    """Write text (UTF-8) or bytes to ``path`` through a temporary file, so a
-    reader never sees it half-written; returns ``path``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    if isinstance(data, bytes):
-        tmp.write_bytes(data)
-    else:
-        tmp.write_text(data, encoding="utf-8")
-    tmp.replace(path)
-    return path
