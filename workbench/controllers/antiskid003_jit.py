@@ -31,7 +31,7 @@ import numpy as np
 from ..sim.history import split_delay
 from ..sim.wheel_slip import PARAM_ORDER
 from ..sim.wheel_slip_jit import BRAKING, TRACTION, braking, fmax, fmin, forms, phi1, \
-    stiff_step, traction, wheel_speed
+    stiff_step, stiff_step_at, traction, wheel_speed
 from .antiskid003 import PhaseEvents
 from .antiskid003_settings import (ACCEL, BRAKE, BRAKE_IN, CRUISE, DIVERGED, HANDOVER, STOPPED,
                                    ControllerSettings)
@@ -50,10 +50,14 @@ CFG = ("v_d", "lambda_d", "lambda_opt", "K0", "K1", "a1", "a2", "d1", "d2", "d3"
  V_STOP, V_FLOOR, LAM_DIVERGED, U_RANGE, OBSERVER_ON, ALPHA, DT, NC, FC, R_C,
  GROUP) = range(len(CFG))
 
-#: Entries of the controller state ``st``.
+#: Entries of the controller state ``st``. The last five: the traction forms
+#: (lambda'_0, lambda'_u, J_0, J_u) that the last predictor rollout of
+#: :func:`rollout_lanes` evaluated at the sample's (v, lambda), and whether
+#: they are there (1) -- the mismatch estimate of the next sample needs the
+#: same forms at the same point (:func:`observe`).
 STATE = ("phase", "has_prev", "prev_v", "prev_lam", "prev_phase", "delta", "unresolved",
-         "pushed")
-PH, HAS_PREV, PV, PL, PPH, DELTA, UNRES, PUSHED = range(len(STATE))
+         "pushed", "kept", "kept_f20", "kept_f2u", "kept_j0", "kept_ju")
+PH, HAS_PREV, PV, PL, PPH, DELTA, UNRES, PUSHED, KEPT, KF20, KF2U, KJ0, KJU = range(len(STATE))
 
 _EV = {f.name: i for i, f in enumerate(fields(PhaseEvents))}
 E_HANDOVER, E_V_HANDOVER, E_LAM_HANDOVER = (_EV["t_handover_done"], _EV["v_at_handover"],
@@ -194,12 +198,14 @@ def observe(v, lam, ph, st, ubuf, j, cfg, p):
             den = cfg[D4] * ve + cfg[D5] * le + cfg[D6]
             f20 = cfg[D1] * ve + cfg[D2] * le + cfg[D3]
             f2u, j0, ju = den, cfg[D2], cfg[D5]
+        elif st[j, KEPT] != 0.0 and pl >= 0:    # the forms the rollout kept: eq 13 at (pv, pl)
+            f20, f2u, j0, ju = st[j, KF20], st[j, KF2U], st[j, KJ0], st[j, KJU]
         else:
             _, f20, f2u, j0, ju = forms(fmax(pv, cfg[V_FLOOR]), pl, p, 0)
         d = (lam - pl) / (dt * phi1((j0 + ju * ua) * dt)) - (f20 + f2u * ua)
         new = st[j, DELTA] + cfg[ALPHA] * (d - st[j, DELTA])
         st[j, DELTA] = 0.0 * v if not abs(new) < 1e6 else new
-    st[j, HAS_PREV], st[j, PV], st[j, PL], st[j, PPH] = 1.0, v, lam, ph
+    st[j, HAS_PREV], st[j, PV], st[j, PL], st[j, PPH], st[j, KEPT] = 1.0, v, lam, ph, 0.0
 
 
 @numba.njit(**_JIT)
@@ -335,15 +341,22 @@ def control(t, lam_true, v, lam, st, ubuf, ev, cfg, p):
 
 
 @numba.njit(**_JITI)
-def rollout_lanes(Pv, Pl, kind, ubuf, n, active, cfg, p):
+def rollout_lanes(Pv, Pl, kind, ubuf, st, n, fm, active, cfg, p):
     """:func:`rollout` of several runs ("lanes") at once, in place on
     (Pv[j], Pl[j]) for the lanes with ``active[j]`` and ``kind[j] >= 0``
     (:func:`kind_of`): the same operations per run as :func:`rollout`
     (predictor group 1), their steps interleaved, so that the processor
-    overlaps the runs' dependency chains (a rollout step of one run is a
-    chain of about 100 dependent operations). ``n[j]``: the lane's pushed
-    sample count, overwritten (scratch)."""
-    N, f, dt, L = int(cfg[NC]), cfg[FC], cfg[DT], ubuf.shape[1]
+    overlaps the runs' dependency chains. A step of the nonlinear model is
+    done in two passes over the lanes: the model's forms of every lane (an
+    ``exp`` each), then the steps (an ``expm1`` each), so that the calls of
+    independent lanes follow each other and overlap. ``n[j]``: the lane's
+    pushed sample count, overwritten (scratch); ``fm``: (lanes, 5) scratch.
+
+    A traction rollout keeps the forms of its first step, evaluated at the
+    sample's (v, lambda), in ``st[j]`` (:data:`STATE`): the next sample's
+    mismatch estimate (:func:`observe`) reads them instead of evaluating
+    eq (13) again at that point (the same values)."""
+    N, f, dt, L, vfl = int(cfg[NC]), cfg[FC], cfg[DT], ubuf.shape[1], cfg[V_FLOOR]
     K = Pv.shape[0]
     first = -1 if f > 0 else 0           # -1: the fraction f of the oldest sample's step
     for j in range(K):
@@ -351,6 +364,17 @@ def rollout_lanes(Pv, Pl, kind, ubuf, n, active, cfg, p):
     for i in range(first, N):
         step = f * dt if i < 0 else dt
         for j in range(K):
-            if active[j] and kind[j] >= 0:
-                Pv[j], Pl[j] = _model_step(Pv[j], Pl[j], ubuf[j, n[j]], step, kind[j], cfg, p)
+            if active[j] and kind[j] > 0:
+                fm[j, 0], fm[j, 1], fm[j, 2], fm[j, 3], fm[j, 4] = forms(
+                    fmax(Pv[j], vfl), Pl[j], p, kind[j])
+                if i == first and kind[j] == TRACTION:
+                    st[j, KEPT], st[j, KF20], st[j, KF2U], st[j, KJ0], st[j, KJU] = (
+                        1.0, fm[j, 1], fm[j, 2], fm[j, 3], fm[j, 4])
+        for j in range(K):
+            if active[j] and kind[j] > 0:
+                Pv[j], Pl[j], _ = stiff_step_at(Pv[j], Pl[j], ubuf[j, n[j]], step, p, vfl,
+                                                kind[j], (fm[j, 0], fm[j, 1], fm[j, 2],
+                                                          fm[j, 3], fm[j, 4]))
+            elif active[j] and kind[j] == 0:
+                Pv[j], Pl[j] = _model_step(Pv[j], Pl[j], ubuf[j, n[j]], step, 0, cfg, p)
             n[j] = n[j] + 1 if n[j] + 1 < L else 0

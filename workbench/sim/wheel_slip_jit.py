@@ -139,7 +139,14 @@ def stiff_step(v, lam, u, dt, p, v_floor, form):
     """(v, lambda, unresolved) after one step of :func:`forms` (speed
     floored at ``v_floor`` in the model), halved recursively as
     :func:`workbench.sim.wheel_slip.stiff_step_flagged`."""
-    f1, f20, f2u, j0, ju = forms(fmax(v, v_floor), lam, p, form)
+    return stiff_step_at(v, lam, u, dt, p, v_floor, form, forms(fmax(v, v_floor), lam, p, form))
+
+
+@numba.njit(**_JITI)
+def stiff_step_at(v, lam, u, dt, p, v_floor, form, fm):
+    """:func:`stiff_step` given ``fm = forms(fmax(v, v_floor), lam, p, form)``
+    (for a caller that keeps the forms for another use)."""
+    f1, f20, f2u, j0, ju = fm
     nv = v + dt * f1
     nl = lam + dt * phi1((j0 + ju * u) * dt) * (f20 + f2u * u)
     big = not abs(nl - lam) <= MAX_DLAMBDA

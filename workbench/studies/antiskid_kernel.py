@@ -11,10 +11,13 @@ per-run adaptive halving (:func:`workbench.sim.wheel_slip_jit.stiff_step`).
 A run ends when it stops or diverges, as its lane of the batch freezes.
 
 Speed without changing a bit: the small model and controller functions are
-inlined into the loop (``inline="always"``), and the predictor rollouts of
-the runs in flight are interleaved step by step. A rollout step is a chain
-of dependent operations (an ``exp``, an ``expm1``, four divisions); a second
-independent chain fills the processor's idle units. Nothing in the loop
+inlined into the loop (``inline="always"``), and the predictor rollouts and
+plant steps of the runs in flight are interleaved. A model step is a chain
+of dependent operations (an ``exp``, an ``expm1``, four divisions) around
+two library calls, which the compiler does not reorder; each step is done
+in two passes over the lanes (the model's forms of every lane, one ``exp``
+each, then the steps, one ``expm1`` each), so that the calls of independent
+runs follow each other and the processor overlaps them. Nothing in the loop
 makes an array view (a view costs two atomic reference-count updates): the
 lanes' state is read by row index, and the settings and the model
 parameters are tuples of floats (values the compiler keeps in registers and
@@ -46,9 +49,9 @@ KERNELS = ("compiled", "numpy")
 Kernel = Literal["compiled", "numpy"]
 
 #: Runs a compiled batch keeps in flight at a time, their predictor rollouts
-#: interleaved. Measured on the dry sweep (one process, ns per sample): 1 lane
-#: 828, 2 lanes 632, 4 lanes 619; two dependency chains already fill the
-#: processor, and lanes cost nothing when runs end (a lane takes the next run).
+#: and plant steps interleaved. Measured on the dry sweep before the steps
+#: were split in two passes (one process, ns per sample): 1 lane 828, 2 lanes
+#: 632, 4 lanes 619; lanes cost nothing when runs end (a lane takes the next run).
 LANES = 4
 
 #: Field order of the metrics array (RunMetrics; PhaseEvents first).
@@ -77,8 +80,8 @@ def _build():
 
     from ..controllers import antiskid003_jit as C
     from ..sim.counter_rng import jit_functions
-    from ..sim.wheel_slip_jit import (BY_SIGN, GRADED, creep_speed, delay_at, fmax, fmin,
-                                      measured_state, split_delay, stiff_step, wheel_speed)
+    from ..sim.wheel_slip_jit import (BY_SIGN, GRADED, creep_speed, delay_at, fmax, fmin, forms,
+                                      measured_state, split_delay, stiff_step_at, wheel_speed)
 
     _, uniform, normal4 = jit_functions()
 
@@ -199,6 +202,9 @@ def _build():
         phs, tcs, tbs, tss = (np.zeros(K, np.int64), np.zeros(K, np.bool_),
                               np.zeros(K, np.bool_), np.zeros(K, np.bool_))
         active = np.zeros(K, np.bool_)
+        fm = np.empty((K, 5))                     # scratch: the model forms of each lane
+        ua_, go = np.zeros(K), np.zeros(K, np.bool_)   # the plant's input; lanes stepping
+        form = GRADED if graded else BY_SIGN
         pc = params_tuple(pc)     # the controller's model: constants the compiler hoists
         cfg = cfg_tuple(cfg)      # the settings (:data:`~workbench.controllers.antiskid003_jit.CFG`)
         nxt = 0
@@ -226,7 +232,7 @@ def _build():
                 Pv[j], Pl[j] = vm[j], lm[j]
             if not busy:
                 break
-            C.rollout_lanes(Pv, Pl, kind, ubuf, ncs, active, cfg, pc)
+            C.rollout_lanes(Pv, Pl, kind, ubuf, st, ncs, fm, active, cfg, pc)
             for j in range(K):
                 if not active[j]:
                     continue
@@ -255,11 +261,21 @@ def _build():
                     jj = np.uint64(math.floor(fmax(pos[j], 0.0) / pert[6]))
                     pg[j, P] = pert[4] + (pert[5] - pert[4]) * uniform(keys[run[j], 2], jj)
                     pos[j] = pos[j] + dt * v[j]
-                # BY_SIGN reads the first P entries only
-                v[j], lam[j], unres = stiff_step(v[j], lam[j], ua, dt, row_tuple(pg, j), 1e-3,
-                                                 GRADED if graded else BY_SIGN)
-                st[j, C.UNRES] = 1.0 if unres else 0.0
-                T[j] += 1
+                ua_[j], go[j] = ua, True
+            # the plant steps in two passes over the lanes, as the rollouts
+            # (C.rollout_lanes): the model's forms of every lane, then the steps
+            for j in range(K):
+                if go[j]:      # BY_SIGN reads the first P entries only
+                    fm[j, 0], fm[j, 1], fm[j, 2], fm[j, 3], fm[j, 4] = forms(
+                        fmax(v[j], 1e-3), lam[j], row_tuple(pg, j), form)
+            for j in range(K):
+                if go[j]:
+                    v[j], lam[j], unres = stiff_step_at(
+                        v[j], lam[j], ua_[j], dt, row_tuple(pg, j), 1e-3, form,
+                        (fm[j, 0], fm[j, 1], fm[j, 2], fm[j, 3], fm[j, 4]))
+                    st[j, C.UNRES] = 1.0 if unres else 0.0
+                    T[j] += 1
+                    go[j] = False
 
     return run_batch
 
