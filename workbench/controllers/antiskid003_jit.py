@@ -209,8 +209,21 @@ def observe(v, lam, ph, st, ubuf, j, cfg, p):
 
 
 @numba.njit(**_JIT)
-def _accel(Pv, Pl, target, delta, cfg, p):
-    y1, y2, y3, dy2, dy3 = traction(fmax(Pv, cfg[V_FLOOR]), Pl, p)
+def law_forms(ph, Pv, Pl, cfg, p):
+    """The model forms the law of phase ``ph`` needs at the prediction (Pv,
+    Pl): eq (13) for the traction laws, eq (16) for the braking law, at the
+    speed floored at v_floor; zeros for the others (:func:`law_with`)."""
+    if ph == ACCEL or ph == HANDOVER or ph == BRAKE_IN:
+        return traction(fmax(Pv, cfg[V_FLOOR]), Pl, p)
+    if ph == BRAKE:
+        return braking(fmax(Pv, cfg[V_FLOOR]), Pl, p)
+    z = 0.0 * Pv
+    return z, z, z, z, z
+
+
+@numba.njit(**_JIT)
+def _accel(Pl, target, delta, cfg, y):
+    y1, y2, y3, dy2, dy3 = y
     return sampled((-y2 - cfg[K_AC] * (Pl - target)) / y3, y2, y3, dy2, dy3, delta, cfg)
 
 
@@ -223,9 +236,9 @@ def _cruise(v, lam, Pv, Pl, delta, cfg):
 
 
 @numba.njit(**_JIT)
-def _brake(t, Pv, Pl, delta, cfg, p):
+def _brake(t, Pv, Pl, delta, cfg, z):
     vg = fmax(Pv, cfg[V_FLOOR])
-    z1, z2, z3, dz2, dz3 = braking(vg, Pl, p)
+    z1, z2, z3, dz2, dz3 = z
     omega = wheel_speed(vg, Pl, cfg[R_C])
     vs, dvs = profile(t + cfg[H_MODEL], vg, z1, omega, cfg)
     u = ((-cfg[K_DE] * (vg * Pl - vs) + z1 + dvs) / vg - (1.0 + Pl) / vg * z1 - z2) / z3
@@ -247,16 +260,22 @@ def kind_of(ph, cfg):
 def law_at(t, v, lam, Pv, Pl, ph, delta, cfg, p):
     """The torque of the active phase's law at the prediction (Pv, Pl), with
     the mismatch estimate ``delta`` (:meth:`Antiskid003._laws`)."""
+    return law_with(t, v, lam, Pv, Pl, ph, delta, cfg, law_forms(ph, Pv, Pl, cfg, p))
+
+
+@numba.njit(**_JITI)
+def law_with(t, v, lam, Pv, Pl, ph, delta, cfg, fm):
+    """:func:`law_at` given ``fm = law_forms(ph, Pv, Pl, cfg, p)``."""
     if ph == ACCEL:
-        return _accel(Pv, Pl, cfg[LAMBDA_OPT], delta, cfg, p)
+        return _accel(Pl, cfg[LAMBDA_OPT], delta, cfg, fm)
     if ph == HANDOVER:
-        return _accel(Pv, Pl, cfg[LAMBDA_D], delta, cfg, p)
+        return _accel(Pl, cfg[LAMBDA_D], delta, cfg, fm)
     if ph == CRUISE:
         return _cruise(v, lam, Pv, Pl, delta, cfg)
     if ph == BRAKE_IN:
-        return _accel(Pv, Pl, -cfg[BAND], delta, cfg, p)
+        return _accel(Pl, -cfg[BAND], delta, cfg, fm)
     if ph == BRAKE:
-        return _brake(t, Pv, Pl, delta, cfg, p)
+        return _brake(t, Pv, Pl, delta, cfg, fm)
     return 0.0 * v
 
 
@@ -305,11 +324,12 @@ def control_pre(t, lam_true, v, lam, st, ubuf, ev, j, cfg, p):
 
 
 @numba.njit(**_JITI)
-def control_post(t, v, lam, Pv, Pl, ph, st, ubuf, ev, j, cfg, p):
+def control_post(t, v, lam, Pv, Pl, ph, fm, st, ubuf, ev, j, cfg):
     """The last part of :func:`control` for run ``j`` (as :func:`control_pre`):
-    the law at the prediction (Pv, Pl), the range test, the push into the
-    input history; returns (u, phase)."""
-    u = law_at(t, v, lam, Pv, Pl, ph, st[j, DELTA], cfg, p)
+    the law at the prediction (Pv, Pl) with its model forms ``fm``
+    (:func:`law_forms`), the range test, the push into the input history;
+    returns (u, phase)."""
+    u = law_with(t, v, lam, Pv, Pl, ph, st[j, DELTA], cfg, fm)
     if not abs(u) <= cfg[U_RANGE] and ph < STOPPED:
         ev[j, E_T_DIV], ev[j, E_PH_DIV], ev[j, E_HOW] = t, ph, 2.0
         ph, u = DIVERGED, 0.0
@@ -336,7 +356,7 @@ def control(t, lam_true, v, lam, st, ubuf, ev, cfg, p):
         Pv, Pl = v, lam
     else:
         Pv, Pl = rollout(v, lam, ph, ubuf, int(st[PUSHED]), cfg, p)
-    u, ph = control_post(t, v, lam, Pv, Pl, ph, S, U, E, 0, cfg, p)
+    u, ph = control_post(t, v, lam, Pv, Pl, ph, law_forms(ph, Pv, Pl, cfg, p), S, U, E, 0, cfg)
     return u, ph, to_cruise, to_brake, to_stop
 
 

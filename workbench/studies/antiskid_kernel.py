@@ -233,12 +233,17 @@ def _build():
             if not busy:
                 break
             C.rollout_lanes(Pv, Pl, kind, ubuf, st, ncs, fm, active, cfg, pc)
+            for j in range(K):     # the laws' model forms, a pass of their own (as the steps)
+                if active[j]:
+                    fm[j, 0], fm[j, 1], fm[j, 2], fm[j, 3], fm[j, 4] = C.law_forms(
+                        phs[j], Pv[j], Pl[j], cfg, pc)
             for j in range(K):
                 if not active[j]:
                     continue
                 t = T[j] * dt
-                u, ph = control_post(t, vm[j], lm[j], Pv[j], Pl[j], phs[j], st, ubuf, m, j,
-                                     cfg, pc)
+                u, ph = control_post(t, vm[j], lm[j], Pv[j], Pl[j], phs[j],
+                                     (fm[j, 0], fm[j, 1], fm[j, 2], fm[j, 3], fm[j, 4]), st,
+                                     ubuf, m, j, cfg)
                 record(t, v[j], lam[j], ph, tcs[j], tbs[j], tss[j], m, rs, j, cfg,
                        pg[j, r_i], settle)
                 L = Lp[j]
