@@ -38,7 +38,8 @@ from .files import atomic_write  # noqa: E402
 from .markdown import Figure  # noqa: E402
 
 _RC = {"svg.hashsalt": "workbench", "figure.dpi": 100, "savefig.dpi": 100,
-       "font.size": 9, "axes.grid": True, "grid.alpha": 0.3}
+       "font.size": 9, "axes.grid": True, "grid.alpha": 0.3,
+       "path.simplify": False}
 
 #: Grid cells per axis span of :func:`snap_figure` (the grid step is the
 #: largest power of two not above span / SNAP_CELLS).
@@ -46,24 +47,114 @@ SNAP_CELLS = 4096
 
 
 class _AxisGrid:
-    """Rounding of one axis' data coordinates (in its scale's space)."""
+    """Rounding of one axis' data coordinates, in its scale's space.
+
+    A linear axis keeps its data unit. A log or symlog axis is *re-drawn as a
+    linear axis of its scale coordinate* (``log_b x``, or the symlog
+    coordinate), computed here with Python's scalar ``math`` functions:
+    matplotlib's own log transforms run numpy's SIMD loops, whose last bits
+    differ between CPUs (AVX-512 against AVX2), and a 1-ulp move of a snapped
+    point can move an antialiased pixel. Its ticks and labels are placed by
+    :func:`_log_ticks` at the same positions a log axis would show.
+    """
 
     def __init__(self, axis, lim):
-        self.tr = axis.get_transform()                      # the scale (identity, log10, ...)
-        lo, hi = self.tr.transform(np.asarray(lim, float))
+        scale = axis.get_scale()
+        self.kind = scale if scale in ("log", "symlog") else "linear"
+        tr = axis.get_transform()
+        self.base = float(getattr(tr, "base", 10.0))
+        self.linthresh = float(getattr(tr, "linthresh", 1.0))
+        linscale = float(getattr(tr, "linscale", 1.0))
+        self.linscale_adj = linscale / (1.0 - 1.0 / self.base)
+        lo, hi = self.forward(np.asarray(lim, float))
+        self.lim = (lo, hi)
         span = abs(hi - lo)
         ok = math.isfinite(span) and span > 0
         self.step = 2.0 ** math.floor(math.log2(span / SNAP_CELLS)) if ok else 0.0
 
+    def _scalar(self, v: float) -> float:
+        if not math.isfinite(v):
+            return v
+        if self.kind == "log":
+            return math.log(v) / math.log(self.base) if self.base != 10.0 else (
+                math.log10(v) if v > 0 else -math.inf)
+        a = abs(v)
+        if a <= self.linthresh:
+            return v * self.linscale_adj
+        y = self.linthresh * (self.linscale_adj + math.log10(a / self.linthresh)
+                              / math.log10(self.base))
+        return math.copysign(y, v)
+
+    def forward(self, x):
+        """Data -> the axis' (linear) drawing coordinate."""
+        x = np.asarray(x, float)
+        if self.kind == "linear" or x.size == 0:
+            return x
+        flat = [self._scalar(float(v)) for v in x.reshape(-1)]
+        return np.array(flat, float).reshape(x.shape)
+
     def __call__(self, x):
         x = np.asarray(x, float)
+        s = self.forward(x)
         if self.step == 0.0 or x.size == 0:
-            return x
-        s = self.tr.transform(x.reshape(-1)).reshape(x.shape)
+            return s
         fin = np.isfinite(s)
-        s = np.where(fin, np.round(np.where(fin, s, 0.0) / self.step) * self.step, s)
-        back = self.tr.inverted().transform(s.reshape(-1)).reshape(x.shape)
-        return np.where(np.isfinite(x) & fin, back, x)
+        out = np.where(fin, np.round(np.where(fin, s, 0.0) / self.step) * self.step, s)
+        if self.kind != "linear":      # log of a non-positive value: below the axis
+            out = np.where(np.isneginf(out), self.lim[0] - 16 * abs(self.lim[1] - self.lim[0]),
+                           out)
+        return out
+
+
+def _log_ticks(ax, which: str, grid: _AxisGrid) -> None:
+    """Ticks and labels of a log / symlog axis re-drawn as linear
+    (:class:`_AxisGrid`): decades ``base**k`` labelled as powers (minor ticks
+    at their multiples), or, within less than a decade, a few round values."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullLocator
+    axis = ax.xaxis if which == "x" else ax.yaxis
+    lo, hi = sorted(grid.lim)
+    major, labels, minor = [], {}, []
+    b = grid.base
+    bname = f"{b:g}"
+
+    def power(k):
+        return f"$\\mathdefault{{{bname}^{{{k}}}}}$"
+
+    if grid.kind == "log":
+        k0, k1 = math.floor(lo), math.ceil(hi)
+        if hi - lo >= 1.0:
+            stride = max(1, math.ceil((k1 - k0) / 8))
+            for k in range(k0, k1 + 1):
+                if k % stride == 0:
+                    major.append(float(k))
+                    labels[float(k)] = power(k)
+                if stride == 1 and b == 10.0:
+                    minor += [k + math.log10(m) for m in range(2, 10)]
+        else:                          # within about a decade: round values
+            vals = MaxNLocator(5).tick_values(b ** lo, b ** hi)
+            for v in vals:
+                if v > 0:
+                    pos = grid._scalar(float(v))
+                    major.append(pos)
+                    labels[pos] = f"{float(v):g}"
+    else:                              # symlog: 0, ±linthresh * base**k
+        t = grid.linthresh
+        cand = [0.0] + [s * t * b ** k for k in range(0, 40) for s in (1, -1)]
+        for v in cand:
+            pos = grid._scalar(v)
+            if lo <= pos <= hi:
+                major.append(pos)
+                labels[pos] = f"{v:g}"
+        if len(major) > 9:
+            keep = major[::math.ceil(len(major) / 9)]
+            labels = {p: labels[p] for p in keep}
+            major = keep
+    axis.set_major_locator(FixedLocator(sorted(major)))
+    axis.set_major_formatter(FuncFormatter(lambda v, _pos: labels.get(v, "")))
+    if minor:
+        axis.set_minor_locator(FixedLocator([m for m in minor if lo <= m <= hi]))
+    else:
+        axis.set_minor_locator(NullLocator())
 
 
 def _data_dims(ax, transform):
@@ -86,11 +177,12 @@ def _snap_xy(xy, gx, gy, dims):
     return xy
 
 
-def snap_axes(ax) -> None:
+def snap_axes(ax, grids=None) -> None:
     """Round the data coordinates of ``ax``'s lines, collections, patches,
-    images and texts, and its autoscaled limits (module docstring)."""
-    xlim, ylim = ax.get_xlim(), ax.get_ylim()     # autoscales now, from the drawn data
-    gx, gy = _AxisGrid(ax.xaxis, xlim), _AxisGrid(ax.yaxis, ylim)
+    images and texts, and its autoscaled limits (module docstring).
+    ``grids``: the axes' ``(xlim, ylim, gx, gy)`` taken before any axes of the
+    figure was changed (shared axes change together)."""
+    xlim, ylim, gx, gy = grids or _axes_grids(ax)
     for a in ax.get_children():
         if isinstance(a, Line2D):
             dims = _data_dims(ax, a.get_transform())
@@ -131,17 +223,28 @@ def snap_axes(ax) -> None:
             dims = _data_dims(ax, a.get_transform())
             if any(dims):
                 a.set_position(tuple(_snap_xy(a.get_position(), gx, gy, dims)[0]))
-    if ax.get_autoscalex_on():
-        ax.set_xlim(*gx(xlim))
-    if ax.get_autoscaley_on():
-        ax.set_ylim(*gy(ylim))
+    auto = ax.get_autoscalex_on(), ax.get_autoscaley_on()
+    for which, g, lim, a in (("x", gx, xlim, auto[0]), ("y", gy, ylim, auto[1])):
+        if g.kind != "linear":
+            getattr(ax, f"set_{which}scale")("linear")
+            getattr(ax, f"set_{which}lim")(*g(lim))
+            _log_ticks(ax, which, g)
+        elif a:
+            getattr(ax, f"set_{which}lim")(*g(lim))
+
+
+def _axes_grids(ax):
+    xlim, ylim = ax.get_xlim(), ax.get_ylim()     # autoscales now, from the drawn data
+    return xlim, ylim, _AxisGrid(ax.xaxis, xlim), _AxisGrid(ax.yaxis, ylim)
 
 
 def snap_figure(fig) -> None:
-    """:func:`snap_axes` on every axes of ``fig`` (module docstring)."""
-    for ax in fig.axes:
-        if ax.name == "rectilinear":
-            snap_axes(ax)
+    """:func:`snap_axes` on every axes of ``fig`` (module docstring); every
+    axes' grids are taken first, since shared axes change scale together."""
+    axes = [ax for ax in fig.axes if ax.name == "rectilinear"]
+    grids = [_axes_grids(ax) for ax in axes]
+    for ax, g in zip(axes, grids):
+        snap_axes(ax, g)
 
 
 def figure_png(fig_spec: Figure) -> bytes:
