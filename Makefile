@@ -1,6 +1,7 @@
 # The two commands a newcomer needs: `make report` and `make test`.
 # Both create .venv when missing and install the package with the pinned
 # versions of constraints.txt (so reports are reproduced byte for byte).
+SHELL  := /bin/bash
 PYTHON ?= python3
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
@@ -11,7 +12,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 # A second CPU's BLAS kernels (no FMA): the report check must hold under it too.
 OTHER_KERNEL ?= Sandybridge
 
-.PHONY: install report test test-wheel bench clean
+.PHONY: install report test test-full test-wheel bench clean
 
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -25,29 +26,58 @@ install: $(STAMP)
 report: install
 	$(WB) report --all
 
-## tests, every claim (designs and proofs) and report freshness, on two CPUs' BLAS
-## kernels. Three processes share the two cores: pytest; `workbench check`
-## (`workbench verify` + `workbench report --all --check` in one process, each
-## study computed once; its output ends with the time each design's study took);
-## and the report check again under another CPU's kernels (OTHER_KERNEL). Their
-## outputs are shown after pytest's, then the golden report runs under OTHER_KERNEL.
+## The five-minute check: every claim of every design and proof, the report
+## freshness check (Markdown and figures) and the unit tests, on every core.
+## `workbench check --jobs $(JOBS)` runs each study once (a pool of processes)
+## and leaves the results in a run folder; the test session (pytest-xdist,
+## $(JOBS) workers, tests marked `slow` deselected: `make test-full`) reads
+## them instead of computing them again. Ends with the wall time and the
+## five slowest studies and tests.
+JOBS ?= $(shell $(PYTHON) -c "import os; print(max(1, len(os.sched_getaffinity(0))))")
 test: install
-	@t0=$$(date +%s); log=$$(mktemp); other=$$(mktemp); \
-	$(WB) check > $$log 2>&1 & check=$$!; \
-	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(WB) report --all --check > $$other 2>&1 & second=$$!; \
-	$(PY) -m pytest --durations=15; tests=$$?; \
-	echo "== pytest done after $$(( $$(date +%s) - t0 )) s"; \
-	wait $$check; checked=$$?; wait $$second; seconded=$$?; \
-	echo; echo "== workbench check (verify + report --all --check)"; cat $$log; \
-	echo; echo "== report --all --check under OPENBLAS_CORETYPE=$(OTHER_KERNEL)"; cat $$other; \
-	rm -f $$log $$other; \
+	@t0=$$(date +%s); run=$$(mktemp -d); times=$$(mktemp); \
+	echo "== workbench check --jobs $(JOBS) (every claim, report freshness)"; \
+	WORKBENCH_STUDY_CACHE=$$run $(WB) check --jobs $(JOBS) 2> $$times; checked=$$?; \
+	echo "== check done after $$(( $$(date +%s) - t0 )) s"; \
+	echo "== pytest -n $(JOBS) (not slow)"; \
+	WORKBENCH_STUDY_CACHE=$$run $(PY) -m pytest -n $(JOBS) -m "not slow and not wheel" \
+	  --durations=5 -p no:cacheprovider; tests=$$?; \
+	rm -rf $$run; \
+	echo; echo "== five slowest studies (workbench check; the whole table: workbench check --jobs $(JOBS))"; \
+	grep -v 'per-task time' $$times | sed -n '/^| task/,$$p' | sed -n '1,7p'; \
+	grep -v '^|\|^$$\|per-task time' $$times; rm -f $$times; \
+	echo "workbench check exit $$checked, pytest exit $$tests; make test: $$(( $$(date +%s) - t0 )) s wall"; \
+	test $$checked -eq 0 && test $$tests -eq 0
+
+## The full tier: the slow tests; the check again under another CPU's BLAS
+## kernels ($(OTHER_KERNEL)), with every physical input moved 3 ulp, and
+## with numpy's widest SIMD loops switched off (where this CPU has them);
+## each must find every report byte-identical; the golden report under
+## $(OTHER_KERNEL).
+# the lines of a check that matter here: problems, summaries, claims not ok
+NOT_OK := awk '!/^\| / || /✗/'
+test-full: install
+	@t0=$$(date +%s); \
+	echo "== pytest -n $(JOBS) -m slow"; \
+	$(PY) -m pytest -n $(JOBS) -m "slow and not wheel" --durations=10 -p no:cacheprovider; slow=$$?; \
+	echo "== workbench check under OPENBLAS_CORETYPE=$(OTHER_KERNEL)"; \
+	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(WB) check --jobs $(JOBS) 2>/dev/null | $(NOT_OK); \
+	  other=$${PIPESTATUS[0]}; \
 	echo "== golden report under OPENBLAS_CORETYPE=$(OTHER_KERNEL)"; \
 	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(PY) -m pytest -q -p no:cacheprovider \
 	  tests/test_cli_and_reports.py::test_golden_report; golden=$$?; \
-	echo "pytest exit $$tests, workbench check exit $$checked," \
-	     "$(OTHER_KERNEL) report check exit $$seconded, golden exit $$golden;" \
-	     "$$(( $$(date +%s) - t0 )) s"; \
-	test $$tests -eq 0 && test $$checked -eq 0 && test $$seconded -eq 0 && test $$golden -eq 0
+	echo "== last-bit perturbation: every physical input moved +3 and -3 ulp"; \
+	WORKBENCH_PERTURB_ULPS=3 $(WB) check --jobs $(JOBS) 2>/dev/null | $(NOT_OK); up=$${PIPESTATUS[0]}; \
+	WORKBENCH_PERTURB_ULPS=-3 $(WB) check --jobs $(JOBS) 2>/dev/null | $(NOT_OK); down=$${PIPESTATUS[0]}; \
+	simd=$$($(PY) tests/simd_features.py); \
+	echo "== numpy SIMD: NPY_DISABLE_CPU_FEATURES='$$simd'"; \
+	if [ -n "$$simd" ]; then NPY_DISABLE_CPU_FEATURES="$$simd" $(WB) check --jobs $(JOBS) 2>/dev/null \
+	  | $(NOT_OK); npy=$${PIPESTATUS[0]}; else echo "(none to switch off on this CPU)"; npy=0; fi; \
+	echo "slow tests exit $$slow, $(OTHER_KERNEL) check exit $$other, golden exit $$golden," \
+	     "+3 ulp exit $$up, -3 ulp exit $$down, numpy SIMD exit $$npy; make test-full:" \
+	     "$$(( $$(date +%s) - t0 )) s wall"; \
+	test $$slow -eq 0 && test $$other -eq 0 && test $$golden -eq 0 && test $$up -eq 0 \
+	  && test $$down -eq 0 && test $$npy -eq 0
 
 ## the wheel in a fresh venv outside the checkout: init, verify --junit-xml,
 ## pytest --workbench (needs PyPI for the dependencies; run by .ci/run)

@@ -99,6 +99,7 @@ def test_bad_design_is_exit_2(tmp_path, capsys):
     assert "cruise_entry" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_sweep_is_seeded(tmp_path, capsys):
     short = tmp_path / "antiskid-run-dry.toml"
     text = DRY.read_text().replace('value = 300.0,  unit = "s"', 'value = 31.5,  unit = "s"')

@@ -27,6 +27,14 @@ from workbench.studies.antiskid_run_spec import gain_for  # noqa: E402
 from workbench.studies.antiskid_scenario import RunSettings  # noqa: E402
 
 RTOL = 1e-9
+#: Absolute tolerance of the creep-speed errors (m/s), which end a run near
+#: zero: the two paths agree to RTOL on a speed of order 10 m/s, so their
+#: difference is of order 10 x RTOL x (steps of the run's end) ~ 1e-11 m/s
+#: whatever the error itself is; 1e-9 m/s (1 nm/s) is far below the 2
+#: printed digits of any creep-speed error and far above that noise. A
+#: relative tolerance alone fails on values that are rounding-level zeros
+#: (1e-9 against 1e-11 differed by 2.3e-14 m/s under AVX-512's exp).
+ATOL = {"evs_last": 1e-9, "evs_max_tracking": 1e-9}
 
 
 def assert_close(a: dict, b: dict, keys) -> None:
@@ -37,7 +45,7 @@ def assert_close(a: dict, b: dict, keys) -> None:
         np.testing.assert_array_equal(np.isnan(x), np.isnan(y), err_msg=f"{k}: NaN pattern")
         np.testing.assert_array_equal(x[np.isinf(x)], y[np.isinf(x)], err_msg=f"{k}: infinities")
         fin = np.isfinite(x)
-        np.testing.assert_allclose(x[fin], y[fin], rtol=RTOL, atol=0, err_msg=k)
+        np.testing.assert_allclose(x[fin], y[fin], rtol=RTOL, atol=ATOL.get(k, 0.0), err_msg=k)
 
 
 def _runs(design, n: int, *, t_brake=None, t_end=None, v0=None):
@@ -72,6 +80,7 @@ VARIANTS = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("variant", VARIANTS)
 def test_variants_agree_on_a_short_run(dry, variant):
     # braking from 8 s, end at 16 s, v(0) near v_d: every phase is visited

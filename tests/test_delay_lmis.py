@@ -137,6 +137,7 @@ def _random_systems(count: int, seed: int):
 SOUND_TOL = 1e-4
 
 
+@pytest.mark.slow
 def test_soundness_random_systems():
     """200 seeded systems. No criterion certifies h* (1 + 1e-4) (free-weighting,
     Bessel-Legendre N = 0 (Jensen), 1 (Wirtinger), 2). At a random h < h*,

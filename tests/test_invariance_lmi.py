@@ -162,6 +162,7 @@ def test_synthesis_scales_with_time(c):
     assert _close(r1.gain.h_certified, c * rc.gain.h_certified)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("c", [1e-4, 1e4])
 def test_robust_synthesis_scales_with_time(c):
     """The polytopic (descriptor) synthesis with a decay rate: (c A_i, c B_i),

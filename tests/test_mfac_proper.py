@@ -218,6 +218,7 @@ def small_reading():
     return dataclasses.replace(spec, readings=(reading,), line=())
 
 
+@pytest.mark.slow
 def test_study_is_deterministic(small_reading):
     from workbench.studies.tracking002_run import run_study, study_quantities
     a, b = run_study(small_reading), run_study(small_reading)

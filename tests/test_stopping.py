@@ -106,6 +106,7 @@ def small_spec():
     return replace(load_design(DESIGN).spec, repeats=3)
 
 
+@pytest.mark.slow
 def test_stop_study_is_deterministic_and_batching_invariant(small_spec):
     a = run_station_stops(small_spec)
     b = run_station_stops(small_spec, batch="per-section")

@@ -55,6 +55,7 @@ def test_compiled_and_numpy_paths_agree_bit_for_bit_here(reference):
     assert_identical(reference["compiled"], reference["numpy"])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kernel, chunks", [("compiled", (16, 23)), ("numpy", (23,))])
 def test_process_pool_and_chunk_sizes(short, reference, kernel, chunks):
     for chunk in chunks:
@@ -62,6 +63,7 @@ def test_process_pool_and_chunk_sizes(short, reference, kernel, chunks):
                                progress=False), reference[kernel])
 
 
+@pytest.mark.slow
 def test_local_dask_cluster(short, reference):
     res = sweep(short, N, 3, workers=2, chunk=20, kernel="numpy", progress=False,
                 scheduler="local")
@@ -69,6 +71,7 @@ def test_local_dask_cluster(short, reference):
     assert_identical(res, reference["numpy"])
 
 
+@pytest.mark.slow
 def test_killed_worker_mid_sweep(short, reference):
     pending = start_sweep(short, N, 3, workers=2, chunk=16, kernel="numpy", scheduler="local")
     pids = pending.client.run(os.getpid)        # worker address -> process id

@@ -85,6 +85,7 @@ def test_varying_delay_stays_inside_its_range():
         assert (f >= 0).all() and (f < 1).all()
 
 
+@pytest.mark.slow
 def test_zero_gradient_reproduces_the_ungraded_plant(dry):
     base = _with(dry, None, t_brake=5.0, t_end=8.0)
     zero = _with(dry, SweepPerturbations(gradient=(0.0, 0.0)), t_brake=5.0, t_end=8.0)
@@ -97,6 +98,7 @@ def test_zero_gradient_reproduces_the_ungraded_plant(dry):
             np.testing.assert_array_equal(a[k], b[k], err_msg=f"{kernel}: {k}")
 
 
+@pytest.mark.slow
 def test_compiled_and_numpy_agree_with_every_perturbation_on(dry):
     """8 runs, noise + gradient + varying delay, every phase visited."""
     pytest.importorskip("numba")

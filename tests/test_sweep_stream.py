@@ -49,6 +49,7 @@ def test_a_chunk_draws_its_own_samples():
         uniform_draws(100, 9, r, start=101)
 
 
+@pytest.mark.slow
 def test_stream_resume_and_refusals(short, in_memory, tmp_path, monkeypatch):
     out = tmp_path / "run"
     res = S.start_streaming(short, N, 5, out, workers=1, chunk=CHUNK).result()

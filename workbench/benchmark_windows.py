@@ -11,7 +11,8 @@ import math
 
 import numpy as np
 
-from .lmi.interval import certified_interval
+from .lmi.core import Outcome
+from .lmi.interval import IntervalCertificate, IntervalLMI, IntervalSearch, Link, certified_interval
 from .margins import SpectrumNotConverged, spectral_abscissa, stability_windows
 
 #: Relative slack of the window tests for the exact windows' rounding.
@@ -71,6 +72,55 @@ def interval_inside(lo: float, hi: float, windows, rtol: float = WINDOW_RTOL) ->
                and (hi == b == math.inf or hi < b * (1 + rtol)) for a, b in windows)
 
 
+#: Significant digits of the printed interval ends (the grid they are decided on).
+PRINTED_DIGITS = 4
+
+
+def settle_interval(lmi, c: IntervalCertificate, h_max: float,
+                    sig: int = PRINTED_DIGITS) -> IntervalCertificate:
+    """The interval ``c`` with its ends decided on the grid of printed values.
+
+    A search ends within its tolerance of the criterion's boundary, and where
+    that boundary lies near a printed digit's rounding point the end is
+    printed one way on one CPU and the other way on another. So the printed
+    digits are certified themselves: a finite lower end ``lo`` becomes the
+    grid value below it when one more link [that value, lo] is certified
+    (else the grid value above it, inside the certified interval), and an
+    upper end ``hi`` the grid value above it when the link [hi, that value]
+    is certified (else the grid value below it). Each end is then a printed
+    value, decided by a solve *at* that value: a last-bit difference can
+    change it only where the criterion's own boundary lies within solver
+    noise of the grid value, not wherever the search happened to stop.
+    """
+    win = IntervalLMI(lmi, from_zero=False)
+    links, lo, hi = list(c.links), c.lo, c.hi
+    if 0 < lo:
+        down, up = directed(lo, up=False, sig=sig), directed(lo, up=True, sig=sig)
+        s = None
+        if 0 < down < lo:
+            win.set_lower(down)
+            s = win.solve_at(lo)
+        if s is not None and s.outcome is Outcome.CERTIFIED:
+            links.insert(0, Link(down, lo, s))
+            lo = down
+        else:
+            lo = up
+    if math.isfinite(hi) and hi > 0:
+        down, up = directed(hi, up=False, sig=sig), directed(hi, up=True, sig=sig)
+        s = None
+        if hi < up <= h_max:
+            win.set_lower(hi)
+            s = win.solve_at(up)
+        if s is not None and s.outcome is Outcome.CERTIFIED:
+            links.append(Link(hi, up, s))
+            hi = up
+        else:
+            hi = down
+    if not lo <= hi:                 # narrower than one grid step: keep the search's ends
+        return c
+    return IntervalCertificate(lo, hi, tuple(links))
+
+
 def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: float,
                     guess=None) -> dict:
     """Interval search of one criterion and its comparison with the exact windows:
@@ -87,6 +137,10 @@ def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: f
     search = certified_interval(lmi, h_hi=h_max, starts=starts, rel_tol=rel_tol,
                                 guess=guess or (h if 0 < h < h_max else None),
                                 max_solves=260)
+    if search.interval is not None:
+        settled = tuple(settle_interval(lmi, c, h_max) for c in search.intervals)
+        pick = search.intervals.index(search.interval)
+        search = IntervalSearch(settled[pick], settled, search.outcome, search.steps)
     iv = search.bounds
     out.update(interval=iv, interval_solves=search.solves,
                intervals=tuple((c.lo, c.hi) for c in search.intervals))

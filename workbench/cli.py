@@ -10,6 +10,7 @@ import argparse
 import json
 import math
 import sys
+import time
 from pathlib import Path
 from typing import Callable
 
@@ -125,7 +126,9 @@ def _extra_verifications(args) -> dict:
     return verification_rows()
 
 
-def cmd_report(args) -> int:
+def cmd_report(args, *, checked=frozenset(), problems=()) -> int:
+    """``checked``: designs whose reports a worker of ``check --jobs``
+    already compared (their ``problems``), only the index is checked again."""
     from .report.writer import check_reports, write_reports
     from .verify import evaluate_design, report_files
 
@@ -141,7 +144,10 @@ def cmd_report(args) -> int:
     from .project import find_project
     out = Path(args.out or display_path(find_project().reports))
     if args.check:
-        problems = check_reports(files, out, index=index)
+        problems = list(problems) + check_reports(
+            [f for f in files if f.name not in checked], out, index=False)
+        if index:
+            problems += check_reports(files, out, index=True, only_index=True)
         for p in problems:
             print(p)
         if not problems:
@@ -156,8 +162,18 @@ def cmd_check(args) -> int:
     """``workbench verify`` then ``workbench report --all --check`` in one
     process, each study computed once (:mod:`workbench.memo`; the Monte
     Carlo pools start first and run while the other designs are checked);
-    then the time of every design's study, slowest first, on stderr. Exit
-    code: the larger of the two."""
+    then the time of every design's study, slowest first, on stderr. With
+    ``--jobs N`` (N > 1) the studies and their report checks run on N
+    processes first (:mod:`workbench.checkrun`). Exit code: the larger of the
+    two."""
+    jobs = args.jobs
+    if jobs is None:
+        from .sim.batch import available_cpus
+        jobs = available_cpus()
+    if jobs < 1:
+        raise DesignError("<cli>", "--jobs", jobs, "a positive number of processes")
+    if jobs > 1:
+        return _check_parallel(args, jobs)
     from . import studies
     from .memo import cancel_started, start_studies, study_times
 
@@ -174,8 +190,41 @@ def cmd_check(args) -> int:
     return code
 
 
-def study_times_table(times) -> str:
-    """Markdown table of :func:`workbench.memo.study_times`, slowest first."""
+def _check_parallel(args, jobs: int) -> int:
+    from .checkrun import prefetch, run_folder
+    from .design import display_path
+    from .memo import StudyTime
+    from .project import find_project
+    from .prove import proof_modules
+    t0 = time.perf_counter()
+    out = Path(args.out or display_path(find_project().reports))
+    with run_folder():
+        checked, problems, times = prefetch(_designs([]), [m.name for m in proof_modules()],
+                                            out, jobs)
+        code = cmd_verify(argparse.Namespace(designs=[], json=False, junit_xml=None,
+                                              changed_since=None))
+        print()
+        code = max(code, cmd_report(argparse.Namespace(designs=[], all=True, check=True,
+                                                       out=args.out),
+                                    checked=checked, problems=problems))
+    print(study_times_table([StudyTime(t.name, t.kind, t.wall, t.cpu) for t in times],
+                            jobs=jobs, wall=time.perf_counter() - t0), file=sys.stderr)
+    return code
+
+
+def study_times_table(times, *, jobs: int = 1, wall: float | None = None) -> str:
+    """Markdown table of :func:`workbench.memo.study_times`, slowest first
+    (``jobs > 1``: each row is a task of the pool, with its report check,
+    its CPU including its own pools' workers)."""
+    if jobs > 1:
+        from .report.markdown import md_table
+        rows = [[t.design, t.kind, f"{t.wall:.1f}", f"{t.cpu:.1f}"]
+                for t in sorted(times, key=lambda t: -t.wall)]
+        rows.append(["total", "", f"{sum(t.wall for t in times):.1f}",
+                     f"{sum(t.cpu for t in times):.1f}"])
+        return (f"\nper-task time on {jobs} processes (a task: one design's study and its "
+                f"report check, or one proof module; {wall:.1f} s wall for the whole check):\n"
+                + md_table(["task", "kind", "wall s", "cpu s"], rows, "llrr"))
     from .report.markdown import md_table
     rows = [[t.design, t.kind, f"{t.wall:.1f}", f"{t.cpu:.1f}",
              "" if t.since_start is None else f"{t.since_start:.1f}"]
@@ -325,6 +374,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="output folder (default: reports/ of the project root)")
     p = sub.add_parser("check", help=COMMANDS["check"][0])
     p.add_argument("--out", help="report folder (default: reports/ of the project root)")
+    p.add_argument("--jobs", type=int, default=None,
+                   help="processes for the studies (default: the CPUs granted to this "
+                        "process; 1: everything in this process)")
     p = sub.add_parser("prove", help=COMMANDS["prove"][0])
     p.add_argument("proofs", nargs="*", metavar="PROOF",
                    help="paper (e.g. 003), module of proofs/ or claim id (default: all)")

@@ -22,6 +22,8 @@ unknown keys (often typos) are errors too.
 """
 from __future__ import annotations
 
+import math
+import os
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -53,6 +55,33 @@ class Design:
     claims: tuple
 
 
+#: Environment variable of the last-bit perturbation test (``make test-full``):
+#: an integer k moves every physical parameter of every design k ulps.
+PERTURB_ENV = "WORKBENCH_PERTURB_ULPS"
+
+
+def perturbed(data: Any, ulps: int) -> Any:
+    """``data`` with every float ``value`` of a physical quantity (a table
+    with ``value`` and ``unit``) moved by ``ulps`` units in the last place.
+
+    The last-bit perturbation test: a report must not change when its
+    inputs move by a few ulp, as they do between CPUs (numpy's SIMD loops,
+    BLAS kernels). Numerical settings (steps, tolerances, grids) and claims
+    are not physical inputs and are left alone.
+    """
+    if isinstance(data, dict):
+        out = {k: perturbed(v, ulps) for k, v in data.items()}
+        v = data.get("value")
+        if "unit" in data and isinstance(v, float) and math.isfinite(v) and v != 0.0:
+            for _ in range(abs(ulps)):
+                v = math.nextafter(v, math.copysign(math.inf, ulps))
+            out["value"] = v
+        return out
+    if isinstance(data, list):
+        return [perturbed(v, ulps) for v in data]
+    return data
+
+
 def load_design(path: str | Path) -> Design:
     """Load and validate a design file.
 
@@ -72,6 +101,11 @@ def load_design(path: str | Path) -> Design:
         data = tomllib.loads(p.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise DesignError(shown, "<file>", "<unparsable>", f"valid TOML ({exc})") from None
+    ulps = os.environ.get(PERTURB_ENV, "").strip()
+    if ulps:
+        if not ulps.lstrip("+-").isdigit() or len(ulps) > 6:
+            raise DesignError("<environment>", PERTURB_ENV, ulps[:40], "an integer number of ulps")
+        data = perturbed(data, int(ulps))
     root = Reader(shown, data)
     head = root.table("design")
     name = head.string("name")

@@ -7,9 +7,16 @@ any later design with an equal spec (the study's input: its ``run`` reads
 nothing else of the design). Results are frozen dataclasses, and report
 rendering is pure, so sharing one is the same as recomputing it.
 
-Nothing is kept across processes and nothing is written to disk: every
-``workbench`` command and every test session computes each study afresh,
-once.
+By default nothing is kept across processes and nothing is written to disk:
+every ``workbench`` command and every test session computes each study
+afresh, once. A *run folder* shares results between the processes of one
+run: with ``WORKBENCH_STUDY_CACHE=DIR`` set (``make test`` sets it to a new
+temporary folder, filled by ``workbench check --jobs N`` and read by the
+test session after it), a result is pickled to ``DIR`` under a hash of the
+package's source, the study function and the exact spec key, and a later
+process of the same run loads it instead of computing it again. The folder
+belongs to one run of one source tree: the source hash in every name keeps a
+result from being read by other code.
 
 :func:`start_studies` starts the parts of studies that run in worker
 processes ahead of time (``workbench check`` starts the Monte Carlo pools
@@ -139,6 +146,84 @@ def cancel_started() -> None:
                 p.cancel()
 
 
+#: Environment variable naming the run folder of shared study results.
+CACHE_ENV = "WORKBENCH_STUDY_CACHE"
+_SOURCE_HASH: list[str] = []
+
+
+def _source_hash() -> str:
+    """SHA-256 of every module of the package (computed once per process)."""
+    if not _SOURCE_HASH:
+        import hashlib
+        from pathlib import Path
+        root = Path(__file__).resolve().parent
+        h = hashlib.sha256()
+        for f in sorted(root.rglob("*.py")):
+            h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+        _SOURCE_HASH.append(h.hexdigest())
+    return _SOURCE_HASH[0]
+
+
+def _cache_file(key, run):
+    """The run folder's file of (key, run), or None (no folder, or a run
+    function without a stable name such as a lambda)."""
+    name = f"{getattr(run, '__module__', '')}.{getattr(run, '__qualname__', '')}"
+    if key is None or "<" in name:
+        return None
+    return shared_file(name, key)
+
+
+def shared_file(name: str, key):
+    """The run folder's file for the result named ``name`` with exact key
+    ``key`` (see the module docstring), or None when no run folder is set."""
+    folder = os.environ.get(CACHE_ENV)
+    if not folder:
+        return None
+    import hashlib
+    from pathlib import Path
+    digest = hashlib.sha256(f"{_source_hash()}|{name}|{key!r}".encode()).hexdigest()
+    return Path(folder) / f"{digest}.pickle"
+
+
+def shared(name: str, key, compute: Callable[[], Any]) -> Any:
+    """``compute()``, or its result left in the run folder by an earlier
+    process of the same run (``key`` must determine the result exactly)."""
+    path = shared_file(name, key)
+    if path is not None and path.is_file():
+        found, result = _load(path)
+        if found:
+            return result
+    result = compute()
+    if path is not None:
+        _store(path, result)
+    return result
+
+
+def _load(path):
+    import pickle
+    try:
+        with open(path, "rb") as f:
+            return True, pickle.load(f)
+    except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ImportError):
+        return False, None
+
+
+def _store(path, result) -> None:
+    """Pickle ``result`` to ``path`` atomically (a result that does not pickle
+    is simply not shared)."""
+    import pickle
+    import tempfile
+    try:
+        data = pickle.dumps(result, protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception:            # closures, locks: not shareable, compute again
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".", suffix=".tmp")
+    with os.fdopen(fd, "wb") as f:
+        f.write(data)
+    os.replace(tmp, path)
+
+
 def run_study(design, run: Callable[..., Any]) -> Any:
     """``run(design)``, computed once per process for an equal (kind, spec).
 
@@ -152,6 +237,12 @@ def run_study(design, run: Callable[..., Any]) -> Any:
     key = _design_key(design)
     if key is not None and key in _RESULTS:
         return _RESULTS[key]
+    shared = _cache_file(key, run)
+    if shared is not None and shared.is_file():
+        found, result = _load(shared)
+        if found:
+            _RESULTS[key] = result
+            return result
     w0, c0, started = time.perf_counter(), _cpu(), None
     if key is not None and key in _STARTED:
         _, handle, started = _STARTED.pop(key)
@@ -163,6 +254,8 @@ def run_study(design, run: Callable[..., Any]) -> Any:
                             None if started is None else w1 - started))
     if key is not None:
         _RESULTS[key] = result
+    if shared is not None:
+        _store(shared, result)
     return result
 
 

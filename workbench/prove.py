@@ -136,10 +136,15 @@ def select(names: list[str] | tuple[str, ...] = ()) -> list[tuple[ProofModule, o
 @lru_cache(maxsize=None)
 def check_proof_claim(folder: Path, module: str, claim_id: str) -> ProofResult:
     """Check one claim of a ``proofs/`` module (once per process)."""
+    from .memo import shared
     claim = next(c for m in proof_modules(folder) if m.name == module for c in m.claims
                  if c.id == claim_id)
-    r = check_claim(claim)
-    return replace(r, severity_holds=rounding_holds(r))
+    source = (folder / f"{module}.py").read_bytes()
+
+    def check():
+        r = check_claim(claim)
+        return replace(r, severity_holds=rounding_holds(r))
+    return shared("proof-claim", (module, claim_id, source), check)
 
 
 def rounding_holds(r: ProofResult) -> bool:

@@ -1,0 +1,103 @@
+"""``workbench check --jobs N``: every study once, on N processes.
+
+The check's work is the studies (and the proofs); the verdicts and the report
+comparison that follow are cheap once the results exist. With ``N > 1`` each
+design (and each proof module) is a task of a process pool, slowest first:
+the worker runs the study (:func:`workbench.verify.evaluate_design`), compares
+that design's committed report with the one it renders (Markdown and every
+figure, :func:`workbench.report.writer.check_reports`) and leaves the study
+result in the run folder (:mod:`workbench.memo`, ``WORKBENCH_STUDY_CACHE``).
+The parent then prints ``workbench verify``'s table from those results,
+checks the index and the reports the workers did not, and prints the time of
+every task. A test session started afterwards with the same run folder
+(``make test``) reads the same results instead of computing them again.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+from .memo import CACHE_ENV
+
+__all__ = ["TaskTime", "run_folder", "prefetch"]
+
+#: Kinds whose studies take longest, started first (the rest by file size).
+_SLOW_KINDS = ("antiskid-run", "delay-benchmark", "antiskid-robust", "ntsm-platoon")
+
+
+@dataclass(frozen=True)
+class TaskTime:
+    """Wall and CPU seconds of one task in its worker process."""
+
+    name: str
+    kind: str
+    wall: float
+    cpu: float
+
+
+@contextmanager
+def run_folder():
+    """The run folder of shared study results: ``WORKBENCH_STUDY_CACHE`` if
+    set (kept), else a new temporary folder removed on exit."""
+    if os.environ.get(CACHE_ENV):
+        yield Path(os.environ[CACHE_ENV])
+        return
+    folder = tempfile.mkdtemp(prefix="workbench-run-")
+    os.environ[CACHE_ENV] = folder
+    try:
+        yield Path(folder)
+    finally:
+        os.environ.pop(CACHE_ENV, None)
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _cpu() -> float:
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+def _design_task(path: str, out: str):
+    """Worker: the study of one design and the check of its report."""
+    from .design import load_design
+    from .report.writer import check_reports
+    from .verify import evaluate_design, report_files
+    w0, c0 = time.perf_counter(), _cpu()
+    d = load_design(path)
+    files = report_files(evaluate_design(d))
+    problems = check_reports([files], Path(out), index=False)
+    return d.name, problems, TaskTime(d.name, d.kind, time.perf_counter() - w0, _cpu() - c0)
+
+
+def _proof_task(module: str):
+    """Worker: every claim of one proof module (results cached in the run folder)."""
+    from .prove import run_proofs
+    w0, c0 = time.perf_counter(), _cpu()
+    run_proofs([module])
+    name = f"proofs/{module}"
+    return name, [], TaskTime(name, "proof", time.perf_counter() - w0, _cpu() - c0)
+
+
+def prefetch(designs, proof_modules, out: Path, jobs: int):
+    """Run every design's study and report check, and every proof module, on
+    ``jobs`` processes. Returns (names of designs whose reports were checked,
+    their problems, task times)."""
+    import multiprocessing as mp
+    order = sorted(designs, key=lambda d: (d.kind not in _SLOW_KINDS,
+                                            -Path(d.path).stat().st_size, d.name))
+    checked, problems, times = set(), [], []
+    with ProcessPoolExecutor(jobs, mp_context=mp.get_context("fork")) as ex:
+        futs = [ex.submit(_design_task, str(d.path), str(out)) for d in order]
+        futs += [ex.submit(_proof_task, m) for m in proof_modules]
+        for f in as_completed(futs):
+            name, probs, t = f.result()
+            if t.kind != "proof":
+                checked.add(name)
+            problems += probs
+            times.append(t)
+    return checked, problems, times
