@@ -4,6 +4,7 @@ and the report check."""
 from __future__ import annotations
 
 import dataclasses
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -94,3 +95,45 @@ def test_study_times_count_the_run_and_the_pool_apart():
         assert t["pooled"].wall < 0.1 and t["pooled"].since_start >= 0.2
     finally:
         memo.clear()
+
+
+def _double(design):
+    _double.calls += 1
+    return {"name": design.name, "calls": _double.calls}
+
+
+_double.calls = 0
+
+
+def test_run_folder_shares_results_between_processes(tmp_path, monkeypatch):
+    """With WORKBENCH_STUDY_CACHE set, a result computed by one process is
+    read by the next one of the run (here: the memo cleared in between)."""
+    from workbench.design import load_design
+    monkeypatch.setenv(memo.CACHE_ENV, str(tmp_path))
+    d = load_design(DATA / "small-cruise.toml")
+    memo.clear()
+    try:
+        first = memo.run_study(d, _double)
+        assert len(list(tmp_path.glob("*.pickle"))) == 1
+        memo.clear()                                   # "another process"
+        assert memo.run_study(d, _double) == first and _double.calls == 1
+        memo.clear()
+        assert memo.run_study(d, lambda x: "fresh") == "fresh"   # no stable name: not shared
+        monkeypatch.delenv(memo.CACHE_ENV)
+        memo.clear()
+        memo.run_study(d, _double)                     # no run folder: computed again
+        assert _double.calls == 2
+    finally:
+        memo.clear()
+
+
+def test_perturbed_moves_physical_values_only():
+    from workbench.design import perturbed
+    data = {"parameters": {"m": {"value": 1.0, "unit": "kg"}, "n": {"value": 3, "unit": "-"}},
+            "settings": {"dt": 0.001}, "list": [{"value": -2.5, "unit": "m"}]}
+    up = perturbed(data, 3)
+    assert up["parameters"]["m"]["value"] == 1.0 + 3 * 2.0 ** -52
+    assert up["parameters"]["n"]["value"] == 3 and up["settings"]["dt"] == 0.001
+    assert up["list"][0]["value"] == math.nextafter(math.nextafter(math.nextafter(
+        -2.5, math.inf), math.inf), math.inf)
+    assert perturbed(data, -1)["parameters"]["m"]["value"] == math.nextafter(1.0, 0.0)

@@ -100,19 +100,19 @@ class _AxisGrid:
             return s
         fin = np.isfinite(s)
         out = np.where(fin, np.round(np.where(fin, s, 0.0) / self.step) * self.step, s)
-        if self.kind != "linear":      # log of a non-positive value: below the axis
-            out = np.where(np.isneginf(out), self.lim[0] - 16 * abs(self.lim[1] - self.lim[0]),
-                           out)
+        if self.kind != "linear":      # log of a non-positive value: far below the axis
+            low = min(self.lim) - 16 * abs(self.lim[1] - self.lim[0])
+            out = np.where(np.isneginf(out), math.floor(low / self.step) * self.step, out)
         return out
 
 
-def _log_ticks(ax, which: str, grid: _AxisGrid) -> None:
+def _log_ticks(ax, which: str, grid: _AxisGrid, lim) -> None:
     """Ticks and labels of a log / symlog axis re-drawn as linear
     (:class:`_AxisGrid`): decades ``base**k`` labelled as powers (minor ticks
     at their multiples), or, within less than a decade, a few round values."""
     from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullLocator
     axis = ax.xaxis if which == "x" else ax.yaxis
-    lo, hi = sorted(grid.lim)
+    lo, hi = sorted(float(v) for v in lim)
     major, labels, minor = [], {}, []
     b = grid.base
     bname = f"{b:g}"
@@ -183,6 +183,9 @@ def snap_axes(ax, grids=None) -> None:
     ``grids``: the axes' ``(xlim, ylim, gx, gy)`` taken before any axes of the
     figure was changed (shared axes change together)."""
     xlim, ylim, gx, gy = grids or _axes_grids(ax)
+    for which, g in (("x", gx), ("y", gy)):
+        if g.kind != "linear":         # drawn as a linear axis of the scale coordinate
+            getattr(ax, f"set_{which}scale")("linear")
     for a in ax.get_children():
         if isinstance(a, Line2D):
             dims = _data_dims(ax, a.get_transform())
@@ -226,9 +229,9 @@ def snap_axes(ax, grids=None) -> None:
     auto = ax.get_autoscalex_on(), ax.get_autoscaley_on()
     for which, g, lim, a in (("x", gx, xlim, auto[0]), ("y", gy, ylim, auto[1])):
         if g.kind != "linear":
-            getattr(ax, f"set_{which}scale")("linear")
-            getattr(ax, f"set_{which}lim")(*g(lim))
-            _log_ticks(ax, which, g)
+            snapped = g(lim)
+            getattr(ax, f"set_{which}lim")(*snapped)
+            _log_ticks(ax, which, g, snapped)
         elif a:
             getattr(ax, f"set_{which}lim")(*g(lim))
 
