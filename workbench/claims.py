@@ -33,7 +33,8 @@ Traceability (issue 33, item 2): a claim with no ``requirement`` traces to a
 requirement of its own, ``R-<claim id>``; with no ``criterion`` its
 acceptance criterion is its comparison (``quantity compare value``); with no
 ``basis`` it is ``paper`` when the claim states the paper's result and ``our
-choice`` otherwise. :attr:`Claim.derived` names the fields so derived, and the
+choice`` otherwise. A workbench finding's claim states the defect, so its
+derived criterion is the negation of its comparison. :attr:`Claim.derived` names the fields so derived, and the
 report marks them.
 
 A design's hazard log and assumptions register (issue 33, item 3)::
@@ -323,6 +324,8 @@ def _traceability(r: Reader, cid, q, cmp_, value, tol, digits, rounding, origin,
         raise r.fail("requirement", req, "letters, digits and _ . = + - only")
     crit = r.string("criterion", default=None) or criterion_text(q, cmp_, value, tol, digits,
                                                                  rounding)
+    if not r.has("criterion") and severity is not None and r.raw("expect", "pass") == "pass":
+        crit = f"not ({crit}): the claim shows the defect"
     basis = r.string("basis", default="paper" if origin == "paper" else "our choice",
                      choices=BASES)
     standard = r.string("standard", default="")

@@ -194,7 +194,8 @@ def traceability_section(results: tuple[ClaimResult, ...], link) -> str:
              f"not tested ({len(claims)} claims: {count(claims, 'met')} met, "
              f"{count(claims, 'not met')} not met, {count(claims, 'not tested')} not tested).")
     note = ("*(derived)*: the design file is silent and the field follows the claim "
-            "(requirement `R-<claim id>`; criterion: the claim's comparison; origin: `paper` "
+            "(requirement `R-<claim id>`; criterion: the claim's comparison, negated for a "
+            "workbench finding, whose claim states the defect; origin: `paper` "
             "for a paper claim, else `our choice`, with the claim's source). A requirement "
             "is met only when all its claims are.")
     return ("## Traceability\n\n" + md_table(["requirement", "origin", "acceptance criterion",
