@@ -103,7 +103,9 @@ def test_bad_traceability_input_names_the_key(tmp_path, extra, key):
 def test_design_hash_and_registers(tmp_path):
     p = _write(tmp_path, '\n[[assumptions]]\ntext = "we chose t"\neffect = "e"\n')
     d = load_design(p)
-    assert len(d.sha256) == 64 and d.assumptions[0].effect == "e"
+    assert len(d.sha256) == 64 and d.assumptions[-1].effect == "e"
+    import hashlib
+    assert d.sha256 == hashlib.sha256(p.read_bytes()).hexdigest()
 
 
 def test_hazards_markdown_lists_orphans():

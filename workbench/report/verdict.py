@@ -238,25 +238,33 @@ def hazard_entries(design) -> tuple:
 
 
 def hazards_markdown(entries) -> str:
-    """``reports/HAZARDS.md``: every hazard of every design (one row per
-    hazard id and design), the safety findings it is linked to, and every
-    safety finding with no hazard id."""
-    rows, orphans = [], []
+    """``reports/HAZARDS.md``: every hazard id of every design (one row per
+    id: its text from the first design that logs it, the status and safety
+    findings per design), and every safety finding with no hazard id."""
+    by_id, orphans = {}, []
     for name, hazards, safety in sorted(entries, key=lambda e: e[0]):
         link = f"[{name}]({name}.md#{slug(HAZARD_HEADING)})"
         for h in hazards:
-            rows.append([f"`{h.id}`", link, h.hazard, h.cause, h.consequence, h.mitigation,
-                         f"**{h.status}**", _findings_of(h.id, safety)])
+            by_id.setdefault(h.id, []).append((link, h, _findings_of(h.id, safety)))
         orphans += [f"{link}: `{c.id}`" for c in safety if c.hazard is None]
-    rows.sort(key=lambda r: (r[0], r[1]))
-    body = (md_table(["hazard", "design", "what", "cause", "consequence", "mitigation",
-                      "status", "safety findings"], rows, "llllllll")
+    rows = []
+    for hid in sorted(by_id):
+        first = by_id[hid][0][1]
+        differs = [link for link, h, _ in by_id[hid][1:]
+                   if (h.hazard, h.cause, h.consequence, h.mitigation) !=
+                   (first.hazard, first.cause, first.consequence, first.mitigation)]
+        where = "; ".join(f"{link} (**{h.status}**): {found}" for link, h, found in by_id[hid])
+        what = first.hazard + (" (worded differently in " + ", ".join(differs) + ")"
+                               if differs else "")
+        rows.append([f"`{hid}`", what, first.cause, first.consequence, first.mitigation, where])
+    body = (md_table(["hazard", "what", "cause", "consequence", "mitigation",
+                      "designs (status): safety findings"], rows, "llllll")
             if rows else "_No design has a hazard log._")
     tail = ("\n\n## Safety findings without a hazard id\n\n"
             + ("\n".join(f"- {o}" for o in orphans) if orphans else "None.") + "\n")
     return ("# Hazard log\n\nGenerated from the `[[hazards]]` tables and the safety findings "
             "(`severity = \"safety\"`, linked by `hazard = \"<id>\"`) of every design file in "
-            "`designs/`; checked fresh with the index by `workbench report --all --check`. A "
-            "hazard shared by several designs has one row per design. Status: `open` (no "
-            "mitigation), `mitigated` (a mitigation named, not shown by the design's claims), "
-            "`closed` (mitigation shown).\n\n" + body + tail)
+            "`designs/`; checked fresh with the index by `workbench report --all --check`. One "
+            "row per hazard id; its status and safety findings per design that logs it. Status: "
+            "`open` (no mitigation), `mitigated` (a mitigation named, not shown by the design's "
+            "claims), `closed` (mitigation shown).\n\n" + body + tail)
