@@ -217,7 +217,8 @@ def index_row(s: Summary, v: DesignVerdict, labels: Labels = DESIGN) -> list[str
     if v.decisive:
         why = f"{len(v.decisive)} decisive: " + _ids(v.decisive)
     elif v.conditions:
-        why = f"{len(v.conditions)} conditions: " + _ids(v.conditions)
+        n = len(v.conditions)
+        why = f"{n} condition{'s' if n > 1 else ''}: " + _ids(v.conditions)
     else:
         why = "—"
     tool = f"{s.claims - len(s.not_ok)} of {s.claims}" + (" **NOT OK**" if s.not_ok else "")
