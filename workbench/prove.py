@@ -329,7 +329,8 @@ def _traceability(pairs) -> str:
     items = proof_items([r for _, r in pairs])
     rows = [[f"`R-{r.claim.id}`", ("paper" if r.claim.origin == "paper" else "our choice")
              + f": paper {r.claim.paper}, {_eqs(r.claim.equations)}",
-             f"{expected_verdict(r)}", f"`{r.claim.id}`",
+             "PROVED" + (" as printed (expected REFUTED: an erratum)"
+                         if r.claim.expect == "refuted" else ""), f"`{r.claim.id}`",
              f"[its section](#{slug(_heading(r))})",
              f"**{it.status}**" + (f" ({it.severity})" if it.status == "not met" and it.severity
                                    else "")] for (_, r), it in zip(pairs, items)]
@@ -338,7 +339,7 @@ def _traceability(pairs) -> str:
                                                "claim", "evidence", "verdict"], rows, "llllll")
             + f"\n\nCoverage: {len(items)} requirements — {n['met']} met, {n['not met']} not "
             f"met, {n['not tested']} not tested. Each proof claim is a requirement of its own "
-            "(derived: `R-<claim id>`; criterion: the expected verdict; origin: `paper` for a "
+            "(derived: `R-<claim id>`; criterion: the step is PROVED; origin: `paper` for a "
             "step of the paper, `our choice` for a corrected form the workbench adds).")
 
 
