@@ -37,7 +37,9 @@ from matplotlib.text import Text  # noqa: E402
 from .files import atomic_write  # noqa: E402
 from .markdown import Figure  # noqa: E402
 
-_RC = {"svg.hashsalt": "workbench", "figure.dpi": 100, "savefig.dpi": 100,
+#: Export resolution (issue 33, item 7: at least 150 dpi for a review pack).
+DPI = 150
+_RC = {"svg.hashsalt": "workbench", "figure.dpi": DPI, "savefig.dpi": DPI,
        "font.size": 9, "axes.grid": True, "grid.alpha": 0.3}
 
 #: Grid cells per axis span of :func:`snap_figure` (the grid step is the
@@ -145,13 +147,16 @@ def snap_figure(fig) -> None:
 
 
 def figure_png(fig_spec: Figure) -> bytes:
-    """The PNG of ``fig_spec``: drawn, snapped (:func:`snap_figure`), laid
-    out, with no timestamp or version metadata."""
+    """The PNG of ``fig_spec``: drawn, snapped (:func:`snap_figure`),
+    titled (``fig_spec.title``), laid out at :data:`DPI`, with no timestamp
+    or version metadata."""
     with matplotlib.rc_context(_RC):
         fig = plt.figure(figsize=fig_spec.size)
         try:
             fig_spec.draw(fig)
             snap_figure(fig)
+            if fig_spec.title:
+                fig.suptitle(fig_spec.title, fontsize=7, x=0.01, ha="left")
             fig.tight_layout()
             buf = io.BytesIO()
             fig.savefig(buf, format="png", metadata={"Software": None})

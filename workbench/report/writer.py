@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import platform
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib import metadata
 from pathlib import Path
 
@@ -173,9 +173,17 @@ def build(ev, rendered: Rendered, solver: str | None,
           config: Configuration = Configuration()) -> ReportFiles:
     """The report files of one evaluated design (see :func:`render_report`)."""
     md, figs = render_report(ev, rendered, ev.design.name, solver, config)
+    figs = tuple(replace(f, title=figure_title(ev.design, f)) for f in figs)
     v = decide(design_items(ev.claims, ev.design.hazards))
     return ReportFiles(ev.design.name, md, figs, ev.ok, verdict_summary(ev.claims),
                        tuple(index_cells(ev.claims, v)), hazard_entries(ev.design))
+
+
+def figure_title(design, fig: Figure) -> str:
+    """The title drawn on a figure: design name, figure name, and the
+    design's title (its case and key parameters, e.g. rail and v_d), kept
+    when the figure already has one of its own."""
+    return fig.title or f"{design.name} / {fig.name}\n{design.title}"
 
 
 def index_markdown(files: list[ReportFiles]) -> str:
