@@ -88,7 +88,8 @@ class Summary:
     paper : int
         Claims that state the paper's own results.
     reproduced : int
-        Paper claims that hold as printed (and are not findings).
+        Paper claims that hold as printed (and are not findings, and their
+        check can test them: not ``untested``).
     findings : tuple[Finding, ...]
         Most severe first (paper findings before workbench ones within a
         severity; those not assessed last).
@@ -148,7 +149,8 @@ def summarise(results: tuple[ClaimResult, ...], anchors=()) -> Summary:
                          if r.claim.severity_reason else ""), r.claim.hazard)
                 for r in results if r.claim.is_finding]
     paper = [r for r in results if r.claim.origin == "paper"]
-    reproduced = sum(r.verdict is Verdict.PASS and not r.claim.is_finding for r in paper)
+    reproduced = sum(r.verdict is Verdict.PASS and not r.claim.is_finding and not r.claim.untested
+                     for r in paper)
     return Summary(len(results), tuple(r.claim.id for r in results if not r.ok), len(paper),
                    reproduced, ordered(findings))
 

@@ -132,7 +132,7 @@ def decide(items: tuple[Item, ...]) -> DesignVerdict:
 
 
 def _item_rows(pairs) -> str:
-    return md_table(["claim", "requirement not met", "why it counts"],
+    return md_table(["claim", "statement", "why it counts"],
                     [[f"`{it.id}`", it.what, why] for it, why in pairs], "lll")
 
 
