@@ -115,3 +115,27 @@ def test_hazards_markdown_lists_orphans():
     md = hazards_markdown([("d", (h,), (lock, spin))])
     assert "`HZ-1`" in md and "`spin`" in md
     assert md.split("## Safety findings without a hazard id")[1].strip().endswith("`lock`")
+
+
+def test_project_commit_or_uncommitted(tmp_path):
+    import shutil
+    import subprocess
+
+    from workbench.verify import pinned_versions, project_commit
+    if shutil.which("git") is None:
+        pytest.skip("no git")
+    run = lambda *a: subprocess.run(["git", *a], cwd=tmp_path, check=True, capture_output=True)
+    assert project_commit(tmp_path) == ""                       # not a checkout
+    run("init", "-q")
+    (tmp_path / "constraints.txt").write_text("numpy==2.4.6\n# a comment\nSciPy==1.17.1\n")
+    run("add", ".")
+    run("-c", "user.name=t", "-c", "user.email=t@t", "commit", "-qm", "x")
+    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=tmp_path, capture_output=True,
+                          text=True).stdout.strip()
+    assert project_commit(tmp_path) == head
+    (tmp_path / "reports").mkdir()
+    (tmp_path / "reports" / "r.md").write_text("a report\n")   # reports/ never counts
+    assert project_commit(tmp_path) == head
+    (tmp_path / "design.toml").write_text("x = 1\n")           # an untracked design does
+    assert project_commit(tmp_path) == ""
+    assert pinned_versions(tmp_path) == {"numpy": "2.4.6", "scipy": "1.17.1"}

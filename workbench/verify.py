@@ -36,13 +36,14 @@ def evaluate_design(design: Design) -> Evaluation:
 
 def project_commit(root) -> str:
     """The commit of the project at ``root`` (``git rev-parse HEAD``), or
-    "" when it is not a git checkout or tracked files outside ``reports/``
-    differ from that commit (the report is then "uncommitted")."""
+    "" when it is not a git checkout or files outside ``reports/`` differ
+    from that commit, untracked ones included (the report is then
+    "uncommitted")."""
     import subprocess
     try:
         head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True,
                               text=True, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--",
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=normal", "--",
                                 ".", ":(exclude)reports"], cwd=root, capture_output=True,
                                text=True, check=True).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
