@@ -34,8 +34,8 @@ requirement of its own, ``R-<claim id>``; with no ``criterion`` its
 acceptance criterion is its comparison (``quantity compare value``); with no
 ``basis`` it is ``paper`` when the claim states the paper's result and ``our
 choice`` otherwise. A workbench finding's claim states the defect, so its
-derived criterion is the negation of its comparison. :attr:`Claim.derived` names the fields so derived, and the
-report marks them.
+derived criterion is the negation of its comparison. :attr:`Claim.derived`
+names the fields so derived, and the report marks them.
 
 A design's hazard log and assumptions register (issue 33, item 3)::
 

@@ -7,8 +7,9 @@ and its findings (each a :class:`Finding` with its severity from
 :mod:`workbench.prove` from a paper's proof claims. :func:`render_findings`
 writes the ``## Findings`` block (after the design verdict of
 :mod:`workbench.report.verdict`) and :func:`index_row` the columns of
-``reports/README.md``; both are pure functions of the summary. :func:`findings_section` and :func:`index_cells`
-are the two for a design's claims.
+``reports/README.md``; both are pure functions of the summary.
+:func:`findings_section` and :func:`index_cells` are the two for a design's
+claims.
 """
 from __future__ import annotations
 
