@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import io
 import math
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -156,7 +157,10 @@ def figure_png(fig_spec: Figure) -> bytes:
             fig_spec.draw(fig)
             snap_figure(fig)
             if fig_spec.title:
-                fig.suptitle(fig_spec.title, fontsize=7, x=0.01, ha="left")
+                width = max(40, int(fig_spec.size[0] * 17))   # characters of 7 pt per line
+                lines = [w for line in fig_spec.title.split("\n")
+                         for w in textwrap.wrap(line, width) or [""]]
+                fig.suptitle("\n".join(lines), fontsize=7, x=0.01, ha="left")
             fig.tight_layout()
             buf = io.BytesIO()
             fig.savefig(buf, format="png", metadata={"Software": None})

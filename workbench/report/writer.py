@@ -180,10 +180,10 @@ def build(ev, rendered: Rendered, solver: str | None,
 
 
 def figure_title(design, fig: Figure) -> str:
-    """The title drawn on a figure: design name, figure name, and the
-    design's title (its case and key parameters, e.g. rail and v_d), kept
-    when the figure already has one of its own."""
-    return fig.title or f"{design.name} / {fig.name}\n{design.title}"
+    """The title drawn on a figure: design name and the figure's caption,
+    then the design's title (its case and key parameters, e.g. rail and
+    v_d); a title the study gave the figure is kept."""
+    return fig.title or f"{design.name}: {fig.caption}\n{design.title}"
 
 
 def index_markdown(files: list[ReportFiles]) -> str:
