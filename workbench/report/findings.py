@@ -94,6 +94,8 @@ class Summary:
     findings : tuple[Finding, ...]
         Most severe first (paper findings before workbench ones within a
         severity; those not assessed last).
+    untested : int
+        Paper claims whose check holds but cannot test them (``untested``).
     """
 
     claims: int
@@ -101,6 +103,7 @@ class Summary:
     paper: int
     reproduced: int
     findings: tuple[Finding, ...]
+    untested: int = 0
 
     def by_severity(self, origin: str | None = None) -> dict[str, int]:
         """Findings (of one origin, or all) per severity, most severe first,
@@ -152,8 +155,9 @@ def summarise(results: tuple[ClaimResult, ...], anchors=()) -> Summary:
     paper = [r for r in results if r.claim.origin == "paper"]
     reproduced = sum(r.verdict is Verdict.PASS and not r.claim.is_finding and not r.claim.untested
                      for r in paper)
+    untested = sum(bool(r.claim.untested) for r in paper)
     return Summary(len(results), tuple(r.claim.id for r in results if not r.ok), len(paper),
-                   reproduced, ordered(findings))
+                   reproduced, ordered(findings), untested)
 
 
 def _counts(d: dict[str, int]) -> str:
@@ -184,7 +188,9 @@ def render_findings(s: Summary, labels: Labels = DESIGN, notes: tuple[str, ...] 
     if not s.claims:
         return f"## Findings\n\n_This design states no {labels.items}._"
     lines = [f"- {labels.reproduced}: {s.reproduced} of {s.paper}; {labels.not_reproduced}: "
-             f"{_counts(s.by_severity('paper'))}."]
+             f"{_counts(s.by_severity('paper'))}"
+             + (f"; not tested (the check cannot test them): {s.untested}" if s.untested else "")
+             + "."]
     if labels.workbench:
         lines.append(f"- {labels.workbench}: {_counts(s.by_severity('workbench'))}.")
     lines += notes
