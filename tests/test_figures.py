@@ -44,10 +44,24 @@ def test_a_visible_change_changes_the_png():
     assert _png(0.0) != _png(1e-3)
 
 
+def test_title_and_resolution():
+    import io
+
+    from PIL import Image
+    plain = figure_png(Figure("t", "test", lambda f: _draw(f, 0.0)))
+    titled = figure_png(Figure("t", "test", lambda f: _draw(f, 0.0), title="design / t"))
+    assert titled != plain
+    img = Image.open(io.BytesIO(titled))
+    assert img.size == (round(6.4 * figures.DPI), round(4.0 * figures.DPI))
+    assert figures.DPI >= 150
+
+
 def test_without_snapping_the_last_digits_change_the_png(monkeypatch):
     # the property above is the snapping's, not the renderer's
+    # (at 150 dpi a 1e-10 change happens to land on the same pixels; -3e-9, one of the
+    # changes the snapped PNG ignores above, does not)
     monkeypatch.setattr(figures, "snap_figure", lambda fig: None)
-    assert _png(0.0) != _png(1e-10)
+    assert _png(0.0) != _png(-3e-9)
 
 
 def test_grid_is_a_power_of_two_below_span_over_cells():

@@ -8,6 +8,7 @@ import pytest
 
 from workbench.claims import SEVERITIES, Claim, Verdict, check_claim, origin_of
 from workbench.report.findings import findings_section, index_cells, summarise
+from workbench.report.verdict import decide, design_items
 
 REPORTS = Path(__file__).resolve().parents[1] / "reports"
 
@@ -47,30 +48,33 @@ def test_summary_orders_findings_most_severe_first():
     assert s.by_severity("paper") == {"safety": 1, "minor": 1}
     assert s.by_severity("workbench") == {"changes-the-result": 1}
     text = findings_section(results)
-    assert text.startswith("## Findings\n\n**Verified: all 4 claims hold")
+    assert "Verified" not in text
     assert text.index("claim spin") < text.index("claim offset") < text.index("claim minor")
-    cells = index_cells(results)
-    assert cells[0] == "verified" and cells[1] == "1 of 3"
-    assert cells[3].startswith("**safety** (not reproduced: claim spin")
+    assert "**no hazard id** (flagged)" in text        # the safety finding links to none
+    cells = index_cells(results, decide(design_items(results)))
+    assert cells[:2] == ["**reject**", "1 decisive: `spin`"]
+    assert cells[3] == "1 of 3" and cells[4] == "<sub>4 of 4</sub>"
 
 
-def test_a_claim_that_does_not_hold_leads_the_block():
+def test_a_claim_that_does_not_hold_is_decisive_and_not_ok():
     results = (check_claim(_claim("broken", 1.0, tol=0.1), 2.0),)
-    assert findings_section(results).startswith("## Findings\n\n**NOT OK: 1 of 1 claims")
-    assert index_cells(results)[0] == "**NOT OK** (1)"
+    v = decide(design_items(results))
+    assert v.verdict == "reject" and "no severity assessed" in v.decisive[0][1]
+    assert index_cells(results, v)[4] == "<sub>0 of 1 **NOT OK**</sub>"
 
 
 @pytest.mark.parametrize("path", sorted(p for p in REPORTS.glob("*.md")
-                                        if p.stem != "README"),
+                                        if p.stem not in ("README", "HAZARDS")),
                          ids=lambda p: p.stem)
-def test_every_design_report_opens_with_findings(path):
+def test_every_report_opens_with_the_design_verdict(path):
     md = path.read_text(encoding="utf-8")
     first = re.search(r"^## .*$", md, re.M)[0]
-    assert first == "## Findings"
+    assert first == "## Design verdict"
+    assert not re.search(r"^\**Verified", md, re.M)
 
 
 def test_index_shows_severities():
     index = (REPORTS / "README.md").read_text(encoding="utf-8")
-    assert "all ok" not in index
-    assert "most severe finding" in index
+    assert "all ok" not in index and "Verified" not in index
+    assert "design verdict" in index
     assert any(f"**{s}**" in index for s in SEVERITIES)

@@ -154,10 +154,14 @@ def test_a_bad_proof_severity_is_bad_input(severity, expect, kind, reason, key):
     assert len(msg.splitlines()) == 1 and f"claims()[x-printed].{key}" in msg and "expected" in msg
 
 
-def test_proof_reports_open_with_findings():
+def test_proof_reports_open_with_the_verdict_then_findings():
     for f in report_files():
         md = f.markdown
-        assert re.search(r"^## .*$", md, re.M)[0] == "## Findings", f.name
+        heads = re.findall(r"^## .*$", md, re.M)
+        assert heads[:2] == ["## Design verdict", "## Findings"], f.name
+        assert heads[-1] == "## Traceability" and "Coverage: " in md, f.name
+        assert "Verified" not in md and "- Project commit: " in md, f.name
+        assert f.index[0] in ("**accept**", "**accept with conditions**", "**reject**")
         findings = md.split("## Findings")[1].split("\n## ")[0]
         errata = [c for m in proof_modules() if f"proofs-{m.paper}" == f.name
                   for c in m.claims if c.expect == "refuted"]

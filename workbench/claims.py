@@ -18,6 +18,38 @@ A claim in a design file::
     severity = "minor"        # required with expect = "fail"; on a passing claim
                               #   it makes the claim a workbench finding
     origin = "paper"          # "paper" | "workbench" (default: from `source`)
+    requirement = "R-003-H1"  # requirement id (default: "R-" + the claim id)
+    criterion = "..."         # acceptance criterion (default: quantity, compare, value)
+    basis = "paper"           # where the requirement comes from: "paper" | "standard"
+                              #   | "customer" | "our choice" (default: "paper" for a
+                              #   paper claim, else "our choice")
+    standard = "EN 15595, 4.2"  # name and clause; required with basis = "standard"
+    hazard = "HZ-003-LOCK"    # the hazard a safety finding shows (an id of [[hazards]])
+    untested = "..."          # the check holds but cannot test the requirement (why):
+                              #   the requirement counts as not tested
+    severity_reason = "..."   # why this severity (shown with the finding)
+
+Traceability (issue 33, item 2): a claim with no ``requirement`` traces to a
+requirement of its own, ``R-<claim id>``; with no ``criterion`` its
+acceptance criterion is its comparison (``quantity compare value``); with no
+``basis`` it is ``paper`` when the claim states the paper's result and ``our
+choice`` otherwise. A workbench finding's claim states the defect, so its
+derived criterion is the negation of its comparison. :attr:`Claim.derived`
+names the fields so derived, and the report marks them.
+
+A design's hazard log and assumptions register (issue 33, item 3)::
+
+    [[hazards]]
+    id = "HZ-003-LOCK"
+    hazard = "wheel lock in braking"
+    cause = "..."
+    consequence = "..."
+    mitigation = "..."
+    status = "open"           # "open" | "mitigated" | "closed" (HAZARD_STATUSES)
+
+    [[assumptions]]
+    text = "we chose ..."
+    effect = "..."            # its effect on the result
 
 A ``description`` or ``reason`` never types a measured number: it names it,
 ``{quantity}`` or ``{quantity:N}`` (N significant digits, default 4;
@@ -87,6 +119,14 @@ class Claim:
     reason: str
     severity: str | None = None
     origin: str = "paper"
+    requirement: str = ""
+    criterion: str = ""
+    basis: str = "paper"
+    standard: str = ""
+    hazard: str | None = None
+    derived: tuple[str, ...] = ()
+    untested: str = ""
+    severity_reason: str = ""
 
     @property
     def is_finding(self) -> bool:
@@ -98,6 +138,11 @@ class Claim:
 SEVERITIES = ("rounding", "minor", "changes-the-result", "safety")
 #: Where a claim comes from: a statement of a paper, or the workbench's own check.
 ORIGINS = ("paper", "workbench")
+#: Where a requirement comes from (issue 33, item 2).
+BASES = ("paper", "standard", "customer", "our choice")
+#: Status of a hazard: no mitigation yet; a mitigation named but not shown by
+#: this design's claims; mitigation shown (the hazard no longer blocks a verdict).
+HAZARD_STATUSES = ("open", "mitigated", "closed")
 #: Relative size of a "rounding" discrepancy.
 ROUNDING_RTOL = 1e-3
 _PAPER_SOURCE = re.compile(r"^(paper\s*)?\d{3}\b", re.I)
@@ -246,10 +291,103 @@ def parse_claims(root: Reader, study, spec) -> list[Claim]:
         if severity is not None and expect == "pass" and origin == "paper":
             raise r.fail("severity", severity, 'no severity on a reproduced paper claim '
                          '(a finding is expect = "fail", or origin = "workbench")')
+        meta = _traceability(r, cid, q, cmp_, value, tol, digits, rounding, origin, severity)
         r.finish()
         out.append(Claim(cid, desc, q, cmp_, value, tol, digits, rounding, src, allow,
-                         expect, reason, severity, origin))
+                         expect, reason, severity, origin, **meta))
     return out
+
+
+def criterion_text(quantity: str, compare: str, value, tolerance: float,
+                   digits: int | None, rounding: str) -> str:
+    """A claim's comparison as an acceptance criterion: ``quantity == 0.0255
+    (4 decimals, truncated)``, ``quantity within 10.5 ± 0.105``."""
+    def fmt(x, sig=6):
+        if isinstance(x, str):
+            return x
+        return ("∞" if x > 0 else "−∞") if math.isinf(x) else f"{x:.{sig}g}"
+    want = f"{quantity} {compare} {fmt(value)}"
+    if compare == "within" or (compare != "==" and tolerance):
+        want += f" ± {fmt(tolerance, 4)}"
+    if digits is not None:
+        want += f" ({digits} decimals, {'truncated' if rounding == 'truncate' else 'rounded'})"
+    return want
+
+
+def _traceability(r: Reader, cid, q, cmp_, value, tol, digits, rounding, origin,
+                  severity) -> dict:
+    """The requirement keys of one claim, with the defaults of the module
+    docstring (``derived`` names those the file left out)."""
+    derived = tuple(k for k in ("requirement", "criterion", "basis") if not r.has(k))
+    req = r.string("requirement", default=f"R-{cid}")
+    if not _ID.match(req):
+        raise r.fail("requirement", req, "letters, digits and _ . = + - only")
+    crit = r.string("criterion", default=None) or criterion_text(q, cmp_, value, tol, digits,
+                                                                 rounding)
+    if not r.has("criterion") and severity is not None and r.raw("expect", "pass") == "pass":
+        crit = f"not ({crit}): the claim shows the defect"
+    basis = r.string("basis", default="paper" if origin == "paper" else "our choice",
+                     choices=BASES)
+    standard = r.string("standard", default="")
+    if basis == "standard" and not standard:
+        raise r.fail("standard", "<missing>", 'the standard and clause (e.g. "EN 15595, '
+                     'wheel slide protection") when basis = "standard"')
+    if standard and basis != "standard":
+        raise r.fail("standard", standard, 'no standard unless basis = "standard"')
+    hazard = r.string("hazard", default=None)
+    if hazard is not None and severity != "safety":
+        raise r.fail("hazard", hazard, 'a hazard only on a finding with severity = "safety"')
+    untested = r.string("untested", default="")
+    why = r.string("severity_reason", default="")
+    if why and severity is None:
+        raise r.fail("severity_reason", why, "a severity_reason only on a claim with a severity")
+    return dict(requirement=req, criterion=crit, basis=basis, standard=standard,
+                hazard=hazard, derived=derived, untested=untested, severity_reason=why)
+
+
+@dataclass(frozen=True)
+class Hazard:
+    """One entry of a design's hazard log (module docstring)."""
+
+    id: str
+    hazard: str
+    cause: str
+    consequence: str
+    mitigation: str
+    status: str
+
+
+@dataclass(frozen=True)
+class Assumption:
+    """One entry of a design's assumptions register: what was assumed or
+    chosen, and its effect on the result."""
+
+    text: str
+    effect: str
+
+
+def parse_register(root: Reader, claims) -> tuple[tuple[Hazard, ...], tuple[Assumption, ...]]:
+    """The ``[[hazards]]`` and ``[[assumptions]]`` of a design (both
+    optional); every ``hazard`` a claim names must be in the log."""
+    hazards, seen = [], set()
+    for r in root.tables("hazards", default=[]):
+        hid = r.string("id")
+        if not _ID.match(hid) or hid in seen:
+            raise r.fail("id", hid, "a hazard id (letters, digits, _ . = + -) used once")
+        seen.add(hid)
+        hazards.append(Hazard(hid, r.string("hazard"), r.string("cause"),
+                              r.string("consequence"), r.string("mitigation"),
+                              r.string("status", choices=HAZARD_STATUSES)))
+        r.finish()
+    assumptions = []
+    for r in root.tables("assumptions", default=[]):
+        assumptions.append(Assumption(r.string("text"), r.string("effect")))
+        r.finish()
+    for i, c in enumerate(claims):
+        if c.hazard is not None and c.hazard not in seen:
+            raise root.fail(f"claims[{i}].hazard", c.hazard,
+                            "the id of a [[hazards]] entry of this design")
+    return tuple(hazards), tuple(assumptions)
 
 
 def _printed(x: float, digits: int, rounding: str) -> Decimal:

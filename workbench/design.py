@@ -15,6 +15,8 @@ Layout shared by every design::
 
     [[claims]]                        # optional, see workbench.claims
     ...
+    [[hazards]]                       # optional hazard log, see workbench.claims
+    [[assumptions]]                   # optional assumptions register
 
 The rest of the file belongs to the study named by ``kind``; it reads it
 through a :class:`~workbench.reader.Reader`, which records which keys were used so that
@@ -22,6 +24,7 @@ unknown keys (often typos) are errors too.
 """
 from __future__ import annotations
 
+import hashlib
 import math
 import os
 import tomllib
@@ -44,6 +47,11 @@ class Design:
         The study-specific, validated spec (frozen dataclass).
     claims : tuple
         Validated :class:`workbench.claims.Claim` objects.
+    hazards, assumptions : tuple
+        The design's hazard log and assumptions register
+        (:class:`workbench.claims.Hazard`, :class:`workbench.claims.Assumption`).
+    sha256 : str
+        SHA-256 of the design file's bytes (configuration identification).
     """
 
     path: str
@@ -53,6 +61,9 @@ class Design:
     source: str
     spec: Any
     claims: tuple
+    hazards: tuple = ()
+    assumptions: tuple = ()
+    sha256: str = ""
 
 
 #: Environment variable of the last-bit perturbation test (``make test-full``):
@@ -91,14 +102,15 @@ def load_design(path: str | Path) -> Design:
         On any problem, naming file, key, value and what was expected.
     """
     from . import studies
-    from .claims import parse_claims
+    from .claims import parse_claims, parse_register
 
     shown = display_path(path)
     p = Path(path)
     if not p.is_file():
         raise DesignError(shown, "<file>", "<missing>", "an existing design file (.toml)")
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
+        raw = p.read_bytes()
+        data = tomllib.loads(raw.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise DesignError(shown, "<file>", "<unparsable>", f"valid TOML ({exc})") from None
     ulps = os.environ.get(PERTURB_ENV, "").strip()
@@ -118,5 +130,7 @@ def load_design(path: str | Path) -> Design:
     study = studies.REGISTRY[kind]
     spec = study.load(root)
     claims = parse_claims(root, study, spec)
+    hazards, assumptions = parse_register(root, claims)
     root.finish()
-    return Design(shown, name, kind, title, source, spec, tuple(claims))
+    return Design(shown, name, kind, title, source, spec, tuple(claims), hazards, assumptions,
+                  hashlib.sha256(raw).hexdigest())

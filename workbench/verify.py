@@ -34,6 +34,47 @@ def evaluate_design(design: Design) -> Evaluation:
                                             for c in design.claims))
 
 
+def project_commit(root) -> str:
+    """The commit of the project at ``root`` (``git rev-parse HEAD``), or
+    "" when it is not a git checkout or files outside ``reports/`` differ
+    from that commit, untracked ones included (the report is then
+    "uncommitted")."""
+    import subprocess
+    try:
+        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True,
+                              text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=normal", "--",
+                                ".", ":(exclude)reports"], cwd=root, capture_output=True,
+                               text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return ""
+    return "" if dirty else head
+
+
+def pinned_versions(root) -> dict:
+    """``package -> version`` of the ``name==version`` lines of
+    ``<root>/constraints.txt`` (lower-case names; empty when absent)."""
+    from pathlib import Path
+    p = Path(root) / "constraints.txt"
+    if not p.is_file():
+        return {}
+    out = {}
+    for line in p.read_text(encoding="utf-8").splitlines():
+        name, sep, version = line.split("#")[0].strip().partition("==")
+        if sep:
+            out[name.strip().lower()] = version.strip()
+    return out
+
+
+def configuration(design):
+    """The :class:`workbench.report.writer.Configuration` of a design's
+    report: file hash, project commit, pinned versions."""
+    from .project import find_project
+    from .report.writer import Configuration
+    root = find_project().root
+    return Configuration(design.sha256, project_commit(root), pinned_versions(root))
+
+
 def report_files(ev: Evaluation):
     """The report of an evaluated design: the study renders its sections,
     :func:`workbench.report.writer.build` assembles them (the writer never
@@ -44,4 +85,4 @@ def report_files(ev: Evaluation):
     solver = None
     if getattr(studies.REGISTRY[ev.design.kind], "uses_solver", True):
         solver = ", ".join(f"{k}={v}" for k, v in CLARABEL_SETTINGS.items()) or "Clarabel defaults"
-    return build(ev, rendered, solver)
+    return build(ev, rendered, solver, configuration(ev.design))

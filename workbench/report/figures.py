@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import io
 import math
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -37,9 +38,10 @@ from matplotlib.text import Text  # noqa: E402
 from .files import atomic_write  # noqa: E402
 from .markdown import Figure  # noqa: E402
 
-_RC = {"svg.hashsalt": "workbench", "figure.dpi": 100, "savefig.dpi": 100,
-       "font.size": 9, "axes.grid": True, "grid.alpha": 0.3,
-       "path.simplify": False}
+#: Export resolution (issue 33, item 7: at least 150 dpi for a review pack).
+DPI = 150
+_RC = {"svg.hashsalt": "workbench", "figure.dpi": DPI, "savefig.dpi": DPI,
+       "font.size": 9, "axes.grid": True, "grid.alpha": 0.3, "path.simplify": False}
 
 #: Grid cells per axis span of :func:`snap_figure` (the grid step is the
 #: largest power of two not above span / SNAP_CELLS).
@@ -251,13 +253,19 @@ def snap_figure(fig) -> None:
 
 
 def figure_png(fig_spec: Figure) -> bytes:
-    """The PNG of ``fig_spec``: drawn, snapped (:func:`snap_figure`), laid
-    out, with no timestamp or version metadata."""
+    """The PNG of ``fig_spec``: drawn, snapped (:func:`snap_figure`),
+    titled (``fig_spec.title``), laid out at :data:`DPI`, with no timestamp
+    or version metadata."""
     with matplotlib.rc_context(_RC):
         fig = plt.figure(figsize=fig_spec.size)
         try:
             fig_spec.draw(fig)
             snap_figure(fig)
+            if fig_spec.title:
+                width = max(40, int(fig_spec.size[0] * 17))   # characters of 7 pt per line
+                lines = [w for line in fig_spec.title.split("\n")
+                         for w in textwrap.wrap(line, width) or [""]]
+                fig.suptitle("\n".join(lines), fontsize=7, x=0.01, ha="left")
             fig.tight_layout()
             buf = io.BytesIO()
             fig.savefig(buf, format="png", metadata={"Software": None})

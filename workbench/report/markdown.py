@@ -24,12 +24,17 @@ class Figure:
         Pure function of the results it closes over.
     size : tuple[float, float]
         Inches.
+    title : str
+        Drawn above the figure (design, figure and key parameters), so a
+        figure cut into a review pack keeps its meaning; the report writer
+        fills it (:func:`workbench.report.writer.build`).
     """
 
     name: str
     caption: str
     draw: Callable = field(compare=False, repr=False)
     size: tuple[float, float] = (6.4, 4.0)
+    title: str = ""
 
 
 @dataclass(frozen=True)
