@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from .benchmark_windows import (abscissa_curve, directed, exact_windows, interval_fields, middle,
-                                show_window)
+                                settle_point, show_window)
 from .errors import DesignError
 from .lmi.analysis import METHODS, certified_delay, make_criterion
 from .lmi.core import DEFAULT_MARGIN
@@ -315,7 +315,7 @@ def load_settings(r: Reader) -> BenchmarkSettings:
 # -- running -------------------------------------------------------------------------
 def _row(s: BenchmarkSettings, method: str, N: int | None, b, h_star: float, solves: int,
          seconds: float, check: str | None, lmi, windows, guess=None) -> MethodRow:
-    h = b.h_certified
+    h = settle_point(lmi, b.h_certified, b.bracket.h_refuted)
     return MethodRow(method, N, h, b.bracket.h_refuted, _ratio(h, h_star), solves, seconds,
                      check, b.bracket.outcome.value, bool(s.h_max <= h < math.inf),
                      **interval_fields(lmi, b, windows, h_star, s.h_max, s.rel_tol, guess))
@@ -373,7 +373,8 @@ def run_example(ex: Example, s: BenchmarkSettings) -> ExampleResult:
                    lmi if best.N not in by_N else None, windows)
         if best.N in by_N:          # the same order's interval, not searched twice
             t = by_N[best.N]
-            row = replace(row, interval=t.interval, intervals=t.intervals,
+            row = replace(row, h_certified=t.h_certified, ratio=t.ratio,
+                          interval=t.interval, intervals=t.intervals,
                           interval_solves=t.interval_solves,
                           interval_sound=t.interval_sound, interval_ratio=t.interval_ratio)
         rows.append(row)

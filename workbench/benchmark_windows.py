@@ -76,6 +76,27 @@ def interval_inside(lo: float, hi: float, windows, rtol: float = WINDOW_RTOL) ->
 PRINTED_DIGITS = 4
 
 
+#: Significant digits of a printed point bound (the report's h column).
+POINT_DIGITS = 5
+
+
+def settle_point(lmi, h: float, h_refuted: float, sig: int = POINT_DIGITS) -> float:
+    """A bisection's certified delay ``h`` decided on the grid of printed
+    values (see :func:`settle_interval`): the grid value above ``h`` when the
+    criterion certifies the system *at* that value (a solve there), else the
+    grid value below when it certifies there, else ``h`` itself (printed
+    rounded down). ``lmi`` None (no criterion to solve): ``h``."""
+    if lmi is None or not (0 < h < math.inf):
+        return h
+    up, down = directed(h, up=True, sig=sig), directed(h, up=False, sig=sig)
+    for g in ((up,) if up < h_refuted else ()) + (down,):
+        if g == h:
+            return h
+        if 0 < g and lmi.solve_at(g).outcome is Outcome.CERTIFIED:
+            return g
+    return h
+
+
 def settle_interval(lmi, c: IntervalCertificate, h_max: float,
                     sig: int = PRINTED_DIGITS) -> IntervalCertificate:
     """The interval ``c`` with its ends decided on the grid of printed values.
