@@ -62,6 +62,7 @@ from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, Step, bise
 from .delay_input import check_bisection, search_range, system_matrices
 from .legendre import blockdiag_S, legendre_derivative_coefficients
 from .point_search import resumed
+from .scaling import balance_loop
 
 #: Clarabel settings of the retries after an ``optimal_inaccurate`` answer, in order
 #: (near the bound the higher Bessel-Legendre orders are degenerate); a retry certifies
@@ -88,13 +89,13 @@ def _sym(n: int, name: str) -> cp.Variable:
 
 
 class _DelayAnalysis(MarginLMI):
-    """Common parts: the system matrices."""
+    """Common parts: the system matrices, balanced (x = T x~, exact: scaling.balance_loop)."""
 
     method: str = ""
     retry_settings = RETRY_SETTINGS
 
     def __init__(self, A, Ad, **kw):
-        self.A, self.Ad = system_matrices(A, Ad)
+        self.T, _, self.A, self.Ad = balance_loop(*system_matrices(A, Ad))
         self.n = self.A.shape[0]
         R = float(np.linalg.norm(self.A, 2) + np.linalg.norm(self.Ad, 2))
         #: time unit (s) of the blocks: the power of two nearest UNIT_SCALE / R
@@ -127,10 +128,8 @@ class _DelayAnalysis(MarginLMI):
         again = MarginLMI.solve_at(self._twin_lmi, h)
         return dataclasses.replace(again, seconds=step.seconds + again.seconds)
 
-    @property
-    def N(self) -> int | None:
-        """Bessel-Legendre order (None for the other criteria)."""
-        return None
+    N = None          # Bessel-Legendre order (None for the other criteria)
+
 
 class DelayIndependentLMI(_DelayAnalysis):
     """Delay-independent test: stable for every constant h >= 0.
