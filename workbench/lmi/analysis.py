@@ -59,7 +59,7 @@ import cvxpy as cp
 import numpy as np
 
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, Step, bisect_delay
-from .delay_input import check_bisection, search_range, system_matrices
+from .delay_input import check_bisection, search_range, system_matrices, time_scale
 from .legendre import blockdiag_S, legendre_derivative_coefficients
 from .point_search import resumed
 from .scaling import balance_loop
@@ -73,9 +73,10 @@ RETRY_SETTINGS = (
     {"tol_gap_abs": 1e-7, "tol_gap_rel": 1e-7, "tol_feas": 1e-7, "tol_ktratio": 1e-5},
 )
 
-#: Blocks' time unit: within sqrt 2 of UNIT_SCALE / (||A||_2 + ||A_d||_2). Any fixed
-#: multiple of 1/R makes the margins independent of the unit of A; 4 keeps the classic
-#: 2 x 2 example (R = 3.4) in its published unit (u = 1), as measured in issue 4.
+#: Blocks' time unit: UNIT_SCALE / R, R = rho(A) + rho(A_d) (time_scale), not rounded to a
+#: power of two: (c A, c A_d) then reaches the solver as the same numbers for any c (issue 31).
+#: In exact arithmetic the unit is an exact time scaling; in floating point u A is one more
+#: rounding, of the size of those of the numpy re-check (the relative margin covers both).
 UNIT_SCALE = 4.0
 
 MethodName = Literal["delay-independent", "jensen", "free-weighting", "wirtinger",
@@ -97,18 +98,17 @@ class _DelayAnalysis(MarginLMI):
     def __init__(self, A, Ad, **kw):
         self.T, _, self.A, self.Ad = balance_loop(*system_matrices(A, Ad))
         self.n = self.A.shape[0]
-        R = float(np.linalg.norm(self.A, 2) + np.linalg.norm(self.Ad, 2))
-        #: time unit (s) of the blocks: the power of two nearest UNIT_SCALE / R
-        self.unit = 2.0 ** round(math.log2(UNIT_SCALE / R)) if R > 0 else 1.0
+        R = 1.0 / time_scale(self.A, self.Ad)       # similarity-invariant rate (1/s)
+        #: time unit (s) of the blocks: UNIT_SCALE / R, so that (c A, c A_d) gives the
+        #: solver the same numbers for every c (one rounding of A u, as the re-check's own)
+        self.unit = UNIT_SCALE / R if R > 0 else 1.0
         super().__init__(**kw)
 
     def scaled(self, p):
         """(A u, A_d u, h / u, iota u) with u = :attr:`unit`: every block is written
-        for the system in its own time unit (exact: u is a power of two), so
-        the relative margins and the solver's scaling do not depend on the
-        unit of A (time scaling (c A, c A_d) changes u by at most a factor
-        sqrt 2). Certificates are those of the scaled system at h / u, which is
-        the same system."""
+        for the system in its own time unit, so the relative margins and the
+        solver's numbers do not depend on the unit of A. Certificates are those
+        of the scaled system at h / u, which is the same system."""
         u = self.unit
         if self.A.dtype == object:          # exact rational re-check
             u = Fraction(u)

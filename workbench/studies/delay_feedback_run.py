@@ -138,7 +138,7 @@ def synthesise(spec, A, B, points=()) -> SynthesisOutcome:
         h_an = min(c.h_certified for c in checks) if checks else None
         return SynthesisOutcome("robust-descriptor", r.bracket.h_certified, r.bracket.h_refuted,
                                 r.K, None if r.gain is None else r.gain.h_certified,
-                                "certified" if ok else "inconclusive", r.eps, h_an,
+                                "certified" if ok else _failed(r.bracket), r.eps, h_an,
                                 syn.decay_rate == 0, r.bracket.h_certified >= st.h_max,
                                 robust=(r, checks))
     from ..crosscheck import check_tight
@@ -152,9 +152,14 @@ def synthesise(spec, A, B, points=()) -> SynthesisOutcome:
                                                  h_hi=st.h_max).check
     return SynthesisOutcome(syn.method, t.h_certified, t.bracket.h_refuted, t.K,
                             None if t.gain is None else t.gain.h_certified,
-                            "certified" if ok else "inconclusive", t.eps,
+                            "certified" if ok else _failed(t.bracket), t.eps,
                             None if check is None else check.h_certified, False,
                             t.at_cap, tight=t)
+
+
+def _failed(bracket) -> str:
+    """``infeasible`` when a diagnosis stopped the synthesis, else ``inconclusive``."""
+    return "infeasible" if bracket.outcome.value == "infeasible" else "inconclusive"
 
 
 def delay_range_stable(windows, h_min: float, h_max: float) -> bool:
@@ -325,7 +330,8 @@ def quantities(res: DelayFeedbackResult) -> dict:
     """Values of the claimable quantities (None: not determined)."""
     s = res.synthesis
     q = {"operating_point.residual": res.op.residual,
-         "synthesis.h_certified": s.h_certified if s.h_certified > 0 else None,
+         "synthesis.h_certified": s.h_certified if s.h_certified > 0 and s.K is not None
+         else None,                                   # no gain returned: not determined
          "synthesis.h_refuted": s.h_refuted, "synthesis.h_gain": s.h_gain,
          "synthesis.status": s.status, "synthesis.eps": s.eps,
          "synthesis.h_analysis": s.h_analysis, "synthesis.at_cap": "yes" if s.at_cap else "no",
