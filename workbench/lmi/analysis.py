@@ -1,9 +1,8 @@
 """Analysis LMIs for x'(t) = A x(t) + A_d x(t - h) with a constant delay h.
 
-Each criterion is a :class:`~workbench.lmi.core.MarginLMI` (blocks written
-once, solved by Clarabel, re-checked with numpy, margins relative to the
-largest block norm); :func:`certified_delay` bisects with
-:func:`~workbench.lmi.core.bisect_delay`.
+Each criterion is a :class:`~workbench.lmi.core.MarginLMI` (blocks written once, solved
+by Clarabel in canonical coordinates, re-checked with numpy against the caller's loop,
+margins relative to the largest block norm); :func:`certified_delay` bisects.
 
 Notation (block selectors on the augmented vector xi):
 ``x = x(t)``, ``x_d = x(t - h)``, and for the Bessel-Legendre hierarchy the
@@ -58,6 +57,7 @@ from typing import Literal, Mapping
 import cvxpy as cp
 import numpy as np
 
+from .coordinates import canonical, recheck_original
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, Step, bisect_delay
 from .delay_input import check_bisection, search_range, system_matrices, time_scale
 from .legendre import blockdiag_S, legendre_derivative_coefficients
@@ -73,10 +73,9 @@ RETRY_SETTINGS = (
     {"tol_gap_abs": 1e-7, "tol_gap_rel": 1e-7, "tol_feas": 1e-7, "tol_ktratio": 1e-5},
 )
 
-#: Blocks' time unit: UNIT_SCALE / R, R = rho(A) + rho(A_d) (time_scale), not rounded to a
-#: power of two: (c A, c A_d) then reaches the solver as the same numbers for any c (issue 31).
-#: In exact arithmetic the unit is an exact time scaling; in floating point u A is one more
-#: rounding, of the size of those of the numpy re-check (the relative margin covers both).
+#: Blocks' time unit UNIT_SCALE / R, R = rho(A) + rho(A_d) (time_scale), not a power of two: (c A,
+#: c A_d) reaches the solver as the same numbers for any c (issue 31); u A is one more rounding,
+#: of the size of the numpy re-check's own (the relative margin covers both).
 UNIT_SCALE = 4.0
 
 MethodName = Literal["delay-independent", "jensen", "free-weighting", "wirtinger",
@@ -90,18 +89,18 @@ def _sym(n: int, name: str) -> cp.Variable:
 
 
 class _DelayAnalysis(MarginLMI):
-    """Common parts: the system matrices, balanced (x = T x~, exact: scaling.balance_loop)."""
+    """Common parts: the loop, balanced (x = T x~, exact: scaling.balance_loop) as ``A0``,
+    ``Ad0``, and as ``A``, ``Ad`` in the solve's modal coordinates x~ = L z (coordinates.py)."""
 
     method: str = ""
     retry_settings = RETRY_SETTINGS
 
     def __init__(self, A, Ad, **kw):
-        self.T, _, self.A, self.Ad = balance_loop(*system_matrices(A, Ad))
+        self.T, _, A0, Ad0 = balance_loop(*system_matrices(A, Ad))
+        self.L, self.A0, self.Ad0, self.A, self.Ad = canonical(A0, Ad0)
         self.n = self.A.shape[0]
         R = 1.0 / time_scale(self.A, self.Ad)       # similarity-invariant rate (1/s)
-        #: time unit (s) of the blocks: UNIT_SCALE / R, so that (c A, c A_d) gives the
-        #: solver the same numbers for every c (one rounding of A u, as the re-check's own)
-        self.unit = UNIT_SCALE / R if R > 0 else 1.0
+        self.unit = UNIT_SCALE / R if R > 0 else 1.0   # time unit (s): see UNIT_SCALE
         super().__init__(**kw)
 
     def scaled(self, p):
@@ -113,6 +112,9 @@ class _DelayAnalysis(MarginLMI):
         if self.A.dtype == object:          # exact rational re-check
             u = Fraction(u)
         return self.A * u, self.Ad * u, p["h"] * (1 / u), p["iota"] * u
+
+    def recheck(self, values, h: float) -> dict[str, float]:   # against A0, A_d0
+        return recheck_original(self, values, h)
 
     def solve_at(self, h: float) -> Step:
         """:meth:`MarginLMI.solve_at`; an answer still INCONCLUSIVE after the
