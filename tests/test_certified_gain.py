@@ -87,6 +87,15 @@ def test_uncontrollable_unstable_mode_is_infeasible_before_any_solve(monkeypatch
     r = synthesize_robust([(A, B)], h_hi=2.0, alpha=0.5)
     assert r.bracket.outcome is Outcome.INFEASIBLE and r.K is None
     assert r.reason.endswith("no gain can give decay 0.5")
+    from workbench.lmi.tight_synthesis import synthesize_tight
+    from workbench.lmi.varying_synthesis import synthesize_varying
+    from workbench.synthesis import synthesize_delay_bound
+    t = synthesize_tight(A, B, h_max=2.0)
+    assert t.bracket.outcome is Outcome.INFEASIBLE and t.K is None and "eigenvalue 1" in t.reason
+    v = synthesize_varying(A, B, h_max=2.0, mu=0.5)
+    assert v.bracket.outcome is Outcome.INFEASIBLE and v.K is None
+    (row,) = synthesize_delay_bound(A, B, (0.1,))
+    assert row.status is Outcome.INFEASIBLE and row.K is None and "eigenvalue 1" in row.reason
 
 
 @pytest.mark.parametrize("A, B, alpha, infeasible", [

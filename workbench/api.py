@@ -87,9 +87,12 @@ class DelayBoundResult:
     h_certified, h_refuted : float
         The bracket (s): certified by an optimal solve whose numpy re-check
         passed / refuted by an optimal solve (``inf``: none refuted up to
-        ``h_max``). 0 when nothing was certified.
+        ``h_max``). 0 when nothing was certified. For a synthesis it is the
+        bracket of the returned K itself (rounded, then certified with K
+        fixed), never the unrounded solver gain's.
     status : str
-        ``"certified"``, ``"inconclusive"`` or ``"refuted"``.
+        ``"certified"``, ``"inconclusive"``, ``"refuted"`` or ``"infeasible"``
+        (an uncontrollable mode with Re >= 0, diagnosed before any solve).
     certificate_kind : str
         ``"every delay in [0, h]"`` or ``"at h"``.
     K : numpy.ndarray or None
@@ -99,9 +102,9 @@ class DelayBoundResult:
     recheck : dict[str, float]
         Relative margin of every LMI block of the certificate, recomputed
         with numpy by a fresh criterion object: the bracket's certificate
-        (analysis, Bessel-Legendre), the synthesis certificate at
-        h_certified (Wirtinger), or the canonical certificate the gain was
-        taken from, at 0.99 h_certified (problem (60)).
+        (analysis; Bessel-Legendre with the returned K), or the certificate
+        of the returned, rounded K with K fixed at h_certified (Wirtinger,
+        problem (60)).
     recheck_passed : bool
         Every block margin >= ``margin``.
     margin : float
