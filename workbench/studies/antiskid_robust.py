@@ -84,7 +84,8 @@ class RobustResult:
 
     def to_json(self) -> dict:
         return {"eps": self.synthesis.eps, "h_certified": self.synthesis.bracket.h_certified,
-                "K": None if self.synthesis.K is None else self.synthesis.K.tolist()}
+                "K": None if self.synthesis.K is None else self.synthesis.K.tolist(),
+                "reason": self.synthesis.reason}
 
 
 def _points(path, common, rails, op: Reader) -> tuple[Point, ...]:

@@ -71,6 +71,16 @@ class SynthesisOutcome:
     tight: object = field(default=None, repr=False)
     robust: object = field(default=None, repr=False)
 
+    @property
+    def reason(self) -> str:
+        """Why the status is not ``certified`` (empty when it is)."""
+        if self.status == "certified":
+            return ""
+        own = (self.tight if self.tight is not None else
+               self.robust[0] if self.robust is not None else
+               max(self.rows, key=lambda r: r.h_certified, default=None))
+        return getattr(own, "reason", "") or "no reason recorded"
+
 
 @dataclass(frozen=True)
 class ScenarioResult:
@@ -108,6 +118,7 @@ class DelayFeedbackResult:
                 "u_op": self.op.u.tolist(), "method": s.method,
                 "h_certified": s.h_certified, "h_refuted": inf(s.h_refuted),
                 "K": None if s.K is None else s.K.tolist(), "status": s.status,
+                "reason": s.reason,
                 "exact_margin": None if self.exact is None else inf(self.exact.h),
                 "windows": [[inf(a), inf(b)] for a, b in self.windows],
                 "scenarios": {r.scenario.name: r.metrics for r in self.scenarios}}
