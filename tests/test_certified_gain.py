@@ -176,3 +176,13 @@ def test_claim_on_a_synthesis_without_gain_is_inconclusive():
     claim = Claim("h", "h", "synthesis.h_certified", ">=", 0.5, 0.0, None, "round", "", False,
                   "pass", "")
     assert check_claim(claim, q["synthesis.h_certified"]).verdict is Verdict.INCONCLUSIVE
+
+
+def test_design_reason_names_a_search_cap_below_the_required_delay():
+    from workbench.studies.delay_feedback_run import SynthesisOutcome
+    s = SynthesisOutcome("robust-descriptor", 0.0, math.inf, None, None, "inconclusive", 0.1,
+                         None, True, False, required=3.0, h_cap=2.0)
+    assert s.reason == "search cap below the required delay: h_max = 2 s < 3 s"
+    s = SynthesisOutcome("wirtinger", 0.0, math.inf, None, None, "inconclusive", 0.1, None,
+                         False, False, required=0.5, h_cap=2.0)
+    assert s.reason == "no reason recorded"      # (no result object attached here)

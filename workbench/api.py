@@ -185,8 +185,9 @@ class DelayBoundResult:
 
 
 def _analysis(method, A, Ad, N, margin, rel_tol, h_max):
-    """Certified bracket of an analysis criterion on the balanced loop, and the
-    numpy re-check of its certificate by a fresh criterion object.
+    """Certified bracket of an analysis criterion (solved in the balanced, canonical
+    coordinates of :mod:`workbench.lmi.coordinates`), and the numpy re-check of its
+    certificate by a fresh criterion object.
 
     Bessel-Legendre of order N is decided as the hierarchy 0, 1, ..., N, each
     order's search starting from the previous bound and never reporting less
@@ -195,21 +196,19 @@ def _analysis(method, A, Ad, N, margin, rel_tol, h_max):
     monotone in N by construction."""
     from .lmi.analysis import certified_delay, make_criterion
     from .lmi.hierarchy import bessel_legendre_auto
-    from .lmi.scaling import balance_loop
-    T, Tinv, At, Adt = balance_loop(A, Ad)
-    if method == "bessel-legendre":
-        auto = bessel_legendre_auto(At, Adt, math.inf, N_max=N, N_through=N, rel_tol=rel_tol,
+    if method == "bessel-legendre":       # (every criterion balances the loop itself)
+        auto = bessel_legendre_auto(A, Ad, math.inf, N_max=N, N_through=N, rel_tol=rel_tol,
                                     margin=margin, h_hi=h_max)
         bound = auto.bounds[-1]
         order = N if bound.certified_by is None else bound.certified_by
     else:
-        bound = certified_delay(make_criterion(method, At, Adt, margin=margin),
+        bound = certified_delay(make_criterion(method, A, Ad, margin=margin),
                                 rel_tol=rel_tol, h_hi=h_max)
         order = None
     br = bound.bracket
     if br.certificate is None or br.certificate.certificate is None:
         return br, {}
-    crit = make_criterion(method, Tinv @ A @ T, Tinv @ Ad @ T, N=order, margin=margin)
+    crit = make_criterion(method, A, Ad, N=order, margin=margin)
     return br, crit.recheck(br.certificate.certificate, br.certificate.h)
 
 

@@ -13,7 +13,7 @@ plant with the input delay, at dt and dt/2).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -70,10 +70,16 @@ class SynthesisOutcome:
     rows: tuple = ()
     tight: object = field(default=None, repr=False)
     robust: object = field(default=None, repr=False)
+    required: float | None = None      # the design's largest delay (s)
+    h_cap: float | None = None         # the synthesis search cap (s)
 
     @property
     def reason(self) -> str:
-        """Why the status is not ``certified`` (empty when it is)."""
+        """Why the status is not ``certified``, or why the certificate cannot
+        reach the design's delay (empty otherwise)."""
+        if self.required is not None and self.h_cap is not None and self.h_cap < self.required:
+            return (f"search cap below the required delay: h_max = {self.h_cap:g} s < "
+                    f"{self.required:g} s")
         if self.status == "certified":
             return ""
         own = (self.tight if self.tight is not None else
@@ -183,7 +189,8 @@ def run(spec) -> DelayFeedbackResult:
     from ..margins import exact_margin, stability_windows
     model, values, op, A, B = nominal_point(spec)
     points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
-    syn = synthesise(spec, A, B, points)
+    syn = replace(synthesise(spec, A, B, points), required=spec.delay.h_max,
+                  h_cap=spec.synthesis.settings.h_max)
     exact, windows, stable = None, (), None
     checks = ()
     if syn.K is not None:
