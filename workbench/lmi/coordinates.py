@@ -140,17 +140,24 @@ def original(lmi, values):
     return {k: congruence(np.asarray(v, float), Li) for k, v in values.items()}
 
 
-def recheck_original(lmi, values, h: float) -> dict[str, float]:
+def recheck_original(lmi, values, h: float, owner=None) -> dict[str, float]:
     """Relative margins of a certificate re-evaluated with numpy against the
     caller's own (A0, Ad0): the certificate mapped back by :func:`original`,
-    every block then measured in the z coordinates (congruence by L)."""
+    every block then measured in the z coordinates (congruence by L).
+    ``owner``: the criterion holding L, A0, Ad0 when it is ``lmi.base`` (an
+    interval LMI built on it)."""
     import copy
 
     from .core import Block, MarginLMI, relative_margins
-    if getattr(lmi, "L", None) is None:
+    owner = lmi if owner is None else owner
+    if getattr(owner, "L", None) is None:
         return MarginLMI.recheck(lmi, values, h)
-    twin = copy.copy(lmi)
-    twin.A, twin.Ad = lmi.A0, lmi.Ad0
-    blocks = MarginLMI.evaluate_blocks(twin, original(lmi, values), h)
-    return relative_margins([Block(b.name, congruence(np.asarray(b.matrix, float), lmi.L),
+    twin_owner = copy.copy(owner)
+    twin_owner.A, twin_owner.Ad = owner.A0, owner.Ad0
+    twin = twin_owner
+    if owner is not lmi:
+        twin = copy.copy(lmi)
+        twin.base = twin_owner
+    blocks = MarginLMI.evaluate_blocks(twin, original(owner, values), h)
+    return relative_margins([Block(b.name, congruence(np.asarray(b.matrix, float), owner.L),
                                    b.sense) for b in blocks])
