@@ -335,7 +335,7 @@ def _synthesis(method, A, B, N, eps, margin, rel_tol, h_max):
     diag = uncontrollable_mode([(A, B)])
     kind = "every delay in [0, h]" if method == "free-weighting-003" else "at h"
     if diag is not None:
-        return None, 0.0, 0.0, "infeasible", {}, kind, diag.reason
+        return None, 0.0, math.inf, "infeasible", {}, kind, diag.reason   # nothing solved
     if method == "free-weighting-003":
         from .synthesis import SynthesisSettings, synthesize_delay_bound
         eps = tuple(float(e) for e in eps)
