@@ -87,9 +87,12 @@ class DelayBoundResult:
     h_certified, h_refuted : float
         The bracket (s): certified by an optimal solve whose numpy re-check
         passed / refuted by an optimal solve (``inf``: none refuted up to
-        ``h_max``). 0 when nothing was certified.
+        ``h_max``). 0 when nothing was certified. For a synthesis it is the
+        bracket of the returned K itself (rounded, then certified with K
+        fixed), never the unrounded solver gain's.
     status : str
-        ``"certified"``, ``"inconclusive"`` or ``"refuted"``.
+        ``"certified"``, ``"inconclusive"``, ``"refuted"`` or ``"infeasible"``
+        (an uncontrollable mode with Re >= 0, diagnosed before any solve).
     certificate_kind : str
         ``"every delay in [0, h]"`` or ``"at h"``.
     K : numpy.ndarray or None
@@ -99,9 +102,9 @@ class DelayBoundResult:
     recheck : dict[str, float]
         Relative margin of every LMI block of the certificate, recomputed
         with numpy by a fresh criterion object: the bracket's certificate
-        (analysis, Bessel-Legendre), the synthesis certificate at
-        h_certified (Wirtinger), or the canonical certificate the gain was
-        taken from, at 0.99 h_certified (problem (60)).
+        (analysis; Bessel-Legendre with the returned K), or the certificate
+        of the returned, rounded K with K fixed at h_certified (Wirtinger,
+        problem (60)).
     recheck_passed : bool
         Every block margin >= ``margin``.
     margin : float
@@ -114,6 +117,15 @@ class DelayBoundResult:
     horizon : float
     at_cap : bool
         The bound is the search cap ``h_max`` (a lower bound only).
+    certifies : str
+        What the certificate is about: for a synthesis, the returned K itself
+        (rounded to its printed digits, then certified with K fixed), so
+        ``h_certified`` is that K's own bound, never the unrounded solver
+        gain's.
+    reason : str
+        Why the status is not ``"certified"`` (solver status, the block that
+        failed the re-check and its margin, an uncontrollable mode, ...);
+        empty when certified.
     """
 
     method: str
@@ -133,6 +145,8 @@ class DelayBoundResult:
     windows: tuple
     horizon: float
     at_cap: bool
+    certifies: str = ""
+    reason: str = ""
 
     def to_json(self) -> dict:
         """A JSON-ready dict (``"inf"`` for infinite values)."""
@@ -145,7 +159,8 @@ class DelayBoundResult:
                 "margin": self.margin, "exact_margin": inf(self.exact_margin),
                 "exact_agreement": self.exact_agreement,
                 "windows": [[inf(a), inf(b)] for a, b in self.windows],
-                "horizon": self.horizon, "at_cap": self.at_cap}
+                "horizon": self.horizon, "at_cap": self.at_cap,
+                "certifies": self.certifies, "reason": self.reason}
 
     def _repr_markdown_(self) -> str:
         from .report.markdown import fmt, margin_text, md_table
@@ -156,36 +171,45 @@ class DelayBoundResult:
         win = ", ".join(f"({fmt(a, 5)}, {fmt(b, 5)})" for a, b in self.windows) or "none"
         rows = [["method", name], ["status", f"**{self.status}**"],
                 ["certified bracket (s)", f"[{cap(self.h_certified)}, {fmt(self.h_refuted, 5)}]"],
-                ["certificate", self.certificate_kind], ["K", K],
+                ["certificate", self.certificate_kind + (f" ({self.certifies})"
+                                                         if self.certifies else "")],
+                ["K", K],
                 ["re-check (numpy)", ("passed" if self.recheck_passed else "**failed**")
                  + f", smallest block margin {margin_text(min(self.recheck.values()))}"
                  if self.recheck else "—"],
                 ["exact margin h* (s)", fmt(self.exact_margin, 5) + f" ({self.exact_agreement})"],
                 [f"exact stability windows up to {fmt(self.horizon)} s", win]]
+        if self.reason:
+            rows.insert(2, ["reason", self.reason])
         return md_table(["", "value"], rows, "ll")
 
 
-def _recheck_analysis(method, A, Ad, N, margin, step, T):
-    from .lmi.analysis import make_criterion
-    Tinv = np.diag(1.0 / np.diag(T))
-    crit = make_criterion(method, Tinv @ A @ T, Tinv @ Ad @ T,
-                          N=N if method == "bessel-legendre" else None, margin=margin)
-    return crit.recheck(step.certificate, step.h)
-
-
 def _analysis(method, A, Ad, N, margin, rel_tol, h_max):
-    """Certified bracket of an analysis criterion on the balanced loop."""
+    """Certified bracket of an analysis criterion (solved in the balanced, canonical
+    coordinates of :mod:`workbench.lmi.coordinates`), and the numpy re-check of its
+    certificate by a fresh criterion object.
+
+    Bessel-Legendre of order N is decided as the hierarchy 0, 1, ..., N, each
+    order's search starting from the previous bound and never reporting less
+    (:func:`~workbench.lmi.hierarchy.bessel_legendre_auto`: a certificate of a
+    lower order at h is one of order N, SG15 Theorem 4), so the bound is
+    monotone in N by construction."""
     from .lmi.analysis import certified_delay, make_criterion
-    from .lmi.scaling import balancing
-    T = balancing(A)
-    Tinv = np.diag(1.0 / np.diag(T))
-    crit = make_criterion(method, Tinv @ A @ T, Tinv @ Ad @ T,
-                          N=N if method == "bessel-legendre" else None, margin=margin)
-    bound = certified_delay(crit, rel_tol=rel_tol, h_hi=h_max)
+    from .lmi.hierarchy import bessel_legendre_auto
+    if method == "bessel-legendre":       # (every criterion balances the loop itself)
+        auto = bessel_legendre_auto(A, Ad, math.inf, N_max=N, N_through=N, rel_tol=rel_tol,
+                                    margin=margin, h_hi=h_max)
+        bound = auto.bounds[-1]
+        order = N if bound.certified_by is None else bound.certified_by
+    else:
+        bound = certified_delay(make_criterion(method, A, Ad, margin=margin),
+                                rel_tol=rel_tol, h_hi=h_max)
+        order = None
     br = bound.bracket
-    recheck = ({} if br.certificate is None or br.certificate.certificate is None
-               else _recheck_analysis(method, A, Ad, N, margin, br.certificate, T))
-    return br, recheck
+    if br.certificate is None or br.certificate.certificate is None:
+        return br, {}
+    crit = make_criterion(method, A, Ad, N=order, margin=margin)
+    return br, crit.recheck(br.certificate.certificate, br.certificate.h)
 
 
 def delay_bound(sys, B=None, *, Ad=None, method: Method = "bessel-legendre", N: int = 3,
@@ -252,6 +276,8 @@ def delay_bound(sys, B=None, *, Ad=None, method: Method = "bessel-legendre", N: 
     if (B is None) == (Ad is None):
         raise ValueError("expected exactly one of B (synthesis; or a StateSpace) and Ad "
                          "(analysis)")
+    from .lmi.diagnosis import inconclusive_reason
+    certifies = ""
     if Ad is not None:
         if method not in _ANALYSIS:
             raise ValueError(f"method = {method!r}; expected one of {', '.join(_ANALYSIS)} "
@@ -260,17 +286,26 @@ def delay_bound(sys, B=None, *, Ad=None, method: Method = "bessel-legendre", N: 
         br, recheck = _analysis(method, A, Ad, N, margin, rel_tol, h_max)
         K, kind = None, "at h"
         h_c, h_r, status = br.h_certified, br.h_refuted, br.outcome.value
+        reason = inconclusive_reason(br, margin=margin, h_cap=h_max)
     else:
         if method not in _SYNTHESIS:
             raise ValueError(f"method = {method!r}; expected one of {', '.join(_SYNTHESIS)} "
                              "for a synthesis (B given)")
         B = _matrix(B, "B", n, None if np.ndim(B) == 2 else 1)
-        K, h_c, h_r, status, recheck, kind = _synthesis(method, A, B, N, eps, margin,
-                                                        rel_tol, h_max)
+        K, h_c, h_r, status, recheck, kind, reason = _synthesis(method, A, B, N, eps, margin,
+                                                                rel_tol, h_max)
         Ad = np.zeros((n, n)) if K is None else B @ K
+        if K is not None:
+            certifies = (f"K as returned, rounded to {_digits()} significant digits, "
+                         "certified with K fixed")
     passed = bool(recheck) and all(v >= margin for v in recheck.values())
     if status == "certified" and not passed:
         status = "inconclusive"
+        bad = min(recheck.items(), key=lambda kv: kv[1]) if recheck else ("—", math.nan)
+        reason = (f"block {bad[0]!r} failed the fresh numpy re-check: relative margin "
+                  f"{bad[1]:.3g} < {margin:g}")
+    if status not in ("certified", "refuted", "infeasible") and not reason:
+        reason = "no certified delay in the search range"
     horizon = float(horizon) if horizon is not None else max(2.0 * (h_c if math.isfinite(h_c)
                                                                     else 1.0), 1.0)
     ex = exact_margin(A, Ad)
@@ -278,11 +313,29 @@ def delay_bound(sys, B=None, *, Ad=None, method: Method = "bessel-legendre", N: 
     return DelayBoundResult(method, N if method == "bessel-legendre" else None, float(h_c),
                             float(h_r), status, kind, K, A, Ad, dict(recheck), passed,
                             float(margin), float(ex.h), ex.outcome.value, win, horizon,
-                            bool(h_c >= h_max))
+                            bool(h_c >= h_max), certifies, reason)
+
+
+def _digits() -> int:
+    from .lmi.gain import DEFAULT_DIGITS
+    return DEFAULT_DIGITS
 
 
 def _synthesis(method, A, B, N, eps, margin, rel_tol, h_max):
+    """(K, h_certified, h_refuted, status, recheck, certificate kind, reason).
+
+    The bracket is always the one of the returned K itself (rounded, then
+    certified with K fixed: the same LMI with V = K Y, or the Bessel-Legendre
+    analysis of order N), never the synthesis LMI's bracket of the unrounded
+    solver gain; ``recheck`` is that certificate's, re-evaluated by a fresh
+    criterion object. An uncontrollable mode with Re >= 0 is diagnosed before
+    any solve (status ``"infeasible"``)."""
+    from .lmi.diagnosis import inconclusive_reason, uncontrollable_mode
     from .lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
+    diag = uncontrollable_mode([(A, B)])
+    kind = "every delay in [0, h]" if method == "free-weighting-003" else "at h"
+    if diag is not None:
+        return None, 0.0, math.inf, "infeasible", {}, kind, diag.reason   # nothing solved
     if method == "free-weighting-003":
         from .synthesis import SynthesisSettings, synthesize_delay_bound
         eps = tuple(float(e) for e in eps)
@@ -290,30 +343,33 @@ def _synthesis(method, A, B, N, eps, margin, rel_tol, h_max):
             raise ValueError(f"eps = {eps!r}; expected positive numbers")
         st = SynthesisSettings(margin=margin, rel_tol=rel_tol, h_max=h_max)
         rows = synthesize_delay_bound(A, B, eps, st)
-        r = max(rows, key=lambda r: r.h_certified)
+        r = max(rows, key=lambda r: (r.h_gain or 0.0, r.h_certified))
         K = None if r.K is None else np.array(r.K).reshape(B.shape[1], -1)
+        if r.gain is None or r.gain.analysis is None:
+            return None, 0.0, r.h_refuted, r.status.value, {}, kind, r.reason
+        from .lmi.freeweighting003 import FreeWeighting003FixedK
+        an = r.gain.analysis
         recheck = {}
-        if r.certificate and r.gain is not None:   # a fresh criterion object re-checks it
-            from .lmi.freeweighting003 import FreeWeighting003
+        if an.certificate is not None:   # a fresh criterion object re-checks it
             from .lmi.scaling import balancing
             T = balancing(A)
             Tinv = np.diag(1.0 / np.diag(T))
-            crit = FreeWeighting003(Tinv @ A @ T, Tinv @ B, r.eps, margin=margin)
-            recheck = crit.recheck(r.certificate, r.gain.h_design)
-        return (K, r.h_certified, r.h_refuted, r.status.value, recheck,
-                "every delay in [0, h]")
-    from .lmi.tight_synthesis import recheck_tight, synthesize_tight
+            crit = FreeWeighting003FixedK(Tinv @ A @ T, Tinv @ B, r.eps, K=K @ T, margin=margin)
+            recheck = crit.recheck(an.certificate.certificate, an.certificate.h)
+        return (K, an.h_certified, an.h_refuted, an.outcome.value, recheck, kind,
+                inconclusive_reason(an, margin=margin, h_cap=h_max))
+    from .lmi.tight_synthesis import recheck_gain, synthesize_tight
     t = synthesize_tight(A, B, h_max=h_max, margin=margin, rel_tol=rel_tol,
                          gain_fraction=DEFAULT_FRACTION, gain_digits=DEFAULT_DIGITS)
     if t.K is None:
-        return None, t.h_certified, t.bracket.h_refuted, t.bracket.outcome.value, {}, "at h"
+        return None, 0.0, t.bracket.h_refuted, "inconclusive", {}, kind, t.reason
     if method == "wirtinger":
-        ok = t.gain is not None and t.gain.outcome.value == "certified"
-        return (t.K, t.h_certified, t.bracket.h_refuted,
-                "certified" if ok and t.bracket.outcome.value == "certified" else "inconclusive",
-                recheck_tight(A, B, t), "at h")
+        an = t.gain.analysis
+        return (t.K, an.h_certified, an.h_refuted, an.outcome.value, recheck_gain(A, B, t),
+                kind, inconclusive_reason(an, margin=margin, h_cap=h_max))
     br, recheck = _analysis("bessel-legendre", A, B @ t.K, N, margin, rel_tol, h_max)
-    return t.K, br.h_certified, br.h_refuted, br.outcome.value, recheck, "at h"
+    return (t.K, br.h_certified, br.h_refuted, br.outcome.value, recheck, kind,
+            inconclusive_reason(br, margin=margin, h_cap=h_max))
 
 
 def simulate_delay(sys, K, *, h: float, x0, t_end: float, dt: float = 1e-3, B=None):

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from .benchmark_windows import (abscissa_curve, directed, exact_windows, interval_fields, middle,
-                                settle_point, show_window)
+                                monotone, settle_point, show_window)
 from .errors import DesignError
 from .lmi.analysis import METHODS, certified_delay, make_criterion
 from .lmi.core import DEFAULT_MARGIN
@@ -314,8 +314,9 @@ def load_settings(r: Reader) -> BenchmarkSettings:
 
 # -- running -------------------------------------------------------------------------
 def _row(s: BenchmarkSettings, method: str, N: int | None, b, h_star: float, solves: int,
-         seconds: float, check: str | None, lmi, windows, guess=None) -> MethodRow:
-    h = settle_point(lmi, b.h_certified, b.bracket.h_refuted)
+         seconds: float, check: str | None, lmi, windows, guess=None,
+         point_lmi=None) -> MethodRow:
+    h = settle_point(point_lmi or lmi, b.h_certified, b.bracket.h_refuted)
     return MethodRow(method, N, h, b.bracket.h_refuted, _ratio(h, h_star), solves, seconds,
                      check, b.bracket.outcome.value, bool(s.h_max <= h < math.inf),
                      **interval_fields(lmi, b, windows, h_star, s.h_max, s.rel_tol, guess))
@@ -362,8 +363,11 @@ def run_example(ex: Example, s: BenchmarkSettings) -> ExampleResult:
         for b in auto.bounds:
             if b.N <= s.orders:
                 lmi = make_criterion("bessel-legendre", A, Ad, N=b.N, margin=s.margin)
-                rows.append(_row(s, b.method, b.N, b, h_star, b.solves, b.seconds,
-                                 _check(lmi, b, s.exact_check), lmi, windows))
+                by = make_criterion("bessel-legendre", A, Ad, N=b.certified_by, margin=s.margin
+                                    ) if b.certified_by is not None else lmi
+                rows.append(monotone(by_N.get(b.N - 1), _row(
+                    s, b.method, b.N, b, h_star, b.solves, b.seconds,
+                    _check(by, b, s.exact_check), lmi, windows, point_lmi=by)))
                 by_N[b.N] = rows[-1]
         best = auto.best
         used = [b for b in auto.bounds if b.N <= best.N]

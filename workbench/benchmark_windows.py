@@ -8,6 +8,7 @@ independent picture of the figure.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -202,3 +203,15 @@ def abscissa_curve(A, Ad, windows, h_star: float, h_max: float, intervals
             alpha = math.nan
         out.append((float(h), float(alpha)))
     return tuple(out)
+
+
+def monotone(prev, row):
+    """Order N's row with at least order N - 1's interval: a certificate of
+    order N - 1 on an interval is one of order N there (SG15 Theorem 4), so
+    the hierarchy's intervals never shrink with N (by construction)."""
+    if prev is None or prev.interval is None or (
+            row.interval is not None and row.interval[0] <= prev.interval[0]
+            and row.interval[1] >= prev.interval[1]):
+        return row
+    return replace(row, interval=prev.interval, intervals=prev.intervals,
+                   interval_sound=prev.interval_sound, interval_ratio=prev.interval_ratio)

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .lmi.core import DEFAULT_MARGIN, Bracket, Outcome, bisect_delay
+from .lmi.diagnosis import synthesis_reason, uncontrollable_mode
 from .lmi.freeweighting003 import FreeWeighting003, FreeWeighting003FixedK
 from .lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
 from .lmi.scaling import balancing
@@ -102,6 +103,9 @@ class SynthesisRow:
     windows : tuple of (lo, hi)
         Exact stable windows of x' = A x + B K x(t - h) (canonical K) within
         [0, h_max] (``hi = inf``: stable for every larger delay).
+    reason : str
+        Why the row is not certified (an uncontrollable mode, the solver
+        status, the block that failed its re-check, ...); empty otherwise.
     """
 
     eps: float
@@ -119,6 +123,7 @@ class SynthesisRow:
     certificate: dict = field(default_factory=dict, repr=False)
     gain: CanonicalGain | None = field(default=None, repr=False)
     windows: tuple = ()
+    reason: str = ""
 
     @property
     def certified_interval(self) -> tuple[float, float] | None:
@@ -152,7 +157,7 @@ class SynthesisRow:
                 "certified_interval": None if self.certified_interval is None
                 else list(self.certified_interval),
                 "status": self.status.value, "solves": self.solves,
-                "seconds": round(self.seconds, 4)}
+                "seconds": round(self.seconds, 4), "reason": self.reason}
 
 
 def _balanced(A, B):
@@ -190,10 +195,12 @@ def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, T,
                             for a, b in stability_windows(A, B @ gain.K, settings.h_max))
             if B.shape[1] == 1:
                 exact_siso = delay_margin_siso(A, B, gain.K)
+    reason = ("" if status is Outcome.CERTIFIED else
+              synthesis_reason(br, gain, margin=settings.margin, h_cap=settings.h_max))
     return SynthesisRow(float(eps), br.h_certified, br.h_refuted, K, status, exact,
                         exact_siso, rmin, len(steps), sum(s.seconds for s in steps),
                         tuple(s.outcome.value[0] for s in br.steps), recheck, cert, gain,
-                        windows)
+                        windows, reason)
 
 
 def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = SynthesisSettings()
@@ -216,6 +223,10 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
         In the order of ``eps_values``.
     """
     A, B = np.asarray(A, float), np.asarray(B, float).reshape(np.shape(A)[0], -1)
+    diag = uncontrollable_mode([(A, B)])
+    if diag is not None:                 # diagnosed before any solve
+        return tuple(SynthesisRow(float(e), 0.0, math.inf, None, Outcome.INFEASIBLE, None, None,
+                                  None, 0, 0.0, (), reason=diag.reason) for e in eps_values)
     At, Bt, T, _ = _balanced(A, B)
     crit = FreeWeighting003(At, Bt, eps_values[0], margin=settings.margin)
     rows, guess = [], None

@@ -1,9 +1,8 @@
 """Analysis LMIs for x'(t) = A x(t) + A_d x(t - h) with a constant delay h.
 
-Each criterion is a :class:`~workbench.lmi.core.MarginLMI` (blocks written
-once, solved by Clarabel, re-checked with numpy, margins relative to the
-largest block norm); :func:`certified_delay` bisects with
-:func:`~workbench.lmi.core.bisect_delay`.
+Each criterion is a :class:`~workbench.lmi.core.MarginLMI` (blocks written once, solved
+by Clarabel in canonical coordinates, re-checked with numpy against the caller's loop,
+margins relative to the largest block norm); :func:`certified_delay` bisects.
 
 Notation (block selectors on the augmented vector xi):
 ``x = x(t)``, ``x_d = x(t - h)``, and for the Bessel-Legendre hierarchy the
@@ -58,10 +57,12 @@ from typing import Literal, Mapping
 import cvxpy as cp
 import numpy as np
 
+from .coordinates import canonical, recheck_original
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, Step, bisect_delay
-from .delay_input import check_bisection, search_range, system_matrices
+from .delay_input import check_bisection, search_range, system_matrices, time_scale
 from .legendre import blockdiag_S, legendre_derivative_coefficients
 from .point_search import resumed
+from .scaling import balance_loop
 
 #: Clarabel settings of the retries after an ``optimal_inaccurate`` answer, in order
 #: (near the bound the higher Bessel-Legendre orders are degenerate); a retry certifies
@@ -72,9 +73,9 @@ RETRY_SETTINGS = (
     {"tol_gap_abs": 1e-7, "tol_gap_rel": 1e-7, "tol_feas": 1e-7, "tol_ktratio": 1e-5},
 )
 
-#: Blocks' time unit: within sqrt 2 of UNIT_SCALE / (||A||_2 + ||A_d||_2). Any fixed
-#: multiple of 1/R makes the margins independent of the unit of A; 4 keeps the classic
-#: 2 x 2 example (R = 3.4) in its published unit (u = 1), as measured in issue 4.
+#: Blocks' time unit UNIT_SCALE / R, R = rho(A) + rho(A_d) (time_scale), not a power of two: (c A,
+#: c A_d) reaches the solver as the same numbers for any c (issue 31); u A is one more rounding,
+#: of the size of the numpy re-check's own (the relative margin covers both).
 UNIT_SCALE = 4.0
 
 MethodName = Literal["delay-independent", "jensen", "free-weighting", "wirtinger",
@@ -88,30 +89,32 @@ def _sym(n: int, name: str) -> cp.Variable:
 
 
 class _DelayAnalysis(MarginLMI):
-    """Common parts: the system matrices."""
+    """Common parts: the loop, balanced (x = T x~, exact: scaling.balance_loop) as ``A0``,
+    ``Ad0``, and as ``A``, ``Ad`` in the solve's modal coordinates x~ = L z (coordinates.py)."""
 
     method: str = ""
     retry_settings = RETRY_SETTINGS
 
     def __init__(self, A, Ad, **kw):
-        self.A, self.Ad = system_matrices(A, Ad)
+        self.T, _, A0, Ad0 = balance_loop(*system_matrices(A, Ad))
+        self.L, self.A0, self.Ad0, self.A, self.Ad = canonical(A0, Ad0)
         self.n = self.A.shape[0]
-        R = float(np.linalg.norm(self.A, 2) + np.linalg.norm(self.Ad, 2))
-        #: time unit (s) of the blocks: the power of two nearest UNIT_SCALE / R
-        self.unit = 2.0 ** round(math.log2(UNIT_SCALE / R)) if R > 0 else 1.0
+        R = 1.0 / time_scale(self.A, self.Ad)       # similarity-invariant rate (1/s)
+        self.unit = UNIT_SCALE / R if R > 0 else 1.0   # time unit (s): see UNIT_SCALE
         super().__init__(**kw)
 
     def scaled(self, p):
         """(A u, A_d u, h / u, iota u) with u = :attr:`unit`: every block is written
-        for the system in its own time unit (exact: u is a power of two), so
-        the relative margins and the solver's scaling do not depend on the
-        unit of A (time scaling (c A, c A_d) changes u by at most a factor
-        sqrt 2). Certificates are those of the scaled system at h / u, which is
-        the same system."""
+        for the system in its own time unit, so the relative margins and the
+        solver's numbers do not depend on the unit of A. Certificates are those
+        of the scaled system at h / u, which is the same system."""
         u = self.unit
         if self.A.dtype == object:          # exact rational re-check
             u = Fraction(u)
         return self.A * u, self.Ad * u, p["h"] * (1 / u), p["iota"] * u
+
+    def recheck(self, values, h: float) -> dict[str, float]:   # against A0, A_d0
+        return recheck_original(self, values, h)
 
     def solve_at(self, h: float) -> Step:
         """:meth:`MarginLMI.solve_at`; an answer still INCONCLUSIVE after the
@@ -127,10 +130,8 @@ class _DelayAnalysis(MarginLMI):
         again = MarginLMI.solve_at(self._twin_lmi, h)
         return dataclasses.replace(again, seconds=step.seconds + again.seconds)
 
-    @property
-    def N(self) -> int | None:
-        """Bessel-Legendre order (None for the other criteria)."""
-        return None
+    N = None          # Bessel-Legendre order (None for the other criteria)
+
 
 class DelayIndependentLMI(_DelayAnalysis):
     """Delay-independent test: stable for every constant h >= 0.

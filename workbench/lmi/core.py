@@ -66,6 +66,9 @@ class Outcome(str, enum.Enum):
     CERTIFIED = "certified"
     REFUTED = "refuted"
     INCONCLUSIVE = "inconclusive"
+    #: a diagnosis proves that nothing can be certified (e.g. an uncontrollable
+    #: unstable mode, :mod:`workbench.lmi.diagnosis`); never a solver's answer
+    INFEASIBLE = "infeasible"
 
 
 @dataclass(frozen=True)
@@ -266,6 +269,10 @@ class MarginLMI:
             status = str(problem.status)
         except cp.error.SolverError as exc:  # an answer, not a crash
             status = f"error: {exc}".splitlines()[0]
+        except BaseException as exc:         # Clarabel's Rust panics: pyo3 PanicException
+            if type(exc).__name__ != "PanicException":
+                raise
+            status = f"error: solver panic: {exc}".splitlines()[0]
         return status, time.perf_counter() - t0
 
     def _checked(self, h: float, status: str, t_opt: float, seconds: float) -> Step:

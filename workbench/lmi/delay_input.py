@@ -34,14 +34,26 @@ def system_matrices(A, Ad) -> tuple[np.ndarray, np.ndarray]:
 
 
 def time_scale(A, Ad) -> float:
-    """1 / (||A||_2 + ||A_d||_2) (s): the system's own time unit (inf when both
-    vanish). Time scaling (c A, c A_d) divides it by c."""
-    R = float(np.linalg.norm(np.asarray(A, float), 2) + np.linalg.norm(np.asarray(Ad, float), 2))
+    """1 / R (s): the system's own time unit (inf when A = A_d = 0).
+
+    R = rho(A) + rho(A_d) (spectral radii), or rho(A + A_d) when both vanish,
+    or ||A||_2 + ||A_d||_2 when that vanishes too (nilpotent matrices). The
+    spectral radii do not change under a similarity x = T x~, so a search
+    started from this time scale starts at the same delay in any state
+    coordinates (a stability window is found or missed alike); time scaling
+    (c A, c A_d) divides it by c."""
+    A, Ad = np.asarray(A, float), np.asarray(Ad, float)
+    rho = lambda M: float(np.max(np.abs(np.linalg.eigvals(M)))) if M.size else 0.0
+    R = rho(A) + rho(Ad)
+    if not R > 0:
+        R = rho(A + Ad)
+    if not R > 0:
+        R = float(np.linalg.norm(A, 2) + np.linalg.norm(Ad, 2))
     return 1.0 / R if R > 0 else math.inf
 
 
 #: Default search range of :func:`certified_delay` in units of the system's
-#: time scale 1 / (||A||_2 + ||A_d||_2) (scale-free: (c A, c A_d) gives h / c).
+#: time scale (:func:`time_scale`; scale-free: (c A, c A_d) gives h / c).
 H_LO_SCALE, H_HI_SCALE = 1e-4, 1e4
 
 

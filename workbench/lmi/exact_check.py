@@ -22,6 +22,7 @@ from typing import Mapping
 
 import numpy as np
 
+from .coordinates import original
 from .core import MarginLMI, Outcome
 
 
@@ -91,8 +92,11 @@ def exact_check(lmi: MarginLMI, values: Mapping[str, np.ndarray], h: float) -> E
     """
     exact = copy.copy(lmi)          # same blocks, exact system matrices
     for name in ("A", "Ad", "B", "K"):
-        if hasattr(lmi, name):
-            setattr(exact, name, to_rational(np.atleast_2d(getattr(lmi, name))))
+        if hasattr(lmi, name):      # the caller's own (A, A_d) when solved in other coordinates
+            own = getattr(lmi, name + "0", None) if getattr(lmi, "L", None) is not None else None
+            setattr(exact, name, to_rational(np.atleast_2d(getattr(lmi, name) if own is None
+                                                           else own)))
+    values = original(lmi, values)
     x = {}
     for k, var in lmi._vars.items():
         x[k] = to_rational(np.reshape(values[k], var.shape),

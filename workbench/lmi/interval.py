@@ -58,6 +58,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from .coordinates import recheck_original
 from .core import Block, MarginLMI, Outcome, Step
 from .delay_input import check_bisection, time_scale
 
@@ -108,6 +109,9 @@ class IntervalLMI(MarginLMI):
 
     def variables(self):
         return self.base.variables()
+
+    def recheck(self, values, h: float) -> dict[str, float]:   # against the caller's loop
+        return recheck_original(self, values, h, owner=self.base)
 
     def set_lower(self, h_a: float) -> None:
         """Lower end h_a > 0 (s) of the interval (not for ``from_zero``)."""

@@ -42,7 +42,9 @@ from .analysis import RETRY_SETTINGS, BesselLegendreLMI, certified_delay
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, bisect_delay
 from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
 from .delay_input import H_HI_SCALE, H_LO_SCALE
-from .scaling import SYNTHESIS_CAP_IN_UNITS, balance_points, check_unit, time_unit
+from .diagnosis import INFEASIBLE, synthesis_reason, uncontrollable_mode
+from .scaling import (SYNTHESIS_CAP_IN_UNITS, balance_loop, balance_points, check_unit,
+                      time_unit)
 
 #: The eps-search bisections of a synthesis stop going down at this fraction
 #: of the search cap (relative: the search is the same in any time unit).
@@ -173,6 +175,11 @@ class RobustSynthesis:
         (eps, h_certified) of the automatic search.
     gain : CanonicalGain or None
         How K was chosen, and the delay it certifies on its own.
+    reason : str
+        Why no certified gain was returned: an uncontrollable mode found
+        before any solve (the bracket is then INFEASIBLE), the solver status,
+        the block that failed its re-check, a search cap below the delay the
+        caller requires; empty when K certifies a delay.
     """
 
     eps: float
@@ -180,6 +187,7 @@ class RobustSynthesis:
     K: np.ndarray | None
     eps_tried: tuple[tuple[float, float], ...]
     gain: CanonicalGain | None = None
+    reason: str = ""
 
 
 def maximise_log_scalar(value: Callable[[float], float], grid: Sequence[float], *,
@@ -278,6 +286,9 @@ def synthesize_robust(points, *, h_hi: float, alpha: float = 0.0,
     gain and h / c, numerically too (issue 21).
     """
     eps_grid = eps_grid_for(eps_grid, ROBUST_EPS_GRID, h_hi)
+    diag = uncontrollable_mode(points, alpha)
+    if diag is not None:                 # no solve: nothing can be certified
+        return RobustSynthesis(math.nan, INFEASIBLE, None, (), None, diag.reason)
     T, Tinv, pts = balance_points(points)
     u = time_unit(h_hi, SYNTHESIS_CAP_IN_UNITS)
     lmi = DescriptorSynthesis(pts, eps_grid[0], alpha, margin=margin, unit=u)
@@ -293,7 +304,8 @@ def synthesize_robust(points, *, h_hi: float, alpha: float = 0.0,
                                                  unit=u), T,
             fraction=gain_fraction, digits=gain_digits, h_hi=h_hi, rel_tol=rel_tol)
     pairs = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
-    return RobustSynthesis(best, br, None if gain is None else gain.K, pairs, gain)
+    return RobustSynthesis(best, br, None if gain is None else gain.K, pairs, gain,
+                           synthesis_reason(br, gain, margin=margin, h_cap=h_hi))
 
 
 def gain_delay_bound(A, B, K, *, N: int = 2, margin: float = DEFAULT_MARGIN,
@@ -308,8 +320,8 @@ def gain_delay_bound(A, B, K, *, N: int = 2, margin: float = DEFAULT_MARGIN,
     """
     A = np.atleast_2d(np.asarray(A, float))
     Ad = np.asarray(B, float).reshape(A.shape[0], -1) @ np.atleast_2d(np.asarray(K, float))
-    T, Tinv, ((At, _),) = balance_points([(A, B)])
-    return certified_delay(BesselLegendreLMI(At, Tinv @ Ad @ T, N, margin=margin),
+    _, _, At, Adt = balance_loop(A, Ad)
+    return certified_delay(BesselLegendreLMI(At, Adt, N, margin=margin),
                            rel_tol=rel_tol, h_hi=h_hi)
 
 
@@ -327,8 +339,7 @@ def decay_rate_bracket(A, Ad, alpha: float, *, N: int = 2, margin: float = DEFAU
     if not alpha >= 0:
         raise ValueError(f"alpha = {alpha!r}; expected a non-negative rate (1/s)")
     A, Ad = np.atleast_2d(np.asarray(A, float)), np.atleast_2d(np.asarray(Ad, float))
-    T, Tinv, ((At, _),) = balance_points([(A, np.zeros((A.shape[0], 1)))])
-    Adt = Tinv @ Ad @ T
+    _, _, At, Adt = balance_loop(A, Ad)
     Aa = At + alpha * np.eye(A.shape[0])
 
     def decide(h: float):

@@ -89,3 +89,29 @@ def balance_points(points: Sequence[tuple[np.ndarray, np.ndarray]]):
     T = balancing(points[0][0])
     Tinv = np.diag(1 / np.diag(T))
     return T, Tinv, [(Tinv @ A @ T, Tinv @ B) for A, B in points]
+
+
+def balance_loop(A, Ad):
+    """Common power-of-two balancing of the delayed loop x' = A x + A_d x(t - h).
+
+    Osborne balancing (LAPACK's, :func:`balancing`) of ``|A| + |A_d|``: the
+    diagonal similarity that equalises row and column norms of both matrices
+    at once, so a loop whose coupling is only in A_d (e.g. A_d = B K) is
+    balanced too. Exact in floating point (powers of two).
+
+    Returns
+    -------
+    T, Tinv : numpy.ndarray
+        x = T x~ and T^{-1}.
+    At, Adt : numpy.ndarray
+        T^{-1} A T and T^{-1} A_d T.
+
+    References
+    ----------
+    .. [OSB60] Osborne E. E., "On pre-conditioning of matrices", J. ACM 7(4),
+       338-345, 1960.
+    """
+    A, Ad = np.atleast_2d(np.asarray(A, float)), np.atleast_2d(np.asarray(Ad, float))
+    T = balancing(np.abs(A) + np.abs(Ad))
+    Tinv = np.diag(1 / np.diag(T))
+    return T, Tinv, Tinv @ A @ T, Tinv @ Ad @ T

@@ -40,7 +40,10 @@ from typing import Mapping, Sequence
 import cvxpy as cp
 import numpy as np
 
+import math
+
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI
+from .diagnosis import INFEASIBLE, synthesis_reason, uncontrollable_mode
 from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
 from .robust import DescriptorSynthesis, best_eps_bracket, eps_grid_for
 from .scaling import SYNTHESIS_CAP_IN_UNITS, balance_points, check_unit, time_unit
@@ -162,6 +165,9 @@ class TightSynthesis:
     unit : float
         Time unit (s, a power of two) the blocks were written in
         (:func:`~workbench.lmi.scaling.time_unit` of the cap).
+    diagnosis : str
+        An uncontrollable mode found before any solve (the bracket is then
+        INFEASIBLE), else empty.
     """
 
     eps: float
@@ -172,11 +178,20 @@ class TightSynthesis:
     T: np.ndarray = field(repr=False)
     gain: CanonicalGain | None = field(default=None, repr=False)
     unit: float = 1.0
+    margin: float = DEFAULT_MARGIN
+    diagnosis: str = ""
 
     @property
     def h_certified(self) -> float:
-        """Delay certified by the synthesis LMI (s)."""
+        """Delay certified by the synthesis LMI (s), for the unrounded solver
+        gain; what the returned K certifies is ``gain.h_certified``."""
         return self.bracket.h_certified
+
+    @property
+    def reason(self) -> str:
+        """Why no certified gain was returned (empty when one was)."""
+        return synthesis_reason(self.bracket, self.gain, margin=self.margin, h_cap=self.h_max,
+                                diagnosis=self.diagnosis)
 
     @property
     def at_cap(self) -> bool:
@@ -229,6 +244,10 @@ def synthesize_tight(A, B, *, h_max: float, eps_grid: Sequence[float] | None = N
     B = np.asarray(B, float).reshape(A.shape[0], -1)
     T, Tinv, ((At, Bt),) = balance_points([(A, B)])
     u = time_unit(h_max, SYNTHESIS_CAP_IN_UNITS)
+    diag = uncontrollable_mode([(A, B)])
+    if diag is not None:                 # no solve: nothing can be certified
+        return TightSynthesis(math.nan, INFEASIBLE, None, (), float(h_max), T, None, u,
+                              margin, diag.reason)
     lmi = WirtingerSynthesis(At, Bt, eps_grid[0], margin=margin, unit=u)
     best, tried = best_eps_bracket(lmi, eps_grid, golden_steps=golden_steps, h_hi=h_max,
                                    rel_tol=rel_tol, stop_at=h_max)   # nothing beyond the cap
@@ -242,7 +261,7 @@ def synthesize_tight(A, B, *, h_max: float, eps_grid: Sequence[float] | None = N
             fraction=gain_fraction, digits=gain_digits, h_hi=h_max, rel_tol=rel_tol)
         K = gain.K
     tried_h = tuple(sorted((e, b.h_certified) for e, b in tried.items()))
-    return TightSynthesis(best, br, K, tried_h, float(h_max), T, gain, u)
+    return TightSynthesis(best, br, K, tried_h, float(h_max), T, gain, u, margin)
 
 
 def recheck_tight(A, B, result: TightSynthesis,
@@ -269,6 +288,21 @@ def recheck_tight(A, B, result: TightSynthesis,
     lmi = WirtingerSynthesis(Tinv @ A @ result.T, Tinv @ B, result.eps, unit=result.unit)
     cert = result.bracket.certificate.certificate if certificate is None else certificate
     return lmi.recheck(cert, result.bracket.h_certified)
+
+
+def recheck_gain(A, B, result: TightSynthesis) -> dict[str, float]:
+    """Re-evaluate, with numpy and a fresh criterion object, the certificate of
+    the *returned* (rounded) K: :class:`WirtingerSynthesisFixedK` at the delay
+    ``result.gain.h_certified`` (empty when that K certified nothing)."""
+    an = None if result.gain is None else result.gain.analysis
+    if an is None or an.certificate is None:
+        return {}
+    A = np.atleast_2d(np.asarray(A, float))
+    B = np.asarray(B, float).reshape(A.shape[0], -1)
+    Tinv = np.diag(1.0 / np.diag(result.T))
+    lmi = WirtingerSynthesisFixedK(Tinv @ A @ result.T, Tinv @ B, result.eps,
+                                   K=result.K @ result.T, unit=result.unit)
+    return lmi.recheck(an.certificate.certificate, an.certificate.h)
 
 
 class WirtingerSynthesisFixedK(FixedGain, WirtingerSynthesis):

@@ -80,6 +80,7 @@ import numpy as np
 from .analysis import RETRY_SETTINGS, UNIT_SCALE
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, bisect_delay
 from .delay_input import H_HI_SCALE, time_scale
+from .scaling import balance_loop
 
 
 def _check_interval(h1: float, mu: float | None) -> tuple[float, float | None]:
@@ -312,6 +313,8 @@ class VaryingDelayLMI(_VaryingTerms, MarginLMI):
         if self.A.shape != self.Ad.shape or self.A.shape[0] != self.A.shape[1]:
             raise ValueError(f"A {self.A.shape}, A_d {self.Ad.shape}; expected equal square "
                              "shapes")
+        # balanced coordinates, exact (as the constant-delay criteria)
+        self.T, _, self.A, self.Ad = balance_loop(self.A, self.Ad)
         self._init_terms(h1, mu, windows, self.A.shape[0])
         R = float(np.linalg.norm(self.A, 2) + np.linalg.norm(self.Ad, 2))
         #: as the constant-delay criteria (:data:`~workbench.lmi.analysis.UNIT_SCALE`)

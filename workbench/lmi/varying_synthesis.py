@@ -49,6 +49,7 @@ import cvxpy as cp
 import numpy as np
 
 from .core import DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, bisect_delay
+from .diagnosis import INFEASIBLE, uncontrollable_mode
 from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, FixedGain, canonical_gain
 
 #: Fractions of the certified h2 at which the canonical gain is tried, in order.
@@ -231,6 +232,9 @@ def synthesize_varying(A, B, *, h_max: float, h1: float = 0.0, mu: float | None 
     lmi = VaryingDelaySynthesis(At, Bt, eps_grid[0], h1=h1, mu=mu, windows=windows,
                                 margin=margin, unit=u)
     h_lo = lmi.h1 + 1e-3 * max(lmi.h1, h_max / 10)
+    if uncontrollable_mode([(A, B)]) is not None:   # diagnosed before any solve
+        return VaryingSynthesis(lmi.h1, lmi.mu, lmi.windows, eps_grid[0], INFEASIBLE, None, (),
+                                None, None, float(h_max), T)
     tried: dict[float, Bracket] = {}
 
     def h_of(eps: float) -> float:

@@ -84,7 +84,8 @@ class RobustResult:
 
     def to_json(self) -> dict:
         return {"eps": self.synthesis.eps, "h_certified": self.synthesis.bracket.h_certified,
-                "K": None if self.synthesis.K is None else self.synthesis.K.tolist()}
+                "K": None if self.synthesis.K is None else self.synthesis.K.tolist(),
+                "reason": self.synthesis.reason}
 
 
 def _points(path, common, rails, op: Reader) -> tuple[Point, ...]:
@@ -193,7 +194,7 @@ class AntiskidRobust:
         syn = res.synthesis
         h = syn.bracket.h_certified
         h_gain = syn.gain.h_certified if syn.gain else 0.0
-        q = {"synthesis.h_certified": h if h > 0 else None,
+        q = {"synthesis.h_certified": h if h > 0 and syn.K is not None else None,  # no gain
              "synthesis.h_gain": h_gain if h_gain > 0 else None, "synthesis.eps": syn.eps,
              "synthesis.K1": None if syn.K is None else float(syn.K[0, 0]),
              "synthesis.K2": None if syn.K is None else float(syn.K[0, 1])}

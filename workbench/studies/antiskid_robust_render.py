@@ -35,7 +35,7 @@ def render(design, res) -> Rendered:
                         for p in pts], "llrrr"))
     if syn.K is None:
         return Rendered((prob, "## Robust gain\n\n**No gain was certified** at these points "
-                         f"(best eps {fmt(syn.eps, 3)})."))
+                         f"(best eps {fmt(syn.eps, 3)}): {syn.reason or 'no reason recorded'}."))
     g = syn.gain
     gain = (f"## Robust gain\n\n$K = {latex_matrix(syn.K, g.digits)}$, certified at every point "
             f"with decay rate {fmt(res.alpha)} 1/s at the delay **h = {fmt(g.h_certified, 3)} s**."

@@ -66,7 +66,8 @@ def synthesize_command(design, *, eps=None, as_json: bool = False) -> int:
         spec = replace(spec, synthesis=replace(spec.synthesis, eps=tuple(eps)))
     _, _, op, A, B = nominal_point(spec)
     points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
-    s = synthesise(spec, A, B, points)
+    s = replace(synthesise(spec, A, B, points), required=spec.delay.h_max,
+                h_cap=spec.synthesis.settings.h_max)
     st = spec.synthesis.settings
     if spec.synthesis.method == "free-weighting-003":
         ok = all(r.status.value == "certified" for r in s.rows)
@@ -87,6 +88,7 @@ def synthesize_command(design, *, eps=None, as_json: bool = False) -> int:
                           "h_certified": s.h_certified, "h_refuted": inf(s.h_refuted),
                           "K": None if s.K is None else s.K.tolist(), "h_gain": s.h_gain,
                           "h_analysis": s.h_analysis, "status": s.status,
+                          "reason": s.reason,
                           "exact_margin": None if ex is None else inf(ex.h)}, indent=2))
         return 0 if ok else 1
     what = {"wirtinger": "Wirtinger synthesis (Seuret & Gouaisbaut 2013), eps searched",
@@ -107,6 +109,9 @@ def synthesize_command(design, *, eps=None, as_json: bool = False) -> int:
                              "at the delay h (not for smaller delays; see the exact windows)")
           + ". K: canonical gain (minimum-norm certificate at "
           f"{fmt(st.gain_fraction)} x h_certified, {st.gain_digits} significant digits).")
+    if s.reason:
+        print(("Not certified: " if not ok else "Short of the design's delay range: ")
+              + s.reason + ".")
     return 0 if ok else 1
 
 

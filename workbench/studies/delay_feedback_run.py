@@ -13,7 +13,7 @@ plant with the input delay, at dt and dt/2).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -70,6 +70,22 @@ class SynthesisOutcome:
     rows: tuple = ()
     tight: object = field(default=None, repr=False)
     robust: object = field(default=None, repr=False)
+    required: float | None = None      # the design's largest delay (s)
+    h_cap: float | None = None         # the synthesis search cap (s)
+
+    @property
+    def reason(self) -> str:
+        """Why the status is not ``certified``, or why the certificate cannot
+        reach the design's delay (empty otherwise)."""
+        if self.required is not None and self.h_cap is not None and self.h_cap < self.required:
+            return (f"search cap below the required delay: h_max = {self.h_cap:g} s < "
+                    f"{self.required:g} s")
+        if self.status == "certified":
+            return ""
+        own = (self.tight if self.tight is not None else
+               self.robust[0] if self.robust is not None else
+               max(self.rows, key=lambda r: r.h_certified, default=None))
+        return getattr(own, "reason", "") or "no reason recorded"
 
 
 @dataclass(frozen=True)
@@ -108,6 +124,7 @@ class DelayFeedbackResult:
                 "u_op": self.op.u.tolist(), "method": s.method,
                 "h_certified": s.h_certified, "h_refuted": inf(s.h_refuted),
                 "K": None if s.K is None else s.K.tolist(), "status": s.status,
+                "reason": s.reason,
                 "exact_margin": None if self.exact is None else inf(self.exact.h),
                 "windows": [[inf(a), inf(b)] for a, b in self.windows],
                 "scenarios": {r.scenario.name: r.metrics for r in self.scenarios}}
@@ -138,7 +155,7 @@ def synthesise(spec, A, B, points=()) -> SynthesisOutcome:
         h_an = min(c.h_certified for c in checks) if checks else None
         return SynthesisOutcome("robust-descriptor", r.bracket.h_certified, r.bracket.h_refuted,
                                 r.K, None if r.gain is None else r.gain.h_certified,
-                                "certified" if ok else "inconclusive", r.eps, h_an,
+                                "certified" if ok else _failed(r.bracket), r.eps, h_an,
                                 syn.decay_rate == 0, r.bracket.h_certified >= st.h_max,
                                 robust=(r, checks))
     from ..crosscheck import check_tight
@@ -152,9 +169,14 @@ def synthesise(spec, A, B, points=()) -> SynthesisOutcome:
                                                  h_hi=st.h_max).check
     return SynthesisOutcome(syn.method, t.h_certified, t.bracket.h_refuted, t.K,
                             None if t.gain is None else t.gain.h_certified,
-                            "certified" if ok else "inconclusive", t.eps,
+                            "certified" if ok else _failed(t.bracket), t.eps,
                             None if check is None else check.h_certified, False,
                             t.at_cap, tight=t)
+
+
+def _failed(bracket) -> str:
+    """``infeasible`` when a diagnosis stopped the synthesis, else ``inconclusive``."""
+    return "infeasible" if bracket.outcome.value == "infeasible" else "inconclusive"
 
 
 def delay_range_stable(windows, h_min: float, h_max: float) -> bool:
@@ -167,7 +189,8 @@ def run(spec) -> DelayFeedbackResult:
     from ..margins import exact_margin, stability_windows
     model, values, op, A, B = nominal_point(spec)
     points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
-    syn = synthesise(spec, A, B, points)
+    syn = replace(synthesise(spec, A, B, points), required=spec.delay.h_max,
+                  h_cap=spec.synthesis.settings.h_max)
     exact, windows, stable = None, (), None
     checks = ()
     if syn.K is not None:
@@ -325,7 +348,8 @@ def quantities(res: DelayFeedbackResult) -> dict:
     """Values of the claimable quantities (None: not determined)."""
     s = res.synthesis
     q = {"operating_point.residual": res.op.residual,
-         "synthesis.h_certified": s.h_certified if s.h_certified > 0 else None,
+         "synthesis.h_certified": s.h_certified if s.h_certified > 0 and s.K is not None
+         else None,                                   # no gain returned: not determined
          "synthesis.h_refuted": s.h_refuted, "synthesis.h_gain": s.h_gain,
          "synthesis.status": s.status, "synthesis.eps": s.eps,
          "synthesis.h_analysis": s.h_analysis, "synthesis.at_cap": "yes" if s.at_cap else "no",
