@@ -44,6 +44,9 @@ GAMMA_SPAN = 1e6
 FLOOR = 1e-5
 #: Points of the eps grid (:func:`eps_grid`).
 EPS_POINTS = 6
+#: Fractions of the optimum tried, after ``fraction``, when the minimum-norm
+#: certificate is not certified (solver inaccurate close to the optimum).
+FALLBACK_FRACTIONS = (0.95, 0.9, 0.8)
 #: Golden-section steps of the eps search after its grid.
 GOLDEN_STEPS = 4
 
@@ -256,16 +259,11 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float, h_min
         return RequirementDesign(objective, br, best, None, None, None,
                                  reason=_why(br, objective))
     lmi.set_eps(best)
-    v = fraction * br.h_certified
-    if objective == "decay":
-        lmi.set_rate(v, gamma)
-        point = lmi.canonical_point(H)
-    elif objective == "l2_gain":
-        lmi.set_rate(alpha, 1.0 / v)
-        point = lmi.canonical_point(H)
-    else:
-        lmi.set_rate(alpha, gamma)
-        point = lmi.canonical_point(v)
+    for f in (fraction,) + tuple(x for x in FALLBACK_FRACTIONS if x < fraction):
+        v = f * br.h_certified           # alpha, 1/gamma or H
+        point = _canonical(lmi, objective, v, H=H, alpha=alpha, gamma=gamma)
+        if point.outcome is Outcome.CERTIFIED:
+            break
     if point.outcome is not Outcome.CERTIFIED:
         return RequirementDesign(objective, br, best, None, point, None,
                                  reason="canonical point not certified (solver "
@@ -276,6 +274,19 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float, h_min
                         alpha_guess=v if objective == "decay" else None,
                         gamma_free=objective == "l2_gain")
     return RequirementDesign(objective, br, best, K, point, cert)
+
+
+def _canonical(lmi, objective: str, v: float, *, H: float, alpha: float, gamma: float) -> Step:
+    """The minimum-norm certificate at the objective value ``v`` (alpha,
+    1/gamma or H)."""
+    if objective == "decay":
+        lmi.set_rate(v, gamma)
+        return lmi.canonical_point(H)
+    if objective == "l2_gain":
+        lmi.set_rate(alpha, 1.0 / v)
+        return lmi.canonical_point(H)
+    lmi.set_rate(alpha, gamma)
+    return lmi.canonical_point(v)
 
 
 def _why(br: Bracket, objective: str) -> str:
