@@ -40,7 +40,7 @@ import numpy as np
 from .analysis import BesselLegendreLMI
 from .core import DEFAULT_MARGIN, Bracket, MarginLMI, Outcome, Step, bisect_delay
 from .interval import IntervalLMI
-from .scaling import balance_points
+from .scaling import balancing
 
 __all__ = ["CellLMI", "decay_cells", "certified_decay"]
 
@@ -123,14 +123,15 @@ def certified_decay(points: Sequence[tuple[np.ndarray, np.ndarray]], *, h_lo: fl
     rate) holds for every cell of every point; the bisection is the shared
     :func:`~workbench.lmi.core.bisect_delay` on alpha in
     [1e-5 alpha_hi, alpha_hi]. Coordinates are balanced per point by a
-    power-of-two diagonal (exact).
+    power-of-two diagonal (exact) from |A| + |A_d|.
     """
     if not (0 <= h_lo < H < math.inf):
         raise ValueError(f"delay range [{h_lo!r}, {H!r}] s; expected 0 <= h_min < h_max < inf")
     bal = []
     for A, Ad in points:
-        T, Tinv, ((At, _),) = balance_points([(np.asarray(A, float),
-                                               np.zeros((np.shape(A)[0], 1)))])
-        bal.append((At, Tinv @ np.asarray(Ad, float) @ T))
+        A, Ad = np.asarray(A, float), np.asarray(Ad, float)
+        T = balancing(np.abs(A) + np.abs(Ad))     # both matrices: A alone may be triangular
+        Tinv = np.diag(1.0 / np.diag(T))
+        bal.append((Tinv @ A @ T, Tinv @ Ad @ T))
     return bisect_delay(lambda a: _decide(bal, a, h_lo, H, N, margin), h_lo=1e-5 * alpha_hi,
                         h_hi=alpha_hi, rel_tol=rel_tol, guess=guess)

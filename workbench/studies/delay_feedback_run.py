@@ -70,6 +70,7 @@ class SynthesisOutcome:
     rows: tuple = ()
     tight: object = field(default=None, repr=False)
     robust: object = field(default=None, repr=False)
+    requirements: object = field(default=None, repr=False)   # RequirementResult
 
 
 @dataclass(frozen=True)
@@ -110,7 +111,9 @@ class DelayFeedbackResult:
                 "K": None if s.K is None else s.K.tolist(), "status": s.status,
                 "exact_margin": None if self.exact is None else inf(self.exact.h),
                 "windows": [[inf(a), inf(b)] for a, b in self.windows],
-                "scenarios": {r.scenario.name: r.metrics for r in self.scenarios}}
+                "scenarios": {r.scenario.name: r.metrics for r in self.scenarios},
+                **({} if s.requirements is None
+                   else {"requirements": s.requirements.as_dict()["requirements"]})}
 
 
 def synthesise(spec, A, B, points=()) -> SynthesisOutcome:
@@ -167,7 +170,11 @@ def run(spec) -> DelayFeedbackResult:
     from ..margins import exact_margin, stability_windows
     model, values, op, A, B = nominal_point(spec)
     points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
-    syn = synthesise(spec, A, B, points)
+    if spec.synthesis.method == "requirements":
+        from .delay_feedback_requirements import synthesise_requirements
+        syn = synthesise_requirements(spec, model, values, op, A, B, points)
+    else:
+        syn = synthesise(spec, A, B, points)
     exact, windows, stable = None, (), None
     checks = ()
     if syn.K is not None:
@@ -368,6 +375,9 @@ def quantities(res: DelayFeedbackResult) -> dict:
         q[f"{b}.diverged"] = "yes" if sr.metrics["diverged"] else "no"
         q[f"{b}.converged"] = "yes" if sr.converged else "no"
     q["certificate.covers_delay_range"] = covers(res)
+    if s.method == "requirements":
+        from .delay_feedback_requirements import requirement_quantities
+        q.update(requirement_quantities(s.requirements))
     if res.basin is not None:
         from .delay_feedback_basin import basin_quantities
         q.update(basin_quantities(res.basin))
