@@ -143,7 +143,7 @@ _WHAT = {
 }
 
 
-def _ceil(x, sig: int = 3) -> str:
+def _ceil(x, sig: int = 2) -> str:
     import math
     if x is None or not math.isfinite(x) or x <= 0:
         return fmt(x)
@@ -153,16 +153,20 @@ def _ceil(x, sig: int = 3) -> str:
 
 def requirements_table(spec, r) -> str:
     """The requirements table: required, certified, exact, verdict (Markdown)."""
+    return requirements_rows(spec.requirements, r, spec.synthesis.settings.gain_digits)
+
+
+def requirements_rows(req, r, digits: int) -> str:
+    """The table of :func:`requirements_table` from a RequirementsSpec ``req``."""
     rows = []
     for row in r.rows:
         cert = row.certified
         if cert is not None:
             cert = (_ceil(cert) if row.name == "l2_gain" else
-                    "yes" if row.name == "input_limit" else fmt_floor(cert, 3))
+                    "yes" if row.name == "input_limit" else fmt_floor(cert, 2))
         rows.append([row.name, row.required, cert if cert is not None else "—",
-                     fmt(row.exact, 3), f"**{row.verdict}**",
-                     spec.requirements.sources.get(row.name, "")])
-    K = gain_text(r.K, spec.synthesis.settings.gain_digits)
+                     fmt(row.exact, 3), f"**{row.verdict}**", req.sources.get(row.name, "")])
+    K = gain_text(r.K, digits)
     return (md_table(["requirement", "required", "certified", "exact", "verdict", "source"],
                      rows, "llrrll") + f"\n\nGain (rounded, the gain every row is about): "
             f"K = {K}" + (f". No gain: {r.reason}" if r.K is None else "")

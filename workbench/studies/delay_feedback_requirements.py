@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["RequirementsSpec", "load_requirements", "requirement_quantities",
+__all__ = ["RequirementsSpec", "load_rate_requirements", "load_requirements", "requirement_quantities",
            "requirement_quantity_names", "run_requirements"]
 
 ROWS = ("delay", "decay", "l2_gain", "input_limit")
@@ -113,6 +113,26 @@ def load_requirements(root, plant, delay) -> RequirementsSpec | None:
     t.finish()
     return RequirementsSpec(objective, (float(rng[0]), float(rng[1])), alpha, limit, box,
                             gamma, dist, outputs, sources)
+
+
+def load_rate_requirements(root) -> RequirementsSpec | None:
+    """``[requirements]`` with ``delay = [h_min, h_max]`` (s), ``decay_rate``
+    and ``objective`` ("decay" or "delay") only: for studies whose plant is
+    not a ``delay-feedback`` model (e.g. ``antiskid-robust``)."""
+    if not root.has("requirements"):
+        return None
+    t = root.table("requirements")
+    objective = t.string("objective", default="decay", choices=("decay", "delay"))
+    rng = t.numbers("delay", what="delays (s)")
+    if len(rng) != 2 or not (0 <= rng[0] <= rng[1] and rng[1] > 0):
+        raise t.fail("delay", list(rng), "[h_min, h_max] with 0 <= h_min <= h_max, h_max > 0 (s)")
+    sources = {"delay": t.string("delay_source")}
+    alpha = None
+    if t.has("decay_rate"):
+        alpha, sources["decay"] = _entry(t, "decay_rate", "1/s")
+    t.finish()
+    return RequirementsSpec(objective, (float(rng[0]), float(rng[1])), alpha, None, None,
+                            None, None, (), sources)
 
 
 def _l2_matrices(spec, req, model, values, op):
