@@ -59,7 +59,7 @@ def main() -> None:
     hs = np.linspace(0.0, H, 7)
     for name, A in PLANTS.items():
         t0 = time.perf_counter()
-        r = workbench.design((A), B, delay=(0.0, H), objective="decay")
+        r = workbench.design_gain((A), B, delay=(0.0, H), objective="decay")
         dt = time.perf_counter() - t0
         row = r.row("decay")
         g, Kg = grid_best(A, hs)
@@ -82,7 +82,7 @@ def main() -> None:
     print("pendulum, delay [0, 0.3] s: time per requirement set")
     for name, kw in sets.items():
         t0 = time.perf_counter()
-        r = workbench.design(A, B, delay=(0.0, H), **kw)
+        r = workbench.design_gain(A, B, delay=(0.0, H), **kw)
         dt = time.perf_counter() - t0
         rows = "; ".join(f"{x.name}: cert {x.certified if x.certified is None else round(x.certified, 4)}"
                          f" exact {x.exact if x.exact is None else round(x.exact, 4)} {x.verdict}"

@@ -75,7 +75,7 @@ def test_hinf_norm_of_a_first_order_loop():
 
 @pytest.mark.slow
 def test_design_pendulum_every_row_confirmed_by_its_exact_check():
-    r = workbench.design(PENDULUM, B, delay=(0.0, 0.3), decay_rate=0.3, objective="l2_gain",
+    r = workbench.design_gain(PENDULUM, B, delay=(0.0, 0.3), decay_rate=0.3, objective="l2_gain",
                          input_limit=5.0, box=(0.5, 0.5), Bw=B, Cz=[[1.0, 0.0]])
     assert r.K is not None
     for row in r.rows:
@@ -89,7 +89,7 @@ def test_design_pendulum_every_row_confirmed_by_its_exact_check():
 def test_design_without_a_gain_is_inconclusive_never_pass():
     # x1' = x1 is not controllable from u: no gain can stabilise it
     A = np.array([[1.0, 0.0], [0.0, -1.0]])
-    r = workbench.design(A, B, delay=(0.0, 0.2), decay_rate=0.5, objective="delay")
+    r = workbench.design_gain(A, B, delay=(0.0, 0.2), decay_rate=0.5, objective="delay")
     assert r.K is None
     assert r.rows and all(row.verdict == "INCONCLUSIVE" for row in r.rows)
     assert r.reason
@@ -104,14 +104,14 @@ def test_design_without_a_gain_is_inconclusive_never_pass():
 ])
 def test_design_bad_input(kw, text):
     with pytest.raises(ValueError, match=text):
-        workbench.design(PENDULUM, B, **kw)
+        workbench.design_gain(PENDULUM, B, **kw)
 
 
 @pytest.mark.slow
 def test_pendulum_certified_decay_is_70_percent_of_the_best_grid_decay():
     """Issue 31 done-when: certified >= 0.7 x the best exact worst-case decay of
     a direct K grid over [0, 0.3] s (benchmarks/requirements.py prints both)."""
-    r = workbench.design(PENDULUM, B, delay=(0.0, 0.3), objective="decay")
+    r = workbench.design_gain(PENDULUM, B, delay=(0.0, 0.3), objective="decay")
     hs = np.linspace(0.0, 0.3, 7)
     best = max(
         worst_decay([(PENDULUM, B @ np.array([[k1, k2]]))], 0.0, 0.3, grid=7).decay

@@ -16,7 +16,7 @@ _API = ("delay_bound", "simulate_delay", "DelayBoundResult")
 
 
 #: Loaded from :mod:`workbench.api_design` (design to requirements).
-_DESIGN_API = ("design",)
+_DESIGN_API = ("design_gain",)
 
 
 def __getattr__(name):

@@ -1,4 +1,6 @@
-"""``workbench.design``: a state-feedback gain designed to requirements.
+"""``workbench.design_gain``: a state-feedback gain designed to requirements.
+
+(Not ``workbench.design``: that name is the design-file module :mod:`workbench.design`.)
 
 The API face of :mod:`workbench.requirements` (the same as a
 ``delay-feedback`` design's requirement set): a delay range, a decay rate,
@@ -15,7 +17,7 @@ import numpy as np
 from .api import _matrix, _system
 from .requirements import RequirementResult, Requirements, design_to_requirements
 
-__all__ = ["design"]
+__all__ = ["design_gain"]
 
 
 def _positive(name: str, v, *, allow_none: bool = True) -> float | None:
@@ -27,7 +29,7 @@ def _positive(name: str, v, *, allow_none: bool = True) -> float | None:
     return float(v)
 
 
-def design(sys, B=None, *, delay: tuple[float, float], decay_rate: float | None = None,
+def design_gain(sys, B=None, *, delay: tuple[float, float], decay_rate: float | None = None,
            l2_gain: float | None = None, input_limit: Sequence[float] | float | None = None,
            box: Sequence[float] | None = None,
            objective: Literal["decay", "l2_gain", "delay"] = "decay",

@@ -16,7 +16,7 @@ def _margin(pc) -> str:
 
 def _requirements(spec, res) -> str:
     """The requirements section (issue 31) that opens the report."""
-    from .delay_feedback_render import requirements_rows
+    from .delay_feedback_requirements_render import requirements_rows
     r, q = res.requirements, spec.requirements
     return ("## Requirements\n\nOne gain for every operating point below, designed to "
             f"requirements: objective **{q.objective}**, every constant delay in "

@@ -11,7 +11,7 @@ import numpy as np
 from ..report.markdown import Figure, Rendered, fmt, fmt_floor, latex_matrix, md_table
 from .antiskid_cruise_render import (capped_text, closed_loop_eigs_text, exact_margin_text,
                                      recheck_table)
-from .delay_feedback_cli import gain_text
+from .delay_feedback_requirements_render import gain_text, requirements_section
 
 _METHOD = {
     "free-weighting-003": "paper 003's free-weighting problem (60) (Theorem 1 + Remark 3), "
@@ -122,67 +122,6 @@ def render(design, res) -> Rendered:
         sections.append(sec)
         figs = [*figs, *bfigs]
     return Rendered(tuple(sections), tuple(figs))
-
-
-_UNITS = {"delay": "s", "decay": "1/s", "l2_gain": "", "input_limit": ""}
-_WHAT = {
-    "delay": ("certified: the largest cap H such that the rounded gain meets the required "
-              "decay rate, L2 gain and input limit for every constant delay in [0, H] (s, "
-              "rounded down); exact: the worst decay rate on the range (1/s, > 0: stable)"),
-    "decay": ("certified: decay rate of the rounded gain for every constant delay in the range "
-              "and every vertex, Bessel-Legendre (N = 2) cells over the range (1/s, rounded "
-              "down); exact: the worst rightmost root on a 61-point delay grid, with no "
-              "crossing of Re s = −certified between grid points"),
-    "l2_gain": ("certified: bounded-real descriptor LMI, every constant delay in [0, h_max] "
-                "(rounded up); exact: the H-infinity norm of the delayed loop on the delay "
-                "grid"),
-    "input_limit": ("certified: 1 when an invariant ellipsoid contains the box of constant "
-                    "initial histories and keeps |u_k| ≤ u_max,k; exact: peak |u_k| / u_max,k "
-                    "of linear simulations from the box's vertices at h_min, mid-range and "
-                    "h_max"),
-}
-
-
-def _ceil(x, sig: int = 2) -> str:
-    import math
-    if x is None or not math.isfinite(x) or x <= 0:
-        return fmt(x)
-    q = 10.0 ** (math.floor(math.log10(x)) - (sig - 1))
-    return fmt(math.ceil(x / q - 1e-12) * q, sig)
-
-
-def requirements_table(spec, r) -> str:
-    """The requirements table: required, certified, exact, verdict (Markdown)."""
-    return requirements_rows(spec.requirements, r, spec.synthesis.settings.gain_digits)
-
-
-def requirements_rows(req, r, digits: int) -> str:
-    """The table of :func:`requirements_table` from a RequirementsSpec ``req``."""
-    rows = []
-    for row in r.rows:
-        cert = row.certified
-        if cert is not None:
-            cert = (_ceil(cert) if row.name == "l2_gain" else
-                    "yes" if row.name == "input_limit" else fmt_floor(cert, 2))
-        rows.append([row.name, row.required, cert if cert is not None else "—",
-                     fmt(row.exact, 3), f"**{row.verdict}**", req.sources.get(row.name, "")])
-    K = gain_text(r.K, digits)
-    return (md_table(["requirement", "required", "certified", "exact", "verdict", "source"],
-                     rows, "llrrll") + f"\n\nGain (rounded, the gain every row is about): "
-            f"K = {K}" + (f". No gain: {r.reason}" if r.K is None else "")
-            + ".\n\n" + "\n".join(f"- *{k}*: {v}" for k, v in _WHAT.items()
-                                   if any(row.name == k for row in r.rows)))
-
-
-def requirements_section(spec, r) -> str:
-    """The section that opens the report of a design with ``[requirements]``."""
-    q = spec.requirements
-    box = ("" if q.box is None else " Input limit from the box of initial deviations "
-           + ", ".join(f"|δ{k}| ≤ {fmt(v)}" for k, v in q.box.items())
-           + " (constant initial history, w = 0).")
-    return (f"## Requirements\n\nObjective: **{q.objective}**, subject to the others; "
-            f"delays: every constant delay in [{fmt(q.delay[0])}, {fmt(q.delay[1])}] s."
-            + box + "\n\n" + requirements_table(spec, r))
 
 
 def _residual(r: float) -> str:

@@ -189,18 +189,3 @@ def requirement_quantities(result) -> dict:
                                              else v)
     return q
 
-
-def synthesise_requirements(spec, model, values, op, A, B, points=()):
-    """The design's synthesis when it has ``[requirements]``: a
-    :class:`~.delay_feedback_run.SynthesisOutcome` whose delay fields are
-    the gain's own certified cap (every delay in [0, H] at the required
-    decay rate, gain and input limit)."""
-    from .delay_feedback_run import SynthesisOutcome
-    res = run_requirements(spec, spec.requirements, model, values, op, A, B, points)
-    d, c = res.design, res.design.certificate
-    h = None if c is None else c.h_certified
-    ok = h is not None and h >= spec.requirements.delay[1]
-    refuted = math.inf if c is None else c.delay.h_refuted
-    return SynthesisOutcome("requirements", h or 0.0, refuted, res.K, h,
-                            "certified" if ok else "inconclusive", d.eps, None, True, False,
-                            requirements=res)

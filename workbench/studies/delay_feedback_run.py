@@ -160,6 +160,22 @@ def synthesise(spec, A, B, points=()) -> SynthesisOutcome:
                             t.at_cap, tight=t)
 
 
+def synthesise_requirements(spec, model, values, op, A, B, points=()):
+    """The design's synthesis when it has ``[requirements]``: a
+    :class:`~.delay_feedback_run.SynthesisOutcome` whose delay fields are
+    the gain's own certified cap (every delay in [0, H] at the required
+    decay rate, gain and input limit)."""
+    from .delay_feedback_requirements import run_requirements
+    res = run_requirements(spec, spec.requirements, model, values, op, A, B, points)
+    d, c = res.design, res.design.certificate
+    h = None if c is None else c.h_certified
+    ok = h is not None and h >= spec.requirements.delay[1]
+    refuted = math.inf if c is None else c.delay.h_refuted
+    return SynthesisOutcome("requirements", h or 0.0, refuted, res.K, h,
+                            "certified" if ok else "inconclusive", d.eps, None, True, False,
+                            requirements=res)
+
+
 def delay_range_stable(windows, h_min: float, h_max: float) -> bool:
     """True when one exact stability window contains every delay in [h_min, h_max]."""
     return any(a < h_min and h_max < b for a, b in windows)
@@ -171,7 +187,6 @@ def run(spec) -> DelayFeedbackResult:
     model, values, op, A, B = nominal_point(spec)
     points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
     if spec.synthesis.method == "requirements":
-        from .delay_feedback_requirements import synthesise_requirements
         syn = synthesise_requirements(spec, model, values, op, A, B, points)
     else:
         syn = synthesise(spec, A, B, points)
