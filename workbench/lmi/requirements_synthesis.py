@@ -61,20 +61,24 @@ class GainCertificate:
         Decay rate (1/s) for every constant delay in [h_min, H]
         (Bessel-Legendre cells, :func:`~workbench.lmi.requirements_decay.certified_decay`).
     gamma : Bracket or None
-        Bisection on 1/gamma at the required decay rate over [0, H], the
-        input limit included (None: no L2 requirement).
+        Bisection on 1/gamma (every constant delay in [0, H], the bounded-real
+        descriptor analysis; None: no L2 requirement).
     delay : Bracket
-        Largest cap H (s) at the required decay rate and gamma, input limit
-        included (every delay in [0, H]).
-    joint : Step
-        The analysis LMI at the required values (decay rate, gamma, input
-        limit) and cap H: CERTIFIED proves them together over [0, H].
+        Largest cap H' (s) with asymptotic stability certified for every
+        constant delay in [0, H'] (descriptor analysis).
+    joint : Step or None
+        The input-limit certificate at cap H (invariant ellipsoid containing
+        the box, w = 0); None without an input limit.
+
+    Each requirement is a property of its own (decay of every solution, L2
+    gain from zero history, the input bound from the box with w = 0), so
+    each has its own certificate.
     """
 
     alpha: Bracket
     gamma: Bracket | None
     delay: Bracket
-    joint: Step
+    joint: Step | None
 
     @property
     def alpha_certified(self) -> float | None:
@@ -184,23 +188,32 @@ def certify_gain(loop: Loop, K: np.ndarray, *, h_min: float = 0.0, H: float, alp
                  gamma: float, margin: float = DEFAULT_MARGIN, rel_tol: float = 1e-3,
                  alpha_guess: float | None = None, N: int = 2,
                  gamma_free: bool = False) -> GainCertificate:
-    """What the gain ``K`` (coordinates of ``loop``) certifies on its own:
-    the decay rate over [h_min, H] (Bessel-Legendre cells of order N), the
-    L2 gain at ``alpha`` (when declared), the largest cap at ``alpha`` and
-    ``gamma`` and the joint certificate (see :class:`GainCertificate`).
-    With ``gamma_free`` (no required gamma) the cap and the joint certificate
-    hold the gain's own certified gamma."""
-    lmi = RequirementAnalysis(loop, K, margin=margin)
+    """What the gain ``K`` (coordinates of ``loop``) certifies on its own,
+    one certificate per requirement (see :class:`GainCertificate`): the decay
+    rate over [h_min, H] (Bessel-Legendre cells of order N), the L2 gain and
+    the input limit over [0, H] and the largest stability cap (descriptor
+    analysis with P2, P3 free, at rate 0). ``alpha``, ``gamma`` and
+    ``gamma_free`` are kept for the callers' signature (unused)."""
+    del alpha, gamma_free
+    plain = dataclasses.replace(loop, Bw=None, Cz=None, Dz=None, box=None, u_max=None)
     a = certified_decay([(A, B @ K) for A, B in loop.points], h_lo=h_min, H=H,
                         alpha_hi=_rate_scale(loop, H), N=N, margin=margin, rel_tol=rel_tol,
                         guess=alpha_guess)
-    g = (_bisect(lmi, "l2_gain", H=H, alpha=alpha, gamma=gamma, rel_tol=rel_tol,
-                 guess=1.0 / gamma) if loop.l2 else None)
-    if gamma_free and g is not None and g.outcome is Outcome.CERTIFIED:
-        gamma = 1.0 / g.h_certified          # the gain's own gamma, held below
-    d = _bisect(lmi, "delay", H=H, alpha=alpha, gamma=gamma, rel_tol=rel_tol, guess=H)
-    lmi.set_rate(alpha, gamma)
-    return GainCertificate(a, g, d, lmi.solve_at(H))
+    g = None
+    if loop.l2:
+        lmi = RequirementAnalysis(dataclasses.replace(loop, box=None, u_max=None), K,
+                                  margin=margin)
+        g = _bisect(lmi, "l2_gain", H=H, alpha=0.0, gamma=gamma, rel_tol=rel_tol,
+                    guess=1.0 / gamma)
+    d = _bisect(RequirementAnalysis(plain, K, margin=margin), "delay", H=H, alpha=0.0,
+                gamma=1.0, rel_tol=rel_tol, guess=H)
+    joint = None
+    if loop.limited:
+        lmi = RequirementAnalysis(dataclasses.replace(loop, Bw=None, Cz=None, Dz=None), K,
+                                  margin=margin)
+        lmi.set_rate(0.0)
+        joint = lmi.solve_at(H)
+    return GainCertificate(a, g, d, joint)
 
 
 def synthesize_requirements(loop: Loop, *, objective: Objective, H: float, h_min: float = 0.0,

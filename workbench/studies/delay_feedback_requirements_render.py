@@ -21,16 +21,16 @@ def gain_text(K, digits: int) -> str:
 
 
 _WHAT = {
-    "delay": ("certified: the largest cap H such that the rounded gain meets the required "
-              "decay rate, L2 gain and input limit for every constant delay in [0, H] (s, "
-              "rounded down); exact: the worst decay rate on the range (1/s, > 0: stable)"),
+    "delay": ("certified: the largest cap H such that the rounded gain is certified stable for "
+              "every constant delay in [0, H] (s, rounded down); exact: the worst decay rate on "
+              "the range (1/s, > 0: stable)"),
     "decay": ("certified: decay rate of the rounded gain for every constant delay in the range "
               "and every vertex, Bessel-Legendre (N = 2) cells over the range (1/s, rounded "
               "down); exact: the worst rightmost root on a 61-point delay grid, with no "
               "crossing of Re s = −certified between grid points"),
-    "l2_gain": ("certified: bounded-real descriptor LMI, every constant delay in [0, h_max] "
-                "(rounded up); exact: the H-infinity norm of the delayed loop on the delay "
-                "grid"),
+    "l2_gain": ("certified: bounded-real descriptor LMI with P2, P3 free, every constant delay "
+                "in [0, h_max] (rounded up); exact: the largest H-infinity norm of the delayed "
+                "loop on the delay grid"),
     "input_limit": ("certified: 1 when an invariant ellipsoid contains the box of constant "
                     "initial histories and keeps |u_k| ≤ u_max,k; exact: peak |u_k| / u_max,k "
                     "of linear simulations from the box's vertices at h_min, mid-range and "
