@@ -123,15 +123,26 @@ def certified_decay(points: Sequence[tuple[np.ndarray, np.ndarray]], *, h_lo: fl
     rate) holds for every cell of every point; the bisection is the shared
     :func:`~workbench.lmi.core.bisect_delay` on alpha in
     [1e-5 alpha_hi, alpha_hi]. Coordinates are balanced per point by a
-    power-of-two diagonal (exact) from |A| + |A_d|.
+    power-of-two diagonal (exact) from A, and, when that does not certify a
+    rate, from |A| + |A_d| (both are similarity transforms of the same loop,
+    so either certificate proves the rate; solvers differ on them).
     """
     if not (0 <= h_lo < H < math.inf):
         raise ValueError(f"delay range [{h_lo!r}, {H!r}] s; expected 0 <= h_min < h_max < inf")
-    bal = []
+    bal: list[list] = [[], []]        # two exact power-of-two scalings of every point
     for A, Ad in points:
         A, Ad = np.asarray(A, float), np.asarray(Ad, float)
-        T = balancing(np.abs(A) + np.abs(Ad))     # both matrices: A alone may be triangular
-        Tinv = np.diag(1.0 / np.diag(T))
-        bal.append((Tinv @ A @ T, Tinv @ Ad @ T))
-    return bisect_delay(lambda a: _decide(bal, a, h_lo, H, N, margin), h_lo=1e-5 * alpha_hi,
+        for k, M in enumerate((A, np.abs(A) + np.abs(Ad))):   # A alone may be triangular
+            T = balancing(M)
+            Tinv = np.diag(1.0 / np.diag(T))
+            bal[k].append((Tinv @ A @ T, Tinv @ Ad @ T))
+
+    def decide(a: float) -> Step:
+        step = _decide(bal[0], a, h_lo, H, N, margin)
+        if step.outcome is Outcome.CERTIFIED:
+            return step
+        other = _decide(bal[1], a, h_lo, H, N, margin)
+        return other if other.outcome is Outcome.CERTIFIED else step
+
+    return bisect_delay(decide, h_lo=1e-5 * alpha_hi,
                         h_hi=alpha_hi, rel_tol=rel_tol, guess=guess)
