@@ -15,8 +15,15 @@ _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 _API = ("delay_bound", "simulate_delay", "DelayBoundResult")
 
 
+#: Loaded from :mod:`workbench.api_design` (design to requirements).
+_DESIGN_API = ("design_gain",)
+
+
 def __getattr__(name):
     """Lazy access to :mod:`workbench.api` (``workbench.delay_bound`` etc.)."""
+    if name in _DESIGN_API:
+        from . import api_design
+        return getattr(api_design, name)
     if name in _API:
         from . import api
         return getattr(api, name)
@@ -24,4 +31,4 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(list(globals()) + list(_API))
+    return sorted(list(globals()) + list(_API) + list(_DESIGN_API))

@@ -69,6 +69,7 @@ class RobustSpec:
     gain_fraction: float
     gain_digits: int
     compare: tuple[Compare, ...]
+    requirements: object = None     # RequirementsSpec ([requirements]) or None
 
 
 @dataclass(frozen=True)
@@ -81,6 +82,7 @@ class RobustResult:
     checks: tuple[PointCheck, ...]           # robust K, per point
     abscissa: tuple[float, ...]              # spectral abscissa at h_certified, per point
     compared: tuple[tuple[PointCheck, ...], ...]
+    requirements: object = None     # workbench.requirements.RequirementResult or None
 
     def to_json(self) -> dict:
         return {"eps": self.synthesis.eps, "h_certified": self.synthesis.bracket.h_certified,
@@ -156,7 +158,9 @@ class AntiskidRobust:
                 raise c.fail("K", list(K), f"{points[0].B.shape[0]} gain entries")
             compare.append(Compare(c.string("name"), K, c.string("source")))
             c.finish()
-        return RobustSpec(common, rails, points, compare=tuple(compare), **spec)
+        from .delay_feedback_requirements import load_rate_requirements
+        return RobustSpec(common, rails, points, compare=tuple(compare),
+                          requirements=load_rate_requirements(root), **spec)
 
     def quantity_names(self, spec: RobustSpec) -> set[str]:
         names = {"synthesis.h_certified", "synthesis.h_gain", "synthesis.eps", "synthesis.K1",
@@ -166,6 +170,9 @@ class AntiskidRobust:
         for p in spec.points:
             names |= {f"points[{p.id}].{f}" for f in ("exact_margin", "h_certified",
                                                         "abscissa_at_h", "lambda_d")}
+        from .delay_feedback_requirements import requirement_quantity_names
+        names |= requirement_quantity_names(spec.requirements)
+        names |= {"requirements.K1", "requirements.K2"} if spec.requirements else set()
         for c in spec.compare:
             names |= {f"compare[{c.name}].unstable_points", f"compare[{c.name}].all_stable"}
             names |= {f"compare[{c.name}].points[{p.id}].exact_margin" for p in spec.points}
@@ -188,7 +195,14 @@ class AntiskidRobust:
             absc = tuple(spectral_abscissa(A, B @ syn.K, h) for A, B in pts)
         compared = tuple(check_gain(pts, np.array([c.K]), N=s.order, margin=s.margin)
                          for c in s.compare)
-        return RobustResult(s.points, s.compare, s.alpha, s.order, syn, checks, absc, compared)
+        req = None
+        if s.requirements is not None:       # the design to requirements (issue 31)
+            from ..requirements import Requirements, design_to_requirements
+            r = s.requirements
+            req = design_to_requirements(pts, Requirements(r.delay, r.decay_rate,
+                                                           objective=r.objective))
+        return RobustResult(s.points, s.compare, s.alpha, s.order, syn, checks, absc, compared,
+                            req)
 
     def quantities(self, res: RobustResult) -> dict:
         syn = res.synthesis
@@ -211,6 +225,12 @@ class AntiskidRobust:
                 q[f"points[{p.id}].abscissa_at_h"] = a
         for p in spec_points:
             q[f"points[{p.id}].lambda_d"] = p.lambda_d
+        if res.requirements is not None:
+            from .delay_feedback_requirements import requirement_quantities
+            q.update(requirement_quantities(res.requirements))
+            K = res.requirements.K
+            q["requirements.K1"] = None if K is None else float(K[0, 0])
+            q["requirements.K2"] = None if K is None else float(K[0, 1])
         for c, checks in zip(res.compare, res.compared):
             q[f"compare[{c.name}].unstable_points"] = float(sum(not k.stable_at_zero
                                                                 for k in checks))

@@ -14,6 +14,22 @@ def _margin(pc) -> str:
     return fmt(pc.exact.h, 4)
 
 
+def _requirements(spec, res) -> str:
+    """The requirements section (issue 31) that opens the report."""
+    from .delay_feedback_requirements_render import requirements_rows
+    r, q = res.requirements, spec.requirements
+    return ("## Requirements\n\nOne gain for every operating point below, designed to "
+            f"requirements: objective **{q.objective}**, every constant delay in "
+            f"[{fmt(q.delay[0])}, {fmt(q.delay[1])}] s "
+            "(`workbench/requirements.py`: exponentially weighted descriptor synthesis, the "
+            "rounded gain's decay certified by Bessel-Legendre cells over the range, exact "
+            "rightmost roots on a delay grid).\n\n"
+            + requirements_rows(q, r, spec.gain_digits)
+            + "\n\nThe sections below are the earlier *largest certified delay* synthesis "
+            "(maximise h at a decay rate certified at h only), kept as a comparison: its gain "
+            "has almost no creep feedback.")
+
+
 def render(design, res) -> Rendered:
     syn = res.synthesis
     h = syn.bracket.h_certified
@@ -33,6 +49,8 @@ def render(design, res) -> Rendered:
             + md_table(["point", "rail", "v_d (m/s)", "mass factor", "lambda_d"],
                        [[f"`{p.id}`", p.rail, fmt(p.v_d), fmt(p.mass_factor), fmt(p.lambda_d, 4)]
                         for p in pts], "llrrr"))
+    if res.requirements is not None:
+        prob = _requirements(design.spec, res) + "\n\n" + prob
     if syn.K is None:
         return Rendered((prob, "## Robust gain\n\n**No gain was certified** at these points "
                          f"(best eps {fmt(syn.eps, 3)}): {syn.reason or 'no reason recorded'}."))

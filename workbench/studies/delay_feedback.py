@@ -104,6 +104,7 @@ class DelayFeedbackSpec:
     scenarios: tuple[Scenario, ...]
     window_horizon: float
     basin: object = None     # delay_feedback_basin.BasinSettings or None ([basin] table)
+    requirements: object = None   # delay_feedback_requirements.RequirementsSpec or None
 
 
 def _variables(root: Reader, table: str, taken: set[str], min_len: int = 1
@@ -213,16 +214,20 @@ def _synthesis(root: Reader, delay: DelaySpec) -> SynthesisChoice:
     from ..lmi.core import DEFAULT_MARGIN
     from ..lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
     from ..synthesis import SynthesisSettings
-    s = root.table("synthesis")
-    method = s.string("method", choices=METHODS + ("robust-descriptor",))
-    if (method == "robust-descriptor") != root.has("vertices"):
+    req = root.has("requirements")
+    s = root.table("synthesis", default=None) if req else root.table("synthesis")
+    method = s.string("method", choices=METHODS + ("robust-descriptor", "requirements"),
+                      **({"default": "requirements"} if req else {}))
+    if (method == "requirements") != req:
+        raise s.fail("method", method, '"requirements" exactly when [requirements] is given')
+    if method != "requirements" and (method == "robust-descriptor") != root.has("vertices"):
         raise s.fail("method", method, '"robust-descriptor" exactly when [[vertices]] are given')
     eps = grid = ()
     if method == "free-weighting-003":
         eps = s.numbers("eps", positive=True, what="eps values")
         if len(set(eps)) != len(eps):
             raise s.fail("eps", list(eps), "distinct eps values")
-    else:
+    elif method != "requirements":
         grid = s.numbers("grid", default=(0.01, 0.1, 1.0, 10.0, 100.0), positive=True,
                          min_len=2, what="eps values")
         if list(grid) != sorted(set(grid)):
@@ -329,7 +334,9 @@ class DelayFeedback:
         ex.finish()
         from .delay_feedback_basin import check_domain, load_basin_settings
         basin = load_basin_settings(root, plant, len(scenarios))
-        spec = DelayFeedbackSpec(plant, delay, syn, vertices, scenarios, horizon, basin)
+        from .delay_feedback_requirements import load_requirements
+        req = load_requirements(root, plant, delay)
+        spec = DelayFeedbackSpec(plant, delay, syn, vertices, scenarios, horizon, basin, req)
         from .delay_feedback_run import nominal_point
         op = nominal_point(spec)[2]  # no operating point in range is bad input: fail now
         for v in vertices:
@@ -362,6 +369,8 @@ class DelayFeedback:
             names |= {f"{b}.peak_error.{k}" for k in p.state_names}
             names |= {f"{b}.final_error.{k}" for k in p.state_names}
             names |= {f"{b}.peak_input_dev.{k}" for k in p.input_names}
+        from .delay_feedback_requirements import requirement_quantity_names
+        names |= requirement_quantity_names(spec.requirements)
         if spec.basin is not None:
             from .delay_feedback_basin import basin_quantity_names
             names |= basin_quantity_names(spec)

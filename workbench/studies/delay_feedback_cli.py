@@ -9,6 +9,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from .delay_feedback_requirements_render import gain_text
+
 
 def synthesis_table(rows, settings) -> str:
     """The printed table of a problem (60) eps sweep (``workbench synthesize
@@ -43,16 +45,6 @@ def _op_text(spec, op) -> str:
                      for k, v in vals.items())
 
 
-def gain_text(K, digits: int) -> str:
-    """A gain matrix as printed: rows in brackets, ``digits`` significant digits."""
-    from ..report.markdown import fmt
-    if K is None:
-        return "—"
-    K = np.atleast_2d(K)
-    rows = ["[" + ", ".join(fmt(float(k), digits) for k in row) + "]" for row in K]
-    return rows[0] if len(rows) == 1 else "[" + ", ".join(rows) + "]"
-
-
 def synthesize_command(design, *, eps=None, as_json: bool = False) -> int:
     """Print the synthesis of a ``delay-feedback`` design; exit 0 if certified, else 1."""
     from ..report.markdown import fmt, md_table
@@ -64,8 +56,20 @@ def synthesize_command(design, *, eps=None, as_json: bool = False) -> int:
             raise DesignError("<cli>", "--eps", list(eps), "no --eps: the design's method "
                               f"{spec.synthesis.method!r} searches eps itself")
         spec = replace(spec, synthesis=replace(spec.synthesis, eps=tuple(eps)))
-    _, _, op, A, B = nominal_point(spec)
+    model, values, op, A, B = nominal_point(spec)
     points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
+    if spec.synthesis.method == "requirements":
+        from .delay_feedback_requirements_render import requirements_table
+        from .delay_feedback_run import synthesise_requirements
+        s = synthesise_requirements(spec, model, values, op, A, B, points)
+        r = s.requirements
+        ok = all(row.verdict == "PASS" for row in r.rows)
+        if as_json:
+            print(json.dumps({"design": design.name, **r.as_dict()}, indent=2))
+        else:
+            print(f"{design.name}: designed to requirements at {_op_text(spec, op)}")
+            print(requirements_table(spec, r))
+        return 0 if ok else 1
     s = replace(synthesise(spec, A, B, points), required=spec.delay.h_max,
                 h_cap=spec.synthesis.settings.h_max)
     st = spec.synthesis.settings

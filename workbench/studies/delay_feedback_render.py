@@ -11,7 +11,7 @@ import numpy as np
 from ..report.markdown import Figure, Rendered, fmt, fmt_floor, latex_matrix, md_table
 from .antiskid_cruise_render import (capped_text, closed_loop_eigs_text, exact_margin_text,
                                      recheck_table)
-from .delay_feedback_cli import gain_text
+from .delay_feedback_requirements_render import gain_text, requirements_section
 
 _METHOD = {
     "free-weighting-003": "paper 003's free-weighting problem (60) (Theorem 1 + Remark 3), "
@@ -21,6 +21,11 @@ _METHOD = {
     "bessel-legendre": "Wirtinger-based synthesis with the gain certified by the "
                        "Bessel-Legendre analysis of order N (Seuret & Gouaisbaut 2015); "
                        "certificates at the delay h",
+    "requirements": "design to requirements (`workbench/lmi/requirements.py`): the "
+                    "exponentially weighted descriptor/Jensen synthesis LMI, one gain for the "
+                    "operating point and every vertex, eps searched; the certificate holds for "
+                    "every constant delay in [0, h]. h below: the largest cap the rounded gain "
+                    "certifies at the required decay rate, gain and input limit",
     "robust-descriptor": "one gain for every polytope vertex: Jensen/descriptor synthesis with "
                          "common Y, V (`workbench/lmi/robust.py`), eps searched; with decay "
                          "rate 0 the certificate holds for every constant delay in [0, h] at "
@@ -73,6 +78,8 @@ def render(design, res) -> Rendered:
     spec, p = design.spec, design.spec.plant
     s, st = res.synthesis, spec.synthesis.settings
     sections = []
+    if s.requirements is not None:
+        sections.append(requirements_section(spec, s.requirements))
     var = [[f"`{v.name}`", "state", v.unit, v.description, v.source] for v in p.states]
     var += [[f"`{v.name}`", "input", v.unit, v.description, v.source] for v in p.inputs]
     par = [[f"`{k}`", fmt(q.value, 6), q.unit, q.source] for k, q in p.parameters.items()]

@@ -72,6 +72,7 @@ class SynthesisOutcome:
     robust: object = field(default=None, repr=False)
     required: float | None = None      # the design's largest delay (s)
     h_cap: float | None = None         # the synthesis search cap (s)
+    requirements: object = field(default=None, repr=False)   # RequirementResult
 
     @property
     def reason(self) -> str:
@@ -83,6 +84,7 @@ class SynthesisOutcome:
         if self.status == "certified":
             return ""
         own = (self.tight if self.tight is not None else
+               self.requirements if self.requirements is not None else
                self.robust[0] if self.robust is not None else
                max(self.rows, key=lambda r: r.h_certified, default=None))
         return getattr(own, "reason", "") or "no reason recorded"
@@ -127,7 +129,9 @@ class DelayFeedbackResult:
                 "reason": s.reason,
                 "exact_margin": None if self.exact is None else inf(self.exact.h),
                 "windows": [[inf(a), inf(b)] for a, b in self.windows],
-                "scenarios": {r.scenario.name: r.metrics for r in self.scenarios}}
+                "scenarios": {r.scenario.name: r.metrics for r in self.scenarios},
+                **({} if s.requirements is None
+                   else {"requirements": s.requirements.as_dict()["requirements"]})}
 
 
 def synthesise(spec, A, B, points=()) -> SynthesisOutcome:
@@ -179,6 +183,22 @@ def _failed(bracket) -> str:
     return "infeasible" if bracket.outcome.value == "infeasible" else "inconclusive"
 
 
+def synthesise_requirements(spec, model, values, op, A, B, points=()):
+    """The design's synthesis when it has ``[requirements]``: a
+    :class:`~.delay_feedback_run.SynthesisOutcome` whose delay fields are
+    the gain's own certified cap (every delay in [0, H] at the required
+    decay rate, gain and input limit)."""
+    from .delay_feedback_requirements import run_requirements
+    res = run_requirements(spec, spec.requirements, model, values, op, A, B, points)
+    d, c = res.design, res.design.certificate
+    h = None if c is None else c.h_certified
+    ok = h is not None and h >= spec.requirements.delay[1]
+    refuted = math.inf if c is None else c.delay.h_refuted
+    return SynthesisOutcome("requirements", h or 0.0, refuted, res.K, h,
+                            "certified" if ok else "inconclusive", d.eps, None, True, False,
+                            requirements=res)
+
+
 def delay_range_stable(windows, h_min: float, h_max: float) -> bool:
     """True when one exact stability window contains every delay in [h_min, h_max]."""
     return any(a < h_min and h_max < b for a, b in windows)
@@ -189,8 +209,11 @@ def run(spec) -> DelayFeedbackResult:
     from ..margins import exact_margin, stability_windows
     model, values, op, A, B = nominal_point(spec)
     points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
-    syn = replace(synthesise(spec, A, B, points), required=spec.delay.h_max,
-                  h_cap=spec.synthesis.settings.h_max)
+    if spec.synthesis.method == "requirements":
+        syn = synthesise_requirements(spec, model, values, op, A, B, points)
+    else:
+        syn = replace(synthesise(spec, A, B, points), required=spec.delay.h_max,
+                      h_cap=spec.synthesis.settings.h_max)
     exact, windows, stable = None, (), None
     checks = ()
     if syn.K is not None:
@@ -392,6 +415,9 @@ def quantities(res: DelayFeedbackResult) -> dict:
         q[f"{b}.diverged"] = "yes" if sr.metrics["diverged"] else "no"
         q[f"{b}.converged"] = "yes" if sr.converged else "no"
     q["certificate.covers_delay_range"] = covers(res)
+    if s.method == "requirements":
+        from .delay_feedback_requirements import requirement_quantities
+        q.update(requirement_quantities(s.requirements))
     if res.basin is not None:
         from .delay_feedback_basin import basin_quantities
         q.update(basin_quantities(res.basin))
