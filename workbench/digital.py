@@ -110,6 +110,11 @@ class ImplementationResult:
         return self.T_certified / self.first_unstable if math.isfinite(self.first_unstable) else 0.0
 
     @property
+    def at_cap(self) -> bool:
+        """The certified bound is the search cap (a lower bound only)."""
+        return self.T_certified > 0 and math.isinf(self.T_refuted)
+
+    @property
     def recheck_passed(self) -> bool:
         return bool(self.recheck) and min(self.recheck.values()) >= self.margin
 
@@ -148,6 +153,7 @@ def render_markdown(r: ImplementationResult) -> str:
     jit = ("none found" if r.jitter is None else
            f"T1 = {fmt(r.jitter[0])}, T2 = {fmt(r.jitter[1])} (growth {fmt(r.jitter[2], 3)})")
     cert = fmt_floor(r.T_certified, 4) if r.T_certified > 0 else "0"
+    cert = f"≥ {cert} (search cap)" if r.at_cap else cert
     rows = [["request", req + f", network delay [{fmt(tau[0])}, {fmt(tau[1])}] s, ZOH"],
             ["outcome", f"**{r.outcome.value}** — {r.reason}"],
             ["method", r.method + (f", decay rate {fmt(r.decay_rate)} 1/s" if r.decay_rate else "")],
@@ -246,7 +252,7 @@ def implementation(sys, K, *, B=None, sampling=None, network_delay=(0.0, 0.0),
     decay_rate : float
         Required decay rate alpha (1/s) of the certificate (delay-free case).
     T_hi : float, optional
-        Search cap on T_max (s); default 20 / (||A|| + ||B K||) or 4 T_max.
+        Search cap on T_max (s); default 100 / (||A|| + ||B K||) or 4 T_max.
     margin : float
         Named relative LMI margin.
     rel_tol : float
@@ -271,11 +277,11 @@ def implementation(sys, K, *, B=None, sampling=None, network_delay=(0.0, 0.0),
         raise ValueError(f"decay_rate = {decay_rate!r}; expected >= 0 (1/s)")
     scale = 1.0 / (np.linalg.norm(A, 2) + np.linalg.norm(B @ K, 2))
     if T_hi is None:
-        T_hi = max(20 * scale, 4 * req[1]) if req else 20 * scale
+        T_hi = max(100 * scale, 4 * req[1]) if req else 100 * scale
     T_min = 0.0 if (req is None or periodic) else req[0]
     method, T_cert, T_ref, rc, note = _certify(A, B, K, T_min, taus, decay_rate, margin,
                                                T_hi, rel_tol)
-    top = max(2 * T_cert, 2 * req[1] if req else 0.0, 4 * scale)
+    top = max(4 * T_cert, 2 * req[1] if req else 0.0, 4 * scale)
     sets = tuple(periodic_stable_set(A, B, K, tau=t, T_max=top, grid=PERIODIC_GRID,
                                      T_min=max(top / PERIODIC_GRID, t / MAX_QUEUE))
                  for t in sorted(set(taus)))
