@@ -18,34 +18,25 @@ B0 = np.array([[0.0], [0.1]])
 K0 = -np.array([[3.75, 11.5]])
 
 
-def _simulate_samples(A, B, K, T, tau, x0, periods, sub=400):
-    """The sampled loop stepped exactly between input switches (event list)."""
+def _simulate_samples(A, B, K, T, tau, x0, periods):
+    """The sampled loop stepped exactly between input switches: u_k = K x(kT)
+    arrives at kT + tau and is held until the next arrival (zero before the first)."""
     n, m = B.shape
-    events, x, t = [], np.array(x0, float), 0.0
-    sent = []                          # (arrival time, u)
-    samples = [x.copy()]
-    u_now = np.zeros(m)
+    M = np.zeros((n + m, n + m))
+    M[:n, :n], M[:n, n:] = A, B
+    x, sent, samples = np.array(x0, float), [], []
+    samples.append(x.copy())
     for k in range(periods):
-        tk = k * T
-        sent.append((tk + tau, K @ x))
-        # integrate over [tk, tk + T) switching input at arrivals
-        t, t_end = tk, tk + T
-        while True:
-            arrivals = [a for a, _ in sent if t < a < t_end - 1e-15]
-            t_next = min(arrivals) if arrivals else t_end
-            for a, u in sent:
-                if a <= t + 1e-15:
-                    u_now = u
-            M = np.zeros((n + m, n + m))
-            M[:n, :n], M[:n, n:] = A, B
+        sent.append((k * T + tau, K @ x))
+        t, t_end = k * T, (k + 1) * T
+        while t < t_end - 1e-12:
+            arrived = [u for a, u in sent if a <= t + 1e-12]
+            u = arrived[-1] if arrived else np.zeros(m)
+            t_next = min([a for a, _ in sent if t + 1e-12 < a < t_end] + [t_end])
             E = sl.expm(M * (t_next - t))
-            x = E[:n, :n] @ x + E[:n, n:] @ u_now
+            x = E[:n, :n] @ x + E[:n, n:] @ u
             t = t_next
-            sent = [(a, u) for a, u in sent if a > t - 1e-15 or a == max(s for s, _ in sent)]
-            if t >= t_end - 1e-15:
-                break
         samples.append(x.copy())
-    del events
     return np.array(samples)
 
 

@@ -49,7 +49,7 @@ def cmd_synthesize(args) -> int:
 
     design = load_design(args.design)
     if args.what == "sampled":
-        from .studies.delay_feedback_implementation import sampled_command
+        from .studies.delay_feedback_sampled_cli import sampled_command
         return sampled_command(design, as_json=args.json)
     kinds = (antiskid_cruise.STUDY.kind, "delay-feedback")
     if design.kind not in kinds:

@@ -106,8 +106,10 @@ class ImplementationResult:
 
     @property
     def ratio(self) -> float:
-        """T_certified / first unstable periodic T (<= 1 by theory)."""
-        return self.T_certified / self.first_unstable if math.isfinite(self.first_unstable) else 0.0
+        """T_certified / first unstable periodic T (<= 1 by theory); nan when no
+        unstable period was found in the scanned range."""
+        return (self.T_certified / self.first_unstable if math.isfinite(self.first_unstable)
+                else math.nan)
 
     @property
     def at_cap(self) -> bool:
@@ -121,7 +123,8 @@ class ImplementationResult:
     def quantities(self) -> dict[str, object]:
         """Claim quantities (``implementation.<key>``)."""
         return {"T_certified": self.T_certified, "T_exact": self.first_unstable,
-                "ratio": self.ratio, "outcome": self.outcome.value,
+                "ratio": None if math.isnan(self.ratio) else self.ratio,
+                "outcome": self.outcome.value,
                 "rate_certified": 1.0 / self.T_certified if self.T_certified > 0 else math.inf}
 
     def to_json(self) -> dict:
@@ -131,7 +134,8 @@ class ImplementationResult:
                 "T_certified": self.T_certified, "T_refuted": inf(self.T_refuted),
                 "outcome": self.outcome.value, "reason": self.reason,
                 "recheck": dict(self.recheck), "margin": self.margin,
-                "first_unstable": inf(self.first_unstable), "ratio": self.ratio,
+                "first_unstable": inf(self.first_unstable),
+                "ratio": None if math.isnan(self.ratio) else self.ratio,
                 "stable_sets": [{"tau": s.tau, "intervals": [list(i) for i in s.intervals]}
                                 for s in self.stable_sets],
                 "jitter": None if self.jitter is None else list(self.jitter),
@@ -163,9 +167,38 @@ def render_markdown(r: ImplementationResult) -> str:
              if r.recheck else "—"],
             ["exact: first unstable periodic T (s)", fmt(r.first_unstable, 5)],
             ["exact: stable periods (s)", sets],
-            ["ratio certified / exact", fmt_floor(r.ratio, 3) if r.ratio > 0 else "0"],
+            ["ratio certified / exact", _ratio_text(r)],
             ["jitter falsifier (alternating T1, T2)", jit]]
     return md_table(["", "value"], rows, "ll")
+
+
+def _loop(sys, B, K):
+    """(A, B, K) from a continuous StateSpace or arrays, shape-checked (ValueError)."""
+    from .margins._input import real_matrix, square
+    if hasattr(sys, "A") and hasattr(sys, "B") and not isinstance(sys, np.ndarray):
+        if B is not None:
+            raise ValueError("B given together with a StateSpace; pass one or the other")
+        if getattr(sys, "dt", 0) not in (0, None):
+            raise ValueError(f"sys.dt = {sys.dt!r}; expected a continuous-time system (dt = 0)")
+        sys, B = sys.A, sys.B
+    A = square(sys, "A")
+    if B is None:
+        raise ValueError("B is required when sys is a matrix")
+    B = real_matrix(np.reshape(B, (-1, 1)) if np.ndim(B) == 1 else B, "B")
+    K = real_matrix(np.reshape(K, (1, -1)) if np.ndim(K) == 1 else K, "K")
+    n, m = A.shape[0], B.shape[1]
+    if B.shape[0] != n or K.shape != (m, n):
+        raise ValueError(f"B has shape {B.shape} and K {K.shape}; expected ({n}, m) and (m, {n})")
+    return A, B, K
+
+
+def _ratio_text(r: ImplementationResult) -> str:
+    """The ratio rounded down, or why there is none."""
+    from .report.markdown import fmt, fmt_floor
+    if math.isnan(r.ratio):
+        top = max(s.T_range[1] for s in r.stable_sets)
+        return f"— (no unstable constant period up to {fmt(top)} s)"
+    return fmt_floor(r.ratio, 3) if r.ratio > 0 else "0"
 
 
 def _sampling(sampling) -> tuple[tuple[float, float] | None, bool]:
@@ -262,15 +295,9 @@ def implementation(sys, K, *, B=None, sampling=None, network_delay=(0.0, 0.0),
     -------
     ImplementationResult
     """
-    from .api import _matrix, _system
     if hold != "zoh":
         raise ValueError(f"hold = {hold!r}; expected 'zoh'")
-    A, B = _system(sys, B)
-    n = A.shape[0]
-    if B is None:
-        raise ValueError("B is required when sys is a matrix")
-    B = _matrix(B, "B", rows=n)
-    K = _matrix(K, "K", rows=B.shape[1], cols=n)
+    A, B, K = _loop(sys, B, K)
     req, periodic = _sampling(sampling)
     taus = _delays(network_delay)
     if not decay_rate >= 0:

@@ -126,10 +126,12 @@ def render_implementation_section(spec, di: DesignImplementation) -> tuple[str, 
     from ..report.markdown import Figure, fmt, fmt_floor, md_table
     r, (d0, d1) = di.result, di.delays
     cert = fmt_floor(r.T_certified, 3) if r.T_certified > 0 else "0"
+    cert = f"≥ {cert} (search cap)" if r.at_cap else cert
     rows = [["certified T_max (every interval sequence, every delay in range)", cert,
              "Hz: " + (fmt_floor(1 / r.T_certified, 3) if r.T_certified > 0 else "—")],
             ["exact: first unstable constant period", fmt(r.first_unstable, 4), "lifted map"],
-            ["ratio certified / exact", fmt_floor(r.ratio, 3) if r.ratio > 0 else "0", ""]]
+            ["ratio certified / exact", "—" if math.isnan(r.ratio) else
+             fmt_floor(r.ratio, 3) if r.ratio > 0 else "0", ""]]
     text = (
         "## Digital implementation\n\n"
         "Loop: the nominal linearisation with u(t) = K x(t_k) held (zero-order hold) from "
@@ -177,32 +179,3 @@ def _plot(fig, di: DesignImplementation) -> None:
     ax.set_ylim(0, tau[-1])
     ax.legend(loc="upper right", fontsize=8)
 
-
-def sampled_command(design, *, as_json: bool = False) -> int:
-    """``workbench synthesize sampled DESIGN``: the design's gain (synthesised as in
-    the report), then its implementation check; exit 0 if CERTIFIED, else 1."""
-    import json
-
-    from ..digital import render_markdown
-    from ..errors import DesignError
-    from .delay_feedback_run import nominal_point, synthesise
-    if design.kind != "delay-feedback":
-        raise DesignError(design.path, "design.kind", design.kind,
-                          'a "delay-feedback" design (synthesize sampled)')
-    spec = design.spec
-    settings = spec.implementation or ImplementationSettings(None, (0.0, 0.0), "zoh")
-    _, _, _, A, B = nominal_point(spec)
-    points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
-    syn = synthesise(spec, A, B, points)
-    if syn.K is None:
-        print(f"{design.name}: no gain was certified; nothing to implement")
-        return 1
-    di = run_implementation(settings, spec.delay, A, B, syn.K)
-    if as_json:
-        print(json.dumps({"design": design.name, "delays": list(di.delays),
-                          **di.result.to_json()}, indent=2))
-    else:
-        print(f"{design.name}: digital implementation of K = {syn.K.tolist()} "
-              f"(total delay [{di.delays[0]:g}, {di.delays[1]:g}] s)")
-        print(render_markdown(di.result))
-    return 0 if di.result.outcome.value == "certified" else 1
