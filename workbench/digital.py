@@ -234,8 +234,12 @@ def _certify(A, B, K, T_min, taus, alpha, margin, T_hi, rel_tol):
         br = sb.bracket
         rc = {} if br.certificate is None else dict(br.certificate.recheck)
         return "lifted-quadratic", br.h_certified, br.h_refuted, rc, ""
+    from .lmi.scaling import balancing
     from .lmi.varying import certified_varying_delay
-    vb = certified_varying_delay(A, B @ K, h1=taus[0], mu=None, windows="fixed",
+    S = balancing(A + B @ K)                 # diagonal powers of two: exact similarity
+    Sinv = np.diag(1.0 / np.diag(S))
+    vb = certified_varying_delay(Sinv @ A @ S, Sinv @ B @ K @ S, h1=taus[0], mu=None,
+                                 windows="fixed",
                                  h_hi=T_hi + taus[1], rel_tol=rel_tol, margin=margin)
     br = vb.bracket
     rc = {} if br.certificate is None else dict(br.certificate.recheck)
@@ -313,7 +317,7 @@ def implementation(sys, K, *, B=None, sampling=None, network_delay=(0.0, 0.0),
                                      T_min=max(top / PERIODIC_GRID, t / MAX_QUEUE))
                  for t in sorted(set(taus)))
     first = min(s.first_unstable for s in sets)
-    jit = _jitter(A, B, K, min(first, top), taus[0])
+    jit = _jitter(A, B, K, 0.999 * min(first, top), taus[0])   # T2 periodic-stable
     outcome, reason = _decide(req, periodic, T_min, T_cert, sets, first, jit, taus)
     return ImplementationResult(method, req, periodic, taus, float(decay_rate), T_cert, T_ref,
                                 outcome, reason + note, rc, margin, sets, first, jit, K)

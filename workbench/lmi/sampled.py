@@ -69,6 +69,7 @@ import numpy as np
 import scipy.linalg as sl
 
 from .core import DEFAULT_MARGIN, Bracket, Outcome, Step, bisect_delay
+from .scaling import balancing
 
 __all__ = ["LiftedFamily", "continuum_margin", "decide_lifted", "certified_sampling_bound",
            "SamplingBound"]
@@ -84,6 +85,11 @@ CELL_BUDGET = 40000
 class LiftedFamily:
     """The maps s -> (M(s), M'(s)) of the module docstring for one loop.
 
+    The loop is first balanced: z = S^{-1} x with S the diagonal power-of-two
+    balancing of A + B K (:func:`workbench.lmi.scaling.balancing`; exact in
+    floating point, stability unchanged), so A, B, K and the certificate's P
+    below are those of the balanced coordinates (P_x = S^{-T} P S^{-1}).
+
     Parameters
     ----------
     A, B, K : array_like
@@ -91,7 +97,11 @@ class LiftedFamily:
     """
 
     def __init__(self, A, B, K):
-        self.A, self.B, self.K = (np.asarray(M, dtype=float) for M in (A, B, K))
+        A, B, K = (np.asarray(M, dtype=float) for M in (A, B, K))
+        S = balancing(A + B @ K)
+        Sinv = np.diag(1.0 / np.diag(S))
+        self.S = S
+        self.A, self.B, self.K = Sinv @ A @ S, Sinv @ B, K @ S
         n = self.A.shape[0]
         self.n = n
         self.Acl = self.A + self.B @ self.K
