@@ -87,6 +87,33 @@ def main() -> None:
         r = implementation(A, K, B=B, network_delay=(0.0, tau))
         print(f"| {tau:g} | {_floor(r.T_certified, 3)} | {r.first_unstable:.4f} | "
               f"{time.perf_counter() - t0:.1f} |")
+    cruise()
+
+
+def cruise() -> None:
+    """Paper 003's cruise loop: certified lowest rate on the linearisation next to the
+    simulated lowest rate of the nonlinear laws (issue 20, reports/antiskid-run-dry.md)."""
+    from workbench.studies.antiskid_cruise_sampled import cruise_sampling
+    print("\nPaper 003 cruise loop, linearisation of designs/antiskid-cruise-dry.toml with the "
+          "printed Table 3 gain (eps = 0.35):\n")
+    print("| implementation | certified T_max (s) | certified lowest rate (Hz) | "
+          "exact first unstable T (s) | simulated lowest rate, nonlinear laws (issue 20) | "
+          "seconds |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    t0 = time.perf_counter()
+    c = cruise_sampling("designs/antiskid-cruise-dry.toml")
+    sec = time.perf_counter() - t0
+    for label, r, sim in (
+            ("predictor (exact prediction: delay-free sampled loop)", c.predictor,
+             "25 Hz (ZOH; bisected 23 fails / 25 meets)"),
+            (f"no predictor, delay {c.h_m:g} + {c.measurement_delay:g} s", c.delayed,
+             "55 Hz (ZOH, 8 N m quantisation, 2 ms measurement delay; 52 fails / 55 meets)")):
+        cap = " (search cap)" if r.at_cap else ""
+        rate = 1.0 / r.T_certified
+        print(f"| {label} | >= {_floor(r.T_certified, 3)}{cap} | <= {rate:.3g} | "
+              f"{r.first_unstable:.4g} | {sim} | {sec / 2:.1f} |")
+    print("\nThe simulated rates come from the nonlinear run (traction from rest, braking entry "
+          "with law 69), which the linearisation at cruise does not see.")
 
 
 if __name__ == "__main__":

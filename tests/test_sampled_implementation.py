@@ -155,3 +155,15 @@ def test_api_outcomes_and_markdown():
 def test_bad_input_is_one_clear_error(kw, match):
     with pytest.raises(ValueError, match=match):
         implementation(A0, K0, B=B0, **kw)
+
+
+@pytest.mark.slow
+def test_cruise_loop_003_certified_rate():
+    """Paper 003's cruise linearisation with the Table 3 gain: certified without a
+    predictor for a 43.3 ms + 2 ms delay at a rate far below the simulated 25 Hz."""
+    from workbench.studies.antiskid_cruise_sampled import cruise_sampling
+    c = cruise_sampling("designs/antiskid-cruise-dry.toml")
+    assert c.delayed.outcome is Outcome.CERTIFIED and c.delayed.recheck_passed
+    assert 0.1 < c.delayed.T_certified <= c.delayed.first_unstable
+    assert c.rate_delayed < 25.0
+    assert c.predictor.T_certified >= c.delayed.T_certified
