@@ -167,3 +167,36 @@ def test_cruise_loop_003_certified_rate():
     assert 0.1 < c.delayed.T_certified <= c.delayed.first_unstable
     assert c.rate_delayed < 25.0
     assert c.predictor.T_certified >= c.delayed.T_certified
+
+
+DESIGN = "designs/wheel-slip-burckhardt-delay-feedback.toml"
+
+
+@pytest.mark.parametrize("line,key", [
+    ("sampling = -0.01", "implementation.sampling"),
+    ("sampling = [0.2, 0.1]", "implementation.sampling"),
+    ('sampling = "fast"', "implementation.sampling"),
+    ("network_delay = [0.01, 0.0]", "implementation.network_delay"),
+    ('hold = "foh"', "implementation.hold"),
+    ("samplnig = 0.01", "implementation.samplnig"),
+])
+def test_bad_implementation_table_names_the_key(tmp_path, line, key):
+    from pathlib import Path
+
+    from workbench.design import load_design
+    from workbench.errors import DesignError
+    text = Path(DESIGN).read_text(encoding="utf-8")
+    head, tail = text.split("[implementation]\n", 1)
+    body, rest = tail.split("\n\n", 1)
+    keep = [ln for ln in body.splitlines() if not ln.startswith(line.split(" ")[0] + " ")]
+    bad = tmp_path / "wheel-slip-burckhardt-delay-feedback.toml"
+    bad.write_text(head + "[implementation]\n" + "\n".join(keep + [line]) + "\n\n" + rest,
+                   encoding="utf-8")
+    with pytest.raises(DesignError, match=key.replace(".", r"\.")):
+        load_design(bad)
+
+
+def test_cli_synthesize_sampled_rejects_other_kinds(capsys):
+    from workbench.cli import main
+    assert main(["synthesize", "sampled", "designs/delay-benchmarks.toml"]) == 2
+    assert "delay-feedback" in capsys.readouterr().err
