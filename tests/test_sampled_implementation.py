@@ -200,3 +200,14 @@ def test_cli_synthesize_sampled_rejects_other_kinds(capsys):
     from workbench.cli import main
     assert main(["synthesize", "sampled", "designs/delay-benchmarks.toml"]) == 2
     assert "delay-feedback" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_synthesized_gain_is_certified_as_returned():
+    """A gain for T_max = 2 s on the standard example's plant (its published gain
+    fails at 1.7294 s): the rounded gain certifies 2 s over the continuum."""
+    import workbench
+    r = workbench.synthesize_sampled(A0, B=B0, T_max=2.0)
+    assert r.outcome is Outcome.CERTIFIED and r.T_certified >= 2.0
+    assert r.T_certified <= r.first_unstable
+    assert np.all(r.K == np.round(r.K, 3))          # rounded to 4 significant digits here

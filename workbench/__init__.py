@@ -13,7 +13,7 @@ _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 #: Public API names loaded on first use (``import workbench`` stays light).
 _API = ("delay_bound", "simulate_delay", "DelayBoundResult", "implementation",
-        "ImplementationResult")
+        "ImplementationResult", "synthesize_sampled")
 
 
 def __getattr__(name):

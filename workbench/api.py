@@ -27,7 +27,7 @@ from typing import Literal, Sequence
 
 import numpy as np
 
-from .digital import ImplementationResult, implementation  # noqa: F401  (API)
+from .digital import ImplementationResult, implementation, synthesize_sampled  # noqa: F401
 
 Method = Literal["bessel-legendre", "wirtinger", "free-weighting-003", "jensen",
                  "free-weighting", "delay-independent"]

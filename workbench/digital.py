@@ -46,7 +46,7 @@ import numpy as np
 from .lmi.core import DEFAULT_MARGIN, Outcome
 from .margins.sampled import PeriodicStableSet, alternating_radius, periodic_stable_set
 
-__all__ = ["ImplementationResult", "implementation"]
+__all__ = ["ImplementationResult", "implementation", "synthesize_sampled"]
 
 #: Points of the exact periodic scan and of each axis of the jitter scan.
 PERIODIC_GRID, JITTER_GRID = 240, 24
@@ -172,8 +172,8 @@ def render_markdown(r: ImplementationResult) -> str:
     return md_table(["", "value"], rows, "ll")
 
 
-def _loop(sys, B, K):
-    """(A, B, K) from a continuous StateSpace or arrays, shape-checked (ValueError)."""
+def _plant(sys, B):
+    """(A, B) from a continuous StateSpace or arrays, shape-checked (ValueError)."""
     from .margins._input import real_matrix, square
     if hasattr(sys, "A") and hasattr(sys, "B") and not isinstance(sys, np.ndarray):
         if B is not None:
@@ -185,10 +185,19 @@ def _loop(sys, B, K):
     if B is None:
         raise ValueError("B is required when sys is a matrix")
     B = real_matrix(np.reshape(B, (-1, 1)) if np.ndim(B) == 1 else B, "B")
+    if B.shape[0] != A.shape[0]:
+        raise ValueError(f"B has shape {B.shape}; expected ({A.shape[0]}, m)")
+    return A, B
+
+
+def _loop(sys, B, K):
+    """(A, B, K), shape-checked (ValueError)."""
+    from .margins._input import real_matrix
+    A, B = _plant(sys, B)
     K = real_matrix(np.reshape(K, (1, -1)) if np.ndim(K) == 1 else K, "K")
     n, m = A.shape[0], B.shape[1]
-    if B.shape[0] != n or K.shape != (m, n):
-        raise ValueError(f"B has shape {B.shape} and K {K.shape}; expected ({n}, m) and (m, {n})")
+    if K.shape != (m, n):
+        raise ValueError(f"K has shape {K.shape}; expected ({m}, {n})")
     return A, B, K
 
 
@@ -345,3 +354,43 @@ def _decide(req, periodic, T_min, T_cert, sets, first, jit, taus):
                                  "grow (jitter counterexample)")
     return Outcome.INCONCLUSIVE, (f"certified only up to {fmt(T_cert)} s < {fmt(T_req)} s, "
                                   "and no counterexample was found")
+
+
+def synthesize_sampled(sys, *, T_max: float, B=None, digits: int = 4,
+                       margin: float = DEFAULT_MARGIN) -> ImplementationResult:
+    """A gain for every sampling interval in (0, T_max], re-certified as returned.
+
+    The gain comes from the gridded convex LMI of
+    :func:`workbench.lmi.sampled_synthesis.synthesize_sampled_gain`, rounded to
+    ``digits`` significant digits; that rounded gain is then decided by
+    :func:`implementation` with ``sampling = (0, T_max)`` (certificate over the
+    continuum, exact periodic set, jitter falsifier). When the synthesis LMI
+    has no point, the result is INCONCLUSIVE with the solver's answer and
+    K = 0 (nothing certified).
+
+    Parameters
+    ----------
+    sys : control.StateSpace or (n, n) array_like
+        Plant (its A, B) or A (then pass ``B``).
+    T_max : float
+        Required largest sampling interval (s).
+    B : array_like, optional
+    digits : int
+        Significant digits of the gain.
+    margin : float
+        Named relative margin of the certificate.
+
+    Returns
+    -------
+    ImplementationResult
+    """
+    from .lmi.sampled_synthesis import synthesize_sampled_gain
+    A, B = _plant(sys, B)
+    K, status, t = synthesize_sampled_gain(A, B, T_max, digits=digits)
+    if K is None:
+        zero = np.zeros((B.shape[1], A.shape[0]))
+        return ImplementationResult("lifted-quadratic synthesis", (0.0, float(T_max)), False,
+                                    (0.0, 0.0), 0.0, 0.0, math.inf, Outcome.INCONCLUSIVE,
+                                    f"the synthesis LMI has no point (status {status}, t = {t})",
+                                    {}, margin, (), math.inf, None, zero)
+    return implementation(A, K, B=B, sampling=(0.0, float(T_max)), margin=margin)
