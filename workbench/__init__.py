@@ -12,7 +12,8 @@ _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
 #: Public API names loaded on first use (``import workbench`` stays light).
-_API = ("delay_bound", "simulate_delay", "DelayBoundResult")
+_API = ("delay_bound", "simulate_delay", "DelayBoundResult", "implementation",
+        "ImplementationResult", "synthesize_sampled")
 
 
 #: Loaded from :mod:`workbench.api_design` (design to requirements).

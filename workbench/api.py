@@ -27,6 +27,8 @@ from typing import Literal, Sequence
 
 import numpy as np
 
+from .digital import ImplementationResult, implementation, synthesize_sampled  # noqa: F401
+
 Method = Literal["bessel-legendre", "wirtinger", "free-weighting-003", "jensen",
                  "free-weighting", "delay-independent"]
 _SYNTHESIS = ("bessel-legendre", "wirtinger", "free-weighting-003")

@@ -49,6 +49,9 @@ def cmd_synthesize(args) -> int:
     from .studies.delay_feedback_cli import synthesis_table
 
     design = load_design(args.design)
+    if args.what == "sampled":
+        from .studies.delay_feedback_sampled_cli import sampled_command
+        return sampled_command(design, as_json=args.json)
     kinds = (antiskid_cruise.STUDY.kind, "delay-feedback")
     if design.kind not in kinds:
         raise DesignError(design.path, "design.kind", design.kind,
@@ -307,7 +310,8 @@ COMMANDS: dict[str, tuple[str, Callable]] = {
     "sweep": ("Monte Carlo robustness sweep (sweep DESIGN --samples N --seed S)", cmd_sweep),
     "benchmark": ("delay LMIs vs exact margins (benchmark delay [DESIGN] [--json])",
                   cmd_benchmark),
-    "synthesize": ("certified LMI synthesis (synthesize delay-bound DESIGN)", cmd_synthesize),
+    "synthesize": ("certified LMI synthesis (synthesize delay-bound|sampled DESIGN)",
+                   cmd_synthesize),
     "verify": ("evaluate every claim; exit 1 if any is not ok", cmd_verify),
     "fit": ("fit paper 000's brake model to a brake-fit design's synthetic logs", _cmd_fit),
     "report": ("write reports/<design>.md and figures (--check: fail if stale)", cmd_report),
@@ -329,6 +333,11 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("design")
     q.add_argument("--eps", type=float, nargs="+", help="eps values (override the design's)")
     q.add_argument("--json", action="store_true")
+    q = ssub.add_parser("sampled", help="digital implementation: certified and exact sampling "
+                        "bounds of a delay-feedback design's gain")
+    q.add_argument("design")
+    q.add_argument("--json", action="store_true")
+    q.set_defaults(eps=None)
     p = sub.add_parser("fit", help=COMMANDS["fit"][0])
     p.add_argument("design")
     p.add_argument("--json", action="store_true")

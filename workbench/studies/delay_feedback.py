@@ -27,6 +27,8 @@ Tables (see ``designs/antiskid-cruise-dry-generic.toml`` for a full file)::
     [[scenarios]]  name, t_end, dt, x0 = {...}, setpoint = {...}, h, rtol, predictor
     [basin]        enabled, domain = {...}, plane, seed     (optional: region of attraction,
                    :mod:`.delay_feedback_basin`)
+    [implementation] sampling, network_delay, hold   (optional: digital implementation,
+                   :mod:`.delay_feedback_implementation`)
 
 The design tables are read here (light: no sympy until the operating point
 is solved); :mod:`.delay_feedback_run` computes, :mod:`.delay_feedback_render`
@@ -105,6 +107,7 @@ class DelayFeedbackSpec:
     window_horizon: float
     basin: object = None     # delay_feedback_basin.BasinSettings or None ([basin] table)
     requirements: object = None   # delay_feedback_requirements.RequirementsSpec or None
+    implementation: object = None   # delay_feedback_implementation.ImplementationSettings
 
 
 def _variables(root: Reader, table: str, taken: set[str], min_len: int = 1
@@ -336,7 +339,9 @@ class DelayFeedback:
         basin = load_basin_settings(root, plant, len(scenarios))
         from .delay_feedback_requirements import load_requirements
         req = load_requirements(root, plant, delay)
-        spec = DelayFeedbackSpec(plant, delay, syn, vertices, scenarios, horizon, basin, req)
+        from .delay_feedback_implementation import load_implementation_settings
+        spec = DelayFeedbackSpec(plant, delay, syn, vertices, scenarios, horizon, basin, req,
+                                 load_implementation_settings(root))
         from .delay_feedback_run import nominal_point
         op = nominal_point(spec)[2]  # no operating point in range is bad input: fail now
         for v in vertices:
@@ -374,6 +379,9 @@ class DelayFeedback:
         if spec.basin is not None:
             from .delay_feedback_basin import basin_quantity_names
             names |= basin_quantity_names(spec)
+        if spec.implementation is not None:
+            from .delay_feedback_implementation import implementation_quantity_names
+            names |= implementation_quantity_names(spec)
         return names
 
     def run(self, design):

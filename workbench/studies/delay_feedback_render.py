@@ -121,6 +121,11 @@ def render(design, res) -> Rendered:
         sec, bfigs = render_basin_section(spec, res, res.basin)
         sections.append(sec)
         figs = [*figs, *bfigs]
+    if res.implementation is not None:
+        from .delay_feedback_implementation import render_implementation_section
+        sec, ifigs = render_implementation_section(spec, res.implementation)
+        sections.append(sec)
+        figs = [*figs, *ifigs]
     return Rendered(tuple(sections), tuple(figs))
 
 

@@ -118,6 +118,7 @@ class DelayFeedbackResult:
     delay: object = None       # DelaySpec of the design
     names: tuple = ()          # state names, then input names
     basin: object = None       # delay_feedback_basin.DelayFeedbackBasin or None
+    implementation: object = None   # delay_feedback_implementation.DesignImplementation
 
     def to_json(self) -> dict:
         s = self.synthesis
@@ -237,9 +238,13 @@ def run(spec) -> DelayFeedbackResult:
     if spec.basin is not None and syn.K is not None:
         from .delay_feedback_basin import run_basin
         basin = run_basin(spec.basin, spec, model, values, op, syn.K)
+    impl = None
+    if spec.implementation is not None and syn.K is not None:
+        from .delay_feedback_implementation import run_implementation
+        impl = run_implementation(spec.implementation, spec.delay, A, B, syn.K)
     return DelayFeedbackResult(op, A, B, syn, exact, tuple(windows), stable, checks, scen,
                                points, spec.delay,
-                               spec.plant.state_names + spec.plant.input_names, basin)
+                               spec.plant.state_names + spec.plant.input_names, basin, impl)
 
 
 # -- simulation -----------------------------------------------------------------------
@@ -421,6 +426,9 @@ def quantities(res: DelayFeedbackResult) -> dict:
     if res.basin is not None:
         from .delay_feedback_basin import basin_quantities
         q.update(basin_quantities(res.basin))
+    if res.implementation is not None:
+        from .delay_feedback_implementation import implementation_quantities
+        q.update(implementation_quantities(res.implementation))
     return q
 
 
