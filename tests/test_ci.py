@@ -38,7 +38,8 @@ def test_init_writes_the_skeleton(tmp_path, capsys):
     for ci in (".github/workflows/workbench.yml", ".gitlab-ci.yml"):
         text = (p / ci).read_text()
         assert "workbench verify --junit-xml reports/junit.xml" in text
-        assert "pip install \"workbench==" in text and "{" not in text.split("pip")[1][:40]
+        assert "pip install \"traincontrol-workbench==" in text
+        assert "{" not in text.split("pip")[1][:40]
     assert load_design(p / "designs/example-cruise.toml").name == "example-cruise"
 
 

@@ -28,6 +28,21 @@ class _BadArgs(Exception):
     pass
 
 
+class _Version(argparse.Action):
+    """``workbench --version``: print it and stop (exit 0, no SystemExit)."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, nargs=0, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from . import DISTRIBUTION, version
+        raise _Shown(f"workbench {version()} (distribution {DISTRIBUTION})")
+
+
+class _Shown(Exception):
+    pass
+
+
 def _designs(paths: list[str]) -> list:
     from .design import load_design
     if not paths:
@@ -213,7 +228,8 @@ def _cmd_fit(args) -> int:
 def cmd_init(args) -> int:
     from .scaffold import DEFAULT_REQUIREMENT, init_project
     files = init_project(args.path, papers=args.papers,
-                         requirement=args.requirement or DEFAULT_REQUIREMENT)
+                         requirement=DEFAULT_REQUIREMENT if args.requirement is None
+                         else args.requirement)
     print(f"wrote {len(files)} files in {args.path}/; next: cd {args.path} && workbench verify")
     return 0
 
@@ -273,6 +289,7 @@ COMMANDS: dict[str, tuple[str, Callable]] = {
 def build_parser() -> argparse.ArgumentParser:
     ap = _Parser(prog="workbench", description="Robust-control design and verification "
                  "workbench for train control.")
+    ap.add_argument("--version", action=_Version, help="print the version and exit")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
     p = sub.add_parser("synthesize", help=COMMANDS["synthesize"][0])
     ssub = p.add_subparsers(dest="what", required=True, parser_class=_Parser)
@@ -334,8 +351,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--papers", action="store_true",
                    help="copy the shipped designs and proofs of papers 000-004 instead of "
                         "the example")
-    p.add_argument("--requirement", help="what the CI files pip-install (default: "
-                   "workbench==<this version>)")
+    p.add_argument("--requirement", help="what the CI files pip-install: "
+                   "traincontrol-workbench==VERSION (default: this version), "
+                   "git+https://REPOSITORY@COMMIT or a traincontrol_workbench-*.whl path or URL")
     p = sub.add_parser("new", help=COMMANDS["new"][0])
     p.add_argument("kind", metavar="KIND", help="design kind (delay-feedback)")
     p.add_argument("name", metavar="NAME", help="design name (the file stem)")
@@ -350,6 +368,9 @@ def main(argv: list[str] | None = None) -> int:
     except _BadArgs as exc:
         print(exc, file=sys.stderr)
         return 2
+    except _Shown as exc:
+        print(exc)
+        return 0
     try:
         return COMMANDS[args.command][1](args)
     except (DesignError, ModelError) as exc:

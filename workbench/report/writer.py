@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 
+from .. import DISTRIBUTION
 from ..claims import ROUNDING_RTOL, ClaimResult, Verdict
 from .files import atomic_write
 from .findings import findings_section, index_cells
@@ -71,7 +72,7 @@ def provenance(solver: str | None) -> str:
     rows = []
     for p in PACKAGES:
         try:
-            rows.append([p, metadata.version(p)])
+            rows.append([p, metadata.version(DISTRIBUTION if p == "workbench" else p)])
         except metadata.PackageNotFoundError:
             rows.append([p, "not installed"])
     rows.append(["python", ".".join(platform.python_version_tuple()[:2])])

@@ -232,12 +232,14 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
         raise DesignError("<cli>", "--kernel", kernel, " or ".join(KERNELS))
     if kernel == "compiled" and not compiled_available():
         raise DesignError("<cli>", "--kernel", kernel,
-                          "numpy here: numba is not installed (pip install 'workbench[fast]')")
+                          "numpy here: numba is not installed "
+                          "(pip install 'traincontrol-workbench[fast]')")
     if scheduler is not None:
         from importlib.util import find_spec
         if find_spec("distributed") is None:
-            raise DesignError("<cli>", "--scheduler", scheduler, "no flag here: dask.distributed "
-                              "is not installed (pip install 'workbench[scale]')")
+            raise DesignError("<cli>", "--scheduler", scheduler,
+                              "no flag here: dask.distributed is not installed "
+                              "(pip install 'traincontrol-workbench[scale]')")
     if resume and not out:
         raise DesignError("<cli>", "--resume", True, "with --out DIR (the folder to resume)")
     try:
