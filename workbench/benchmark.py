@@ -23,7 +23,6 @@ from __future__ import annotations
 import json
 import math
 import time
-import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -38,6 +37,7 @@ from .lmi.hierarchy import bessel_legendre_auto
 from .margins import (AGREEMENT_RTOL, Agreement, DelayMargin, compare_margins, delay_margin_eig,
                       delay_margin_sweep)
 from .reader import Reader, display_path
+from .toml_input import load_toml
 
 AUTO = "bessel-legendre-auto"
 
@@ -266,11 +266,7 @@ def _matrix(r: Reader, name: str) -> tuple:
 def load_example(path: str | Path) -> Example:
     """Read one example file (an ``[example]`` table); DesignError on any problem."""
     shown = display_path(path)
-    try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise DesignError(shown, "<file>", "<unreadable>", f"a valid TOML example ({exc})") \
-            from None
+    data = load_toml(path, shown)
     root = Reader(shown, data)
     ex = root.table("example")
     name = ex.string("name")

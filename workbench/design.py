@@ -22,13 +22,14 @@ unknown keys (often typos) are errors too.
 """
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from .errors import DesignError
 from .reader import Quantity, Reader, display_path  # noqa: F401  (re-exported)
+from .report.files import SAFE_NAME
+from .toml_input import load_toml
 
 @dataclass(frozen=True)
 class Design:
@@ -68,15 +69,15 @@ def load_design(path: str | Path) -> Design:
     p = Path(path)
     if not p.is_file():
         raise DesignError(shown, "<file>", "<missing>", "an existing design file (.toml)")
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise DesignError(shown, "<file>", "<unparsable>", f"valid TOML ({exc})") from None
+    data = load_toml(p, shown)
     root = Reader(shown, data)
     head = root.table("design")
     name = head.string("name")
     if name != p.stem:
         raise head.fail("name", name, f'the file name without .toml, "{p.stem}"')
+    if not SAFE_NAME.fullmatch(name):
+        raise head.fail("name", name, "a file-name-safe name: letters, digits, '-', '_', '.', "
+                        "not starting with '.' (reports are written under it)")
     kind = head.string("kind", choices=sorted(studies.REGISTRY))
     title = head.string("title")
     source = head.string("source")

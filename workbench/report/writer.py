@@ -13,9 +13,8 @@ from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 
-from .. import DISTRIBUTION
 from ..claims import ROUNDING_RTOL, ClaimResult, Verdict
-from .files import atomic_write
+from .files import atomic_write, check_name, replace_set
 from .findings import findings_section, index_cells
 from .markdown import Figure, Rendered, fmt, github_math, md_table
 
@@ -70,9 +69,11 @@ def provenance(solver: str | None) -> str:
     """``## Provenance``: package versions and the solver settings ``solver``
     (None: the study runs no convex solver)."""
     rows = []
+    # the workbench's distribution has a name of its own (workbench.DISTRIBUTION)
+    dist = {"workbench": metadata.packages_distributions().get("workbench", ["workbench"])[0]}
     for p in PACKAGES:
         try:
-            rows.append([p, metadata.version(DISTRIBUTION if p == "workbench" else p)])
+            rows.append([p, metadata.version(dist.get(p, p))])
         except metadata.PackageNotFoundError:
             rows.append([p, "not installed"])
     rows.append(["python", ".".join(platform.python_version_tuple()[:2])])
@@ -144,16 +145,17 @@ def index_markdown(files: list[ReportFiles]) -> str:
 
 
 def write_reports(files: list[ReportFiles], outdir: Path, *, index: bool) -> list[Path]:
-    """Write Markdown (atomically) and figures; returns the paths written."""
+    """Write each report's Markdown and figures as a set
+    (:func:`workbench.report.files.replace_set`), and the index; returns the
+    paths written."""
     from .figures import figure_png
     written = []
     outdir.mkdir(parents=True, exist_ok=True)
     for f in files:
-        for fig in f.figures:
-            written.append(atomic_write(outdir / f.name / f"{fig.name}.png", figure_png(fig)))
-        written.append(atomic_write(outdir / f"{f.name}.md", f.markdown))
+        figs = {f"{check_name(fig.name, 'figure')}.png": figure_png(fig) for fig in f.figures}
+        written += replace_set(outdir, f.name, f.markdown, figs)
     if index:
-        written.append(atomic_write(outdir / "README.md", index_markdown(files)))
+        written.append(atomic_write(outdir / "README.md", index_markdown(files), folder=outdir))
     return written
 
 
