@@ -73,7 +73,11 @@ class Reader:
         ok_type = isinstance(val, int) if integer else isinstance(val, (int, float))
         if isinstance(val, bool) or not ok_type:
             raise self.fail(name, val, f"a {what}")
-        x = int(val) if integer else float(val)
+        try:
+            x = int(val) if integer else float(val)
+        except OverflowError:         # an int past the float range
+            raise self.fail(name, f"<{len(str(abs(val)))}-digit integer>",
+                            f"a finite {what}") from None
         if not math.isfinite(x):
             raise self.fail(name, val, f"a finite {what}")
         if positive and not x > 0:
@@ -81,7 +85,9 @@ class Reader:
         if nonneg and not x >= 0:
             raise self.fail(name, val, f"a non-negative {what}")
         if lo is not None and not x >= lo or hi is not None and not x <= hi:
-            raise self.fail(name, val, f"a {what} in [{lo}, {hi}]")
+            where = (f"in [{lo:g}, {hi:g}]" if lo is not None and hi is not None else
+                     f"at most {hi:g}" if lo is None else f"at least {lo:g}")
+            raise self.fail(name, val, f"a {what} {where}")
         return x
 
     def string(self, name: str, *, default: Any = _MISSING,

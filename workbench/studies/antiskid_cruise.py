@@ -211,7 +211,7 @@ class AntiskidCruise:
         settings = SynthesisSettings(
             margin=syn.number("margin", default=DEFAULT_MARGIN, positive=True, hi=1e-2),
             rel_tol=syn.number("rel_tol", default=1e-4, positive=True, hi=0.1),
-            h_max=syn.number("h_max", default=100.0, positive=True),
+            h_max=syn.number("h_max", default=100.0, lo=1e-3, hi=1e4, what="number (s)"),
             gain_fraction=syn.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
                                      hi=1.0, what="fraction of h_certified"),
             gain_digits=int(syn.number("gain_digits", default=DEFAULT_DIGITS, integer=True,

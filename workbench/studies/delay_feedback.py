@@ -237,12 +237,15 @@ def _synthesis(root: Reader, delay: DelaySpec) -> SynthesisChoice:
         rel_tol=s.number("rel_tol", default=1e-4 if method == METHODS[0] else 1e-3,
                          positive=True, hi=0.1),
         h_max=s.number("h_max", default=max(100.0 if method == METHODS[0] else 10.0,
-                                            4 * delay.h_max), positive=True, hi=1e4,
+                                            4 * delay.h_max), lo=1e-3, hi=1e4,
                        what="number (s)"),
         gain_fraction=s.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
                                hi=1.0, what="fraction of h_certified"),
         gain_digits=int(s.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
                                  lo=2, hi=8)))
+    if settings.h_max < delay.h_max:
+        raise s.fail("h_max", settings.h_max, f"a search cap at least the design's delay, "
+                     f"delay.max = {delay.h_max:g} s")
     s.finish()
     return SynthesisChoice(method, eps, grid, order, settings, alpha)
 
@@ -330,7 +333,11 @@ class DelayFeedback:
         from .delay_feedback_basin import check_domain, load_basin_settings
         basin = load_basin_settings(root, plant, len(scenarios))
         spec = DelayFeedbackSpec(plant, delay, syn, vertices, scenarios, horizon, basin)
+        from .delay_feedback_model import PlantModel
         from .delay_feedback_run import nominal_point
+        from .delay_feedback_units import check_units, physical_ranges
+        physical_ranges(spec)      # times and masses positive, before any solve
+        check_units(PlantModel(plant))
         op = nominal_point(spec)[2]  # no operating point in range is bad input: fail now
         for v in vertices:
             nominal_point(spec, v)

@@ -24,6 +24,11 @@ from ..errors import DesignError
 from .delay_feedback_spec import PlantSpec
 
 
+#: Largest |entry| of A = df/dx and B = df/du (SI) the LMIs are asked to handle:
+#: past it Clarabel's factorisations fail (a Rust panic at J = 1e-300).
+MAX_ENTRY = 1e9
+
+
 @dataclass(frozen=True)
 class OperatingPoint:
     """A solved operating point.
@@ -81,6 +86,34 @@ class PlantModel:
         self.f = sp.Matrix([parse_expression(t, names, path=spec.path,
                                              key=f"equations.{s}")
                             for s, t in zip(spec.state_names, spec.equations)])
+        self.check_finite(None, "parameters")
+
+    def _texts(self):
+        """(key, text, sympy expression) of every definition and equation."""
+        sp = self.spec
+        yield from ((f"definitions.{n}", t, self.definitions[n]) for n, t in sp.definitions)
+        yield from ((f"equations.{s}", t, self.f[i])
+                    for i, (s, t) in enumerate(zip(sp.state_names, sp.equations)))
+
+    def check_finite(self, values: dict[str, float] | None, where: str) -> None:
+        """No division by zero, infinity or complex value in any definition or
+        equation, as written (``values`` None) or at the parameter values.
+
+        Raises
+        ------
+        DesignError
+            Naming the expression (and ``where`` the values come from).
+        """
+        import sympy as sp
+        bad = (sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I)
+        for key, text, e in self._texts():
+            v = e if values is None else self.substituted(e, values)
+            if v.has(*bad) or (values is not None and v.is_real is False):
+                kind = ("a complex value" if v.has(sp.I) or v.is_real is False
+                        else "a division by zero or an infinity")
+                at = "" if values is None else f" at the parameter values of {where}"
+                raise DesignError(self.spec.path, key, text, f"a finite real expression{at} "
+                                  f"(found {kind})")
 
     def substituted(self, expr, values: dict[str, float]):
         """``expr`` with every parameter replaced by its (double) value."""
@@ -131,10 +164,16 @@ def linearise(model: PlantModel, values: dict[str, float], op: OperatingPoint):
         (n, n) and (n, m); the linear model is dx' = A dx + B du(t - h).
     """
     fx, fu = model.jacobian_functions(values)
-    A, B = fx(op.x, op.u), fu(op.x, op.u)
+    with np.errstate(all="ignore"):
+        A, B = fx(op.x, op.u), fu(op.x, op.u)
     if not (np.all(np.isfinite(A)) and np.all(np.isfinite(B))):
         raise DesignError(model.spec.path, "operating_point", op.as_dict(model.spec),
                           "a point where the Jacobians of the equations are finite")
+    big = max(np.max(np.abs(A), initial=0.0), np.max(np.abs(B), initial=0.0))
+    if not big <= MAX_ENTRY:
+        raise DesignError(model.spec.path, "parameters", f"<a Jacobian entry of {big:.3g}>",
+                          f"a model whose linearisation has entries of magnitude at most "
+                          f"{MAX_ENTRY:g} (SI; check the parameters' values and units)")
     return A, B
 
 
