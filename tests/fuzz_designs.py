@@ -68,7 +68,7 @@ def mutate(rng: random.Random, design: str, kinds=None) -> Mutation:
     if kind == "expression":
         ms = [m for m in _EXPR.finditer(text) if m.group(1) not in (
             "name", "kind", "title", "source", "method", "model", "rail", "id", "quantity",
-            "description", "unit", "plane")]
+            "description", "unit", "plane", "value", "verdict", "severity", "note")]
         if not ms:
             return mutate(rng, design, ["number"])
         m = rng.choice(ms)
@@ -170,6 +170,11 @@ def run_one(m: Mutation, command: str, work: Path, timeout: float = 120.0, tag: 
 def campaign(seed: int, n: int, work: Path, kinds=None, timeout: float = 120.0,
              log=None) -> list[tuple[Mutation, str, str, str]]:
     """``n`` seeded mutations over :data:`DESIGNS`, commands in rotation."""
+    import workbench.cli  # noqa: F401 - loaded once here, not in every forked child
+    import workbench.design  # noqa: F401
+    from workbench import studies
+    for kind in studies.REGISTRY:   # the studies' modules too
+        studies.REGISTRY[kind]
     rng = random.Random(seed)
     out = []
     for i in range(n):
