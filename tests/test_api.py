@@ -105,7 +105,7 @@ def test_simulate_delay_returns_time_response(bl3):
     (lambda: workbench.delay_bound(control.ss([[0.5]], [[1]], [[1]], [[0]], 0.1)), "continuous"),
     (lambda: workbench.simulate_delay(UNSTABLE, [[1, 2, 3]], h=0.1, x0=[0, 0], t_end=1),
      "shape"),
-    (lambda: workbench.simulate_delay(UNSTABLE, [[1, 2]], h=0.0, x0=[0, 0], t_end=1), "h = 0"),
+    (lambda: workbench.simulate_delay(UNSTABLE, [[1, 2]], h=-1.0, x0=[0, 0], t_end=1), "h = -1"),
     (lambda: workbench.simulate_delay(UNSTABLE, [[1, 2]], h=0.1, x0=[0], t_end=1), "x0"),
 ])
 def test_bad_input_is_a_value_error(call, word):

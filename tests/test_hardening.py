@@ -194,3 +194,28 @@ def test_matrix_size_is_capped():
         api.simulate_delay(np.eye(500), np.ones((1, 500)), B=np.ones((500, 1)), h=0.1,
                            x0=np.ones(500), t_end=1.0, dt=0.01)
     assert math.isfinite(api.MAX_ORDER)
+
+
+# -- equilibria (item 6) ----------------------------------------------------------------
+_GIVEN = ('a = { solve = [-3.0, 3.0], source = "the force holding the speed on the grade (solved)" }\n'
+          'u = { solve = [-3.0, 3.0], source = "its command (solved)" }')
+
+
+def test_a_given_point_must_be_an_equilibrium(tmp_path, capsys):
+    given = ('a = { value = 0.0, unit = "m/s^2", source = "t" }\n'
+             'u = { value = 0.0, unit = "m/s^2", source = "t" }')
+    err = _verify(tmp_path, capsys, TRAIN, _GIVEN, given)
+    assert "operating_point = <max |f| = " in err and "trim = false" in err
+
+
+def test_trim_false_linearises_off_equilibrium(tmp_path):
+    from workbench.design import load_design
+    from workbench.studies.delay_feedback_run import nominal_point
+    given = ('a = { value = 0.0, unit = "m/s^2", source = "t" }\n'
+             'u = { value = 0.0, unit = "m/s^2", source = "t" }\ntrim = false')
+    text = (ROOT / "designs" / f"{TRAIN}.toml").read_text().replace(_GIVEN, given)
+    p = tmp_path / f"{TRAIN}.toml"
+    p.write_text(text)
+    d = load_design(p)
+    assert d.spec.plant.trim is False
+    assert nominal_point(d.spec)[2].residual > 1e-3      # reported, not hidden

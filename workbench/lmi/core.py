@@ -333,7 +333,7 @@ class MarginLMI:
 
 def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
                  rel_tol: float = 1e-4, max_solves: int = 60, guess: float | None = None,
-                 secant: bool = True, max_seconds: float = 600.0) -> Bracket:
+                 secant: bool = True, max_seconds: float = 3600.0) -> Bracket:
     """Bracketed bisection of a delay criterion (cf. cvxpy's ``bisection.py``).
 
     The search first brackets the boundary geometrically from ``guess`` (or
@@ -394,10 +394,7 @@ def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
         return s
 
     t0 = time.perf_counter()
-
-    def budget() -> bool:
-        return len(steps) < max_solves and time.perf_counter() - t0 < max_seconds
-
+    budget = lambda: len(steps) < max_solves and time.perf_counter() - t0 < max_seconds  # noqa
     h = min(max(guess if guess else math.sqrt(h_lo * h_hi), h_lo), h_hi)
     run(h)
     # ten-fold steps; a range wider than 1e12 in 12 steps, so any cap is bracketed

@@ -184,6 +184,7 @@ def _plant(root: Reader) -> PlantSpec:
                 raise e.fail("unit", u, f'"{v.unit}" (the unit declared for {v.name})')
             entries.append(OperatingEntry(v.name, val, source=e.string("source")))
         e.finish()
+    trim = op.boolean("trim", default=True)
     op.finish()
     n_solved = sum(e.solved for e in entries)
     if n_solved not in (0, len(states)):
@@ -191,7 +192,7 @@ def _plant(root: Reader) -> PlantSpec:
                         f"as many entries with solve = [lo, hi] as equations ({len(states)}), "
                         "or none (a given point)")
     return PlantSpec(root.path, states, inputs, params, tuple(defs), tuple(texts),
-                     tuple(entries))
+                     tuple(entries), trim)
 
 
 def _delay(root: Reader) -> DelaySpec:

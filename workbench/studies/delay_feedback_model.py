@@ -27,6 +27,8 @@ from .delay_feedback_spec import PlantSpec
 #: Largest |entry| of A = df/dx and B = df/du (SI) the LMIs are asked to handle:
 #: past it Clarabel's factorisations fail (a Rust panic at J = 1e-300).
 MAX_ENTRY = 1e9
+#: Largest residual max |f| (state units per second) of a given operating point.
+TRIM_TOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -212,9 +214,16 @@ def solve_operating_point(model: PlantModel, values: dict[str, float], *,
         x, u = split(z)
         return np.hstack([fx(x, u), fu(x, u)])[:, free]
 
-    if not free:   # a given point: its residual is reported, not required to vanish
+    if not free:   # a given point: an equilibrium, unless the design says trim = false
         x, u = split(np.zeros(0))
-        return OperatingPoint(x, u, float(np.max(np.abs(f(x, u)))), ())
+        with np.errstate(all="ignore"):
+            residual = float(np.max(np.abs(f(x, u))))
+        if spec.trim and not residual <= TRIM_TOL:
+            raise DesignError(spec.path, key, f"<max |f| = {residual:.3g}>",
+                              f"an equilibrium: max |f| <= {TRIM_TOL:g} (state units per "
+                              "second) at the given point, or trim = false in "
+                              "[operating_point] to linearise off-equilibrium")
+        return OperatingPoint(x, u, residual, ())
     lo = np.array([entries[i].lo for i in free])
     hi = np.array([entries[i].hi for i in free])
     first = np.array([entries[i].guess if entries[i].guess is not None
