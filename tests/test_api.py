@@ -63,7 +63,9 @@ def test_synthesis_on_statespace(bl3):
 def test_result_renders_and_serialises(bl3):
     md = bl3._repr_markdown_()
     assert "bessel-legendre (N = 3)" in md and "certified" in md and "exact margin" in md
-    js = json.loads(json.dumps(bl3.to_json()))
+    assert isinstance(bl3.to_json(), str) and isinstance(bl3.to_dict(), dict)
+    js = json.loads(bl3.to_json())
+    assert js == json.loads(json.dumps(bl3.to_dict()))
     assert js["K"] == bl3.K.tolist() and js["N"] == 3 and js["recheck_passed"] is True
 
 

@@ -219,3 +219,16 @@ def test_trim_false_linearises_off_equilibrium(tmp_path):
     d = load_design(p)
     assert d.spec.plant.trim is False
     assert nominal_point(d.spec)[2].residual > 1e-3      # reported, not hidden
+
+
+def test_simulate_writes_the_trajectory_csv(tmp_path, capsys):
+    out = tmp_path / "run.csv"
+    code = main(["simulate", str(ROOT / "designs" / "two-train-spacing-delay-feedback.toml"),
+                 "--csv", str(out), "--json"])
+    assert code == 0, capsys.readouterr().err
+    lines = out.read_text().splitlines()
+    head = lines[0].split(",")
+    assert head[0] == "t" and len(lines) > 100
+    data = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
+    assert data.shape[1] == len(head) and np.all(np.diff(data[:, 0]) > 0)
+    assert np.all(np.isfinite(data))

@@ -158,7 +158,13 @@ class DelayBoundResult:
     horizon: float
     at_cap: bool
 
-    def to_json(self) -> dict:
+    def to_json(self, **kwargs) -> str:
+        """The result as a JSON string (:meth:`to_dict`; ``kwargs`` go to
+        :func:`json.dumps`, e.g. ``indent=2``)."""
+        import json
+        return json.dumps(self.to_dict(), **kwargs)
+
+    def to_dict(self) -> dict:
         """A JSON-ready dict (``"inf"`` for infinite values)."""
         inf = lambda x: "inf" if isinstance(x, float) and math.isinf(x) else x
         return {"method": self.method, "N": self.N, "h_certified": self.h_certified,

@@ -110,8 +110,10 @@ def synthesize_command(design, *, eps=None, as_json: bool = False) -> int:
     return 0 if ok else 1
 
 
-def simulate_command(design, *, case: str | None, dt: float | None, as_json: bool) -> int:
-    """``workbench simulate`` of one scenario: its metrics; exit 0."""
+def simulate_command(design, *, case: str | None, dt: float | None, as_json: bool,
+                     csv: str | None = None) -> int:
+    """``workbench simulate`` of one scenario: its metrics (and with ``csv``
+    its trajectory, :func:`trajectory_csv`, written to that file); exit 0."""
     import time
 
     from ..errors import DesignError
@@ -136,6 +138,11 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
     r = simulate(spec, model, values, op, s.K, sc, dt or sc.dt)
     wall = time.perf_counter() - t0
     m = metrics(spec, op, sc, r)
+    if csv:
+        from pathlib import Path
+
+        from ..report.files import atomic_write
+        atomic_write(Path(csv), trajectory_csv(spec, r))
     if as_json:
         print(json.dumps({"design": design.name, "case": sc.name, "dt": dt or sc.dt,
                           "metrics": m, "wall_s": round(wall, 3)}, indent=2))
@@ -144,3 +151,17 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
           f"K = {gain_text(s.K, spec.synthesis.settings.gain_digits)}")
     print(md_table(["metric", "value"], [[k, fmt(v, 6)] for k, v in m.items()], "lr"))
     return 0
+
+
+def trajectory_csv(spec, r) -> str:
+    """A simulated run as CSV: ``t`` (s), each state, each input as the
+    controller outputs it at t (it acts h later), in the design's units, one
+    row per recorded step (``repr`` floats: the file reads back bit for bit)."""
+    import numpy as np
+
+    from .delay_feedback_run import input_history
+    U = input_history(r, len(spec.plant.input_names))
+    cols = ["t", *spec.plant.state_names, *spec.plant.input_names]
+    rows = np.vstack([r.t, r.x, U]).T
+    return ",".join(cols) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n"
+                                           for row in rows)
