@@ -7,7 +7,8 @@ each symbol stands for one of its declared unit, and
 
 * the terms of a sum, the arguments of ``min``/``max`` and the branches of
   ``where``/``piecewise`` must have the same unit (``km/h + m/s`` mixes
-  scales: 1 km/h = 0.2778 m/s, and is refused);
+  scales: 1 km/h = 0.2778 m/s, and is refused); a bare number there takes
+  the unit of the others (``min(u, 10)``: 10 in the unit of u);
 * the arguments of ``exp log sin cos tanh atan`` and a non-numeric exponent
   must be dimensionless (of scale 1);
 * each equation's right-hand side must have the unit of its state per
@@ -96,6 +97,9 @@ class _Walker:
         self.path, self.units, self.shown = path, units, shown
 
     def same(self, qs, key, what):
+        qs = [q for q in qs if q is not None]     # bare numbers take the others' unit
+        if not qs:
+            return None
         ref = qs[0]
         for q in qs[1:]:
             if q.dimensionality != ref.dimensionality or not math.isclose(
@@ -105,29 +109,33 @@ class _Walker:
         return ref
 
     def dimensionless(self, q, key, what):
+        if q is None:
+            return
         if not q.dimensionless or not math.isclose(q.to("").magnitude, 1.0, rel_tol=_RTOL):
             raise DesignError(self.path, key, self.shown[key],
                               f"a dimensionless {what}; found {_show(q)}")
 
     def unit(self, e, key):
+        """The unit of ``e`` as a pint quantity of magnitude 1 (None: a bare number)."""
         import sympy as sp
         one = _registry().Quantity(1, "")
         if e.is_Symbol:
             return self.units[e.name]
-        if e.is_Number or e.is_NumberSymbol:
-            return one
+        if not e.free_symbols:
+            return None
         if e.is_Add:
             return self.same([self.unit(a, key) for a in e.args], key, "terms")
         if e.is_Mul:
             out = one
             for a in e.args:
-                out = out * self.unit(a, key)
+                q = self.unit(a, key)
+                out = out if q is None else out * q
             return out
         if e.is_Pow:
             base, ex = e.args
             if ex.is_Number:
                 qb = self.unit(base, key)
-                return qb if qb.dimensionless and math.isclose(
+                return qb if qb is None or qb.dimensionless and math.isclose(
                     qb.to("").magnitude, 1.0) else qb ** float(ex)
             self.dimensionless(self.unit(base, key), key, "base of a power with a "
                                "non-numeric exponent")
@@ -173,6 +181,8 @@ def check_units(model) -> None:
         key = f"equations.{s.name}"
         got = w.unit(model.f[i], key)
         want = units[s.name] * per_s
+        if got is None:          # a constant right-hand side takes the state's unit per second
+            continue
         if got.dimensionality != want.dimensionality or not math.isclose(
                 got.to(want.units).magnitude, 1.0, rel_tol=_RTOL):
             raise DesignError(spec.path, key, shown[key], f"a right-hand side in the unit of "
