@@ -48,6 +48,12 @@ class Mutation:
     text: bytes
 
 
+def _is_value(text: str, pos: int) -> bool:
+    """True when ``pos`` is outside strings and comments (a TOML value)."""
+    line = text[text.rfind("\n", 0, pos) + 1:pos]
+    return line.count('"') % 2 == 0 and "#" not in line.replace('"#', "")
+
+
 def mutate(rng: random.Random, design: str, kinds=None) -> Mutation:
     """One seeded mutation of ``design``'s file."""
     text = (ROOT / "designs" / f"{design}.toml").read_text(encoding="utf-8")
@@ -56,7 +62,7 @@ def mutate(rng: random.Random, design: str, kinds=None) -> Mutation:
     if kind == "structural":
         kind = rng.choice(STRUCTURAL)
     if kind == "number":
-        m = rng.choice(list(_NUM.finditer(text)))
+        m = rng.choice([m for m in _NUM.finditer(text) if _is_value(text, m.start())])
         new = rng.choice(NUMBERS)
         return Mutation(design, kind, f"{m.group(1)} -> {new[:20]} at {m.start()}",
                         (text[:m.start()] + new + text[m.end():]).encode())

@@ -232,3 +232,12 @@ def test_simulate_writes_the_trajectory_csv(tmp_path, capsys):
     data = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
     assert data.shape[1] == len(head) and np.all(np.diff(data[:, 0]) > 0)
     assert np.all(np.isfinite(data))
+
+
+def test_new_writes_into_the_project_roots_designs(tmp_path, monkeypatch, capsys):
+    assert main(["init", str(tmp_path / "p")]) == 0
+    (tmp_path / "p" / "proofs" / "deep").mkdir()
+    monkeypatch.chdir(tmp_path / "p" / "proofs" / "deep")
+    assert main(["new", "delay-feedback", "my-plant"]) == 0
+    assert (tmp_path / "p" / "designs" / "my-plant.toml").is_file()
+    assert not (tmp_path / "p" / "proofs" / "deep" / "designs").exists()

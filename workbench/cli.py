@@ -235,8 +235,9 @@ def cmd_init(args) -> int:
 
 
 def cmd_new(args) -> int:
+    from .project import find_project
     from .scaffold.new import new_design
-    path = new_design(args.kind, args.name, args.dir)
+    path = new_design(args.kind, args.name, args.dir or find_project().designs)
     print(f"wrote {path}; next: workbench verify {path}")
     return 0
 
@@ -363,7 +364,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("new", help=COMMANDS["new"][0])
     p.add_argument("kind", metavar="KIND", help="design kind (delay-feedback)")
     p.add_argument("name", metavar="NAME", help="design name (the file stem)")
-    p.add_argument("--dir", default=str(DESIGNS_DIR), help="folder (default: designs/)")
+    p.add_argument("--dir", help="folder (default: designs/ of the project root)")
     return ap
 
 

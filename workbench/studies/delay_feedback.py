@@ -140,7 +140,7 @@ def _plant(root: Reader) -> PlantSpec:
     taken: set[str] = set()
     states = _variables(root, "states", taken)
     inputs = _variables(root, "inputs", taken)
-    pt = root.table("parameters")
+    pt = root.table("parameters", default=None)     # a plant may have none
     params = {}
     for name in list(pt.data):
         _check_name(pt, name, taken)
