@@ -241,3 +241,15 @@ def test_new_writes_into_the_project_roots_designs(tmp_path, monkeypatch, capsys
     assert main(["new", "delay-feedback", "my-plant"]) == 0
     assert (tmp_path / "p" / "designs" / "my-plant.toml").is_file()
     assert not (tmp_path / "p" / "proofs" / "deep" / "designs").exists()
+
+
+@pytest.mark.parametrize("J", ["5e-324", "1e-300"])
+def test_an_ill_scaled_paper_model_exits_2(tmp_path, capsys, J):
+    """J = 1e-300 ended in Clarabel's Rust panic, J = 5e-324 in a scipy traceback."""
+    err = _verify(tmp_path, capsys, CRUISE, "J    = { value = 80.0,", f"J    = {{ value = {J},")
+    assert "the linearisation at v_d = 70 m/s has an entry of" in err
+
+
+def test_an_absurd_initial_state_exits_2(tmp_path, capsys):
+    err = _verify(tmp_path, capsys, TRAIN, "x0 = { v = 22.89 }", "x0 = { v = 1e308 }")
+    assert "scenarios[0].x0.v = 1e+308" in err

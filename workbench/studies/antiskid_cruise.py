@@ -176,8 +176,15 @@ def operating_point(spec: CruiseSpec) -> tuple[float, float, float, Linearisatio
     plant = NumericAdhesion.from_dict({k: q.value for k, q in spec.params.items()})
     lam_solved = plant.cruise_lambda(spec.v_d.value)
     lam_used = spec.lambda_d_pinned.value if spec.lambda_d_pinned else lam_solved
-    return (plant.lambda_opt(), lam_solved, lam_used,
-            linearise_cruise(plant, spec.v_d.value, lam_used))
+    import numpy as np
+    with np.errstate(all="ignore"):
+        lin = linearise_cruise(plant, spec.v_d.value, lam_used)
+    big = max(np.max(np.abs(lin.A)), np.max(np.abs(lin.B)))
+    if not big <= 1e9:    # past it Clarabel's factorisations fail (a Rust panic at J = 1e-300)
+        raise ModelError(f"the linearisation at v_d = {spec.v_d.value:g} m/s has an entry of "
+                         f"{big:.3g}; expected a model whose A and B entries are finite and at "
+                         "most 1e9 in magnitude (check the [plant] values)")
+    return plant.lambda_opt(), lam_solved, lam_used, lin
 
 
 def _eps_key(eps: float) -> str:

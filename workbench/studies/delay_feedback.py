@@ -282,7 +282,7 @@ def _scenarios(root: Reader, plant: PlantSpec, delay: DelaySpec) -> tuple[Scenar
         for k in list(x0t.data):
             if k not in states:
                 raise x0t.fail(k, x0t.data[k], "a state: " + ", ".join(states))
-            x0[k] = x0t.number(k)
+            x0[k] = x0t.number(k, lo=-1e12, hi=1e12)
         x0t.finish()
         spt = r.table("setpoint", default=None)
         sp = {}
