@@ -30,7 +30,10 @@ class SchedulerUnreachable(ConnectionError):
 def die_with_parent(parent: int) -> None:
     """Pool worker initializer: the worker is killed when its parent dies
     (Linux ``prctl(PR_SET_PDEATHSIG, SIGKILL)``), so a killed ``sweep`` leaves
-    no workers behind; if the parent is already gone, the worker exits."""
+    no workers behind; if the parent is already gone, the worker exits.
+    The signal fires when the *thread* that started the worker ends, so a
+    pool is started by the thread that waits for it (as here: submit in
+    :class:`PendingBatch`, the fork start method launching every worker at once)."""
     if sys.platform.startswith("linux"):
         import ctypes
         libc = ctypes.CDLL(None, use_errno=True)
