@@ -419,7 +419,8 @@ def simulate_delay(sys, K, *, h: float, x0, t_end: float, dt: float = 1e-3, B=No
 
     r = simulate_closed_loop(step, lambda t, x, line: (K @ np.asarray(x, float), 0),
                              tuple(x0), h=float(h), dt=float(dt), t_end=float(t_end),
-                             u_init=np.zeros(B.shape[1]))
+                             u_init=np.zeros(B.shape[1]),
+                             done=lambda t, x, phase: not np.all(np.abs(x) <= DIVERGED))
     size = r.t.size
     fix = lambda U: np.asarray(U, float).reshape(size, -1).T
     r = replace(r, u=fix(r.u), u_applied=fix(r.u_applied),
