@@ -253,3 +253,11 @@ def test_an_ill_scaled_paper_model_exits_2(tmp_path, capsys, J):
 def test_an_absurd_initial_state_exits_2(tmp_path, capsys):
     err = _verify(tmp_path, capsys, TRAIN, "x0 = { v = 22.89 }", "x0 = { v = 1e308 }")
     assert "scenarios[0].x0.v = 1e+308" in err
+
+
+def test_a_syntax_error_at_the_end_is_not_column_0():
+    from workbench.expr import check_expression
+    with pytest.raises(DesignError, match="at the end of the expression"):
+        check_expression("x +", {"x"}, path="p", key="k")
+    with pytest.raises(DesignError, match="at col 3"):
+        check_expression("a b", {"a", "b"}, path="p", key="k")
