@@ -156,6 +156,7 @@ def test_changed_since_checks_only_what_changed(tmp_path, monkeypatch, capsys):
     assert main(["verify", "--changed-since", "HEAD"]) == 0       # nothing changed
     std = capsys.readouterr()
     assert "0 of 0 claims ok" in std.out
+    assert "nothing changed since HEAD" in std.out and "| design |" not in std.out
     assert "2 unchanged" in std.err and "example-cruise" in std.err
     proof = p / "proofs" / "braking_distance.py"
     proof.write_text(proof.read_text() + "\n")

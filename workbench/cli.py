@@ -119,7 +119,11 @@ def cmd_verify(args) -> int:
                 rows.append([e.design.name, c.claim.id, f"{c.claim.compare} {fmt(c.claim.value, 6)}",
                              fmt(c.got, 6), v if c.ok else v + " ✗", c.claim.source])
         rows += extra.get("rows", [])
-        print(md_table(["design", "claim", "expected", "got", "verdict", "source"], rows))
+        if rows:
+            print(md_table(["design", "claim", "expected", "got", "verdict", "source"], rows))
+        else:
+            print("no claims to check" + (f" (nothing changed since {args.changed_since})"
+                                          if args.changed_since else ""))
         n_bad = sum(not c.ok for e in evs for c in e.claims) + extra.get("bad", 0)
         n = sum(len(e.claims) for e in evs) + len(extra.get("rows", []))
         print(f"\n{n - n_bad} of {n} claims ok" + ("" if not n_bad else f"; {n_bad} not ok"))
