@@ -42,12 +42,6 @@ MAX_ORDER = 200
 MAX_STEPS = 10_000_000
 
 
-def _cut(value, limit: int = 200) -> str:
-    """``repr(value)`` cut to about ``limit`` characters (for messages)."""
-    text = repr(value)
-    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
-
-
 def _matrix(M, name: str, rows: int | None = None, cols: int | None = None) -> np.ndarray:
     """A finite real 2-D float array, shape-checked (ValueError otherwise)."""
     if type(M).__name__ in ("TransferFunction", "FrequencyResponseData"):
@@ -396,7 +390,7 @@ def simulate_delay(sys, K, *, h: float, x0, t_end: float, dt: float = 1e-3, B=No
         low = 0 <= v if name == "h" else 0 < v
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not (low and v < math.inf):
             sign = "non-negative" if name == "h" else "positive"
-            raise ValueError(f"{name} = {_cut(v)}; expected a {sign} finite number (s)")
+            raise ValueError(f"{name} = {v!r:.200}; expected a {sign} finite number (s)")
     if dt > t_end / 10:
         raise ValueError(f"dt = {dt!r}; expected at most t_end / 10 = {t_end / 10:g} s")
     if max(t_end, h) / dt > MAX_STEPS:

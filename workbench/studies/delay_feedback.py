@@ -20,7 +20,8 @@ Tables (see ``designs/antiskid-cruise-dry-generic.toml`` for a full file)::
     [parameters]   name = { value, unit, source }
     [definitions]  name = "expression"          (optional, in order)
     [equations]    state = "expression"         (one per state)
-    [operating_point]  name = { value, unit, source } | { solve = [lo, hi], guess }
+    [operating_point]  name = { value, unit, source } | { solve = [lo, hi], guess };
+                   trim = false: a given point need not be an equilibrium
     [delay]        h = { value, unit = "s", source } | min = {...}, max = {...}
     [synthesis]    method = "free-weighting-003" | "wirtinger" | "bessel-legendre"
     [[vertices]]   name, source, parameter = value ...   (optional: robust gain)
