@@ -261,3 +261,15 @@ def test_a_syntax_error_at_the_end_is_not_column_0():
         check_expression("x +", {"x"}, path="p", key="k")
     with pytest.raises(DesignError, match="at col 3"):
         check_expression("a b", {"a", "b"}, path="p", key="k")
+
+
+def test_a_large_benchmark_matrix_is_refused(tmp_path):
+    """A 500 x 500 example tried to allocate 466 GiB."""
+    from workbench.benchmark import MAX_ORDER, load_example
+    n = MAX_ORDER + 1
+    row = "[" + ", ".join(["0.0"] * n) + "]"
+    p = tmp_path / "big.toml"
+    p.write_text('[example]\nname = "big"\ntitle = "t"\nsource = "s"\n'
+                 f"A = [{', '.join([row] * n)}]\nAd = [{', '.join([row] * n)}]\n")
+    with pytest.raises(DesignError, match=f"example.A = <a {n} x {n} matrix>; expected at most"):
+        load_example(p)

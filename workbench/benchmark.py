@@ -250,12 +250,19 @@ def _j(x):
 
 
 # -- loading -------------------------------------------------------------------------
+#: Largest order of a benchmark example.
+MAX_ORDER = 40
+
+
 def _matrix(r: Reader, name: str) -> tuple:
     val = r.raw(name)
     if (not isinstance(val, list) or not val or not all(isinstance(row, list) for row in val)
             or any(len(row) != len(val) for row in val)):
         raise r.fail(name, val, "a square matrix as a list of rows, e.g. [[-1.0, 0.0], "
                      "[0.0, -2.0]]")
+    if len(val) > MAX_ORDER:     # the LMIs' memory grows as n^4 (500 states: 466 GiB)
+        raise r.fail(name, f"<a {len(val)} x {len(val)} matrix>",
+                     f"at most {MAX_ORDER} states (the delay LMIs grow as n^4 in memory)")
     for i, row in enumerate(val):
         for j, x in enumerate(row):
             if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
