@@ -223,8 +223,9 @@ def test_trim_false_linearises_off_equilibrium(tmp_path):
 
 def test_simulate_writes_the_trajectory_csv(tmp_path, capsys):
     out = tmp_path / "run.csv"
+    png = tmp_path / "run.png"
     code = main(["simulate", str(ROOT / "designs" / "two-train-spacing-delay-feedback.toml"),
-                 "--csv", str(out), "--json"])
+                 "--csv", str(out), "--plot", str(png), "--json"])
     assert code == 0, capsys.readouterr().err
     lines = out.read_text().splitlines()
     head = lines[0].split(",")
@@ -232,6 +233,7 @@ def test_simulate_writes_the_trajectory_csv(tmp_path, capsys):
     data = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
     assert data.shape[1] == len(head) and np.all(np.diff(data[:, 0]) > 0)
     assert np.all(np.isfinite(data))
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_new_writes_into_the_project_roots_designs(tmp_path, monkeypatch, capsys):

@@ -258,10 +258,11 @@ def cmd_simulate(args) -> int:
     if design.kind == "delay-feedback":
         from .studies.delay_feedback_cli import simulate_command as simulate_feedback
         return simulate_feedback(design, case=args.case, dt=args.dt, as_json=args.json,
-                                 csv=args.csv)
-    if args.csv:
-        raise DesignError("<cli>", "--csv", args.csv, "a delay-feedback design (the "
-                          "antiskid-run trajectory is in its report's figures)")
+                                 csv=args.csv, plot=args.plot)
+    for flag, val in (("--csv", args.csv), ("--plot", args.plot)):
+        if val:
+            raise DesignError("<cli>", flag, val, "a delay-feedback design (the "
+                              "antiskid-run trajectory is in its report's figures)")
     if design.kind != "antiskid-run":
         raise DesignError(design.path, "design.kind", design.kind,
                           'an "antiskid-run" or "delay-feedback" design')
@@ -323,7 +324,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dt", type=float, help="step (s; default: the design's dt)")
     p.add_argument("--json", action="store_true")
     p.add_argument("--csv", metavar="FILE", help="also write the trajectory (t, states, "
-                   "applied inputs) to FILE (delay-feedback designs)")
+                   "controller outputs) to FILE (delay-feedback designs)")
+    p.add_argument("--plot", metavar="PNG", help="also plot the states and inputs against "
+                   "time to PNG (delay-feedback designs)")
     p = sub.add_parser("sweep", help=COMMANDS["sweep"][0])
     p.add_argument("design")
     p.add_argument("--samples", type=int, required=True)
