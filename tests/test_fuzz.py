@@ -77,6 +77,15 @@ def _misuse_cases():
                                                    x0=[1.0, 0.0])
     yield "shape mismatch", lambda: api.simulate_delay(A, np.eye(3), h=0.1, t_end=1.0,
                                                        dt=0.01, x0=[1.0, 0.0])
+    U = np.array([[0.0, 1.0], [2.0, -1.0]])
+    yield "huge entry", lambda: api.delay_bound(np.array([[1e300, 1.0], [2.0, -1.0]]), B,
+                                                method="wirtinger")
+    yield "h_max 1e308", lambda: api.delay_bound(U, B, method="wirtinger", h_max=1e308)
+    yield "tf to delay_bound", lambda: api.delay_bound(control.tf([1], [1, 1]))
+    yield "unknown method", lambda: api.delay_bound(U, B, method="magic")
+    yield "negative order", lambda: api.delay_bound(U, B, method="bessel-legendre", N=-1)
+    yield "eps text", lambda: api.delay_bound(U, B, method="free-weighting-003", eps="x")
+    yield "500 states", lambda: api.delay_bound(np.eye(500), np.ones((500, 1)))
 
 
 def test_api_misuse_raises_value_errors_only():

@@ -36,6 +36,8 @@ _ANALYSIS = ("bessel-legendre", "wirtinger", "jensen", "free-weighting", "delay-
 
 #: A state past this magnitude has diverged (the simulation stops there).
 DIVERGED = 1e150
+#: Largest |entry| of a matrix the API accepts.
+MAX_ENTRY = 1e12
 #: Largest system order (states, inputs) the API accepts.
 MAX_ORDER = 200
 #: Most steps (t_end / dt, or h / dt in the delay buffer) of a simulation.
@@ -69,6 +71,9 @@ def _matrix(M, name: str, rows: int | None = None, cols: int | None = None) -> n
                          f"{cols if cols is not None else 'any'})")
     if arr.size == 0:
         raise ValueError(f"{name} is empty; expected at least one entry")
+    if not np.max(np.abs(arr)) <= MAX_ENTRY:     # Clarabel panics far past it
+        raise ValueError(f"{name} has an entry of magnitude {np.max(np.abs(arr)):.3g}; "
+                         f"expected at most {MAX_ENTRY:g} (rescale the model's units)")
     if max(arr.shape) > MAX_ORDER:
         raise ValueError(f"{name} has shape {arr.shape}; expected at most {MAX_ORDER} rows "
                          "and columns (the LMIs grow as the cube of the order)")
