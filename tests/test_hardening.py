@@ -275,3 +275,9 @@ def test_a_large_benchmark_matrix_is_refused(tmp_path):
                  f"A = [{', '.join([row] * n)}]\nAd = [{', '.join([row] * n)}]\n")
     with pytest.raises(DesignError, match=f"example.A = <a {n} x {n} matrix>; expected at most"):
         load_example(p)
+
+
+def test_eps_values_in_a_sane_range(tmp_path, capsys):
+    """grid = [1e-300, ...] left the robust bisection solving past 120 s."""
+    err = _verify(tmp_path, capsys, TRAIN, "grid = [0.3, 1.0, 3.0]", "grid = [1e-300, 1.0, 3.0]")
+    assert "synthesis.grid[0] = 1e-300" in err and "[1e-06, 1e+06]" in err

@@ -108,7 +108,8 @@ class Reader:
         return val
 
     def numbers(self, name: str, *, default: Any = _MISSING, positive: bool = False,
-                min_len: int = 1, what: str = "numbers") -> tuple[float, ...]:
+                min_len: int = 1, what: str = "numbers", lo: float | None = None,
+                hi: float | None = None) -> tuple[float, ...]:
         val = self.raw(name, default)
         if val is default and default is not _MISSING:
             return val
@@ -120,6 +121,8 @@ class Reader:
                 raise self.fail(f"{name}[{i}]", x, f"a finite number ({what})")
             if positive and not x > 0:
                 raise self.fail(f"{name}[{i}]", x, f"a positive number ({what})")
+            if lo is not None and not x >= lo or hi is not None and not x <= hi:
+                raise self.fail(f"{name}[{i}]", x, f"a number in [{lo:g}, {hi:g}] ({what})")
             out.append(float(x))
         return tuple(out)
 

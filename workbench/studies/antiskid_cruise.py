@@ -209,7 +209,7 @@ class AntiskidCruise:
         op.finish()
         syn = root.table("synthesis")
         syn.string("method", choices=("free-weighting-003",))
-        eps = syn.numbers("eps", positive=True, what="eps values")
+        eps = syn.numbers("eps", positive=True, what="eps values", lo=1e-6, hi=1e6)
         if len(set(eps)) != len(eps):
             raise syn.fail("eps", list(eps), "distinct eps values")
         from ..lmi.core import DEFAULT_MARGIN
@@ -253,7 +253,7 @@ class AntiskidCruise:
         enable = t.boolean("enable", default=True)
         h_max = t.number("h_max", default=10.0, positive=True, hi=1e3, what="number (s)")
         grid = t.numbers("grid", default=(0.01, 0.1, 1.0, 10.0, 100.0), positive=True,
-                         min_len=2, what="eps values")
+                         min_len=2, what="eps values", lo=1e-6, hi=1e6)
         if list(grid) != sorted(set(grid)):
             raise t.fail("grid", list(grid), "distinct eps values in increasing order")
         order = t.number("order", default=2, integer=True, lo=0, hi=8, what="integer N")

@@ -44,6 +44,8 @@ from .delay_feedback_spec import OperatingEntry, PlantSpec, Variable
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 METHODS = ("free-weighting-003", "wirtinger", "bessel-legendre")
+#: eps values a synthesis may try (1e-300 left the robust bisection solving for minutes).
+EPS_RANGE = (1e-6, 1e6)
 #: Metrics of every scenario (per state / input where marked).
 SIM_METRICS = ("peak_error", "final_error", "peak_input_dev", "diverged")
 
@@ -221,12 +223,13 @@ def _synthesis(root: Reader, delay: DelaySpec) -> SynthesisChoice:
         raise s.fail("method", method, '"robust-descriptor" exactly when [[vertices]] are given')
     eps = grid = ()
     if method == "free-weighting-003":
-        eps = s.numbers("eps", positive=True, what="eps values")
+        eps = s.numbers("eps", positive=True, what="eps values", lo=EPS_RANGE[0],
+                        hi=EPS_RANGE[1])
         if len(set(eps)) != len(eps):
             raise s.fail("eps", list(eps), "distinct eps values")
     else:
         grid = s.numbers("grid", default=(0.01, 0.1, 1.0, 10.0, 100.0), positive=True,
-                         min_len=2, what="eps values")
+                         min_len=2, what="eps values", lo=EPS_RANGE[0], hi=EPS_RANGE[1])
         if list(grid) != sorted(set(grid)):
             raise s.fail("grid", list(grid), "distinct eps values in increasing order")
     order = int(s.number("order", default=2, integer=True, lo=0, hi=8, what="integer N"))
