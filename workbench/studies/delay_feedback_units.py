@@ -86,10 +86,10 @@ def physical_ranges(spec) -> None:
                 if q.dimensionality == _registry().get_dimensionality(dim):
                     si = value * q.to_base_units().magnitude
                     if not lo <= si <= hi:
-                        what = dim.strip("[]")
+                        base = f"{q.to_base_units().units:~}"
                         raise DesignError(plant.path, f"{where}.{name}{suffix}", value,
-                                          f"a positive {what} in [{lo:g}, {hi:g}] "
-                                          f"{q.to_base_units().units:~} ({unit})")
+                                          f"a positive {dim.strip('[]')} in [{lo:g}, {hi:g}] "
+                                          + base + ("" if unit == base else f" (given in {unit})"))
 
 
 class _Walker:
