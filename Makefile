@@ -17,6 +17,8 @@ OTHER_KERNEL ?= Sandybridge
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
+	# the distribution was named "workbench" before (an unrelated project's name on the index)
+	$(PY) -m pip uninstall -q -y workbench 2>/dev/null || true
 	$(PY) -m pip install -q -c constraints.txt -e '.[test,fast,scale]'
 	touch $(STAMP)
 

@@ -147,7 +147,7 @@ def montecarlo(design, spec, samples: int, workers: int) -> None:
                   f"(target: compiled >= 3000 runs/min on 2 cores); "
                   f"load average after: {os.getloadavg()[0]:.2f}")
         else:
-            print("  compiled: numba not installed (pip install 'workbench[fast]')")
+            print("  compiled: numba not installed (pip install 'traincontrol-workbench[fast]')")
 
 
 if __name__ == "__main__":

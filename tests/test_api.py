@@ -63,7 +63,9 @@ def test_synthesis_on_statespace(bl3):
 def test_result_renders_and_serialises(bl3):
     md = bl3._repr_markdown_()
     assert "bessel-legendre (N = 3)" in md and "certified" in md and "exact margin" in md
-    js = json.loads(json.dumps(bl3.to_json()))
+    assert isinstance(bl3.to_json(), str) and isinstance(bl3.to_dict(), dict)
+    js = json.loads(bl3.to_json())
+    assert js == json.loads(json.dumps(bl3.to_dict()))
     assert js["K"] == bl3.K.tolist() and js["N"] == 3 and js["recheck_passed"] is True
 
 
@@ -105,7 +107,7 @@ def test_simulate_delay_returns_time_response(bl3):
     (lambda: workbench.delay_bound(control.ss([[0.5]], [[1]], [[1]], [[0]], 0.1)), "continuous"),
     (lambda: workbench.simulate_delay(UNSTABLE, [[1, 2, 3]], h=0.1, x0=[0, 0], t_end=1),
      "shape"),
-    (lambda: workbench.simulate_delay(UNSTABLE, [[1, 2]], h=0.0, x0=[0, 0], t_end=1), "h = 0"),
+    (lambda: workbench.simulate_delay(UNSTABLE, [[1, 2]], h=-1.0, x0=[0, 0], t_end=1), "h = -1"),
     (lambda: workbench.simulate_delay(UNSTABLE, [[1, 2]], h=0.1, x0=[0], t_end=1), "x0"),
 ])
 def test_bad_input_is_a_value_error(call, word):

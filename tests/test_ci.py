@@ -38,7 +38,8 @@ def test_init_writes_the_skeleton(tmp_path, capsys):
     for ci in (".github/workflows/workbench.yml", ".gitlab-ci.yml"):
         text = (p / ci).read_text()
         assert "workbench verify --junit-xml reports/junit.xml" in text
-        assert "pip install \"workbench==" in text and "{" not in text.split("pip")[1][:40]
+        assert "pip install \"traincontrol-workbench==" in text
+        assert "{" not in text.split("pip")[1][:40]
     assert load_design(p / "designs/example-cruise.toml").name == "example-cruise"
 
 
@@ -155,6 +156,7 @@ def test_changed_since_checks_only_what_changed(tmp_path, monkeypatch, capsys):
     assert main(["verify", "--changed-since", "HEAD"]) == 0       # nothing changed
     std = capsys.readouterr()
     assert "0 of 0 claims ok" in std.out
+    assert "nothing changed since HEAD" in std.out and "| design |" not in std.out
     assert "2 unchanged" in std.err and "example-cruise" in std.err
     proof = p / "proofs" / "braking_distance.py"
     proof.write_text(proof.read_text() + "\n")

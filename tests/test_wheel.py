@@ -51,7 +51,7 @@ def venv(tmp_path_factory):
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
     _run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(tmp / "dist"),
           str(src)], tmp, env)
-    (wheel,) = (tmp / "dist").glob("workbench-*.whl")
+    (wheel,) = (tmp / "dist").glob("traincontrol_workbench-*.whl")
     _run([sys.executable, "-m", "venv", str(tmp / "venv")], tmp, env)
     py = tmp / "venv" / "bin" / "python"
     _run([str(py), "-m", "pip", "install", "-q", "-c", str(ROOT / "constraints.txt"),
@@ -59,18 +59,18 @@ def venv(tmp_path_factory):
     env["PATH"] = f"{tmp / 'venv' / 'bin'}{os.pathsep}{env.get('PATH', '')}"
     work = tmp / "work"
     work.mkdir()
-    return work, env, py
+    return work, env, py, wheel
 
 
 def test_the_wheel_imports_from_the_venv(venv):
-    work, env, py = venv
+    work, env, py, _ = venv
     out = _run([str(py), "-c", "import workbench, sys; print(workbench.__file__)"],
                work, env).stdout.strip()
     assert str(py.parent.parent) in out and str(ROOT) not in out, out
 
 
 def test_readme_snippets_run_from_the_wheel(venv):
-    work, env, _ = venv
+    work, env, _, _ = venv
     snippets = readme_snippets()
     assert len(snippets) == 3 and "workbench init" in snippets[0]
     assert "--junit-xml" in snippets[1] and "pytest --workbench" in snippets[2]
@@ -87,7 +87,7 @@ def test_readme_snippets_run_from_the_wheel(venv):
 
 
 def test_a_broken_claim_is_a_named_failing_test(venv):
-    work, env, _ = venv
+    work, env, _, _ = venv
     if not (work / "my-claims").is_dir():
         _run("workbench init my-claims", work, env)
     broken = work / "broken"
@@ -111,7 +111,7 @@ def test_a_broken_claim_is_a_named_failing_test(venv):
 
 
 def test_the_papers_from_the_wheel(venv):
-    work, env, _ = venv
+    work, env, _, _ = venv
     _run(["workbench", "init", "--papers", "papers"], work, env)
     papers = work / "papers"
     assert (papers / "designs" / "antiskid-cruise-dry.toml").is_file()
@@ -121,3 +121,23 @@ def test_the_papers_from_the_wheel(venv):
     assert "claims ok" in res.stdout and "not ok" not in res.stdout
     res = _run(["workbench", "init", "papers"], work, env, ok=(2,))
     assert "never overwrites" in res.stderr and "Traceback" not in res.stderr
+
+
+def test_the_ci_install_line_installs_our_package(venv, tmp_path):
+    """A project from ``workbench init --requirement WHEEL`` installs our
+    distribution in a fresh venv by its GitHub CI file's own install line."""
+    work, env, _, wheel = venv
+    _run(["workbench", "init", "--requirement", str(wheel), "ci-proj"], work, env)
+    line = next(ln for ln in (work / "ci-proj" / ".github/workflows/workbench.yml")
+                .read_text().splitlines() if "pip install" in ln)
+    cmd = line.split("run:", 1)[1].split("#")[0].strip()
+    assert cmd == f'python -m pip install "{wheel}"', cmd
+    fresh = tmp_path / "fresh"
+    _run([sys.executable, "-m", "venv", str(fresh)], tmp_path, env)
+    env2 = dict(env, PATH=f"{fresh / 'bin'}{os.pathsep}{os.environ.get('PATH', '')}")
+    _run(cmd, work / "ci-proj", env2)
+    res = _run(["workbench", "--version"], work / "ci-proj", env2)
+    assert "(distribution traincontrol-workbench)" in res.stdout
+    res = _run([str(fresh / "bin" / "python"), "-m", "pip", "list"], work, env2)
+    assert re.search(r"^traincontrol-workbench\s", res.stdout, flags=re.M), res.stdout
+    assert not re.search(r"^workbench\s", res.stdout, flags=re.M), res.stdout

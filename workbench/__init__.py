@@ -10,6 +10,21 @@ import os as _os
 
 _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+#: The distribution (the name on the package index and in ``pip install``).
+#: ``workbench`` on the index is an unrelated project, so ours is published
+#: under a name of its own; the import name and the command stay ``workbench``.
+DISTRIBUTION = "traincontrol-workbench"
+
+
+def version() -> str:
+    """The installed version of :data:`DISTRIBUTION` ("unknown" when run
+    from a source tree that was never installed)."""
+    from importlib import metadata
+    try:
+        return metadata.version(DISTRIBUTION)
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
 
 #: Public API names loaded on first use (``import workbench`` stays light).
 _API = ("delay_bound", "simulate_delay", "DelayBoundResult", "implementation",

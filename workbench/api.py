@@ -22,6 +22,7 @@ the workbench's own: :mod:`workbench.synthesis` (paper 003's problem (60)),
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Literal, Sequence
 
@@ -35,8 +36,21 @@ _SYNTHESIS = ("bessel-legendre", "wirtinger", "free-weighting-003")
 _ANALYSIS = ("bessel-legendre", "wirtinger", "jensen", "free-weighting", "delay-independent")
 
 
+#: A state past this magnitude has diverged (the simulation stops there).
+DIVERGED = 1e150
+#: Largest |entry| of a matrix the API accepts.
+MAX_ENTRY = 1e12
+#: Largest system order (states, inputs) the API accepts.
+MAX_ORDER = 200
+#: Most steps (t_end / dt, or h / dt in the delay buffer) of a simulation.
+MAX_STEPS = 10_000_000
+
+
 def _matrix(M, name: str, rows: int | None = None, cols: int | None = None) -> np.ndarray:
     """A finite real 2-D float array, shape-checked (ValueError otherwise)."""
+    if type(M).__name__ in ("TransferFunction", "FrequencyResponseData"):
+        raise ValueError(f"{name} is a control.{type(M).__name__}; expected a StateSpace "
+                         "(convert with control.ss(sys)) or a real matrix")
     try:
         arr = np.asarray(M)
     except Exception as exc:   # ragged lists and the like
@@ -59,11 +73,20 @@ def _matrix(M, name: str, rows: int | None = None, cols: int | None = None) -> n
                          f"{cols if cols is not None else 'any'})")
     if arr.size == 0:
         raise ValueError(f"{name} is empty; expected at least one entry")
+    if not np.max(np.abs(arr)) <= MAX_ENTRY:     # Clarabel panics far past it
+        raise ValueError(f"{name} has an entry of magnitude {np.max(np.abs(arr)):.3g}; "
+                         f"expected at most {MAX_ENTRY:g} (rescale the model's units)")
+    if max(arr.shape) > MAX_ORDER:
+        raise ValueError(f"{name} has shape {arr.shape}; expected at most {MAX_ORDER} rows "
+                         "and columns (the LMIs grow as the cube of the order)")
     return arr
 
 
 def _system(sys, B):
     """(A, B) from a StateSpace or from arrays."""
+    if type(sys).__name__ in ("TransferFunction", "FrequencyResponseData"):
+        raise ValueError(f"sys is a control.{type(sys).__name__}; expected a StateSpace "
+                         "(convert with control.ss(sys)) or the matrix A")
     if hasattr(sys, "A") and hasattr(sys, "B") and not isinstance(sys, np.ndarray):
         if B is not None:
             raise ValueError("B given together with a StateSpace; pass one or the other")
@@ -150,7 +173,13 @@ class DelayBoundResult:
     certifies: str = ""
     reason: str = ""
 
-    def to_json(self) -> dict:
+    def to_json(self, **kwargs) -> str:
+        """The result as a JSON string (:meth:`to_dict`; ``kwargs`` go to
+        :func:`json.dumps`, e.g. ``indent=2``)."""
+        import json
+        return json.dumps(self.to_dict(), **kwargs)
+
+    def to_dict(self) -> dict:
         """A JSON-ready dict (``"inf"`` for infinite values)."""
         inf = lambda x: "inf" if isinstance(x, float) and math.isinf(x) else x
         return {"method": self.method, "N": self.N, "h_certified": self.h_certified,
@@ -384,7 +413,8 @@ def simulate_delay(sys, K, *, h: float, x0, t_end: float, dt: float = 1e-3, B=No
     K : (m, n) array_like
         State-feedback gain.
     h : float
-        Input delay (s), > 0. The input is u = 0 on [-h, 0).
+        Input delay (s), >= 0 (0: the delay-free reference). The input is
+        u = 0 on [-h, 0).
     x0 : (n,) array_like
         Initial state.
     t_end, dt : float
@@ -396,12 +426,17 @@ def simulate_delay(sys, K, *, h: float, x0, t_end: float, dt: float = 1e-3, B=No
     Returns
     -------
     control.TimeResponseData
-        States (also the outputs) and the applied input u(t - h).
+        States (also the outputs) and the applied input u(t - h). A loop
+        that diverges (a state past 1e150 in magnitude) stops there: the
+        response ends at that time, its attribute ``diverged`` is
+        ``(t, state name)`` (None when it did not diverge), and a
+        RuntimeWarning says so; no NaN is returned.
 
     Raises
     ------
     ValueError
-        Bad shapes, non-finite entries, non-positive h, dt or t_end.
+        Bad shapes, non-finite entries, negative h, non-positive dt or t_end,
+        more than :data:`MAX_STEPS` steps.
     """
     from dataclasses import replace
 
@@ -415,16 +450,24 @@ def simulate_delay(sys, K, *, h: float, x0, t_end: float, dt: float = 1e-3, B=No
     x0 = _matrix(np.reshape(np.asarray(x0, dtype=float), (-1, 1)) if np.size(x0) else x0,
                  "x0", n, 1).ravel()
     for name, v in (("h", h), ("t_end", t_end), ("dt", dt)):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v < math.inf:
-            raise ValueError(f"{name} = {v!r}; expected a positive finite number (s)")
+        low = 0 <= v if name == "h" else 0 < v
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not (low and v < math.inf):
+            sign = "non-negative" if name == "h" else "positive"
+            raise ValueError(f"{name} = {v!r:.200}; expected a {sign} finite number (s)")
     if dt > t_end / 10:
         raise ValueError(f"dt = {dt!r}; expected at most t_end / 10 = {t_end / 10:g} s")
+    if max(t_end, h) / dt > MAX_STEPS:
+        raise ValueError(f"max(t_end, h) / dt = {max(t_end, h) / dt:.3g} steps (t_end = "
+                         f"{t_end:g} s, h = {h:g} s, dt = {dt:g} s); expected at most "
+                         f"{MAX_STEPS:g}")
 
     def f(x, u):
         return A @ x + B @ u
 
     def step(x, ua, t, s):
         x, ua = np.asarray(x, float), np.atleast_1d(ua)
+        if not np.all(np.abs(x) <= DIVERGED):
+            return tuple(x)     # diverged: held (cut off below), no overflow
         k1 = f(x, ua)
         k2 = f(x + 0.5 * s * k1, ua)
         k3 = f(x + 0.5 * s * k2, ua)
@@ -433,10 +476,24 @@ def simulate_delay(sys, K, *, h: float, x0, t_end: float, dt: float = 1e-3, B=No
 
     r = simulate_closed_loop(step, lambda t, x, line: (K @ np.asarray(x, float), 0),
                              tuple(x0), h=float(h), dt=float(dt), t_end=float(t_end),
-                             u_init=np.zeros(B.shape[1]))
+                             u_init=np.zeros(B.shape[1]),
+                             done=lambda t, x, phase: not np.all(np.abs(x) <= DIVERGED))
     size = r.t.size
     fix = lambda U: np.asarray(U, float).reshape(size, -1).T
     r = replace(r, u=fix(r.u), u_applied=fix(r.u_applied),
                 state_names=tuple(f"x{i + 1}" for i in range(n)),
                 input_names=tuple(f"u{i + 1}" for i in range(B.shape[1])))
-    return r.to_time_response()
+    out = np.flatnonzero(~np.all(np.abs(r.x) <= DIVERGED, axis=0))
+    diverged = None
+    if out.size:
+        k = int(out[0])
+        i = int(np.flatnonzero(~(np.abs(r.x[:, k]) <= DIVERGED))[0])
+        diverged = (float(r.t[k]), r.state_names[i])
+        warnings.warn(f"the loop diverged: |{diverged[1]}| > {DIVERGED:g} at t = "
+                      f"{diverged[0]:.6g} s; the response ends there", RuntimeWarning,
+                      stacklevel=2)
+        r = replace(r, t=r.t[:k + 1], x=r.x[:, :k + 1], u=r.u[:, :k + 1],
+                    u_applied=r.u_applied[:, :k + 1], phase=r.phase[:k + 1])
+    resp = r.to_time_response()
+    resp.diverged = diverged
+    return resp

@@ -23,7 +23,6 @@ from __future__ import annotations
 import json
 import math
 import time
-import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -38,6 +37,7 @@ from .lmi.hierarchy import bessel_legendre_auto
 from .margins import (AGREEMENT_RTOL, Agreement, DelayMargin, compare_margins, delay_margin_eig,
                       delay_margin_sweep)
 from .reader import Reader, display_path
+from .toml_input import load_toml
 
 AUTO = "bessel-legendre-auto"
 
@@ -250,12 +250,19 @@ def _j(x):
 
 
 # -- loading -------------------------------------------------------------------------
+#: Largest order of a benchmark example.
+MAX_ORDER = 40
+
+
 def _matrix(r: Reader, name: str) -> tuple:
     val = r.raw(name)
     if (not isinstance(val, list) or not val or not all(isinstance(row, list) for row in val)
             or any(len(row) != len(val) for row in val)):
         raise r.fail(name, val, "a square matrix as a list of rows, e.g. [[-1.0, 0.0], "
                      "[0.0, -2.0]]")
+    if len(val) > MAX_ORDER:     # the LMIs' memory grows as n^4 (500 states: 466 GiB)
+        raise r.fail(name, f"<a {len(val)} x {len(val)} matrix>",
+                     f"at most {MAX_ORDER} states (the delay LMIs grow as n^4 in memory)")
     for i, row in enumerate(val):
         for j, x in enumerate(row):
             if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
@@ -266,11 +273,7 @@ def _matrix(r: Reader, name: str) -> tuple:
 def load_example(path: str | Path) -> Example:
     """Read one example file (an ``[example]`` table); DesignError on any problem."""
     shown = display_path(path)
-    try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise DesignError(shown, "<file>", "<unreadable>", f"a valid TOML example ({exc})") \
-            from None
+    data = load_toml(path, shown)
     root = Reader(shown, data)
     ex = root.table("example")
     name = ex.string("name")

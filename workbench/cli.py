@@ -29,6 +29,21 @@ class _BadArgs(Exception):
     pass
 
 
+class _Version(argparse.Action):
+    """``workbench --version``: print it and stop (exit 0, no SystemExit)."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, nargs=0, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from . import DISTRIBUTION, version
+        raise _Shown(f"workbench {version()} (distribution {DISTRIBUTION})")
+
+
+class _Shown(Exception):
+    pass
+
+
 def _designs(paths: list[str]) -> list:
     from .design import load_design
     if not paths:
@@ -108,7 +123,11 @@ def cmd_verify(args) -> int:
                 rows.append([e.design.name, c.claim.id, f"{c.claim.compare} {fmt(c.claim.value, 6)}",
                              fmt(c.got, 6), v if c.ok else v + " ✗", c.claim.source])
         rows += extra.get("rows", [])
-        print(md_table(["design", "claim", "expected", "got", "verdict", "source"], rows))
+        if rows:
+            print(md_table(["design", "claim", "expected", "got", "verdict", "source"], rows))
+        else:
+            print("no claims to check" + (f" (nothing changed since {args.changed_since})"
+                                          if args.changed_since else ""))
         n_bad = sum(not c.ok for e in evs for c in e.claims) + extra.get("bad", 0)
         n = sum(len(e.claims) for e in evs) + len(extra.get("rows", []))
         print(f"\n{n - n_bad} of {n} claims ok" + ("" if not n_bad else f"; {n_bad} not ok"))
@@ -265,14 +284,16 @@ def _cmd_fit(args) -> int:
 def cmd_init(args) -> int:
     from .scaffold import DEFAULT_REQUIREMENT, init_project
     files = init_project(args.path, papers=args.papers,
-                         requirement=args.requirement or DEFAULT_REQUIREMENT)
+                         requirement=DEFAULT_REQUIREMENT if args.requirement is None
+                         else args.requirement)
     print(f"wrote {len(files)} files in {args.path}/; next: cd {args.path} && workbench verify")
     return 0
 
 
 def cmd_new(args) -> int:
+    from .project import find_project
     from .scaffold.new import new_design
-    path = new_design(args.kind, args.name, args.dir)
+    path = new_design(args.kind, args.name, args.dir or find_project().designs)
     print(f"wrote {path}; next: workbench verify {path}")
     return 0
 
@@ -288,7 +309,12 @@ def cmd_simulate(args) -> int:
     design = load_design(args.design)
     if design.kind == "delay-feedback":
         from .studies.delay_feedback_cli import simulate_command as simulate_feedback
-        return simulate_feedback(design, case=args.case, dt=args.dt, as_json=args.json)
+        return simulate_feedback(design, case=args.case, dt=args.dt, as_json=args.json,
+                                 csv=args.csv, plot=args.plot)
+    for flag, val in (("--csv", args.csv), ("--plot", args.plot)):
+        if val:
+            raise DesignError("<cli>", flag, val, "a delay-feedback design (the "
+                              "antiskid-run trajectory is in its report's figures)")
     if design.kind != "antiskid-run":
         raise DesignError(design.path, "design.kind", design.kind,
                           'an "antiskid-run" or "delay-feedback" design')
@@ -326,6 +352,7 @@ COMMANDS: dict[str, tuple[str, Callable]] = {
 def build_parser() -> argparse.ArgumentParser:
     ap = _Parser(prog="workbench", description="Robust-control design and verification "
                  "workbench for train control.")
+    ap.add_argument("--version", action=_Version, help="print the version and exit")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
     p = sub.add_parser("synthesize", help=COMMANDS["synthesize"][0])
     ssub = p.add_subparsers(dest="what", required=True, parser_class=_Parser)
@@ -354,6 +381,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--case", help="case name (default: the design's first)")
     p.add_argument("--dt", type=float, help="step (s; default: the design's dt)")
     p.add_argument("--json", action="store_true")
+    p.add_argument("--csv", metavar="FILE", help="also write the trajectory (t, states, "
+                   "controller outputs) to FILE (delay-feedback designs)")
+    p.add_argument("--plot", metavar="PNG", help="also plot the states and inputs against "
+                   "time to PNG (delay-feedback designs)")
     p = sub.add_parser("sweep", help=COMMANDS["sweep"][0])
     p.add_argument("design")
     p.add_argument("--samples", type=int, required=True)
@@ -395,12 +426,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--papers", action="store_true",
                    help="copy the shipped designs and proofs of papers 000-004 instead of "
                         "the example")
-    p.add_argument("--requirement", help="what the CI files pip-install (default: "
-                   "workbench==<this version>)")
+    p.add_argument("--requirement", help="what the CI files pip-install: "
+                   "traincontrol-workbench==VERSION (default: this version), "
+                   "git+https://REPOSITORY@COMMIT or a traincontrol_workbench-*.whl path or URL")
     p = sub.add_parser("new", help=COMMANDS["new"][0])
     p.add_argument("kind", metavar="KIND", help="design kind (delay-feedback)")
     p.add_argument("name", metavar="NAME", help="design name (the file stem)")
-    p.add_argument("--dir", default=str(DESIGNS_DIR), help="folder (default: designs/)")
+    p.add_argument("--dir", help="folder (default: designs/ of the project root)")
     return ap
 
 
@@ -411,6 +443,9 @@ def main(argv: list[str] | None = None) -> int:
     except _BadArgs as exc:
         print(exc, file=sys.stderr)
         return 2
+    except _Shown as exc:
+        print(exc)
+        return 0
     try:
         return COMMANDS[args.command][1](args)
     except (DesignError, ModelError) as exc:

@@ -27,13 +27,14 @@ from __future__ import annotations
 import hashlib
 import math
 import os
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from .errors import DesignError
 from .reader import Quantity, Reader, display_path  # noqa: F401  (re-exported)
+from .report.files import SAFE_NAME
+from .toml_input import load_toml
 
 @dataclass(frozen=True)
 class Design:
@@ -108,11 +109,8 @@ def load_design(path: str | Path) -> Design:
     p = Path(path)
     if not p.is_file():
         raise DesignError(shown, "<file>", "<missing>", "an existing design file (.toml)")
-    try:
-        raw = p.read_bytes()
-        data = tomllib.loads(raw.decode("utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise DesignError(shown, "<file>", "<unparsable>", f"valid TOML ({exc})") from None
+    data = load_toml(p, shown)
+    raw = p.read_bytes()
     ulps = os.environ.get(PERTURB_ENV, "").strip()
     if ulps:
         if not ulps.lstrip("+-").isdigit() or len(ulps) > 6:
@@ -123,6 +121,9 @@ def load_design(path: str | Path) -> Design:
     name = head.string("name")
     if name != p.stem:
         raise head.fail("name", name, f'the file name without .toml, "{p.stem}"')
+    if not SAFE_NAME.fullmatch(name):
+        raise head.fail("name", name, "a file-name-safe name: letters, digits, '-', '_', '.', "
+                        "not starting with '.' (reports are written under it)")
     kind = head.string("kind", choices=sorted(studies.REGISTRY))
     title = head.string("title")
     source = head.string("source")

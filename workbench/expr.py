@@ -92,10 +92,10 @@ def _parse(text: Any, path: str, key: str) -> ast.Expression:
     try:
         return ast.parse(text, mode="eval")
     except SyntaxError as exc:
-        col = exc.offset or 0
+        col = exc.offset if exc.offset and exc.offset <= len(text) else None
+        at = f"at col {col}" if col else "at the end of the expression"
         raise DesignError(path, key, text if len(text) <= 80 else text[:77] + "...",
-                          f"an expression; found a syntax error at col {col} ({exc.msg})"
-                          ) from None
+                          f"an expression; found a syntax error {at} ({exc.msg})") from None
     except (RecursionError, MemoryError, ValueError):
         raise DesignError(path, key, text[:77] + "...", f"an expression nested at most "
                           f"{MAX_DEPTH} levels deep") from None

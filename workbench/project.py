@@ -13,11 +13,11 @@ The marker is data (TOML, never evaluated). It may be empty; its only keys are::
 """
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 from .errors import DesignError
+from .toml_input import load_toml
 
 MARKER = "workbench.toml"
 
@@ -69,10 +69,7 @@ def read_marker(path: Path) -> str:
     DesignError
         If the file is not TOML or has keys other than ``project.name``.
     """
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise DesignError(str(path), "<file>", "<unparsable>", f"valid TOML ({exc})") from None
+    data = load_toml(path, str(path))
     for key, val in data.items():
         if key != "project" or not isinstance(val, dict):
             raise DesignError(str(path), key, val, "only a [project] table")

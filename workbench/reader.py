@@ -73,7 +73,11 @@ class Reader:
         ok_type = isinstance(val, int) if integer else isinstance(val, (int, float))
         if isinstance(val, bool) or not ok_type:
             raise self.fail(name, val, f"a {what}")
-        x = int(val) if integer else float(val)
+        try:
+            x = int(val) if integer else float(val)
+        except OverflowError:         # an int past the float range
+            raise self.fail(name, f"<{len(str(abs(val)))}-digit integer>",
+                            f"a finite {what}") from None
         if not math.isfinite(x):
             raise self.fail(name, val, f"a finite {what}")
         if positive and not x > 0:
@@ -81,7 +85,9 @@ class Reader:
         if nonneg and not x >= 0:
             raise self.fail(name, val, f"a non-negative {what}")
         if lo is not None and not x >= lo or hi is not None and not x <= hi:
-            raise self.fail(name, val, f"a {what} in [{lo}, {hi}]")
+            where = (f"in [{lo:g}, {hi:g}]" if lo is not None and hi is not None else
+                     f"at most {hi:g}" if lo is None else f"at least {lo:g}")
+            raise self.fail(name, val, f"a {what} {where}")
         return x
 
     def string(self, name: str, *, default: Any = _MISSING,
@@ -102,7 +108,8 @@ class Reader:
         return val
 
     def numbers(self, name: str, *, default: Any = _MISSING, positive: bool = False,
-                min_len: int = 1, what: str = "numbers") -> tuple[float, ...]:
+                min_len: int = 1, what: str = "numbers", lo: float | None = None,
+                hi: float | None = None) -> tuple[float, ...]:
         val = self.raw(name, default)
         if val is default and default is not _MISSING:
             return val
@@ -114,6 +121,8 @@ class Reader:
                 raise self.fail(f"{name}[{i}]", x, f"a finite number ({what})")
             if positive and not x > 0:
                 raise self.fail(f"{name}[{i}]", x, f"a positive number ({what})")
+            if lo is not None and not x >= lo or hi is not None and not x <= hi:
+                raise self.fail(f"{name}[{i}]", x, f"a number in [{lo:g}, {hi:g}] ({what})")
             out.append(float(x))
         return tuple(out)
 

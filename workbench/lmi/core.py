@@ -267,12 +267,12 @@ class MarginLMI:
                 warnings.simplefilter("ignore", UserWarning)
                 problem.solve(solver=cp.CLARABEL, **settings)
             status = str(problem.status)
-        except cp.error.SolverError as exc:  # an answer, not a crash
-            status = f"error: {exc}".splitlines()[0]
-        except BaseException as exc:         # Clarabel's Rust panics: pyo3 PanicException
+        except (cp.error.SolverError, ValueError, ArithmeticError) as exc:  # an answer
+            status = f"error: {exc}".splitlines()[0][:200]
+        except BaseException as exc:  # Clarabel's Rust panic (pyo3 PanicException) is one
             if type(exc).__name__ != "PanicException":
                 raise
-            status = f"error: solver panic: {exc}".splitlines()[0]
+            status = f"error: solver panic: {exc}".splitlines()[0][:200]
         return status, time.perf_counter() - t0
 
     def _checked(self, h: float, status: str, t_opt: float, seconds: float) -> Step:
@@ -336,7 +336,7 @@ class MarginLMI:
 
 def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
                  rel_tol: float = 1e-4, max_solves: int = 60, guess: float | None = None,
-                 secant: bool = True) -> Bracket:
+                 secant: bool = True, max_seconds: float = 3600.0) -> Bracket:
     """Bracketed bisection of a delay criterion (cf. cvxpy's ``bisection.py``).
 
     The search first brackets the boundary geometrically from ``guess`` (or
@@ -368,6 +368,9 @@ def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
         Expected location of the boundary (s), e.g. from a neighbouring row.
     secant : bool
         Use the margin-secant proposals (see above).
+    max_seconds : float
+        Wall-clock budget (s): no new solve starts after it (the bracket so
+        far is returned; without a certified point it is INCONCLUSIVE).
 
     Returns
     -------
@@ -393,10 +396,13 @@ def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
                 refuted = min(refuted, h)
         return s
 
+    t0 = time.perf_counter()
+    budget = lambda: len(steps) < max_solves and time.perf_counter() - t0 < max_seconds  # noqa
     h = min(max(guess if guess else math.sqrt(h_lo * h_hi), h_lo), h_hi)
     run(h)
-    factor = 1.2 if guess else 10.0
-    while len(steps) < max_solves:      # geometric bracketing
+    # ten-fold steps; a range wider than 1e12 in 12 steps, so any cap is bracketed
+    factor = 1.2 if guess else max(10.0, math.exp((math.log(h_hi) - math.log(h_lo)) / 12))
+    while budget():      # geometric bracketing
         if lo == 0.0:
             if h <= h_lo:
                 break
@@ -409,7 +415,7 @@ def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
             break
         run(h)
     stalls = 0
-    while len(steps) < max_solves and lo > 0 and hi < math.inf and hi / lo > 1 + rel_tol:
+    while budget() and lo > 0 and hi < math.inf and hi / lo > 1 + rel_tol:
         width = math.log(hi / lo)
         h = _secant_proposal(steps, lo, hi, rel_tol) if secant and stalls < 2 else None
         if h is None:

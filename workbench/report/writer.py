@@ -15,7 +15,7 @@ from importlib import metadata
 from pathlib import Path
 
 from ..claims import ROUNDING_RTOL, ClaimResult, Verdict
-from .files import atomic_write
+from .files import atomic_write, check_name, replace_set
 from .findings import findings_section, index_cells, section_link, summarise, tool_status
 from .markdown import Figure, Rendered, fmt, github_math, md_table
 from .verdict import (decide, design_items, hazard_entries, hazards_markdown, register_section,
@@ -99,9 +99,11 @@ def provenance(solver: str | None, pins: dict | None = None, ident: str = "") ->
     the study runs no convex solver)."""
     pins = pins or {}
     rows = []
+    # the workbench's distribution has a name of its own (workbench.DISTRIBUTION)
+    dist = {"workbench": metadata.packages_distributions().get("workbench", ["workbench"])[0]}
     for p in PACKAGES:
         try:
-            rows.append([p, metadata.version(p), pins.get(p, "—")])
+            rows.append([p, metadata.version(dist.get(p, p)), pins.get(p, "—")])
         except metadata.PackageNotFoundError:
             rows.append([p, "not installed", pins.get(p, "—")])
     rows.append(["python", ".".join(platform.python_version_tuple()[:2]), "—"])
@@ -207,17 +209,18 @@ def hazard_log(files: list[ReportFiles]) -> str:
 
 
 def write_reports(files: list[ReportFiles], outdir: Path, *, index: bool) -> list[Path]:
-    """Write Markdown (atomically) and figures; returns the paths written."""
+    """Write each report's Markdown and figures as a set
+    (:func:`workbench.report.files.replace_set`), and the index; returns the
+    paths written."""
     from .figures import figure_png
     written = []
     outdir.mkdir(parents=True, exist_ok=True)
     for f in files:
-        for fig in f.figures:
-            written.append(atomic_write(outdir / f.name / f"{fig.name}.png", figure_png(fig)))
-        written.append(atomic_write(outdir / f"{f.name}.md", f.markdown))
+        figs = {f"{check_name(fig.name, 'figure')}.png": figure_png(fig) for fig in f.figures}
+        written += replace_set(outdir, f.name, f.markdown, figs)
     if index:
-        written.append(atomic_write(outdir / "README.md", index_markdown(files)))
-        written.append(atomic_write(outdir / "HAZARDS.md", hazard_log(files)))
+        written.append(atomic_write(outdir / "README.md", index_markdown(files), folder=outdir))
+        written.append(atomic_write(outdir / "HAZARDS.md", hazard_log(files), folder=outdir))
     return written
 
 

@@ -19,10 +19,11 @@ missing or an empty folder.
 """
 from __future__ import annotations
 
+import re
 import shutil
-from importlib import metadata
 from pathlib import Path
 
+from .. import DISTRIBUTION, version
 from ..errors import DesignError
 
 FILES = Path(__file__).resolve().parent / "files"
@@ -39,7 +40,41 @@ EXAMPLE = {
     "example-cruise.toml": "designs/example-cruise.toml",
     "braking_distance.py.tmpl": "proofs/braking_distance.py",
 }
-DEFAULT_REQUIREMENT = f"workbench=={metadata.version('workbench')}"
+DEFAULT_REQUIREMENT = f"{DISTRIBUTION}=={version()}"
+
+_EXTRAS = r"(\[[a-z]+(,[a-z]+)*\])?"
+_PIN = re.compile(re.escape(DISTRIBUTION) + _EXTRAS +
+                  r"==\d+(\.\d+)*((a|b|rc)\d+)?(\.post\d+)?(\.dev\d+)?")
+_GIT = re.compile(r"git\+(https|ssh)://[A-Za-z0-9._~:/@%+-]+@[0-9a-f]{40}")
+_WHEEL = re.compile(r"([A-Za-z0-9._~:/%+][A-Za-z0-9._~:/%+-]*/)?" + DISTRIBUTION.replace("-", "_") +
+                    r"-[0-9][A-Za-z0-9.+]*-[A-Za-z0-9._]+-[A-Za-z0-9._]+-[A-Za-z0-9._]+\.whl")
+FORMS = (f"{DISTRIBUTION}==VERSION, git+https://REPOSITORY@COMMIT (40 hex digits) "
+         f"or a path or URL of a {DISTRIBUTION.replace('-', '_')}-*.whl")
+
+
+def install_requirement(text: str) -> str:
+    """What the CI files ``pip install``: exactly this package, pinned.
+
+    ``workbench`` on the package index is an unrelated project, and an
+    unpinned name lets an index serve anything under it (dependency
+    confusion). Accepted: ``traincontrol-workbench==VERSION`` (with extras),
+    a git URL pinned to a full commit hash (returned as
+    ``traincontrol-workbench @ git+...@COMMIT``), or a wheel of this
+    distribution by path or URL.
+
+    Raises
+    ------
+    DesignError
+        For anything else (a range, another name, an unpinned URL, options).
+    """
+    req = text.strip()
+    if req.startswith(f"{DISTRIBUTION} @ "):
+        req = req[len(DISTRIBUTION) + 3:].strip()
+    if _PIN.fullmatch(req) or _WHEEL.fullmatch(req):
+        return req
+    if _GIT.fullmatch(req):
+        return f"{DISTRIBUTION} @ {req}"
+    raise DesignError("<cli>", "--requirement", text, FORMS)
 
 
 def init_project(path: str | Path, *, papers: bool = False,
@@ -54,20 +89,19 @@ def init_project(path: str | Path, *, papers: bool = False,
         Copy the shipped designs and proofs of papers 000-004 instead of the
         one example design and proof module.
     requirement : str
-        What the CI files ``pip install`` (a requirement, wheel URL or VCS URL).
+        What the CI files ``pip install``: see :func:`install_requirement`.
 
     Raises
     ------
     DesignError
-        If ``path`` exists and is not an empty folder (nothing is written).
+        If ``path`` exists and is not an empty folder, or ``requirement`` is not
+        a pinned form of this distribution (nothing is written).
     """
     target = Path(path)
     if target.exists() and (not target.is_dir() or any(target.iterdir())):
         raise DesignError("<cli>", "PATH", str(target),
                           "a new or empty folder (init never overwrites)")
-    if not requirement.strip() or any(c in requirement for c in '"\n'):
-        raise DesignError("<cli>", "--requirement", requirement,
-                          "a pip requirement without quotes or newlines")
+    requirement = install_requirement(requirement)
     name = target.resolve().name
     written = []
     for template, dest in {**COMMON, **({} if papers else EXAMPLE)}.items():

@@ -48,8 +48,5 @@ def new_design(kind: str, name: str, folder: str | Path = "designs") -> Path:
         raise DesignError("<cli>", "NAME", name, f"a design that does not exist yet ({path} "
                           "does; never overwritten)")
     text = (FILES / f"{kind}.toml.tmpl").read_text(encoding="utf-8").format(name=name)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".toml.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
-    return path
+    from ..report.files import atomic_write
+    return atomic_write(path, text)

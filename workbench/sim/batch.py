@@ -10,6 +10,9 @@ the payloads and what to make of the outputs (``collect``). Progress is a
 """
 from __future__ import annotations
 
+import os
+import signal
+import sys
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Callable
@@ -17,6 +20,27 @@ from typing import Callable
 import numpy as np
 
 from .progress import progress as progress_bar
+
+
+class SchedulerUnreachable(ConnectionError):
+    """The Dask scheduler could not be reached (raised only while connecting,
+    so an error of a chunk or of writing its file is never taken for it)."""
+
+
+def die_with_parent(parent: int) -> None:
+    """Pool worker initializer: the worker is killed when its parent dies
+    (Linux ``prctl(PR_SET_PDEATHSIG, SIGKILL)``), so a killed ``sweep`` leaves
+    no workers behind; if the parent is already gone, the worker exits.
+    The signal fires when the *thread* that started the worker ends, so a
+    pool is started by the thread that waits for it (as here: submit in
+    :class:`PendingBatch`, the fork start method launching every worker at once)."""
+    if sys.platform.startswith("linux"):
+        import ctypes
+        libc = ctypes.CDLL(None, use_errno=True)
+        PR_SET_PDEATHSIG = 1
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() != parent:
+        os._exit(1)
 
 
 def available_cpus() -> int:
@@ -88,7 +112,7 @@ class PendingBatch:
 
     Raises
     ------
-    OSError
+    SchedulerUnreachable
         The scheduler cannot be reached.
     """
 
@@ -106,7 +130,9 @@ class PendingBatch:
         if scheduler is not None:
             self._start_dask(scheduler)
         elif pool and payloads:
-            self._pool = ProcessPoolExecutor(max_workers=min(workers, len(payloads)))
+            self._pool = ProcessPoolExecutor(max_workers=min(workers, len(payloads)),
+                                             initializer=die_with_parent,
+                                             initargs=(os.getpid(),))
             self._futures = [self._pool.submit(worker, p) for p in payloads]
 
     def _start_dask(self, scheduler: str) -> None:
@@ -118,6 +144,9 @@ class PendingBatch:
                 self.client = Client(self._cluster)
             else:
                 self.client = Client(scheduler, timeout="10s")
+        except OSError as exc:
+            self.cancel()
+            raise SchedulerUnreachable(str(exc)) from exc
         except BaseException:
             self.cancel()
             raise

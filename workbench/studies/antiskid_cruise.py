@@ -176,8 +176,15 @@ def operating_point(spec: CruiseSpec) -> tuple[float, float, float, Linearisatio
     plant = NumericAdhesion.from_dict({k: q.value for k, q in spec.params.items()})
     lam_solved = plant.cruise_lambda(spec.v_d.value)
     lam_used = spec.lambda_d_pinned.value if spec.lambda_d_pinned else lam_solved
-    return (plant.lambda_opt(), lam_solved, lam_used,
-            linearise_cruise(plant, spec.v_d.value, lam_used))
+    import numpy as np
+    with np.errstate(all="ignore"):
+        lin = linearise_cruise(plant, spec.v_d.value, lam_used)
+    big = max(np.max(np.abs(lin.A)), np.max(np.abs(lin.B)))
+    if not big <= 1e9:    # past it Clarabel's factorisations fail (a Rust panic at J = 1e-300)
+        raise ModelError(f"the linearisation at v_d = {spec.v_d.value:g} m/s has an entry of "
+                         f"{big:.3g}; expected a model whose A and B entries are finite and at "
+                         "most 1e9 in magnitude (check the [plant] values)")
+    return plant.lambda_opt(), lam_solved, lam_used, lin
 
 
 def _eps_key(eps: float) -> str:
@@ -202,7 +209,7 @@ class AntiskidCruise:
         op.finish()
         syn = root.table("synthesis")
         syn.string("method", choices=("free-weighting-003",))
-        eps = syn.numbers("eps", positive=True, what="eps values")
+        eps = syn.numbers("eps", positive=True, what="eps values", lo=1e-6, hi=1e6)
         if len(set(eps)) != len(eps):
             raise syn.fail("eps", list(eps), "distinct eps values")
         from ..lmi.core import DEFAULT_MARGIN
@@ -211,7 +218,7 @@ class AntiskidCruise:
         settings = SynthesisSettings(
             margin=syn.number("margin", default=DEFAULT_MARGIN, positive=True, hi=1e-2),
             rel_tol=syn.number("rel_tol", default=1e-4, positive=True, hi=0.1),
-            h_max=syn.number("h_max", default=100.0, positive=True),
+            h_max=syn.number("h_max", default=100.0, lo=1e-3, hi=1e4, what="number (s)"),
             gain_fraction=syn.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
                                      hi=1.0, what="fraction of h_certified"),
             gain_digits=int(syn.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
@@ -246,7 +253,7 @@ class AntiskidCruise:
         enable = t.boolean("enable", default=True)
         h_max = t.number("h_max", default=10.0, positive=True, hi=1e3, what="number (s)")
         grid = t.numbers("grid", default=(0.01, 0.1, 1.0, 10.0, 100.0), positive=True,
-                         min_len=2, what="eps values")
+                         min_len=2, what="eps values", lo=1e-6, hi=1e6)
         if list(grid) != sorted(set(grid)):
             raise t.fail("grid", list(grid), "distinct eps values in increasing order")
         order = t.number("order", default=2, integer=True, lo=0, hi=8, what="integer N")

@@ -26,8 +26,8 @@ performs exactly the operations it performs alone (a test compares runs in
 flight together with runs alone, bit for bit).
 
 :data:`KERNELS` names the two paths a sweep may take; :func:`compiled_available`
-says whether numba is installed (``pip install workbench[fast]``). The numpy
-path is the reference: ``tests/test_compiled_kernel.py`` compares every
+says whether numba is installed (``pip install 'traincontrol-workbench[fast]'``).
+The numpy path is the reference: ``tests/test_compiled_kernel.py`` compares every
 metric of the first 64 runs of the dry design's sweep.
 """
 from __future__ import annotations

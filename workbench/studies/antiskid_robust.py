@@ -140,7 +140,8 @@ class AntiskidRobust:
         from ..lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
         spec = dict(
             alpha=syn.number("alpha", nonneg=True, hi=10.0, what="decay rate (1/s)"),
-            eps_grid=syn.numbers("eps_grid", positive=True, min_len=2, what="eps values"),
+            eps_grid=syn.numbers("eps_grid", positive=True, min_len=2, what="eps values",
+                                 lo=1e-6, hi=1e6),
             golden_steps=int(syn.number("golden_steps", default=3, integer=True, lo=0, hi=20)),
             rel_tol=syn.number("rel_tol", default=1e-2, positive=True, hi=0.1),
             h_max=syn.number("h_max", default=10.0, positive=True),

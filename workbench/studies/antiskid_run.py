@@ -20,6 +20,7 @@ from ..controllers.antiskid003_settings import ControllerSettings
 from ..errors import DesignError
 from ..margins import DelayMargin, delay_margin_eig
 from ..reader import Reader
+from ..sim.batch import SchedulerUnreachable
 from ..sim.delay import SimResult, envelope_ratio, simulate_linear_dde, step_halving
 from ..sim.wheel_slip import PARAM_ORDER, model_functions
 from .antiskid_run_spec import (METRICS, Case, RunSpec, agree, case_mesh, case_metrics,
@@ -232,12 +233,14 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
         raise DesignError("<cli>", "--kernel", kernel, " or ".join(KERNELS))
     if kernel == "compiled" and not compiled_available():
         raise DesignError("<cli>", "--kernel", kernel,
-                          "numpy here: numba is not installed (pip install 'workbench[fast]')")
+                          "numpy here: numba is not installed "
+                          "(pip install 'traincontrol-workbench[fast]')")
     if scheduler is not None:
         from importlib.util import find_spec
         if find_spec("distributed") is None:
-            raise DesignError("<cli>", "--scheduler", scheduler, "no flag here: dask.distributed "
-                              "is not installed (pip install 'workbench[scale]')")
+            raise DesignError("<cli>", "--scheduler", scheduler,
+                              "no flag here: dask.distributed is not installed "
+                              "(pip install 'traincontrol-workbench[scale]')")
     if resume and not out:
         raise DesignError("<cli>", "--resume", True, "with --out DIR (the folder to resume)")
     try:
@@ -253,11 +256,14 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
         else:
             res = sweep(design, samples, seed, workers=workers, kernel=kernel,
                         progress=not as_json, scheduler=scheduler)
-    except OSError as e:       # the scheduler cannot be reached
-        if scheduler is None:
-            raise
+    except SchedulerUnreachable as e:
         raise DesignError("<cli>", "--scheduler", scheduler,
                           f"'local' or the address of a running Dask scheduler ({e})") from None
+    except OSError as e:       # writing a chunk file (--out), not the scheduler
+        if not out:
+            raise
+        raise DesignError("<cli>", "--out", out, f"a folder the chunks can be written to "
+                          f"({type(e).__name__}: {e})") from None
     if figure:
         from ..report.figures import save_figure
         save_figure(Figure(Path(figure).stem, "Monte Carlo histograms",

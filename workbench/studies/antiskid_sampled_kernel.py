@@ -213,7 +213,7 @@ def kernel():
         if find_spec("numba") is None:
             from ..errors import ModelError
             raise ModelError("a design's [sampled] table runs a compiled loop, which needs "
-                             "numba: pip install 'workbench[fast]'")
+                             "numba: pip install 'traincontrol-workbench[fast]'")
         _KERNEL = _build()
     return _KERNEL
 

@@ -26,7 +26,6 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import os
 from pathlib import Path
 
 import numpy as np
@@ -72,10 +71,8 @@ def _manifest(design, samples: int, seed: int, chunk: int, kernel: str, K) -> di
 
 
 def _write(path: Path, arrays: dict) -> Path:
-    tmp = path.with_name(path.name + ".part.npz")
-    np.savez(tmp, **arrays)
-    os.replace(tmp, path)
-    return path
+    from ..report.files import atomic_write
+    return atomic_write(path, lambda fh: np.savez(fh, **arrays))
 
 
 def start_streaming(design, samples: int, seed: int, out, *, resume: bool = False,
@@ -108,7 +105,8 @@ def start_streaming(design, samples: int, seed: int, out, *, resume: bool = Fals
         if old != man:
             raise FileExistsError(f"{out} holds another sweep ({old}); expected {man}")
     out.mkdir(parents=True, exist_ok=True)
-    mpath.write_text(json.dumps(man, indent=1) + "\n")
+    from ..report.files import atomic_write
+    atomic_write(mpath, json.dumps(man, indent=1) + "\n")
     ranges = [(i0, min(i0 + chunk, samples)) for i0 in range(0, samples, chunk)]
     todo = [r for r in ranges if not chunk_file(out, *r).exists()]
     payloads = [{"design": design, "K": K, "seed": seed, "i0": i0, "i1": i1, "kernel": kernel}

@@ -20,7 +20,8 @@ Tables (see ``designs/antiskid-cruise-dry-generic.toml`` for a full file)::
     [parameters]   name = { value, unit, source }
     [definitions]  name = "expression"          (optional, in order)
     [equations]    state = "expression"         (one per state)
-    [operating_point]  name = { value, unit, source } | { solve = [lo, hi], guess }
+    [operating_point]  name = { value, unit, source } | { solve = [lo, hi], guess };
+                   trim = false: a given point need not be an equilibrium
     [delay]        h = { value, unit = "s", source } | min = {...}, max = {...}
     [synthesis]    method = "free-weighting-003" | "wirtinger" | "bessel-legendre"
     [[vertices]]   name, source, parameter = value ...   (optional: robust gain)
@@ -45,6 +46,8 @@ from .delay_feedback_spec import OperatingEntry, PlantSpec, Variable
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 METHODS = ("free-weighting-003", "wirtinger", "bessel-legendre")
+#: eps values a synthesis may try (1e-300 left the robust bisection solving for minutes).
+EPS_RANGE = (1e-6, 1e6)
 #: Metrics of every scenario (per state / input where marked).
 SIM_METRICS = ("peak_error", "final_error", "peak_input_dev", "diverged")
 
@@ -144,7 +147,7 @@ def _plant(root: Reader) -> PlantSpec:
     taken: set[str] = set()
     states = _variables(root, "states", taken)
     inputs = _variables(root, "inputs", taken)
-    pt = root.table("parameters")
+    pt = root.table("parameters", default=None)     # a plant may have none
     params = {}
     for name in list(pt.data):
         _check_name(pt, name, taken)
@@ -188,6 +191,7 @@ def _plant(root: Reader) -> PlantSpec:
                 raise e.fail("unit", u, f'"{v.unit}" (the unit declared for {v.name})')
             entries.append(OperatingEntry(v.name, val, source=e.string("source")))
         e.finish()
+    trim = op.boolean("trim", default=True)
     op.finish()
     n_solved = sum(e.solved for e in entries)
     if n_solved not in (0, len(states)):
@@ -195,7 +199,7 @@ def _plant(root: Reader) -> PlantSpec:
                         f"as many entries with solve = [lo, hi] as equations ({len(states)}), "
                         "or none (a given point)")
     return PlantSpec(root.path, states, inputs, params, tuple(defs), tuple(texts),
-                     tuple(entries))
+                     tuple(entries), trim)
 
 
 def _delay(root: Reader) -> DelaySpec:
@@ -227,12 +231,13 @@ def _synthesis(root: Reader, delay: DelaySpec) -> SynthesisChoice:
         raise s.fail("method", method, '"robust-descriptor" exactly when [[vertices]] are given')
     eps = grid = ()
     if method == "free-weighting-003":
-        eps = s.numbers("eps", positive=True, what="eps values")
+        eps = s.numbers("eps", positive=True, what="eps values", lo=EPS_RANGE[0],
+                        hi=EPS_RANGE[1])
         if len(set(eps)) != len(eps):
             raise s.fail("eps", list(eps), "distinct eps values")
     elif method != "requirements":
         grid = s.numbers("grid", default=(0.01, 0.1, 1.0, 10.0, 100.0), positive=True,
-                         min_len=2, what="eps values")
+                         min_len=2, what="eps values", lo=EPS_RANGE[0], hi=EPS_RANGE[1])
         if list(grid) != sorted(set(grid)):
             raise s.fail("grid", list(grid), "distinct eps values in increasing order")
     order = int(s.number("order", default=2, integer=True, lo=0, hi=8, what="integer N"))
@@ -245,12 +250,15 @@ def _synthesis(root: Reader, delay: DelaySpec) -> SynthesisChoice:
         rel_tol=s.number("rel_tol", default=1e-4 if method == METHODS[0] else 1e-3,
                          positive=True, hi=0.1),
         h_max=s.number("h_max", default=max(100.0 if method == METHODS[0] else 10.0,
-                                            4 * delay.h_max), positive=True, hi=1e4,
+                                            4 * delay.h_max), lo=1e-3, hi=1e4,
                        what="number (s)"),
         gain_fraction=s.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
                                hi=1.0, what="fraction of h_certified"),
         gain_digits=int(s.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
                                  lo=2, hi=8)))
+    if settings.h_max < delay.h_max:
+        raise s.fail("h_max", settings.h_max, f"a search cap at least the design's delay, "
+                     f"delay.max = {delay.h_max:g} s")
     s.finish()
     return SynthesisChoice(method, eps, grid, order, settings, alpha)
 
@@ -286,7 +294,7 @@ def _scenarios(root: Reader, plant: PlantSpec, delay: DelaySpec) -> tuple[Scenar
         for k in list(x0t.data):
             if k not in states:
                 raise x0t.fail(k, x0t.data[k], "a state: " + ", ".join(states))
-            x0[k] = x0t.number(k)
+            x0[k] = x0t.number(k, lo=-1e12, hi=1e12)
         x0t.finish()
         spt = r.table("setpoint", default=None)
         sp = {}
@@ -342,7 +350,11 @@ class DelayFeedback:
         from .delay_feedback_implementation import load_implementation_settings
         spec = DelayFeedbackSpec(plant, delay, syn, vertices, scenarios, horizon, basin, req,
                                  load_implementation_settings(root))
+        from .delay_feedback_model import PlantModel
         from .delay_feedback_run import nominal_point
+        from .delay_feedback_units import check_units, physical_ranges
+        physical_ranges(spec)      # times and masses positive, before any solve
+        check_units(PlantModel(plant))
         op = nominal_point(spec)[2]  # no operating point in range is bad input: fail now
         for v in vertices:
             nominal_point(spec, v)

@@ -119,8 +119,10 @@ def synthesize_command(design, *, eps=None, as_json: bool = False) -> int:
     return 0 if ok else 1
 
 
-def simulate_command(design, *, case: str | None, dt: float | None, as_json: bool) -> int:
-    """``workbench simulate`` of one scenario: its metrics; exit 0."""
+def simulate_command(design, *, case: str | None, dt: float | None, as_json: bool,
+                     csv: str | None = None, plot: str | None = None) -> int:
+    """``workbench simulate`` of one scenario: its metrics (with ``csv`` its
+    trajectory, :func:`trajectory_csv`; with ``plot`` a PNG of it); exit 0."""
     import time
 
     from ..errors import DesignError
@@ -145,6 +147,18 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
     r = simulate(spec, model, values, op, s.K, sc, dt or sc.dt)
     wall = time.perf_counter() - t0
     m = metrics(spec, op, sc, r)
+    if csv:
+        from pathlib import Path
+
+        from ..report.files import atomic_write
+        atomic_write(Path(csv), trajectory_csv(spec, r))
+    if plot:
+        from pathlib import Path
+
+        from ..report.figures import save_figure
+        from ..report.markdown import Figure
+        save_figure(Figure(Path(plot).stem, f"{design.name}: {sc.name}",
+                           lambda fig: _draw_run(fig, spec, r), (8.0, 4.5)), Path(plot))
     if as_json:
         print(json.dumps({"design": design.name, "case": sc.name, "dt": dt or sc.dt,
                           "metrics": m, "wall_s": round(wall, 3)}, indent=2))
@@ -153,3 +167,32 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
           f"K = {gain_text(s.K, spec.synthesis.settings.gain_digits)}")
     print(md_table(["metric", "value"], [[k, fmt(v, 6)] for k, v in m.items()], "lr"))
     return 0
+
+
+def trajectory_csv(spec, r) -> str:
+    """A simulated run as CSV: ``t`` (s), each state, each input as the
+    controller outputs it at t (it acts h later), in the design's units, one
+    row per recorded step (``repr`` floats: the file reads back bit for bit)."""
+    import numpy as np
+
+    from .delay_feedback_run import input_history
+    U = input_history(r, len(spec.plant.input_names))
+    cols = ["t", *spec.plant.state_names, *spec.plant.input_names]
+    rows = np.vstack([r.t, r.x, U]).T
+    return ",".join(cols) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n"
+                                           for row in rows)
+
+
+def _draw_run(fig, spec, r) -> None:
+    """States (top) and controller outputs (bottom) against time."""
+    from .delay_feedback_run import input_history
+    U = input_history(r, len(spec.plant.input_names))
+    for k, (rows, names, units) in enumerate((
+            (r.x, spec.plant.state_names, [v.unit for v in spec.plant.states]),
+            (U, spec.plant.input_names, [v.unit for v in spec.plant.inputs]))):
+        ax = fig.add_subplot(2, 1, k + 1)
+        for row, name, unit in zip(rows, names, units):
+            ax.plot(r.t, row, label=f"{name} ({unit})")
+        ax.legend(loc="best", fontsize=8)
+        ax.grid(True, alpha=0.3)
+    ax.set_xlabel("t (s)")

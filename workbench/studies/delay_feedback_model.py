@@ -24,6 +24,13 @@ from ..errors import DesignError
 from .delay_feedback_spec import PlantSpec
 
 
+#: Largest |entry| of A = df/dx and B = df/du (SI) the LMIs are asked to handle:
+#: past it Clarabel's factorisations fail (a Rust panic at J = 1e-300).
+MAX_ENTRY = 1e9
+#: Largest residual max |f| (state units per second) of a given operating point.
+TRIM_TOL = 1e-6
+
+
 @dataclass(frozen=True)
 class OperatingPoint:
     """A solved operating point.
@@ -81,6 +88,34 @@ class PlantModel:
         self.f = sp.Matrix([parse_expression(t, names, path=spec.path,
                                              key=f"equations.{s}")
                             for s, t in zip(spec.state_names, spec.equations)])
+        self.check_finite(None, "parameters")
+
+    def _texts(self):
+        """(key, text, sympy expression) of every definition and equation."""
+        sp = self.spec
+        yield from ((f"definitions.{n}", t, self.definitions[n]) for n, t in sp.definitions)
+        yield from ((f"equations.{s}", t, self.f[i])
+                    for i, (s, t) in enumerate(zip(sp.state_names, sp.equations)))
+
+    def check_finite(self, values: dict[str, float] | None, where: str) -> None:
+        """No division by zero, infinity or complex value in any definition or
+        equation, as written (``values`` None) or at the parameter values.
+
+        Raises
+        ------
+        DesignError
+            Naming the expression (and ``where`` the values come from).
+        """
+        import sympy as sp
+        bad = (sp.zoo, sp.oo, -sp.oo, sp.nan, sp.I)
+        for key, text, e in self._texts():
+            v = e if values is None else self.substituted(e, values)
+            if v.has(*bad) or (values is not None and v.is_real is False):
+                kind = ("a complex value" if v.has(sp.I) or v.is_real is False
+                        else "a division by zero or an infinity")
+                at = "" if values is None else f" at the parameter values of {where}"
+                raise DesignError(self.spec.path, key, text, f"a finite real expression{at} "
+                                  f"(found {kind})")
 
     def substituted(self, expr, values: dict[str, float]):
         """``expr`` with every parameter replaced by its (double) value."""
@@ -131,10 +166,16 @@ def linearise(model: PlantModel, values: dict[str, float], op: OperatingPoint):
         (n, n) and (n, m); the linear model is dx' = A dx + B du(t - h).
     """
     fx, fu = model.jacobian_functions(values)
-    A, B = fx(op.x, op.u), fu(op.x, op.u)
+    with np.errstate(all="ignore"):
+        A, B = fx(op.x, op.u), fu(op.x, op.u)
     if not (np.all(np.isfinite(A)) and np.all(np.isfinite(B))):
         raise DesignError(model.spec.path, "operating_point", op.as_dict(model.spec),
                           "a point where the Jacobians of the equations are finite")
+    big = max(np.max(np.abs(A), initial=0.0), np.max(np.abs(B), initial=0.0))
+    if not big <= MAX_ENTRY:
+        raise DesignError(model.spec.path, "parameters", f"<a Jacobian entry of {big:.3g}>",
+                          f"a model whose linearisation has entries of magnitude at most "
+                          f"{MAX_ENTRY:g} (SI; check the parameters' values and units)")
     return A, B
 
 
@@ -173,9 +214,16 @@ def solve_operating_point(model: PlantModel, values: dict[str, float], *,
         x, u = split(z)
         return np.hstack([fx(x, u), fu(x, u)])[:, free]
 
-    if not free:   # a given point: its residual is reported, not required to vanish
+    if not free:   # a given point: an equilibrium, unless the design says trim = false
         x, u = split(np.zeros(0))
-        return OperatingPoint(x, u, float(np.max(np.abs(f(x, u)))), ())
+        with np.errstate(all="ignore"):
+            residual = float(np.max(np.abs(f(x, u))))
+        if spec.trim and not residual <= TRIM_TOL:
+            raise DesignError(spec.path, key, f"<max |f| = {residual:.3g}>",
+                              f"an equilibrium: max |f| <= {TRIM_TOL:g} (state units per "
+                              "second) at the given point, or trim = false in "
+                              "[operating_point] to linearise off-equilibrium")
+        return OperatingPoint(x, u, residual, ())
     lo = np.array([entries[i].lo for i in free])
     hi = np.array([entries[i].hi for i in free])
     first = np.array([entries[i].guess if entries[i].guess is not None

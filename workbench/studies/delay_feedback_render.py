@@ -105,7 +105,9 @@ def render(design, res) -> Rendered:
     sections.append(
         "## Operating point and linearisation\n\n"
         + md_table(["name", "value", "how", "source"], op, "lrll")
-        + f"\n\nResidual max |f| at the point: {_residual(res.op.residual)}.\n\n"
+        + f"\n\nResidual max |f| at the point: {_residual(res.op.residual)}."
+        + ("" if p.trim else " The design sets `trim = false`: the model is linearised at "
+           "this point although it is not an equilibrium.") + "\n\n"
         "Jacobians at the point (`control.StateSpace(A, B, I, 0)` is the linear model "
         "δx' = A δx + B δu(t − h)):\n\n"
         f"$$\nA = {latex_matrix(res.A, 5)}, \\qquad B = {latex_matrix(res.B, 5)}\n$$\n\n"

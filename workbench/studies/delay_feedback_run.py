@@ -25,6 +25,7 @@ def nominal_point(spec, vertex=None):
     model = PlantModel(spec.plant)
     values = spec.plant.values(None if vertex is None else vertex.values)
     key = "operating_point" if vertex is None else f"vertices[{vertex.name}]"
+    model.check_finite(values, "parameters" if vertex is None else key)
     op = solve_operating_point(model, values, key=key)
     A, B = linearise(model, values, op)
     return model, values, op, A, B

@@ -47,6 +47,9 @@ class PlantSpec:
         f_i as text, in the order of ``states``.
     operating_point : tuple[OperatingEntry, ...]
         One entry per state, then per input.
+    trim : bool
+        A given point must be an equilibrium (``operating_point.trim``,
+        default true); false: linearise off-equilibrium, as the report says.
     """
 
     path: str
@@ -56,6 +59,7 @@ class PlantSpec:
     definitions: tuple[tuple[str, str], ...]
     equations: tuple[str, ...]
     operating_point: tuple[OperatingEntry, ...] = field(default=())
+    trim: bool = True
 
     @property
     def state_names(self) -> tuple[str, ...]:
