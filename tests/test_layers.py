@@ -16,7 +16,9 @@ from pathlib import Path
 import pytest
 
 PKG = Path(__file__).resolve().parents[1] / "workbench"
-MAX_LINES = 450
+#: One concept per module, about 500 lines as a guide (issue 35, item 4): a
+#: module past it is a sign that it holds two concepts, and this test says so.
+MAX_LINES = 500
 
 #: package -> the packages (first component under workbench/) it may import.
 ALLOWED = {

@@ -25,7 +25,7 @@ from pathlib import Path
 
 from .memo import CACHE_ENV
 
-__all__ = ["TaskTime", "run_folder", "prefetch"]
+__all__ = ["TaskTime", "check_parallel", "prefetch", "run_folder", "task_times_table"]
 
 #: Kinds whose studies take longest, started first (the rest by file size).
 _SLOW_KINDS = ("antiskid-run", "delay-benchmark", "antiskid-robust", "ntsm-platoon")
@@ -101,3 +101,36 @@ def prefetch(designs, proof_modules, out: Path, jobs: int):
             problems += probs
             times.append(t)
     return checked, problems, times
+
+
+def task_times_table(times, jobs: int, wall: float) -> str:
+    """Markdown table of the tasks' times, slowest first, with the total."""
+    from .report.markdown import md_table
+    rows = [[t.name, t.kind, f"{t.wall:.1f}", f"{t.cpu:.1f}"]
+            for t in sorted(times, key=lambda t: (-t.wall, t.name))]
+    rows.append(["total", "", f"{sum(t.wall for t in times):.1f}",
+                 f"{sum(t.cpu for t in times):.1f}"])
+    return (f"\nper-task time on {jobs} processes (a task: one design's study and its report "
+            f"check, or one proof module; cpu includes the task's own pool workers; "
+            f"{wall:.1f} s wall for the whole check):\n"
+            + md_table(["task", "kind", "wall s", "cpu s"], rows, "llrr"))
+
+
+def check_parallel(designs, out: str | None, jobs: int, verify, report) -> int:
+    """``workbench check --jobs N`` (N > 1): :func:`prefetch` in a run folder,
+    then ``verify()`` and ``report(checked, problems)`` (the CLI's verbs, which
+    find every study result in the folder); the task times on stderr."""
+    import sys
+    from .design import display_path
+    from .project import find_project
+    from .prove import proof_modules
+    t0 = time.perf_counter()
+    folder = Path(out or display_path(find_project().reports))
+    with run_folder():
+        checked, problems, times = prefetch(designs, [m.name for m in proof_modules()],
+                                            folder, jobs)
+        code = verify()
+        print()
+        code = max(code, report(checked, problems))
+    print(task_times_table(times, jobs, time.perf_counter() - t0), file=sys.stderr)
+    return code

@@ -10,7 +10,6 @@ import argparse
 import json
 import math
 import sys
-import time
 from pathlib import Path
 from typing import Callable
 
@@ -194,59 +193,29 @@ def cmd_check(args) -> int:
         jobs = available_cpus()
     if jobs < 1:
         raise DesignError("<cli>", "--jobs", jobs, "a positive number of processes")
+    verify = argparse.Namespace(designs=[], json=False, junit_xml=None, changed_since=None)
+    report = argparse.Namespace(designs=[], all=True, check=True, out=args.out)
     if jobs > 1:
-        return _check_parallel(args, jobs)
+        from .checkrun import check_parallel
+        return check_parallel(_designs([]), args.out, jobs, lambda: cmd_verify(verify),
+                              lambda checked, problems: cmd_report(report, checked=checked,
+                                                                   problems=problems))
     from . import studies
     from .memo import cancel_started, start_studies, study_times
 
     try:
         start_studies(_designs([]), studies.REGISTRY)   # the Monte Carlo pools, first
-        code = cmd_verify(argparse.Namespace(designs=[], json=False, junit_xml=None,
-                                              changed_since=None))
+        code = cmd_verify(verify)
         print()
-        code = max(code, cmd_report(argparse.Namespace(designs=[], all=True, check=True,
-                                                       out=args.out)))
+        code = max(code, cmd_report(report))
     finally:
         cancel_started()
     print(study_times_table(study_times()), file=sys.stderr)
     return code
 
 
-def _check_parallel(args, jobs: int) -> int:
-    from .checkrun import prefetch, run_folder
-    from .design import display_path
-    from .memo import StudyTime
-    from .project import find_project
-    from .prove import proof_modules
-    t0 = time.perf_counter()
-    out = Path(args.out or display_path(find_project().reports))
-    with run_folder():
-        checked, problems, times = prefetch(_designs([]), [m.name for m in proof_modules()],
-                                            out, jobs)
-        code = cmd_verify(argparse.Namespace(designs=[], json=False, junit_xml=None,
-                                              changed_since=None))
-        print()
-        code = max(code, cmd_report(argparse.Namespace(designs=[], all=True, check=True,
-                                                       out=args.out),
-                                    checked=checked, problems=problems))
-    print(study_times_table([StudyTime(t.name, t.kind, t.wall, t.cpu) for t in times],
-                            jobs=jobs, wall=time.perf_counter() - t0), file=sys.stderr)
-    return code
-
-
-def study_times_table(times, *, jobs: int = 1, wall: float | None = None) -> str:
-    """Markdown table of :func:`workbench.memo.study_times`, slowest first
-    (``jobs > 1``: each row is a task of the pool, with its report check,
-    its CPU including its own pools' workers)."""
-    if jobs > 1:
-        from .report.markdown import md_table
-        rows = [[t.design, t.kind, f"{t.wall:.1f}", f"{t.cpu:.1f}"]
-                for t in sorted(times, key=lambda t: -t.wall)]
-        rows.append(["total", "", f"{sum(t.wall for t in times):.1f}",
-                     f"{sum(t.cpu for t in times):.1f}"])
-        return (f"\nper-task time on {jobs} processes (a task: one design's study and its "
-                f"report check, or one proof module; {wall:.1f} s wall for the whole check):\n"
-                + md_table(["task", "kind", "wall s", "cpu s"], rows, "llrr"))
+def study_times_table(times) -> str:
+    """Markdown table of :func:`workbench.memo.study_times`, slowest first."""
     from .report.markdown import md_table
     rows = [[t.design, t.kind, f"{t.wall:.1f}", f"{t.cpu:.1f}",
              "" if t.since_start is None else f"{t.since_start:.1f}"]
