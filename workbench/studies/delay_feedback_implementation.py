@@ -73,7 +73,8 @@ def load_implementation_settings(root) -> ImplementationSettings | None:
         sampling = t.number("sampling", positive=True, what="period (s) or [T_min, T_max]")
     nd = t.numbers("network_delay", default=(0.0, 0.0), min_len=2, what="delays (s)")
     if len(nd) != 2 or not 0 <= nd[0] <= nd[1]:
-        raise t.fail("network_delay", list(nd), "[tau_min, tau_max] with 0 <= tau_min <= tau_max (s)")
+        raise t.fail("network_delay", list(nd),
+                     "[tau_min, tau_max] with 0 <= tau_min <= tau_max (s)")
     hold = t.string("hold", default="zoh", choices=("zoh",))
     t.finish()
     return ImplementationSettings(sampling, (float(nd[0]), float(nd[1])), hold)
