@@ -337,8 +337,10 @@ def implementation(sys, K, *, B=None, sampling=None, network_delay=(0.0, 0.0),
     method, T_cert, T_ref, rc, note = _certify(A, B, K, T_min, taus, decay_rate, margin,
                                                T_hi, rel_tol)
     top = max(4 * T_cert, 2 * req[1] if req else 0.0, 4 * scale)
+    lo = min(top / PERIODIC_GRID, req[0] if req and req[0] > 0 else top / PERIODIC_GRID,
+             1e-2 * scale)
     sets = tuple(periodic_stable_set(A, B, K, tau=t, T_max=top, grid=PERIODIC_GRID,
-                                     T_min=max(top / PERIODIC_GRID, t / MAX_QUEUE))
+                                     T_min=max(lo, t / MAX_QUEUE))
                  for t in sorted(set(taus)))
     first = min(s.first_unstable for s in sets)
     jit = _jitter(A, B, K, 0.999 * min(first, top), taus[0])   # T2 periodic-stable

@@ -128,8 +128,10 @@ def render_implementation_section(spec, di: DesignImplementation) -> tuple[str, 
     r, (d0, d1) = di.result, di.delays
     cert = fmt_floor(r.T_certified, 3) if r.T_certified > 0 else "0"
     cert = f"≥ {cert} (search cap)" if r.at_cap else cert
+    q = r.quantities()
     rows = [["certified T_max (every interval sequence, every delay in range)", cert,
-             "Hz: " + (fmt_floor(1 / r.T_certified, 3) if r.T_certified > 0 else "—")],
+             "lowest certified rate (Hz): " + (fmt(q["rate_certified"], 3)
+                                               if r.T_certified > 0 else "—")],
             ["exact: first unstable constant period", fmt(r.first_unstable, 4), "lifted map"],
             ["ratio certified / exact", "—" if math.isnan(r.ratio) else
              fmt_floor(r.ratio, 3) if r.ratio > 0 else "0", ""]]
