@@ -157,7 +157,6 @@ def test_bad_input_is_one_clear_error(kw, match):
         implementation(A0, K0, B=B0, **kw)
 
 
-@pytest.mark.slow
 def test_cruise_loop_003_certified_rate():
     """Paper 003's cruise linearisation with the Table 3 gain: certified without a
     predictor for a 43.3 ms + 2 ms delay at a rate far below the simulated 25 Hz."""
@@ -202,7 +201,6 @@ def test_cli_synthesize_sampled_rejects_other_kinds(capsys):
     assert "delay-feedback" in capsys.readouterr().err
 
 
-@pytest.mark.slow
 def test_synthesized_gain_is_certified_as_returned():
     """A gain for T_max = 2 s on the standard example's plant (its published gain
     fails at 1.7294 s): the rounded gain certifies 2 s over the continuum."""

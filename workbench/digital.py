@@ -121,11 +121,15 @@ class ImplementationResult:
         return bool(self.recheck) and min(self.recheck.values()) >= self.margin
 
     def quantities(self) -> dict[str, object]:
-        """Claim quantities (``implementation.<key>``)."""
-        return {"T_certified": self.T_certified, "T_exact": self.first_unstable,
-                "ratio": None if math.isnan(self.ratio) else self.ratio,
+        """Claim quantities (``implementation.<key>``), rounded so that they
+        reproduce on every CPU: the certified bound and the ratio down to 3
+        significant digits, the lowest certified rate (Hz) up to 3, the exact
+        period to 5."""
+        cert = _sig(self.T_certified, 3, math.floor)
+        return {"T_certified": cert, "T_exact": _sig(self.first_unstable, 5, round),
+                "ratio": None if math.isnan(self.ratio) else _sig(self.ratio, 3, math.floor),
                 "outcome": self.outcome.value,
-                "rate_certified": 1.0 / self.T_certified if self.T_certified > 0 else math.inf}
+                "rate_certified": _sig(1.0 / cert, 3, math.ceil) if cert > 0 else math.inf}
 
     def to_json(self) -> dict:
         inf = lambda x: "inf" if isinstance(x, float) and math.isinf(x) else x
@@ -145,6 +149,14 @@ class ImplementationResult:
         return render_markdown(self)
 
 
+def _sig(x: float, digits: int, how) -> float:
+    """x rounded with ``how`` (floor, ceil or round) to ``digits`` significant digits."""
+    if not (math.isfinite(x) and x > 0):
+        return x
+    q = 10.0 ** (math.floor(math.log10(x)) - (digits - 1))
+    return float(f"{how(x / q + (1e-12 if how is math.floor else 0.0)) * q:.{digits + 2}g}")
+
+
 def render_markdown(r: ImplementationResult) -> str:
     """The result as a Markdown table (digits that reproduce: 4 significant,
     certified bounds rounded down)."""
@@ -156,12 +168,14 @@ def render_markdown(r: ImplementationResult) -> str:
         f"({fmt(a)}, {fmt(b)})" for a, b in s.intervals) or "none") for s in r.stable_sets)
     jit = ("none found" if r.jitter is None else
            f"T1 = {fmt(r.jitter[0])}, T2 = {fmt(r.jitter[1])} (growth {fmt(r.jitter[2], 3)})")
-    cert = fmt_floor(r.T_certified, 4) if r.T_certified > 0 else "0"
+    cert = fmt_floor(r.T_certified, 3) if r.T_certified > 0 else "0"
     cert = f"≥ {cert} (search cap)" if r.at_cap else cert
     rows = [["request", req + f", network delay [{fmt(tau[0])}, {fmt(tau[1])}] s, ZOH"],
             ["outcome", f"**{r.outcome.value}** — {r.reason}"],
-            ["method", r.method + (f", decay rate {fmt(r.decay_rate)} 1/s" if r.decay_rate else "")],
-            ["certified T_max (s), every interval sequence", f"[{cert}, {fmt(r.T_refuted)}]"],
+            ["method", r.method
+             + (f", decay rate {fmt(r.decay_rate)} 1/s" if r.decay_rate else "")],
+            ["certified T_max (s), every interval sequence",
+             f"[{cert}, {fmt(_sig(r.T_refuted, 3, math.ceil), 3)}]"],
             ["re-check (numpy)", ("passed" if r.recheck_passed else "**failed**")
              + f", smallest block margin {margin_text(min(r.recheck.values()))}"
              if r.recheck else "—"],
@@ -220,7 +234,8 @@ def _sampling(sampling) -> tuple[tuple[float, float] | None, bool]:
         return (0.0, T), True
     lo, hi = (float(v) for v in sampling)
     if not (0 <= lo <= hi and hi > 0 and math.isfinite(hi)):
-        raise ValueError(f"sampling = {sampling!r}; expected [T_min, T_max] with 0 <= T_min <= T_max")
+        raise ValueError(f"sampling = {sampling!r}; expected [T_min, T_max] with "
+                         "0 <= T_min <= T_max")
     return (lo, hi), False
 
 
@@ -322,8 +337,10 @@ def implementation(sys, K, *, B=None, sampling=None, network_delay=(0.0, 0.0),
     method, T_cert, T_ref, rc, note = _certify(A, B, K, T_min, taus, decay_rate, margin,
                                                T_hi, rel_tol)
     top = max(4 * T_cert, 2 * req[1] if req else 0.0, 4 * scale)
+    lo = min(top / PERIODIC_GRID, req[0] if req and req[0] > 0 else top / PERIODIC_GRID,
+             1e-2 * scale)
     sets = tuple(periodic_stable_set(A, B, K, tau=t, T_max=top, grid=PERIODIC_GRID,
-                                     T_min=max(top / PERIODIC_GRID, t / MAX_QUEUE))
+                                     T_min=max(lo, t / MAX_QUEUE))
                  for t in sorted(set(taus)))
     first = min(s.first_unstable for s in sets)
     jit = _jitter(A, B, K, 0.999 * min(first, top), taus[0])   # T2 periodic-stable
@@ -333,26 +350,26 @@ def implementation(sys, K, *, B=None, sampling=None, network_delay=(0.0, 0.0),
 
 
 def _decide(req, periodic, T_min, T_cert, sets, first, jit, taus):
-    from .report.markdown import fmt
+    from .report.markdown import fmt, fmt_floor
+    tc = fmt_floor(T_cert, 3) if T_cert > 0 else "0"
     if req is None:
-        return ((Outcome.CERTIFIED, f"certified up to {fmt(T_cert)} s") if T_cert > 0
+        return ((Outcome.CERTIFIED, f"certified up to {tc} s") if T_cert > 0
                 else (Outcome.INCONCLUSIVE, "nothing certified"))
     T_req = req[1]
     if T_cert >= T_req:
-        return Outcome.CERTIFIED, (f"every interval sequence up to {fmt(T_cert)} s "
+        return Outcome.CERTIFIED, (f"every interval sequence up to {tc} s "
                                    f"(>= {fmt(T_req)} s) is proved stable")
-    if periodic:
-        bad = [s for s in sets if s.T_range[0] <= T_req and not s.contains(T_req)]
-        if bad:
-            return Outcome.REFUTED, (f"the constant period {fmt(T_req)} s is unstable at "
-                                     f"the constant delay {fmt(bad[0].tau)} s (exact lifted map)")
-    elif first <= T_req and first >= T_min:
+    bad = [s for s in sets if s.T_range[0] <= T_req and not s.contains(T_req)]
+    if periodic and bad:
+        return Outcome.REFUTED, (f"the constant period {fmt(T_req)} s is unstable at "
+                                 f"the constant delay {fmt(bad[0].tau)} s (exact lifted map)")
+    if T_min <= first <= T_req:
         return Outcome.REFUTED, (f"the constant period {fmt(first)} s in the range is unstable "
                                  "(exact lifted map)")
-    elif jit is not None and jit[1] <= T_req and jit[0] >= T_min:
+    if jit is not None and jit[1] <= T_req and jit[0] >= T_min:
         return Outcome.REFUTED, (f"the alternating intervals {fmt(jit[0])}, {fmt(jit[1])} s "
                                  "grow (jitter counterexample)")
-    return Outcome.INCONCLUSIVE, (f"certified only up to {fmt(T_cert)} s < {fmt(T_req)} s, "
+    return Outcome.INCONCLUSIVE, (f"certified only up to {tc} s < {fmt(T_req)} s, "
                                   "and no counterexample was found")
 
 

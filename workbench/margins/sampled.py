@@ -176,8 +176,8 @@ def periodic_stable_set(A, B, K, *, tau: float = 0.0, T_max: float,
                         T_min: float | None = None, grid: int = 400) -> PeriodicStableSet:
     """The set of stable constant periods T in [T_min, T_max] at delay tau.
 
-    A uniform scan of ``grid`` points, every sign change of rho(F) - 1
-    refined by bisection. A stable window narrower than the grid step can be
+    A scan of ``grid`` points (uniform, or geometric when the range spans more
+    than two decades), every sign change of rho(F) - 1 refined by bisection. A stable window narrower than the grid step can be
     missed; the scan is a map of the set, its ends are exact to
     :data:`BOUNDARY_RTOL`.
 
@@ -204,7 +204,8 @@ def periodic_stable_set(A, B, K, *, tau: float = 0.0, T_max: float,
     if not 0 < T_min < T_max:
         raise ValueError(f"T_min = {T_min!r} s; expected 0 < T_min < T_max = {T_max!r} s")
     f = _radius_minus_one(A, B, K, tau)
-    Ts = np.linspace(T_min, T_max, grid)
+    Ts = (np.geomspace(T_min, T_max, grid) if T_max > 100 * T_min
+          else np.linspace(T_min, T_max, grid))
     vals = [f(float(T)) for T in Ts]
     intervals, start, first_unstable = [], None, math.inf
     if vals[0] < 0:

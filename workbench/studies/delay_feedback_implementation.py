@@ -73,7 +73,8 @@ def load_implementation_settings(root) -> ImplementationSettings | None:
         sampling = t.number("sampling", positive=True, what="period (s) or [T_min, T_max]")
     nd = t.numbers("network_delay", default=(0.0, 0.0), min_len=2, what="delays (s)")
     if len(nd) != 2 or not 0 <= nd[0] <= nd[1]:
-        raise t.fail("network_delay", list(nd), "[tau_min, tau_max] with 0 <= tau_min <= tau_max (s)")
+        raise t.fail("network_delay", list(nd),
+                     "[tau_min, tau_max] with 0 <= tau_min <= tau_max (s)")
     hold = t.string("hold", default="zoh", choices=("zoh",))
     t.finish()
     return ImplementationSettings(sampling, (float(nd[0]), float(nd[1])), hold)
@@ -127,8 +128,10 @@ def render_implementation_section(spec, di: DesignImplementation) -> tuple[str, 
     r, (d0, d1) = di.result, di.delays
     cert = fmt_floor(r.T_certified, 3) if r.T_certified > 0 else "0"
     cert = f"≥ {cert} (search cap)" if r.at_cap else cert
+    q = r.quantities()
     rows = [["certified T_max (every interval sequence, every delay in range)", cert,
-             "Hz: " + (fmt_floor(1 / r.T_certified, 3) if r.T_certified > 0 else "—")],
+             "lowest certified rate (Hz): " + (fmt(q["rate_certified"], 3)
+                                               if r.T_certified > 0 else "—")],
             ["exact: first unstable constant period", fmt(r.first_unstable, 4), "lifted map"],
             ["ratio certified / exact", "—" if math.isnan(r.ratio) else
              fmt_floor(r.ratio, 3) if r.ratio > 0 else "0", ""]]
