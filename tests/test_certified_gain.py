@@ -43,7 +43,7 @@ def test_api_bound_is_the_returned_gains(a, b):
     assert 0 < res.h_certified < h_star
     assert np.array_equal(res.K, round_significant(res.K, DEFAULT_DIGITS))   # printed digits
     assert "K fixed" in res.certifies and res.reason == ""
-    assert res.to_json()["certifies"] == res.certifies
+    assert res.to_dict()["certifies"] == res.certifies
 
 
 def _random_systems(count: int, seed: int = 3101):
@@ -171,7 +171,7 @@ def test_claim_on_a_synthesis_without_gain_is_inconclusive():
                                                           u=np.zeros(1)),
                           A=np.array([[-1.0]]), B=np.array([[1.0]]), exact=None,
                           range_stable=None, names=("x", "u"), vertex_checks=(), scenarios=(),
-                          basin=None, delay=SimpleNamespace(h_max=0.5))
+                          basin=None, implementation=None, delay=SimpleNamespace(h_max=0.5))
     q = quantities(res)
     claim = Claim("h", "h", "synthesis.h_certified", ">=", 0.5, 0.0, None, "round", "", False,
                   "pass", "")

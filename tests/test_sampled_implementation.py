@@ -142,7 +142,7 @@ def test_api_outcomes_and_markdown():
     assert 0.5 <= r.T_certified <= r.first_unstable
     md = r._repr_markdown_()
     assert "first unstable periodic T" in md and "certified" in md
-    assert r.to_json()["outcome"] == "certified"
+    assert r.to_dict()["outcome"] == "certified"
 
 
 @pytest.mark.parametrize("kw,match", [

@@ -131,7 +131,14 @@ class ImplementationResult:
                 "outcome": self.outcome.value,
                 "rate_certified": _sig(1.0 / cert, 3, math.ceil) if cert > 0 else math.inf}
 
-    def to_json(self) -> dict:
+    def to_json(self, **kwargs) -> str:
+        """The result as a JSON string (:meth:`to_dict`; ``kwargs`` go to
+        :func:`json.dumps`)."""
+        import json
+        return json.dumps(self.to_dict(), **kwargs)
+
+    def to_dict(self) -> dict:
+        """A JSON-ready dict (``"inf"`` for infinite values)."""
         inf = lambda x: "inf" if isinstance(x, float) and math.isinf(x) else x
         return {"method": self.method, "sampling": self.sampling, "periodic": self.periodic,
                 "network_delay": list(self.network_delay), "decay_rate": self.decay_rate,

@@ -30,7 +30,7 @@ def sampled_command(design, *, as_json: bool = False) -> int:
     di = run_implementation(settings, spec.delay, A, B, syn.K)
     if as_json:
         print(json.dumps({"design": design.name, "delays": list(di.delays),
-                          **di.result.to_json()}, indent=2))
+                          **di.result.to_dict()}, indent=2))
     else:
         print(f"{design.name}: digital implementation of K = {syn.K.tolist()} "
               f"(total delay [{di.delays[0]:g}, {di.delays[1]:g}] s)")
