@@ -26,7 +26,7 @@ install: $(STAMP)
 
 ## main job: every shipped design -> reports/<design>.md, figures, index
 report: install
-	$(WB) report --all
+	$(WB) report --all --jobs $(JOBS)
 
 ## The five-minute check: every claim of every design and proof, the report
 ## freshness check (Markdown and figures) and the unit tests, on every core.

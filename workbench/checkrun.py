@@ -25,7 +25,8 @@ from pathlib import Path
 
 from .memo import CACHE_ENV
 
-__all__ = ["TaskTime", "check_parallel", "prefetch", "run_folder", "task_times_table"]
+__all__ = ["TaskTime", "check_parallel", "prefetch", "report_parallel", "run_folder",
+           "task_times_table"]
 
 #: Kinds whose studies take longest, started first (the rest by file size).
 _SLOW_KINDS = ("antiskid-run", "delay-benchmark", "antiskid-robust", "ntsm-platoon")
@@ -62,15 +63,19 @@ def _cpu() -> float:
     return t.user + t.system + t.children_user + t.children_system
 
 
-def _design_task(path: str, out: str):
-    """Worker: the study of one design and the check of its report."""
+def _design_task(path: str, out: str, write: bool = False):
+    """Worker: the study of one design and the check of its report (or,
+    ``write``, the writing of it)."""
     from .design import load_design
-    from .report.writer import check_reports
+    from .report.writer import check_reports, write_reports
     from .verify import evaluate_design, report_files
     w0, c0 = time.perf_counter(), _cpu()
     d = load_design(path)
     files = report_files(evaluate_design(d))
-    problems = check_reports([files], Path(out), index=False)
+    if write:
+        problems = [f"wrote {p}" for p in write_reports([files], Path(out), index=False)]
+    else:
+        problems = check_reports([files], Path(out), index=False)
     return d.name, problems, TaskTime(d.name, d.kind, time.perf_counter() - w0, _cpu() - c0)
 
 
@@ -83,16 +88,17 @@ def _proof_task(module: str):
     return name, [], TaskTime(name, "proof", time.perf_counter() - w0, _cpu() - c0)
 
 
-def prefetch(designs, proof_modules, out: Path, jobs: int):
-    """Run every design's study and report check, and every proof module, on
-    ``jobs`` processes. Returns (names of designs whose reports were checked,
-    their problems, task times)."""
+def prefetch(designs, proof_modules, out: Path, jobs: int, *, write: bool = False):
+    """Run every design's study and report check (``write``: its report
+    written), and every proof module, on ``jobs`` processes. Returns (names
+    of designs whose reports were checked or written, their problems or the
+    paths written, task times)."""
     import multiprocessing as mp
     order = sorted(designs, key=lambda d: (d.kind not in _SLOW_KINDS,
                                             -Path(d.path).stat().st_size, d.name))
     checked, problems, times = set(), [], []
     with ProcessPoolExecutor(jobs, mp_context=mp.get_context("fork")) as ex:
-        futs = [ex.submit(_design_task, str(d.path), str(out)) for d in order]
+        futs = [ex.submit(_design_task, str(d.path), str(out), write) for d in order]
         futs += [ex.submit(_proof_task, m) for m in proof_modules]
         for f in as_completed(futs):
             name, probs, t = f.result()
@@ -134,3 +140,16 @@ def check_parallel(designs, out: str | None, jobs: int, verify, report) -> int:
         code = max(code, report(checked, problems))
     print(task_times_table(times, jobs, time.perf_counter() - t0), file=sys.stderr)
     return code
+
+
+def report_parallel(designs, args, jobs: int, finish) -> int:
+    """``workbench report --jobs N``: each design's study and report (written,
+    or checked with ``--check``) on a pool of N processes, then
+    ``finish(names, lines)`` (the CLI's verb) writes or checks the rest: the
+    index, the hazard log and the proof reports."""
+    from .design import display_path
+    from .project import find_project
+    folder = Path(args.out or display_path(find_project().reports))
+    with run_folder():
+        done, lines, _ = prefetch(designs, [], folder, jobs, write=not args.check)
+        return finish(done, lines)

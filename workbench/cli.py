@@ -153,6 +153,15 @@ def cmd_report(args, *, checked=frozenset(), problems=()) -> int:
     from .report.writer import check_reports, write_reports
     from .verify import evaluate_design, report_files
 
+    jobs = getattr(args, "jobs", None) or 1
+    if jobs < 1:
+        raise DesignError("<cli>", "--jobs", jobs, "a positive number of processes")
+    if jobs > 1:
+        from .checkrun import report_parallel
+        one = argparse.Namespace(**{**vars(args), "jobs": 1})
+        return report_parallel(_designs([] if args.all else args.designs), args, jobs,
+                               lambda done, lines: cmd_report(one, checked=done,
+                                                              problems=lines))
     from .sim.progress import progress
     designs = _designs([] if args.all else args.designs)
     files = [report_files(evaluate_design(d))
@@ -174,7 +183,9 @@ def cmd_report(args, *, checked=frozenset(), problems=()) -> int:
         if not problems:
             print(f"{len(files)} report(s) fresh in {out}/")
         return 1 if problems else 0
-    for p in write_reports(files, out, index=index):
+    for p in problems:           # the workers' lines of ``report --jobs``
+        print(p)
+    for p in write_reports(files, out, index=index, skip=checked):
         print(f"wrote {p}")
     return 0
 
@@ -381,6 +392,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--all", action="store_true", help="every design in designs/ and the index")
     p.add_argument("--check", action="store_true", help="exit 1 if a committed report is stale")
     p.add_argument("--out", help="output folder (default: reports/ of the project root)")
+    p.add_argument("--jobs", type=int, default=1,
+                   help="processes: each design's study and report on one (default 1)")
     p = sub.add_parser("check", help=COMMANDS["check"][0])
     p.add_argument("--out", help="report folder (default: reports/ of the project root)")
     p.add_argument("--jobs", type=int, default=None,

@@ -208,14 +208,18 @@ def hazard_log(files: list[ReportFiles]) -> str:
     return hazards_markdown([f.hazards for f in files if f.hazards])
 
 
-def write_reports(files: list[ReportFiles], outdir: Path, *, index: bool) -> list[Path]:
+def write_reports(files: list[ReportFiles], outdir: Path, *, index: bool,
+                  skip=frozenset()) -> list[Path]:
     """Write each report's Markdown and figures as a set
     (:func:`workbench.report.files.replace_set`), and the index; returns the
-    paths written."""
+    paths written. ``skip``: reports written elsewhere (``report --jobs``),
+    still counted in the index."""
     from .figures import figure_png
     written = []
     outdir.mkdir(parents=True, exist_ok=True)
     for f in files:
+        if f.name in skip:
+            continue
         figs = {f"{check_name(fig.name, 'figure')}.png": figure_png(fig) for fig in f.figures}
         written += replace_set(outdir, f.name, f.markdown, figs)
     if index:
