@@ -49,6 +49,8 @@ def _verify(tmp_path, capsys, design, old, new):
      ["equations.a", "m / s ** 3", "pc"]),
     ('T_b   = { value = 0.65,       unit = "s"', 'T_b   = { value = 0.65,       unit = "blorp"',
      ["parameters.T_b.unit = 'blorp'", "a unit pint knows"]),
+    ('T_b   = { value = 0.65,       unit = "s"', 'T_b   = { value = 0.65,       unit = "degC"',
+     ["parameters.T_b.unit = 'degC'", "OffsetUnitCalculusError"]),   # fuzz run 186
     ('a = "(u - a)/T_b"', 'a = "(u - a)*T_b"', ["equations.a", "m / s ** 3", "found m / s"]),
     ('a = "(u - a)/T_b"', 'a = "(u - a)/T_b + v"', ["equations.a", "terms of one unit"]),
     ('F_rail = "F_max*tanh(m0*a/F_max)"', 'F_rail = "F_max*tanh(m0*a)"',

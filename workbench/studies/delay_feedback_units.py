@@ -58,6 +58,7 @@ def parse_unit(text: str, path: str, key: str):
         if q.magnitude != 1:
             raise ValueError("a number in the unit")
         q.to_base_units()
+        q * ureg.Quantity(1, "s")       # an offset unit (degC) cannot be multiplied
     except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError,
             ZeroDivisionError, OverflowError, RecursionError) as exc:
         raise DesignError(path, key, text, f"a unit pint knows ({type(exc).__name__}: "
@@ -173,6 +174,15 @@ def check_units(model) -> None:
         units[name] = parse_unit(q.unit, spec.path, f"parameters.{name}.unit")
     shown.update({f"definitions.{n}": t for n, t in spec.definitions})
     shown.update({f"equations.{s}": t for s, t in zip(spec.state_names, spec.equations)})
+    import pint
+    try:
+        _check(spec, model, units, shown)
+    except pint.errors.PintError as exc:    # a safety net: the walk names its key itself
+        raise DesignError(spec.path, "<units>", "<pint>", f"units pint can combine "
+                          f"({type(exc).__name__}: {str(exc)[:120]})") from None
+
+
+def _check(spec, model, units, shown) -> None:
     w = _Walker(spec.path, units, shown)
     for name, _ in spec.definitions:
         w.unit(model.definitions[name], f"definitions.{name}")
