@@ -25,10 +25,11 @@ u = {{ unit = "m/s^2", source = "test" }}
 
 [parameters]
 w = {{ value = 0.0, unit = "m/s^2", source = "disturbance (zero at the point)" }}
+k = {{ value = 1.0, unit = "1/s^2", source = "test (the stiffness that makes x + u + w one unit)" }}
 
 [equations]
 x = "v"
-v = "x + u + w"
+v = "k*x + u + w"
 
 [operating_point]
 x = {{ value = 0.0, unit = "m", source = "test" }}

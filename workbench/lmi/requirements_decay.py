@@ -17,7 +17,13 @@ variables shared by the four corners:
 
 So h Phi_N(h, beta) is below the convex combination of its values at the
 corners, and the cell is certified when the four corner blocks are
-(h_a = 0: the interval module's limit block at both beta ends). This is
+(h_a = 0: the interval module's limit block at both beta ends). The
+argument needs the shared variables to be one functional in one set of
+coordinates and one time unit at both beta ends: the analysis LMIs choose
+their own balancing, modal coordinates and unit from (A, A_d)
+(:mod:`workbench.lmi.coordinates`), so a cell fixes them once, from its
+middle beta, and both ends are written and re-checked (on the caller's
+loop) in that frame. This is
 less conservative than the descriptor/Jensen synthesis LMI of
 :mod:`workbench.lmi.requirements` and it is the certificate of the decay of
 the returned gain.
@@ -31,6 +37,7 @@ References
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from typing import Sequence
@@ -38,7 +45,9 @@ from typing import Sequence
 import numpy as np
 
 from .analysis import BesselLegendreLMI
-from .core import DEFAULT_MARGIN, Bracket, MarginLMI, Outcome, Step, bisect_delay
+from .coordinates import congruence, original
+from .core import (DEFAULT_MARGIN, Block, Bracket, MarginLMI, Outcome, Step, bisect_delay,
+                   relative_margins)
 from .interval import IntervalLMI
 from .scaling import balancing
 
@@ -66,12 +75,35 @@ class CellLMI(MarginLMI):
     """
 
     def __init__(self, A, Ad, betas: tuple[float, float], h_a: float, N: int = 2, **kw):
-        self.ends = [IntervalLMI(BesselLegendreLMI(A, b * Ad, N, margin=kw.get(
-            "margin", DEFAULT_MARGIN)), from_zero=h_a == 0) for b in betas]
+        margin = kw.get("margin", DEFAULT_MARGIN)
+        # one frame (balancing T, modal coordinates L, time unit) for both ends, fixed at
+        # the cell's middle beta: the variables are shared, so they must mean the same
+        # functional at every (h, beta) of the cell (the convexity argument above)
+        self.frame = BesselLegendreLMI(A, math.sqrt(betas[0] * betas[1]) * np.asarray(Ad, float),
+                                       N, margin=margin)
+        self.ends = [IntervalLMI(_at_beta(self.frame, Ad, b), from_zero=h_a == 0)
+                     for b in betas]
         self.h_a = float(h_a)
         super().__init__(**kw)
         if h_a > 0:
             self.set_parameters(h_a=h_a, iota_a=1.0 / h_a)
+
+    def recheck(self, values, h: float) -> dict[str, float]:
+        """Margins re-evaluated with numpy on the caller's loop at both betas
+        (:func:`~workbench.lmi.coordinates.recheck_original`, per end)."""
+        L = self.frame.L
+        if L is None:
+            return MarginLMI.recheck(self, values, h)
+        twin = copy.copy(self)
+        twin.ends = []
+        for end in self.ends:
+            base = copy.copy(end.base)
+            base.A, base.Ad = base.A0, base.Ad0
+            twin.ends.append(copy.copy(end))
+            twin.ends[-1].base = base
+        blocks = MarginLMI.evaluate_blocks(twin, original(self.frame, values), h)
+        return relative_margins([Block(b.name, congruence(np.asarray(b.matrix, float), L),
+                                       b.sense) for b in blocks])
 
     def parameters(self):
         return () if self.h_a == 0 else ("h_a", "iota_a")
@@ -86,6 +118,15 @@ class CellLMI(MarginLMI):
                 if "@" in b.name or tag == "lo":
                     out.append(dataclasses.replace(b, name=f"{b.name}/beta_{tag}"))
         return out
+
+
+def _at_beta(frame, Ad, beta: float):
+    """The criterion ``frame`` for the delayed matrix beta A_d, in ``frame``'s
+    balancing, coordinates and time unit (T, L and the unit are not recomputed)."""
+    lmi = copy.copy(frame)
+    lmi.Ad0 = np.diag(1.0 / np.diag(frame.T)) @ (beta * np.asarray(Ad, float)) @ frame.T
+    lmi.Ad = lmi.Ad0 if frame.L is None else np.linalg.solve(frame.L, lmi.Ad0 @ frame.L)
+    return lmi
 
 
 def decay_cells(alpha: float, h_lo: float, H: float) -> list[tuple[float, float]]:
