@@ -184,7 +184,8 @@ def _bisect(lmi, objective, *, H, alpha, gamma, rel_tol, guess=None) -> Bracket:
                         h_hi=hi, rel_tol=rel_tol, guess=guess)
 
 
-def certify_gain(loop: Loop, K: np.ndarray, *, h_min: float = 0.0, H: float, alpha: float,
+def certify_gain(loop: Loop, K: np.ndarray, *, h_min: float | None = None, H: float,
+                 alpha: float,
                  gamma: float, margin: float = DEFAULT_MARGIN, rel_tol: float = 1e-3,
                  alpha_guess: float | None = None, N: int = 2,
                  gamma_free: bool = False) -> GainCertificate:
@@ -195,6 +196,7 @@ def certify_gain(loop: Loop, K: np.ndarray, *, h_min: float = 0.0, H: float, alp
     analysis with P2, P3 free, at rate 0). ``alpha``, ``gamma`` and
     ``gamma_free`` are kept for the callers' signature (unused)."""
     del alpha, gamma_free
+    h_min = 0.0 if h_min is None else h_min
     plain = dataclasses.replace(loop, Bw=None, Cz=None, Dz=None, box=None, u_max=None)
     a = certified_decay([(A, B @ K) for A, B in loop.points], h_lo=h_min, H=H,
                         alpha_hi=_rate_scale(loop, H), N=N, margin=margin, rel_tol=rel_tol,
@@ -216,8 +218,8 @@ def certify_gain(loop: Loop, K: np.ndarray, *, h_min: float = 0.0, H: float, alp
     return GainCertificate(a, g, d, joint)
 
 
-def synthesize_requirements(loop: Loop, *, objective: Objective, H: float, h_min: float = 0.0,
-                            alpha: float = 0.0,
+def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
+                            h_min: float | None = None, alpha: float = 0.0,
                             gamma: float = 1.0, margin: float = DEFAULT_MARGIN,
                             fraction: float = DEFAULT_FRACTION, digits: int = DEFAULT_DIGITS,
                             rel_tol: float = 1e-3) -> RequirementDesign:
@@ -232,7 +234,7 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float, h_min
     H : float
         Delay cap (s): every constant delay in [0, H] (for ``"delay"`` the
         search starts there).
-    h_min : float
+    h_min : float or None
         Smallest delay of the range (s): the decay certificate of the gain
         covers [h_min, H]; the synthesis LMI covers [0, H].
     alpha : float

@@ -127,7 +127,7 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
 
     from ..errors import DesignError
     from ..report.markdown import fmt, md_table
-    from .delay_feedback_run import metrics, nominal_point, simulate, synthesise
+    from .delay_feedback_run import design_synthesis, metrics, nominal_point, simulate
     spec = design.spec
     if not spec.scenarios:
         raise DesignError(design.path, "scenarios", "<missing>", "at least one [[scenarios]]")
@@ -139,7 +139,7 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
         raise DesignError("<cli>", "--dt", dt, f"a step in (0, {sc.t_end / 10:g}] s")
     model, values, op, A, B = nominal_point(spec)
     points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
-    s = synthesise(spec, A, B, points)
+    s = design_synthesis(spec, model, values, op, A, B, points)
     if s.K is None:
         print(f"{design.name}: no gain was certified; nothing to simulate")
         return 1

@@ -206,16 +206,22 @@ def delay_range_stable(windows, h_min: float, h_max: float) -> bool:
     return any(a < h_min and h_max < b for a, b in windows)
 
 
+def design_synthesis(spec, model, values, op, A, B, points=()) -> SynthesisOutcome:
+    """The design's own synthesis: to its ``[requirements]`` when it has them
+    (:func:`synthesise_requirements`), else the method of ``[synthesis]``
+    with the design's delay and search cap attached (for the reason)."""
+    if spec.synthesis.method == "requirements":
+        return synthesise_requirements(spec, model, values, op, A, B, points)
+    return replace(synthesise(spec, A, B, points), required=spec.delay.h_max,
+                   h_cap=spec.synthesis.settings.h_max)
+
+
 def run(spec) -> DelayFeedbackResult:
     """Compute a design (see the module docstring)."""
     from ..margins import exact_margin, stability_windows
     model, values, op, A, B = nominal_point(spec)
     points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
-    if spec.synthesis.method == "requirements":
-        syn = synthesise_requirements(spec, model, values, op, A, B, points)
-    else:
-        syn = replace(synthesise(spec, A, B, points), required=spec.delay.h_max,
-                      h_cap=spec.synthesis.settings.h_max)
+    syn = design_synthesis(spec, model, values, op, A, B, points)
     exact, windows, stable = None, (), None
     checks = ()
     if syn.K is not None:

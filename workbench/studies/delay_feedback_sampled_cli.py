@@ -15,15 +15,15 @@ def sampled_command(design, *, as_json: bool = False) -> int:
 
     from ..digital import render_markdown
     from ..errors import DesignError
-    from .delay_feedback_run import nominal_point, synthesise
+    from .delay_feedback_run import design_synthesis, nominal_point
     if design.kind != "delay-feedback":
         raise DesignError(design.path, "design.kind", design.kind,
                           'a "delay-feedback" design (synthesize sampled)')
     spec = design.spec
     settings = spec.implementation or ImplementationSettings(None, (0.0, 0.0), "zoh")
-    _, _, _, A, B = nominal_point(spec)
+    model, values, op, A, B = nominal_point(spec)
     points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
-    syn = synthesise(spec, A, B, points)
+    syn = design_synthesis(spec, model, values, op, A, B, points)
     if syn.K is None:
         print(f"{design.name}: no gain was certified; nothing to implement")
         return 1
