@@ -35,18 +35,21 @@ report: install
 ## $(JOBS) workers, tests marked `slow` deselected: `make test-full`) reads
 ## them instead of computing them again. Ends with the wall time and the
 ## five slowest studies and tests.
+# the lines of a check's output shown: problems, summaries and the claims not ok
+NOT_OK := awk '!/^\| / || /✗/'
 JOBS ?= $(shell $(PYTHON) -c "import os; print(max(1, len(os.sched_getaffinity(0))))")
 test: install
 	@t0=$$(date +%s); run=$$(mktemp -d); times=$$(mktemp); \
 	echo "== workbench check --jobs $(JOBS) (every claim, report freshness)"; \
-	WORKBENCH_STUDY_CACHE=$$run $(WB) check --jobs $(JOBS) 2> $$times; checked=$$?; \
+	WORKBENCH_STUDY_CACHE=$$run $(WB) check --jobs $(JOBS) 2> $$times | $(NOT_OK); \
+	  checked=$${PIPESTATUS[0]}; \
 	echo "== check done after $$(( $$(date +%s) - t0 )) s"; \
 	echo "== pytest -n $(JOBS) (not slow)"; \
 	WORKBENCH_STUDY_CACHE=$$run $(PY) -m pytest -n $(JOBS) -m "not slow and not wheel" \
 	  --durations=5 -p no:cacheprovider; tests=$$?; \
 	rm -rf $$run; \
 	echo; echo "== five slowest studies (workbench check; the whole table: workbench check --jobs $(JOBS))"; \
-	grep -v 'per-task time' $$times | sed -n '/^| task/,$$p' | sed -n '1,7p'; \
+	grep -A 6 -- '| task | kind | wall s | cpu s |' $$times | sed 's/.*\(| task | kind\)/\1/'; \
 	grep -v '^|\|^$$\|per-task time' $$times; rm -f $$times; \
 	echo "workbench check exit $$checked, pytest exit $$tests; make test: $$(( $$(date +%s) - t0 )) s wall"; \
 	test $$checked -eq 0 && test $$tests -eq 0
@@ -56,8 +59,6 @@ test: install
 ## moved -3 ulp with numpy's widest SIMD loops switched off (the features
 ## tests/simd_features.py finds on this CPU); each must find every report
 ## byte-identical; the golden report under $(OTHER_KERNEL).
-# the lines of a check that matter here: problems, summaries, claims not ok
-NOT_OK := awk '!/^\| / || /✗/'
 test-full: install
 	@t0=$$(date +%s); \
 	echo "== pytest -n $(JOBS) -m slow"; \
