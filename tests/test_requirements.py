@@ -8,7 +8,9 @@ import pytest
 import workbench
 from workbench.lmi.core import Outcome
 from workbench.lmi.requirements import Loop, RequirementAnalysis, box_vertices
-from workbench.lmi.requirements_decay import certified_decay
+import math
+
+from workbench.lmi.requirements_decay import CellLMI, certified_decay
 from workbench.margins.decay import hinf_norm, worst_decay
 
 B = np.array([[0.0], [1.0]])
@@ -43,6 +45,27 @@ def test_scalar_loop_decay_bracket_around_the_exact_decay():
     ex = worst_decay([(A, Ad)], 0.2, 0.5, alpha=br.h_certified, grid=11)
     assert br.outcome is Outcome.CERTIFIED and ex.clear
     assert 0.8 * ex.decay <= br.h_certified <= ex.decay
+
+
+def test_decay_cell_ends_share_one_frame_and_recheck_on_the_callers_loop():
+    # heavy-dry vertex of designs/train-brake-lag-delay-feedback.toml (rounded), K of its
+    # report; one cell [0.3, 0.8] s at alpha = 0.4 (exact worst decay 0.437). With a frame
+    # (balancing, modal coordinates, time unit) per beta end it was refuted (integration
+    # of issue 31's cells with the scale-free analysis LMIs).
+    A = np.array([[-0.0014, 1.157], [0.0, -1.5385]])
+    Ad = np.array([[0.0], [1 / 0.65]]) @ np.array([[-0.5299, -0.3102]])
+    alpha = 0.4
+    cell = CellLMI(A + alpha * np.eye(2), Ad, (math.exp(0.3 * alpha), math.exp(0.8 * alpha)),
+                   0.3, 2)
+    lo, hi = (end.base for end in cell.ends)
+    assert lo.L is hi.L and lo.T is hi.T and lo.unit == hi.unit and lo.A is hi.A
+    step = cell.solve_at(0.8)
+    assert step.outcome is Outcome.CERTIFIED
+    assert min(step.recheck.values()) >= cell.margin
+    bad = dict(step.certificate)
+    bad["R"] = -bad["R"]
+    assert min(cell.recheck(bad, 0.8).values()) < 0
+    assert worst_decay([(A, Ad)], 0.3, 0.8, alpha=alpha, grid=11).decay >= alpha
 
 
 def test_analysis_lmi_blocks_recheck_and_tamper():
