@@ -8,7 +8,9 @@ import pytest
 import workbench
 from workbench.lmi.core import Outcome
 from workbench.lmi.requirements import Loop, RequirementAnalysis, box_vertices
-from workbench.lmi.requirements_decay import certified_decay
+import math
+
+from workbench.lmi.requirements_decay import CellLMI, certified_decay
 from workbench.margins.decay import hinf_norm, worst_decay
 
 B = np.array([[0.0], [1.0]])
@@ -45,17 +47,38 @@ def test_scalar_loop_decay_bracket_around_the_exact_decay():
     assert 0.8 * ex.decay <= br.h_certified <= ex.decay
 
 
+def assert_sound_and_tamper(lmi, h: float, key: str) -> None:
+    """Certified at h with every re-checked margin; the re-check rejects -key."""
+    step = lmi.solve_at(h)
+    assert step.outcome is Outcome.CERTIFIED
+    assert min(step.recheck.values()) >= lmi.margin
+    bad = dict(step.certificate)
+    bad[key] = -bad[key]
+    assert min(lmi.recheck(bad, h).values()) < 0
+
+
+def test_decay_cell_ends_share_one_frame_and_recheck_on_the_callers_loop():
+    # heavy-dry vertex of designs/train-brake-lag-delay-feedback.toml (rounded), K of its
+    # report; one cell [0.3, 0.8] s at alpha = 0.4 (exact worst decay 0.437). With a frame
+    # (balancing, modal coordinates, time unit) per beta end it was refuted (integration
+    # of issue 31's cells with the scale-free analysis LMIs).
+    A = np.array([[-0.0014, 1.157], [0.0, -1.5385]])
+    Ad = np.array([[0.0], [1 / 0.65]]) @ np.array([[-0.5299, -0.3102]])
+    alpha = 0.4
+    cell = CellLMI(A + alpha * np.eye(2), Ad, (math.exp(0.3 * alpha), math.exp(0.8 * alpha)),
+                   0.3, 2)
+    lo, hi = (end.base for end in cell.ends)
+    assert lo.L is hi.L and lo.T is hi.T and lo.unit == hi.unit and lo.A is hi.A
+    assert_sound_and_tamper(cell, 0.8, "R")
+    assert worst_decay([(A, Ad)], 0.3, 0.8, alpha=alpha, grid=11).decay >= alpha
+
+
 def test_analysis_lmi_blocks_recheck_and_tamper():
     loop = Loop(((PENDULUM, B),), B, np.array([[1.0, 0.0]]), np.zeros((1, 1)),
                 np.array([0.5, 0.5]), np.array([5.0]))
     lmi = RequirementAnalysis(loop, np.array([[-3.22, -2.605]]))
     lmi.set_rate(0.3, 2.0)
-    step = lmi.solve_at(0.3)
-    assert step.outcome is Outcome.CERTIFIED
-    assert min(step.recheck.values()) >= lmi.margin
-    bad = dict(step.certificate)
-    bad["P0"] = -bad["P0"]
-    assert min(lmi.recheck(bad, 0.3).values()) < 0
+    assert_sound_and_tamper(lmi, 0.3, "P0")
     lmi.set_rate(0.3, 0.05)          # below the exact H-infinity norm (0.45): never certified
     assert lmi.solve_at(0.3).outcome is not Outcome.CERTIFIED
 
