@@ -97,7 +97,9 @@ def prefetch(designs, proof_modules, out: Path, jobs: int, *, write: bool = Fals
     order = sorted(designs, key=lambda d: (d.kind not in _SLOW_KINDS,
                                             -Path(d.path).stat().st_size, d.name))
     checked, problems, times = set(), [], []
-    with ProcessPoolExecutor(jobs, mp_context=mp.get_context("fork")) as ex:
+    from .sim.batch import die_with_parent   # workers die with the check (issue 32)
+    with ProcessPoolExecutor(jobs, mp_context=mp.get_context("fork"),
+                             initializer=die_with_parent, initargs=(os.getpid(),)) as ex:
         futs = [ex.submit(_design_task, str(d.path), str(out), write) for d in order]
         futs += [ex.submit(_proof_task, m) for m in proof_modules]
         for f in as_completed(futs):
