@@ -43,7 +43,7 @@ def main() -> None:
         [-y, x - (1 - x**2) * y], (x, y), (0.0, 0.0),
         lyapunov_P(np.array([[0.0, -1.0], [1.0, -1.0]]))), 10.0)
     from workbench.plants.adhesion import NumericAdhesion
-    from workbench.studies import antiskid_basin as AB
+    from workbench.papers.p003 import antiskid_basin as AB
     dry = dict(a=0.3315, b=40.19, c=5.392, J=80.0, r=0.445, m=12000.0, zeta=0.01, c0=180.9,
                c1=112.2, c2=2.6, g=9.8)                       # 003 Tables 1-2
     wet = dict(dry, a=0.2478, b=22.87, c=5.396)
@@ -67,8 +67,8 @@ def _delay_feedback() -> None:
     from pathlib import Path
 
     from workbench.design import load_design
-    from workbench.studies.delay_feedback_basin import delay_feedback_basin, run_basin
-    from workbench.studies.delay_feedback_model import PlantModel, solve_operating_point
+    from workbench.features.basin import delay_feedback_basin, run_basin
+    from workbench.kinds.delay_feedback.model import PlantModel, solve_operating_point
     path = (Path(__file__).resolve().parents[1] / "designs"
             / "wheel-slip-burckhardt-delay-feedback.toml")
     spec = load_design(path).spec

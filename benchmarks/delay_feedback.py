@@ -27,7 +27,7 @@ DESIGNS = sorted((ROOT / "designs").glob("*generic.toml")) + sorted(
 
 def stages(path: Path) -> list[str]:
     from workbench.margins import exact_margin, stability_windows
-    from workbench.studies.delay_feedback_run import nominal_point, simulate_scenario, synthesise
+    from workbench.kinds.delay_feedback.run import nominal_point, simulate_scenario, synthesise
     t0 = time.perf_counter()
     d = load_design(path)
     spec = d.spec

@@ -21,8 +21,8 @@ from pathlib import Path
 
 from workbench.design import load_design
 from workbench.sim.progress import progress
-from workbench.studies import antiskid_run_spec as S
-from workbench.studies.antiskid_scenario import Mesh, simulate_antiskid
+from workbench.papers.p003 import antiskid_run_spec as S
+from workbench.papers.p003.antiskid_scenario import Mesh, simulate_antiskid
 
 ROOT = Path(__file__).resolve().parents[1]
 

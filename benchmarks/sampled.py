@@ -93,7 +93,7 @@ def main() -> None:
 def cruise() -> None:
     """Paper 003's cruise loop: certified lowest rate on the linearisation next to the
     simulated lowest rate of the nonlinear laws (issue 20, reports/antiskid-run-dry.md)."""
-    from workbench.studies.antiskid_cruise_sampled import cruise_sampling
+    from workbench.papers.p003.antiskid_cruise_sampled import cruise_sampling
     print("\nPaper 003 cruise loop, linearisation of designs/antiskid-cruise-dry.toml with the "
           "printed Table 3 gain (eps = 0.35):\n")
     print("| implementation | certified T_max (s) | certified lowest rate (Hz) | "

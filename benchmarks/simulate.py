@@ -10,7 +10,7 @@ Prints, in one process:
    sample interval the delayed input is known history, so the interval is
    an ODE) — over the first ``--ref-horizon`` seconds, and the difference in
    the time to cruise;
-3. batched Monte Carlo throughput (``workbench.studies.antiskid_montecarlo.sweep``,
+3. batched Monte Carlo throughput (``workbench.papers.p003.antiskid_montecarlo.sweep``,
    process pool) of both stepping paths side by side, the same runs: the
    batched numpy reference and the compiled kernel (numba; compiled once in
    this process before the pool forks, which is not in its time), runs/min
@@ -33,9 +33,9 @@ from workbench.controllers.antiskid003 import Antiskid003
 from workbench.design import load_design
 from workbench.sim.history import DelayLine
 from workbench.sim.wheel_slip import PARAM_ORDER, ScalarOps, model_functions, plant_forms
-from workbench.studies import antiskid_run_spec as S
-from workbench.studies.antiskid_montecarlo import sweep
-from workbench.studies.antiskid_scenario import MetricsRecorder, simulate_antiskid
+from workbench.papers.p003 import antiskid_run_spec as S
+from workbench.papers.p003.antiskid_montecarlo import sweep
+from workbench.papers.p003.antiskid_scenario import MetricsRecorder, simulate_antiskid
 
 
 def reference_run(rs, dt: float, t_end: float) -> tuple[float, float]:
@@ -121,7 +121,7 @@ def montecarlo(design, spec, samples: int, workers: int) -> None:
     import os
     import resource
 
-    from workbench.studies.antiskid_kernel import LANES, compiled_available
+    from workbench.papers.p003.antiskid_kernel import LANES, compiled_available
     mc_dt = spec.montecarlo.dt or spec.dt
     print(f"Monte Carlo: {samples} runs of up to {spec.scenario['t_end']:g} s at dt = {mc_dt:g} s, "
           f"seed 1, {workers} workers; compiled batches keep {LANES} runs in flight")

@@ -14,7 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from workbench.design import load_design
-from workbench.studies.stopping000 import CONTROLLERS, run_station_stops
+from workbench.papers.p000.station_stopping import CONTROLLERS, run_station_stops
 
 REPEATS = int(sys.argv[1]) if len(sys.argv) > 1 else 50
 

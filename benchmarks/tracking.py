@@ -21,8 +21,9 @@ from workbench.design import load_design
 from workbench.plants.platoon001 import TrainParams
 from workbench.profiles import build_profile
 from workbench.sim.tracking import simulate_tracking
-from workbench.studies import platoon001, tracking002
-from workbench.studies.tracking002_spec import MFAC_KEYS
+from workbench.papers.p001 import ntsm_platoon as platoon001
+from workbench.papers.p002 import ato_tracking as tracking002
+from workbench.papers.p002.ato_tracking_spec import MFAC_KEYS
 
 N_GRID = 40
 

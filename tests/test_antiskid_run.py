@@ -12,9 +12,9 @@ import pytest
 from workbench.cli import main
 from workbench.controllers.antiskid003_settings import DIVERGED
 from workbench.design import load_design
-from workbench.studies import antiskid_run as R
-from workbench.studies import antiskid_run_spec as S
-from workbench.studies.antiskid_scenario import simulate_antiskid
+from workbench.papers.p003 import antiskid_run as R
+from workbench.papers.p003 import antiskid_run_spec as S
+from workbench.papers.p003.antiskid_scenario import simulate_antiskid
 
 DRY = Path("designs/antiskid-run-dry.toml")
 K_TABLE3 = (-0.0049, 10.5080)   # paper 003, Table 3, eps = 0.35
@@ -106,7 +106,7 @@ def test_sweep_is_seeded(tmp_path, capsys):
     text = text.replace("dt = 0.005                          # s, step of the sweep's runs",
                         "dt = 0.01                          # s, step of the sweep's runs")
     short.write_text(text.replace('value = 420.0,', 'value = 32.0,'))
-    from workbench.studies.antiskid_montecarlo import sweep
+    from workbench.papers.p003.antiskid_montecarlo import sweep
     d = load_design(short)
     a = sweep(d, 3, seed=7, workers=1, progress=False)
     b = sweep(d, 3, seed=7, workers=1, progress=False)

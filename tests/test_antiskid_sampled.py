@@ -1,6 +1,6 @@
 """Sampled-data antiskid (issue 20): the laws of paper 003 at a fixed rate
 with a zero-order hold, on a plant mesh independent of the rate
-(:mod:`workbench.studies.antiskid_sampled`)."""
+(:mod:`workbench.papers.p003.antiskid_sampled`)."""
 from __future__ import annotations
 
 import math
@@ -11,9 +11,9 @@ import pytest
 
 from workbench.cli import main
 from workbench.design import load_design
-from workbench.studies import antiskid_sampled as S
-from workbench.studies.antiskid_run_spec import sampled_context
-from workbench.studies.antiskid_sampled_check import replay
+from workbench.papers.p003 import antiskid_sampled as S
+from workbench.papers.p003.antiskid_run_spec import sampled_context
+from workbench.papers.p003.antiskid_sampled_check import replay
 
 pytest.importorskip("numba")
 

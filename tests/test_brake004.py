@@ -6,7 +6,7 @@ import pytest
 
 from workbench.controllers.fuzzy import FuzzyIncrement, memberships
 from workbench.design import load_design
-from workbench.studies.brake004 import compute_worked, run_grid
+from workbench.papers.p004.closed_loop_brake import compute_worked, run_grid
 
 DESIGN = "designs/closed-loop-brake-004.toml"
 

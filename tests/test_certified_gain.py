@@ -164,7 +164,7 @@ def test_claim_on_a_synthesis_without_gain_is_inconclusive():
     from types import SimpleNamespace
 
     from workbench.claims import Claim, Verdict, check_claim
-    from workbench.studies.delay_feedback_run import SynthesisOutcome, quantities
+    from workbench.kinds.delay_feedback.run import SynthesisOutcome, quantities
     s = SynthesisOutcome("robust-descriptor", 0.8, math.inf, None, None, "inconclusive", 0.1,
                          None, True, False)
     res = SimpleNamespace(synthesis=s, op=SimpleNamespace(residual=0.0, x=np.zeros(1),
@@ -179,7 +179,7 @@ def test_claim_on_a_synthesis_without_gain_is_inconclusive():
 
 
 def test_design_reason_names_a_search_cap_below_the_required_delay():
-    from workbench.studies.delay_feedback_run import SynthesisOutcome
+    from workbench.kinds.delay_feedback.run import SynthesisOutcome
     s = SynthesisOutcome("robust-descriptor", 0.0, math.inf, None, None, "inconclusive", 0.1,
                          None, True, False, required=3.0, h_cap=2.0)
     assert s.reason == "search cap below the required delay: h_max = 2 s < 3 s"

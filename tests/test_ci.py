@@ -172,17 +172,17 @@ def test_changed_since_checks_only_what_changed(tmp_path, monkeypatch, capsys):
 def test_changed_since_follows_the_study_imports(tmp_path):
     from workbench.changes import PACKAGE_DIR, design_changed, study_files
     files = study_files("antiskid-cruise")
-    assert PACKAGE_DIR / "studies" / "antiskid_cruise.py" in files
+    assert PACKAGE_DIR / "papers" / "p003" / "antiskid_cruise.py" in files
     assert PACKAGE_DIR / "lmi" / "freeweighting003.py" in files      # imported by the study
     assert PACKAGE_DIR / "claims.py" in files                         # claim machinery
-    assert PACKAGE_DIR / "studies" / "brake004.py" not in files       # another study
+    assert PACKAGE_DIR / "papers" / "p004" / "closed_loop_brake.py" not in files  # another study
     d = tmp_path / "designs"
     d.mkdir()
     design = d / "x.toml"
     assert design_changed(design, "antiskid-cruise", d, {design.resolve()})
     assert design_changed(design, "antiskid-cruise", d, {PACKAGE_DIR / "lmi" / "core.py"})
     assert not design_changed(design, "antiskid-cruise", d,
-                              {PACKAGE_DIR / "studies" / "brake004.py"})
+                              {PACKAGE_DIR / "papers" / "p004" / "closed_loop_brake.py"})
     assert design_changed(design, "antiskid-cruise", d, {(d / "benchmarks" / "a.toml").resolve()})
     assert design_changed(design, "antiskid-cruise", d, {(tmp_path / "constraints.txt").resolve()})
 

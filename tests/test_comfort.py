@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from workbench.reader import Quantity
-from workbench.studies.antiskid_comfort import ComfortSpec, comfort_of, comfort_quantities
+from workbench.papers.p003.antiskid_comfort import ComfortSpec, comfort_of, comfort_quantities
 
 SPEC = ComfortSpec(Quantity(1.0, "m/s^2", "test"), Quantity(0.75, "m/s^3", "test"),
                    Quantity(1.0, "s", "test"))

@@ -20,11 +20,11 @@ pytest.importorskip("numba")
 from workbench.controllers.antiskid003_settings import ControllerSettings, CreepSpeedProfile  # noqa: E402
 from workbench.design import load_design  # noqa: E402
 from workbench.sim.wheel_slip import PARAM_ORDER  # noqa: E402
-from workbench.studies.antiskid_kernel import LANES, METRIC_FIELDS, simulate_batch  # noqa: E402
-from workbench.studies.antiskid_montecarlo import (chunk_payload, chunk_worker, per_run,  # noqa: E402
+from workbench.papers.p003.antiskid_kernel import LANES, METRIC_FIELDS, simulate_batch  # noqa: E402
+from workbench.papers.p003.antiskid_montecarlo import (chunk_payload, chunk_worker, per_run,  # noqa: E402
                                                    run_lambda_opt, sweep_inputs)
-from workbench.studies.antiskid_run_spec import gain_for  # noqa: E402
-from workbench.studies.antiskid_scenario import RunSettings  # noqa: E402
+from workbench.papers.p003.antiskid_run_spec import gain_for  # noqa: E402
+from workbench.papers.p003.antiskid_scenario import RunSettings  # noqa: E402
 
 RTOL = 1e-9
 #: Absolute tolerance of the creep-speed errors (m/s), which end a run near

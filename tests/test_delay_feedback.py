@@ -53,7 +53,7 @@ def write(tmp_path, name="d", lo=-5.0, hi=5.0, extra="", replace=None):
 
 def test_operating_point_and_jacobians_are_analytic(tmp_path, monkeypatch):
     """x' = -a sin x + u at x = 0.5: u = a sin 0.5, A = -a cos 0.5, B = 1."""
-    from workbench.studies.delay_feedback_run import nominal_point
+    from workbench.kinds.delay_feedback.run import nominal_point
     monkeypatch.chdir(tmp_path)
     d = load_design(write(tmp_path))
     _, _, op, A, B = nominal_point(d.spec)
@@ -131,7 +131,7 @@ def test_template_runs_as_written(tmp_path, monkeypatch, capsys):
 def test_expression_functions_reach_the_model(tmp_path, monkeypatch):
     """where/min/max/abs build piecewise sympy that lambdifies: the Jacobian
     of x' = where(x > 0, -a x, -2 a x) + u at x = 0.5 is -a."""
-    from workbench.studies.delay_feedback_run import nominal_point
+    from workbench.kinds.delay_feedback.run import nominal_point
     monkeypatch.chdir(tmp_path)
     d = load_design(write(tmp_path, replace={'"-a*sin(x) + u"':
                                              '"where(x > 0, -a*x, -2*a*x) + min(u, 10)"'}))
@@ -140,7 +140,7 @@ def test_expression_functions_reach_the_model(tmp_path, monkeypatch):
 
 
 def test_delay_range_stable_needs_one_window():
-    from workbench.studies.delay_feedback_run import delay_range_stable
+    from workbench.kinds.delay_feedback.run import delay_range_stable
     assert delay_range_stable(((0.0, 1.0),), 0.3, 0.8)
     assert not delay_range_stable(((0.0, 0.5), (0.6, 2.0)), 0.3, 0.8)
     assert delay_range_stable(((0.0, 0.2), (0.25, np.inf)), 0.3, 0.8)
@@ -194,7 +194,7 @@ def test_robust_vertices_end_to_end(tmp_path, monkeypatch):
     certified at both vertices with decay rate 0.1 at its delay; the exact
     margin at each vertex is at least the certified delay and the spectral
     abscissa there is at most -0.1 (independent checks)."""
-    from workbench.studies.delay_feedback import STUDY
+    from workbench.kinds.delay_feedback import STUDY
     monkeypatch.chdir(tmp_path)
     p = tmp_path / "rob.toml"
     p.write_text(ROBUST, encoding="utf-8")
@@ -240,7 +240,7 @@ def test_predictor_removes_the_delay_from_the_loop(tmp_path, monkeypatch):
     with the synthesised K: without the predictor the nonlinear run grows,
     with it (paper 003 Lemma 1; the model is exact here) it decays as the
     delay-free loop A + BK does."""
-    from workbench.studies.delay_feedback import STUDY
+    from workbench.kinds.delay_feedback import STUDY
     monkeypatch.chdir(tmp_path)
     p = tmp_path / "pred.toml"
     p.write_text(PREDICTOR, encoding="utf-8")

@@ -40,8 +40,8 @@ def test_same_eps_list():
 
 def test_same_linearisation_to_rounding():
     from workbench.design import load_design
-    from workbench.studies import antiskid_cruise
-    from workbench.studies.delay_feedback_run import nominal_point
+    from workbench.papers.p003 import antiskid_cruise
+    from workbench.kinds.delay_feedback.run import nominal_point
     _, _, op, A, B = nominal_point(load_design(GENERIC).spec)
     _, lam, _, lin = antiskid_cruise.operating_point(load_design(SPECIAL).spec)
     assert op.x[1] == pytest.approx(lam, rel=1e-13)

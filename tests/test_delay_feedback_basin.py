@@ -90,8 +90,8 @@ def evaluated(tmp_path_factory):
 
 
 def test_section_figure_and_claims(evaluated, tmp_path, monkeypatch, capsys):
-    from workbench.studies import renderer
-    from workbench.studies.delay_feedback import STUDY
+    from workbench.kinds import renderer
+    from workbench.kinds.delay_feedback import STUDY
     ev = evaluated
     assert all(c.ok for c in ev.claims), [(c.claim.id, c.got) for c in ev.claims]
     q = STUDY.quantities(ev.result)
@@ -119,8 +119,8 @@ def test_certified_level_agrees_with_simulation(evaluated):
     import sympy as sp
     from scipy.integrate import solve_ivp
 
-    from workbench.studies.delay_feedback_basin import closed_loop
-    from workbench.studies.delay_feedback_model import PlantModel
+    from workbench.features.basin import closed_loop
+    from workbench.kinds.delay_feedback.model import PlantModel
     res, spec = evaluated.result, evaluated.design.spec
     est = res.basin.check.estimate
     model = PlantModel(spec.plant)

@@ -138,7 +138,7 @@ def _toml_string(text: str) -> str:
 
 @pytest.mark.parametrize("text, word", HOSTILE)
 def test_hostile_expression_through_the_cli(text, word, tmp_path, monkeypatch, capsys):
-    from workbench.studies import delay_feedback_run
+    from workbench.kinds.delay_feedback import run as delay_feedback_run
     ran = []
     monkeypatch.setattr(delay_feedback_run, "nominal_point", lambda *a, **k: ran.append(a))
     monkeypatch.setattr(delay_feedback_run, "run", lambda *a, **k: ran.append(a))

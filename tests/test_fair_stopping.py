@@ -11,11 +11,11 @@ from workbench.cli import main
 from workbench.controllers.stop_predictor import NominalBrakeModel
 from workbench.design import load_design
 from workbench.sim.stopping import batch_params, simulate
-from workbench.studies.pid_tuning import damping, speed_loop, tune_pid
-from workbench.studies.stopping000 import run_station_stops
-from workbench.studies.stopping000_run import loop_dead_time
-from workbench.studies.stopping000_spec import MC_FACTORS, NOMINAL
-from workbench.studies.stopping_mc import (Distribution, MonteCarloSpec, draw, percentile,
+from workbench.tuning.pid import damping, speed_loop, tune_pid
+from workbench.papers.p000.station_stopping import run_station_stops
+from workbench.papers.p000.station_stopping_run import loop_dead_time
+from workbench.papers.p000.station_stopping_spec import MC_FACTORS, NOMINAL
+from workbench.features.montecarlo import (Distribution, MonteCarloSpec, draw, percentile,
                                            stop_statistics, within_rate)
 
 D000 = "designs/stopping-line5.toml"
@@ -170,7 +170,7 @@ def test_predictor_loop_dead_time(spec000):
 # -- 004: retuned nominal corner, sensor faults, Monte Carlo determinism ----------------------
 @pytest.fixture(scope="module")
 def res004():
-    from workbench.studies.brake004 import run_grid
+    from workbench.papers.p004.closed_loop_brake import run_grid
     spec = load_design(D004).spec
     nominal = replace(spec, force_error=(0.0,), gradient=(0.0,), friction=(1.0,))
     return spec, run_grid(nominal, montecarlo=False)
@@ -200,7 +200,7 @@ def test_004_sensor_reading_high_wins_max_of_4_and_stuck_one_defeats_it(res004):
 
 
 def test_004_montecarlo_is_seeded():
-    from workbench.studies.brake004_run import run_montecarlo
+    from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
     spec = load_design(D004).spec
     spec = replace(spec, speeds_kmh=(50.0,), montecarlo=MonteCarloSpec(
         6, spec.montecarlo.seed, spec.montecarlo.distributions))

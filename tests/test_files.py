@@ -149,7 +149,7 @@ def test_pool_workers_die_with_their_parent(tmp_path):
 def test_a_chunk_write_failure_names_the_folder_not_the_scheduler(tmp_path, monkeypatch,
                                                                     capsys):
     """Under any scheduler, an OSError writing a chunk is an --out problem."""
-    from workbench.studies import antiskid_stream
+    from workbench.papers.p003 import antiskid_stream
 
     class Refused:
         def result(self, progress=False):    # a chunk's file cannot be written

@@ -220,7 +220,7 @@ def test_a_given_point_must_be_an_equilibrium(tmp_path, capsys):
 
 def test_trim_false_linearises_off_equilibrium(tmp_path):
     from workbench.design import load_design
-    from workbench.studies.delay_feedback_run import nominal_point
+    from workbench.kinds.delay_feedback.run import nominal_point
     given = ('a = { value = 0.0, unit = "m/s^2", source = "t" }\n'
              'u = { value = 0.0, unit = "m/s^2", source = "t" }\ntrim = false')
     text = (ROOT / "designs" / f"{TRAIN}.toml").read_text().replace(_GIVEN, given)

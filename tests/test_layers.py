@@ -6,7 +6,12 @@ Every ``import`` counts, at module level, inside functions and under
     errors, reader  <- plants <- symbolic, sim <- controllers
     lmi (LMIs only)      margins (exact methods only)
     crosscheck, synthesis, benchmark: the layer that calls both
-    report (rendering only) <- studies <- design, verify, cli
+    report (rendering only) <- features, tuning <- kinds <- papers <- design, verify, cli
+
+``kinds`` holds the general design kinds and the registry (kind -> module),
+``features`` the machinery several designs use (Monte Carlo, basin,
+sampled-data check), ``tuning`` PID tuning and Pareto fronts, ``papers/pNNN``
+the paper-specific studies. General code never imports a paper's.
 """
 from __future__ import annotations
 
@@ -33,9 +38,14 @@ ALLOWED = {
 }
 
 #: (importer package, imported package) pairs the issue names explicitly.
-FORBIDDEN = [("lmi", "margins"), ("margins", "lmi"), ("sim", "studies"), ("sim", "report"),
-             ("sim", "design"), ("report", "lmi"), ("report", "sim"), ("report", "studies"),
-             ("report", "margins")]
+FORBIDDEN = [("lmi", "margins"), ("margins", "lmi"), ("sim", "kinds"), ("sim", "papers"),
+             ("sim", "report"), ("sim", "design"), ("report", "lmi"), ("report", "sim"),
+             ("report", "kinds"), ("report", "papers"), ("report", "margins")]
+
+#: (importer package, imported package) pairs the package layout forbids (issue 35):
+#: the general machinery never imports a paper's code, nor a feature a kind.
+GENERAL = [("kinds", "papers"), ("features", "papers"), ("tuning", "papers"),
+           ("features", "kinds"), ("tuning", "kinds"), ("tuning", "features")]
 
 
 def _modules() -> dict[str, Path]:
@@ -126,8 +136,9 @@ def test_the_parser_sees_function_level_and_relative_imports():
     # registry loads studies by name only, and a study's render module
     # imports its study (function level in some)
     assert "workbench.sim.wheel_slip" in GRAPH["workbench.controllers.antiskid003"]
-    assert "workbench.studies.antiskid_run_spec" in GRAPH["workbench.studies.antiskid_montecarlo"]
-    assert "workbench.studies.antiskid_cruise" in GRAPH["workbench.studies.antiskid_cruise_render"]
+    p003 = "workbench.papers.p003."
+    assert p003 + "antiskid_run_spec" in GRAPH[p003 + "antiskid_montecarlo"]
+    assert p003 + "antiskid_cruise" in GRAPH[p003 + "antiskid_cruise_render"]
     assert len(MODULES) > 60
 
 
@@ -155,6 +166,13 @@ def test_forbidden_edges(src, dst):
     assert bad == []                        # ... and the code obeys
 
 
+@pytest.mark.parametrize("src,dst", GENERAL, ids=[f"{a}-not-{b}" for a, b in GENERAL])
+def test_general_machinery_respects_the_layout(src, dst):
+    bad = [f"{m} -> {t}" for m in GRAPH if _package(m) == src
+           for t in GRAPH[m] if _package(t) == dst]
+    assert bad == []
+
+
 def _subpackage(module: str) -> str:
     """The sub-package of a module ("" for the top-level modules of workbench/)."""
     parent = MODULES[module].parent
@@ -177,11 +195,11 @@ def test_no_module_over_the_size_limit():
 
 
 def test_every_study_kind_has_a_renderer_and_no_study_imports_its_renderer():
-    from workbench import studies
-    assert set(studies.RENDERERS) == set(studies.STUDIES)
-    for kind, spec in studies.RENDERERS.items():
-        render_mod = "workbench.studies." + spec.split(":")[0]
-        study_mod = "workbench.studies." + studies.STUDIES[kind].split(":")[0]
+    from workbench import kinds
+    assert set(kinds.RENDERERS) == set(kinds.STUDIES)
+    for kind, spec in kinds.RENDERERS.items():
+        render_mod = spec.split(":")[0]
+        study_mod = kinds.STUDIES[kind].split(":")[0]
         assert render_mod in MODULES
         if render_mod != study_mod:
             assert render_mod not in GRAPH[study_mod], kind

@@ -276,7 +276,7 @@ def test_cli_fails_when_the_exact_methods_disagree(tmp_path, monkeypatch, capsys
 
 def test_verify_fails_when_the_exact_methods_disagree(monkeypatch):
     from workbench.design import load_design
-    from workbench.studies.delay_benchmark import STUDY
+    from workbench.kinds.delay_benchmark import STUDY
     design = load_design("designs/delay-benchmarks.toml")
     assert "suite.exact_methods_agree" in STUDY.quantity_names(design.spec)
     claim = next(c for c in design.claims if c.quantity == "suite.exact_methods_agree")

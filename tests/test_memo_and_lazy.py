@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from workbench import memo, studies
+from workbench import kinds, memo
 from workbench.design import load_design
 
 DATA = Path("tests/data")
@@ -19,9 +19,9 @@ HEAVY = ("cvxpy", "control", "matplotlib", "sympy", "scipy.optimize")
 
 
 def test_registry_names_each_study_by_its_kind():
-    assert sorted(studies.REGISTRY) == sorted(studies.STUDIES)
-    for kind in studies.REGISTRY:
-        assert studies.REGISTRY[kind].kind == kind
+    assert sorted(kinds.REGISTRY) == sorted(kinds.STUDIES)
+    for kind in kinds.REGISTRY:
+        assert kinds.REGISTRY[kind].kind == kind
 
 
 def test_a_design_error_imports_no_solver():

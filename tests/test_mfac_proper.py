@@ -12,7 +12,7 @@ from workbench.controllers.mfac import (MFAC, MFACGains, frozen_loop_poles, froz
 from workbench.controllers.pid import PID, BatchPID
 from workbench.plants.train002 import FirstOrderTrain002, Train002, dc_gain, speed_time_constant
 from workbench.sim.tracking import Route, simulate_tracking
-from workbench.studies.pareto import choose, dominated_share, pareto_mask, weighted_cost
+from workbench.tuning.pareto import choose, dominated_share, pareto_mask, weighted_cost
 
 DESIGN = Path("designs/ato-mfac-pid-002.toml")
 EPS = 1e-5
@@ -220,7 +220,7 @@ def small_reading():
 
 @pytest.mark.slow
 def test_study_is_deterministic(small_reading):
-    from workbench.studies.tracking002_run import run_study, study_quantities
+    from workbench.papers.p002.ato_tracking_run import run_study, study_quantities
     a, b = run_study(small_reading), run_study(small_reading)
     ra, rb = a.readings[0], b.readings[0]
     for x, y in ((ra.mfac.objectives, rb.mfac.objectives), (ra.pid.objectives, rb.pid.objectives),
@@ -232,7 +232,7 @@ def test_study_is_deterministic(small_reading):
 
 def test_a_grid_where_nothing_stops_is_a_model_error(small_reading):
     from workbench.errors import ModelError
-    from workbench.studies.tracking002_run import run_study
+    from workbench.papers.p002.ato_tracking_run import run_study
     r = small_reading.readings[0]
     # a command pinned at a demanded speed of 2 cm/s: the train creeps and never stands still
     creep = dataclasses.replace(r.train, u_min=0.02, u_max=0.02)

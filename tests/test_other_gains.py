@@ -9,8 +9,8 @@ import pytest
 from workbench.design import load_design
 from workbench.report.findings import section_link
 from workbench.report.markdown import slug
-from workbench.studies.antiskid_cruise import operating_point
-from workbench.studies.antiskid_cruise_gains import (check_other_gains,
+from workbench.papers.p003.antiskid_cruise import operating_point
+from workbench.papers.p003.antiskid_cruise_gains import (check_other_gains,
                                                      other_gain_quantities)
 
 REPORTS = Path(__file__).resolve().parents[1] / "reports"

@@ -15,8 +15,8 @@ from workbench.design import load_design
 from workbench.margins import delay_margin_eig, delay_margin_siso
 from workbench.plants.platoon001 import TrainParams
 from workbench.sim.platoon import Actuator, Link, packet_delays, received_steps
-from workbench.studies.platoon001 import scenario
-from workbench.studies.platoon001_realism import (delay_margin_model, emergency_run, envelope,
+from workbench.papers.p001.ntsm_platoon import scenario
+from workbench.papers.p001.ntsm_platoon_realism import (delay_margin_model, emergency_run, envelope,
                                                   link)
 
 DESIGN = Path("designs/platoon-ntsm-001.toml")

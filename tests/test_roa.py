@@ -169,7 +169,7 @@ def test_check_basin_renders_its_verdicts():
 
 def test_roa_respects_the_layers():
     root = Path(__file__).resolve().parents[1] / "workbench" / "roa"
-    banned = ("studies", "report", "design", "sim", "lmi", "margins")
+    banned = ("kinds", "features", "tuning", "papers", "report", "design", "sim", "lmi", "margins")
     for f in root.glob("*.py"):
         for node in ast.walk(ast.parse(f.read_text())):
             if isinstance(node, ast.ImportFrom) and node.level >= 1 and node.module:

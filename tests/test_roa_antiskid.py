@@ -1,12 +1,12 @@
 """Basin of paper 003's cruise law (61): the printed switch at lambda_opt is
 outside every certified basin and diverges; the workbench's handover state is
-inside; a small k2 makes the printed switch safe (workbench.studies.antiskid_basin)."""
+inside; a small k2 makes the printed switch safe (workbench.papers.p003.antiskid_basin)."""
 import numpy as np
 import pytest
 
 from workbench.plants.adhesion import NumericAdhesion
 from workbench.roa import LevelOutcome
-from workbench.studies import antiskid_basin as AB
+from workbench.papers.p003 import antiskid_basin as AB
 
 # 003 Tables 1-2 (dry rail); the gain is the workbench's certified synthesis at
 # eps = 0.35 (reports/antiskid-run-dry.md: K = [-0.004575, 10.27])
@@ -92,8 +92,8 @@ def test_delay_feedback_design_gets_a_basin():
     point and gain (its report's canonical K = [-0.1218, -0.1211]) give a
     certified basin that holds a nearby state."""
     from workbench.design import load_design
-    from workbench.studies.delay_feedback_basin import delay_feedback_basin
-    from workbench.studies.delay_feedback_model import PlantModel, solve_operating_point
+    from workbench.features.basin import delay_feedback_basin
+    from workbench.kinds.delay_feedback.model import PlantModel, solve_operating_point
     spec = load_design("designs/train-brake-lag-delay-feedback.toml").spec
     model = PlantModel(spec.plant)
     values = spec.plant.values()
@@ -112,8 +112,8 @@ def test_brake_switch_at_lambda_d_is_in_no_basin_and_spins():
     no equilibrium of the frozen loop (lambda' > 0 proven up to 0.9), and the
     time-varying delay-free loop spins the wheel too."""
     from workbench.controllers.antiskid003_settings import CreepSpeedProfile
-    from workbench.studies.antiskid_basin_brake import brake_switch
-    from workbench.studies.antiskid_basin_render import brake_text
+    from workbench.papers.p003.antiskid_basin_brake import brake_switch
+    from workbench.papers.p003.antiskid_basin_render import brake_text
     b = brake_switch(DRY, "compensated", (70.0126, 0.01954),
                      profile=CreepSpeedProfile(t_brake=300.0), k_de=10.0)
     assert b.outcome is LevelOutcome.REFUTED and b.why == "no equilibrium up to spin"
@@ -127,7 +127,7 @@ def test_brake_switch_on_the_braking_side_is_certified():
     state at lambda = -0.01 reaches the certified level set of the equilibrium;
     the time-varying delay-free loop (no frozen assumption) tracks."""
     from workbench.controllers.antiskid003_settings import CreepSpeedProfile
-    from workbench.studies.antiskid_basin_brake import brake_switch
+    from workbench.papers.p003.antiskid_basin_brake import brake_switch
     b = brake_switch(DRY, "later", (69.0, -0.01), profile=CreepSpeedProfile(t_brake=300.0),
                      k_de=10.0, t=301.0)
     assert b.outcome is LevelOutcome.CERTIFIED and b.lam_star < 0 and b.fate == "tracks"

@@ -160,7 +160,7 @@ def test_bad_input_is_one_clear_error(kw, match):
 def test_cruise_loop_003_certified_rate():
     """Paper 003's cruise linearisation with the Table 3 gain: certified without a
     predictor for a 43.3 ms + 2 ms delay at a rate far below the simulated 25 Hz."""
-    from workbench.studies.antiskid_cruise_sampled import cruise_sampling
+    from workbench.papers.p003.antiskid_cruise_sampled import cruise_sampling
     c = cruise_sampling("designs/antiskid-cruise-dry.toml")
     assert c.delayed.outcome is Outcome.CERTIFIED and c.delayed.recheck_passed
     assert 0.1 < c.delayed.T_certified <= c.delayed.first_unstable

@@ -14,7 +14,7 @@ import pytest
 
 from workbench.cli import main
 from workbench.design import load_design
-from workbench.studies.antiskid_montecarlo import start_sweep, sweep
+from workbench.papers.p003.antiskid_montecarlo import start_sweep, sweep
 
 N = 64
 distributed = pytest.importorskip("distributed")

@@ -17,8 +17,8 @@ import pytest
 from workbench.design import load_design
 from workbench.sim import counter_rng as R
 from workbench.sim.perturb import delay_at, split_delays
-from workbench.studies.antiskid_montecarlo import chunk_payload, chunk_worker, sweep_inputs
-from workbench.studies.antiskid_run_spec import SweepPerturbations, gain_for
+from workbench.papers.p003.antiskid_montecarlo import chunk_payload, chunk_worker, sweep_inputs
+from workbench.papers.p003.antiskid_run_spec import SweepPerturbations, gain_for
 
 RTOL = 1e-9
 
@@ -103,7 +103,7 @@ def test_compiled_and_numpy_agree_with_every_perturbation_on(dry):
     """8 runs, noise + gradient + varying delay, every phase visited."""
     pytest.importorskip("numba")
     from tests.test_compiled_kernel import assert_close
-    from workbench.studies.antiskid_kernel import METRIC_FIELDS
+    from workbench.papers.p003.antiskid_kernel import METRIC_FIELDS
     d = _with(dry, ALL_ON, t_brake=5.0, t_end=8.0)
     a = chunk_worker(_payload(d, 8, kernel="compiled", v0=66.0))["metrics"]
     b = chunk_worker(_payload(d, 8, kernel="numpy", v0=66.0))["metrics"]

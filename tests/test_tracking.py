@@ -150,7 +150,7 @@ def evaluation():
 
 
 def test_study_runs_and_claims_are_ok(evaluation):
-    from workbench.studies.tracking002_run import study_quantities
+    from workbench.papers.p002.ato_tracking_run import study_quantities
     assert evaluation.ok
     res = evaluation.result
     q = study_quantities(res)

@@ -146,30 +146,41 @@ def test_the_rule_fails_on_a_typed_number(reason, typed):
 
 # -- report prose: string literals of the renderers ----------------------------------
 #: Modules whose strings become report text.
-RENDERERS = sorted([*(ROOT / "workbench/studies").glob("*_render.py"),
-                    ROOT / "workbench/studies/antiskid_run_figures.py",
-                    ROOT / "workbench/studies/fit000.py",
+RENDERERS = sorted([*(ROOT / "workbench").glob("[fkp]*/**/*_render.py"),
+                    ROOT / "workbench/kinds/delay_feedback/render.py",
+                    ROOT / "workbench/papers/p003/antiskid_run_figures.py",
+                    ROOT / "workbench/papers/p000/brake_fit.py",
                     *(ROOT / "workbench/report").glob("*.py"),
                     ROOT / "workbench/roa/render.py", ROOT / "workbench/prove.py"])
 
+def _key(path: Path) -> str:
+    """A module's path under workbench/ (the key of :data:`RENDERER_CONSTANTS`)."""
+    return path.relative_to(ROOT / "workbench").as_posix()
+
+
 #: (module, number) typed in a renderer's prose on purpose, and why.
 RENDERER_CONSTANTS = {
-    ("antiskid_basin_render.py", "0.6"): "a matplotlib grey level, not text",
-    ("antiskid_cruise_render.py", "1e-12"): "display floor of a printed residual",
-    ("delay_feedback_render.py", "1e-12"): "display floor of a printed residual",
-    ("delay_benchmark_render.py", "1e-12"): "display floor of a printed relative difference",
-    ("brake004_render.py", "1.3"): "section number of paper 004",
-    ("brake004_render.py", "0.703"):
+    ("papers/p003/antiskid_basin_render.py", "0.6"): "a matplotlib grey level, not text",
+    ("papers/p003/antiskid_cruise_render.py", "1e-12"): "display floor of a printed residual",
+    ("kinds/delay_feedback/render.py", "1e-12"): "display floor of a printed residual",
+    ("kinds/delay_benchmark_render.py", "1e-12"): "display floor of a printed relative difference",
+    ("papers/p004/closed_loop_brake_render.py", "1.3"): "section number of paper 004",
+    ("papers/p004/closed_loop_brake_render.py", "0.703"):
         "the deceleration paper 004 printed (its rounding is the finding)",
-    ("stopping000_render.py", "3.2"): "section number of paper 000",
-    ("stopping000_render.py", "85.16"): "K1/K2 as paper 000's Table 1 prints it",
-    ("delay_feedback_basin_render.py", "0.6"): "a matplotlib grey level, not text",
-    ("platoon001_realism_render.py", "1e-9"): "display floor of a printed relative difference",
-    ("brake004_fair_render.py", "0.5"): "the horizon before the retuning (a t_predict_sweep value)",
-    ("brake004_fair_render.py", "0.7"): "paper 000's damping criterion of its PID",
-    ("brake004_fair_render.py", "0.9"): "a matplotlib grey level, not text",
-    ("stopping000_fair_render.py", "0.0"): "how a zero is printed, not a number in prose",
-    ("stopping000_fair_render.py", "-0.0"): "how a zero is printed, not a number in prose",
+    ("papers/p000/station_stopping_render.py", "3.2"): "section number of paper 000",
+    ("papers/p000/station_stopping_render.py", "85.16"): "K1/K2 as paper 000's Table 1 prints it",
+    ("features/basin_render.py", "0.6"): "a matplotlib grey level, not text",
+    ("papers/p001/ntsm_platoon_realism_render.py", "1e-9"):
+        "display floor of a printed relative difference",
+    ("papers/p004/closed_loop_brake_fair_render.py", "0.5"):
+        "the horizon before the retuning (a t_predict_sweep value)",
+    ("papers/p004/closed_loop_brake_fair_render.py", "0.7"):
+        "paper 000's damping criterion of its PID",
+    ("papers/p004/closed_loop_brake_fair_render.py", "0.9"): "a matplotlib grey level, not text",
+    ("papers/p000/station_stopping_fair_render.py", "0.0"):
+        "how a zero is printed, not a number in prose",
+    ("papers/p000/station_stopping_fair_render.py", "-0.0"):
+        "how a zero is printed, not a number in prose",
 }
 
 
@@ -193,11 +204,11 @@ def renderer_numbers(path: Path) -> list[tuple[str, int]]:
             and id(node) not in skip for m in DECIMAL.findall(node.value)]
 
 
-@pytest.mark.parametrize("path", RENDERERS, ids=lambda p: p.name)
+@pytest.mark.parametrize("path", RENDERERS, ids=lambda p: _key(p))
 def test_no_typed_numbers_in_report_prose(path):
     typed = [(n, line) for n, line in renderer_numbers(path)
-             if (path.name, n) not in RENDERER_CONSTANTS]
-    assert typed == [], f"{path.name}: format these from the result or constant they state"
+             if (_key(path), n) not in RENDERER_CONSTANTS]
+    assert typed == [], f"{_key(path)}: format these from the result or constant they state"
 
 
 def test_the_prose_rule_fails_on_a_typed_number(tmp_path):

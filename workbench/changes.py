@@ -15,7 +15,7 @@ that git does not ignore. A design is checked again when any of these changed:
   Imports are read statically from the source (:mod:`ast`, every ``import``
   statement anywhere in a module, so a lazy import counts too); a package's
   ``__init__.py`` counts as a file but the imports of
-  ``workbench/studies/__init__.py`` (the registry of every study) are not
+  ``workbench/kinds/__init__.py`` (the registry of every study) are not
   followed. Package files only change in a checkout of the workbench
   itself; in a user's project the installed package is not under git.
 
@@ -34,7 +34,7 @@ from .errors import DesignError
 PACKAGE_DIR = Path(__file__).resolve().parent
 GLOBAL_FILES = ("workbench.toml", "pyproject.toml", "constraints.txt")
 #: Package files whose imports are not followed (registries of every study).
-_NOT_FOLLOWED = (PACKAGE_DIR / "studies" / "__init__.py",)
+_NOT_FOLLOWED = (PACKAGE_DIR / "kinds" / "__init__.py",)
 _CORE = ("workbench.verify", "workbench.claims", "workbench.design")
 
 
@@ -138,11 +138,11 @@ def _closure(start: Path, package: str, siblings: Path | None = None) -> frozens
 @cache
 def study_files(kind: str) -> frozenset[Path]:
     """Package files a design of ``kind`` runs (see the module docstring)."""
-    from . import studies
-    study = studies.REGISTRY[kind]
+    from . import kinds
+    study = kinds.REGISTRY[kind]
     modname = study if isinstance(study, str) else type(study).__module__
     if not modname.startswith("workbench."):
-        modname = f"workbench.studies.{modname}"
+        modname = f"workbench.kinds.{modname}"
     files: set[Path] = set()
     for name in (modname, *_CORE):
         f = _module_file(name)

@@ -59,12 +59,12 @@ def cmd_synthesize(args) -> int:
     from .design import load_design
     from .report.markdown import fmt
     from .synthesis import synthesize_delay_bound
-    from .studies import antiskid_cruise
-    from .studies.delay_feedback_cli import synthesis_table
+    from .papers.p003 import antiskid_cruise
+    from .kinds.delay_feedback.cli import synthesis_table
 
     design = load_design(args.design)
     if args.what == "sampled":
-        from .studies.delay_feedback_sampled_cli import sampled_command
+        from .kinds.delay_feedback.sampled_cli import sampled_command
         return sampled_command(design, as_json=args.json)
     kinds = (antiskid_cruise.STUDY.kind, "delay-feedback")
     if design.kind not in kinds:
@@ -76,7 +76,7 @@ def cmd_synthesize(args) -> int:
             if not (math.isfinite(e) and e > 0):
                 raise DesignError("<cli>", "--eps", e, "a positive number")
     if design.kind == "delay-feedback":
-        from .studies.delay_feedback_cli import synthesize_command
+        from .kinds.delay_feedback.cli import synthesize_command
         return synthesize_command(design, eps=args.eps, as_json=args.json)
     spec = design.spec
     eps = tuple(args.eps) if args.eps else spec.eps
@@ -211,11 +211,11 @@ def cmd_check(args) -> int:
         return check_parallel(_designs([]), args.out, jobs, lambda: cmd_verify(verify),
                               lambda checked, problems: cmd_report(report, checked=checked,
                                                                    problems=problems))
-    from . import studies
+    from . import kinds
     from .memo import cancel_started, start_studies, study_times
 
     try:
-        start_studies(_designs([]), studies.REGISTRY)   # the Monte Carlo pools, first
+        start_studies(_designs([]), kinds.REGISTRY)   # the Monte Carlo pools, first
         code = cmd_verify(verify)
         print()
         code = max(code, cmd_report(report))
@@ -257,7 +257,7 @@ def _load_kind(path: str, kind: str):
 
 
 def _cmd_fit(args) -> int:
-    from .studies.fit000 import fit_command
+    from .papers.p000.brake_fit import fit_command
     return fit_command(_load_kind(args.design, "brake-fit"), as_json=args.json)
 
 
@@ -288,7 +288,7 @@ def cmd_simulate(args) -> int:
     from .design import load_design
     design = load_design(args.design)
     if design.kind == "delay-feedback":
-        from .studies.delay_feedback_cli import simulate_command as simulate_feedback
+        from .kinds.delay_feedback.cli import simulate_command as simulate_feedback
         return simulate_feedback(design, case=args.case, dt=args.dt, as_json=args.json,
                                  csv=args.csv, plot=args.plot)
     for flag, val in (("--csv", args.csv), ("--plot", args.plot)):
@@ -298,12 +298,12 @@ def cmd_simulate(args) -> int:
     if design.kind != "antiskid-run":
         raise DesignError(design.path, "design.kind", design.kind,
                           'an "antiskid-run" or "delay-feedback" design')
-    from .studies.antiskid_run import simulate_command
+    from .papers.p003.antiskid_run import simulate_command
     return simulate_command(design, case=args.case, dt=args.dt, as_json=args.json)
 
 
 def cmd_sweep(args) -> int:
-    from .studies.antiskid_run import sweep_command
+    from .papers.p003.antiskid_run import sweep_command
     return sweep_command(_load_kind(args.design, "antiskid-run"), samples=args.samples, seed=args.seed,
                          workers=args.workers, figure=args.figure, as_json=args.json,
                          kernel=args.kernel, scheduler=args.scheduler, out=args.out,

@@ -9,7 +9,7 @@ Layout shared by every design::
 
     [design]
     name = "antiskid-cruise-dry"     # = file stem
-    kind = "antiskid-cruise"         # selects the study (workbench.studies)
+    kind = "antiskid-cruise"         # selects the study (workbench.kinds)
     title = "..."
     source = "paper 003, ..."
 
@@ -102,7 +102,7 @@ def load_design(path: str | Path) -> Design:
     DesignError
         On any problem, naming file, key, value and what was expected.
     """
-    from . import studies
+    from . import kinds
     from .claims import parse_claims, parse_register
 
     shown = display_path(path)
@@ -124,11 +124,11 @@ def load_design(path: str | Path) -> Design:
     if not SAFE_NAME.fullmatch(name):
         raise head.fail("name", name, "a file-name-safe name: letters, digits, '-', '_', '.', "
                         "not starting with '.' (reports are written under it)")
-    kind = head.string("kind", choices=sorted(studies.REGISTRY))
+    kind = head.string("kind", choices=sorted(kinds.REGISTRY))
     title = head.string("title")
     source = head.string("source")
     head.finish()
-    study = studies.REGISTRY[kind]
+    study = kinds.REGISTRY[kind]
     spec = study.load(root)
     claims = parse_claims(root, study, spec)
     hazards, assumptions = parse_register(root, claims)

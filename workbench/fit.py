@@ -18,7 +18,7 @@ K1 and K2 enter eq 7 only as K1/K2 (see :mod:`workbench.plants.brake000`):
 they are not separately identifiable, and the recovery table says so.
 
 ``workbench fit DESIGN`` runs a ``brake-fit`` design and prints the table
-(:func:`workbench.studies.fit000.fit_command`).
+(:func:`workbench.papers.p000.brake_fit.fit_command`).
 """
 from __future__ import annotations
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from . import studies
+from . import kinds
 from .claims import ClaimResult, check_claim, fill_claim
 from .design import Design
 from .memo import run_study
@@ -27,7 +27,7 @@ class Evaluation:
 def evaluate_design(design: Design) -> Evaluation:
     """Run the design's study (once per process for an equal spec,
     :func:`workbench.memo.run_study`) and check each of its claims."""
-    study = studies.REGISTRY[design.kind]
+    study = kinds.REGISTRY[design.kind]
     result = run_study(design, study.run)
     q = study.quantities(result)
     return Evaluation(design, result, tuple(check_claim(fill_claim(c, q, fmt), q.get(c.quantity))
@@ -81,8 +81,8 @@ def report_files(ev: Evaluation):
     runs a study)."""
     from .lmi.core import CLARABEL_SETTINGS
     from .report.writer import build
-    rendered = studies.renderer(ev.design.kind)(ev.design, ev.result)
+    rendered = kinds.renderer(ev.design.kind)(ev.design, ev.result)
     solver = None
-    if getattr(studies.REGISTRY[ev.design.kind], "uses_solver", True):
+    if getattr(kinds.REGISTRY[ev.design.kind], "uses_solver", True):
         solver = ", ".join(f"{k}={v}" for k, v in CLARABEL_SETTINGS.items()) or "Clarabel defaults"
     return build(ev, rendered, solver, configuration(ev.design))

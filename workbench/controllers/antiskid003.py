@@ -50,7 +50,7 @@ resolved (:class:`ControllerSettings`); :class:`PhaseEvents` records when,
 in which phase and why (:data:`DIVERGED_HOW`). Every other run metric is
 the caller's: the controller calls ``recorder(t, v, lambda, phase,
 to_cruise, to_brake, to_stop, dt_prev)`` once per sample (the antiskid-run
-study's recorder, :mod:`workbench.studies.antiskid_scenario`).
+study's recorder, :mod:`workbench.papers.p003.antiskid_scenario`).
 """
 from __future__ import annotations
 

@@ -70,7 +70,7 @@ def settings_array(s: ControllerSettings, dt: float, group: int = 1) -> np.ndarr
     ``group``: the predictor's rollout steps over ``group`` held samples at a
     time, with their exact average (1: every sample, as
     :meth:`Antiskid003._rollout`; a fast sampled controller's choice, see
-    :mod:`workbench.studies.antiskid_sampled`)."""
+    :mod:`workbench.papers.p003.antiskid_sampled`)."""
     if not (isinstance(group, int) and group >= 1):
         raise ValueError(f"group = {group!r}; expected an integer >= 1")
     if s.compensate and s.predictor != "rollout":

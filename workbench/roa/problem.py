@@ -6,7 +6,7 @@ prediction: paper 003's Theorems 2 and 3 argue on it (the predicted state
 x(t + h) replaces x(t) in the law, so that the delayed input acts as an
 undelayed one). A basin computed here says nothing about a predictor error
 or about a delayed term left in the law; the caller states which loop it
-built (see :mod:`workbench.studies.antiskid_basin` for paper 003's cruise law).
+built (see :mod:`workbench.papers.p003.antiskid_basin` for paper 003's cruise law).
 
 The Lyapunov function is quadratic, V(x) = (x - x*)' P (x - x*), with P
 symmetric positive definite; its derivative along f is

@@ -37,7 +37,7 @@ BY_SIGN, TRACTION, BRAKING, GRADED = 0, 1, 2, 3
 _JIT = dict(nogil=True, error_model="numpy")   # numpy's inf/nan, never ZeroDivisionError
 #: The small hot functions are inlined into their callers (numba IR): a call
 #: costs as much as the arithmetic, and inlined steps of independent runs
-#: overlap in the processor (:mod:`workbench.studies.antiskid_kernel`). numba
+#: overlap in the processor (:mod:`workbench.papers.p003.antiskid_kernel`). numba
 #: types an inlined body again at every call site, so the rarely taken ones
 #: (the graded forms) stay calls: compiling the sweep kernel takes ~16 s
 #: instead of ~40 s with everything inlined, at the same speed.

@@ -1,0 +1,38 @@
+"""``workbench synthesize sampled DESIGN``: a delay-feedback design's gain (synthesised
+as in its report) and its digital implementation check
+(:mod:`.delay_feedback_implementation`)."""
+from __future__ import annotations
+
+from ...features.sampled import ImplementationSettings, run_implementation
+
+__all__ = ["sampled_command"]
+
+
+def sampled_command(design, *, as_json: bool = False) -> int:
+    """``workbench synthesize sampled DESIGN``: the design's gain (synthesised as in
+    the report), then its implementation check; exit 0 if CERTIFIED, else 1."""
+    import json
+
+    from ...digital import render_markdown
+    from ...errors import DesignError
+    from .run import design_synthesis, nominal_point
+    if design.kind != "delay-feedback":
+        raise DesignError(design.path, "design.kind", design.kind,
+                          'a "delay-feedback" design (synthesize sampled)')
+    spec = design.spec
+    settings = spec.implementation or ImplementationSettings(None, (0.0, 0.0), "zoh")
+    model, values, op, A, B = nominal_point(spec)
+    points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
+    syn = design_synthesis(spec, model, values, op, A, B, points)
+    if syn.K is None:
+        print(f"{design.name}: no gain was certified; nothing to implement")
+        return 1
+    di = run_implementation(settings, spec.delay, A, B, syn.K)
+    if as_json:
+        print(json.dumps({"design": design.name, "delays": list(di.delays),
+                          **di.result.to_dict()}, indent=2))
+    else:
+        print(f"{design.name}: digital implementation of K = {syn.K.tolist()} "
+              f"(total delay [{di.delays[0]:g}, {di.delays[1]:g}] s)")
+        print(render_markdown(di.result))
+    return 0 if di.result.outcome.value == "certified" else 1

@@ -1,0 +1,225 @@
+"""Markdown and figures of the ``station-stopping`` study (pure rendering)."""
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from ...plants.brake000 import brake_model
+from ...report.markdown import Figure, Rendered, fmt, md_table
+from .station_stopping import CONTROLLERS, UNCERTAIN
+from .station_stopping_fair_render import fair_section, figures
+from ...features.montecarlo import within_rate
+
+LABEL = {"pid": "PID", "smc": "SMC", "smarc": "SMARC", "smarc-sgn": "SMARC (sgn)"}
+
+
+#: Stop window of the accuracy table and figure (m): the usual platform-screen-door tolerance.
+STOP_WINDOW_M = 0.3
+
+def model_section() -> str:
+    """The brake model of paper 000 rendered from the sympy source."""
+    m = brake_model()
+    lat = sp.latex
+    eqs = [r"\dot x = v,\quad \dot v = " + lat(m.rhs[0]) + r"\qquad\text{(eqs 5, 10)}",
+           r"\dot b_e = " + lat(m.rhs[1]) + r",\quad e_{in}(t) = \min(c(t - T_1),\ \mathrm{cap}(t))"
+           r"\qquad\text{(eq 2)}",
+           r"\dot b_a = " + lat(m.rhs[2]) + r",\quad d_{air}(t) = c(t - T_3) - \min(c(t-T_3),"
+           r"\ \mathrm{cap}(t))\qquad\text{(eqs 7, 9)}",
+           r"a_{res} = " + lat(m.a_res) + r"\qquad\text{(eqs 3-4; } v \text{ in m/s)}"]
+    return ("## Brake model (paper 000, eqs 1-10)\n\nRendered from `workbench/plants/brake000.py` "
+            "(sympy, the single source of the numeric model). Decelerations are positive, SI "
+            "units; c is the brake command (demanded deceleration, m/s²), kappa the "
+            "load-weighing gain (estimated / true mass), theta the gradient (‰). cap(t) is "
+            "infinite above the hand-over speed v_ho and then falls at k_bra (eq 8). Unit "
+            "slips resolved: eq 3 and eq 7 use V in km/h (the paper writes cm/s); K1/K2 "
+            "(Table 1: 85.16) is read as the air-brake deceleration in cm/s² of a full 1 m/s² "
+            "demand at standstill, hence the division by 100; only the ratio K1/K2 enters.\n\n"
+            + "\n\n".join(f"$$\n{e}\n$$" for e in eqs))
+
+
+def render(design, res) -> Rendered:
+    spec = design.spec
+    prow = [[f"`{k}`", fmt(q.value, 5), q.unit, q.source] for k, q in spec.params.items()]
+    urow = [[f"`{k}`", UNCERTAIN[k][0], f"[{fmt(lo)}, {fmt(hi)}]", UNCERTAIN[k][1]]
+            for k, (lo, hi) in spec.ranges.items()]
+    srow = [[i + 1, s.name, fmt(s.length, 5), fmt(t, 4), s.source]
+            for i, (s, t) in enumerate(zip(res.sections, res.planned_time))]
+    g = spec.sliding
+    sections = [
+        "## Problem\n\nStation stops of paper 000 (section 3.2) on the seven Beijing Line 5 "
+        "sections of Table 3, **synthetic**: the ATO logs are not public. Each run starts "
+        f"where the target curve (v_max {fmt(spec.v_max.value, 4)} m/s, braking at "
+        f"{fmt(spec.a_dec.value, 3)} m/s²) begins to brake and tracks it to the stopping point. "
+        f"{spec.repeats} repeats per section (seed {spec.seed}); the three controllers meet the "
+        "same uncertain plants.\n\n"
+        + md_table(["parameter", "value", "unit", "source"], prow, "lrll")
+        + "\n\nUncertainty (uniform, per repeat):\n\n"
+        + md_table(["factor", "meaning", "range", "unit"], urow, "llll")
+        + "\n\n" + md_table(["#", "section", "length (m)", "planned braking time (s)",
+                             "source"], srow, "rlrrl")
+        + "\n\nEvery section reaches v_max before braking, so the public data (lengths) do not "
+        "distinguish the sections' braking phases: they differ here only by their random "
+        "draws. Controllers: PID on the speed error with the target deceleration as "
+        f"feed-forward (kp {fmt(spec.pid['kp'])}, ki {fmt(spec.pid['ki'])}, kd "
+        f"{fmt(spec.pid['kd'])}); SMC = eq 22 with the fixed estimate theta = 1; SMARC = eq 22 "
+        f"with eqs 26-27 (c {fmt(g.c)} 1/s, k_s {fmt(g.k_s)} 1/s, eta {fmt(g.eta)} m/s², "
+        f"boundary layer phi {fmt(g.phi)} m/s, lambda {fmt(spec.smarc['lam'])}, theta in "
+        f"[{fmt(spec.smarc['theta_min'])}, {fmt(spec.smarc['theta_max'])}]); SMARC (sgn) = "
+        "the same with the discontinuous sgn(z) of eq 22 as printed (phi = 0); sampled every "
+        f"{fmt(spec.dt_ctrl)} s, plant stepped at {fmt(spec.dt)} s.",
+        model_section(),
+    ]
+    ns = len(res.sections)
+    rows = []
+    for i in range(ns):
+        row = [i + 1]
+        for c in CONTROLLERS:
+            s = res.stats[c, i]
+            row += [fmt(s.mean_abs, 3), fmt(s.mean, 3), fmt(s.var, 3)]
+        rows.append(row)
+    rows.append(["all"] + sum(([f"**{fmt(res.overall(c), 3)}**", "", ""] for c in CONTROLLERS), []))
+    head = ["#"] + [f"{LABEL[c]} {h}" for c in CONTROLLERS for h in ("mean abs", "mean", "var")]
+    qrow = []
+    for c in CONTROLLERS:
+        js = [res.stats[c, i].jerk_mean for i in range(ns)]
+        jm = [res.stats[c, i].jerk_max for i in range(ns)]
+        rt = [res.stats[c, i].run_time for i in range(ns)]
+        cr = [res.stats[c, i].command_rate for i in range(ns)]
+        qrow.append([LABEL[c], fmt(np.mean(js), 3), fmt(np.max(jm), 3), fmt(np.mean(cr), 3),
+                     fmt(np.mean(rt), 4), fmt(np.mean(res.planned_time), 4)])
+    sections.append(
+        "## Stop accuracy (cf. Tables 3-4)\n\nStop error = stop position − stopping point "
+        "(cm, + = overshoot), per section over the repeats: mean |error|, signed mean, "
+        "variance (cm²).\n\n" + md_table(head, rows, "r" * len(head))
+        + "\n\nRide quality and time (braking phase, up to standstill):\n\n"
+        + md_table(["controller", "mean |jerk| (m/s³)", "max |jerk| (m/s³)",
+                    "mean |dc/dt| of the command (m/s³)", "mean run time (s)", "planned (s)"],
+                   qrow, "lrrrrr")
+        + f"\n\nThe command rate measures chattering of the brake command. With the robust "
+        f"gain eta = {fmt(g.eta)} m/s² the switching term of eq 22 is small beside k_s z, so "
+        "the boundary layer changes little here (compare the two SMARC rows); the brake's "
+        "delays and lags filter the rest before it reaches the jerk."
+        + "\n\nShare of stops beyond the stopping point (overshoots): " + ", ".join(
+            f"{LABEL[c]} {fmt(_overshoot_share(res, c, ns), 3)} %" for c in CONTROLLERS)
+        + ": the errors are mostly a systematic overshoot, set by the air stage's delay and lag "
+        "after the hand-over, not scatter."
+        + f"\n\nFinal SMARC mass estimates theta_hat span [{fmt(res.theta_hat_final[0], 3)}, "
+        f"{fmt(res.theta_hat_final[1], 3)}] (per unit of the nominal mass; > 1 absorbs the "
+        "brake's under-delivery, P1 and the air gain).\n\n"
+        "![stop errors]({figdir}/stop-errors.png)\n\n![curves]({figdir}/stop-curves.png)"
+        + "\n\n" + _within_section(res))
+    sections.append(fair_section(spec, res))
+    if spec.published:
+        prow = []
+        for k, smarc, smc, pid, m4, v4, src in spec.published:
+            ours = [res.stats[c, k - 1].mean_abs for c in ("smarc", "smc", "pid")]
+            st = res.stats["smarc", k - 1]
+            prow.append([k, fmt(smarc, 3), fmt(ours[0], 3), fmt(smc, 3), fmt(ours[1], 3),
+                         fmt(pid, 3), fmt(ours[2], 3), fmt(m4, 3), fmt(st.mean, 3), fmt(v4, 3),
+                         fmt(st.var, 3), src])
+        sections.append(
+            "## Comparison with the printed Tables 3-4\n\nPrinted stop accuracy (cm, Table 3) "
+            "beside our mean |stop error|, and SMARC's printed signed mean (cm) and variance "
+            "(cm², Table 4) beside ours, on the synthetic stops (data for comparison, never an "
+            "input).\n\n"
+            + md_table(["#", "SMARC printed", "SMARC ours", "SMC printed", "SMC ours",
+                        "PID printed", "PID ours", "SMARC mean printed", "ours",
+                        "SMARC var printed", "ours", "source"], prow, "rrrrrrrrrrrl")
+            + _consistency(spec.published))
+    figs = (Figure("stop-errors", "Stop-error distribution per controller and section.",
+                   lambda fig, res=res: _plot_errors(fig, res), size=(7.0, 4.0)),
+            Figure("stop-curves", "Speed against distance to the stopping point, section 1.",
+                   lambda fig, res=res: _plot_curves(fig, res), size=(7.0, 4.0)),
+            Figure("stop-error-cdf", "Distribution of |stop error| per controller.",
+                   lambda fig, res=res: _plot_cdf(fig, res), size=(7.0, 4.0))) + figures(res)
+    return Rendered(tuple(sections), figs)
+
+
+def _errors(res, c: str) -> list[float]:
+    """Every stop error of controller ``c`` over all sections (cm)."""
+    return [e for i in range(len(res.sections)) for e in res.stats[c, i].errors]
+
+
+def _within_section(res) -> str:
+    """P(|e| <= 30 cm) per controller over all sections, Wilson 95 % interval."""
+    rows = []
+    for c in CONTROLLERS:
+        k, n, p, lo, hi = within_rate(_errors(res, c), 100 * STOP_WINDOW_M)
+        rows.append([LABEL[c], f"{k} / {n}", fmt(p, 3), f"[{fmt(lo, 3)}, {fmt(hi, 3)}]",
+                     fmt(float(np.percentile(np.abs(_errors(res, c)), 95)), 3)])
+    w = fmt(STOP_WINDOW_M)
+    return (f"**Stops within ±{w} m** (the usual platform-screen-door tolerance), over all "
+            "sections and repeats, with the Wilson 95 % interval of the proportion:\n\n"
+            + md_table(["controller", f"stops within {w} m", f"P(|e| <= {w} m)", "95 % interval",
+                        "95th percentile of |e| (cm)"], rows, "lrrrr")
+            + "\n\n![stop error distribution]({figdir}/stop-error-cdf.png)\n\nThese are the paper "
+            "rows over the repeats' uniform ranges; the Monte Carlo over continuous distributions, "
+            "the nominal row and the rows with known-delay compensation follow.")
+
+
+def _plot_cdf(fig, res):
+    ax = fig.add_subplot(111)
+    for k, c in enumerate(CONTROLLERS):
+        e = np.sort(np.abs(_errors(res, c)))
+        ax.step(e, np.arange(1, len(e) + 1) / len(e), where="post", color=f"C{k}",
+                label=LABEL[c])
+    ax.axvline(100 * STOP_WINDOW_M, color="k", ls="--", lw=0.8, label=f"{fmt(STOP_WINDOW_M)} m")
+    ax.set_xscale("symlog", linthresh=1.0)
+    ax.set_xlabel("|stop error| (cm)")
+    ax.set_ylabel("fraction of stops")
+    ax.legend(fontsize=8)
+
+
+def _overshoot_share(res, c: str, ns: int) -> float:
+    """Percentage of the stops of controller ``c`` beyond the stopping point."""
+    return 100 * float(np.mean([e > 0 for i in range(ns) for e in res.stats[c, i].errors]))
+
+
+def _consistency(published) -> str:
+    """Check the printed tables against |mean e| <= mean |e| (Jensen)."""
+    bad = [(k, m4, smarc) for k, smarc, _, _, m4, _, _ in published
+           if m4 is not None and abs(m4) > smarc]
+    if not bad:
+        return ""
+    rows = "; ".join(f"section {k}: |{fmt(m4, 3)}| > {fmt(a, 3)}" for k, m4, a in bad)
+    return ("\n\n**The printed tables are not mutually consistent** if Table 3 is the mean "
+            "|stop error| of Table 4's runs: |mean e| ≤ mean |e| always, but " + rows
+            + ". Table 3 must come from other runs (or be another statistic).")
+
+
+def _plot_errors(fig, res):
+    ax = fig.add_subplot(111)
+    ns = len(res.sections)
+    for k, c in enumerate(CONTROLLERS):
+        data = [res.stats[c, i].errors for i in range(ns)]
+        pos = np.arange(ns) + 1 + (k - (len(CONTROLLERS) - 1) / 2) * 0.2
+        b = ax.boxplot(data, positions=pos, widths=0.17, patch_artist=True, showfliers=True,
+                       flierprops={"markersize": 2})
+        for patch in b["boxes"]:
+            patch.set_facecolor(f"C{k}")
+            patch.set_alpha(0.6)
+        ax.plot([], [], "s", color=f"C{k}", label=LABEL[c])
+    ax.axhline(0, color="k", lw=0.6)
+    ax.set_xticks(np.arange(ns) + 1)
+    ax.set_xticklabels([str(i + 1) for i in range(ns)])
+    ax.set_xlabel("section (Table 3 order)")
+    ax.set_ylabel("stop error (cm, + overshoot)")
+    ax.legend(ncol=len(CONTROLLERS), loc="lower center", bbox_to_anchor=(0.5, 1.0),
+              fontsize=8, frameon=False)
+
+
+def _plot_curves(fig, res):
+    ax1, ax2 = fig.add_subplot(121), fig.add_subplot(122)
+    for k, c in enumerate(CONTROLLERS):
+        t, dx, v, _, vd = res.example[c]
+        keep = np.concatenate(([True], v[1:] > 0)) if len(v) > 1 else np.ones(len(v), bool)
+        ax1.plot(dx[keep], v[keep] * 3.6, color=f"C{k}", label=LABEL[c])
+        ax2.plot(t[keep], (v[keep] - vd[keep]) * 100, color=f"C{k}", label=LABEL[c])
+    t, _, _, xd, vd = res.example["pid"]
+    ax1.plot(xd, vd * 3.6, "k--", lw=0.8, label="target")
+    ax1.set_xlabel("position − stopping point (m)")
+    ax1.set_ylabel("speed (km/h)")
+    ax1.legend()
+    ax2.set_xlabel("time from braking start (s)")
+    ax2.set_ylabel("speed error (cm/s)")
+    ax2.set_title("speed error (cf. fig 8)")

@@ -1,0 +1,231 @@
+"""Design tables of the ``ato-tracking`` study (paper 002) and the names of its quantities.
+
+Design tables read here: ``[route]`` (the main station pair), ``[profile]``
+(limits of the target curve), ``[train]`` (the 002 train: Davis resistance,
+gravity, and the integrating reading's eq 1-2 chain, units checked),
+``[simulation]`` (sample, step), ``[tuning]`` (the four objectives' scales
+and weights of the rule that picks one point of each Pareto front),
+``[[plant_readings]]`` (the readings of the lost Table 1: model, parameters
+of a non-integrating reading, and per reading the MFAC and PID grids, whose
+units follow the command's), ``[requirements]`` and ``[[line]]`` (further
+station pairs). The computation is in :mod:`.ato_tracking_run`, the study
+object in :mod:`.ato_tracking`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ...errors import DesignError, ModelError
+from ...plants.train002 import MODELS, PARAMETER_UNITS, FirstOrderTrain002, Train002
+from ...profiles import ProfileSpec, build_profile
+from ...reader import Quantity, Reader
+from ...sim.tracking import Objectives, Route
+
+OBJECTIVES = Objectives.NAMES
+OBJECTIVE_UNITS = {"stop_error": "m", "punctuality": "s", "comfort": "m/s^3", "energy": "J/kg"}
+MFAC_KEYS = ("eta", "mu", "rho", "lam", "phi1")
+PID_KEYS = ("kp", "ki", "kd")
+#: units of the first-order reading's parameters (its command is a demanded speed)
+FIRST_ORDER_UNITS = {"f": "1", "e": "m/s", "delay": "s", "lag": "s", "a_min": "m/s^2",
+                     "a_max": "m/s^2", "u_min": "m/s", "u_max": "m/s"}
+
+
+@dataclass(frozen=True)
+class Section:
+    """One station pair: route, planned time and where its data come from."""
+
+    name: str
+    route: Route
+    run_time: float
+    v_limit: float
+    source: str
+
+
+@dataclass(frozen=True)
+class Reading:
+    """One reading of the lost Table 1: the plant and the two controllers' grids.
+
+    Attributes
+    ----------
+    name, model, source : str
+        Name used in claims, plant model (one of ``MODELS``), where it comes from.
+    train : Train002
+        The plant (a :class:`FirstOrderTrain002` for ``"first-order-002"``).
+    params : dict[str, Quantity]
+        The reading's own parameters as written (empty when they are ``[train]``'s).
+    mfac_grid : dict[str, tuple[float, ...]]
+        eta, mu, rho, lam, phi1 values; every combination is simulated.
+    epsilon : float
+        Reset threshold of eq 9 (in the command's and the PPD's units).
+    pid_grid : dict[str, tuple[float, ...]]
+        kp, ki, kd values.
+    """
+
+    name: str
+    model: str
+    source: str
+    train: Train002
+    params: dict
+    mfac_grid: dict
+    epsilon: float
+    pid_grid: dict
+
+
+@dataclass(frozen=True)
+class TrackingSpec:
+    main: Section
+    line: tuple[Section, ...]
+    profile: dict           # accel, brake, jerk (m/s^2, m/s^2, m/s^3)
+    train: dict             # Quantity per PARAMETER_UNITS key ([train])
+    u_limits: tuple[float, float]
+    Ts: float
+    dt: float
+    readings: tuple[Reading, ...]
+    scales: dict            # objective -> Quantity
+    weights: tuple[float, ...]
+    stop_tolerance: Quantity
+
+    def profile_spec(self, sec: Section) -> ProfileSpec:
+        return ProfileSpec(sec.route.distance, sec.v_limit, self.profile["accel"],
+                           self.profile["brake"], self.profile["jerk"], sec.run_time)
+
+
+def read_gradients(r: Reader) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """``grade_from`` (m, increasing from 0) and ``grade`` (-, |i| <= 0.05) of a table."""
+    g_from = r.numbers("grade_from", default=(0.0,), what="positions (m)")
+    grade = r.numbers("grade", default=(0.0,), what="gradients (-)")
+    if len(g_from) != len(grade) or g_from[0] != 0.0 or list(g_from) != sorted(g_from):
+        raise r.fail("grade_from", list(g_from), "increasing positions starting at 0, one per "
+                     "entry of grade")
+    if any(abs(x) > 0.05 for x in grade):
+        raise r.fail("grade", list(grade), "gradients within +/-0.05 (50 permille)")
+    return g_from, grade
+
+
+def _section(r: Reader, *, with_source: bool) -> Section:
+    dist = r.quantity("distance", "m", positive=True)
+    T = r.quantity("run_time", "s", positive=True)
+    vlim = r.quantity("v_limit", "m/s", positive=True, hi=150.0)
+    name = r.string("name")
+    g_from, grade = read_gradients(r)
+    src = r.string("source") if with_source else dist.source
+    r.finish()
+    return Section(name, Route(dist.value, g_from, grade), T.value, vlim.value, src)
+
+
+def _grid(r: Reader, keys, *, positive: bool) -> dict:
+    grid = {k: r.numbers(k, positive=positive, what=f"{k} values") for k in keys}
+    for k, vals in grid.items():
+        if not positive and min(vals) < 0:
+            raise r.fail(k, list(vals), "non-negative gains")
+        if k in ("rho", "eta") and max(vals) > 1.0:
+            raise r.fail(k, list(vals), "values in (0, 1] (paper 002)")
+    return grid
+
+
+def _multiple_of(path, key: str, x: float, dt: float) -> None:
+    if abs(round(x / dt) * dt - x) > 1e-9:
+        raise DesignError(path, key, x, f"a multiple of simulation.dt = {dt} s")
+
+
+def _reading(r: Reader, base: dict, u_lim, dt: float) -> Reading:
+    name = r.string("name")
+    model = r.string("model", choices=MODELS)
+    source = r.string("source")
+    params: dict = {}
+    davis = {k: base[k].value for k in ("c0", "c1", "c2", "g")}
+    if model == "delay-lag-002":
+        train = Train002(**{k: q.value for k, q in base.items()}, u_min=u_lim[0], u_max=u_lim[1])
+    else:
+        for k, unit in FIRST_ORDER_UNITS.items():
+            kw = {"positive": True} if k in ("f", "delay", "lag", "a_max", "u_max") else {}
+            params[k] = r.quantity(k, unit, **kw)
+        p = {k: q.value for k, q in params.items()}
+        if not p["a_min"] < 0 or not p["u_min"] < p["u_max"]:
+            raise r.fail("a_min" if not p["a_min"] < 0 else "u_min",
+                         p["a_min"] if not p["a_min"] < 0 else p["u_min"],
+                         "a_min < 0 and u_min < u_max")
+        train = FirstOrderTrain002(**p, **davis)
+    _multiple_of(r.path, r.key("delay") if params else "train.delay", train.delay, dt)
+    mf = r.table("mfac")
+    mgrid = _grid(mf, MFAC_KEYS, positive=True)
+    eps = mf.number("epsilon", positive=True)
+    mf.finish()
+    pi = r.table("pid")
+    pgrid = _grid(pi, PID_KEYS, positive=False)
+    pi.finish()
+    r.finish()
+    return Reading(name, model, source, train, params, mgrid, eps, pgrid)
+
+
+def load_spec(root: Reader) -> TrackingSpec:
+    """The validated spec of an ``ato-tracking`` design (see the module docstring)."""
+    main = _section(root.table("route"), with_source=False)
+    line = tuple(_section(r, with_source=True) for r in root.tables("line", default=[]))
+    pr = root.table("profile")
+    prof = {"accel": pr.quantity("accel", "m/s^2", positive=True, hi=2.0).value,
+            "brake": pr.quantity("brake", "m/s^2", positive=True, hi=2.0).value,
+            "jerk": pr.quantity("jerk", "m/s^3", positive=True, hi=5.0).value}
+    pr.finish()
+    tr = root.table("train")
+    tr.string("model", choices=("delay-lag-002",))
+    sign = {"e": {}, "c0": {"nonneg": True}, "c1": {"nonneg": True}, "c2": {"nonneg": True}}
+    train = {k: tr.quantity(k, unit, **sign.get(k, {"positive": True}))
+             for k, unit in PARAMETER_UNITS.items()}
+    u_lim = (tr.quantity("u_min", "m/s^2", hi=0.0).value,
+             tr.quantity("u_max", "m/s^2", positive=True).value)
+    tr.finish()
+    sim = root.table("simulation")
+    Ts = sim.quantity("Ts", "s", positive=True, hi=2.0).value
+    dt = sim.quantity("dt", "s", positive=True, hi=0.1).value
+    sim.finish()
+    _multiple_of(root.path, "simulation.Ts", Ts, dt)
+    readings = tuple(_reading(r, train, u_lim, dt) for r in root.tables("plant_readings"))
+    names = [r.name for r in readings]
+    if not readings or len(set(names)) != len(names):
+        raise DesignError(root.path, "plant_readings", names, "one or more readings with "
+                          "distinct names")
+    tu = root.table("tuning")
+    tu.string("rule", choices=("weighted-sum",))
+    scales = {k: tu.quantity(k, OBJECTIVE_UNITS[k], positive=True) for k in OBJECTIVES}
+    weights = tu.numbers("weights", min_len=len(OBJECTIVES), what="weights (one per "
+                         "objective: " + ", ".join(OBJECTIVES) + ")")
+    if len(weights) != len(OBJECTIVES) or min(weights) < 0 or not max(weights) > 0:
+        raise tu.fail("weights", list(weights), f"{len(OBJECTIVES)} non-negative weights, "
+                      "not all 0")
+    tu.finish()
+    req = root.table("requirements")
+    tol = req.quantity("stop_tolerance", "m", positive=True)
+    req.finish()
+    spec = TrackingSpec(main, line, prof, train, u_lim, Ts, dt, readings, scales, weights,
+                        tol)
+    for i, sec in enumerate((main, *line)):
+        try:
+            build_profile(spec.profile_spec(sec), dt=Ts)
+        except ModelError as exc:
+            key = "route.run_time" if i == 0 else f"line[{i - 1}].run_time"
+            raise DesignError(root.path, key, sec.run_time, f"a feasible run time ({exc})") \
+                from None
+    return spec
+
+
+def quantity_names(spec: TrackingSpec) -> set[str]:
+    """Every quantity a claim may name."""
+    names = {"profile.v_cruise", "profile.end_error", "line.sections"}
+    for r in spec.readings:
+        p = f"reading[{r.name}]"
+        for c in ("mfac", "pid"):
+            names |= {f"{p}.{c}.{i}" for i in (*OBJECTIVES, "rms_speed_error", "cost")}
+            names |= {f"{p}.{c}.front_size", f"{p}.line.{c}.within_tolerance",
+                      f"{p}.line.{c}.max_stop_error"}
+        names |= {f"{p}.{k}" for k in (
+            "verdict", "mfac_wins", "front.pid_dominated", "front.mfac_dominated",
+            "mfac.reset_rate", "mfac.reset_rate.small_du", "mfac.reset_rate.sign_change",
+            "mfac.reset_rate.small_phi", "mfac.reset_rate.at_limit", "mfac.saturated",
+            "grid.reset_rate_min", "grid.reset_rate_median", "ppd.phi_min", "ppd.phi_max",
+            "ppd.data_sign_agreement", "ppd.data_median", "ppd.data_p95",
+            "ppd.median_to_dc_gain", "plant.dc_gain", "plant.time_constant",
+            "frozen.spectral_radius", "sensitivity.most_sensitive")}
+        names |= {f"{p}.best.{c}.{i}" for c in ("mfac", "pid") for i in OBJECTIVES}
+        names |= {f"{p}.sensitivity.{k}" for k in ("eta", "mu", "rho", "lam")}
+    return names

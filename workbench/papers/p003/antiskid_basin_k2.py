@@ -1,0 +1,131 @@
+"""A certified switching rule for paper 003's eq (75): the cruise gains k2
+for which the printed switch state (v_d, lambda_opt) lies in a certified
+basin of the cruise law (61).
+
+For each k2 of a grid (k1 kept), :func:`~workbench.papers.p003.antiskid_basin.switch_in_basin`
+decides whether the switch state is CERTIFIED (inside {V <= c_certified}
+for some P = modal_P(A + B K, [1, w]) of the grid) or not, and simulates
+the delay-free trajectory from it; the edge between the largest certified
+grid value and the next one is then bisected. Gains given for comparison
+(e.g. the rows of 003's Table 3) are judged the same way, with their own k1.
+
+The rule is *sufficient*: a state outside every certified level set may
+still converge (the "fate" column says what the delay-free trajectory does).
+
+References
+----------
+.. [003] Cai L., Yue Y., Huang D., "Antiskid control of high-speed trains
+   with input delay", Control Theory & Applications 43(3), 2026: eqs (61),
+   (75); Table 3.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+from ...roa import LevelOutcome
+from .antiskid_basin import SwitchVerdict, switch_in_basin
+
+
+@dataclass(frozen=True)
+class K2Row:
+    """One gain judged at the switch state."""
+
+    k1: float
+    k2: float
+    verdict: SwitchVerdict
+    source: str            # "grid", "edge" (bisection) or the comparison label
+
+
+@dataclass(frozen=True)
+class K2Sweep:
+    """Result of :func:`safe_k2_range` (no rendering).
+
+    Attributes
+    ----------
+    point : (v, lambda)
+        Switch state judged (absolute).
+    k1 : float
+        k1 kept along the sweep.
+    rows : tuple of K2Row
+        Grid and bisection rows, by k2.
+    compared : tuple of K2Row
+        The comparison gains.
+    edge : (float, float) or None
+        (largest certified k2, smallest k2 above it found not certified);
+        None when no grid value, or every grid value, is certified.
+    k2_min : float
+        Smallest k2 of the grid (the certified range is reported from there).
+    certified_below_edge : bool
+        Every grid value from k2_min to the edge's lower end is certified.
+    """
+
+    point: tuple
+    k1: float
+    rows: tuple
+    compared: tuple
+    edge: tuple | None
+    k2_min: float
+    certified_below_edge: bool
+
+
+def _ok(row: K2Row) -> bool:
+    return row.verdict.outcome is LevelOutcome.CERTIFIED
+
+
+@lru_cache(maxsize=8)
+def _sweep(values: tuple, v_d: float, k1: float, point: tuple, grid: tuple, compare: tuple,
+           bisect: int, seed: int) -> K2Sweep:
+    vals = dict(values)
+    judge = lambda k1_, k2_, src: K2Row(k1_, k2_, switch_in_basin(vals, v_d, (k1_, k2_), point,
+                                                                   seed=seed), src)
+    rows = [judge(k1, k2, "grid") for k2 in sorted(grid)]
+    edge = None
+    ok = [_ok(r) for r in rows]
+    for i in range(len(rows) - 1):
+        if ok[i] and not ok[i + 1]:
+            lo, hi = rows[i].k2, rows[i + 1].k2
+            for _ in range(bisect):
+                mid = 0.5 * (lo + hi)
+                r = judge(k1, mid, "edge")
+                rows.append(r)
+                lo, hi = (mid, hi) if _ok(r) else (lo, mid)
+            edge = (lo, hi)
+            break
+    rows.sort(key=lambda r: r.k2)
+    below = edge is not None and all(_ok(r) for r in rows if r.k2 <= edge[0])
+    compared = tuple(judge(float(g[0]), float(g[1]), label) for label, g in compare)
+    return K2Sweep(tuple(point), k1, tuple(rows), compared, edge, min(grid), below)
+
+
+def safe_k2_range(values: dict, v_d: float, k1: float, point, *, grid, compare=(),
+                  bisect: int = 4, seed: int = 0) -> K2Sweep:
+    """Cruise gains k2 (k1 kept) for which ``point`` lies in a certified basin.
+
+    Parameters
+    ----------
+    values : dict
+        Nominal plant constants (SI) the controller is built on.
+    v_d : float
+        Cruise speed (m/s).
+    k1 : float
+        First gain entry, kept along the sweep.
+    point : (v, lambda)
+        Switch state (absolute), e.g. (v_d, lambda_opt) for eq (75) as printed.
+    grid : sequence of float
+        k2 values judged.
+    compare : sequence of (label, (k1, k2))
+        Gains judged for comparison (e.g. 003 Table 3).
+    bisect : int
+        Bisection steps on the edge of the certified range.
+    seed : int
+        Seed of the falsifier.
+
+    Returns
+    -------
+    K2Sweep
+    """
+    vals = tuple(sorted((k, float(v)) for k, v in values.items()))
+    cmp_ = tuple((str(lab), (float(g[0]), float(g[1]))) for lab, g in compare)
+    return _sweep(vals, float(v_d), float(k1), tuple(float(p) for p in point),
+                  tuple(float(g) for g in grid), cmp_, int(bisect), int(seed))

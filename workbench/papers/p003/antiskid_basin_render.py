@@ -1,0 +1,191 @@
+"""Markdown and figure of the cruise-basin check (pure rendering of
+:class:`~workbench.papers.p003.antiskid_basin.CruiseBasin` and
+:class:`~workbench.papers.p003.antiskid_basin_k2.K2Sweep`)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...report.markdown import fmt, md_table
+from ...roa.render import fmt_level, render_basin_markdown
+from .antiskid_basin import LAM_DIVERGED
+
+_FATE_COLOR = {"converges": "tab:green", "diverges": "tab:red", "undecided": "0.6"}
+_SWITCH_MARK = {"CERTIFIED": "o", "REFUTED": "X", "INCONCLUSIVE": "s"}
+
+
+def render_basin_result(res, *, rail: str) -> str:
+    """Section of a :class:`~workbench.papers.p003.antiskid_basin_run.BasinResult`."""
+    text = render_basin_section(res.basin, res.sweep, rail=rail,
+                                compare_source=res.compare_source, brake=res.brake)
+    if res.mass_factor != 1.0:
+        text += (f"\nThe plant of this design has {fmt(res.mass_factor, 3)} x the nominal mass; "
+                 "the basin is that of the controller's nominal model (the switch states are "
+                 "this design's simulated ones).\n")
+    return text
+
+
+#: Heading of the basin section (findings on switch and basin quantities link here).
+HEADING = ("Regions of attraction: does each switch land in the basin of the law that "
+           "takes over?")
+
+
+def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—",
+                         brake=()) -> str:
+    """The report section: loop, certified bracket, switch verdicts, k2 rule."""
+    K = "[" + ", ".join(fmt(k, 4) for k in basin.K) + "]"
+    head = (
+        f"## {HEADING}\n\n"
+        f"Cruise law (61) with K = {K} on {rail} rail, at (v_d, lambda_d) = "
+        f"({fmt(basin.v_d)} m/s, {fmt(basin.lambda_d, 4)}). The loop is the **delay-free** "
+        "loop under exact prediction (as paper 003's Theorems 2-3 argue for laws (64) and "
+        "(69)): law (61) as printed feeds the current error K E(t) to its numerator, so the "
+        "real loop keeps the delayed term B K E(t - h); that term's local stability is what "
+        "the LMI certificate (Theorem 1) proves. A switch is safe when both hold. "
+        "V = E' P E with P = S^-T diag(1, w) S^-1 in the modal coordinates of A + B K "
+        f"(w = {fmt(basin.q)}: the grid value that certifies the switch states best).\n\n")
+    body = render_basin_markdown(basin.check, heading="### Certified level set")
+    rows = []
+    for p, tr in zip(basin.check.points, basin.trajectories):
+        v, lam = p.x[0] + basin.v_d, p.x[1] + basin.lambda_d
+        rows.append([f"`{p.label}`", fmt(v, 4), fmt(lam, 4), fmt_level(p.verdict.level, "up"),
+                     p.verdict.outcome.value, tr.fate])
+    sw = ("\n### Switch states (acceleration → cruise)\n\n"
+          + md_table(["case", "v (m/s)", "lambda", "V", "in the certified basin?",
+                      "delay-free trajectory"], rows, "lrrrll")
+          + "\n\nCERTIFIED: V at the state is below c_certified, so the delay-free loop "
+            "converges from it. REFUTED: its level holds a point with V' >= 0, so this V "
+            "cannot certify it; the last column says what the delay-free trajectory does "
+            f"(\"diverges\": |lambda| reaches {fmt(LAM_DIVERGED)}, the wheel spins).\n")
+    return (head + body + sw + brake_text(brake)
+            + (_k2_text(sweep, compare_source) if sweep is not None else ""))
+
+
+def _floor(x: float, digits: int = 2) -> str:
+    e = math.floor(math.log10(x)) - digits + 1
+    return fmt(math.floor(x / 10.0**e) * 10.0**e, digits)
+
+
+def _ceil(x: float, digits: int = 2) -> str:
+    e = math.floor(math.log10(x)) - digits + 1
+    return fmt(math.ceil(x / 10.0**e) * 10.0**e, digits)
+
+
+def brake_text(brake) -> str:
+    """Subsection of the cruise -> braking switch (:mod:`.antiskid_basin_brake`)."""
+    from .antiskid_basin_brake import FATE_RTOL, LAM_LIMIT, T_FATE, TRACK_TOL
+    rows = []
+    for b in brake:
+        if b.why.startswith("no equilibrium"):
+            side = "up to" if b.why.endswith("spin") else "down to"
+            frozen = (f"no equilibrium from the state {side} lambda = "
+                      f"{'' if side == 'up to' else '−'}{fmt(LAM_LIMIT)}: |lambda'| >= "
+                      f"{_floor(b.rate)} 1/s proven, so it gets there within "
+                      f"{_ceil((LAM_LIMIT - abs(b.lam)) / b.rate)} s")
+        elif b.lam_star is not None:
+            frozen = (f"equilibrium lambda* = {fmt(b.lam_star, 4)} ({b.why}"
+                      + (f"; V = {fmt_level(b.level[0], 'up')}, c_certified = "
+                         f"{fmt_level(b.level[1])}" if b.level else "") + ")")
+        else:
+            frozen = b.why
+        fate = (f"diverges: |lambda| = {fmt(LAM_LIMIT)} at t_brake + {fmt(b.t_fate, 2)} s"
+                if b.fate == "diverges" else b.fate)
+        rows.append([f"`{b.label}`", fmt(b.v, 4), fmt(b.lam, 4), fmt(b.vs_frozen, 4), frozen,
+                     b.outcome.value, fate])
+    if not rows:
+        return ("\n### Switch states (cruise → braking)\n\nNo case reached the braking "
+                "phase.\n")
+    return (
+        "\n### Switch states (cruise → braking)\n\n"
+        "Law (69) takes over at t_brake. It tracks the time-varying creep speed v_s*(t) of "
+        "eq (76), so it has no fixed equilibrium: a basin exists only for the loop **frozen "
+        "at the switch instant**. Assumptions: exact prediction (the delay-free loop, as "
+        "Theorem 3 argues); the speed v frozen at its value at t_brake (the creep ratio "
+        "moves on a time scale of about v / 4000 s, the speed by about 1 % a second); "
+        "v_s* frozen at v_s*(t_brake), with d v_s*/dt = 0; the controller's nominal model, "
+        "traction form (eq 12) for lambda >= 0 and braking form (eq 15) below, as the "
+        "plant; law (69) computed on the braking form (eq 16) whatever the sign of lambda, "
+        "as printed. The frozen loop has one state, lambda' = g(lambda), so its trajectory "
+        "moves monotonically to the nearest equilibrium in the direction of g: the verdict "
+        "is REFUTED when no equilibrium lies between the state and |lambda| = "
+        f"{fmt(LAM_LIMIT)} (the sign of g proven by interval arithmetic on the whole "
+        "interval), CERTIFIED when the state reaches a certified level set of a stable "
+        "equilibrium (a level set of `workbench/roa`, with the sign of g proven on the "
+        "way to it). The last column drops the frozen assumptions: the delay-free loop with "
+        "v and lambda integrated and v_s*(t), d v_s*/dt of eq (76) as printed (Radau, rtol "
+        f"{fmt(FATE_RTOL)}, over {fmt(T_FATE)} s; \"tracks\": lambda < 0 and |v lambda - "
+        f"v_s*| < {fmt(TRACK_TOL)} m/s at the end).\n\n"
+        + md_table(["case", "v (m/s)", "lambda", "v_s* frozen (m/s)", "frozen loop",
+                    "in a basin of law (69)?", "delay-free loop, time-varying"], rows,
+                   "lrrrlll")
+        + "\n\nREFUTED here means that the state lies in the basin of no equilibrium of the "
+          "frozen loop: on the traction side the braking form that law (69) is built on "
+          "(its adhesion branch grows like e^{b lambda} for lambda > 0) is not the plant, "
+          "and the law raises lambda further. The simulated runs are not this loop (their "
+          "predictor integrates the braking form, eq (70), which is not the plant there "
+          "either, and the law is held over each sample): what they do after t_brake is in "
+          "the phase-switch section.\n")
+
+
+def _k2_text(sweep, compare_source) -> str:
+    v, lam = sweep.point
+    rows = [[fmt(r.k1, 4), fmt(r.k2, 5), r.source, r.verdict.outcome.value,
+             "—" if r.verdict.w is None else fmt(r.verdict.w), r.verdict.fate]
+            for r in (*sweep.rows, *sweep.compared)]
+    if sweep.edge is None:
+        rule = "No edge between certified and non-certified gains was found on the grid."
+    else:
+        lo, hi = sweep.edge
+        rule = (f"**Certified switching rule.** With k1 = {fmt(sweep.k1, 4)}, the switch at "
+                f"(v_d, lambda_opt) lands in a certified basin for k2 <= {fmt(lo, 4)} (every "
+                f"grid value from {fmt(sweep.k2_min)} up to it is certified"
+                + ("" if sweep.certified_below_edge else " — except where the table says not")
+                + f"), and not for k2 >= {fmt(hi, 4)}: the edge lies in "
+                  f"[{fmt(lo, 4)}, {fmt(hi, 4)}] (bisected).")
+    return ("\n### Which cruise gains make the printed switch safe?\n\n"
+            f"Switch state of eq (75) as printed: v = {fmt(v, 4)} m/s, lambda = lambda_opt = "
+            f"{fmt(lam, 4)}. Each k2 is judged with every P of the weight grid (CERTIFIED if "
+            "one certifies the state); the gains compared (" + compare_source + ") are judged "
+            "with their own k1.\n\n"
+            + md_table(["k1", "k2", "row", "switch state in a certified basin?", "w",
+                        "delay-free trajectory"], rows, "rrllrl")
+            + "\n\n" + rule + " The rule is sufficient (a quadratic V); where the "
+            "trajectory column says \"diverges\" the state is outside the true basin of the "
+            "delay-free loop as well.\n")
+
+
+def plot_basin(fig, basin) -> None:
+    """(v - v_d, lambda - lambda_d) plane: certified and refuted level sets,
+    the counterexample, sampled delay-free trajectories, switch states."""
+    est = basin.check.estimate
+    ax = fig.add_subplot(111)
+    P = np.array(est.P)
+    T = np.linalg.inv(np.linalg.cholesky(P).T)
+    th = np.linspace(0, 2 * np.pi, 400)
+    circ = np.vstack([np.cos(th), np.sin(th)])
+    for c, style, lab in ((est.c_certified, "-", "certified level c_certified"),
+                          (est.c_refuted, "--", "refuted level c_refuted")):
+        if 0 < c < np.inf:
+            e = np.sqrt(c) * T @ circ
+            ax.plot(e[0], e[1], "k" + style, lw=1.2, label=lab)
+    if est.counterexample is not None:
+        ax.plot(*est.counterexample, "k*", ms=8, label="counterexample (V' >= 0)")
+    seen = set()
+    for tr in basin.trajectories[len(basin.check.points):]:
+        p = tr.path
+        lab = None if tr.fate in seen else f"sampled: {tr.fate}"
+        seen.add(tr.fate)
+        ax.plot(p[:, 0], np.clip(p[:, 1], -0.3, 0.5), color=_FATE_COLOR[tr.fate], lw=0.7,
+                alpha=0.8, label=lab)
+    for pt, tr in zip(basin.check.points, basin.trajectories):
+        p = tr.path
+        ax.plot(p[:, 0], np.clip(p[:, 1], -0.3, 0.5), color=_FATE_COLOR[tr.fate], lw=1.8)
+        ax.plot(*pt.x, _SWITCH_MARK[pt.verdict.outcome.value], color="tab:blue", ms=9,
+                mec="k", label=f"switch `{pt.label}`: {pt.verdict.outcome.value}")
+    ax.axhline(basin.lambda_opt - basin.lambda_d, color="tab:purple", ls=":", lw=0.8,
+               label="lambda = lambda_opt")
+    ax.set_xlabel("v - v_d (m/s)")
+    ax.set_ylabel("lambda - lambda_d")
+    ax.set_ylim(-0.15, 0.3)
+    ax.legend(fontsize=6, loc="upper left", framealpha=0.9)

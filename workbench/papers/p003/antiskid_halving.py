@@ -1,0 +1,193 @@
+"""Step-size check of an ``antiskid-run`` design's Monte Carlo runs.
+
+:func:`start_halving` simulates the first n runs of the sweep (the same
+draws) as one batch at the design's dt and as one batch at dt / 2, and
+compares their metrics and outcomes per run with the design's convergence
+tolerances (:class:`HalvingCheck`; rendered by
+:func:`workbench.papers.p003.antiskid_montecarlo_render.halving_section`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...sim.batch import PendingBatch
+from .antiskid_montecarlo import (SUMMARY_METRICS, SweepResult, SweepSpec, chunk_payload,
+                                  chunk_worker, per_run, run_lambda_opt, sweep_inputs)
+
+#: Metrics compared at dt and dt / 2 by :func:`start_halving`.
+HALVING_METRICS = SUMMARY_METRICS + ("t_diverged",)
+
+#: Outcomes compared (as booleans) at dt and dt / 2.
+HALVING_OUTCOMES = ("diverged", "stopped", "above_lambda_opt")
+
+
+@dataclass(frozen=True)
+class HalvingCheck:
+    """The first ``n`` runs of a design's sweep at dt and at dt / 2.
+
+    Attributes
+    ----------
+    case : str
+        The sweep's case.
+    seed : int
+    dt : float
+        The sweep's step (s): the n runs at dt (the sweep's own, or one
+        batch) and at dt / 2 (one batch).
+    rtol : float
+    atol : dict
+        Metric -> absolute tolerance (0 where the design gives none).
+    draws : dict
+        Sample name -> tuple of n draws (as :func:`draw_samples`).
+    coarse, fine : dict
+        Metric or outcome -> tuple of n values at dt and at dt / 2
+        (``lam_max_over_opt`` NaN for a run that diverged in traction at
+        either step: see :func:`compare_steps`).
+    agree : dict
+        Metric or outcome -> tuple of n bools.
+    seconds : float
+        Wall time (not compared).
+    workers : int
+        Processes (not compared).
+    """
+
+    case: str
+    seed: int
+    dt: float
+    rtol: float
+    atol: dict
+    draws: dict
+    coarse: dict
+    fine: dict
+    agree: dict
+    seconds: float = field(default=math.nan, compare=False)
+    workers: int = field(default=1, compare=False)
+
+    @property
+    def n(self) -> int:
+        return len(self.draws["h"])
+
+    @property
+    def run_agree(self) -> tuple:
+        """Per run: every metric and outcome agrees."""
+        return tuple(all(self.agree[k][i] for k in self.agree) for i in range(self.n))
+
+
+def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict) -> tuple[dict, dict, dict]:
+    """Compare per-run values at dt (``coarse``) and dt / 2 (``fine``).
+
+    Parameters
+    ----------
+    coarse, fine : dict
+        :data:`HALVING_METRICS` -> floats per run, :data:`HALVING_OUTCOMES`
+        -> bools per run, and ``phase_diverged`` (phase index where the run
+        diverged, NaN if it did not).
+    rtol : float
+    atol : dict
+        Metric -> absolute tolerance (missing: 0).
+
+    Returns
+    -------
+    (coarse, fine, agree) : dict, dict, dict
+        Values (tuples per run) and agree flags. A metric agrees by
+        :func:`workbench.papers.p003.antiskid_run.agree` (both NaN agree, one
+        NaN disagrees); an outcome when it is equal. ``lam_max_over_opt``
+        is set NaN at both steps (not compared) for a run that diverged in
+        a traction phase (``phase_diverged`` < BRAKE_IN) at either step:
+        its maximum there is where the divergence test fired, as for the
+        nominal cases (:func:`~workbench.papers.p003.antiskid_run.case_metrics`).
+    """
+    from ...controllers.antiskid003_settings import BRAKE_IN
+    from .antiskid_run_spec import agree as agree_values
+
+    traction = (np.asarray(coarse["phase_diverged"], float) < BRAKE_IN) | (
+        np.asarray(fine["phase_diverged"], float) < BRAKE_IN)
+    out = []
+    for vals in (coarse, fine):
+        d = {k: tuple(float(x) for x in vals[k]) for k in HALVING_METRICS}
+        d["lam_max_over_opt"] = tuple(math.nan if t else x
+                                      for x, t in zip(d["lam_max_over_opt"], traction))
+        d.update({k: tuple(bool(x) for x in vals[k]) for k in HALVING_OUTCOMES})
+        out.append(d)
+    c, f = out
+    agree = {k: tuple(agree_values(a, b, rtol, atol.get(k, 0.0)) for a, b in zip(c[k], f[k]))
+             for k in HALVING_METRICS}
+    agree.update({k: tuple(a == b for a, b in zip(c[k], f[k])) for k in HALVING_OUTCOMES})
+    return c, f, agree
+
+
+def _step_values(metrics: dict, viol: dict) -> dict:
+    """Per-run metrics and outcomes of one step, as :func:`compare_steps` takes them."""
+    return {**{k: np.asarray(metrics[k], float) for k in HALVING_METRICS + ("phase_diverged",)},
+            "diverged": np.asarray(viol["diverged"], bool),
+            "stopped": ~np.asarray(viol["not_stopped"], bool),
+            "above_lambda_opt": np.asarray(viol["above_lambda_opt"], bool)}
+
+
+def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
+                  coarse: bool = True, kernel: str | None = None) -> PendingBatch:
+    """Start the step-halving check of the first ``n`` runs of an
+    ``antiskid-run`` design's sweep (its ``[montecarlo]`` seed and draws).
+
+    The n runs are simulated as one batch at the sweep's dt and as one
+    batch at dt / 2. ``pool``: the batches run in a process pool now, so
+    the caller can work meanwhile, else in-process in
+    :meth:`PendingBatch.result`, which returns the :class:`HalvingCheck`.
+    ``coarse=False``: only the dt / 2 batch runs and ``result()`` returns a
+    function of the sweep's :class:`SweepResult` (whose first n runs are the
+    dt side: each run of a batch follows its single-run trajectory, whatever
+    its chunk) that makes the :class:`HalvingCheck`. ``K``: as
+    :func:`~workbench.papers.p003.antiskid_montecarlo.start_sweep`; ``kernel``: as
+    there (default: compiled when numba is installed).
+    """
+    from .antiskid_kernel import default_kernel
+    kernel = kernel or default_kernel()
+    spec = design.spec
+    ms: SweepSpec = spec.montecarlo
+    if not n >= 1:
+        raise ValueError(f"halving check of {n} runs: need at least 1")
+    inp = sweep_inputs(design, n, ms.seed, K)
+    payloads = ([chunk_payload(inp, 0, n, inp["dt"], kernel)] if coarse else []) + [
+        chunk_payload(inp, 0, n, inp["dt"] / 2, kernel)]
+    atol = {k: spec.conv_atol.get(k, 0.0) for k in HALVING_METRICS}
+
+    def check(steps: list, seconds: float, n_workers: int) -> HalvingCheck:
+        c, f, agree = compare_steps(*steps, spec.conv_rtol, atol)
+        return HalvingCheck(ms.case, ms.seed, inp["dt"], spec.conv_rtol, atol,
+                            {k: tuple(v.tolist()) for k, v in inp["draws"].items()},
+                            c, f, agree, seconds, n_workers)
+
+    def collect(outs: list, seconds: float, n_workers: int):
+        lam_opt = run_lambda_opt(inp)
+        steps = []
+        for o in outs:
+            raw = {k: np.asarray(v, float) for k, v in o["metrics"].items()}
+            steps.append(_step_values(*per_run(raw, lam_opt, inp["scenario"]["t_brake"])))
+        if coarse:
+            return check(steps, seconds, n_workers)
+
+        def with_sweep(res: SweepResult) -> HalvingCheck:
+            if res.n < n:
+                raise ValueError(f"the sweep has {res.n} runs; the check needs its first {n}")
+            first = _step_values({k: v[:n] for k, v in res.metrics.items()},
+                                 {k: v[:n] for k, v in res.violations.items()})
+            return check([first, steps[0]], seconds, n_workers)
+        return with_sweep
+
+    return PendingBatch(chunk_worker, payloads, collect, len(payloads) if pool else 1, pool)
+
+
+def halving_quantity_names() -> set[str]:
+    """Quantities of :func:`halving_quantities`."""
+    return {"montecarlo.halving.runs", "montecarlo.halving.agree",
+            "montecarlo.halving.fraction_agree"}
+
+
+def halving_quantities(hc: HalvingCheck) -> dict:
+    """Runs checked, runs whose every metric and outcome agrees, and their
+    fraction."""
+    k = sum(hc.run_agree)
+    return {"montecarlo.halving.runs": hc.n, "montecarlo.halving.agree": k,
+            "montecarlo.halving.fraction_agree": k / hc.n}

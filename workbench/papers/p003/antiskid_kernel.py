@@ -1,0 +1,397 @@
+"""Compiled batch of antiskid runs: the closed loop of
+:func:`workbench.papers.p003.antiskid_scenario.simulate_antiskid` (fixed step,
+no recording) with numba, :data:`LANES` runs in flight at a time.
+
+Per run and per sample, as the batched numpy path: the controller
+(:func:`workbench.controllers.antiskid003_jit.control`: phase logic,
+predictor rollout, laws), the metrics of
+:class:`~workbench.papers.p003.antiskid_scenario.MetricsRecorder`
+(:func:`record`), the plant's input delay line and the plant step with
+per-run adaptive halving (:func:`workbench.sim.wheel_slip_jit.stiff_step`).
+A run ends when it stops or diverges, as its lane of the batch freezes.
+
+Speed without changing a bit: the small model and controller functions are
+inlined into the loop (``inline="always"``), and the predictor rollouts and
+plant steps of the runs in flight are interleaved. A model step is a chain
+of dependent operations (an ``exp``, an ``expm1``, four divisions) around
+two library calls, which the compiler does not reorder; each step is done
+in two passes over the lanes (the model's forms of every lane, one ``exp``
+each, then the steps, one ``expm1`` each), so that the calls of independent
+runs follow each other and the processor overlaps them. Nothing in the loop
+makes an array view (a view costs two atomic reference-count updates): the
+lanes' state is read by row index, and the settings and the model
+parameters are tuples of floats (values the compiler keeps in registers and
+hoists: 1/c, 1/J of the controller's model are computed once). Each run
+performs exactly the operations it performs alone (a test compares runs in
+flight together with runs alone, bit for bit).
+
+:data:`KERNELS` names the two paths a sweep may take; :func:`compiled_available`
+says whether numba is installed (``pip install 'traincontrol-workbench[fast]'``).
+The numpy path is the reference: ``tests/test_compiled_kernel.py`` compares every
+metric of the first 64 runs of the dry design's sweep.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import fields
+from importlib.util import find_spec
+from typing import Literal
+
+import numpy as np
+
+from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED
+from ...sim.history import split_delay
+from .antiskid_scenario import RunMetrics, RunSettings
+
+#: The stepping paths of a sweep: "compiled" (numba, this module) or "numpy"
+#: (:func:`~workbench.papers.p003.antiskid_scenario.simulate_antiskid` with ``batch``).
+KERNELS = ("compiled", "numpy")
+Kernel = Literal["compiled", "numpy"]
+
+#: Runs a compiled batch keeps in flight at a time, their predictor rollouts
+#: and plant steps interleaved. Measured on the dry sweep before the steps
+#: were split in two passes (one process, ns per sample): 1 lane 828, 2 lanes
+#: 632, 4 lanes 619; lanes cost nothing when runs end (a lane takes the next run).
+LANES = 4
+
+#: Field order of the metrics array (RunMetrics; PhaseEvents first).
+METRIC_FIELDS = tuple(f.name for f in fields(RunMetrics))
+
+
+def compiled_available() -> bool:
+    """Whether numba is installed (the compiled kernel can run)."""
+    return find_spec("numba") is not None
+
+
+def default_kernel() -> Kernel:
+    """"compiled" when numba is installed, else "numpy"."""
+    return "compiled" if compiled_available() else "numpy"
+
+
+def compiled_covers(s) -> bool:
+    """Whether the compiled kernel covers the controller settings ``s`` (the
+    literal recursive predictor is numpy-only)."""
+    return not (s.compensate and s.predictor != "rollout")
+
+
+def _build():
+    """Compile-on-first-use: the numba functions of this kernel."""
+    import numba
+
+    from ...controllers import antiskid003_jit as C
+    from ...sim.counter_rng import jit_functions
+    from ...sim.wheel_slip_jit import (BY_SIGN, GRADED, creep_speed, delay_at, fmax, fmin, forms,
+                                      measured_state, split_delay, stiff_step_at, wheel_speed)
+
+    _, uniform, normal4 = jit_functions()
+
+    jit = numba.njit(nogil=True, error_model="numpy")
+    jiti = numba.njit(nogil=True, error_model="numpy", inline="always")
+    M = {k: i for i, k in enumerate(METRIC_FIELDS)}
+    T_CRUISE, V_CRUISE, L_CRUISE = M["t_cruise"], M["v_at_cruise"], M["lam_at_cruise"]
+    L_MAX, V_MAX, L_BRAKE = M["lam_max_traction"], M["v_max"], M["lam_at_brake"]
+    VE_BRAKE, LE_BRAKE, T_NEG = M["v_err_at_brake"], M["lam_err_at_brake"], M["t_lam_negative"]
+    L_MIN, T_OM3, T_STOP, T_PEAK = (M["lam_min_brake"], M["t_omega3"], M["t_stop"],
+                                    M["t_past_peak"])
+    E_LAST, E_MAX = M["evs_last"], M["evs_max_tracking"]
+    V_D, L_D, L_OPT, DT = C.V_D, C.LAMBDA_D, C.LAMBDA_OPT, C.DT
+    WS, TB = C.OMEGA_SWITCH, C.T_BRAKE
+    profile, control_pre, control_post = C.profile, C.control_pre, C.control_post
+    params_tuple, row_tuple, cfg_tuple = _tuples(jit)
+
+    @jit
+    def load(j, i, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf, st, ubuf, m, rs,
+             v, lam, pos, f, Lp, N, T, n, run, active):
+        """Put run i, at t = 0, into lane j of :func:`run_batch`."""
+        pg[j, :plant.shape[1]] = plant[i]
+        N[j], f[j], Lp[j] = Np[i], fp[i], Np[i] + 2
+        pbuf[j, :Lp[j]] = u_init
+        st[j], ubuf[j], m[j] = st0, ub0, m0
+        rs[j] = 0.0
+        rs[j, 0] = v0[i]
+        v[j], lam[j], pos[j], T[j], n[j], run[j], active[j] = v0[i], lam0, 0.0, 0, 0, i, True
+
+    @jit
+    def clip(x):
+        return fmin(fmax(x, 0.0), 1.0)
+
+    @jit
+    def fmax_nan(a, b):      # NaN = no value yet
+        return b if a != a else fmax(a, b)
+
+    @jiti
+    def record(t, v, lam, ph, to_cruise, to_brake, to_stop, M, RS, j, cfg, r_p, settle):
+        """:meth:`MetricsRecorder.__call__` for run ``j`` (metrics ``M[j]``,
+        ``RS[j]`` = (v_prev, has_track, omega_prev, e_prev, lam_prev))."""
+        dt = cfg[DT]
+        frac = (v - cfg[V_D]) / fmax(v - RS[j, 0], 1e-12)
+        if to_cruise:
+            M[j, T_CRUISE] = t - dt * fmin(frac, 1.0)
+            M[j, V_CRUISE], M[j, L_CRUISE] = v, lam
+        RS[j, 0] = v
+        if ph < BRAKE_IN:
+            M[j, L_MAX], M[j, V_MAX] = fmax(M[j, L_MAX], lam), fmax(M[j, V_MAX], v)
+        if to_brake:
+            M[j, L_BRAKE], M[j, VE_BRAKE], M[j, LE_BRAKE] = lam, v - cfg[V_D], lam - cfg[L_D]
+        if to_stop:
+            M[j, T_STOP] = t
+        if not (ph == BRAKE_IN or ph == BRAKE):
+            return
+        if lam < 0 and M[j, T_NEG] != M[j, T_NEG]:
+            M[j, T_NEG] = t
+        M[j, L_MIN] = fmin(M[j, L_MIN], lam)
+        omega = wheel_speed(fmax(v, cfg[C.V_FLOOR]), lam, r_p)
+        ws = cfg[WS]
+        vs_on, _ = profile(t, v, 0.0 * v, math.inf + 0.0 * v, cfg)
+        vs_star = vs_on if omega > ws else 0.0
+        vs = creep_speed(v, lam)
+        e, e_on = abs(vs - vs_star), abs(vs - vs_on)
+        M[j, E_LAST] = e
+        in_window = M[j, T_OM3] != M[j, T_OM3] and M[j, T_PEAK] != M[j, T_PEAK]
+        cross_w = omega <= ws and M[j, T_OM3] != M[j, T_OM3]
+        cross_l = lam < -cfg[L_OPT] and M[j, T_PEAK] != M[j, T_PEAK]
+        if RS[j, 1] == 0.0:
+            f_w = f_l = 1.0 + 0.0 * v
+            e_prev = e_on
+        else:
+            w_prev, e_prev, l_prev = RS[j, 2], RS[j, 3], RS[j, 4]
+            f_w = clip((w_prev - ws) / fmax(w_prev - omega, 1e-300))
+            f_l = clip((l_prev + cfg[L_OPT]) / fmax(l_prev - lam, 1e-300))
+        if cross_w:
+            M[j, T_OM3] = t - dt * (1.0 - f_w)
+        if cross_l:
+            M[j, T_PEAK] = t - dt * (1.0 - f_l)
+        settled = in_window and t >= cfg[TB] + settle
+        if settled and not cross_w and not cross_l:
+            M[j, E_MAX] = fmax_nan(M[j, E_MAX], e)
+        f_end = fmin(f_w if cross_w else 1.0, f_l if cross_l else 1.0)
+        e_end = e_prev + f_end * (e_on - e_prev)
+        if settled and (cross_w or cross_l):
+            M[j, E_MAX] = fmax_nan(M[j, E_MAX], e_end)
+        RS[j, 1], RS[j, 2], RS[j, 3], RS[j, 4] = 1.0, omega, e_on, lam
+
+    @jit
+    def run_batch(plant, Np, fp, v0, lam0, u_init, T_end, cfg, pc, settle, st0, ub0, m0,
+                  keys, pert, period, phase, out):
+        """Simulate each run i (plant parameters ``plant[i]``, input delay
+        (Np[i] + fp[i]) dt, initial speed v0[i]) into ``out[i]``; ``keys[i]``
+        (v, omega, grade streams), ``pert`` (:data:`PERT`), ``period[i]``,
+        ``phase[i]``: the perturbations of :mod:`workbench.sim.perturb`.
+
+        :data:`LANES` runs are in flight at a time, each with its own state and
+        clock; a lane that ends takes the next run. Per sample, the lanes'
+        predictor rollouts are interleaved (:func:`~workbench.controllers.antiskid003_jit.rollout_lanes`);
+        every run performs the operations of a run simulated alone."""
+        dt = cfg[DT]
+        r_i = 4      # PARAM_ORDER index of r (checked by the caller)
+        sv, sw, every = pert[0], pert[1], int(pert[2])
+        noisy, graded, varying = sv > 0 or sw > 0, pert[3] != 0.0, pert[7] != 0.0
+        B, P, K = plant.shape[0], plant.shape[1], LANES
+        Lmax = 2
+        for i in range(B):
+            Lmax = max(Lmax, Np[i] + 2)
+        pg = np.zeros((K, P + 1))                 # plant parameters (+ the slope)
+        pbuf = np.empty((K, Lmax))                # plant input delay line
+        st, ubuf = np.empty((K, st0.shape[0])), np.empty((K, ub0.shape[0]))
+        m, rs = np.empty((K, m0.shape[0])), np.zeros((K, 5))
+        v, lam, pos = np.zeros(K), np.zeros(K), np.zeros(K)
+        vm, lm, Pv, Pl = np.zeros(K), np.zeros(K), np.zeros(K), np.zeros(K)
+        f, Lp, N, T, n = (np.zeros(K), np.zeros(K, np.int64), np.zeros(K, np.int64),
+                          np.zeros(K, np.int64), np.zeros(K, np.int64))
+        run, kind, ncs = np.full(K, -1), np.zeros(K, np.int64), np.zeros(K, np.int64)
+        phs, tcs, tbs, tss = (np.zeros(K, np.int64), np.zeros(K, np.bool_),
+                              np.zeros(K, np.bool_), np.zeros(K, np.bool_))
+        active = np.zeros(K, np.bool_)
+        fm = np.empty((K, 5))                     # scratch: the model forms of each lane
+        ua_, go = np.zeros(K), np.zeros(K, np.bool_)   # the plant's input; lanes stepping
+        form = GRADED if graded else BY_SIGN
+        pc = params_tuple(pc)     # the controller's model: constants the compiler hoists
+        cfg = cfg_tuple(cfg)      # the settings (:data:`~workbench.controllers.antiskid003_jit.CFG`)
+        nxt = 0
+        for j in range(K):
+            if nxt < B:
+                load(j, nxt, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf, st, ubuf,
+                     m, rs, v, lam, pos, f, Lp, N, T, n, run, active)
+                nxt += 1
+        while True:
+            busy = False
+            for j in range(K):
+                if not active[j]:
+                    continue
+                busy = True
+                i, t = run[j], T[j] * dt
+                vm[j], lm[j] = v[j], lam[j]
+                if noisy:
+                    k = np.uint64(T[j] // every)
+                    vm[j], lm[j] = measured_state(v[j], lam[j], normal4(keys[i, 0], k),
+                                                  normal4(keys[i, 1], k), sv, sw, pg[j, r_i],
+                                                  cfg[C.R_C], cfg[C.V_FLOOR])
+                phs[j], tcs[j], tbs[j], tss[j] = control_pre(t, lam[j], vm[j], lm[j], st, ubuf,
+                                                             m, j, cfg, pc)
+                kind[j], ncs[j] = C.kind_of(phs[j], cfg), int(st[j, C.PUSHED])
+                Pv[j], Pl[j] = vm[j], lm[j]
+            if not busy:
+                break
+            C.rollout_lanes(Pv, Pl, kind, ubuf, st, ncs, fm, active, cfg, pc)
+            for j in range(K):     # the laws' model forms, a pass of their own (as the steps)
+                if active[j]:
+                    fm[j, 0], fm[j, 1], fm[j, 2], fm[j, 3], fm[j, 4] = C.law_forms(
+                        phs[j], Pv[j], Pl[j], cfg, pc)
+            for j in range(K):
+                if not active[j]:
+                    continue
+                t = T[j] * dt
+                u, ph = control_post(t, vm[j], lm[j], Pv[j], Pl[j], phs[j],
+                                     (fm[j, 0], fm[j, 1], fm[j, 2], fm[j, 3], fm[j, 4]), st,
+                                     ubuf, m, j, cfg)
+                record(t, v[j], lam[j], ph, tcs[j], tbs[j], tss[j], m, rs, j, cfg,
+                       pg[j, r_i], settle)
+                L = Lp[j]
+                pbuf[j, n[j] % L] = u
+                n[j] += 1
+                if varying:
+                    N[j], f[j] = split_delay(delay_at(t, pert[8], pert[9], period[run[j]],
+                                                      phase[run[j]]), dt)
+                a = pbuf[j, (n[j] - 1 - N[j]) % L]
+                ua = (1.0 - f[j]) * a + f[j] * pbuf[j, (n[j] - 2 - N[j]) % L]
+                if T[j] >= T_end or ph >= STOPPED:
+                    out[run[j]] = m[j]
+                    active[j] = False
+                    if nxt < B:
+                        load(j, nxt, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf,
+                             st, ubuf, m, rs, v, lam, pos, f, Lp, N, T, n, run, active)
+                        nxt += 1
+                    continue
+                if graded:
+                    jj = np.uint64(math.floor(fmax(pos[j], 0.0) / pert[6]))
+                    pg[j, P] = pert[4] + (pert[5] - pert[4]) * uniform(keys[run[j], 2], jj)
+                    pos[j] = pos[j] + dt * v[j]
+                ua_[j], go[j] = ua, True
+            # the plant steps in two passes over the lanes, as the rollouts
+            # (C.rollout_lanes): the model's forms of every lane, then the steps
+            for j in range(K):
+                if go[j]:      # BY_SIGN reads the first P entries only
+                    fm[j, 0], fm[j, 1], fm[j, 2], fm[j, 3], fm[j, 4] = forms(
+                        fmax(v[j], 1e-3), lam[j], row_tuple(pg, j), form)
+            for j in range(K):
+                if go[j]:
+                    v[j], lam[j], unres = stiff_step_at(
+                        v[j], lam[j], ua_[j], dt, row_tuple(pg, j), 1e-3, form,
+                        (fm[j, 0], fm[j, 1], fm[j, 2], fm[j, 3], fm[j, 4]))
+                    st[j, C.UNRES] = 1.0 if unres else 0.0
+                    T[j] += 1
+                    go[j] = False
+
+    return run_batch
+
+
+def _tuples(jit):
+    """(params_tuple(p), row_tuple(a, j), cfg_tuple(c)), compiled: the model
+    parameters (PARAM_ORDER, then the slope) as a tuple of floats, from an
+    array ``p`` (slope 0) or from row ``j`` of a 2-D array; the settings
+    array ``c`` (:data:`~workbench.controllers.antiskid003_jit.CFG`) as a
+    tuple. Tuple entries are values: a loop over them reloads nothing and
+    creates no array view (no reference counting). The source is generated
+    from the two name lists, as :func:`workbench.sim.wheel_slip_jit._unpacked`."""
+    from ...controllers import antiskid003_jit as C
+    from ...sim.wheel_slip import PARAM_ORDER
+    n = len(PARAM_ORDER)
+    ns = {}
+    exec(f"def params_tuple(p):\n    return ({', '.join(f'p[{i}]' for i in range(n))}, 0.0)\n"
+         f"def row_tuple(a, j):\n    return ({', '.join(f'a[j, {i}]' for i in range(n + 1))})\n"
+         f"def cfg_tuple(c):\n    return ({', '.join(f'c[{i}]' for i in range(len(C.CFG)))})\n",
+         ns)
+    return jit(ns["params_tuple"]), jit(ns["row_tuple"]), jit(ns["cfg_tuple"])
+
+
+_KERNEL = None
+
+
+def compile_kernel() -> None:
+    """Compile the kernel in this process now (a few seconds, once). A
+    process pool started afterwards by ``fork`` inherits the compiled code,
+    so its workers do not compile it again."""
+    global _KERNEL
+    if _KERNEL is None:
+        from numba import float64, int64, uint64
+        k = _build()
+        a1, a2 = float64[::1], float64[:, ::1]
+        k.compile((a2, int64[::1], a1, a1, float64, float64, int64, a1, a1, float64, a1, a1,
+                   a1, uint64[:, ::1], a1, a1, a1, a2))
+        _KERNEL = k
+
+
+def simulate_batch_compiled(run: RunSettings, dt: float, *,
+                            evs_settle: float = 5.0) -> RunMetrics:
+    """Compiled counterpart of ``simulate_antiskid(run, dt, record_dt=None,
+    batch=B)``: the same :class:`RunMetrics` (arrays of B runs).
+
+    Parameters
+    ----------
+    run : RunSettings
+        ``plant_params`` entries, ``h`` and ``x0[0]`` may be (B,) arrays.
+    dt : float
+        Step and sampling period (s).
+    evs_settle : float
+        As :class:`~workbench.papers.p003.antiskid_scenario.MetricsRecorder`.
+    """
+    from ...controllers.antiskid003_jit import initial_state, settings_array
+    from ...sim.wheel_slip import PARAM_ORDER
+    if PARAM_ORDER.index("r") != 4:
+        raise RuntimeError("PARAM_ORDER changed: update run_batch's index of r")
+    compile_kernel()
+    B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))
+    plant = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(x, float), (B,))
+                                           for x in run.plant_params], axis=1))
+    parts = [split_delay(float(h), dt) for h in np.broadcast_to(run.h, (B,))]
+    Np = np.array([q[0] for q in parts], np.int64)
+    fp = np.array([q[1] for q in parts], float)
+    v0 = np.array(np.broadcast_to(np.asarray(run.x0[0], float), (B,)))
+    cs = run.controller
+    st0, ub0 = initial_state(cs, dt, run.u_init)
+    m0 = np.array([getattr(RunMetrics(), k) for k in METRIC_FIELDS], float)
+    out = np.empty((B, len(METRIC_FIELDS)))
+    keys, pert, period, phase = perturbation_arrays(run.perturb, B)
+    if run.perturb is not None and run.perturb.delay is not None:
+        Np[:] = split_delay(run.perturb.delay[1], dt)[0]     # the ring holds the longest delay
+    _KERNEL(plant, Np, fp, v0, float(run.x0[1]), float(run.u_init),
+            int(round(run.t_end / dt)), settings_array(cs, dt),
+            np.asarray(cs.params, float), float(evs_settle), st0, ub0, m0,
+            keys, pert, period, phase, out)
+    return RunMetrics(**{k: out[:, j].copy() for j, k in enumerate(METRIC_FIELDS)})
+
+
+#: Entries of the kernel's ``pert`` array (:func:`perturbation_arrays`).
+PERT = ("noise_v", "noise_omega", "noise_every", "graded", "grade_lo", "grade_hi", "segment",
+        "varying", "h_lo", "h_hi")
+
+
+def perturbation_arrays(pt, B: int):
+    """(keys (B, 3) uint64, pert (:data:`PERT`), period (B,), phase (B,)) of
+    the :class:`~workbench.sim.perturb.Perturbations` ``pt`` (None: none)."""
+    keys = np.zeros((B, 3), np.uint64)
+    period, phase = np.ones(B), np.zeros(B)
+    if pt is None:
+        return keys, np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]), period, phase
+    for j, c in enumerate(("v", "omega", "grade")):
+        if c in pt.keys:
+            keys[:, j] = np.asarray(pt.keys[c], np.uint64)
+    g, d = pt.grade or (0.0, 0.0), pt.delay or (0.0, 0.0)
+    if pt.delay is not None:
+        period, phase = np.asarray(pt.period, float), np.asarray(pt.phase, float)
+    pert = np.array([pt.noise_v, pt.noise_omega, float(pt.noise_every),
+                     float(pt.grade is not None), g[0], g[1], pt.segment,
+                     float(pt.delay is not None), d[0], d[1]])
+    return keys, pert, period, phase
+
+
+def simulate_batch(run: RunSettings, dt: float, kernel: Kernel) -> RunMetrics:
+    """A batch's :class:`RunMetrics` by the ``kernel`` path (:data:`KERNELS`;
+    "compiled" runs the numpy path where :func:`compiled_covers` says no)."""
+    if kernel not in KERNELS:
+        raise ValueError(f"kernel = {kernel!r}; expected one of {KERNELS}")
+    if kernel == "compiled" and compiled_covers(run.controller):
+        return simulate_batch_compiled(run, dt)
+    from .antiskid_scenario import simulate_antiskid
+    B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))
+    return simulate_antiskid(run, dt, record_dt=None, batch=B)[1]

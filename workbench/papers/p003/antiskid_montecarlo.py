@@ -1,0 +1,365 @@
+"""Monte Carlo robustness sweep of an ``antiskid-run`` design.
+
+Samples (seeded, numpy ``SeedSequence``): plant mass factor, adhesion
+between the wet and the dry curve (a, b, c interpolated with s in [0, 1]:
+s = 0 wet, s = 1 dry), true input delay in [0, h_max] (the predictor keeps
+the design's h), initial speed. Sample i is row i of one (n, 4) uniform draw,
+so the first n runs of a larger sweep with the same seed have the same
+parameters. Each worker simulates one chunk of samples as a batch (arrays,
+one pass of the fixed-step loop) and returns plain lists; a local process
+pool runs the chunks (:mod:`workbench.sim.batch`); progress goes to stderr.
+
+A batch halves a step only for the runs that need it
+(:func:`workbench.sim.wheel_slip.stiff_step`), so a run's metrics
+do not depend on its chunk mates (up to rounding: the batch evaluates the
+model with numpy, a single run with ``math``). The partition into chunks
+depends on the sample count (and ``chunk``) only, never on the worker count.
+
+The controller always uses the design's nominal model (dry rail, nominal
+mass): the sweep measures robustness, not re-tuning.
+
+The step-size check of the sweep's runs is :mod:`workbench.papers.p003.antiskid_halving`;
+the rendering is :mod:`workbench.papers.p003.antiskid_montecarlo_render`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from ...sim.batch import PendingBatch, available_cpus, uniform_draws
+from .antiskid_run_spec import SweepSpec
+
+#: Summary statistics reported per metric. The time to the stop (v <= v_stop)
+#: is not one: after omega <= 3 rad/s the desired creep speed steps to 0 and
+#: the train coasts on running resistance, ~46 s per m/s of speed left when the
+#: creep is released; that release is a transient at dt |J| ~ 40 which the
+#: fixed step resolves for the nominal plant (the design's braking time agrees
+#: with a refined mesh) but not for mismatched plants (dt / 2 moved it by up
+#: to 13 s in the halving check). The stop itself is the ``not_stopped``
+#: outcome; ``omega3_after_brake`` (the end of creep-controlled braking, the
+#: paper's "about 350 s") is converged.
+SUMMARY_METRICS = ("lam_max_over_opt", "t_cruise", "omega3_after_brake")
+
+#: Statistics of each summary metric (over its finite values).
+STATISTICS = ("n_finite", "min", "median", "p95", "max")
+
+#: Checks counted per run: key -> what a violation means.
+VIOLATIONS = {"above_lambda_opt": "creep ratio above the sample's lambda_opt in traction",
+              "diverged": "diverged (|lambda| >= 0.9, torque out of range, or step not resolved)",
+              "not_stopped": "not stopped by t_end"}
+
+#: Outcomes reported as rates with their Wilson 95 % interval: the checks of
+#: :data:`VIOLATIONS` and "ok" (none of them).
+OUTCOMES = (*VIOLATIONS, "ok")
+
+#: Default number of chunks a sweep is cut into (independent of the workers)...
+DEFAULT_CHUNKS = 4
+#: ... unless a chunk would hold more runs than this: a large sweep streams,
+#: resumes and reports progress in chunks of at most MAX_CHUNK runs (about a
+#: minute of one core with the compiled kernel), and a worker's memory does
+#: not grow with the sweep.
+MAX_CHUNK = 500
+
+
+def default_chunk(samples: int) -> int:
+    """Runs per chunk when the caller gives none: samples / DEFAULT_CHUNKS,
+    at most MAX_CHUNK, at least 1 (the results do not depend on it)."""
+    return max(1, min(math.ceil(samples / DEFAULT_CHUNKS), MAX_CHUNK))
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    samples: dict           # name -> list of floats
+    metrics: dict           # name -> list of floats
+    violations: dict        # key of VIOLATIONS -> list of bool
+    seconds: float
+    workers: int
+
+    @property
+    def n(self) -> int:
+        return len(self.metrics["t_cruise"])
+
+    def summary_rows(self) -> list[list]:
+        """[metric, n finite, min, median, 95th percentile, max] per summary
+        metric (None where no run has a finite value)."""
+        rows = []
+        for k in SUMMARY_METRICS:
+            x = np.asarray(self.metrics[k], float)
+            ok = x[np.isfinite(x)]
+            if ok.size == 0:
+                rows.append([k, 0, None, None, None, None])
+                continue
+            rows.append([k, int(ok.size), float(ok.min()), float(np.median(ok)),
+                         float(np.percentile(ok, 95)), float(ok.max())])
+        return rows
+
+    def statistics(self) -> dict:
+        """``{"<metric>.<statistic>": value}`` from :meth:`summary_rows`,
+        ``{"fraction.<violation>": value}`` (fraction of all runs) and
+        ``{"wilson.<outcome>.lo" | ".hi": bound}`` (:meth:`outcome_rates`)."""
+        out = {f"{r[0]}.{s}": x for r in self.summary_rows() for s, x in zip(STATISTICS, r[1:])}
+        out.update({f"fraction.{k}": sum(v) / self.n for k, v in self.violations.items()})
+        for o, _, _, _, lo, hi in self.outcome_rates():
+            out[f"wilson.{o}.lo"], out[f"wilson.{o}.hi"] = lo, hi
+        return out
+
+    def outcome_rates(self) -> list[tuple]:
+        """(outcome, k, n, k / n, lo, hi) per :data:`OUTCOMES`: runs with the
+        outcome and the Wilson 95 % score interval of its rate."""
+        from ...features.montecarlo import wilson_interval
+        flags = {k: np.asarray(v, bool) for k, v in self.violations.items()}
+        flags["ok"] = ~np.logical_or.reduce(list(flags.values()))
+        return [(o, *wilson_interval(int(flags[o].sum()), self.n)) for o in OUTCOMES]
+
+
+def montecarlo_quantity_names() -> set[str]:
+    """Quantities of a sweep run by the ``antiskid-run`` study:
+    ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
+    ``montecarlo.fraction.<violation>`` and ``montecarlo.wilson.<outcome>.lo``
+    / ``.hi`` (the Wilson 95 % interval of an outcome's rate)."""
+    return ({"montecarlo.samples"}
+            | {f"montecarlo.{m}.{s}" for m in SUMMARY_METRICS for s in STATISTICS}
+            | {f"montecarlo.fraction.{k}" for k in VIOLATIONS}
+            | {f"montecarlo.wilson.{o}.{b}" for o in OUTCOMES for b in ("lo", "hi")})
+
+
+def montecarlo_quantities(res: SweepResult) -> dict:
+    """The values of :func:`montecarlo_quantity_names` (None: no finite value)."""
+    return {"montecarlo.samples": res.n,
+            **{f"montecarlo.{k}": v for k, v in res.statistics().items()}}
+
+
+def draw_samples(n: int, seed: int, spec: SweepSpec, start: int = 0) -> dict:
+    """Samples ``start <= i < n`` of (mass factor, adhesion s, delay h, v0),
+    uniform, seeded; sample i does not depend on n or start. With a varying
+    delay (``delay_variation``), also its period and phase (fraction of a
+    period) per run, uniform, from the counter-based generator of
+    (seed, run) (:mod:`workbench.sim.counter_rng`): the first four draws
+    are those of the same design without perturbations."""
+    out = uniform_draws(n, seed, {"mass": spec.mass, "adhesion": spec.adhesion, "h": spec.h,
+                                  "v0": spec.v0}, start)
+    pt = spec.perturb
+    if pt is not None and pt.delay_period is not None:
+        from ...sim.counter_rng import DELAY_PERIOD, DELAY_PHASE, run_key, uniform
+        runs = np.arange(start, n)
+        lo, hi = pt.delay_period
+        out["delay_period"] = lo + (hi - lo) * uniform(run_key(seed, DELAY_PERIOD, runs), 0)
+        out["delay_phase"] = uniform(run_key(seed, DELAY_PHASE, runs), 0)
+    return out
+
+
+def perturbations(p: dict | None, sl: slice):
+    """The :class:`~workbench.sim.perturb.Perturbations` of a payload's
+    ``perturb`` entry (None: none)."""
+    if p is None:
+        return None
+    from ...sim.counter_rng import GRADE, NOISE_OMEGA, NOISE_V, run_key
+    from ...sim.perturb import Perturbations
+    run = np.asarray(p["run"], np.int64)[sl]
+    keys = {c: tuple(run_key(p["seed"], k, run).tolist())
+            for c, k in (("v", NOISE_V), ("omega", NOISE_OMEGA), ("grade", GRADE))}
+    return Perturbations(tuple(run.tolist()), keys, p["noise_v"], p["noise_omega"],
+                         p["noise_every"], p["grade"], p["segment"], p["delay"],
+                         tuple(p["period"][sl]), tuple(p["phase"][sl]))
+
+
+def chunk_worker(payload: dict) -> dict:
+    """Simulate one chunk (plain data in, plain data out)."""
+    from ...controllers.antiskid003_settings import ControllerSettings, CreepSpeedProfile
+    from ...sim.wheel_slip import PARAM_ORDER
+    from .antiskid_kernel import simulate_batch
+    from .antiskid_scenario import RunSettings
+    cs_d = dict(payload["controller"])
+    cs_d["profile"] = CreepSpeedProfile(**cs_d["profile"])
+    cs_d["params"] = tuple(cs_d["params"])
+    cs_d["K"] = tuple(cs_d["K"])
+    cs = ControllerSettings(**cs_d)
+    plant = tuple(np.asarray(payload["plant"][k], float) for k in PARAM_ORDER)
+    run = RunSettings(plant, cs, np.asarray(payload["h"], float),
+                      (np.asarray(payload["v0"], float), payload["lambda0"]),
+                      payload["u_init"], payload["t_end"],
+                      perturbations(payload.get("perturb"), slice(None)))
+    m = simulate_batch(run, payload["dt"], payload.get("kernel", "numpy"))
+    return {"index": payload["index"], "metrics": {k: np.asarray(v, float).tolist()
+                                                   for k, v in vars(m).items()}}
+
+
+def sweep_inputs(design, samples: int, seed: int, K: tuple | None, start: int = 0) -> dict:
+    """Runs ``start <= i < samples`` of the design's sweep with ``seed`` as
+    plain data: ``draws``, per-run ``plant`` parameters, the nominal values
+    ``base``, the ``controller`` (``asdict`` of the case's settings), the
+    ``scenario`` and ``dt``; ``K``: the cruise gain if the caller has it
+    (default: :func:`~workbench.papers.p003.antiskid_run.gain_for`)."""
+    from ...sim.wheel_slip import PARAM_ORDER
+    from .antiskid_run_spec import controller_settings, gain_for, plant_values
+
+    spec = design.spec
+    ms: SweepSpec = spec.montecarlo
+    case = next(c for c in spec.cases if c.name == ms.case)
+    K = gain_for(spec)[0] if K is None else K
+    cs = controller_settings(spec, K, case)
+    draws = draw_samples(samples, seed, ms, start)
+    base = plant_values(spec)
+    plant = {k: np.full(samples - start, base[k], float) for k in PARAM_ORDER}
+    s = draws["adhesion"]
+    for k in ("a", "b", "c"):
+        plant[k] = ms.wet[k] + s * (base[k] - ms.wet[k])
+    plant["m"] = base["m"] * draws["mass"]
+    return {"draws": draws, "plant": plant, "base": base, "controller": asdict(cs),
+            "scenario": spec.scenario, "dt": ms.dt or spec.dt, "seed": seed,
+            "run": np.arange(start, samples), "perturb": ms.perturb, "h_range": ms.h}
+
+
+def chunk_payload(inp: dict, i0: int, i1: int, dt: float, kernel: str = "numpy") -> dict:
+    """The :func:`chunk_worker` payload of runs ``i0 <= i < i1`` at step
+    ``dt``, simulated by the ``kernel`` path
+    (:data:`~workbench.papers.p003.antiskid_kernel.KERNELS`)."""
+    sl, sc, d = slice(i0, i1), inp["scenario"], inp["draws"]
+    out = {"index": i0, "kernel": kernel, "controller": inp["controller"],
+           "plant": {k: v[sl].tolist() for k, v in inp["plant"].items()},
+           "h": d["h"][sl].tolist(), "v0": d["v0"][sl].tolist(),
+           "lambda0": sc["lambda0"], "u_init": sc["u_init"], "t_end": sc["t_end"], "dt": dt}
+    pt = inp.get("perturb")
+    if pt is not None:
+        # the noise is held over the sweep's step: a run at dt / 2 sees the same noise
+        every = round(inp["dt"] / dt)
+        if not abs(every * dt - inp["dt"]) <= 1e-12 * inp["dt"]:
+            raise ValueError(f"dt = {dt!r}: the noise needs a step that divides {inp['dt']!r}")
+        varying = pt.delay_period is not None
+        out["perturb"] = {
+            "seed": inp["seed"], "run": inp["run"][sl].tolist(), "noise_v": pt.noise_v,
+            "noise_omega": pt.noise_omega, "noise_every": every,
+            "grade": None if pt.gradient is None else tuple(g / 1000 for g in pt.gradient),
+            "segment": pt.segment, "delay": tuple(inp["h_range"]) if varying else None,
+            "period": d["delay_period"][sl].tolist() if varying else [],
+            "phase": d["delay_phase"][sl].tolist() if varying else []}
+    return out
+
+
+@lru_cache(maxsize=1)
+def _dmu_traction():
+    """d mu / d lambda of the traction curve (eq 6), lambdified (``math``)
+    from the one sympy model, parameters as arguments (PARAM_ORDER)."""
+    import sympy as sp
+
+    from ...plants.adhesion import adhesion_model
+    from ...sim.wheel_slip import PARAM_ORDER
+    mdl = adhesion_model()
+    return sp.lambdify((mdl.lam, *[mdl.params[k] for k in PARAM_ORDER]),
+                       sp.diff(mdl.mu_traction, mdl.lam), "math")
+
+
+def lambda_opt_of(plant: dict) -> np.ndarray:
+    """lambda_opt (argmax of mu on lambda > 0) of each run's own adhesion
+    curve: the root of d mu / d lambda on (0, 1), as
+    :meth:`~workbench.plants.adhesion.NumericAdhesion.lambda_opt` (same
+    bracket and tolerances) but with one lambdified derivative for every run
+    (~0.1 ms a run instead of a sympy substitution and lambdify per run)."""
+    from scipy.optimize import brentq
+
+    from ...errors import ModelError
+    from ...sim.wheel_slip import PARAM_ORDER
+    f = _dmu_traction()
+    cols = [np.asarray(plant[k], float) for k in PARAM_ORDER]
+    out = np.empty(len(cols[0]))
+    for i in range(out.size):
+        row = tuple(float(c[i]) for c in cols)
+        g = lambda lam: f(lam, *row)     # noqa: E731
+        if not g(1e-12) > 0 or g(1.0) > 0:
+            raise ModelError(f"run {i}: adhesion curve without a peak on (0, 1) "
+                             f"(a, b, c = {row[:3]})")
+        out[i] = brentq(g, 1e-12, 1.0, xtol=1e-15, rtol=1e-14)
+    return out
+
+
+def run_lambda_opt(inp: dict) -> np.ndarray:
+    """lambda_opt of each run's own adhesion curve (:func:`lambda_opt_of`)."""
+    return lambda_opt_of(inp["plant"])
+
+
+def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]:
+    """(metrics, violations) per run, as arrays, from a batch's raw
+    :class:`~workbench.papers.p003.antiskid_scenario.RunMetrics` arrays."""
+    from ...controllers.antiskid003_settings import BRAKE_IN
+    # the max over the phase a run diverged in is where the test fired
+    in_traction = raw["phase_diverged"] < BRAKE_IN      # NaN (not diverged): False
+    metrics = {"lam_max_over_opt": np.where(in_traction, np.nan,
+                                            raw["lam_max_traction"] / lam_opt),
+               "t_cruise": raw["t_cruise"],
+               "omega3_after_brake": raw["t_omega3"] - t_brake,
+               "t_diverged": raw["t_diverged"],
+               "phase_diverged": raw["phase_diverged"]}
+    viol = {"above_lambda_opt": raw["lam_max_traction"] > lam_opt * 1.001,
+            "diverged": np.isfinite(raw["t_diverged"]),
+            "not_stopped": ~np.isfinite(raw["t_stop"])}
+    return metrics, viol
+
+
+def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
+                chunk: int | None = None, pool: bool | None = None,
+                K: tuple | None = None, kernel: str | None = None,
+                scheduler: str | None = None) -> PendingBatch:
+    """Draw the samples of an ``antiskid-run`` design's sweep and start its
+    chunks (see :func:`sweep`); ``pool`` (default: ``workers > 1``) runs them
+    in a process pool now, so the caller can work meanwhile, else in-process
+    in :meth:`PendingBatch.result`. ``K``: the cruise gain if the caller has
+    it (default: :func:`~workbench.papers.p003.antiskid_run.gain_for`). ``kernel``:
+    "compiled" or "numpy" (default: compiled when numba is installed).
+    ``scheduler``: run the chunks on Dask (``"local"`` or a scheduler's
+    address; :class:`~workbench.sim.batch.PendingBatch`). ``workers``
+    defaults to the CPUs granted (:func:`~workbench.sim.batch.available_cpus`)."""
+    from .antiskid_kernel import default_kernel
+
+    inp = sweep_inputs(design, samples, seed, K)
+    workers = max(1, workers or available_cpus())
+    chunk = chunk or default_chunk(samples)
+    kernel = kernel or default_kernel()
+    pool = workers > 1 if pool is None else pool
+    payloads = [chunk_payload(inp, i0, min(i0 + chunk, samples), inp["dt"], kernel)
+                for i0 in range(0, samples, chunk)]
+    if kernel == "compiled" and pool and len(payloads) > 1 and scheduler is None:
+        from .antiskid_kernel import compile_kernel
+        compile_kernel()     # once, here: the forked workers inherit it
+
+    def collect(outs: list, seconds: float, n_workers: int) -> SweepResult:
+        raw = {k: np.concatenate([o["metrics"][k] for o in outs]) for k in outs[0]["metrics"]}
+        metrics, viol = per_run(raw, run_lambda_opt(inp), inp["scenario"]["t_brake"])
+        return SweepResult({k: v.tolist() for k, v in inp["draws"].items()},
+                           {k: v.tolist() for k, v in metrics.items()},
+                           {k: v.tolist() for k, v in viol.items()}, seconds, n_workers)
+
+    return PendingBatch(chunk_worker, payloads, collect, workers, pool,
+                        sizes=[len(p["h"]) for p in payloads], unit="run", scheduler=scheduler)
+
+
+def sweep(design, samples: int, seed: int, *, workers: int | None = None,
+          chunk: int | None = None, progress: bool = True,
+          kernel: str | None = None, scheduler: str | None = None) -> SweepResult:
+    """Run the Monte Carlo sweep of an ``antiskid-run`` design.
+
+    Parameters
+    ----------
+    design : workbench.design.Design
+        Of kind ``antiskid-run`` with a ``[montecarlo]`` table.
+    samples, seed : int
+    workers : int, optional
+        Process count (default: CPU count); 1 runs in-process.
+    chunk : int, optional
+        Samples per batch (default: :func:`default_chunk`).
+        The results depend on it, not on ``workers``.
+    progress : bool
+        Progress bar on stderr.
+    kernel : {"compiled", "numpy"}, optional
+        The stepping path (default: compiled when numba is installed); the
+        results agree to rounding (``tests/test_compiled_kernel.py``).
+    scheduler : str, optional
+        Run the chunks on a Dask distributed cluster: ``"local"`` (a
+        LocalCluster of ``workers`` processes) or a scheduler address. The
+        results do not depend on the executor, the worker count or the
+        chunking (``tests/test_sweep_executors.py``).
+    """
+    return start_sweep(design, samples, seed, workers=workers, chunk=chunk,
+                       kernel=kernel, scheduler=scheduler).result(progress)

@@ -1,0 +1,135 @@
+"""Rendering of the Monte Carlo sweep and its step-halving check (pure)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...report.markdown import fmt, md_table
+from .antiskid_halving import HALVING_METRICS, HALVING_OUTCOMES, HalvingCheck
+from .antiskid_montecarlo import SUMMARY_METRICS, VIOLATIONS, SweepResult
+
+
+#: Column labels of the draws in :func:`halving_section`.
+_DRAW_LABELS = (("mass", "mass factor"), ("adhesion", "adhesion s"), ("h", "h (s)"),
+                ("v0", "v(0) (m/s)"))
+
+
+def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
+    """Markdown (no heading) of a :class:`HalvingCheck`: what was done, a
+    row per metric (runs finite at both steps, runs that agree, largest
+    |difference| over the runs finite at both), a row per outcome, and the
+    disagreeing runs (``sig`` significant digits for their values).
+    ``spec``: the design's ``RunSpec``, for the size of the sweep (optional;
+    the tolerances are the check's own)."""
+    n, k = hc.n, sum(hc.run_agree)
+    of = "the sweep's runs" if spec is None or spec.montecarlo is None else \
+        f"the sweep's {spec.montecarlo.samples} runs"
+    tol = ", ".join(f"`{m}` {fmt(a)}" for m, a in hc.atol.items() if a > 0) or "none"
+    text = (f"The first {n} of {of} (seed {hc.seed}, case `{hc.case}`, the same draws), "
+            f"run at the sweep's dt = {fmt(hc.dt)} s, were simulated again as one batch at "
+            f"dt / 2 (each run of a batch follows its single-run trajectory, so a run's "
+            f"values do not depend on its chunk). A metric agrees when "
+            f"|a − b| <= atol + rtol max(|a|, |b|), rtol = {fmt(hc.rtol)}, atol: {tol} "
+            f"(else 0); two missing values agree, a missing and a finite one do not; "
+            f"`lam_max_over_opt` is not compared for a run that diverged in traction at "
+            f"either step. An outcome agrees when it is the same at both steps. "
+            f"**{k} of {n} runs agree in every metric and outcome.**\n\n")
+    rows = []
+    for m in HALVING_METRICS:
+        a, b = np.asarray(hc.coarse[m], float), np.asarray(hc.fine[m], float)
+        both = np.isfinite(a) & np.isfinite(b)
+        diff = float(np.max(np.abs(a[both] - b[both]))) if both.any() else None
+        rows.append([f"`{m}`", fmt(hc.atol[m]), int(both.sum()), sum(hc.agree[m]),
+                     fmt(diff, 2)])
+    text += md_table(["metric", "atol", "finite at both", f"agree (of {n})",
+                      "largest |difference|"], rows, "lrrrr")
+    text += "\n\n" + md_table(
+        ["outcome", "runs at dt", "runs at dt / 2", f"agree (of {n})"],
+        [[f"`{o}`", sum(hc.coarse[o]), sum(hc.fine[o]), sum(hc.agree[o])]
+         for o in HALVING_OUTCOMES], "lrrr")
+    labels = tuple(("delay_period", "h(t) period (s)") if d == "h" and "delay_period" in hc.draws
+                   else (d, lab) for d, lab in _DRAW_LABELS)    # the h draw unused then
+    bad = [[i] + [fmt(hc.draws[d][i], 4) for d, _ in labels]
+           + [f"`{key}`", fmt(hc.coarse[key][i], sig), fmt(hc.fine[key][i], sig)]
+           for i in range(n) for key in hc.agree if not hc.agree[key][i]]
+    text += "\n\nRuns that disagree:"
+    if not bad:
+        return text + " none."
+    return text + "\n\n" + md_table(["run"] + [lab for _, lab in labels]
+                                    + ["metric or outcome", "at dt", "at dt / 2"],
+                                    bad, "rrrrrlrr")
+
+
+def draw_histograms(fig, res: SweepResult) -> None:
+    """Histograms of the summary metrics (pure)."""
+    axes = fig.subplots(1, len(SUMMARY_METRICS))
+    for ax, k in zip(axes, SUMMARY_METRICS):
+        x = np.asarray(res.metrics[k], float)
+        x = x[np.isfinite(x)]
+        if x.size:
+            ax.hist(x, bins=int(np.clip(2 * np.sqrt(x.size), 5, 30)), color="tab:blue")
+        if k == "lam_max_over_opt":
+            ax.axvline(1.0, color="k", ls="--", lw=0.8, label="lambda_opt")
+            ax.legend(fontsize=7)
+        ax.set_title(f"{k} (n = {x.size})", fontsize=8)
+        ax.set_xlabel(k + {"lam_max_over_opt": " (-)"}.get(k, " (s)"))
+
+
+def draw_rates(fig, res: SweepResult) -> None:
+    """Each outcome's rate (percent of the runs) with its Wilson 95 %
+    interval (pure)."""
+    ax = fig.subplots()
+    rows = res.outcome_rates()
+    y = np.arange(len(rows))[::-1]
+    p = np.array([100 * r[3] for r in rows])
+    lo, hi = np.array([100 * r[4] for r in rows]), np.array([100 * r[5] for r in rows])
+    ax.errorbar(p, y, xerr=[p - lo, hi - p], fmt="o", color="tab:blue", capsize=4)
+    ax.set_yticks(y, [r[0] for r in rows], fontsize=8)
+    ax.set_xlim(-2, 102)
+    ax.set_xlabel(f"runs with the outcome (%) of {res.n}, Wilson 95 % interval")
+    ax.grid(alpha=0.3)
+
+
+def draw_outcomes(fig, res: SweepResult) -> None:
+    """Each run at its (adhesion s, true delay h) and (mass factor, v0),
+    marked by its outcome: stopped, diverged, or neither (pure)."""
+    d = {k: np.asarray(v, float) for k, v in res.samples.items()}
+    div = np.asarray(res.violations["diverged"], bool)
+    stuck = np.asarray(res.violations["not_stopped"], bool) & ~div
+    groups = (("stopped", ~div & ~stuck, "tab:blue", "o"),
+              ("diverged", div, "tab:red", "x"),
+              ("not stopped, not diverged", stuck, "tab:gray", "s"))
+    delay = (("delay_period", "period of the varying delay h(t) (s)") if "delay_period" in d
+             else ("h", "true input delay h (s)"))
+    for ax, (kx, ky, lx, ly) in zip(fig.subplots(1, 2), (
+            ("adhesion", delay[0], "adhesion s (0 wet, 1 dry)", delay[1]),
+            ("mass", "v0", "plant mass / nominal", "v(0) (m/s)"))):
+        for label, sel, color, marker in groups:
+            if sel.any():
+                ax.scatter(d[kx][sel], d[ky][sel], s=14, c=color, marker=marker,
+                           label=f"{label}: {int(sel.sum())}")
+        ax.set_xlabel(lx)
+        ax.set_ylabel(ly)
+    fig.axes[0].legend(fontsize=7)
+
+
+def summary_tables(res: SweepResult, sig: int) -> str:
+    """Markdown: the summary statistics and the violation fractions (``sig``
+    significant digits), as printed by ``workbench sweep`` and in reports."""
+    stats = md_table(["metric", "n finite", "min", "median", "95 %", "max"],
+                     [[f"`{r[0]}`", r[1]] + [fmt(x, sig) for x in r[2:]]
+                      for r in res.summary_rows()], "lrrrrr")
+    label = {**VIOLATIONS, "ok": "ok: none of the above"}
+    viol = md_table(["outcome", "runs", "fraction", "rate [Wilson 95 % interval]"],
+                    [[label[o], k, fmt(p, 3), rate_text(k, n, lo, hi)]
+                     for o, k, n, p, lo, hi in res.outcome_rates()], "lrrr")
+    return stats + "\n\n" + viol
+
+
+def rate_text(k: int, n: int, lo: float, hi: float) -> str:
+    """"k / n = p % [lo, hi] %" (one decimal; the interval's ends rounded
+    outwards, so the printed interval contains the computed one)."""
+    down = math.floor(1000 * lo) / 10
+    up = math.ceil(1000 * hi) / 10
+    return f"{k} / {n} = {100 * k / n:.1f} % [{down:.1f}, {up:.1f}] %"

@@ -1,0 +1,433 @@
+"""Study ``antiskid-run``: the full runs of paper 003, section 4, in the time
+domain (acceleration, cruise, braking with input delay), with the cruise
+gain from the certified synthesis, a step-halving convergence check of every
+reported metric, checks of the state at every phase switch, and linear
+cross-checks of the LMI delay bound.
+
+The design tables and what derives from them (controller settings, the
+gain, the run of the scenario) are :mod:`workbench.papers.p003.antiskid_run_spec`;
+the Monte Carlo part is :mod:`workbench.papers.p003.antiskid_montecarlo` and
+:mod:`workbench.papers.p003.antiskid_halving`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...controllers.antiskid003_settings import ControllerSettings
+from ...errors import DesignError
+from ...margins import DelayMargin, delay_margin_eig
+from ...reader import Reader
+from ...sim.batch import SchedulerUnreachable
+from ...sim.delay import SimResult, envelope_ratio, simulate_linear_dde, step_halving
+from ...sim.wheel_slip import PARAM_ORDER, model_functions
+from .antiskid_run_spec import (METRICS, Case, RunSpec, agree, case_mesh, case_metrics,
+                                controller_settings, gain_for, load_run_spec, nominal_cruise,
+                                plant_values, run_settings)
+from .antiskid_scenario import simulate_antiskid
+
+#: Record step (s) of the runs (figures, comfort) at dt and dt / 2.
+RECORD_DT = 0.05
+#: (a, h, t_end) of the step-halving check x' = -a x(t - h), x = 1 on [-h, 0], over t_end s.
+HALVING_PROBLEM = (1.0, 0.7, 10.0)
+
+@dataclass(frozen=True)
+class SwitchCheck:
+    """Frozen linearisation of the cruise loop at the state where cruise starts.
+
+    ``abscissa``: spectral abscissa of A_loc + A_d (delay-free);
+    ``margin``: exact delay margin of x' = A_loc x + A_d x(t - h).
+    """
+
+    v: float
+    lam: float
+    dmu_dlam: float
+    A_loc: np.ndarray
+    abscissa: float
+    margin: DelayMargin
+
+
+@dataclass(frozen=True)
+class CaseResult:
+    case: Case
+    metrics: dict            # at dt / 2 (reported)
+    metrics_coarse: dict     # at dt
+    converged: dict          # metric -> bool
+    run: SimResult           # recorded at dt / 2
+    switch: SwitchCheck | None
+    comfort: object = None         # antiskid_comfort.Comfort at dt / 2 (design with [comfort])
+    comfort_coarse: object = None  # the same at dt
+
+
+@dataclass(frozen=True)
+class LinearCheck:
+    A: np.ndarray
+    B: np.ndarray
+    K_paper: tuple
+    K_finite: tuple
+    finite_margin: DelayMargin
+    ratios_finite: tuple      # (factor, h, envelope ratio)
+    paper_margin: DelayMargin
+    ratios_paper: tuple       # (h, envelope ratio)
+    runs: tuple               # SimResult per finite factor (for the figure)
+    halving: tuple = ()       # HalvingRow of x' = -x(t - 0.7) against the exact solution
+
+
+@dataclass(frozen=True)
+class RunResult:
+    lambda_opt: float
+    lambda_d: float
+    K: tuple
+    K_how: str
+    h_certified: float | None
+    cases: tuple
+    linear: LinearCheck
+    dt: float
+    montecarlo: object = None   # antiskid_montecarlo.SweepResult or None
+    halving: object = None      # antiskid_halving.HalvingCheck or None
+    basin: object = None        # antiskid_basin_run.BasinResult or None
+    sampled: object = None      # antiskid_sampled.SampledResult or None
+
+    def case(self, name: str) -> CaseResult:
+        return next(c for c in self.cases if c.case.name == name)
+
+    def to_json(self) -> dict:
+        out = {"lambda_opt": self.lambda_opt, "lambda_d": self.lambda_d, "K": list(self.K),
+               "cases": {c.case.name: c.metrics for c in self.cases}}
+        if self.sampled is not None:
+            out["sampled"] = self.sampled.to_json()
+        return out
+
+
+def switch_check(cs: ControllerSettings, v: float, lam: float) -> SwitchCheck:
+    """Frozen linearisation of the cruise loop (eq 61 on the traction form)
+    at (v, lambda), by central differences of the lambdified model."""
+    fn = model_functions("math")["traction"]
+    p, c = cs.params, cs.lin
+
+    def rhs(x):
+        vv, ll = x
+        y1, y2, y3, *_ = fn(vv, ll, *p)
+        den = c["d4"] * (vv - cs.v_d) + c["d5"] * (ll - cs.lambda_d) + c["d6"]
+        return np.array([y1, y2 - y3 / den * c["d3"]]), y3 / den
+
+    x0 = np.array([v, lam])
+    A = np.zeros((2, 2))
+    for j, step in enumerate((1e-4 * max(v, 1.0), 1e-7)):
+        e = np.zeros(2)
+        e[j] = step
+        A[:, j] = (rhs(x0 + e)[0] - rhs(x0 - e)[0]) / (2 * step)
+    gain = rhs(x0)[1]
+    Ad = gain * np.array([[0.0], [1.0]]) @ np.array([cs.K])
+    mdl_dmu = _dmu(cs.params)
+    return SwitchCheck(v, lam, float(mdl_dmu(lam)), A,
+                       float(np.max(np.linalg.eigvals(A + Ad).real)), delay_margin_eig(A, Ad))
+
+
+def _dmu(params):
+    import sympy as sp
+    from ...plants.adhesion import adhesion_model
+    mdl = adhesion_model()
+    vals = dict(zip(PARAM_ORDER, params))
+    return sp.lambdify(mdl.lam, mdl.substitute(sp.diff(mdl.mu_traction, mdl.lam), vals), "math")
+
+
+def linear_check(spec: RunSpec, A, B, K) -> LinearCheck:
+    """E' = A E + B K E(t - h) simulated (Heun, :func:`simulate_linear_dde`)."""
+    E0 = np.array([1.0, 0.01])
+    Kf = np.array([spec.finite_gain])
+    fin = delay_margin_eig(A, B @ Kf)
+    ratios_f, runs = [], []
+    if math.isfinite(fin.h) and fin.h > 0:
+        period = 2 * math.pi / fin.omega
+        for fac in spec.factors:
+            h = fac * fin.h
+            r = simulate_linear_dde(A, B @ Kf, h, E0, spec.periods * period,
+                                    min(period, h) / 50)
+            ratios_f.append((fac, h, envelope_ratio(r, period)))
+            runs.append(r)
+    Kp = np.array([K])
+    pm = delay_margin_eig(A, B @ Kp)
+    ratios_p = []
+    rate = max(abs(np.linalg.eigvals(A)).max(), 1.0)
+    slow = abs(np.max(np.linalg.eigvals(A + B @ Kp).real))
+    for h in spec.far_delays:
+        window = max(10 * h, 3 / slow)
+        r = simulate_linear_dde(A, B @ Kp, h, E0, 3 * window, min(h, 1 / rate) / 5)
+        ratios_p.append((h, envelope_ratio(r, window)))
+    halving = step_halving(*HALVING_PROBLEM, (0.1, 0.05, 0.025, 0.0125))
+    return LinearCheck(A, B, tuple(K), tuple(spec.finite_gain), fin, tuple(ratios_f), pm,
+                       tuple(ratios_p), tuple(runs), halving)
+
+
+def simulate_design(design, case_name: str | None, dt: float | None) -> dict:
+    """One case of an ``antiskid-run`` design at one step (for ``workbench
+    simulate``): metrics, wall time and the real-time factor."""
+    import time
+    spec: RunSpec = design.spec
+    names = [c.name for c in spec.cases]
+    name = case_name or names[0]
+    if name not in names:
+        raise DesignError("<cli>", "--case", name, "one of " + ", ".join(names))
+    dt = dt or spec.dt
+    if not (dt > 0 and (dt <= spec.scenario["h"] or spec.scenario["h"] == 0)):
+        raise DesignError("<cli>", "--dt", dt, "a positive step no larger than the delay (s)")
+    case = next(c for c in spec.cases if c.name == name)
+    K, how, _ = gain_for(spec)
+    cs = controller_settings(spec, K, case)
+    t0 = time.perf_counter()
+    run, m = simulate_antiskid(run_settings(spec, cs), dt, record_dt=None,
+                               mesh=case_mesh(spec, case))
+    wall = time.perf_counter() - t0
+    metrics = case_metrics(m, cs, spec.scenario["t_brake"])
+    end = m.t_stop if math.isfinite(m.t_stop) else (
+        m.t_diverged if math.isfinite(m.t_diverged) else spec.scenario["t_end"])
+    return {"design": design.name, "case": name, "dt": dt, "K": list(K), "K_source": how,
+            "metrics": metrics, "simulated_s": float(end), "wall_s": wall,
+            "realtime_factor": float(end) / wall}
+
+
+def simulate_command(design, *, case: str | None, dt: float | None, as_json: bool) -> int:
+    """``workbench simulate`` on a loaded ``antiskid-run`` design: print the
+    metrics of one case; exit 0."""
+    import json
+
+    from ...report.markdown import fmt, md_table
+    out = simulate_design(design, case, dt)
+    if as_json:
+        print(json.dumps(out, indent=2, default=lambda x: None))
+        return 0
+    print(f"{out['design']} / {out['case']}: dt = {fmt(out['dt'])} s, K = {out['K']} "
+          f"({out['K_source']})")
+    print(md_table(["metric", "value"], [[k, fmt(v, 6)] for k, v in out["metrics"].items()
+                                         if not (isinstance(v, float) and math.isnan(v))], "lr"))
+    print(f"simulated {fmt(out['simulated_s'], 4)} s in {out['wall_s']:.2f} s wall: "
+          f"{out['realtime_factor']:.0f}x real time")
+    return 0
+
+
+def sweep_command(design, *, samples: int, seed: int, workers: int | None,
+                  figure: str | None, as_json: bool, kernel: str | None = None,
+                  scheduler: str | None = None, out: str | None = None,
+                  resume: bool = False) -> int:
+    """``workbench sweep`` on a loaded ``antiskid-run`` design: run, print summary statistics (and JSON), write
+    the histogram figure; exit 0 (violations are reported, not failures)."""
+    import json
+    from pathlib import Path
+
+    from ...errors import DesignError
+    from ...report.markdown import Figure
+    from .antiskid_montecarlo import sweep
+    from .antiskid_montecarlo_render import draw_histograms, summary_tables
+    if not samples >= 1:
+        raise DesignError("<cli>", "--samples", samples, "a positive integer")
+    if workers is not None and not workers >= 1:
+        raise DesignError("<cli>", "--workers", workers, "a positive integer")
+    if design.spec.montecarlo is None:
+        raise DesignError(design.path, "montecarlo", "<missing>",
+                          "an antiskid-run design with a [montecarlo] table")
+    from .antiskid_kernel import KERNELS, compiled_available
+    if kernel is not None and kernel not in KERNELS:
+        raise DesignError("<cli>", "--kernel", kernel, " or ".join(KERNELS))
+    if kernel == "compiled" and not compiled_available():
+        raise DesignError("<cli>", "--kernel", kernel,
+                          "numpy here: numba is not installed "
+                          "(pip install 'traincontrol-workbench[fast]')")
+    if scheduler is not None:
+        from importlib.util import find_spec
+        if find_spec("distributed") is None:
+            raise DesignError("<cli>", "--scheduler", scheduler,
+                              "no flag here: dask.distributed is not installed "
+                              "(pip install 'traincontrol-workbench[scale]')")
+    if resume and not out:
+        raise DesignError("<cli>", "--resume", True, "with --out DIR (the folder to resume)")
+    try:
+        if out:
+            from .antiskid_stream import start_streaming
+            try:
+                pending = start_streaming(design, samples, seed, out, resume=resume,
+                                          workers=workers, kernel=kernel, scheduler=scheduler)
+            except FileExistsError as e:
+                raise DesignError("<cli>", "--out", out, f"a new folder or --resume ({e})") \
+                    from None
+            res = pending.result(progress=not as_json)
+        else:
+            res = sweep(design, samples, seed, workers=workers, kernel=kernel,
+                        progress=not as_json, scheduler=scheduler)
+    except SchedulerUnreachable as e:
+        raise DesignError("<cli>", "--scheduler", scheduler,
+                          f"'local' or the address of a running Dask scheduler ({e})") from None
+    except OSError as e:       # writing a chunk file (--out), not the scheduler
+        if not out:
+            raise
+        raise DesignError("<cli>", "--out", out, f"a folder the chunks can be written to "
+                          f"({type(e).__name__}: {e})") from None
+    if figure:
+        from ...report.figures import save_figure
+        save_figure(Figure(Path(figure).stem, "Monte Carlo histograms",
+                           lambda fig: draw_histograms(fig, res), (9.0, 3.2)), Path(figure))
+    if as_json:
+        print(json.dumps({"design": design.name, "samples": samples, "seed": seed,
+                          "seconds": res.seconds, "workers": res.workers,
+                          "draws": res.samples, "metrics": res.metrics,
+                          "violations": res.violations}, default=lambda x: None))
+        return 0
+    print(f"{design.name}: {samples} runs, seed {seed}, {res.workers} worker(s), "
+          f"{res.seconds:.1f} s")
+    print(summary_tables(res, 4))
+    if figure:
+        print(f"wrote {figure}")
+    return 0
+
+
+class AntiskidRun:
+    kind = "antiskid-run"
+
+    def load(self, root: Reader) -> RunSpec:
+        return load_run_spec(root)
+
+    def quantity_names(self, spec: RunSpec) -> set[str]:
+        names = {"operating_point.lambda_opt", "operating_point.lambda_d", "gain.K1", "gain.K2",
+                 "gain.h_certified", "linear.finite.h_star", "linear.paper.exact_margin",
+                 "linear.paper.max_envelope_ratio"}
+        names |= {f"linear.finite.ratio[{f:g}]" for f in spec.factors}
+        for c in spec.cases:
+            b = f"cases[{c.name}]"
+            names |= {f"{b}.{m}" for m in METRICS}
+            names |= {f"{b}.diverged", f"{b}.stopped", f"{b}.converged",
+                      f"{b}.switch.abscissa", f"{b}.switch.margin", f"{b}.switch.dmu_dlam"}
+            if spec.comfort is not None:
+                from .antiskid_comfort import COMFORT_QUANTITIES
+                names |= {f"{b}.{k}" for k in COMFORT_QUANTITIES}
+        if spec.montecarlo is not None:
+            from .antiskid_halving import halving_quantity_names
+            from .antiskid_montecarlo import montecarlo_quantity_names
+            names |= montecarlo_quantity_names()
+            if spec.montecarlo.halving:
+                names |= halving_quantity_names()
+        if spec.basin is not None:
+            from .antiskid_basin_run import basin_quantity_names
+            names |= basin_quantity_names([c.name for c in spec.cases], True)
+        if spec.sampled is not None:
+            from .antiskid_sampled import sampled_quantity_names
+            names |= sampled_quantity_names(spec.sampled)
+        return names
+
+    def start(self, design):
+        """Start the Monte Carlo part of :meth:`run` (its process pools) now,
+        so that it overlaps whatever the caller does next; returns the
+        handle :meth:`run` takes as ``started`` (None: nothing to start)."""
+        spec: RunSpec = design.spec
+        if spec.montecarlo is None:
+            return None
+        from .antiskid_halving import start_halving
+        from .antiskid_montecarlo import start_sweep
+        K = gain_for(spec)[0]
+        ms = spec.montecarlo
+        pending = start_sweep(design, ms.samples, ms.seed, workers=ms.workers,
+                              chunk=ms.chunk, pool=True, K=K)
+        halving = None
+        if ms.halving:    # its dt side is the sweep's first runs
+            halving = start_halving(design, ms.halving, K=K, pool=True, coarse=False)
+        return pending, halving
+
+    def run(self, design, started=None) -> RunResult:
+        """The cases, the linear checks and the Monte Carlo part (its chunks
+        run in a pool while the cases run here; ``started``: the handle of
+        :meth:`start` if it was started already)."""
+        spec: RunSpec = design.spec
+        nominal, lam_d, lin = nominal_cruise(spec)
+        K, how, h_cert = gain_for(spec)
+        if started is None:
+            started = self.start(design)
+        pending, halving = started or (None, None)
+        try:
+            cases = self._cases(spec, K)
+            lc = linear_check(spec, lin.A, lin.B, K)
+            sampled = None
+            if spec.sampled is not None:
+                from .antiskid_run_spec import sampled_context
+                from .antiskid_sampled import run_sampled
+                sampled = run_sampled(spec.sampled, sampled_context(spec, K), spec.dt)
+        except BaseException:
+            for p in (pending, halving):
+                if p is not None:
+                    p.cancel()
+            raise
+        mc = None if pending is None else pending.result()
+        hc = None if halving is None else halving.result()(mc)
+        from .antiskid_basin_run import run_basin
+        bs = None if spec.basin is None else run_basin(
+            spec.basin, plant_values(spec), spec.scenario["v_d"], K, nominal.lambda_opt(), cases,
+            spec.mass_factor, profile=controller_settings(spec, K, spec.cases[0]).profile,
+            k_de=spec.k_de)
+        return RunResult(nominal.lambda_opt(), lam_d, tuple(K), how, h_cert, tuple(cases), lc,
+                         spec.dt, mc, hc, bs, sampled)
+
+    def _cases(self, spec: RunSpec, K) -> list[CaseResult]:
+        cases = []
+        for case in spec.cases:
+            cs = controller_settings(spec, K, case)
+            rs = run_settings(spec, cs)
+            t_b = spec.scenario["t_brake"]
+            mesh = case_mesh(spec, case)
+            run1, m1 = simulate_antiskid(rs, spec.dt, record_dt=RECORD_DT, mesh=mesh)
+            run2, m2 = simulate_antiskid(rs, spec.dt / 2, record_dt=RECORD_DT, mesh=mesh)
+            coarse, fine = case_metrics(m1, cs, t_b), case_metrics(m2, cs, t_b)
+            conv = {k: agree(coarse[k], fine[k], spec.conv_rtol, spec.conv_atol.get(k, 0.0))
+                    for k in METRICS}
+            sw = None   # state where the cruise law (61) takes over
+            key = "handover" if case.cruise_entry == "creep" else "cruise"
+            if math.isfinite(fine[f"lam_at_{key}"]):
+                sw = switch_check(cs, fine[f"v_at_{key}"], fine[f"lam_at_{key}"])
+            comfort = (None, None)
+            if spec.comfort is not None:
+                from .antiskid_comfort import comfort_of
+                u_peak = cs.u_range / spec.torque_range
+                comfort = tuple(comfort_of(r, spec.comfort, u_peak, RECORD_DT)
+                                for r in (run2, run1))
+            cases.append(CaseResult(case, fine, coarse, conv, run2, sw, *comfort))
+        return cases
+
+    def quantities(self, res: RunResult) -> dict:
+        nan2none = lambda x: None if x is None or (isinstance(x, float) and math.isnan(x)) else x
+        q = {"operating_point.lambda_opt": res.lambda_opt, "operating_point.lambda_d": res.lambda_d,
+             "gain.K1": res.K[0], "gain.K2": res.K[1], "gain.h_certified": res.h_certified,
+             "linear.finite.h_star": res.linear.finite_margin.h,
+             "linear.paper.exact_margin": res.linear.paper_margin.h,
+             "linear.paper.max_envelope_ratio": max(r for _, r in res.linear.ratios_paper)}
+        for fac, _, r in res.linear.ratios_finite:
+            q[f"linear.finite.ratio[{fac:g}]"] = r
+        for c in res.cases:
+            b = f"cases[{c.case.name}]"
+            for k in METRICS:
+                q[f"{b}.{k}"] = nan2none(c.metrics[k])
+            q[f"{b}.diverged"] = "no" if math.isnan(c.metrics["t_diverged"]) else "yes"
+            q[f"{b}.stopped"] = "yes" if math.isfinite(c.metrics["braking_duration"]) else "no"
+            q[f"{b}.converged"] = "yes" if all(c.converged.values()) else "no"
+            sw = c.switch
+            q[f"{b}.switch.abscissa"] = None if sw is None else sw.abscissa
+            q[f"{b}.switch.margin"] = None if sw is None else sw.margin.h
+            q[f"{b}.switch.dmu_dlam"] = None if sw is None else sw.dmu_dlam
+            if c.comfort is not None:
+                from .antiskid_comfort import comfort_quantities
+                q.update(comfort_quantities(c.case.name, c.comfort, c.comfort_coarse))
+        if res.montecarlo is not None:
+            from .antiskid_halving import halving_quantities
+            from .antiskid_montecarlo import montecarlo_quantities
+            q.update(montecarlo_quantities(res.montecarlo))
+            if res.halving is not None:
+                q.update(halving_quantities(res.halving))
+        if res.basin is not None:
+            from .antiskid_basin_run import basin_quantities
+            q.update(basin_quantities(res.basin.basin, res.basin.sweep,
+                                      [c.case.name for c in res.cases], res.basin.brake))
+        if res.sampled is not None:
+            from .antiskid_sampled import sampled_quantities
+            q.update(sampled_quantities(res.sampled))
+        return q
+
+
+STUDY = AntiskidRun()

@@ -1,0 +1,105 @@
+"""Figures of the ``antiskid-run`` study: draw functions of matplotlib
+figures, pure functions of the study result (see
+:mod:`workbench.papers.p003.antiskid_run_render`)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, CreepSpeedProfile
+from ...sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
+
+_COLORS = {"paper": "tab:red", "compensated": "tab:blue", "uncompensated": "tab:orange",
+           "recursive": "tab:purple"}
+
+
+def color_of(name: str) -> str:
+    """The colour of a case in every figure."""
+    return _COLORS.get(name, "tab:green")
+
+
+def plot_speed(fig, res):
+    ax = fig.add_subplot(111)
+    for c in res.cases:
+        r = c.run
+        v, lam = r.x
+        vw = np.where(lam >= 0, v / (1 - np.minimum(lam, 0.999)), v * (1 + lam))
+        ax.plot(r.t, v, color=color_of(c.case.name), label=f"{c.case.name}: v")
+        ax.plot(r.t, vw, color=color_of(c.case.name), ls=":", label=f"{c.case.name}: v_w")
+    vmax = max(float(np.nanmax(c.run.x[0])) for c in res.cases)
+    ax.set_ylim(-5.0, 1.3 * vmax)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("speed (m/s), clipped")
+    ax.legend(fontsize=7, ncol=2)
+
+
+def plot_creep(fig, res):
+    ax1, ax2 = fig.subplots(2, 1)
+    for ax in (ax1, ax2):
+        for c in res.cases:
+            r = c.run
+            ax.plot(r.t, np.clip(r.x[1], -1, 1), color=color_of(c.case.name), label=c.case.name)
+        ax.axhline(res.lambda_opt, color="k", ls="--", lw=0.8, label="lambda_opt")
+        ax.axhline(res.lambda_d, color="gray", ls=":", lw=0.8, label="lambda_d")
+        ax.set_ylabel("creep ratio")
+    t_c = min((c.metrics["t_cruise"] for c in res.cases
+               if not math.isnan(c.metrics["t_cruise"])), default=0.0)
+    ax1.set_ylim(-0.2, 0.3)
+    ax2.set_xlim(t_c - 1.0, t_c + 3.0)
+    ax2.set_ylim(-0.1, 1.0)
+    ax2.set_xlabel("t (s)")
+    ax1.legend(fontsize=7, ncol=3)
+
+
+def plot_adhesion(fig, res, spec):
+    from ...plants.adhesion import NumericAdhesion
+    from .antiskid_run_spec import plant_values
+    mu = NumericAdhesion.from_dict(plant_values(spec, spec.mass_factor)).mu
+    lam = np.linspace(-0.6, 0.6, 601)
+    ax_mu, ax_pp = fig.subplots(1, 2)
+    ax_mu.plot(lam, mu(lam), color="k", lw=1.0, label="mu(lambda), plant")
+    for c in res.cases:
+        x = np.clip(c.run.x[1], -0.6, 0.6)
+        ax_mu.plot(x, mu(x), ".", ms=2, color=color_of(c.case.name), label=c.case.name)
+        ax_pp.plot(c.run.x[0], np.clip(c.run.x[1], -1, 1), color=color_of(c.case.name), lw=0.8,
+                   label=c.case.name)
+        ax_pp.plot(c.run.x[0][0], c.run.x[1][0], "o", color=color_of(c.case.name), ms=4)
+        ax_pp.plot(c.run.x[0][-1], np.clip(c.run.x[1][-1], -1, 1), "x",
+                   color=color_of(c.case.name), ms=6)
+    for a in (res.lambda_opt, -res.lambda_opt):
+        ax_mu.axvline(a, color="gray", ls="--", lw=0.8)
+    ax_mu.set_xlabel("creep ratio lambda")
+    ax_mu.set_ylabel("adhesion coefficient mu")
+    ax_mu.legend(fontsize=7)
+    ax_pp.axhline(res.lambda_opt, color="gray", ls="--", lw=0.8)
+    ax_pp.set_xlabel("v (m/s)")
+    ax_pp.set_ylabel("lambda (clipped to ±1)")
+
+
+def plot_evs(fig, res, spec):
+    ax = fig.add_subplot(111)
+    prof = CreepSpeedProfile(t_brake=spec.scenario["t_brake"], **spec.profile)
+    r_wheel = spec.params["r"].value
+    for c in res.cases:
+        r = c.run
+        sel = (r.phase == BRAKE) | (r.phase == BRAKE_IN)
+        if not sel.any():
+            continue
+        t, v, lam = r.t[sel], r.x[0][sel], r.x[1][sel]
+        om = wheel_speed(np.maximum(v, 1e-3), lam, r_wheel, ArrayOps)
+        vs, _ = prof(t, v, 0 * v, om, ArrayOps)
+        ax.plot(t, creep_speed(v, lam, ArrayOps) - vs, color=color_of(c.case.name), label=c.case.name)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("e_vs = v_s - v_s* (m/s)")
+    ax.set_ylim(-0.3, 0.3)
+    ax.legend(fontsize=7)
+
+
+def plot_linear(fig, res):
+    ax = fig.add_subplot(111)
+    for (fac, h, _), r in zip(res.linear.ratios_finite, res.linear.runs):
+        ax.semilogy(r.t, np.linalg.norm(r.x, axis=0) + 1e-300, label=f"h = {fac:g} h*")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("|E|")
+    ax.legend(fontsize=7)

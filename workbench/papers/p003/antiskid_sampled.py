@@ -1,0 +1,336 @@
+"""Sampled-data antiskid (issue 20): the laws of paper 003 run as a real
+controller at a fixed rate f_c, inside the ``antiskid-run`` study.
+
+Design table (optional; absent: no sampled section)::
+
+    [sampled]
+    case = "compensated"          # the [[cases]] entry whose controller is sampled
+    rates_hz = [5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0]
+    creep_margin = 0.001          # traction requirement lambda <= lambda_opt (1 + creep_margin)
+    plant_step = 1e-4             # s, largest plant sub-step (mesh checked at its half)
+    predictor_step = 1e-3         # s, the predictor steps over >= this many held samples
+    bisect = 4                    # bisection steps on f_c below the lowest passing grid rate
+    quantisation = { value = 8.0, unit = "N m", source = "..." }        # optional
+    measurement_delay = { value = 0.002, unit = "s", source = "..." }   # optional
+
+What a sampled controller is (:mod:`.antiskid_sampled_kernel`): the state
+measured ``measurement_delay`` before each sample t_k = k / f_c, the law of
+the case evaluated once with the printed hold (``sampling = "zoh"``, no
+mismatch estimate), the torque rounded to a multiple of ``quantisation`` and
+held until the next sample; the wheel receives it h later. The predictor
+covers the known loop delay h + ``measurement_delay`` and steps through the
+commands it sent, ``predictor_step`` at a time (whole samples, their exact
+average). The plant is integrated on a mesh of sub-steps <= ``plant_step``
+that does not depend on f_c.
+
+Two scenarios per rate, each only as long as its requirement needs:
+*traction* from the design's initial state until :data:`~.antiskid_sampled_kernel.TRACTION_TAIL` s
+after the cruise law took over (requirement: no divergence, the cruise law
+reached, lambda <= lambda_opt (1 + creep_margin) throughout); *braking* from
+the cruise equilibrium (v_d, lambda_d) :data:`~.antiskid_sampled_kernel.BRAKING_LEAD` s before
+t_brake, until v <= v_stop (requirement: the stop is reached without
+divergence). Variants: ``zoh`` (exact, current samples, unquantised) and,
+when the design gives a quantisation or a measurement delay, ``zoh_q_tau``.
+The *emulation* row is the case's controller as the other sections run it
+(every step of dt/2, the stiff hold with its mismatch estimate, the plant
+stepped with the control step), in the same two scenarios.
+
+The lowest passing rate is the lowest grid rate from which every higher grid
+rate passes; between it and the grid rate below, ``bisect`` steps on log f_c
+give a bracket (assuming one crossing in between). Checks: every grid rate up
+to :data:`MESH_CHECK_MAX_HZ` again at ``plant_step`` / 2
+(:data:`MESH_ATOL`), and the plant's mesh against scipy's Radau
+(:mod:`.antiskid_sampled_check`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...reader import Quantity
+from .antiskid_sampled_check import RADAU_QUANTITIES, radau_checks, radau_quantities
+from .antiskid_sampled_kernel import Context, run_once
+
+#: Grid rates up to this (Hz) are run again at plant_step / 2.
+MESH_CHECK_MAX_HZ = 1000.0
+#: Largest difference between plant_step and plant_step / 2 for the mesh check.
+MESH_ATOL = {"lam_max_over_opt": 2e-5, "t_cruise": 0.005, "braking_duration": 0.05,
+             "stop_distance": 0.5, "lam_min_brake": 2e-4, "evs_max_tracking": 2e-4}
+#: Metrics of a rate (quantities ``sampled.<variant>.rate[<f>].<metric>``).
+RATE_METRICS = ("lam_max_over_opt", "time_above", "t_cruise", "u_max_over_peak",
+                "braking_duration", "stop_distance", "lam_min_brake", "evs_max_tracking",
+                "omega3_after_brake", "traction_ok", "braking_ok", "ok")
+#: Rates (Hz, those of the grid) and seconds of the traction traces of the figure.
+TRACE_RATES_HZ, TRACE_SECONDS = (100.0, 1000.0), 4.0
+#: Metrics compared between the highest grid rate and the emulation.
+GAP_METRICS = ("lam_max_over_opt", "t_cruise", "braking_duration", "stop_distance")
+
+
+@dataclass(frozen=True)
+class SampledSpec:
+    """The design's ``[sampled]`` table (module docstring)."""
+
+    case: str
+    rates: tuple
+    creep_margin: float
+    plant_step: float
+    predictor_step: float
+    bisect: int
+    quantisation: Quantity | None
+    measurement_delay: Quantity | None
+
+    def variants(self) -> tuple:
+        """((name, q in N m, tau in s), ...): ``zoh``, and ``zoh_q_tau`` when
+        the design gives a quantisation or a measurement delay."""
+        q = 0.0 if self.quantisation is None else self.quantisation.value
+        tau = 0.0 if self.measurement_delay is None else self.measurement_delay.value
+        return (("zoh", 0.0, 0.0),) + ((("zoh_q_tau", q, tau),) if q or tau else ())
+
+
+def load_sampled(root, case_names) -> SampledSpec | None:
+    """Read ``[sampled]`` from a run design (a :class:`workbench.reader.Reader`);
+    None when absent."""
+    if not root.has("sampled"):
+        return None
+    t = root.table("sampled")
+    case = t.string("case", choices=tuple(case_names))
+    rates = t.numbers("rates_hz", positive=True, what="rates (Hz)")
+    if any(not b > a for a, b in zip(rates, rates[1:])) or not 1.0 <= rates[0] or \
+            not rates[-1] <= 1e5:
+        raise t.fail("rates_hz", list(rates), "rates in Hz, increasing, within [1, 100000]")
+    out = SampledSpec(
+        case, rates, t.number("creep_margin", nonneg=True, hi=0.1),
+        t.number("plant_step", positive=True, hi=1e-3, what="number (s)"),
+        t.number("predictor_step", positive=True, hi=0.1, what="number (s)"),
+        t.number("bisect", integer=True, default=4, lo=0, hi=12, what="integer"),
+        t.quantity("quantisation", "N m", positive=True, default=None),
+        t.quantity("measurement_delay", "s", nonneg=True, hi=0.5, default=None))
+    t.finish()
+    return out
+
+
+@dataclass(frozen=True)
+class RateRow:
+    """Both scenarios at one rate (``rate`` NaN: the emulation row).
+
+    ``metrics``: :data:`RATE_METRICS` plus ``traction_diverged`` and
+    ``braking_diverged`` (the time each run was declared diverged, NaN: not)."""
+
+    rate: float
+    metrics: dict
+    probe: bool = False       # a bisection rate, not on the grid
+
+    @property
+    def ok(self) -> bool:
+        return self.metrics["ok"] == "yes"
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One sampled controller over the grid.
+
+    ``min_rate``: lowest grid rate from which every higher grid rate passes
+    (None: the highest fails); ``bracket``: (highest failing, lowest passing)
+    rate known after bisection (None on a side with no rate);
+    ``mesh``: (rate, agree, {metric: |difference|}) of the mesh check."""
+
+    name: str
+    q: float
+    tau: float
+    rows: tuple
+    probes: tuple
+    min_rate: float | None
+    bracket: tuple
+    mesh: tuple
+
+    def row(self, rate: float) -> RateRow:
+        return next(r for r in self.rows if r.rate == rate)
+
+
+@dataclass(frozen=True)
+class Trace:
+    """lambda / lambda_opt - 1 on the plant's mesh from the start of traction."""
+
+    variant: str              # a variant's name, or "emulation"
+    rate: float
+    t: np.ndarray
+    excess: np.ndarray
+
+
+@dataclass(frozen=True)
+class SampledResult:
+    """Everything the sampled section shows (:func:`run_sampled`)."""
+
+    spec: SampledSpec
+    lambda_opt: float
+    u_peak: float
+    emulation: RateRow
+    emulation_dt: float
+    variants: tuple
+    radau: tuple = ()         # antiskid_sampled_check.RadauCheck
+    traces: tuple = ()        # Trace
+
+    def variant(self, name: str) -> Variant:
+        return next(v for v in self.variants if v.name == name)
+
+    def to_json(self) -> dict:
+        rows = lambda rr: [{"rate_hz": r.rate, **r.metrics} for r in rr]
+        return {"emulation": self.emulation.metrics,
+                "variants": {v.name: {"q": v.q, "tau": v.tau, "rows": rows(v.rows),
+                                      "probes": rows(v.probes), "min_rate": v.min_rate,
+                                      "bracket": list(v.bracket)} for v in self.variants},
+                "radau": [dataclasses.asdict(c) for c in self.radau]}
+
+
+def rate_metrics(ctx: Context, trac: dict, brake: dict) -> dict:
+    """:data:`RATE_METRICS` of one rate from its two runs (NaN: not reached)."""
+    lo = ctx.cs.lambda_opt
+    t_ok = (math.isnan(trac["t_diverged"]) and not math.isnan(trac["t_handover"])
+            and trac["lam_max"] / lo <= 1 + ctx.margin)
+    b_ok = math.isnan(brake["t_diverged"]) and not math.isnan(brake["t_stop"])
+    div = not math.isnan(trac["t_diverged"])
+    return {"lam_max_over_opt": math.nan if div else trac["lam_max"] / lo,
+            "time_above": trac["time_above"], "t_cruise": trac["t_cruise"],
+            "u_max_over_peak": max(trac["u_max_abs"], brake["u_max_abs"]) / ctx.u_peak,
+            "braking_duration": brake["t_stop"] - ctx.t_brake,
+            "stop_distance": brake["stop_distance"] if b_ok else math.nan,
+            "lam_min_brake": brake["lam_min"] if b_ok else math.nan,
+            "evs_max_tracking": brake["evs_max"],
+            "omega3_after_brake": brake["t_omega3"] - ctx.t_brake,
+            "traction_ok": "yes" if t_ok else "no", "braking_ok": "yes" if b_ok else "no",
+            "ok": "yes" if t_ok and b_ok else "no",
+            "traction_diverged": trac["t_diverged"], "braking_diverged": brake["t_diverged"]}
+
+
+def rate_row(ctx: Context, rate: float, *, dt_p: float, predictor_step: float,
+             q: float = 0.0, tau: float = 0.0, emulation: bool = False,
+             probe: bool = False) -> RateRow:
+    """Both scenarios at one rate."""
+    kw = dict(q=q, tau=tau, dt_p=dt_p, predictor_step=predictor_step, emulation=emulation)
+    trac, _ = run_once(ctx, rate, 0, **kw)
+    brake, _ = run_once(ctx, rate, 1, **kw)
+    return RateRow(rate, rate_metrics(ctx, trac, brake), probe)
+
+
+def _bisect(ctx, spec: SampledSpec, q, tau, lo: float, hi: float) -> tuple:
+    """Rates probed between a failing ``lo`` and a passing ``hi`` (Hz),
+    geometric midpoints rounded to whole Hz; returns (probes, lo, hi)."""
+    probes = []
+    for _ in range(spec.bisect):
+        mid = float(round(math.sqrt(lo * hi)))
+        if not lo < mid < hi:
+            break
+        row = rate_row(ctx, mid, dt_p=spec.plant_step, predictor_step=spec.predictor_step,
+                       q=q, tau=tau, probe=True)
+        probes.append(row)
+        lo, hi = (lo, mid) if row.ok else (mid, hi)
+    return tuple(probes), lo, hi
+
+
+def _mesh_check(ctx, spec, q, tau, rows) -> tuple:
+    """Grid rates up to MESH_CHECK_MAX_HZ again at plant_step / 2:
+    (rate, agree, {metric: |difference|})."""
+    out = []
+    for row in rows:
+        if row.rate > MESH_CHECK_MAX_HZ:
+            continue
+        fine = rate_row(ctx, row.rate, dt_p=spec.plant_step / 2,
+                        predictor_step=spec.predictor_step, q=q, tau=tau)
+        diffs, agree = {}, fine.metrics["ok"] == row.metrics["ok"]
+        for k, tol in MESH_ATOL.items():
+            a, b = row.metrics[k], fine.metrics[k]
+            same_nan = math.isnan(a) and math.isnan(b)
+            d = 0.0 if same_nan else abs(a - b)
+            diffs[k] = d
+            agree = agree and (same_nan or d <= tol)
+        out.append((row.rate, agree, diffs))
+    return tuple(out)
+
+
+def run_variant(ctx: Context, spec: SampledSpec, name: str, q: float, tau: float) -> Variant:
+    """The grid, the lowest passing rate, its bisection bracket and the mesh check."""
+    kw = dict(dt_p=spec.plant_step, predictor_step=spec.predictor_step, q=q, tau=tau)
+    rows = tuple(rate_row(ctx, f, **kw) for f in spec.rates)
+    min_rate = None
+    for r in reversed(rows):
+        if not r.ok:
+            break
+        min_rate = r.rate
+    probes, bracket = (), (None, min_rate)
+    if min_rate is not None and min_rate > spec.rates[0]:
+        below = spec.rates[spec.rates.index(min_rate) - 1]
+        probes, lo, hi = _bisect(ctx, spec, q, tau, below, min_rate)
+        bracket = (lo, hi)
+    elif min_rate is None:
+        bracket = (spec.rates[-1], None)
+    return Variant(name, q, tau, rows, probes, min_rate, bracket,
+                   _mesh_check(ctx, spec, q, tau, rows))
+
+
+def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:
+    """The sampled section of an ``antiskid-run`` design with ``[sampled]``
+    (``ctx``: :func:`workbench.papers.p003.antiskid_run_spec.sampled_context`;
+    ``dt``: the design's step, the emulation runs at dt/2): the emulation
+    row, every variant, the Radau check, the traces of the figure."""
+    dt_e = dt / 2
+    emu = rate_row(ctx, 1.0 / dt_e, dt_p=dt_e, predictor_step=0.0, emulation=True)
+    variants = tuple(run_variant(ctx, spec, *v) for v in spec.variants())
+    return SampledResult(spec, ctx.cs.lambda_opt, ctx.u_peak, emu, dt_e, variants,
+                         radau_checks(ctx, spec), traces(ctx, spec, dt_e))
+
+
+def traces(ctx: Context, spec: SampledSpec, dt_e: float) -> tuple:
+    """The first :data:`TRACE_SECONDS` of traction of each variant at
+    :data:`TRACE_RATES_HZ` (grid rates only) and of the emulation."""
+    runs = [(name, f, dict(q=q, tau=tau, dt_p=spec.plant_step,
+                           predictor_step=spec.predictor_step))
+            for name, q, tau in spec.variants() for f in TRACE_RATES_HZ if f in spec.rates]
+    runs.append(("emulation", 1.0 / dt_e, dict(dt_p=dt_e, emulation=True)))
+    out = []
+    for name, f, kw in runs:
+        cap = int(TRACE_SECONDS / min(kw["dt_p"], 1.0 / f)) * 3 + 16
+        _, (rec, _) = run_once(ctx, f, 0, record=(0.0, TRACE_SECONDS, cap),
+                               t_cap=TRACE_SECONDS, **kw)
+        out.append(Trace(name, f, rec[:, 0].copy(), rec[:, 2] / ctx.cs.lambda_opt - 1.0))
+    return tuple(out)
+
+
+def _q(x):
+    """A quantity value: None for NaN."""
+    return None if isinstance(x, float) and math.isnan(x) else x
+
+
+def sampled_quantity_names(spec: SampledSpec) -> set[str]:
+    """The ``sampled.*`` quantities a design with ``[sampled]`` has."""
+    names = {f"sampled.emulation.{m}" for m in RATE_METRICS} | set(RADAU_QUANTITIES)
+    for name, _, _ in spec.variants():
+        b = f"sampled.{name}"
+        names |= {f"{b}.min_rate", f"{b}.bracket_low", f"{b}.bracket_high",
+                  f"{b}.mesh_converged"}
+        names |= {f"{b}.gap_to_emulation.{m}" for m in GAP_METRICS}
+        names |= {f"{b}.rate[{f:g}].{m}" for f in spec.rates
+                  for m in RATE_METRICS + ("stop_time_minus_emulation",)}
+    return names
+
+
+def sampled_quantities(res: SampledResult) -> dict:
+    """Values of :func:`sampled_quantity_names`."""
+    q = {f"sampled.emulation.{m}": _q(res.emulation.metrics[m]) for m in RATE_METRICS}
+    q.update(radau_quantities(res.radau, res.lambda_opt))
+    for v in res.variants:
+        b = f"sampled.{v.name}"
+        q[f"{b}.min_rate"] = v.min_rate
+        q[f"{b}.bracket_low"], q[f"{b}.bracket_high"] = v.bracket
+        q[f"{b}.mesh_converged"] = "yes" if all(a for _, a, _ in v.mesh) else "no"
+        top = v.rows[-1].metrics
+        for m in GAP_METRICS:
+            q[f"{b}.gap_to_emulation.{m}"] = _q(abs(top[m] - res.emulation.metrics[m]))
+        emu_stop = res.emulation.metrics["braking_duration"]
+        for r in v.rows:
+            q.update({f"{b}.rate[{r.rate:g}].{m}": _q(r.metrics[m]) for m in RATE_METRICS})
+            q[f"{b}.rate[{r.rate:g}].stop_time_minus_emulation"] = _q(
+                r.metrics["braking_duration"] - emu_stop)
+    return q

@@ -1,0 +1,127 @@
+"""Independent check of the sampled runs' plant integration against scipy's
+Radau (issue 20).
+
+The sampled loop (:mod:`.antiskid_sampled_kernel`) integrates the plant by
+exponential-Euler sub-steps of at most ``plant_step``. Here the torque the
+wheel received in a window of a run (piecewise constant: the held,
+delayed commands) is replayed open loop into
+:func:`scipy.integrate.solve_ivp` (``method="Radau"``, an implicit,
+stiffly accurate Runge-Kutta method of order 5, tight tolerances), restarted
+at each change of the torque from its own previous end point, and both
+trajectories are compared at every mesh point of the window. The right-hand
+side is the lambdified sympy model of :mod:`workbench.sim.wheel_slip` (the
+traction form for lambda >= 0, the braking form otherwise; speed floored as
+the plant step floors it), not a retyped one.
+
+Windows (:data:`WINDOWS`): the start of traction, from the arrival of the
+first command at t = h (3 m/s: the creep ratio's time constant ~ v/4000 s is
+about 1 ms), braking where the wheel speed
+reaches 3 rad/s (v ~ 1.3 m/s) and the last part of the stop (v -> v_stop,
+time constant ~ 10 microseconds), each at the rates :data:`RADAU_RATES_HZ`
+of the ``zoh`` variant.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...sim.wheel_slip import model_functions
+from .antiskid_sampled_kernel import run_once
+
+#: Rates (Hz) of the check (those of the design's grid).
+RADAU_RATES_HZ = (100.0, 1000.0)
+#: Names of the windows (module docstring); each is :data:`WINDOW_SAMPLES` samples long.
+WINDOWS = ("traction start", "braking at omega = 3 rad/s", "braking, last stretch to the stop")
+#: Length of a window in samples of its rate (0.4 s at 100 Hz, 40 ms at 1 kHz).
+WINDOW_SAMPLES = 40
+#: solve_ivp tolerances: rtol, and atol of (v, lambda).
+RTOL, ATOL = 1e-10, (1e-10, 1e-13)
+#: Quantities of the check.
+RADAU_QUANTITIES = ("sampled.radau.max_dlam_over_opt", "sampled.radau.max_dv_rel",
+                    "sampled.radau.windows")
+
+
+@dataclass(frozen=True)
+class RadauCheck:
+    """One window: times (s), speed range (m/s), torque pieces replayed, and
+    the largest |lambda_mesh - lambda_Radau| and |v_mesh - v_Radau| / v over
+    its mesh points."""
+
+    rate: float
+    window: str
+    t0: float
+    t1: float
+    v_lo: float
+    v_hi: float
+    pieces: int
+    points: int
+    max_dlam: float
+    max_dv_rel: float
+
+
+def _rhs(p, u):
+    fns = model_functions("math")
+
+    def f(t, x):
+        v, lam = x
+        y = fns["traction" if lam >= 0 else "braking"](max(v, 1e-3), lam, *p)
+        return (y[0], y[1] + y[2] * u)
+    return f
+
+
+def replay(p, rec: np.ndarray) -> tuple[float, float, int]:
+    """(max |d lambda|, max |d v| / v, pieces) of the mesh record ``rec``
+    (rows t, v, lambda, torque over the sub-step ending at t) against Radau
+    from its first row."""
+    from scipy.integrate import solve_ivp
+    x = rec[0, 1:3].copy()
+    dl = dv = 0.0
+    i, n, pieces = 1, len(rec), 0
+    while i < n:
+        j = i
+        while j + 1 < n and rec[j + 1, 3] == rec[i, 3]:
+            j += 1
+        ts = rec[i:j + 1, 0]
+        sol = solve_ivp(_rhs(p, rec[i, 3]), (rec[i - 1, 0], ts[-1]), x, method="Radau",
+                        t_eval=ts, rtol=RTOL, atol=ATOL)
+        if not sol.success:
+            return math.nan, math.nan, pieces
+        dl = max(dl, float(np.max(np.abs(sol.y[1] - rec[i:j + 1, 2]))))
+        dv = max(dv, float(np.max(np.abs(sol.y[0] - rec[i:j + 1, 1]) / rec[i:j + 1, 1])))
+        x = sol.y[:, -1]
+        i, pieces = j + 1, pieces + 1
+    return dl, dv, pieces
+
+
+def radau_checks(ctx, spec) -> tuple:
+    """:class:`RadauCheck` of every window at every rate of
+    :data:`RADAU_RATES_HZ` in the design's grid (``zoh``, unquantised)."""
+    out = []
+    for rate in (f for f in RADAU_RATES_HZ if f in spec.rates):
+        kw = dict(dt_p=spec.plant_step, predictor_step=spec.predictor_step)
+        brake, _ = run_once(ctx, rate, 1, **kw)
+        length = WINDOW_SAMPLES / rate
+        starts = (ctx.h, brake["t_omega3"] - length / 2, brake["t_stop"] - length)
+        for name, t0, scen in zip(WINDOWS, starts, (0, 1, 1)):
+            if math.isnan(t0):
+                continue
+            cap = int(length / spec.plant_step * 1.5) + 4 * int(length * rate) + 16
+            _, (rec, _) = run_once(ctx, rate, scen, record=(t0, t0 + length, cap), **kw)
+            if len(rec) < 2:
+                continue
+            dl, dv, pieces = replay(ctx.plant, rec)
+            out.append(RadauCheck(rate, name, float(rec[0, 0]), float(rec[-1, 0]),
+                                  float(rec[:, 1].min()), float(rec[:, 1].max()), pieces,
+                                  len(rec), dl, dv))
+    return tuple(out)
+
+
+def radau_quantities(checks, lambda_opt: float) -> dict:
+    """The :data:`RADAU_QUANTITIES` (None without a check)."""
+    if not checks:
+        return dict.fromkeys(RADAU_QUANTITIES)
+    return {"sampled.radau.max_dlam_over_opt": max(c.max_dlam for c in checks) / lambda_opt,
+            "sampled.radau.max_dv_rel": max(c.max_dv_rel for c in checks),
+            "sampled.radau.windows": len(checks)}

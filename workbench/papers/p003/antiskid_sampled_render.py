@@ -1,0 +1,262 @@
+"""Markdown and figures of the sampled-data section of an antiskid run
+(:mod:`workbench.papers.p003.antiskid_sampled`; pure rendering)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...report.markdown import Figure, fmt, md_table
+from .antiskid_sampled import MESH_ATOL, MESH_CHECK_MAX_HZ, TRACE_SECONDS
+from .antiskid_sampled_check import RTOL, WINDOW_SAMPLES
+from .antiskid_sampled_kernel import BRAKING_LEAD, EVS_SETTLE, TRACTION_TAIL
+
+#: Heading of the section (findings on its quantities link here).
+HEADING = "Sampled-data controller: rate f_c, zero-order hold"
+#: Quantities the section shows (a pattern for :class:`~workbench.report.markdown.Rendered`).
+PATTERN = r"sampled\."
+#: The emulation row's label.
+EMULATION = "emulation (continuous law, step-dependent)"
+_COLORS = {"zoh": "tab:blue", "zoh_q_tau": "tab:red", "emulation": "k"}
+#: m/s, the bound of the run designs' creep-speed-tracking claim (drawn for reference).
+EVS_BOUND = 0.01
+
+
+def variant_label(v) -> str:
+    """What a variant is, in words."""
+    if v.name == "zoh":
+        return "ZOH (exact samples, unquantised torque)"
+    parts = [f"torque quantised to {fmt(v.q)} N m" if v.q else "",
+             f"measurement delay {fmt(1e3 * v.tau)} ms" if v.tau else ""]
+    return "ZOH, " + ", ".join(p for p in parts if p)
+
+
+def _outcome(m: dict, which: str) -> str:
+    t = m[f"{which}_diverged"]
+    if not math.isnan(t):
+        return f"diverged, t = {fmt(t, 4)} s"
+    if m[f"{which}_ok"] == "yes":
+        return "meets"
+    if which == "traction" and not math.isnan(m["lam_max_over_opt"]):
+        return "λ > requirement"
+    return "no cruise" if which == "traction" else "no stop"
+
+
+def _row(label: str, m: dict) -> list:
+    n = lambda k, sig: fmt(None if math.isnan(m[k]) else m[k], sig)
+    return [label, n("lam_max_over_opt", 7), n("time_above", 2), n("t_cruise", 5),
+            _outcome(m, "traction"), n("braking_duration", 3), n("stop_distance", 4),
+            n("lam_min_brake", 3), n("evs_max_tracking", 2), n("u_max_over_peak", 3),
+            _outcome(m, "braking")]
+
+
+def _why(v, spec) -> str:
+    """Which requirement the highest failing rate misses (for the summary)."""
+    lo = v.bracket[0]
+    if lo is None:
+        return ""
+    row = next(r for r in v.rows + v.probes if r.rate == lo)
+    miss = [w for w in ("traction", "braking") if row.metrics[f"{w}_ok"] == "no"]
+    return f"; at {fmt(lo)} Hz it fails in " + " and ".join(
+        f"{w} ({_outcome(row.metrics, w)})" for w in miss)
+
+
+def summary_lines(res) -> list[str]:
+    """One line per variant: the lowest passing rate and its bracket."""
+    out = []
+    for v in res.variants:
+        if v.min_rate is None:
+            out.append(f"- **{variant_label(v)}**: no rate of the grid meets both "
+                       f"requirements from {fmt(v.bracket[0])} Hz up.")
+            continue
+        lo, hi = v.bracket
+        if lo is None:
+            refine = (f"every rate of the grid meets both; the grid does not go below "
+                      f"{fmt(v.min_rate)} Hz")
+        else:
+            refine = (f"bisection between the grid rates ({len(v.probes)} steps on log f_c, "
+                      f"whole Hz, assuming one crossing): fails at {fmt(lo)} Hz, meets at "
+                      f"{fmt(hi)} Hz" + _why(v, res.spec))
+        out.append(f"- **{variant_label(v)}**: lowest rate of the grid meeting both "
+                   f"requirements (and every higher grid rate) **{fmt(v.min_rate)} Hz**; "
+                   + refine + ".")
+    return out
+
+
+def sampled_section(res, rail: str) -> str:
+    """``## Sampled-data controller: rate f_c, zero-order hold``."""
+    sp = res.spec
+    q, tau = sp.quantisation, sp.measurement_delay
+    hw = ""
+    if q is not None:
+        hw += f" Quantisation: {fmt(q.value)} N m ({q.source})."
+    if tau is not None:
+        hw += f" Measurement delay: {fmt(1e3 * tau.value)} ms ({tau.source})."
+    head = ["f_c (Hz)", "max λ/λ_opt", f"time λ > λ_opt (1 + {fmt(sp.creep_margin)}) (s)",
+            "time to v_d (s)", "traction", "t_brake → stop (s)", "stop distance (m)",
+            "min λ, braking", "max e_vs (m/s)", "max |u| / T_adh", "braking"]
+    tables = []
+    for v in res.variants:
+        rows = [_row(f"{EMULATION}, dt/2 = {fmt(res.emulation_dt)} s", res.emulation.metrics)]
+        for r in sorted(v.rows + v.probes, key=lambda r: r.rate):
+            rows.append(_row(fmt(r.rate) + (" (bisection)" if r.probe else ""), r.metrics))
+        tables.append(f"**{variant_label(v)}**\n\n" + md_table(head, rows, "l" + "r" * 10))
+    return (
+        f"## {HEADING}\n\n"
+        "The other sections run the laws as an *emulation*: the law is evaluated at every "
+        "integration step and held as the torque that moves the stiff creep ratio of the "
+        "exponential-Euler step by the rate the continuous law asks for, with an estimate "
+        "of the model mismatch the paper does not have (see the numerics appendix); what "
+        "it computes depends on the step. Here the same case (`" + sp.case + "`) runs as a "
+        "sampled controller: the state is measured at t_k = k / f_c (optionally some time "
+        "before) and the printed law is evaluated once per sample, with the predictor of "
+        "eq (2) over the horizon h plus the measurement delay (its rollout steps through "
+        "the commands it sent, whole samples at a time and at least "
+        f"{fmt(1e3 * sp.predictor_step)} ms per step, with their exact average); the torque is "
+        "rounded to the command's step and held until the next sample (zero-order hold), "
+        "and the wheel receives it h later." + hw + " The plant is integrated on a mesh "
+        "independent of f_c: every stretch between two events (a measurement, a sample, a "
+        "command reaching the wheel) in equal exponential-Euler sub-steps of at most "
+        f"{fmt(1e3 * sp.plant_step)} ms under the torque held on it, the metrics taken on "
+        "that mesh (between samples too).\n\n"
+        f"Two scenarios per rate, each only as long as its requirement needs. *Traction*: "
+        f"from the design's initial state until {fmt(TRACTION_TAIL)} s after the cruise "
+        "law took over; it meets the requirement when nothing diverges, the cruise law is "
+        f"reached and lambda <= lambda_opt (1 + {fmt(sp.creep_margin)}) throughout. "
+        f"*Braking*: from the cruise equilibrium (v_d, lambda_d) {fmt(BRAKING_LEAD)} s "
+        "before t_brake; it meets the requirement when the train reaches v <= v_stop "
+        "without diverging. The emulation row is the case's controller as the other "
+        "sections run it (every step of dt/2, the plant stepped with it) in the same two "
+        f"scenarios. e_vs: largest creep-speed error |v_s - v_s*| of eq (76) from "
+        f"{fmt(EVS_SETTLE)} s after t_brake while omega > 3 rad/s (the run's own metric). "
+        f"T_adh: the peak adhesion torque mu(lambda_opt) m g r = {fmt(res.u_peak / 1e3, 3)} "
+        "kN m.\n\n"
+        f"**Lowest control rate meeting both requirements, {rail} rail:**\n\n"
+        + "\n".join(summary_lines(res)) + "\n\n" + "\n\n".join(tables)
+        + "\n\n![sampled]({figdir}/sampled.png)\n\n" + SAMPLED_CAPTION
+        + "\n\n![sampled traction]({figdir}/sampled-traction.png)\n\n"
+        + TRACE_CAPTION + "\n\n" + _checks_text(res))
+
+
+SAMPLED_CAPTION = (
+    "Metrics against the control rate f_c (log axis), one line per variant; dashed black: "
+    "the emulation; top left: max lambda / lambda_opt - 1 (symmetric-log axis, linear within "
+    "a thousandth of the margin) with lambda_opt (solid grey, 0) and the requirement "
+    "lambda_opt (1 + margin) (dotted); top right: e_vs with the "
+    f"{fmt(EVS_BOUND)} m/s of the creep-speed-tracking claim (dotted); bottom: the braking "
+    "run; × at the top of a panel: that scenario's run diverged at that rate (no value).")
+TRACE_CAPTION = (
+    f"The first {fmt(TRACE_SECONDS)} s of traction: lambda / lambda_opt - 1 on the plant's "
+    "mesh, where the approach to lambda_opt ends and the largest creep ratio of the run "
+    "falls; dotted: the requirement.")
+
+
+def bound(x: float) -> str:
+    """A small non-negative difference as the next power of ten above it
+    ("< 1e-6"; "0" for none): its leading digit moves with the CPU's
+    floating-point contractions, its size does not."""
+    if x == 0:
+        return "0"
+    if not x > 0:
+        return fmt(x)
+    return "< " + fmt(10.0 ** (math.floor(math.log10(x)) + 1))
+
+
+def _checks_text(res) -> str:
+    sp = res.spec
+    mesh = []
+    for v in res.variants:
+        for rate, agree, diffs in v.mesh:
+            mesh.append([variant_label(v), fmt(rate), "yes" if agree else "**no**"]
+                        + [bound(diffs[k]) for k in MESH_ATOL])
+    radau = [[fmt(c.rate), c.window, f"{fmt(c.t0, 5)}–{fmt(c.t1, 5)}",
+              f"{fmt(c.v_lo, 2)}–{fmt(c.v_hi, 2)}", str(c.pieces),
+              bound(c.max_dlam / res.lambda_opt), bound(c.max_dv_rel)] for c in res.radau]
+    tol = ", ".join(f"{k} {fmt(t)}" for k, t in MESH_ATOL.items())
+    return (
+        "**Checks of the plant's integration.** *Mesh*: every grid rate up to "
+        f"{fmt(MESH_CHECK_MAX_HZ)} Hz again with sub-steps of at most "
+        f"{fmt(1e3 * sp.plant_step / 2)} ms; largest differences of the metrics (tolerances: "
+        f"{tol}; the outcomes must agree):\n\n"
+        + md_table(["variant", "f_c (Hz)", "agree"] + list(MESH_ATOL), mesh, "lrl" + "r" *
+                   len(MESH_ATOL))
+        + "\n\n*Radau*: the torque the wheel received in a window of "
+        f"{WINDOW_SAMPLES} samples (ZOH variant) replayed into scipy's "
+        f"`solve_ivp(method=\"Radau\")` (rtol {fmt(RTOL)}), restarted from its own state at "
+        "every change of the torque, against the mesh at each of its points (the same "
+        "lambdified model):\n\n"
+        + md_table(["f_c (Hz)", "window", "t (s)", "v (m/s)", "torque pieces",
+                    "max |Δλ| / λ_opt", "max |Δv| / v"], radau, "lllrrrr")
+        + "\n\nWhy not Radau for every run: a sampled run restarts the integration at every "
+        "sample and every arriving command (10 000 restarts per simulated second at 5 kHz), "
+        "each with a creep-ratio transient of time constant ~v/4000 s to resolve; scipy's "
+        "Radau, restarted from Python, costs about a millisecond per restart (the replays "
+        "above), tens of minutes for one variant's grid; the compiled mesh takes seconds.")
+
+
+def sampled_figure(res) -> Figure:
+    """``sampled.png``: the metrics against f_c."""
+    return Figure("sampled", "Sampled-data controller: metrics against the control rate.",
+                  lambda fig, res=res: plot_sampled(fig, res), (9.0, 6.5))
+
+
+def trace_figure(res) -> Figure:
+    """``sampled-traction.png``: lambda / lambda_opt - 1 at the start of traction."""
+    return Figure("sampled-traction", "Creep ratio at the start of traction, sampled.",
+                  lambda fig, res=res: plot_traces(fig, res), (7.0, 4.0))
+
+
+def _series(v, key):
+    rows = sorted(v.rows + v.probes, key=lambda r: r.rate)
+    return (np.array([r.rate for r in rows]), np.array([r.metrics[key] for r in rows]),
+            rows)
+
+
+def plot_sampled(fig, res):
+    axes = fig.subplots(2, 2, sharex=True).ravel()
+    keys = (("lam_max_over_opt", "max λ / λ_opt − 1, traction (symlog)", "traction"),
+            ("evs_max_tracking", "max e_vs (m/s), braking", "braking"),
+            ("braking_duration", "t_brake → stop (s)", "braking"),
+            ("stop_distance", "stop distance (m)", "braking"))
+    shift = {"lam_max_over_opt": 1.0}          # the top left panel shows the excess over 1
+    for ax, (key, label, which) in zip(axes, keys):
+        d = shift.get(key, 0.0)
+        for v in res.variants:
+            f, y, rows = _series(v, key)
+            c = _COLORS.get(v.name, "tab:green")
+            ax.plot(f, y - d, "o-", color=c, ms=3, label=variant_label(v))
+            bad = [r.rate for r in rows if not math.isnan(r.metrics[f"{which}_diverged"])]
+            if bad:     # a diverged run: a cross at the top of the panel
+                ax.plot(bad, [0.97] * len(bad), "x", color=c, ms=7,
+                        transform=ax.get_xaxis_transform())
+        e = res.emulation.metrics[key]
+        if not math.isnan(e):
+            ax.axhline(e - d, color="k", ls="--", lw=0.8, label=EMULATION)
+        ax.set_xscale("log")
+        ax.set_ylabel(label)
+    m = res.spec.creep_margin
+    axes[0].axhline(0.0, color="grey", lw=0.8, label="λ_opt")
+    axes[0].axhline(m, color="dimgrey", ls=":", lw=1.0, label="requirement λ_opt (1 + margin)")
+    axes[0].set_yscale("symlog", linthresh=m / 1000)
+    axes[0].set_ylim(bottom=-m / 1000)
+    axes[1].axhline(EVS_BOUND, color="dimgrey", ls=":", lw=1.0)
+    axes[1].set_yscale("log")
+    for ax in axes[2:]:
+        ax.set_xlabel("control rate f_c (Hz)")
+    axes[0].legend(fontsize=6, loc="lower left")
+
+
+def plot_traces(fig, res):
+    ax = fig.add_subplot(111)
+    styles = {100.0: "-", 1000.0: "--"}
+    for tr in res.traces:
+        c = _COLORS.get(tr.variant, "tab:green")
+        label = (EMULATION if tr.variant == "emulation" else
+                 f"{variant_label(res.variant(tr.variant))}, {fmt(tr.rate)} Hz")
+        ax.plot(tr.t, tr.excess, color=c, lw=0.8, ls=styles.get(tr.rate, ":"), label=label)
+    ax.axhline(res.spec.creep_margin, color="dimgrey", ls=":", lw=1.0)
+    ax.axhline(0.0, color="grey", lw=0.8)
+    ax.set_ylim(-3 * res.spec.creep_margin, 2 * res.spec.creep_margin)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("λ / λ_opt − 1")
+    ax.legend(fontsize=6, loc="lower right")

@@ -1,0 +1,142 @@
+"""Markdown and figures of the ``closed-loop-brake`` study's retuning, sensor
+faults and Monte Carlo (pure rendering of a
+:class:`~workbench.papers.p004.closed_loop_brake.Result004`)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ...report.markdown import Figure, fmt, md_table
+from .closed_loop_brake import FAULTS, MC_FACTORS, MC_MODES
+
+MODE_LABEL = {"ato-open": "ATO open loop", "closed": "closed loop (analogue)"}
+
+
+def retune_section(spec, res) -> str:
+    """``## Retuned closed loop``: the horizon, the PID's damping, the nominal corner."""
+    p = {k: q.value for k, q in spec.params.items()}
+    nominal = dict(mode="closed", force_error=0.0, gradient=0.0, friction=1.0, fault="healthy",
+                   electric=True)
+    rows = []
+    for s in res.distance:
+        pick = lambda **kw: res.select(speed_kmh=s, **{**nominal, **kw})[0][1]
+        rows.append([fmt(s), fmt(pick(channel="analogue"), 3), fmt(pick(channel="3bit"), 3),
+                     fmt(pick(mode="ato-open", channel="analogue"), 3)])
+    d = res.damping
+    return (
+        "## Retuned closed loop (nominal corner)\n\n"
+        f"The ATO evaluates a_req = v_p² / (2 d_p) at the state predicted t_predict = "
+        f"{fmt(spec.t_predict, 3)} s ahead: the brake's dead time plus lag, T1 + T2 = "
+        f"{fmt(p['T1'] + p['T2'], 3)} s, the delay with which a dead time and a first-order lag "
+        "follow a ramp. Before, 0.5 s: less than the dead time alone, so the loop reacted to the "
+        "end of the stop only once it could no longer change it. The deceleration PID (kp "
+        f"{fmt(spec.pid['kp'])}, ki {fmt(spec.pid['ki'])}) is kept: on its linearised loop "
+        "(electric stage, dead time T1 plus one control period, the measurement filter; "
+        "`workbench/studies/pid_tuning.py`) its dominant roots have damping ratio "
+        f"{fmt(d.zeta, 2)} (decay rate {fmt(-d.alpha, 2)} 1/s), the criterion of paper 000's "
+        "PID (ζ ≥ 0.7) holds; the miss was the horizon, not the loop.\n\n"
+        "Stop error at the nominal corner (m, + = overshoot):\n\n"
+        + md_table(["km/h", "closed loop, analogue", "closed loop, 3-bit", "ATO open loop"],
+                   rows, "rrrr")
+        + f"\n\nThe residual overshoot is the hand-over from the electric to the air stage "
+        f"(at {fmt(3.6 * p['v_ho'], 3)} km/h): the air stage's lag T4 = {fmt(p['T4'])} s is "
+        "longer than the electric one, so the achieved deceleration dips in the last metres and "
+        "deceleration feedback can only react to the dip, not anticipate it (compare the "
+        "model-based terminal phase of designs/stopping-line5.toml). The figure sweeps the "
+        "horizon at the nominal corner.\n\n![horizon sweep]({figdir}/horizon-sweep.png)")
+
+
+def fault_text(spec) -> str:
+    return ("Axle states: o = healthy, s = sliding (reads "
+            f"{fmt(100 * spec.slide)} % low), f = failed (reads 0), h = reads high (× "
+            f"{fmt(spec.high_ratio)}, e.g. a wheel diameter set too large), z = stuck at its "
+            "reading when braking starts. Train speed = max of the four; the command generator "
+            "detects s and f (all four: fallback to the ATO open loop), not h or z. The ATO's "
+            "own position and speed are not from these sensors. A sensor reading high or stuck "
+            "high wins the max-of-4 selection: the reading-high case only scales the measured "
+            "deceleration, which the ATO's outer loop re-commands; the stuck one freezes the "
+            "measured speed, the loop sees no deceleration and winds the command up to full "
+            "service.\n\n![sensor faults]({figdir}/sensor-faults.png)")
+
+
+def mc_section(spec, res) -> str:
+    mc = spec.montecarlo
+    drows = [[f"`{k}`", MC_FACTORS[k][0], d.describe(), MC_FACTORS[k][1], d.source]
+             for k, d in mc.distributions.items()]
+    rows = []
+    for (s, m), st in res.mc.items():
+        rows.append([fmt(s), MODE_LABEL[m], f"{st.k} / {st.n}", fmt(st.p, 3),
+                     f"[{fmt(st.lo, 3)}, {fmt(st.hi, 3)}]", fmt(st.p95, 3), fmt(st.mean, 3),
+                     fmt(100 * st.overshoot, 3)])
+    tol = fmt(res.tolerance)
+    return (
+        f"## Monte Carlo: P(|e| ≤ {tol} m) over continuous distributions\n\n"
+        f"{mc.samples} draws (seed {mc.seed}; `workbench/studies/stopping_mc.py`), the same "
+        "draws for both modes and both speeds, analogue channel, healthy sensors; the stopping "
+        "point D is the nominal one of each speed.\n\n"
+        + md_table(["factor", "meaning", "distribution", "unit", "source"], drows, "lllll")
+        + "\n\n" + md_table(["km/h", "mode", f"stops within {tol} m", f"P(|e| ≤ {tol} m)",
+                             "Wilson 95 % interval", "95th percentile of |e| (m)",
+                             "mean e (m)", "overshoots (%)"], rows, "rlrrrrrr")
+        + "\n\n![Monte Carlo]({figdir}/mc-stop-errors.png)")
+
+
+def figures(spec, res) -> tuple[Figure, ...]:
+    return (Figure("horizon-sweep", "Closed-loop stop error at the nominal corner against the "
+                   "ATO's prediction horizon.",
+                   lambda fig, res=res, spec=spec: _plot_sweep(fig, res, spec), size=(6.4, 3.6)),
+            Figure("sensor-faults", "Stop error per axle-sensor case, nominal corner.",
+                   lambda fig, res=res: _plot_faults(fig, res), size=(7.0, 3.8)),
+            Figure("mc-stop-errors", "Monte Carlo stop errors per speed and mode.",
+                   lambda fig, res=res: _plot_mc(fig, res), size=(7.0, 3.8)))
+
+
+def _plot_sweep(fig, res, spec):
+    ax = fig.add_subplot(111)
+    for k, s in enumerate(res.distance):
+        pts = sorted((tp, e) for tp, sp_, e in res.sweep if sp_ == s)
+        ax.plot([a for a, _ in pts], [b for _, b in pts], "o-", color=f"C{k}",
+                label=f"{fmt(s)} km/h")
+    ax.axvline(spec.t_predict, color="k", lw=0.8, ls=":", label="chosen: T1 + T2")
+    ax.axhspan(-res.tolerance, res.tolerance, color="0.9", zorder=0, label=f"±{fmt(res.tolerance)} m")
+    ax.set_xlabel("ATO prediction horizon t_predict (s)")
+    ax.set_ylabel("stop error (m, + overshoot)")
+    ax.legend(fontsize=8)
+
+
+def _plot_faults(fig, res):
+    ax = fig.add_subplot(111)
+    cases = list(FAULTS)
+    speeds = list(res.distance)
+    y = np.arange(len(cases))
+    for k, s in enumerate(speeds):
+        err = [res.select(speed_kmh=s, fault=f, mode="closed", channel="analogue",
+                          force_error=0.0, gradient=0.0, friction=1.0, electric=True)[0][1]
+               for f in cases]
+        ax.barh(y + (k - (len(speeds) - 1) / 2) * 0.35, err, height=0.35, color=f"C{k}",
+                label=f"{fmt(s)} km/h")
+    ax.set_xscale("symlog", linthresh=0.3)
+    ax.axvspan(-res.tolerance, res.tolerance, color="0.9", zorder=0)
+    ax.set_yticks(y)
+    ax.set_yticklabels([f"{c} ({FAULTS[c]})" for c in cases], fontsize=8)
+    ax.invert_yaxis()
+    ax.set_xlabel(f"stop error (m, + overshoot; grey: ±{fmt(res.tolerance)} m)")
+    ax.legend(fontsize=8)
+
+
+def _plot_mc(fig, res):
+    speeds = sorted({s for s, _ in res.mc})
+    first = None
+    for i, s in enumerate(speeds):
+        ax = fig.add_subplot(1, len(speeds), i + 1, sharex=first, sharey=first)
+        first = first or ax
+        for k, m in enumerate(MC_MODES):
+            e = np.sort(np.asarray(res.mc[s, m].errors))
+            ax.step(e, np.arange(1, len(e) + 1) / len(e), where="post", color=f"C{k}",
+                    label=MODE_LABEL[m])
+        for x in (-res.tolerance, res.tolerance):
+            ax.axvline(x, color="k", ls="--", lw=0.8)
+        ax.set_xlabel("stop error (m, + overshoot)")
+        if i == 0:
+            ax.set_ylabel("fraction of stops ≤ error")
+        ax.set_title(f"{fmt(s)} km/h", fontsize=9)
+        ax.legend(fontsize=7, loc="upper left")

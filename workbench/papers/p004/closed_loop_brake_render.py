@@ -1,0 +1,175 @@
+"""Markdown and figures of the ``closed-loop-brake`` study (pure rendering)."""
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from ...report.markdown import Figure, Rendered, fmt, md_table
+from .closed_loop_brake import CHANNELS, FAULTS, MODES, worked_formulas
+from .closed_loop_brake_fair_render import fault_text, figures, mc_section, retune_section
+
+MODE_TEXT = {"open": "open loop, single command",
+             "ato-open": "open loop + ATO re-commands (a_req sent as the brake demand: no "
+                         "gradient feed-forward, brake only)",
+             "closed": "closed deceleration loop"}
+
+
+def _worked_section(res, spec) -> str:
+    _, distance, degraded, share = worked_formulas()
+    w = res.worked
+    rows = [["d1: 50 km/h at a_full, v as printed", fmt(w["d1"], 8), "m"],
+            [f"d1 from exact 50 km/h ({fmt(50 / 3.6, 5)} m/s)", fmt(w["d1_exact_speed"], 8), "m"],
+            ["a2: -15 % force, 15 ‰ down-grade", fmt(w["a2"], 6), "m/s²"],
+            ["d2 at a2", fmt(w["d2"], 8), "m"],
+            ["d2 − d1", fmt(w["delta"], 6), "m"],
+            ["d2 − d1 with a2 rounded to 0.703", fmt(w["delta_rounded_inputs"], 6), "m"],
+            ["d2 − d1 from exact 50 km/h", fmt(w["delta_exact_speed"], 6), "m"]]
+    rows += [[f"grade share: {k.split('[')[1].rstrip(']').replace('permille,', ' ‰ of ')} × full",
+              fmt(v, 5), "%"] for k, v in w.items() if k.startswith("share")]
+    return ("## Worked numbers (paper 004, section 1.3)\n\nComputed from the sympy expressions "
+            f"$d = {sp.latex(distance)}$, $a_2 = {sp.latex(degraded)}$ and the gradient share "
+            f"${sp.latex(share)}$ (i in ‰), with the printed inputs (claims below compare the "
+            "printed results).\n\n" + md_table(["quantity", "value", "unit"], rows, "lrl"))
+
+
+def render(design, res) -> Rendered:
+    spec = design.spec
+    prow = [[f"`{k}`", fmt(q.value, 5), q.unit, q.source] for k, q in spec.params.items()]
+    sections = [
+        "## Problem\n\nPaper 004 argues qualitatively that closing the loop on the measured "
+        "deceleration cancels force errors, gradient and friction scatter; it gives no "
+        "dynamics, gains or simulations. Here the brake is paper 000's electro-pneumatic "
+        f"model (parameters below), the train brakes from {', '.join(fmt(s) for s in spec.speeds_kmh)} "
+        f"km/h to a stopping point D = the nominal open-loop stopping distance of the single "
+        f"command {fmt(spec.a_target)} m/s² (D = "
+        + ", ".join(f"{fmt(d, 5)} m" for d in res.distance.values())
+        + "), over the grid force error "
+        f"{list(spec.force_error)} × gradient {list(spec.gradient)} ‰ × air-brake friction "
+        f"factor {list(spec.friction)}. Modes: " + "; ".join(f"**{m}** = {MODE_TEXT[m]}" for m in MODES)
+        + ". The ATO's required deceleration is a_req = v_p² / (2 d_p) at the state predicted "
+        f"{fmt(spec.t_predict)} s ahead; the closed loop measures the deceleration from the "
+        "maximum of four axle speeds (filtered derivative), uses the incremental fuzzy "
+        f"controller when |a_req − a_meas| > {fmt(spec.e_switch)} m/s² and PID below, and "
+        "falls back to the ATO open loop when all four axles are failed or sliding. The "
+        f"3-bit channel sends round(7 c / {fmt(spec.c_full)}) levels.\n\n"
+        + md_table(["parameter", "value", "unit", "source"], prow, "lrll"),
+        _worked_section(res, spec),
+        retune_section(spec, res),
+    ]
+    rows = []
+    for s in res.distance:
+        grid = dict(speed_kmh=s, fault="healthy", electric=True)
+        for m in MODES:
+            for ch in (CHANNELS if m == "closed" else ("analogue",)):
+                sel = res.select(mode=m, channel=ch, **grid)
+                fail = res.failing(mode=m, channel=ch, **grid)
+                ff = [r for r, _ in fail if res.feasible[res.runs.index(r)]]
+                rows.append([fmt(s), m, ch, fmt(res.max_abs(mode=m, channel=ch, **grid), 3),
+                             f"{len(fail)} / {len(sel)}", len(ff)])
+    n_inf = sum(not f for r, f in zip(res.runs, res.feasible)
+                if r.mode == "closed" and r.channel == "analogue" and r.fault == "healthy"
+                and r.electric) // max(len(res.distance), 1)
+    sections.append(
+        f"## Error grid: stop error against the ±{fmt(res.tolerance)} m window\n\n"
+        + md_table(["km/h", "mode", "channel", "max |error| (m)", "corners outside ±"
+                    f"{fmt(res.tolerance)} m", "of them feasible"], rows, "rllrrr")
+        + f"\n\n*Feasible*: full service applied from the first instant stops at least "
+        f"{fmt(res.tolerance)} m short of D on that corner (simulated); {n_inf} of the corners "
+        "per speed are not, and no brake controller can stop at D there. The map shows the "
+        "closed loop's error per corner.\n\n![error grid]({figdir}/error-grid.png)\n\n"
+        + _corner_details(res))
+    frows = []
+    for s in res.distance:
+        for f in FAULTS:
+            sel = res.select(speed_kmh=s, fault=f, mode="closed", channel="analogue",
+                             force_error=0.0, gradient=0.0, friction=1.0, electric=True)
+            frows.append([fmt(s), f, FAULTS[f], fmt(sel[0][1], 3) if sel else "—",
+                          "fallback (ATO open loop)" if all(c in "sf" for c in FAULTS[f])
+                          else "closed, fault undetected" if set(FAULTS[f]) & set("hz")
+                          else "closed"])
+        for m in ("ato-open", "closed"):
+            sel = res.select(speed_kmh=s, mode=m, electric=False)
+            frows.append([fmt(s), f"electric brake lost ({m})", "oooo", fmt(sel[0][1], 3), m])
+    sections.append(
+        "## Sensor faults and electric-brake loss (nominal corner)\n\n"
+        + md_table(["km/h", "case", "axles", "stop error (m)", "loop"], frows, "rllrl")
+        + "\n\n" + fault_text(spec))
+    sections.append("## Speed against distance\n\nFrom " + fmt(spec.speeds_kmh[0]) + " km/h at "
+                    "the nominal corner and with the lowest force error (gradient 0, friction ×1)."
+                    "\n\n![curves]({figdir}/speed-distance.png)")
+    sections.append(mc_section(spec, res))
+    figs = (Figure("speed-distance", "Speed against position relative to the stopping point.",
+                   lambda fig, res=res: _plot_curves(fig, res), size=(7.0, 4.0)),
+            Figure("error-grid", "Closed-loop stop error per grid corner (analogue channel), "
+                   "with the open loop for contrast.",
+                   lambda fig, res=res, spec=spec: _plot_grid(fig, res, spec), size=(8.0, 5.5)),
+            ) + figures(spec, res)
+    return Rendered(tuple(sections), figs)
+
+
+def _plot_curves(fig, res):
+    corners = sorted({r.force_error for r, _, _ in res.curves}, reverse=True)
+    for i, fe in enumerate(corners):
+        ax = fig.add_subplot(1, len(corners), i + 1)
+        for k, (r, dx, v) in enumerate(c for c in res.curves if c[0].force_error == fe):
+            keep = np.concatenate(([True], v[1:] > 0))
+            ax.plot(dx[keep], 3.6 * v[keep], color=f"C{k}", label=f"{r.mode} ({r.channel})")
+        ax.axvline(0, color="k", lw=0.6)
+        ax.set_xlabel("position − D (m)")
+        ax.set_ylabel("speed (km/h)")
+        ax.set_title(f"force error {fmt(100 * fe)} %", fontsize=9)
+        ax.legend(fontsize=7)
+
+
+def _corner_details(res) -> str:
+    rows = []
+    for s in res.distance:
+        sel = {(r.force_error, r.gradient, r.friction, r.mode, r.channel): e
+               for r, e in res.select(speed_kmh=s, fault="healthy", electric=True)}
+        corners = sorted({k[:3] for k in sel})
+        for c in corners:
+            feas = next(f for r, f in zip(res.runs, res.feasible)
+                        if r.speed_kmh == s and (r.force_error, r.gradient, r.friction) == c)
+            rows.append([fmt(s), fmt(100 * c[0]), fmt(c[1]), fmt(c[2]), "yes" if feas else "no",
+                         fmt(sel[c + ("open", "analogue")], 3),
+                         fmt(sel[c + ("ato-open", "analogue")], 3),
+                         fmt(sel[c + ("closed", "analogue")], 3),
+                         fmt(sel[c + ("closed", "3bit")], 3)])
+    return ("<details><summary>Every corner (stop error, m; + = overshoot)</summary>\n\n"
+            + md_table(["km/h", "force error %", "gradient ‰", "friction", "feasible", "open",
+                        "ATO open", "closed analogue", "closed 3-bit"], rows, "rrrrlrrrr")
+            + "\n\n</details>")
+
+
+def _plot_grid(fig, res, spec):
+    speeds = list(res.distance)
+    nf = len(spec.friction)
+    for i, s in enumerate(speeds):
+        for j, fr in enumerate(spec.friction):
+            ax = fig.add_subplot(len(speeds), nf, i * nf + j + 1)
+            M = np.full((len(spec.force_error), len(spec.gradient)), np.nan)
+            feas = np.ones(M.shape, bool)
+            for a, fe in enumerate(spec.force_error):
+                for b, gr in enumerate(spec.gradient):
+                    sel = res.select(speed_kmh=s, mode="closed", channel="analogue", fault="healthy",
+                                     electric=True, force_error=fe, gradient=gr, friction=fr)
+                    M[a, b] = sel[0][1]
+                    feas[a, b] = res.feasible[res.runs.index(sel[0][0])]
+            ax.imshow(np.clip(np.abs(M), 0, 3 * res.tolerance), cmap="RdYlGn_r", vmin=0,
+                      vmax=3 * res.tolerance, origin="lower", aspect="auto")
+            for a in range(M.shape[0]):
+                for b in range(M.shape[1]):
+                    ax.text(b, a, fmt(M[a, b], 2) + ("" if feas[a, b] else "\ninfeasible"),
+                            ha="center", va="center", fontsize=7)
+            ax.set_xticks(range(len(spec.gradient)))
+            ax.set_xticklabels([fmt(g) for g in spec.gradient])
+            ax.set_yticks(range(len(spec.force_error)))
+            ax.set_yticklabels([fmt(100 * f) for f in spec.force_error])
+            ax.grid(False)
+            ax.set_title(f"{fmt(s)} km/h, friction ×{fmt(fr)}", fontsize=8)
+            if i == len(speeds) - 1:
+                ax.set_xlabel("gradient (‰, + uphill)")
+            if j == 0:
+                ax.set_ylabel("force error (%)")
+    fig.suptitle(f"closed-loop stop error (m); green: within ±{fmt(res.tolerance)} m, "
+                 f"red: ≥ {fmt(3 * res.tolerance)} m")

@@ -1,0 +1,62 @@
+"""Pareto fronts of minimised objectives and a stated rule to pick one point.
+
+Used by the multi-objective tuning of paper 002's controllers
+(:mod:`workbench.papers.p002.ato_tracking_run`): every candidate is a row of
+objective values, all minimised; a row with a non-finite entry (a run that
+did not stop) is never on a front and never chosen.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def dominates(a: np.ndarray, b: np.ndarray) -> bool:
+    """True when ``a`` is no worse than ``b`` in every objective and better in one."""
+    return bool(np.all(a <= b) and np.any(a < b))
+
+
+def pareto_mask(points) -> np.ndarray:
+    """Boolean mask of the non-dominated rows of ``points`` (shape (N, M),
+    minimised). Rows with a non-finite entry are excluded; equal rows are all
+    kept (none dominates the other)."""
+    P = np.asarray(points, float)
+    ok = np.all(np.isfinite(P), axis=1)
+    mask = ok.copy()
+    idx = np.flatnonzero(ok)
+    for i in idx:
+        others = P[idx]
+        dominated = np.all(others <= P[i], axis=1) & np.any(others < P[i], axis=1)
+        mask[i] = not dominated.any()
+    return mask
+
+
+def weighted_cost(points, scales, weights) -> np.ndarray:
+    """sum_j w_j x_j / s_j per row (inf where a row has a non-finite entry).
+
+    The minimiser of a positively weighted sum is always on the Pareto
+    front, so choosing by it picks a front point."""
+    P = np.asarray(points, float)
+    cost = (P / np.asarray(scales, float)) @ np.asarray(weights, float)
+    return np.where(np.all(np.isfinite(P), axis=1), cost, np.inf)
+
+
+def choose(points, scales, weights, admissible=None) -> int:
+    """Index of the row with the smallest :func:`weighted_cost` (the first of
+    equal ones) among the ``admissible`` rows (a boolean mask; all rows when
+    None or when no row is admissible); raises ValueError when no row is finite."""
+    cost = weighted_cost(points, scales, weights)
+    if admissible is not None and np.any(np.asarray(admissible) & np.isfinite(cost)):
+        cost = np.where(admissible, cost, np.inf)
+    if not np.isfinite(cost).any():
+        raise ValueError("no candidate with finite objectives")
+    return int(np.argmin(cost))
+
+
+def dominated_share(front_a, front_b) -> float:
+    """Share of the rows of ``front_b`` that some row of ``front_a`` dominates
+    (0 when ``front_b`` is empty)."""
+    A, B = np.asarray(front_a, float), np.asarray(front_b, float)
+    if len(B) == 0:
+        return 0.0
+    hit = [any(dominates(a, b) for a in A) for b in B]
+    return float(np.mean(hit))
