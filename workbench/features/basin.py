@@ -162,13 +162,13 @@ def closed_loop(model, values: dict, op, K):
     import numpy as np
     import sympy as sp
 
-    from ..kinds.delay_feedback.model import linearise
     K = np.atleast_2d(np.asarray(K, float))
     f = model.substituted(model.f, values)
     Fl = lambda v: sp.Float(float(v))
     law = {u: Fl(op.u[i]) + sum(Fl(K[i, j]) * (x - Fl(op.x[j])) for j, x in enumerate(model.x))
            for i, u in enumerate(model.u)}
-    A, B = linearise(model, values, op)
+    fx, fu = model.jacobian_functions(values)   # as the design's linearisation
+    A, B = fx(op.x, op.u), fu(op.x, op.u)
     return [e.xreplace(law) for e in f], tuple(model.x), A + B @ K
 
 

@@ -36,7 +36,7 @@ import importlib
 from collections.abc import Mapping
 from typing import Any, Iterator
 
-#: kind -> "module:attribute" of the study object (module relative to this package).
+#: kind -> "module:attribute" of the study object.
 STUDIES: dict[str, str] = {
     "antiskid-cruise": "workbench.papers.p003.antiskid_cruise:STUDY",
     "delay-benchmark": "workbench.kinds.delay_benchmark:STUDY",

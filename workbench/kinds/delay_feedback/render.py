@@ -1,16 +1,16 @@
 """Markdown and figures of a ``delay-feedback`` design (pure rendering).
 
 Shares the printed forms of the antiskid-cruise report (exact margins, capped
-bounds, closed-loop eigenvalues, re-check decades) through the public
-helpers of :mod:`workbench.papers.p003.antiskid_cruise_render`.
+bounds, closed-loop eigenvalues, re-check decades) through
+:mod:`workbench.report.synthesis_text`.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ...report.markdown import Figure, Rendered, fmt, fmt_floor, latex_matrix, md_table
-from ...papers.p003.antiskid_cruise_render import (capped_text, closed_loop_eigs_text, exact_margin_text,
-                                     recheck_table)
+from ...report.synthesis_text import (capped_text, closed_loop_eigs_text, exact_margin_text,
+                                      recheck_table)
 from .requirements_render import gain_text, requirements_section
 
 _METHOD = {

@@ -1,6 +1,6 @@
 """``workbench synthesize sampled DESIGN``: a delay-feedback design's gain (synthesised
 as in its report) and its digital implementation check
-(:mod:`.delay_feedback_implementation`)."""
+(:mod:`workbench.features.sampled`)."""
 from __future__ import annotations
 
 from ...features.sampled import ImplementationSettings, run_implementation

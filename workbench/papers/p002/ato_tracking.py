@@ -1,8 +1,8 @@
 """Study ``ato-tracking``: paper 002's CFDL-MFAC against PID on ATO speed profiles,
 per reading of the lost plant table, with multi-objective tuning.
 
-The design tables are read in :mod:`.tracking002_spec`, the computation is in
-:mod:`.tracking002_run`, the report in :mod:`.tracking002_render`.
+The design tables are read in :mod:`.ato_tracking_spec`, the computation is in
+:mod:`.ato_tracking_run`, the report in :mod:`.ato_tracking_render`.
 """
 from __future__ import annotations
 

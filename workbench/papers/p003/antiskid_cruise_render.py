@@ -7,17 +7,9 @@ import numpy as np
 import sympy as sp
 
 from ...plants.adhesion import adhesion_model
-from ...report.markdown import Figure, Rendered, fmt, latex_matrix, margin_text, md_table
-
-
-def exact_margin_text(dm) -> str:
-    """An exact delay margin as printed: 5 significant digits, ``∞``, or
-    ``0 (unstable at h = 0)``; ``—`` for None."""
-    if dm is None:
-        return "—"
-    if dm.reason == "unstable-at-zero-delay":
-        return "0 (unstable at h = 0)"
-    return fmt(dm.h, 5)
+from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
+from ...report.synthesis_text import (capped_text, closed_loop_eigs_text, exact_margin_text,
+                                      recheck_table)
 
 
 def _model_section() -> str:
@@ -208,22 +200,6 @@ def _eig_text(e: complex) -> str:
     return f"{fmt(e.real, 3)} ± {fmt(abs(e.imag), 3)}j"
 
 
-def recheck_table(res) -> str:
-    """Per-block re-check margins of every canonical certificate (``res.rows``,
-    :class:`workbench.synthesis.SynthesisRow`), as decades, in a <details> block."""
-    rows = [r for r in res.rows if r.recheck]
-    if not rows:
-        return ""
-    names = list(rows[0].recheck)
-    body = [[b] + [margin_text(r.recheck[b]) for r in rows] for b in names]
-    return ("<details><summary>Re-check: relative margin of every LMI block of the canonical "
-            "certificate (numpy eigenvalues; must be ≥ the margin)</summary>\n\n"
-            + md_table(["block"] + [f"eps = {fmt(r.eps)}" for r in rows], body,
-                       "l" + "r" * len(rows))
-            + "\n\nShown as the decade the margin lies in: a solver's internal values "
-            "agree between machines only to a few digits.\n\n</details>")
-
-
 def _doc(k):
     from .antiskid_cruise import PARAM_DOC
     return PARAM_DOC.get(k, "")
@@ -319,26 +295,8 @@ def _plot_abscissa(fig, res):
     ax.legend(fontsize=8)
 
 
-def capped_text(h, cap) -> str:
-    """A certified bound, marked when it is the search cap (a lower bound only)."""
-    if h is None:
-        return "—"
-    return f"≥ {fmt(cap, 4)} (cap)" if h >= cap else fmt(h, 4)
-
-
 def _gain(K, digits: int = 4) -> str:
     return "—" if K is None else "[" + ", ".join(fmt(float(k), digits) for k in np.ravel(K)) + "]"
-
-
-def closed_loop_eigs_text(A, B, K) -> str:
-    """Eigenvalues of A + B K (delay-free closed loop), 1/s."""
-    if K is None:
-        return "—"
-    ev = sorted(np.linalg.eigvals(A + B @ np.atleast_2d(np.asarray(K, float))),
-                key=lambda z: (z.real, z.imag))
-    return ", ".join(fmt(complex(e).real, 3) if abs(complex(e).imag) < 1e-9
-                     else f"{fmt(complex(e).real, 3)} ± {fmt(abs(complex(e).imag), 3)}j"
-                     for e in ev if complex(e).imag >= -1e-9)
 
 
 def _tight_section(t, A, B) -> str:
