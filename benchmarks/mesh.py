@@ -20,9 +20,9 @@ import time
 from pathlib import Path
 
 from workbench.design import load_design
-from workbench.sim.progress import progress
 from workbench.papers.p003 import antiskid_run_spec as S
 from workbench.papers.p003.antiskid_scenario import Mesh, simulate_antiskid
+from workbench.sim.progress import progress
 
 ROOT = Path(__file__).resolve().parents[1]
 

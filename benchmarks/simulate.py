@@ -31,11 +31,11 @@ from scipy.integrate import solve_ivp
 
 from workbench.controllers.antiskid003 import Antiskid003
 from workbench.design import load_design
-from workbench.sim.history import DelayLine
-from workbench.sim.wheel_slip import PARAM_ORDER, ScalarOps, model_functions, plant_forms
 from workbench.papers.p003 import antiskid_run_spec as S
 from workbench.papers.p003.antiskid_montecarlo import sweep
 from workbench.papers.p003.antiskid_scenario import MetricsRecorder, simulate_antiskid
+from workbench.sim.history import DelayLine
+from workbench.sim.wheel_slip import PARAM_ORDER, ScalarOps, model_functions, plant_forms
 
 
 def reference_run(rs, dt: float, t_end: float) -> tuple[float, float]:

@@ -14,7 +14,8 @@ from dataclasses import replace
 import numpy as np
 
 from workbench.design import load_design
-from workbench.papers.p000.station_stopping import CONTROLLERS, run_station_stops
+from workbench.papers.p000.station_stopping_run import run_station_stops
+from workbench.papers.p000.station_stopping_spec import CONTROLLERS
 
 REPEATS = int(sys.argv[1]) if len(sys.argv) > 1 else 50
 

@@ -11,10 +11,10 @@ import pytest
 
 from workbench.controllers.antiskid003_settings import DIVERGED_HOW
 from workbench.design import load_design
-from workbench.sim.history import DelayLine, TimedDelayLine
-from workbench.sim.wheel_slip import PARAM_ORDER
 from workbench.papers.p003 import antiskid_run_spec as S
 from workbench.papers.p003.antiskid_scenario import Mesh, RunSettings, simulate_antiskid
+from workbench.sim.history import DelayLine, TimedDelayLine
+from workbench.sim.wheel_slip import PARAM_ORDER
 
 K_TABLE3 = (-0.0049, 10.5080)   # paper 003, Table 3, eps = 0.35
 

@@ -5,8 +5,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from workbench.reader import Quantity
 from workbench.papers.p003.antiskid_comfort import ComfortSpec, comfort_of, comfort_quantities
+from workbench.reader import Quantity
 
 SPEC = ComfortSpec(Quantity(1.0, "m/s^2", "test"), Quantity(0.75, "m/s^3", "test"),
                    Quantity(1.0, "s", "test"))

@@ -10,13 +10,12 @@ import pytest
 from workbench.cli import main
 from workbench.controllers.stop_predictor import NominalBrakeModel
 from workbench.design import load_design
-from workbench.sim.stopping import batch_params, simulate
-from workbench.tuning.pid import damping, speed_loop, tune_pid
-from workbench.papers.p000.station_stopping import run_station_stops
-from workbench.papers.p000.station_stopping_run import loop_dead_time
-from workbench.papers.p000.station_stopping_spec import MC_FACTORS, NOMINAL
 from workbench.features.montecarlo import (Distribution, MonteCarloSpec, draw, percentile,
                                            stop_statistics, within_rate)
+from workbench.papers.p000.station_stopping_run import loop_dead_time, run_station_stops
+from workbench.papers.p000.station_stopping_spec import MC_FACTORS, NOMINAL
+from workbench.sim.stopping import batch_params, simulate
+from workbench.tuning.pid import damping, speed_loop, tune_pid
 
 D000 = "designs/stopping-line5.toml"
 D004 = "designs/closed-loop-brake-004.toml"

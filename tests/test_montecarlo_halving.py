@@ -13,11 +13,11 @@ import pytest
 from workbench.controllers.antiskid003_settings import BRAKE, BRAKE_IN, CRUISE
 from workbench.design import load_design
 from workbench.papers.p003.antiskid_halving import (HALVING_METRICS, HALVING_OUTCOMES, HalvingCheck,
-                                                compare_steps, halving_quantities,
-                                                halving_quantity_names, start_halving)
-from workbench.papers.p003.antiskid_montecarlo import SweepSpec, draw_samples, sweep
+                                                    compare_steps, halving_quantities,
+                                                    halving_quantity_names, start_halving)
+from workbench.papers.p003.antiskid_montecarlo import draw_samples, sweep
 from workbench.papers.p003.antiskid_montecarlo_render import halving_section
-from workbench.papers.p003.antiskid_run_spec import gain_for
+from workbench.papers.p003.antiskid_run_spec import SweepSpec, gain_for
 
 N = 4
 

@@ -12,8 +12,10 @@ import pytest
 from workbench.cli import main
 from workbench.design import load_design
 from workbench.papers.p003 import antiskid_run as R
-from workbench.papers.p003.antiskid_montecarlo import (VIOLATIONS, draw_samples, montecarlo_quantities,
-                                                   montecarlo_quantity_names, start_sweep, sweep)
+from workbench.papers.p003.antiskid_montecarlo import (VIOLATIONS, draw_samples,
+                                                       montecarlo_quantities,
+                                                       montecarlo_quantity_names, start_sweep,
+                                                       sweep)
 from workbench.papers.p003.antiskid_montecarlo_render import summary_tables
 from workbench.papers.p003.antiskid_run_render import _montecarlo_section
 

@@ -7,11 +7,10 @@ import numpy as np
 import pytest
 
 from workbench.design import load_design
+from workbench.papers.p003.antiskid_cruise import operating_point
+from workbench.papers.p003.antiskid_cruise_gains import check_other_gains, other_gain_quantities
 from workbench.report.findings import section_link
 from workbench.report.markdown import slug
-from workbench.papers.p003.antiskid_cruise import operating_point
-from workbench.papers.p003.antiskid_cruise_gains import (check_other_gains,
-                                                     other_gain_quantities)
 
 REPORTS = Path(__file__).resolve().parents[1] / "reports"
 

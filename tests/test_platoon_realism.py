@@ -13,11 +13,11 @@ from workbench.cli import main
 from workbench.controllers.ntsm import NTSMGains, linear_member, pd_ff_force, pd_force
 from workbench.design import load_design
 from workbench.margins import delay_margin_eig, delay_margin_siso
-from workbench.plants.platoon001 import TrainParams
-from workbench.sim.platoon import Actuator, Link, packet_delays, received_steps
 from workbench.papers.p001.ntsm_platoon import scenario
 from workbench.papers.p001.ntsm_platoon_realism import (delay_margin_model, emergency_run, envelope,
-                                                  link)
+                                                        link)
+from workbench.plants.platoon001 import TrainParams
+from workbench.sim.platoon import Actuator, Link, packet_delays, received_steps
 
 DESIGN = Path("designs/platoon-ntsm-001.toml")
 G = NTSMGains(beta=0.2, a=5, b=7, j=3.0, k=3.0, alpha=3, xi=5)

@@ -4,9 +4,9 @@ inside; a small k2 makes the printed switch safe (workbench.papers.p003.antiskid
 import numpy as np
 import pytest
 
+from workbench.papers.p003 import antiskid_basin as AB
 from workbench.plants.adhesion import NumericAdhesion
 from workbench.roa import LevelOutcome
-from workbench.papers.p003 import antiskid_basin as AB
 
 # 003 Tables 1-2 (dry rail); the gain is the workbench's certified synthesis at
 # eps = 0.35 (reports/antiskid-run-dry.md: K = [-0.004575, 10.27])

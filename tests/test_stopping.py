@@ -10,10 +10,10 @@ from workbench.controllers.smarc import AdaptiveSlidingModeController, projectio
 from workbench.controllers.smc import SlidingGains, sliding_law, switching
 from workbench.design import load_design
 from workbench.errors import DesignError
+from workbench.papers.p000.station_stopping_run import run_station_stops
 from workbench.plants.brake000 import (BrakeParams, air_gain, brake_model, existing_model,
                                        resistance)
 from workbench.sim.stopping import TargetCurve, batch_params, simulate
-from workbench.papers.p000.station_stopping import run_station_stops
 
 DESIGN = "designs/stopping-line5.toml"
 TABLE1 = dict(T1=0.9, T2=0.83, P1=0.85, T3=0.8, T4=1.741, K1=1.0142, K2=0.01191,  # 000 Table 1
@@ -139,7 +139,7 @@ def test_bad_input_is_a_design_error_naming_the_key(tmp_path, design, old, new, 
 
 
 def test_within_rate_is_the_wilson_interval():
-    from workbench.papers.p000.station_stopping import within_rate
+    from workbench.features.montecarlo import within_rate
     k, n, p, lo, hi = within_rate([40.0] * 10, 30.0)          # none within: 0 / 10
     assert (k, n, p, lo) == (0, 10, 0.0, 0.0)
     assert hi == pytest.approx(1.959963984540054 ** 2 / (10 + 1.959963984540054 ** 2))

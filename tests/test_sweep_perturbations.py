@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 from workbench.design import load_design
-from workbench.sim import counter_rng as R
-from workbench.sim.perturb import delay_at, split_delays
 from workbench.papers.p003.antiskid_montecarlo import chunk_payload, chunk_worker, sweep_inputs
 from workbench.papers.p003.antiskid_run_spec import SweepPerturbations, gain_for
+from workbench.sim import counter_rng as R
+from workbench.sim.perturb import delay_at, split_delays
 
 RTOL = 1e-9
 

@@ -10,9 +10,9 @@ import pytest
 
 from workbench.cli import main
 from workbench.design import load_design
-from workbench.sim.batch import uniform_draws
 from workbench.papers.p003 import antiskid_stream as S
 from workbench.papers.p003.antiskid_montecarlo import sweep
+from workbench.sim.batch import uniform_draws
 
 N, CHUNK = 24, 8
 

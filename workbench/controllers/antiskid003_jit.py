@@ -30,8 +30,8 @@ import numpy as np
 
 from ..sim.history import split_delay
 from ..sim.wheel_slip import PARAM_ORDER
-from ..sim.wheel_slip_jit import BRAKING, TRACTION, braking, fmax, fmin, forms, phi1, \
-    stiff_step, stiff_step_at, traction, wheel_speed
+from ..sim.wheel_slip_jit import (BRAKING, TRACTION, braking, fmax, fmin, forms, phi1, stiff_step,
+                                  stiff_step_at, traction, wheel_speed)
 from .antiskid003 import PhaseEvents
 from .antiskid003_settings import (ACCEL, BRAKE, BRAKE_IN, CRUISE, DIVERGED, HANDOVER, STOPPED,
                                    ControllerSettings)

@@ -4,25 +4,20 @@ as in the paper and with known-delay compensation.
 The design tables and controller variants are in
 :mod:`~workbench.papers.p000.station_stopping_spec`, the simulation in
 :mod:`~workbench.papers.p000.station_stopping_run`; this module is the study object
-(quantities for the claims). Names used elsewhere are re-exported here.
+(quantities for the claims).
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ...features.montecarlo import MC_QUANTITIES
 from ...reader import Reader
-from .station_stopping_run import (CellStats, StopResult, draw_plants, loop_dead_time,
-                              run_station_stops)
-from .station_stopping_spec import (ABLATION_LAWS, COMPENSATED, CONTROLLERS, DAMPING, MC_CONTROLLERS,
-                               MC_FACTORS, PAPER_CONTROLLERS, UNCERTAIN, UNCOMPENSATED, VARIANTS,
-                               StopSpec, load_plant, load_stop_spec)
-from ...features.montecarlo import MC_QUANTITIES, within_rate
+from .station_stopping_run import StopResult, run_station_stops
+from .station_stopping_spec import (COMPENSATED, CONTROLLERS, DAMPING, MC_CONTROLLERS,
+                                    PAPER_CONTROLLERS, UNCOMPENSATED, VARIANTS, StopSpec,
+                                    load_stop_spec)
 
-__all__ = ["ABLATION_LAWS", "CONTROLLERS", "COMPENSATED", "CellStats", "DAMPING",
-           "MC_CONTROLLERS", "MC_FACTORS", "PAPER_CONTROLLERS",
-           "STUDY", "StopResult", "UNCERTAIN", "UNCOMPENSATED", "VARIANTS", "draw_plants",
-           "load_plant", "load_stop_spec", "loop_dead_time", "run_station_stops",
-           "within_rate"]
+__all__ = ["STUDY", "StationStopping"]
 
 
 

@@ -1,13 +1,15 @@
 """Markdown and figures of the ``station-stopping`` study's fair baselines:
 known-delay compensation, the damped PID, the nominal row and the Monte
-Carlo (pure rendering of a :class:`~workbench.papers.p000.station_stopping.StopResult`)."""
+Carlo (pure rendering of a
+:class:`~workbench.papers.p000.station_stopping_run.StopResult`)."""
 from __future__ import annotations
 
 import numpy as np
 
 from ...report.markdown import Figure, fmt, md_table
-from .station_stopping import (ABLATION_LAWS, COMPENSATED, DAMPING, MC_CONTROLLERS, MC_FACTORS,
-                          UNCOMPENSATED, VARIANTS, loop_dead_time)
+from .station_stopping_run import loop_dead_time
+from .station_stopping_spec import (ABLATION_LAWS, COMPENSATED, DAMPING, MC_CONTROLLERS,
+                                    MC_FACTORS, UNCOMPENSATED, VARIANTS)
 
 GROUP = {**{c: "as in paper 000" for c in UNCOMPENSATED},
          **{c: "with known-delay compensation" for c in MC_CONTROLLERS if c not in UNCOMPENSATED}}

@@ -4,11 +4,11 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from ...features.montecarlo import within_rate
 from ...plants.brake000 import brake_model
 from ...report.markdown import Figure, Rendered, fmt, md_table
-from .station_stopping import CONTROLLERS, UNCERTAIN
 from .station_stopping_fair_render import fair_section, figures
-from ...features.montecarlo import within_rate
+from .station_stopping_spec import CONTROLLERS, UNCERTAIN
 
 LABEL = {"pid": "PID", "smc": "SMC", "smarc": "SMARC", "smarc-sgn": "SMARC (sgn)"}
 

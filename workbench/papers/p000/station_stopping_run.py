@@ -17,11 +17,11 @@ from ...controllers.pid import PID
 from ...controllers.smarc import AdaptiveSlidingModeController
 from ...controllers.smc import SlidingModeController
 from ...controllers.stop_predictor import NominalBrakeModel
+from ...features.montecarlo import StopStatistics, draw, stop_statistics
 from ...sim.stopping import TargetCurve, batch_params, simulate
 from ...tuning.pid import Damping, damping, speed_loop
-from .station_stopping_spec import (ABLATION, CONTROLLERS, DAMPING, MC_CONTROLLERS, MC_FACTORS, NOMINAL,
-                          UNCERTAIN, VARIANTS, Section, StopSpec)
-from ...features.montecarlo import StopStatistics, draw, stop_statistics
+from .station_stopping_spec import (ABLATION, CONTROLLERS, DAMPING, MC_CONTROLLERS, MC_FACTORS,
+                                    NOMINAL, UNCERTAIN, VARIANTS, Section, StopSpec)
 
 #: Speed errors below this (m/s; 0.18 km/h, below a speedometer's resolution) do not
 #: count as a sign change (oscillation count).
@@ -304,5 +304,5 @@ def _repeat_stats(spec, rs, tr, tc, tb, err, stats, example, planned) -> None:
                                  xd - rs["length"][j], vd)
 
 
-__all__ = ["CellStats", "Damping", "NominalRun", "StopResult", "StopStatistics", "draw_plants",
-           "loop_dead_time", "run_station_stops", "simulate_runs"]
+__all__ = ["CellStats", "NominalRun", "StopResult", "draw_plants", "loop_dead_time",
+           "run_station_stops", "simulate_runs"]

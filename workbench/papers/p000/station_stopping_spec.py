@@ -36,9 +36,9 @@ from dataclasses import dataclass, replace
 
 
 from ...controllers.smc import SlidingGains
+from ...features.montecarlo import MonteCarloSpec, load_montecarlo
 from ...plants.brake000 import PARAMETER_UNITS
 from ...reader import Quantity, Reader
-from ...features.montecarlo import MonteCarloSpec, load_montecarlo
 
 #: Paper 000's three controllers, then SMARC with the discontinuous sgn of eq 22
 #: as printed (no boundary layer), to show the chattering the layer removes:

@@ -13,14 +13,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...controllers.ntsm import (convergence_time, linear_member, ntsm_force, pd_ff_force,
-                                pd_force, surface)
+from ...controllers.ntsm import (convergence_time, linear_member, ntsm_force, pd_ff_force, pd_force,
+                                 surface)
 from ...plants.platoon001 import TrainParams, external_force, perturbed
 from ...profiles import Profile, build_profile, spec_for_cruise
 from ...reader import Reader
 from ...sim.platoon import PlatoonRun, simulate_platoon
 from .ntsm_platoon_realism import (Realism, accel_end, realism_quantities, realism_quantity_names,
-                                 run_realism)
+                                   run_realism)
 from .ntsm_platoon_spec import PlatoonSpec, load_spec
 
 #: The followers' laws of :meth:`Scenario.law`.

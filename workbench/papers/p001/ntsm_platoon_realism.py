@@ -36,8 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...controllers.ntsm import linear_member
-from ...margins import (Agreement, DelayMargin, compare_margins, delay_margin_eig,
-                       delay_margin_siso)
+from ...margins import Agreement, DelayMargin, compare_margins, delay_margin_eig, delay_margin_siso
 from ...sim.platoon import Actuator, Link, PlatoonRun, packet_delays, received_steps
 
 CASES = ("constant", "random")

@@ -6,9 +6,9 @@ The design tables are read in :mod:`.ato_tracking_spec`, the computation is in
 """
 from __future__ import annotations
 
-from .ato_tracking_spec import TrackingSpec, load_spec, quantity_names, read_gradients
+from .ato_tracking_spec import TrackingSpec, load_spec, quantity_names
 
-__all__ = ["ATOTracking", "STUDY", "read_gradients"]
+__all__ = ["ATOTracking", "STUDY"]
 
 
 class ATOTracking:

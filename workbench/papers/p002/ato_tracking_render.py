@@ -4,8 +4,8 @@ from __future__ import annotations
 from ...controllers.mfac import RESET_CONDITIONS, MFACGains, frozen_ppd_poles
 from ...plants.train002 import latex_equations
 from ...report.markdown import Figure, Rendered, fmt, md_table
-from . import ato_tracking_figures as F
 from ...tuning.pareto import dominated_share
+from . import ato_tracking_figures as F
 from .ato_tracking_spec import OBJECTIVE_UNITS, OBJECTIVES
 
 LABEL = {"stop_error": "stop error (m)", "punctuality": "punctuality (s)",

@@ -14,8 +14,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...sim.batch import PendingBatch
-from .antiskid_montecarlo import (SUMMARY_METRICS, SweepResult, SweepSpec, chunk_payload,
-                                  chunk_worker, per_run, run_lambda_opt, sweep_inputs)
+from .antiskid_montecarlo import (SUMMARY_METRICS, SweepResult, chunk_payload, chunk_worker,
+                                  per_run, run_lambda_opt, sweep_inputs)
+from .antiskid_run_spec import SweepSpec
 
 #: Metrics compared at dt and dt / 2 by :func:`start_halving`.
 HALVING_METRICS = SUMMARY_METRICS + ("t_diverged",)

@@ -81,7 +81,7 @@ def _build():
     from ...controllers import antiskid003_jit as C
     from ...sim.counter_rng import jit_functions
     from ...sim.wheel_slip_jit import (BY_SIGN, GRADED, creep_speed, delay_at, fmax, fmin, forms,
-                                      measured_state, split_delay, stiff_step_at, wheel_speed)
+                                       measured_state, split_delay, stiff_step_at, wheel_speed)
 
     _, uniform, normal4 = jit_functions()
 

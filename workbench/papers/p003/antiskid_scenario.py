@@ -18,12 +18,12 @@ import numpy as np
 
 from ...controllers.antiskid003 import Antiskid003, PhaseEvents
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED, ControllerSettings
-from ...sim.delay import SimResult, simulate_closed_loop
 from ...sim.counter_rng import normal4
+from ...sim.delay import SimResult, simulate_closed_loop
 from ...sim.history import BatchDelayLine
 from ...sim.perturb import Perturbations, VaryingDelayLine, grade_at, measured_state
 from ...sim.wheel_slip import (PARAM_ORDER, ArrayOps, ScalarOps, creep_rate_coefficient,
-                              creep_speed, model_functions, plant_step, wheel_speed)
+                               creep_speed, model_functions, plant_step, wheel_speed)
 
 
 @dataclass

@@ -33,16 +33,16 @@ import numpy as np
 import sympy as sp
 
 from ...controllers.fuzzy import FuzzyIncrement
+from ...features.montecarlo import MC_QUANTITIES, MonteCarloSpec, load_montecarlo
 from ...reader import Quantity, Reader
 from ...sim.stopping import batch_params, simulate
-from .closed_loop_brake_run import (CHANNELS, FAULTS, FULL, MC_FACTORS, MC_MODES, MODES,
-                           run_horizon_sweep, run_montecarlo, simulate_brake)
 from ...tuning.pid import Damping, damping, deceleration_loop
 from ..p000.station_stopping_spec import load_plant
-from ...features.montecarlo import MC_QUANTITIES, MonteCarloSpec, load_montecarlo
+from .closed_loop_brake_run import (CHANNELS, FAULTS, FULL, MC_FACTORS, MC_MODES, MODES,
+                                    run_horizon_sweep, run_montecarlo, simulate_brake)
 
-__all__ = ["CHANNELS", "FAULTS", "FULL", "MC_FACTORS", "MC_MODES", "MODES", "STUDY", "Result004",
-           "Run", "Spec004", "compute_worked", "decel_damping", "run_grid", "worked_formulas"]
+__all__ = ["STUDY", "Result004", "Run", "Spec004", "compute_worked", "decel_damping", "run_grid",
+           "worked_formulas"]
 
 
 @lru_cache(maxsize=1)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...report.markdown import Figure, fmt, md_table
-from .closed_loop_brake import FAULTS, MC_FACTORS, MC_MODES
+from .closed_loop_brake_run import FAULTS, MC_FACTORS, MC_MODES
 
 MODE_LABEL = {"ato-open": "ATO open loop", "closed": "closed loop (analogue)"}
 

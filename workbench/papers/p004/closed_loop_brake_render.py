@@ -5,8 +5,9 @@ import numpy as np
 import sympy as sp
 
 from ...report.markdown import Figure, Rendered, fmt, md_table
-from .closed_loop_brake import CHANNELS, FAULTS, MODES, worked_formulas
+from .closed_loop_brake import worked_formulas
 from .closed_loop_brake_fair_render import fault_text, figures, mc_section, retune_section
+from .closed_loop_brake_run import CHANNELS, FAULTS, MODES
 
 MODE_TEXT = {"open": "open loop, single command",
              "ato-open": "open loop + ATO re-commands (a_req sent as the brake demand: no "

@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...controllers.pid import PID
-from ...sim.stopping import batch_params, simulate
 from ...features.montecarlo import StopStatistics, draw, stop_statistics
+from ...sim.stopping import batch_params, simulate
 
 MODES = ("open", "ato-open", "closed")
 #: not a control mode: full service from t = 0, to test each corner's feasibility
@@ -166,5 +166,5 @@ def run_horizon_sweep(spec, distance: dict) -> tuple:
     return tuple((tp, s, float(x - distance[s])) for (tp, s), x in zip(cases, tr.x_stop))
 
 
-__all__ = ["CHANNELS", "FAULTS", "FULL", "MC_FACTORS", "MC_MODES", "MODES", "StopStatistics",
-           "axle_speeds", "run_horizon_sweep", "run_montecarlo", "simulate_brake"]
+__all__ = ["CHANNELS", "FAULTS", "FULL", "MC_FACTORS", "MC_MODES", "MODES", "axle_speeds",
+           "run_horizon_sweep", "run_montecarlo", "simulate_brake"]
