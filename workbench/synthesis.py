@@ -63,6 +63,10 @@ class SynthesisSettings:
                     max_solves=self.max_solves)
 
 
+#: Declared range of a delay search cap h_max (s), in design files and the API alike.
+H_MAX_RANGE = (1e-3, 1e4)
+
+
 @dataclass(frozen=True)
 class SynthesisRow:
     """One eps of the sweep (one row of the paper's Table 3).

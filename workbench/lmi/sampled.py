@@ -61,14 +61,13 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 from dataclasses import dataclass
 
 import cvxpy as cp
 import numpy as np
 import scipy.linalg as sl
 
-from .core import DEFAULT_MARGIN, Bracket, Outcome, Step, bisect_delay
+from .core import DEFAULT_MARGIN, Bracket, Outcome, Step, bisect_delay, guarded_solve
 from .scaling import balancing
 
 __all__ = ["LiftedFamily", "continuum_margin", "decide_lifted", "certified_sampling_bound",
@@ -198,13 +197,7 @@ def _solve_grid(fam: LiftedFamily, grid, alpha: float):
         M = _sym(fam.M(P, float(s), alpha))
         cons += [M << -t * np.eye(n), -cp.trace(M) <= 1]
     prob = cp.Problem(cp.Maximize(t), cons)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UserWarning)
-            prob.solve(solver=cp.CLARABEL)
-        status = str(prob.status)
-    except cp.error.SolverError as exc:
-        status = f"error: {exc}".splitlines()[0]
+    status, _ = guarded_solve(prob)
     if status != cp.OPTIMAL:
         return status, None, None
     return status, float(t.value), np.array(P.value, dtype=float)
