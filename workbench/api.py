@@ -93,11 +93,9 @@ def _system(sys, B):
         dt = getattr(sys, "dt", 0)
         if dt not in (0, None):
             raise ValueError(f"sys.dt = {dt!r}; expected a continuous-time system (dt = 0)")
-        D = np.asarray(getattr(sys, "D", 0.0), dtype=complex)
-        if D.size and np.any(D != 0):
-            raise ValueError("sys has D != 0 (a direct feedthrough); expected D = 0: the "
-                             "bound is of the state feedback u = K x(t - h), which uses A "
-                             "and B only (pass control.ss(A, B, C, 0) or the matrices A, B)")
+        if np.any(np.asarray(getattr(sys, "D", 0.0), dtype=complex) != 0):
+            raise ValueError("sys has D != 0 (a feedthrough); expected D = 0: the bound is of "
+                             "u = K x(t - h), with A and B only (pass control.ss(A, B, C, 0))")
         sys, B = sys.A, sys.B
     A = _matrix(sys, "A")
     if A.shape[0] != A.shape[1]:
@@ -298,17 +296,9 @@ def delay_bound(sys, B=None, *, Ad=None, method: Method = "bessel-legendre", N: 
     """
     from .lmi.core import DEFAULT_MARGIN
     from .margins import exact_margin, stability_windows
-    from .synthesis import H_MAX_RANGE
+    from .synthesis import check_search_options
     margin = DEFAULT_MARGIN if margin is None else margin
-    lo, hi = H_MAX_RANGE
-    for name, v, ok, what in (("h_max", h_max, lambda x: lo <= x <= hi,
-                               f"a number (s) in [{lo:g}, {hi:g}]"),
-                              ("margin", margin, lambda x: 0 < x < 1e-2,
-                               "a number in (0, 0.01)"),
-                              ("rel_tol", rel_tol, lambda x: 0 < x <= 0.1,
-                               "a number in (0, 0.1]")):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not ok(float(v)):
-            raise ValueError(f"{name} = {str(v)[:60]}; expected {what} (as in design files)")
+    check_search_options(h_max, margin, rel_tol)
     if isinstance(N, bool) or not isinstance(N, (int, np.integer)) or not 0 <= N <= 8:
         raise ValueError(f"N = {N!r}; expected an integer order in [0, 8]")
     A, B = _system(sys, B)

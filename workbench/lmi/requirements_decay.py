@@ -147,10 +147,11 @@ def _decide(points, alpha: float, h_lo: float, H: float, N: int, margin: float,
     :data:`MAX_CELLS` cells or the ``deadline`` (``time.perf_counter()``)."""
     last = None
     seconds = 0.0
-    cells = decay_cells(alpha, h_lo, H)
-    if len(cells) > MAX_CELLS:
-        return Step(alpha, Outcome.INCONCLUSIVE, f"error: {len(cells)} delay cells at rate "
+    k = math.ceil(alpha * (H - h_lo) / CELL_LOG_SPAN)      # the count of decay_cells
+    if not k <= MAX_CELLS:
+        return Step(alpha, Outcome.INCONCLUSIVE, f"error: {k:g} delay cells at rate "
                     f"{alpha:.3g} 1/s, above the cap of {MAX_CELLS}", None, {}, None, 0.0)
+    cells = decay_cells(alpha, h_lo, H)
     for A, Ad in points:
         Aa = A + alpha * np.eye(A.shape[0])
         for a, b in cells:
