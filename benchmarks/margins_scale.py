@@ -1,18 +1,25 @@
-"""Cost of the exact delay margin against the state dimension n (issue 21, item 7).
+"""Cost of the exact delay margin and stability windows against the state dimension n
+(issue 21, item 7; issue 32, item 8: n = 80 in <= 10 s on one core).
 
-For n = 5..60, one seeded system x' = A x + A_d x(t - h) (a chain of cars with
-delayed velocity feedback, :func:`system`) and the seconds of
+For each n (default 20, 40, 60, 80) one seeded system x' = A x + A_d x(t - h),
+a chain of m = n // 2 cars (:func:`system`: seeded coupler stiffnesses, light
+direct damping, delayed velocity feedback; crossings exist, so h* is finite),
+and the seconds of what a design report asks for:
 
-* :func:`~workbench.margins.delay_margin_sweep` (phase sweep following every
-  eigenvalue branch, O(n^3) per grid point): every n;
-* :func:`~workbench.margins.delay_margin_eig` (Chen-Gu-Nett, a 2 n^2 pencil,
-  O(n^6)): n <= ``KRON_MAX`` (at n = 30 it takes ~20 s, at n = 40 ~170 s);
+* :func:`~workbench.margins.exact_margin` (the phase sweep following every
+  eigenvalue branch of A + A_d e^{-j theta}, O(n^3) per phase point; the
+  Chen-Gu-Nett 2 n^2 pencil, O(n^6), only where it is cheap: n <= 14 under
+  ``cross_check="auto"``) and
+* :func:`~workbench.margins.stability_windows` up to 4 h* (the same sweep's
+  crossings, reused, then root counting);
 
-with the relative difference of the two where both ran. Target: n = 40 under
-2 s on 2 cores. OpenBLAS threads matter on a loaded machine: compare
-``OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/margins_scale.py``.
+as CPU seconds of this process (``time.process_time``: with
+``OPENBLAS_NUM_THREADS=1`` the one-core cost, little changed by other load)
+and wall seconds. ``--kron-max N`` also times the Chen-Gu-Nett pencil for
+n <= N and prints its relative difference from the sweep.
 
-Run: ``.venv/bin/python benchmarks/margins_scale.py [--kron-max N]``
+Run: ``OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/margins_scale.py
+[--sizes 20 40 60 80] [--kron-max N]``
 """
 from __future__ import annotations
 
@@ -22,11 +29,12 @@ import time
 
 import numpy as np
 
-from workbench.margins import delay_margin_eig, delay_margin_sweep, relative_difference
+from workbench.margins import (delay_margin_eig, exact_margin, relative_difference,
+                               stability_windows)
 from workbench.report.markdown import fmt, md_table
 
-SIZES = (5, 10, 15, 20, 25, 30, 40, 50, 60)
-KRON_MAX = 20
+SIZES = (20, 40, 60, 80)
+KRON_MAX = 0
 
 
 def system(n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -49,31 +57,38 @@ def system(n: int) -> tuple[np.ndarray, np.ndarray]:
     return A, Ad
 
 
-def _timed(f, *args):
-    t0 = time.perf_counter()
-    out = f(*args)
-    return out, time.perf_counter() - t0
+def _timed(f, *args, **kw):
+    c0, w0 = time.process_time(), time.perf_counter()
+    out = f(*args, **kw)
+    return out, time.process_time() - c0, time.perf_counter() - w0
+
+
+def _both(A, Ad):
+    ex = exact_margin(A, Ad)
+    return ex, stability_windows(A, Ad, 4 * ex.h if np.isfinite(ex.h) and ex.h > 0 else 10.0)
 
 
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--sizes", type=int, nargs="+", default=list(SIZES))
     p.add_argument("--kron-max", type=int, default=KRON_MAX,
-                   help="largest n for the Kronecker method (default %(default)s)")
+                   help="largest n for timing the Chen-Gu-Nett pencil (default %(default)s)")
     args = p.parse_args(argv)
     rows = []
-    for n in SIZES:
+    for n in args.sizes:
         A, Ad = system(n)
-        sw, t_sw = _timed(delay_margin_sweep, A, Ad)
+        (ex, win), cpu, wall = _timed(_both, A, Ad)
+        kr_txt = diff = "—"
         if n <= args.kron_max:
-            kr, t_kr = _timed(delay_margin_eig, A, Ad)
-            kr_txt, diff = f"{t_kr:.2f}", fmt(relative_difference(sw.h, kr.h), 2)
-        else:
-            kr_txt, diff = "—", "—"
-        rows.append([n, fmt(sw.h, 7), len(sw.crossings), f"{t_sw:.2f}", kr_txt, diff])
+            kr, t_kr, _ = _timed(delay_margin_eig, A, Ad)
+            kr_txt, diff = f"{t_kr:.2f}", fmt(relative_difference(ex.h, kr.h), 2)
+        method = "sweep" + (" + Chen-Gu-Nett" if ex.kronecker is not None else "")
+        rows.append([n, fmt(ex.h, 7), len(ex.sweep.crossings), len(win), method,
+                     f"{cpu:.2f}", f"{wall:.2f}", kr_txt, diff])
     print(f"OPENBLAS_NUM_THREADS = {os.environ.get('OPENBLAS_NUM_THREADS', 'unset')}, "
-          f"{os.cpu_count()} cores visible\n")
-    print(md_table(["n", "h* (s)", "crossings", "sweep (s)", "Kronecker (s)", "rel. diff"],
-                   rows, "rrrrrr"))
+          f"{os.cpu_count()} cores visible, load average {os.getloadavg()[0]:.1f}\n")
+    print(md_table(["n", "h* (s)", "crossings", "windows", "method", "CPU (s)", "wall (s)",
+                    "Chen-Gu-Nett (s)", "rel. diff"], rows, "rrrrlrrrr"))
 
 
 if __name__ == "__main__":

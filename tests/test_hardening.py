@@ -143,7 +143,8 @@ def test_the_search_finds_the_bound_whatever_the_cap(h_hi):
 
 def test_the_search_stops_at_its_wall_clock_cap():
     br = bisect_delay(_threshold(1e-6), h_lo=1e-4, h_hi=10.0, max_seconds=0.0)
-    assert len(br.steps) == 1 and br.outcome is not Outcome.CERTIFIED
+    assert len(br.steps) == 2 and br.outcome is not Outcome.CERTIFIED
+    assert br.steps[-1].solver_status == "error: wall-clock cap of 0 s reached"
 
 
 def test_a_solver_panic_is_inconclusive():

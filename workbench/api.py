@@ -93,6 +93,9 @@ def _system(sys, B):
         dt = getattr(sys, "dt", 0)
         if dt not in (0, None):
             raise ValueError(f"sys.dt = {dt!r}; expected a continuous-time system (dt = 0)")
+        if np.any(np.asarray(getattr(sys, "D", 0.0), dtype=complex) != 0):
+            raise ValueError("sys has D != 0 (a feedthrough); expected D = 0: the bound is of "
+                             "u = K x(t - h), with A and B only (pass control.ss(A, B, C, 0))")
         sys, B = sys.A, sys.B
     A = _matrix(sys, "A")
     if A.shape[0] != A.shape[1]:
@@ -293,13 +296,9 @@ def delay_bound(sys, B=None, *, Ad=None, method: Method = "bessel-legendre", N: 
     """
     from .lmi.core import DEFAULT_MARGIN
     from .margins import exact_margin, stability_windows
+    from .synthesis import check_search_options
     margin = DEFAULT_MARGIN if margin is None else margin
-    for name, v, ok in (("h_max", h_max, lambda x: 0 < x < math.inf),
-                        ("margin", margin, lambda x: 0 < x < 1e-2),
-                        ("rel_tol", rel_tol, lambda x: 0 < x <= 0.1)):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not ok(float(v)):
-            raise ValueError(f"{name} = {v!r}; expected a number in its range "
-                             "(h_max > 0 s, 0 < margin < 1e-2, 0 < rel_tol <= 0.1)")
+    check_search_options(h_max, margin, rel_tol)
     if isinstance(N, bool) or not isinstance(N, (int, np.integer)) or not 0 <= N <= 8:
         raise ValueError(f"N = {N!r}; expected an integer order in [0, 8]")
     A, B = _system(sys, B)

@@ -291,15 +291,15 @@ def cmd_simulate(args) -> int:
         from .kinds.delay_feedback.cli import simulate_command as simulate_feedback
         return simulate_feedback(design, case=args.case, dt=args.dt, as_json=args.json,
                                  csv=args.csv, plot=args.plot)
-    for flag, val in (("--csv", args.csv), ("--plot", args.plot)):
-        if val:
-            raise DesignError("<cli>", flag, val, "a delay-feedback design (the "
-                              "antiskid-run trajectory is in its report's figures)")
+    if args.plot:
+        raise DesignError("<cli>", "--plot", args.plot, "a delay-feedback design (the "
+                          "antiskid-run trajectory is in its report's figures; --csv writes it)")
     if design.kind != "antiskid-run":
         raise DesignError(design.path, "design.kind", design.kind,
                           'an "antiskid-run" or "delay-feedback" design')
     from .papers.p003.antiskid_run import simulate_command
-    return simulate_command(design, case=args.case, dt=args.dt, as_json=args.json)
+    return simulate_command(design, case=args.case, dt=args.dt, as_json=args.json,
+                            csv=args.csv)
 
 
 def cmd_sweep(args) -> int:
@@ -362,7 +362,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dt", type=float, help="step (s; default: the design's dt)")
     p.add_argument("--json", action="store_true")
     p.add_argument("--csv", metavar="FILE", help="also write the trajectory (t, states, "
-                   "controller outputs) to FILE (delay-feedback designs)")
+                   "controller outputs) to FILE (antiskid-run: every 0.01 s)")
     p.add_argument("--plot", metavar="PNG", help="also plot the states and inputs against "
                    "time to PNG (delay-feedback designs)")
     p = sub.add_parser("sweep", help=COMMANDS["sweep"][0])

@@ -63,6 +63,23 @@ class SynthesisSettings:
                     max_solves=self.max_solves)
 
 
+#: Declared range of a delay search cap h_max (s), in design files and the API alike.
+H_MAX_RANGE = (1e-3, 1e4)
+
+
+def check_search_options(h_max, margin, rel_tol) -> None:
+    """ValueError naming the first of ``h_max`` (s, in :data:`H_MAX_RANGE`),
+    ``margin`` (in (0, 0.01)) and ``rel_tol`` (in (0, 0.1]) out of its range,
+    with the design files' range (the API's check of a search's options)."""
+    lo, hi = H_MAX_RANGE
+    for name, v, ok, what in (
+            ("h_max", h_max, lambda x: lo <= x <= hi, f"a number (s) in [{lo:g}, {hi:g}]"),
+            ("margin", margin, lambda x: 0 < x < 1e-2, "a number in (0, 0.01)"),
+            ("rel_tol", rel_tol, lambda x: 0 < x <= 0.1, "a number in (0, 0.1]")):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not ok(float(v)):
+            raise ValueError(f"{name} = {str(v)[:60]}; expected {what} (as in design files)")
+
+
 @dataclass(frozen=True)
 class SynthesisRow:
     """One eps of the sweep (one row of the paper's Table 3).

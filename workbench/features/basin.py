@@ -258,7 +258,8 @@ def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False) -> Trajectory:
     """The delay-free loop from x0 over [0, T] (Radau, rtol 1e-8). Ends when it
     leaves ``box`` (fate "leaves the domain": the domain, or far away), or,
     unless ``full``, when V falls below 1e-3 c_certified; "converges" when it
-    entered {V <= c_certified}."""
+    entered {V <= c_certified}; "undecided" when the integrator stops on an
+    inf/NaN Jacobian (a vector field not finite near x0)."""
     import numpy as np
     from scipy.integrate import solve_ivp
     lo, hi = (np.asarray(b, float) for b in box)
@@ -278,8 +279,13 @@ def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False) -> Trajectory:
     near.terminal = True
     events = [out] if full or not c_cert > 0 else [out, near]
     with np.errstate(all="ignore"):
-        sol = solve_ivp(rhs, (0.0, T), np.asarray(x0, float), method="Radau", rtol=RADAU_RTOL,
-                        atol=1e-10, events=events)
+        try:
+            sol = solve_ivp(rhs, (0.0, T), np.asarray(x0, float), method="Radau",
+                            rtol=RADAU_RTOL, atol=1e-10, events=events)
+        except (ValueError, np.linalg.LinAlgError):
+            # the vector field is not finite near x0 (e.g. a scenario at a wheel speed
+            # of 1e-9 rad/s): Radau's Jacobian has inf/NaN; the fate stays open
+            return Trajectory(tuple(float(v) for v in x0), np.asarray([x0], float), "undecided")
     path = sol.y.T
     if c_cert > 0 and np.any(V(path) <= c_cert):
         fate = "converges"

@@ -34,6 +34,8 @@ __all__ = ["ImplementationSettings", "load_implementation_settings", "run_implem
 
 #: Grid of the (T, tau) stability map of the figure, and the largest input queue drawn.
 MAP_T, MAP_TAU, MAP_QUEUE = 48, 36, 120
+#: Declared ranges (issue 32): the sampling period T (s) and the network delay (s).
+T_RANGE, TAU_MAX = (1e-6, 1e3), 1e3
 
 
 @dataclass(frozen=True)
@@ -63,18 +65,19 @@ def load_implementation_settings(root) -> ImplementationSettings | None:
         return None
     t = root.table("implementation")
     raw = t.raw("sampling")
+    lo, hi = T_RANGE
     if isinstance(raw, list):
         lo_hi = t.numbers("sampling", min_len=2, what="interval ends (s)")
-        if len(lo_hi) != 2 or not 0 <= lo_hi[0] <= lo_hi[1] or not lo_hi[1] > 0:
-            raise t.fail("sampling", raw, "a period T > 0 or [T_min, T_max] with "
-                         "0 <= T_min <= T_max, T_max > 0 (s)")
+        if len(lo_hi) != 2 or not 0 <= lo_hi[0] <= lo_hi[1] or not lo <= lo_hi[1] <= hi:
+            raise t.fail("sampling", raw, f"a period T in [{lo:g}, {hi:g}] or [T_min, T_max] "
+                         f"with 0 <= T_min <= T_max, T_max in [{lo:g}, {hi:g}] (s)")
         sampling = lo_hi
     else:
-        sampling = t.number("sampling", positive=True, what="period (s) or [T_min, T_max]")
+        sampling = t.number("sampling", lo=lo, hi=hi, what="period (s) or [T_min, T_max]")
     nd = t.numbers("network_delay", default=(0.0, 0.0), min_len=2, what="delays (s)")
-    if len(nd) != 2 or not 0 <= nd[0] <= nd[1]:
+    if len(nd) != 2 or not 0 <= nd[0] <= nd[1] <= TAU_MAX:
         raise t.fail("network_delay", list(nd),
-                     "[tau_min, tau_max] with 0 <= tau_min <= tau_max (s)")
+                     f"[tau_min, tau_max] with 0 <= tau_min <= tau_max <= {TAU_MAX:g} (s)")
     hold = t.string("hold", default="zoh", choices=("zoh",))
     t.finish()
     return ImplementationSettings(sampling, (float(nd[0]), float(nd[1])), hold)

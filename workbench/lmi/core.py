@@ -261,19 +261,7 @@ class MarginLMI:
 
     def _run(self, problem: cp.Problem, h: float, settings: Mapping) -> tuple[str, float]:
         self.set_delay(h)
-        t0 = time.perf_counter()
-        try:
-            with warnings.catch_warnings():   # "inaccurate" is an outcome, not a warning
-                warnings.simplefilter("ignore", UserWarning)
-                problem.solve(solver=cp.CLARABEL, **settings)
-            status = str(problem.status)
-        except (cp.error.SolverError, ValueError, ArithmeticError) as exc:  # an answer
-            status = f"error: {exc}".splitlines()[0][:200]
-        except BaseException as exc:  # Clarabel's Rust panic (pyo3 PanicException) is one
-            if type(exc).__name__ != "PanicException":
-                raise
-            status = f"error: solver panic: {exc}".splitlines()[0][:200]
-        return status, time.perf_counter() - t0
+        return guarded_solve(problem, settings)
 
     def _checked(self, h: float, status: str, t_opt: float, seconds: float) -> Step:
         values = {k: np.array(v.value, dtype=float) for k, v in self._vars.items()}
@@ -332,6 +320,30 @@ class MarginLMI:
             return Step(h, Outcome.INCONCLUSIVE, status, None, {}, None, seconds)
         step = self._checked(h, status, 0.0, seconds)
         return dataclasses.replace(step, t_opt=min(step.recheck.values()))
+
+
+def guarded_solve(problem: cp.Problem, settings: Mapping | None = None) -> tuple[str, float]:
+    """Solve ``problem`` with Clarabel: (cvxpy status or ``"error: ..."``, seconds).
+
+    The one place every LMI of the workbench is solved. A solver failure is an
+    answer, not a crash: ``SolverError``, ``ValueError``, ``ArithmeticError``
+    and Clarabel's Rust panic (pyo3 ``PanicException``, a ``BaseException``)
+    become the status ``"error: <reason>"`` (one line, at most 200 characters),
+    which every caller decides as INCONCLUSIVE; ``"inaccurate"`` statuses are
+    returned as they are (no warning)."""
+    t0 = time.perf_counter()
+    try:
+        with warnings.catch_warnings():   # "inaccurate" is an outcome, not a warning
+            warnings.simplefilter("ignore", UserWarning)
+            problem.solve(solver=cp.CLARABEL, **dict(settings or {}))
+        status = str(problem.status)
+    except (cp.error.SolverError, ValueError, ArithmeticError) as exc:  # an answer
+        status = f"error: {exc}".splitlines()[0][:200]
+    except BaseException as exc:  # Clarabel's Rust panic (pyo3 PanicException) is one
+        if type(exc).__name__ != "PanicException":
+            raise
+        status = f"error: solver panic: {exc}".splitlines()[0][:200]
+    return status, time.perf_counter() - t0
 
 
 def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
@@ -422,6 +434,10 @@ def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
             h, stalls = math.sqrt(lo * hi), 0
         run(h)
         stalls = stalls + 1 if math.log(hi / lo) > 0.5 * width else 0
+    if time.perf_counter() - t0 >= max_seconds:   # the cap is a reason, kept with the steps
+        steps.append(Step(h, Outcome.INCONCLUSIVE,
+                          f"error: wall-clock cap of {max_seconds:g} s reached", None, {},
+                          None, 0.0))
     if lo > 0:
         outcome = Outcome.CERTIFIED
     elif refuted < math.inf and all(s.outcome is Outcome.REFUTED for s in steps):

@@ -40,6 +40,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import time
 from typing import Sequence
 
 import numpy as np
@@ -56,6 +57,9 @@ __all__ = ["CellLMI", "decay_cells", "certified_decay"]
 #: Largest alpha (h_b - h_a) of a cell: e^{alpha h} varies by at most 10 %
 #: across a cell.
 CELL_LOG_SPAN = 0.1
+#: Caps (issue 32): cells per point at one rate, and wall-clock seconds of a
+#: decay search; beyond either a rate is INCONCLUSIVE with the cap as its reason.
+MAX_CELLS, MAX_SECONDS = 400, 600.0
 
 
 class CellLMI(MarginLMI):
@@ -136,14 +140,25 @@ def decay_cells(alpha: float, h_lo: float, H: float) -> list[tuple[float, float]
     return [(float(a), float(b)) for a, b in zip(edges[:-1], edges[1:])]
 
 
-def _decide(points, alpha: float, h_lo: float, H: float, N: int, margin: float) -> Step:
+def _decide(points, alpha: float, h_lo: float, H: float, N: int, margin: float,
+            deadline: float = math.inf) -> Step:
     """CERTIFIED when every cell of every point is (the last cell's step is
-    returned); otherwise the first cell that was not."""
+    returned); otherwise the first cell that was not. INCONCLUSIVE past
+    :data:`MAX_CELLS` cells or the ``deadline`` (``time.perf_counter()``)."""
     last = None
     seconds = 0.0
+    k = math.ceil(alpha * (H - h_lo) / CELL_LOG_SPAN)      # the count of decay_cells
+    if not k <= MAX_CELLS:
+        return Step(alpha, Outcome.INCONCLUSIVE, f"error: {k:g} delay cells at rate "
+                    f"{alpha:.3g} 1/s, above the cap of {MAX_CELLS}", None, {}, None, 0.0)
+    cells = decay_cells(alpha, h_lo, H)
     for A, Ad in points:
         Aa = A + alpha * np.eye(A.shape[0])
-        for a, b in decay_cells(alpha, h_lo, H):
+        for a, b in cells:
+            if time.perf_counter() > deadline:
+                return Step(alpha, Outcome.INCONCLUSIVE, f"error: wall-clock cap of "
+                            f"{MAX_SECONDS:g} s of the decay search reached", None, {}, None,
+                            seconds)
             lmi = CellLMI(Aa, Ad, (math.exp(alpha * a), math.exp(alpha * b)), a, N,
                           margin=margin)
             step = lmi.solve_at(b)
@@ -178,12 +193,14 @@ def certified_decay(points: Sequence[tuple[np.ndarray, np.ndarray]], *, h_lo: fl
             Tinv = np.diag(1.0 / np.diag(T))
             bal[k].append((Tinv @ A @ T, Tinv @ Ad @ T))
 
+    deadline = time.perf_counter() + MAX_SECONDS
+
     def decide(a: float) -> Step:
-        step = _decide(bal[0], a, h_lo, H, N, margin)
+        step = _decide(bal[0], a, h_lo, H, N, margin, deadline)
         if step.outcome is Outcome.CERTIFIED:
             return step
-        other = _decide(bal[1], a, h_lo, H, N, margin)
+        other = _decide(bal[1], a, h_lo, H, N, margin, deadline)
         return other if other.outcome is Outcome.CERTIFIED else step
 
     return bisect_delay(decide, h_lo=1e-5 * alpha_hi,
-                        h_hi=alpha_hi, rel_tol=rel_tol, guess=guess)
+                        h_hi=alpha_hi, rel_tol=rel_tol, guess=guess, max_seconds=MAX_SECONDS)

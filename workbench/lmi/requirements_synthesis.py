@@ -28,7 +28,7 @@ import numpy as np
 
 from .core import DEFAULT_MARGIN, Bracket, Outcome, Step, bisect_delay
 from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, round_significant
-from .requirements_decay import certified_decay
+from .requirements_decay import MAX_SECONDS, certified_decay
 from .requirements import Loop, RequirementAnalysis, RequirementSynthesis
 from .robust import maximise_log_scalar
 from .scaling import balance_points
@@ -181,7 +181,7 @@ def _range(loop: Loop, objective: str, H: float) -> tuple[float, float]:
 def _bisect(lmi, objective, *, H, alpha, gamma, rel_tol, guess=None) -> Bracket:
     lo, hi = _range(lmi.loop, objective, H)
     return bisect_delay(_decider(lmi, objective, H=H, alpha=alpha, gamma=gamma), h_lo=lo,
-                        h_hi=hi, rel_tol=rel_tol, guess=guess)
+                        h_hi=hi, rel_tol=rel_tol, guess=guess, max_seconds=MAX_SECONDS)
 
 
 def certify_gain(loop: Loop, K: np.ndarray, *, h_min: float | None = None, H: float,

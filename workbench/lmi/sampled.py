@@ -61,19 +61,21 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 from dataclasses import dataclass
 
 import cvxpy as cp
 import numpy as np
 import scipy.linalg as sl
 
-from .core import DEFAULT_MARGIN, Bracket, Outcome, Step, bisect_delay
+from .core import DEFAULT_MARGIN, Bracket, Outcome, Step, bisect_delay, guarded_solve
 from .scaling import balancing
 
 __all__ = ["LiftedFamily", "continuum_margin", "decide_lifted", "certified_sampling_bound",
            "SamplingBound"]
 
+#: Wall-clock cap (s) of a sampling-bound search (issue 32): past it the bracket so far
+#: is returned, INCONCLUSIVE without a certified point, with the cap as a step's reason.
+MAX_SECONDS = 600.0
 #: Grid points of the first LMI solve on [T_min, T_max].
 INITIAL_GRID = 12
 #: Cutting-plane rounds (LMI solve + continuum re-check) per sampling bound.
@@ -198,13 +200,7 @@ def _solve_grid(fam: LiftedFamily, grid, alpha: float):
         M = _sym(fam.M(P, float(s), alpha))
         cons += [M << -t * np.eye(n), -cp.trace(M) <= 1]
     prob = cp.Problem(cp.Maximize(t), cons)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UserWarning)
-            prob.solve(solver=cp.CLARABEL)
-        status = str(prob.status)
-    except cp.error.SolverError as exc:
-        status = f"error: {exc}".splitlines()[0]
+    status, _ = guarded_solve(prob)
     if status != cp.OPTIMAL:
         return status, None, None
     return status, float(t.value), np.array(P.value, dtype=float)
@@ -297,7 +293,8 @@ def certified_sampling_bound(A, B, K, *, T_min: float = 0.0, alpha: float = 0.0,
     T_hi : float, optional
         Search cap (s); default 20 time scales 1 / (||A|| + ||B K||).
     rel_tol, guess, max_solves
-        Bisection settings (:func:`~workbench.lmi.core.bisect_delay`).
+        Bisection settings (:func:`~workbench.lmi.core.bisect_delay`; at most
+        :data:`MAX_SECONDS` of wall clock).
     margin : float
         Named relative margin.
 
@@ -312,5 +309,5 @@ def certified_sampling_bound(A, B, K, *, T_min: float = 0.0, alpha: float = 0.0,
     lo = max(T_min * (1 + 1e-6), 1e-3 * fam.tau0, T_min + 1e-3 * fam.tau0)
     br = bisect_delay(lambda h: decide_lifted(fam, h, T_min=T_min, alpha=alpha, margin=margin),
                       h_lo=min(lo, T_hi / 2), h_hi=T_hi, rel_tol=rel_tol, guess=guess,
-                      max_solves=max_solves)
+                      max_solves=max_solves, max_seconds=MAX_SECONDS)
     return SamplingBound(T_min, alpha, margin, br)

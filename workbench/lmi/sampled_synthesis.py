@@ -25,11 +25,12 @@ aperiodic sampling: an overview. Automatica 76, 309-335.
 from __future__ import annotations
 
 import math
-import warnings
 
 import cvxpy as cp
 import numpy as np
 import scipy.linalg as sl
+
+from .core import guarded_solve
 
 __all__ = ["synthesize_sampled_gain"]
 
@@ -83,13 +84,9 @@ def synthesize_sampled_gain(A, B, T_max: float, *, digits: int = 4,
         blk = cp.bmat([[Q - s * t * np.eye(n), AdQ.T], [AdQ, Q]])
         cons.append((blk + blk.T) / 2 >> 0)
     prob = cp.Problem(cp.Maximize(t), cons)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UserWarning)
-            prob.solve(solver=cp.CLARABEL)
-        status = str(prob.status)
-    except cp.error.SolverError as exc:
-        return None, f"error: {exc}".splitlines()[0], None
+    status, _ = guarded_solve(prob)
+    if status.startswith("error"):
+        return None, status, None
     if status != cp.OPTIMAL or not t.value > 0:
         return None, status, None if t.value is None else float(t.value)
     K = np.asarray(Y.value) @ np.linalg.inv(np.asarray(Q.value))

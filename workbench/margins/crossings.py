@@ -154,8 +154,9 @@ def _direction(d_re: float, R: float) -> int:
     return 0 if abs(d_re) <= TANGENT_RTOL * R else (1 if d_re > 0 else -1)
 
 
-def _multiplicity(A, Ad, theta: float, lam: complex, R: float) -> int:
-    ev = np.linalg.eigvals(A + Ad * np.exp(-1j * theta))
+def _multiplicity(A, Ad, theta: float, lam: complex, R: float, ev=None) -> int:
+    if ev is None:
+        ev = np.linalg.eigvals(A + Ad * np.exp(-1j * theta))
     return max(1, int(np.sum(np.abs(ev - lam) <= CLUSTER_RTOL * R)))
 
 
@@ -165,13 +166,14 @@ def zero_root(A, Ad, R: float) -> bool:
     return bool(np.min(np.abs(np.linalg.eigvals(A + Ad))) <= ZERO_RTOL * R)
 
 
-def _to_crossing(A, Ad, theta: float, lam: complex, d: complex, R: float):
+def _to_crossing(A, Ad, theta: float, lam: complex, d: complex, R: float, ev=None):
     """(theta, axis eigenvalue lam of M(theta)) -> Crossing with omega > 0, or
-    None for w = 0 (s = 0 is handled by :func:`zero_root`; elsewhere h = inf)."""
+    None for w = 0 (s = 0 is handled by :func:`zero_root`; elsewhere h = inf).
+    ``ev``: the eigenvalues of M(theta) when already computed."""
     w = float(lam.imag)
     if abs(w) <= ZERO_RTOL * R:
         return None
-    mult = _multiplicity(A, Ad, theta, lam, R)
+    mult = _multiplicity(A, Ad, theta, lam, R, ev)
     if w > 0:
         return Crossing(w, _wrap(theta), _direction(d.real, R), mult)
     # conjugate branch: conj(lambda(theta)) is an eigenvalue of M(2 pi - theta)
@@ -200,7 +202,7 @@ def _merge(found, R: float) -> tuple[Crossing, ...]:
 
 
 def _collect(A, Ad, polished, R: float) -> CrossingSet:
-    found = [_to_crossing(A, Ad, theta, lam, d, R) for theta, lam, d in polished]
+    found = [_to_crossing(A, Ad, *p[:3], R, *p[3:]) for p in polished]
     return CrossingSet(_merge([c for c in found if c is not None], R), False)
 
 
@@ -209,8 +211,8 @@ def _newton_phase(A, Ad, theta: float, guess: complex, R: float, *,
                   bracket: tuple[float, float, float] | None = None, iters: int = 60):
     """Polish theta so that the eigenvalue of M(theta) nearest ``guess`` has zero
     real part. With ``bracket = (ta, tb, f(ta))`` (a sign change of the branch)
-    the iteration is safeguarded by bisection. Returns (theta, lambda, dlambda)
-    or None when it does not converge."""
+    the iteration is safeguarded by bisection. Returns (theta, lambda,
+    dlambda/dtheta, eigenvalues of M(theta)), or None when it does not converge."""
     lam = d = None
     for _ in range(iters):
         ev, dv = _eig_derivative(A, Ad, theta)
@@ -218,7 +220,7 @@ def _newton_phase(A, Ad, theta: float, guess: complex, R: float, *,
         lam, d = ev[k], dv[k]
         f, fp = lam.real, d.real
         if abs(f) <= AXIS_RTOL * R:
-            return theta, lam, d
+            return theta, lam, d, ev
         step = f / fp if np.isfinite(fp) and fp != 0 else math.inf
         new = theta - step
         if bracket is not None:
@@ -228,17 +230,17 @@ def _newton_phase(A, Ad, theta: float, guess: complex, R: float, *,
             if not ta < new < tb:
                 new = 0.5 * (ta + tb)
             if tb - ta <= 4 * EPS * max(abs(ta), abs(tb)):
-                return theta, lam, d
+                return theta, lam, d, ev
         elif not math.isfinite(new) or abs(step) > 0.5:
             return None
         guess = lam + d * (new - theta) if np.isfinite(d) else lam
         if abs(new - theta) <= 4 * EPS * max(abs(theta), abs(new)):
             ev, dv = _eig_derivative(A, Ad, new)
             k = int(np.argmin(np.abs(ev - guess)))
-            return new, ev[k], dv[k]
+            return new, ev[k], dv[k], ev
         theta = new
     if lam is not None and abs(lam.real) <= math.sqrt(EPS) * R:
-        return theta, lam, d
+        return theta, lam, d          # lam is of the previous iterate: no eigenvalues given
     return None
 
 
@@ -272,10 +274,27 @@ def kronecker_crossings(A: np.ndarray, Ad: np.ndarray) -> CrossingSet:
 
 
 # -- method 2: phase sweep following every branch --------------------------------------
+#: The last few sweeps, by their exact input (a margin and the windows of one loop
+#: share one sweep: the cost of the exact methods at large n is the sweep).
+_SWEEPS: dict = {}
+SWEEP_CACHE = 8
+
+
 def phase_crossings(A: np.ndarray, Ad: np.ndarray, *, grid: int | None = None) -> CrossingSet:
     """Every crossing by a sweep of theta in [0, pi] that follows each eigenvalue
     branch of A + A_d e^{-j theta} (inputs already checked; ``grid`` initial
-    intervals, default 32 + 4 n)."""
+    intervals, default 32 + 4 n). The result of the same (A, A_d, grid), bit for
+    bit, is computed once (the last :data:`SWEEP_CACHE` inputs are kept)."""
+    A, Ad = np.ascontiguousarray(A, dtype=float), np.ascontiguousarray(Ad, dtype=float)
+    key = (A.shape, A.tobytes(), Ad.tobytes(), grid)
+    if key not in _SWEEPS:
+        if len(_SWEEPS) >= SWEEP_CACHE:
+            del _SWEEPS[next(iter(_SWEEPS))]
+        _SWEEPS[key] = _sweep(A, Ad, grid)
+    return _SWEEPS[key]
+
+
+def _sweep(A: np.ndarray, Ad: np.ndarray, grid: int | None) -> CrossingSet:
     n = A.shape[0]
     R = scale(A, Ad)
     if R == 0 or zero_root(A, Ad, R):

@@ -50,6 +50,8 @@ import scipy.linalg as sl
 __all__ = ["lifted_map", "spectral_radius", "alternating_radius", "PeriodicStableSet",
            "periodic_stable_set", "first_unstable_period"]
 
+#: Largest delay in samples, floor(tau / T), of a lifted map (issue 32: a size cap).
+MAX_QUEUE = 10000
 #: Relative bisection tolerance on each boundary of the stable set of T.
 BOUNDARY_RTOL = 1e-10
 
@@ -85,6 +87,9 @@ def lifted_map(A, B, K, T: float, tau: float = 0.0) -> np.ndarray:
     if not T > 0 or not tau >= 0 or not math.isfinite(T + tau):
         raise ValueError(f"T = {T!r} s, tau = {tau!r} s; expected T > 0 and tau >= 0")
     n, m = B.shape
+    if not tau / T <= MAX_QUEUE:
+        raise ValueError(f"tau / T = {tau / T:.4g}; expected at most {MAX_QUEUE} samples "
+                         f"in the delay (the map has n + (d + 1) m rows)")
     d = int(math.floor(tau / T))
     r = tau - d * T
     if r >= T:                      # rounding of tau / T

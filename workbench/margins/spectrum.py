@@ -149,6 +149,9 @@ def rightmost_roots(A, Ad, h: float, *, order: int = 16, max_size: int = MAX_SIZ
     if R == 0:
         return Spectrum(h, 0.0, (0j,), 0)
     N = max(order, math.ceil(R * h / 3))
+    if not math.isfinite(2.0 * N * N / h):   # h = 5e-324: the differentiation matrix overflows
+        raise SpectrumNotConverged(f"h = {h!r} s: the collocation matrix overflows; "
+                                   "expected a delay above about 1e-300 s")
     prev = None
     while n * (N + 1) <= max_size:
         ev = np.linalg.eigvals(_generator(A, Ad, h, N))

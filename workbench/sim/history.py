@@ -28,6 +28,8 @@ def split_delay(h: float, dt: float) -> tuple[int, float]:
     if not (h >= 0 and dt > 0):
         raise ValueError(f"h = {h!r}, dt = {dt!r}; expected h >= 0 and dt > 0 (s)")
     q = h / dt
+    if not q <= 1e9:
+        raise ValueError(f"h = {h!r}, dt = {dt!r}; expected h / dt at most 1e9 steps")
     n = round(q)
     if abs(q - n) < 1e-9:
         return int(n), 0.0

@@ -220,7 +220,7 @@ def _delay(root: Reader) -> DelaySpec:
 def _synthesis(root: Reader, delay: DelaySpec) -> SynthesisChoice:
     from ...lmi.core import DEFAULT_MARGIN
     from ...lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
-    from ...synthesis import SynthesisSettings
+    from ...synthesis import H_MAX_RANGE, SynthesisSettings
     req = root.has("requirements")
     s = root.table("synthesis", default=None) if req else root.table("synthesis")
     method = s.string("method", choices=METHODS + ("robust-descriptor", "requirements"),
@@ -250,7 +250,8 @@ def _synthesis(root: Reader, delay: DelaySpec) -> SynthesisChoice:
         rel_tol=s.number("rel_tol", default=1e-4 if method == METHODS[0] else 1e-3,
                          positive=True, hi=0.1),
         h_max=s.number("h_max", default=max(100.0 if method == METHODS[0] else 10.0,
-                                            4 * delay.h_max), lo=1e-3, hi=1e4,
+                                            4 * delay.h_max), lo=H_MAX_RANGE[0],
+                       hi=H_MAX_RANGE[1],
                        what="number (s)"),
         gain_fraction=s.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
                                hi=1.0, what="fraction of h_certified"),
@@ -316,7 +317,7 @@ def _scenarios(root: Reader, plant: PlantSpec, delay: DelaySpec) -> tuple[Scenar
         dt = r.number("dt", positive=True, hi=t_end / 10, what="number (s)")
         if t_end / dt > 2e6:
             raise r.fail("dt", dt, "at most 2e6 steps over t_end")
-        h = r.number("h", default=delay.h_max, positive=True, what="number (s)")
+        h = r.number("h", default=delay.h_max, positive=True, hi=t_end, what="number (s)")
         rtol = r.number("rtol", default=1e-3, positive=True, hi=0.5)
         predictor = r.boolean("predictor", default=False)
         r.finish()

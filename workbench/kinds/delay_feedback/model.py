@@ -116,6 +116,17 @@ class PlantModel:
                 at = "" if values is None else f" at the parameter values of {where}"
                 raise DesignError(self.spec.path, key, text, f"a finite real expression{at} "
                                   f"(found {kind})")
+        if values is None:
+            return
+        Jx, Ju = self.jacobians          # e.g. F*tanh(a/F) is finite at F = 0, d/da is not
+        names = self.spec.state_names + self.spec.input_names
+        for i, (s, text) in enumerate(zip(self.spec.state_names, self.spec.equations)):
+            for j, d in enumerate(list(Jx.row(i)) + list(Ju.row(i))):
+                if self.substituted(d, values).has(*bad):
+                    raise DesignError(self.spec.path, f"equations.{s}", text,
+                                      f"an expression with finite derivatives at the parameter "
+                                      f"values of {where} (d/d{names[j]} has a division by "
+                                      f"zero or an infinity)")
 
     def substituted(self, expr, values: dict[str, float]):
         """``expr`` with every parameter replaced by its (double) value."""

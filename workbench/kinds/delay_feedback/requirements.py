@@ -33,6 +33,14 @@ __all__ = ["RequirementsSpec", "load_rate_requirements", "load_requirements", "r
 ROWS = ("delay", "decay", "l2_gain", "input_limit")
 FIELDS = ("certified", "exact", "verdict")
 
+#: Declared ranges of the ``[requirements]`` values (issue 32: out of range exits 2
+#: naming file, key, value and range). Delays (s): h_max in [H_MIN, H_MAX] and
+#: h_min = 0 or in [H_MIN, h_max]: below about 1e-6 s the collocation of the
+#: characteristic roots (order ~ R h) loses every digit. Rates (1/s) and gains as stated.
+H_MIN, H_MAX = 1e-6, 1e3
+RANGES = {"decay_rate": (1e-6, 1e3), "l2_gain": (1e-6, 1e6), "input_limit": (1e-9, 1e9),
+          "box": (1e-9, 1e9)}
+
 
 @dataclass(frozen=True)
 class RequirementsSpec:
@@ -49,10 +57,12 @@ class RequirementsSpec:
     sources: dict
 
 
-def _entry(t, name: str, unit: str | None):
-    """(value, source) of ``{ value, unit, source }`` (unit checked when given)."""
+def _entry(t, name: str, unit: str | None, row: str | None = None):
+    """(value, source) of ``{ value, unit, source }`` (unit checked when given),
+    the value in ``RANGES[row or name]``."""
     sub = t.table(name)
-    x = sub.number("value", positive=True, what=f"positive number ({unit or 'its unit'})")
+    lo, hi = RANGES[row or name]
+    x = sub.number("value", lo=lo, hi=hi, what=f"number ({unit or 'its unit'})")
     if unit is not None:
         u = sub.string("unit")
         if u != unit:
@@ -64,15 +74,25 @@ def _entry(t, name: str, unit: str | None):
     return x, src
 
 
+def _delay_range(t, default=None) -> tuple[float, float]:
+    """``delay = [h_min, h_max]`` (s): h_max in [H_MIN, H_MAX], h_min = 0 or in
+    [H_MIN, h_max]."""
+    rng = t.numbers("delay", what="delays (s)",
+                    **({} if default is None else {"default": default}))
+    if len(rng) != 2 or not (rng[0] == 0 or H_MIN <= rng[0]) or not (
+            rng[0] <= rng[1] and H_MIN <= rng[1] <= H_MAX):
+        raise t.fail("delay", list(rng), f"[h_min, h_max] with h_max in [{H_MIN:g}, {H_MAX:g}] "
+                     f"and h_min = 0 or in [{H_MIN:g}, h_max] (s)")
+    return rng
+
+
 def load_requirements(root, plant, delay) -> RequirementsSpec | None:
     """Read ``[requirements]`` (None when absent); DesignError on bad input."""
     if not root.has("requirements"):
         return None
     t = root.table("requirements")
     objective = t.string("objective", default="decay", choices=("decay", "l2_gain", "delay"))
-    rng = t.numbers("delay", default=(delay.h_min, delay.h_max), what="delays (s)")
-    if len(rng) != 2 or not (0 <= rng[0] <= rng[1] and rng[1] > 0):
-        raise t.fail("delay", list(rng), "[h_min, h_max] with 0 <= h_min <= h_max, h_max > 0 (s)")
+    rng = _delay_range(t, (delay.h_min, delay.h_max))
     sources = {"delay": t.string("delay_source", default=delay.source)}
     alpha = None
     if t.has("decay_rate"):
@@ -86,12 +106,12 @@ def load_requirements(root, plant, delay) -> RequirementsSpec | None:
         lt, bt = t.table("input_limit"), t.table("box")
         limit, box, srcs = {}, {}, []
         for name in plant.input_names:
-            limit[name], s = _entry(lt, name, units[name])
+            limit[name], s = _entry(lt, name, units[name], "input_limit")
             srcs.append(f"{name}: {s}")
         for name in list(bt.data):
             if name not in plant.state_names:
                 raise bt.fail(name, bt.data[name], "a state of [states]")
-            box[name], s = _entry(bt, name, units[name])
+            box[name], s = _entry(bt, name, units[name], "box")
             srcs.append(f"box {name}: {s}")
         lt.finish()
         bt.finish()
@@ -123,9 +143,7 @@ def load_rate_requirements(root) -> RequirementsSpec | None:
         return None
     t = root.table("requirements")
     objective = t.string("objective", default="decay", choices=("decay", "delay"))
-    rng = t.numbers("delay", what="delays (s)")
-    if len(rng) != 2 or not (0 <= rng[0] <= rng[1] and rng[1] > 0):
-        raise t.fail("delay", list(rng), "[h_min, h_max] with 0 <= h_min <= h_max, h_max > 0 (s)")
+    rng = _delay_range(t)
     sources = {"delay": t.string("delay_source")}
     alpha = None
     if t.has("decay_rate"):

@@ -195,7 +195,7 @@ def load_spec(root: Reader) -> TrackingSpec:
                       "not all 0")
     tu.finish()
     req = root.table("requirements")
-    tol = req.quantity("stop_tolerance", "m", positive=True)
+    tol = req.quantity("stop_tolerance", "m", positive=True, hi=1e4)   # declared range (issue 32)
     req.finish()
     spec = TrackingSpec(main, line, prof, train, u_lim, Ts, dt, readings, scales, weights,
                         tol)

@@ -162,9 +162,15 @@ def linear_check(spec: RunSpec, A, B, K) -> LinearCheck:
                        tuple(ratios_p), tuple(runs), halving)
 
 
-def simulate_design(design, case_name: str | None, dt: float | None) -> dict:
+#: Recording interval (s) of the trajectory ``workbench simulate --csv`` writes.
+CSV_DT = 0.01
+
+
+def simulate_design(design, case_name: str | None, dt: float | None,
+                    record: bool = False) -> dict:
     """One case of an ``antiskid-run`` design at one step (for ``workbench
-    simulate``): metrics, wall time and the real-time factor."""
+    simulate``): metrics, wall time and the real-time factor; with ``record``
+    also the trajectory (``"run"``, a SimResult recorded every :data:`CSV_DT` s)."""
     import time
     spec: RunSpec = design.spec
     names = [c.name for c in spec.cases]
@@ -178,7 +184,8 @@ def simulate_design(design, case_name: str | None, dt: float | None) -> dict:
     K, how, _ = gain_for(spec)
     cs = controller_settings(spec, K, case)
     t0 = time.perf_counter()
-    run, m = simulate_antiskid(run_settings(spec, cs), dt, record_dt=None,
+    run, m = simulate_antiskid(run_settings(spec, cs), dt,
+                               record_dt=max(CSV_DT, dt) if record else None,
                                mesh=case_mesh(spec, case))
     wall = time.perf_counter() - t0
     metrics = case_metrics(m, cs, spec.scenario["t_brake"])
@@ -186,16 +193,33 @@ def simulate_design(design, case_name: str | None, dt: float | None) -> dict:
         m.t_diverged if math.isfinite(m.t_diverged) else spec.scenario["t_end"])
     return {"design": design.name, "case": name, "dt": dt, "K": list(K), "K_source": how,
             "metrics": metrics, "simulated_s": float(end), "wall_s": wall,
-            "realtime_factor": float(end) / wall}
+            "realtime_factor": float(end) / wall, **({"run": run} if record else {})}
 
 
-def simulate_command(design, *, case: str | None, dt: float | None, as_json: bool) -> int:
+def _trajectory_csv(run) -> str:
+    """CSV of a recorded antiskid run: t, the states, u(t) and u(t - h) (SI units)."""
+    names = list(run.state_names) or [f"x{i}" for i in range(run.x.shape[0])]
+    ins = list(run.input_names) or [f"u{i}" for i in range(run.u.shape[0])]
+    head = ["t_s"] + names + ins + [f"{u}_applied" for u in ins]
+    cols = np.vstack([run.t[None, :], run.x, run.u, run.u_applied])
+    return ",".join(head) + "\n" + "".join(",".join(f"{v:.9g}" for v in row) + "\n"
+                                          for row in cols.T)
+
+
+def simulate_command(design, *, case: str | None, dt: float | None, as_json: bool,
+                     csv: str | None = None) -> int:
     """``workbench simulate`` on a loaded ``antiskid-run`` design: print the
-    metrics of one case; exit 0."""
+    metrics of one case (with ``csv`` also write its trajectory, every
+    :data:`CSV_DT` s); exit 0."""
     import json
+    from pathlib import Path
 
+    from ...report.files import atomic_write
     from ...report.markdown import fmt, md_table
-    out = simulate_design(design, case, dt)
+    out = simulate_design(design, case, dt, record=bool(csv))
+    if csv:
+        atomic_write(Path(csv), _trajectory_csv(out.pop("run")))
+        print(f"wrote {csv}")
     if as_json:
         print(json.dumps(out, indent=2, default=lambda x: None))
         return 0
