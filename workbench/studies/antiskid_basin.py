@@ -43,10 +43,11 @@ from scipy.integrate import solve_ivp
 from ..controllers.antiskid003_settings import ControllerSettings
 from ..errors import ModelError
 from ..plants.adhesion import NumericAdhesion, adhesion_model
+from ..plants.lambdify_cache import lambdify
 from ..roa import BasinEstimate, BasinProblem, LevelOutcome, estimate_basin, modal_P
 from ..roa.basin import falsified_top
-from ..roa.problem import quadratic_enclosure
 from ..roa.check import BasinCheck, PointCheck, largest_level_in_box
+from ..roa.problem import quadratic_enclosure
 from ..symbolic.linearise import linearise_cruise
 
 #: Weights w of the fast (creep-ratio) mode against the slow (speed) mode
@@ -294,7 +295,7 @@ def _trajectories(prob, est, pts, seed, n, T, lam_d):
                      max(abs(x[1]) for _, x in pts) * 1.5 + 0.02]) if pts else np.array([2, 0.1])
     starts = [tuple(x) for _, x in pts]
     starts += [tuple(rng.uniform(-1, 1, 2) * half) for _ in range(n)]
-    fm = sp.lambdify(prob.states, list(prob.f), "math")
+    fm = lambdify(prob.states, list(prob.f), "math")
     out = []
     for x0 in starts:
         sol = _delay_free(fm, x0, lam_d, T)
@@ -363,7 +364,7 @@ def _fate(vals, v_d, K, x0, lam_d, sets, T) -> str:
     """Fate of the delay-free trajectory from x0 (see :class:`SwitchVerdict`);
     ``sets``: the :class:`_Deferred` estimates of the weight grid."""
     f, _, states, *_ = _loop(vals, v_d, tuple(K))
-    sol = _delay_free(sp.lambdify(states, f, "math"), x0, lam_d, T)
+    sol = _delay_free(lambdify(states, f, "math"), x0, lam_d, T)
     path = sol.y.T
     if any(stage.enters(path) for stage in sets):
         return "converges"

@@ -1,0 +1,72 @@
+"""The basin k2 sweep's deferred certificate (issue 36, item 4): the falsifier
+settles a REFUTED verdict and a diverging fate without the box cover, and
+the answers are those of the full estimate (workbench.studies.antiskid_basin)."""
+import numpy as np
+import pytest
+
+from workbench.plants.adhesion import NumericAdhesion
+from workbench.roa import LevelOutcome
+from workbench.roa.basin import falsified_top
+from workbench.studies import antiskid_basin as AB
+
+# as tests/test_roa_antiskid.py: 003 Tables 1-2 (dry rail), the certified gain at eps = 0.35
+DRY = dict(a=0.3315, b=40.19, c=5.392, J=80.0, r=0.445, m=12000.0, zeta=0.01, c0=180.9,
+           c1=112.2, c2=2.6, g=9.8)
+K = (-0.004575, 10.27)
+VALS = tuple(sorted(DRY.items()))
+
+
+@pytest.fixture(scope="module")
+def switch():
+    """The printed switch state (v_d, lambda_opt) in error coordinates."""
+    lam_opt = NumericAdhesion.from_dict(DRY).lambda_opt()
+    return (0.0, lam_opt - AB.cruise_lambda_d(VALS, 70.0))
+
+
+@pytest.fixture(scope="module")
+def deferred(switch):
+    """One weight of the grid at the printed switch, K of the design: REFUTED."""
+    return AB._Deferred(VALS, 70.0, K, switch, 100.0, 0)
+
+
+def test_refuted_point_needs_no_cover(deferred, switch, monkeypatch):
+    monkeypatch.delenv(AB.EAGER_ENV, raising=False)
+    assert deferred.outcome(switch) is LevelOutcome.REFUTED
+    assert deferred._est is None                       # the cover did not run
+
+
+def test_diverging_path_above_c_top_needs_no_cover(deferred, switch):
+    path = np.array([switch, (switch[0] * 2, switch[1] * 1.5)])
+    assert np.all(deferred.prob.V(path) > deferred.c_top)
+    assert deferred.enters(path) is False and deferred._est is None
+
+
+def test_deferred_answers_are_the_full_estimate(deferred, switch):
+    """The shortcut's premise and its answers, against the full estimate of
+    the same problem (estimate_cruise's, bit for bit)."""
+    out_short = deferred.outcome(switch)
+    est = deferred.est                                  # the cover now runs
+    _, full = AB.estimate_cruise(VALS, 70.0, K, [switch], 100.0, seed=0)
+    assert est == full
+    assert est.c_certified <= deferred.c_top <= est.c_refuted
+    assert out_short is est.point_verdict(switch).outcome
+    inside = np.array([[0.0, 0.0], switch])            # the equilibrium is in the certified set
+    assert deferred.enters(inside) is bool(est.c_certified > 0)
+
+
+def test_falsified_top_is_the_estimates_falsifier(deferred):
+    fal, c_top = falsified_top(deferred.prob, deferred._c, seed=0)
+    assert fal == deferred.fal and c_top == min(deferred._c, fal.c_refuted)
+    with pytest.raises(ValueError):
+        falsified_top(deferred.prob, 0.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("k2", [3.75, 10.0])
+def test_switch_verdict_equals_the_eager_path(switch, k2, monkeypatch):
+    """Every certificate computed (the path before issue 36) gives the same
+    verdict, weight and fate as the deferred one (> 20 s: slow tier)."""
+    pt = (70.0, switch[1] + AB.cruise_lambda_d(VALS, 70.0))
+    fast = AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt)
+    monkeypatch.setenv(AB.EAGER_ENV, "1")
+    assert AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt) == fast
