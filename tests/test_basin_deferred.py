@@ -70,3 +70,25 @@ def test_switch_verdict_equals_the_eager_path(switch, k2, monkeypatch):
     fast = AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt)
     monkeypatch.setenv(AB.EAGER_ENV, "1")
     assert AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt) == fast
+
+
+def test_k2_sweep_is_shared_through_the_run_folder(tmp_path, monkeypatch):
+    """Designs that differ only in the plant's mass share the controller's
+    nominal model and so the k2 sweep: a second process of the same run reads
+    it from the run folder (here: the same key, the in-process cache bypassed)."""
+    from workbench import memo
+    from workbench.studies import antiskid_basin_k2 as K2
+    calls = []
+
+    def fake(*key):
+        calls.append(key)
+        return K2.K2Sweep(key[3], key[2], (), (), None, min(key[4]), False)
+
+    monkeypatch.setenv(memo.CACHE_ENV, str(tmp_path))
+    monkeypatch.setattr(K2, "_sweep", fake)
+    args = dict(grid=[0.0, 2.0], compare=[("row", (K[0], 10.5))], bisect=2, seed=0)
+    a = K2.safe_k2_range(DRY, 70.0, K[0], (70.0, 0.1), **args)
+    b = K2.safe_k2_range(dict(reversed(list(DRY.items()))), 70, K[0], (70.0, 0.1), **args)
+    assert a == b and len(calls) == 1 and len(list(tmp_path.glob("*.pickle"))) == 1
+    K2.safe_k2_range(DRY, 70.0, K[0], (70.0, 0.1), **dict(args, seed=1))
+    assert len(calls) == 2                               # another key: computed
