@@ -1,18 +1,29 @@
-"""Per-study time of `workbench check`, before and after, in one run.
+"""Per-study time, before and after, in one run (issue 36, items 4 and 6).
 
-Before: ``workbench check --jobs 1`` (every study in one process, as `make
-test` ran it until issue 36). After: ``workbench check --jobs N`` (N = the
-CPUs granted; a pool of N processes, each study with its report check in one
-task). Both run here, one after the other, on the same tree; the script
-prints each one's per-study table (wall and CPU seconds), the wall time of
-each whole check and their ratio. The CPU seconds are the figure to compare
-on a loaded machine; the wall times are the ones a developer waits for.
+Default: every shipped design's study (``designs/*.toml``), one after the
+other in ONE process (as a ``workbench check`` worker runs them), and a
+table of each study's wall and CPU seconds (the CPU of the Monte Carlo
+worker processes included). With ``--before``, the same studies run first in
+a second process on the old code paths that a switch still selects, and the
+table gives both and their ratio:
 
-Usage: ``python benchmarks/check_times.py [--jobs N]``
+* ``WORKBENCH_BASIN_EAGER=1``: the basin k2 sweep computes every certificate
+  (Taylor ball and box cover) as before, instead of only those whose value can
+  change a verdict or a fate (:mod:`workbench.papers.p003.antiskid_basin`).
+
+The CPU seconds are the figure to compare on a loaded machine; nothing here
+asserts a time. ``--check [--jobs N]`` instead times ``workbench check
+--jobs 1`` against ``--jobs N`` (the pool of issue 36, item 3).
+
+Usage::
+
+    python benchmarks/check_times.py [--before] [designs/X.toml ...]
+    python benchmarks/check_times.py --check [--jobs N]
 """
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import subprocess
 import sys
@@ -21,6 +32,69 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 WB = [sys.executable, "-m", "workbench"]
+#: Environment of the old code paths (module docstring).
+BEFORE_ENV = {"WORKBENCH_BASIN_EAGER": "1"}
+
+
+def _cpu() -> float:
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+def worker(paths: list[str]) -> None:
+    """Run each design's study in this process; one JSON line per study."""
+    from workbench import memo
+    from workbench.design import load_design
+    from workbench.plants.lambdify_cache import cache_info
+    from workbench.verify import evaluate_design
+    for p in paths:
+        d = load_design(p)
+        w0, c0 = time.perf_counter(), _cpu()
+        ev = evaluate_design(d)
+        wall, cpu = time.perf_counter() - w0, _cpu() - c0
+        print(json.dumps({"design": d.name, "kind": d.kind, "wall": wall, "cpu": cpu,
+                          "claims_ok": ev.ok, "lambdify": cache_info()}), flush=True)
+        memo.clear()
+
+
+def run_studies(paths: list[str], env_extra: dict) -> dict:
+    """{design: row} of a worker process (no run folder: every study computed)."""
+    env = {k: v for k, v in os.environ.items() if k != "WORKBENCH_STUDY_CACHE"}
+    env.update(env_extra)
+    p = subprocess.run([sys.executable, __file__, "--worker", *paths], cwd=ROOT, env=env,
+                       capture_output=True, text=True)
+    if p.returncode:
+        sys.exit(f"worker exited {p.returncode}:\n{p.stderr[-3000:]}")
+    rows = [json.loads(line) for line in p.stdout.splitlines() if line.startswith("{")]
+    return {r["design"]: r for r in rows}
+
+
+def studies_table(paths: list[str], before: bool) -> None:
+    """Print the per-study table (module docstring)."""
+    old = run_studies(paths, BEFORE_ENV) if before else {}
+    new = run_studies(paths, {})
+    head = "| design | kind | wall s | CPU s |"
+    if before:
+        head += " wall s before | CPU s before | CPU before / after |"
+    print(head)
+    print("|" + " --- |" * (head.count("|") - 1))
+    tot = [0.0, 0.0, 0.0, 0.0]
+    for name, r in new.items():
+        line = f"| {name} | {r['kind']} | {r['wall']:.1f} | {r['cpu']:.1f} |"
+        tot[0] += r["wall"]
+        tot[1] += r["cpu"]
+        if before and name in old:
+            o = old[name]
+            tot[2] += o["wall"]
+            tot[3] += o["cpu"]
+            line += f" {o['wall']:.1f} | {o['cpu']:.1f} | {o['cpu'] / max(r['cpu'], 1e-9):.2f} |"
+        print(line)
+    line = f"| total | | {tot[0]:.1f} | {tot[1]:.1f} |"
+    if before:
+        line += f" {tot[2]:.1f} | {tot[3]:.1f} | {tot[3] / max(tot[1], 1e-9):.2f} |"
+    print(line)
+    last = list(new.values())[-1]["lambdify"] if new else {}
+    print(f"\nlambdify cache at the end of the run: {last}")
 
 
 def run_check(jobs: int) -> tuple[float, float, str]:
@@ -36,21 +110,37 @@ def run_check(jobs: int) -> tuple[float, float, str]:
     return time.perf_counter() - t0, cpu, table
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--jobs", type=int, default=len(os.sched_getaffinity(0)))
-    args = ap.parse_args()
-    print(f"machine: {os.cpu_count()} CPUs, {len(os.sched_getaffinity(0))} granted; "
-          f"load average {os.getloadavg()[0]:.1f} at start")
+def check_table(jobs: int) -> None:
+    """``workbench check --jobs 1`` against ``--jobs N``."""
     results = {}
-    for jobs in (1, args.jobs):
-        wall, cpu, table = run_check(jobs)
-        results[jobs] = (wall, cpu)
-        print(f"\n== workbench check --jobs {jobs}: {wall:.1f} s wall, {cpu:.1f} s CPU")
+    for j in (1, jobs):
+        wall, cpu, table = run_check(j)
+        results[j] = (wall, cpu)
+        print(f"\n== workbench check --jobs {j}: {wall:.1f} s wall, {cpu:.1f} s CPU")
         print(table.strip())
-    (w1, c1), (wn, cn) = results[1], results[args.jobs]
+    (w1, c1), (wn, cn) = results[1], results[jobs]
     print(f"\nwall: {w1:.1f} s -> {wn:.1f} s (x {w1 / wn:.2f} faster); "
           f"CPU: {c1:.1f} s -> {cn:.1f} s")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("designs", nargs="*", help="design files (default: designs/*.toml)")
+    ap.add_argument("--before", action="store_true", help="also time the old code paths")
+    ap.add_argument("--check", action="store_true", help="time workbench check --jobs 1 and N")
+    ap.add_argument("--jobs", type=int, default=len(os.sched_getaffinity(0)))
+    ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.worker:
+        worker(args.designs)
+        return
+    print(f"machine: {os.cpu_count()} CPUs, {len(os.sched_getaffinity(0))} granted; "
+          f"load average {os.getloadavg()[0]:.1f} at start")
+    if args.check:
+        check_table(args.jobs)
+        return
+    paths = args.designs or sorted(str(p) for p in (ROOT / "designs").glob("*.toml"))
+    studies_table([str(Path(p).resolve()) for p in paths], args.before)
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ import sympy as sp
 from scipy.optimize import brentq
 
 from ..errors import ModelError
+from .lambdify_cache import lambdify
 from .units import ADHESION_003
 
 #: Parameter names of the model with their SI units (the design loader checks
@@ -166,7 +167,7 @@ class NumericAdhesion:
     def _fn(self, expr: sp.Expr, args=None):
         mdl = adhesion_model()
         args = args or (mdl.v, mdl.lam)
-        return sp.lambdify(args, mdl.substitute(expr, self._subs), "numpy")
+        return lambdify(args, mdl.substitute(expr, self._subs), "numpy")
 
     @cached_property
     def mu(self):

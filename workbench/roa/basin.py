@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .certify import ball_argument, verify_annulus
-from .falsify import falsify
+from .falsify import Falsification, falsify
 from .problem import BasinProblem, quadratic_enclosure
 
 
@@ -150,7 +150,8 @@ class BasinEstimate:
 
 def estimate_basin(problem: BasinProblem, c_search: float, *, seed: int = 0,
                    n_samples: int = 20_000, n_rays: int = 512,
-                   min_width: float = 2.0**-12, max_boxes: int = 400_000) -> BasinEstimate:
+                   min_width: float = 2.0**-12, max_boxes: int = 400_000,
+                   falsified: Falsification | None = None) -> BasinEstimate:
     """Bracket the largest level {V <= c} with V' < 0 (module docstring).
 
     Parameters
@@ -167,6 +168,10 @@ def estimate_basin(problem: BasinProblem, c_search: float, *, seed: int = 0,
         Falsifier sample sizes.
     min_width, max_boxes
         Box cover resolution and budget (:func:`~workbench.roa.certify.verify_annulus`).
+    falsified : Falsification, optional
+        The result of ``falsify(problem, c_search, seed=seed, n_samples=n_samples,
+        n_rays=n_rays)`` when the caller already has it (:func:`falsified_top`):
+        the same object this function would compute, so the estimate is the same.
 
     Returns
     -------
@@ -174,7 +179,8 @@ def estimate_basin(problem: BasinProblem, c_search: float, *, seed: int = 0,
     """
     if not c_search > 0:
         raise ValueError(f"c_search = {c_search!r}; expected a positive level")
-    fal = falsify(problem, c_search, seed=seed, n_samples=n_samples, n_rays=n_rays)
+    fal = falsified if falsified is not None else falsify(
+        problem, c_search, seed=seed, n_samples=n_samples, n_rays=n_rays)
     c_top = min(c_search, fal.c_refuted)
     ball = ball_argument(problem, c_top)
     if ball.c_ball > 0:
@@ -192,3 +198,25 @@ def estimate_basin(problem: BasinProblem, c_search: float, *, seed: int = 0,
         counterexample=fal.counterexample, c_ball=ball.c_ball, c_inner=ball.c_inner,
         mu=ball.mu, boxes=boxes, unresolved=unres, budget_hit=budget, min_width=min_width,
         samples=fal.samples, seed=seed)
+
+
+def falsified_top(problem: BasinProblem, c_search: float, *, seed: int = 0,
+                  n_samples: int = 20_000, n_rays: int = 512) -> tuple[Falsification, float]:
+    """The falsifier's stage of :func:`estimate_basin` alone: (its result, c_top).
+
+    ``c_top = min(c_search, c_refuted)`` bounds the certified level from
+    above: :func:`estimate_basin` certifies the ball level c_ball <= c_top
+    (:func:`~workbench.roa.certify.ball_argument` starts at c_top and only
+    shrinks) and then at most c_top (:func:`~workbench.roa.certify.verify_annulus`
+    never returns more than its ``c_top``), or 0. So before any box is
+    covered, ``c_certified <= c_top <= c_refuted`` is known, and a question
+    this bound settles (a point with a lower bound of V >= c_refuted and an
+    upper bound > c_top is REFUTED whatever the cover finds; a path whose V
+    stays above c_top never enters the certified set) needs no cover. Pass
+    the result to ``estimate_basin(..., falsified=...)`` to finish the
+    estimate with the same numbers as a single call.
+    """
+    if not c_search > 0:
+        raise ValueError(f"c_search = {c_search!r}; expected a positive level")
+    fal = falsify(problem, c_search, seed=seed, n_samples=n_samples, n_rays=n_rays)
+    return fal, min(c_search, fal.c_refuted)

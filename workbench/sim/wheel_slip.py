@@ -28,6 +28,7 @@ import numpy as np
 import sympy as sp
 
 from ..plants.adhesion import PARAMETER_UNITS, adhesion_model
+from ..plants.lambdify_cache import lambdify
 
 #: Order of the plant parameters as lambdify arguments.
 PARAM_ORDER = tuple(PARAMETER_UNITS)
@@ -47,7 +48,7 @@ def model_functions(backend: Literal["math", "numpy"], graded: bool = False) -> 
     out = {}
     for name, (f1, f2, f3) in (("traction", mdl.traction), ("braking", mdl.braking)):
         exprs = (f1, f2, f3, sp.diff(f2, mdl.lam), sp.diff(f3, mdl.lam))
-        out[name] = sp.lambdify(args, exprs, modules=backend, cse=True)
+        out[name] = lambdify(args, exprs, modules=backend, cse=True)
     if not graded:
         return out
     level, terms = out, grade_terms(backend)

@@ -13,6 +13,7 @@ import numpy as np
 import sympy as sp
 
 from ..plants.adhesion import NumericAdhesion, adhesion_model
+from ..plants.lambdify_cache import lambdify
 
 
 @dataclass(frozen=True)
@@ -87,7 +88,7 @@ def linearise_cruise(plant: NumericAdhesion, v_d: float, lambda_d: float) -> Lin
     subs = dict(plant.values)
     coeffs = {}
     for name, expr in taylor_coefficients().items():
-        f = sp.lambdify((mdl.v, mdl.lam), mdl.substitute(expr, subs), "numpy")
+        f = lambdify((mdl.v, mdl.lam), mdl.substitute(expr, subs), "numpy")
         coeffs[name] = float(f(v_d, lambda_d))
     A = np.array([[coeffs["a1"], coeffs["a2"]], [coeffs["d1"], coeffs["d2"]]])
     B = np.array([[0.0], [1.0]])

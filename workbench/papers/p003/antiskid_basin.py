@@ -32,6 +32,7 @@ References
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -42,8 +43,11 @@ from scipy.integrate import solve_ivp
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import ModelError
 from ...plants.adhesion import NumericAdhesion, adhesion_model
+from ...plants.lambdify_cache import lambdify
 from ...roa import BasinEstimate, BasinProblem, LevelOutcome, estimate_basin, modal_P
+from ...roa.basin import falsified_top
 from ...roa.check import BasinCheck, PointCheck, largest_level_in_box
+from ...roa.problem import quadratic_enclosure
 from ...symbolic.linearise import linearise_cruise
 
 #: Weights w of the fast (creep-ratio) mode against the slow (speed) mode
@@ -134,10 +138,8 @@ def _domain(v_d: float, lam_d: float):
     return ((V_MIN - v_d, LAM_LO - lam_d), (v_d, LAM_HI - lam_d))
 
 
-def estimate_cruise(values, v_d, K, points, w, *, seed=0, c_search=None):
-    """Basin estimate with P = modal_P(A + B K, [1, w]) (slow mode weight 1,
-    fast mode w); c_search: 4 x the largest level of ``points`` (capped by
-    the model's domain) unless given."""
+def _cruise_problem(values, v_d, K, points, w, c_search=None):
+    """(problem, level searched) of :func:`estimate_cruise`."""
     f, derivs, states, A_cl, lam_d, _ = _loop(values, v_d, tuple(K))
     P = modal_P(A_cl, [1.0, w])
     prob = BasinProblem(f, states, (0.0, 0.0), P, P_source="optimised",
@@ -146,7 +148,66 @@ def estimate_cruise(values, v_d, K, points, w, *, seed=0, c_search=None):
     lv = [float(prob.V(np.asarray(x)[None, :])[0]) for x in points]
     if c_search is None:
         c_search = 4.0 * max(lv) if lv and max(lv) > 0 else cap
-    return prob, estimate_basin(prob, min(c_search, cap), seed=seed)
+    return prob, min(c_search, cap)
+
+
+def estimate_cruise(values, v_d, K, points, w, *, seed=0, c_search=None):
+    """Basin estimate with P = modal_P(A + B K, [1, w]) (slow mode weight 1,
+    fast mode w); c_search: 4 x the largest level of ``points`` (capped by
+    the model's domain) unless given."""
+    prob, c = _cruise_problem(values, v_d, K, points, w, c_search)
+    return prob, estimate_basin(prob, c, seed=seed)
+
+
+#: Set (to anything) to run every certificate of :func:`switch_in_basin` as
+#: before issue 36 (benchmarks/check_times.py compares the two paths).
+EAGER_ENV = "WORKBENCH_BASIN_EAGER"
+
+
+class _Deferred:
+    """The estimate of :func:`estimate_cruise` in two stages (issue 36, item 4):
+    the falsifier now, the certificate (Taylor ball and box cover, most of
+    the cost) only when asked for. Before the cover, ``c_certified <= c_top``
+    is known (:func:`workbench.roa.basin.falsified_top`)."""
+
+    def __init__(self, values, v_d, K, x, w, seed):
+        self.prob, self._c = _cruise_problem(values, v_d, K, [x], w)
+        self._seed = seed
+        self.fal, self.c_top = falsified_top(self.prob, self._c, seed=seed)
+        self._est = None
+        if os.environ.get(EAGER_ENV) or not self.prob.M_eig_bounds()[0] > 0:
+            # the cover's one ModelError (bounding_box_z): raised here, where
+            # estimate_cruise raised it, so the caller's handling is unchanged
+            self.est
+
+    @property
+    def est(self) -> BasinEstimate:
+        """The full estimate: exactly ``estimate_cruise(...)[1]`` (same problem,
+        level, seed and falsifier result)."""
+        if self._est is None:
+            self._est = estimate_basin(self.prob, self._c, seed=self._seed, falsified=self.fal)
+        return self._est
+
+    def outcome(self, x) -> LevelOutcome:
+        """``est.point_verdict(x).outcome``, without the cover when the
+        falsifier settles it: with lo <= V(x) <= hi, lo >= c_refuted and
+        hi > c_top >= c_certified, point_verdict's first test (hi <=
+        c_certified) fails and its second (lo >= c_refuted) holds: REFUTED."""
+        iv = quadratic_enclosure(self.prob.P, self.prob.x_eq, np.asarray(x, float)[None, :],
+                                 np.asarray(x, float)[None, :])
+        lo, hi = float(iv.lo[0]), float(iv.hi[0])
+        if lo >= self.fal.c_refuted and hi > self.c_top:
+            return LevelOutcome.REFUTED
+        return self.est.point_verdict(x).outcome
+
+    def enters(self, path) -> bool:
+        """``est.c_certified > 0 and any(V(path) <= est.c_certified)``, without
+        the cover when V > c_top >= c_certified along the whole path (a NaN
+        state is not above c_top: the cover then decides)."""
+        if np.all(self.prob.V(path) > self.c_top):
+            return False
+        est = self.est
+        return bool(est.c_certified > 0 and np.any(self.prob.V(path) <= est.c_certified))
 
 
 def _score(est: BasinEstimate, points) -> tuple:
@@ -234,7 +295,7 @@ def _trajectories(prob, est, pts, seed, n, T, lam_d):
                      max(abs(x[1]) for _, x in pts) * 1.5 + 0.02]) if pts else np.array([2, 0.1])
     starts = [tuple(x) for _, x in pts]
     starts += [tuple(rng.uniform(-1, 1, 2) * half) for _ in range(n)]
-    fm = sp.lambdify(prob.states, list(prob.f), "math")
+    fm = lambdify(prob.states, list(prob.f), "math")
     out = []
     for x0 in starts:
         sol = _delay_free(fm, x0, lam_d, T)
@@ -286,12 +347,12 @@ def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0,
     best, sets = (LevelOutcome.REFUTED, None), []
     for w in W_GRID:
         try:
-            prob, est = estimate_cruise(vals, v_d, K, [x], w, seed=seed)
+            stage = _Deferred(vals, v_d, K, x, w, seed)
         except ModelError:
             return SwitchVerdict(LevelOutcome.REFUTED, None, False,
                                  _fate(vals, v_d, K, x, lam_d, [], t_sim))
-        sets.append((prob, est))
-        out = est.point_verdict(x).outcome
+        sets.append(stage)
+        out = stage.outcome(x)
         if rank[out] > rank[best[0]]:
             best = (out, w)
         if out is LevelOutcome.CERTIFIED:
@@ -300,11 +361,12 @@ def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0,
 
 
 def _fate(vals, v_d, K, x0, lam_d, sets, T) -> str:
-    """Fate of the delay-free trajectory from x0 (see :class:`SwitchVerdict`)."""
+    """Fate of the delay-free trajectory from x0 (see :class:`SwitchVerdict`);
+    ``sets``: the :class:`_Deferred` estimates of the weight grid."""
     f, _, states, *_ = _loop(vals, v_d, tuple(K))
-    sol = _delay_free(sp.lambdify(states, f, "math"), x0, lam_d, T)
+    sol = _delay_free(lambdify(states, f, "math"), x0, lam_d, T)
     path = sol.y.T
-    if any(est.c_certified > 0 and np.any(prob.V(path) <= est.c_certified) for prob, est in sets):
+    if any(stage.enters(path) for stage in sets):
         return "converges"
     if sol.status != 0 or not np.all(np.isfinite(path)) or len(sol.t_events[0]):
         return "diverges"

@@ -47,6 +47,7 @@ import numpy as np
 import sympy as sp
 
 from ...plants.adhesion import NumericAdhesion, adhesion_model
+from ...plants.lambdify_cache import lambdify
 from ...roa import BasinProblem, LevelOutcome, estimate_basin, lyapunov_P
 from ...roa.interval import IntervalFunction
 from ...sim.wheel_slip import ScalarOps, wheel_speed
@@ -185,7 +186,7 @@ def brake_switch(values: dict, label: str, point, *, profile, k_de: float,
     vs, _ = profile(t, v, 0.0, wheel_speed(v, lam_s, r, ScalarOps), ScalarOps)
     vs = float(vs)
     g, lam = frozen_loop(values, v, vs, k_de)
-    gn = sp.lambdify(lam, g, "math")
+    gn = lambdify(lam, g, "math")
     fate, t_fate = time_varying_fate(values, (v, lam_s), profile, k_de)
     common = dict(label=label, v=v, lam=lam_s, vs_frozen=vs, fate=fate, t_fate=t_fate)
     g0 = gn(lam_s)
@@ -228,7 +229,7 @@ def time_varying_fate(values: dict, x0, profile, k_de: float) -> tuple[str, floa
     (class :class:`BrakeSwitch`, ``fate``), and when it diverged."""
     from scipy.integrate import solve_ivp
     (y1, y2, y3), (z1, z2, z3), vs_, lam = _forms(tuple(sorted(values.items())))
-    fns = [sp.lambdify((vs_, lam), e, "math") for e in (y1, y2, y3, z1, z2, z3)]
+    fns = [lambdify((vs_, lam), e, "math") for e in (y1, y2, y3, z1, z2, z3)]
     Y1, Y2, Y3, Z1, Z2, Z3 = fns
     r = dict(values)["r"]
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 
+from ...memo import shared
 from ...roa import LevelOutcome
 from .antiskid_basin import SwitchVerdict, switch_in_basin
 
@@ -127,5 +128,8 @@ def safe_k2_range(values: dict, v_d: float, k1: float, point, *, grid, compare=(
     """
     vals = tuple(sorted((k, float(v)) for k, v in values.items()))
     cmp_ = tuple((str(lab), (float(g[0]), float(g[1]))) for lab, g in compare)
-    return _sweep(vals, float(v_d), float(k1), tuple(float(p) for p in point),
-                  tuple(float(g) for g in grid), cmp_, int(bisect), int(seed))
+    key = (vals, float(v_d), float(k1), tuple(float(p) for p in point),
+           tuple(float(g) for g in grid), cmp_, int(bisect), int(seed))
+    # the designs that differ only in the plant's mass share the controller's
+    # nominal model, hence this sweep: computed once per run (run folder)
+    return shared("antiskid_basin_k2.sweep", key, lambda: _sweep(*key))

@@ -131,7 +131,8 @@ def _dmu(params):
     from ...plants.adhesion import adhesion_model
     mdl = adhesion_model()
     vals = dict(zip(PARAM_ORDER, params))
-    return sp.lambdify(mdl.lam, mdl.substitute(sp.diff(mdl.mu_traction, mdl.lam), vals), "math")
+    from ...plants.lambdify_cache import lambdify
+    return lambdify(mdl.lam, mdl.substitute(sp.diff(mdl.mu_traction, mdl.lam), vals), "math")
 
 
 def linear_check(spec: RunSpec, A, B, K) -> LinearCheck:

@@ -1,0 +1,94 @@
+"""The basin k2 sweep's deferred certificate (issue 36, item 4): the falsifier
+settles a REFUTED verdict and a diverging fate without the box cover, and
+the answers are those of the full estimate (workbench.papers.p003.antiskid_basin)."""
+import numpy as np
+import pytest
+
+from workbench.plants.adhesion import NumericAdhesion
+from workbench.roa import LevelOutcome
+from workbench.roa.basin import falsified_top
+from workbench.kinds import antiskid_basin as AB
+
+# as tests/test_roa_antiskid.py: 003 Tables 1-2 (dry rail), the certified gain at eps = 0.35
+DRY = dict(a=0.3315, b=40.19, c=5.392, J=80.0, r=0.445, m=12000.0, zeta=0.01, c0=180.9,
+           c1=112.2, c2=2.6, g=9.8)
+K = (-0.004575, 10.27)
+VALS = tuple(sorted(DRY.items()))
+
+
+@pytest.fixture(scope="module")
+def switch():
+    """The printed switch state (v_d, lambda_opt) in error coordinates."""
+    lam_opt = NumericAdhesion.from_dict(DRY).lambda_opt()
+    return (0.0, lam_opt - AB.cruise_lambda_d(VALS, 70.0))
+
+
+@pytest.fixture(scope="module")
+def deferred(switch):
+    """One weight of the grid at the printed switch, K of the design: REFUTED."""
+    return AB._Deferred(VALS, 70.0, K, switch, 100.0, 0)
+
+
+def test_refuted_point_needs_no_cover(deferred, switch, monkeypatch):
+    monkeypatch.delenv(AB.EAGER_ENV, raising=False)
+    assert deferred.outcome(switch) is LevelOutcome.REFUTED
+    assert deferred._est is None                       # the cover did not run
+
+
+def test_diverging_path_above_c_top_needs_no_cover(deferred, switch):
+    path = np.array([switch, (switch[0] * 2, switch[1] * 1.5)])
+    assert np.all(deferred.prob.V(path) > deferred.c_top)
+    assert deferred.enters(path) is False and deferred._est is None
+
+
+def test_deferred_answers_are_the_full_estimate(deferred, switch):
+    """The shortcut's premise and its answers, against the full estimate of
+    the same problem (estimate_cruise's, bit for bit)."""
+    out_short = deferred.outcome(switch)
+    est = deferred.est                                  # the cover now runs
+    _, full = AB.estimate_cruise(VALS, 70.0, K, [switch], 100.0, seed=0)
+    assert est == full
+    assert est.c_certified <= deferred.c_top <= est.c_refuted
+    assert out_short is est.point_verdict(switch).outcome
+    inside = np.array([[0.0, 0.0], switch])            # the equilibrium is in the certified set
+    assert deferred.enters(inside) is bool(est.c_certified > 0)
+
+
+def test_falsified_top_is_the_estimates_falsifier(deferred):
+    fal, c_top = falsified_top(deferred.prob, deferred._c, seed=0)
+    assert fal == deferred.fal and c_top == min(deferred._c, fal.c_refuted)
+    with pytest.raises(ValueError):
+        falsified_top(deferred.prob, 0.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("k2", [3.75, 10.0])
+def test_switch_verdict_equals_the_eager_path(switch, k2, monkeypatch):
+    """Every certificate computed (the path before issue 36) gives the same
+    verdict, weight and fate as the deferred one (> 20 s: slow tier)."""
+    pt = (70.0, switch[1] + AB.cruise_lambda_d(VALS, 70.0))
+    fast = AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt)
+    monkeypatch.setenv(AB.EAGER_ENV, "1")
+    assert AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt) == fast
+
+
+def test_k2_sweep_is_shared_through_the_run_folder(tmp_path, monkeypatch):
+    """Designs that differ only in the plant's mass share the controller's
+    nominal model and so the k2 sweep: a second process of the same run reads
+    it from the run folder (here: the same key, the in-process cache bypassed)."""
+    from workbench import memo
+    from workbench.kinds import antiskid_basin_k2 as K2
+    calls = []
+
+    def fake(*key):
+        calls.append(key)
+        return K2.K2Sweep(key[3], key[2], (), (), None, min(key[4]), False)
+
+    monkeypatch.setenv(memo.CACHE_ENV, str(tmp_path))
+    monkeypatch.setattr(K2, "_sweep", fake)
+    args = dict(grid=[0.0, 2.0], compare=[("row", (K[0], 10.5))], bisect=2, seed=0)
+    a = K2.safe_k2_range(DRY, 70.0, K[0], (70.0, 0.1), **args)
+    b = K2.safe_k2_range(dict(reversed(list(DRY.items()))), 70, K[0], (70.0, 0.1), **args)
+    assert a == b and len(calls) == 1 and len(list(tmp_path.glob("*.pickle"))) == 1
+    K2.safe_k2_range(DRY, 70.0, K[0], (70.0, 0.1), **dict(args, seed=1))
+    assert len(calls) == 2                               # another key: computed
