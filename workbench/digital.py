@@ -289,7 +289,7 @@ def _certify(A, B, K, T_min, taus, alpha, margin, T_hi, rel_tol):
         lmi = VaryingDelayLMI(*loop, h1=taus[0], mu=None, windows="fixed", margin=margin)
         step = lmi.solve_at(up + taus[1])
         if step.outcome is Outcome.CERTIFIED:
-            T_cert, rc = up, dict(step.certificate.recheck)
+            T_cert, rc = up, dict(step.recheck)
     return "input-delay", T_cert, T_ref, rc, note
 
 
