@@ -15,21 +15,12 @@ import numpy as np
 from .lmi.core import Outcome
 from .lmi.interval import IntervalCertificate, IntervalLMI, IntervalSearch, Link, certified_interval
 from .margins import SpectrumNotConverged, spectral_abscissa, stability_windows
+from .printed_grid import axis_end, directed
 
 #: Relative slack of the window tests for the exact windows' rounding.
 WINDOW_RTOL = 1e-9
 #: Grid points of the spectral-abscissa curve.
 CURVE_POINTS = 161
-
-
-def directed(x: float, *, up: bool, sig: int = 4) -> float:
-    """x to ``sig`` significant digits, rounded up (a lower end) or down (an upper
-    end): an interval quantity never claims more than was certified, and its
-    last digits, which differ between CPUs, are dropped."""
-    if x == 0 or math.isinf(x):
-        return x
-    q = 10.0 ** (math.floor(math.log10(abs(x))) - sig + 1)
-    return float(f"{(math.ceil(x / q) if up else math.floor(x / q)) * q:.{sig}g}")
 
 
 def printed_ratio(r) -> float | None:
@@ -185,16 +176,18 @@ def middle(a: float, b: float, h_max: float) -> float:
 def abscissa_curve(A, Ad, windows, h_star: float, h_max: float, intervals
                    ) -> tuple[tuple[float, float], ...]:
     """(h, spectral abscissa) on a uniform grid over [0, H] with H the plot
-    horizon: 1.3 times the largest finite window end, certified end or h*
-    (capped at h_max); NaN where the collocation did not converge."""
+    horizon: 1.3 times the largest finite window end, certified end or h*,
+    rounded up to 2 significant digits (:func:`~workbench.printed_grid.axis_end`:
+    the same grid on every CPU) and capped at h_max; NaN where the
+    collocation did not converge."""
     ends = [x for w in windows for x in w] + [h_star]
     ends += [x for iv in intervals if iv is not None for x in iv]
     finite = [x for x in ends if math.isfinite(x) and x > 0]
     if finite:
-        H = min(h_max, 1.3 * max(finite))
+        H = min(h_max, axis_end(1.3 * max(finite)))
     else:
         R = float(np.linalg.norm(A, 2) + np.linalg.norm(Ad, 2))
-        H = min(h_max, 20.0 / R if R > 0 else h_max)
+        H = min(h_max, axis_end(20.0 / R) if R > 0 else h_max)
     out = []
     for h in np.linspace(0.0, H, CURVE_POINTS):
         try:

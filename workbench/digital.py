@@ -14,7 +14,8 @@ x' = A x + B u, u(t) = K x(t_k) held (ZOH) from t_k + tau_k:
     input is K x(t - tau(t)) with tau(t) = t - t_k in [tau_min, T_max + tau_max]
     (packets in order), certified for any time-varying delay in that interval
     by :func:`workbench.lmi.varying.certified_varying_delay` (unknown
-    derivative); T_certified = h2 - tau_max;
+    derivative); T_certified = h2 - tau_max, on the grid of printed values
+    (:data:`PRINTED_DIGITS`);
 * **exact periodic** (no LMI): the stable set of constant periods T at the
   constant delays tau_min and tau_max, from the spectral radius of the lifted
   map (:mod:`workbench.margins.sampled`); its first unstable T bounds every
@@ -44,6 +45,7 @@ from typing import Literal
 import numpy as np
 
 from .lmi.core import DEFAULT_MARGIN, Outcome
+from .printed_grid import directed
 from .margins.sampled import PeriodicStableSet, alternating_radius, periodic_stable_set
 
 __all__ = ["ImplementationResult", "implementation", "synthesize_sampled"]
@@ -52,6 +54,11 @@ __all__ = ["ImplementationResult", "implementation", "synthesize_sampled"]
 PERIODIC_GRID, JITTER_GRID = 240, 24
 #: The exact scan keeps at most this many inputs in flight (T >= tau / MAX_QUEUE).
 MAX_QUEUE = 48
+#: Significant digits of the printed T_certified: with network delay it is decided
+#: on that grid (the grid value above the bisection's end, certified by a solve
+#: there, else the end, printed rounded down), so a last-bit difference in the
+#: search cannot move the printed digit (issue 36).
+PRINTED_DIGITS = 3
 
 
 @dataclass(frozen=True)
@@ -266,18 +273,24 @@ def _certify(A, B, K, T_min, taus, alpha, margin, T_hi, rel_tol):
         rc = {} if br.certificate is None else dict(br.certificate.recheck)
         return "lifted-quadratic", br.h_certified, br.h_refuted, rc, ""
     from .lmi.scaling import balancing
-    from .lmi.varying import certified_varying_delay
+    from .lmi.varying import VaryingDelayLMI, certified_varying_delay
     S = balancing(A + B @ K)                 # diagonal powers of two: exact similarity
     Sinv = np.diag(1.0 / np.diag(S))
-    vb = certified_varying_delay(Sinv @ A @ S, Sinv @ B @ K @ S, h1=taus[0], mu=None,
-                                 windows="fixed",
+    loop = (Sinv @ A @ S, Sinv @ B @ K @ S)
+    vb = certified_varying_delay(*loop, h1=taus[0], mu=None, windows="fixed",
                                  h_hi=T_hi + taus[1], rel_tol=rel_tol, margin=margin)
     br = vb.bracket
     rc = {} if br.certificate is None else dict(br.certificate.recheck)
     note = (" (the input-delay criterion carries no decay rate; stability only)"
             if alpha > 0 else "")
-    return ("input-delay", max(br.h_certified - taus[1], 0.0),
-            br.h_refuted - taus[1], rc, note)
+    T_cert, T_ref = max(br.h_certified - taus[1], 0.0), br.h_refuted - taus[1]
+    up = directed(T_cert, up=True, sig=PRINTED_DIGITS)
+    if 0 < T_cert < up < T_ref:              # the printed grid value, certified itself
+        lmi = VaryingDelayLMI(*loop, h1=taus[0], mu=None, windows="fixed", margin=margin)
+        step = lmi.solve_at(up + taus[1])
+        if step.outcome is Outcome.CERTIFIED:
+            T_cert, rc = up, dict(step.recheck)
+    return "input-delay", T_cert, T_ref, rc, note
 
 
 def _jitter(A, B, K, T_top: float, tau: float) -> tuple | None:

@@ -87,6 +87,7 @@ def _stability_map(A, B, K, T_top: float, tau_top: float):
     import numpy as np
 
     from ..margins.sampled import lifted_map, spectral_radius
+    from ..printed_grid import quantised
     Ts = np.linspace(T_top / MAP_T, T_top, MAP_T)
     taus = np.linspace(0.0, tau_top, MAP_TAU)
     rho = np.full((MAP_TAU, MAP_T), np.nan)
@@ -94,6 +95,8 @@ def _stability_map(A, B, K, T_top: float, tau_top: float):
         for j, T in enumerate(Ts):
             if tau / T <= MAP_QUEUE:
                 rho[i, j] = spectral_radius(lifted_map(A, B, K, float(T), float(tau)))
+    # drawn to 0.001 (an eighth of a colour level over [0, 2]): the same map on every CPU
+    rho = quantised(rho, scale=1.0)
     return tuple(map(float, Ts)), tuple(map(float, taus)), tuple(map(tuple, rho.tolist()))
 
 
@@ -101,6 +104,7 @@ def run_implementation(settings: ImplementationSettings, delay, A, B, K) -> Desi
     """Certify and check the design's gain K on the nominal (A, B); ``delay`` is
     the design's DelaySpec (h_min, h_max)."""
     from ..digital import implementation
+    from ..printed_grid import axis_end
     tau = settings.network_delay
     total = (delay.h_min + tau[0], delay.h_max + tau[1])
     res = implementation(A, K, B=B, sampling=settings.sampling, network_delay=total,
@@ -109,8 +113,9 @@ def run_implementation(settings: ImplementationSettings, delay, A, B, K) -> Desi
     top = max(res.T_certified, req)
     if math.isfinite(res.first_unstable):
         top = max(top, res.first_unstable)
-    T_top = 1.25 * top if top > 0 else 1.0
-    Ts, taus, rho = _stability_map(A, B, K, T_top, 1.25 * max(total[1], 1e-3))
+    # axis ends on a 2-digit grid (first_unstable is an exact value with noisy last bits)
+    T_top = axis_end(1.25 * top) if top > 0 else 1.0
+    Ts, taus, rho = _stability_map(A, B, K, T_top, axis_end(1.25 * max(total[1], 1e-3)))
     return DesignImplementation(settings, total, res, Ts, taus, rho)
 
 

@@ -11,6 +11,7 @@ import numpy as np
 from ..benchmark import AUTO, BenchmarkResult, agreement_bound
 from ..benchmark_windows import directed, printed_ratio, show_window
 from ..lmi.analysis import RETRY_SETTINGS
+from ..printed_grid import quantised
 from ..margins import AGREEMENT_RTOL
 from ..report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
 
@@ -179,9 +180,11 @@ def render(design, res: BenchmarkResult) -> Rendered:
 def _draw_set(fig, e) -> None:
     ax, bx = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [1, 1.3]})
     hs = np.array([p[0] for p in e.abscissa])
-    al = np.array([p[1] for p in e.abscissa])
+    # drawn at 4 digits of their decade (printed_grid.quantised): the same pixels on every CPU
+    al = quantised([p[1] for p in e.abscissa])
     H = float(hs[-1]) if len(hs) else 1.0
-    for a, b in e.windows:
+    ends = quantised([x for w in e.windows for x in w], scale=H)
+    for a, b in zip(ends[::2], ends[1::2]):
         for axis in (ax, bx):
             axis.axvspan(a, min(b, H), color="tab:green", alpha=0.15, lw=0)
     ax.plot(hs, al, "k-", lw=1)

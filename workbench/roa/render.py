@@ -13,6 +13,14 @@ from .basin import LevelOutcome
 from .check import BasinCheck
 
 
+#: c_inner below this fraction of c_search is printed as that bound, not its
+#: digits: it grows with the square of the equilibrium's residual f(x*), a
+#: rounding-level number whose digits differ between CPUs and with the inputs'
+#: last bits (2.75e-26 against 2.33e-26 with inputs moved 3 ulp, issue 36); a
+#: residual that is no rounding error (1e-6 of the state scale) gives ~1e-12.
+INNER_NEGLIGIBLE = 1e-12
+
+
 def _sig(x: float, direction: str, digits: int = 4) -> str:
     if x == 0 or not math.isfinite(x):
         return "0" if x == 0 else "∞"
@@ -35,6 +43,8 @@ def render_basin_markdown(check: BasinCheck, *, heading: str = "### Region of at
     names = ", ".join(est.names)
     eq = ", ".join(f"{v:.6g}" for v in est.x_eq)
     inner = ("0 (f(x*) = 0 exactly)" if est.c_inner == 0
+             else f"< {INNER_NEGLIGIBLE:.0e} c_search (residual of the equilibrium: rounding)"
+             if est.c_inner < INNER_NEGLIGIBLE * est.c_search
              else f"{fmt_level(est.c_inner, 'up')} (residual of the equilibrium)")
     lines = [
         heading, "",

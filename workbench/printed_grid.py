@@ -1,0 +1,59 @@
+"""Values decided on a grid, so that a last-bit difference cannot change what
+a report prints or draws (issue 36, item 5).
+
+Two CPUs (OpenBLAS kernels, numpy's SIMD loops) or inputs moved by a few ulp
+give results that differ in their last bits. A printed digit or a drawn pixel
+changes with them only where the value lies within that noise of a rounding
+point. So printed bounds are decided *on* the grid of printed values (the
+callers certify the grid value itself, e.g.
+:func:`workbench.benchmark_windows.settle_interval`), and figure data is
+snapped to a stated resolution far coarser than the noise and far finer than
+a pixel: axis ends to :data:`AXIS_DIGITS` significant digits (rounded up),
+plotted values to a resolution relative to their decade (:func:`quantised`).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["AXIS_DIGITS", "directed", "axis_end", "quantised"]
+
+#: Significant digits of a figure's data-derived axis end (:func:`axis_end`).
+AXIS_DIGITS = 2
+
+
+def directed(x: float, *, up: bool, sig: int = 4) -> float:
+    """x to ``sig`` significant digits, rounded up (a lower end) or down (an upper
+    end): an interval quantity never claims more than was certified, and its
+    last digits, which differ between CPUs, are dropped."""
+    if x == 0 or math.isinf(x) or math.isnan(x):
+        return x
+    q = 10.0 ** (math.floor(math.log10(abs(x))) - sig + 1)
+    return float(f"{(math.ceil(x / q) if up else math.floor(x / q)) * q:.{sig}g}")
+
+
+def axis_end(x: float, sig: int = AXIS_DIGITS) -> float:
+    """A figure's horizon computed from data (e.g. 1.25 times an exact
+    margin), rounded *up* to ``sig`` significant digits: the axis and the grid
+    drawn on it are then the same on every CPU unless ``x`` lies within
+    last-bit noise of a ``sig``-digit value (a relative 1e-12 against 1e-2)."""
+    return directed(float(x), up=True, sig=sig)
+
+
+def quantised(values, digits: int = 4, scale: float | None = None) -> np.ndarray:
+    """``values`` rounded to multiples of 10**(floor(log10(scale)) - digits + 1),
+    ``scale`` the largest finite magnitude (default), NaN kept.
+
+    With the default 4 digits the step is at most 1e-3 of the plotted range's
+    decade: a fraction of a pixel and of one of a colour map's 256 levels,
+    and some 1e8 times the last-bit noise of a converged eigenvalue or
+    simulation, so a plotted value changes only when it lies within that
+    noise of a step's midpoint (probability about 1e-8 per value)."""
+    v = np.asarray(values, dtype=float)
+    finite = np.abs(v[np.isfinite(v)])
+    s = scale if scale is not None else (float(finite.max()) if finite.size else 0.0)
+    if not s > 0:
+        return v.copy()
+    q = 10.0 ** (math.floor(math.log10(s)) - digits + 1)
+    return np.round(v / q) * q
