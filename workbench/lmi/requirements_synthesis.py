@@ -188,31 +188,39 @@ def certify_gain(loop: Loop, K: np.ndarray, *, h_min: float | None = None, H: fl
                  alpha: float,
                  gamma: float, margin: float = DEFAULT_MARGIN, rel_tol: float = 1e-3,
                  alpha_guess: float | None = None, N: int = 2,
-                 gamma_free: bool = False) -> GainCertificate:
+                 gamma_free: bool = False, mu: float | None = None) -> GainCertificate:
     """What the gain ``K`` (coordinates of ``loop``) certifies on its own,
     one certificate per requirement (see :class:`GainCertificate`): the decay
     rate over [h_min, H] (Bessel-Legendre cells of order N), the L2 gain and
     the input limit over [0, H] and the largest stability cap (descriptor
-    analysis with P2, P3 free, at rate 0). ``alpha``, ``gamma`` and
-    ``gamma_free`` are kept for the callers' signature (unused)."""
+    analysis with P2, P3 free, at rate 0). With ``mu`` (|h'(t)| <= mu < 1)
+    every certificate is the descriptor analysis with the (1 - mu) factor
+    (:mod:`workbench.lmi.requirements`): it covers every delay function
+    h(t) in [0, H] with |h'| <= mu, the decay included (bisection on alpha).
+    ``alpha``, ``gamma`` and ``gamma_free`` are kept for the callers'
+    signature (unused)."""
     del alpha, gamma_free
     h_min = 0.0 if h_min is None else h_min
     plain = dataclasses.replace(loop, Bw=None, Cz=None, Dz=None, box=None, u_max=None)
-    a = certified_decay([(A, B @ K) for A, B in loop.points], h_lo=h_min, H=H,
-                        alpha_hi=_rate_scale(loop, H), N=N, margin=margin, rel_tol=rel_tol,
-                        guess=alpha_guess)
+    if mu is None:
+        a = certified_decay([(A, B @ K) for A, B in loop.points], h_lo=h_min, H=H,
+                            alpha_hi=_rate_scale(loop, H), N=N, margin=margin,
+                            rel_tol=rel_tol, guess=alpha_guess)
+    else:
+        a = _bisect(RequirementAnalysis(plain, K, mu=mu, margin=margin), "decay", H=H,
+                    alpha=0.0, gamma=1.0, rel_tol=rel_tol, guess=alpha_guess)
     g = None
     if loop.l2:
         lmi = RequirementAnalysis(dataclasses.replace(loop, box=None, u_max=None), K,
-                                  margin=margin)
+                                  mu=mu, margin=margin)
         g = _bisect(lmi, "l2_gain", H=H, alpha=0.0, gamma=gamma, rel_tol=rel_tol,
                     guess=1.0 / gamma)
-    d = _bisect(RequirementAnalysis(plain, K, margin=margin), "delay", H=H, alpha=0.0,
+    d = _bisect(RequirementAnalysis(plain, K, mu=mu, margin=margin), "delay", H=H, alpha=0.0,
                 gamma=1.0, rel_tol=rel_tol, guess=H)
     joint = None
     if loop.limited:
         lmi = RequirementAnalysis(dataclasses.replace(loop, Bw=None, Cz=None, Dz=None), K,
-                                  margin=margin)
+                                  mu=mu, margin=margin)
         lmi.set_rate(0.0)
         joint = lmi.solve_at(H)
     return GainCertificate(a, g, d, joint)
@@ -222,7 +230,8 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
                             h_min: float | None = None, alpha: float = 0.0,
                             gamma: float = 1.0, margin: float = DEFAULT_MARGIN,
                             fraction: float = DEFAULT_FRACTION, digits: int = DEFAULT_DIGITS,
-                            rel_tol: float = 1e-3) -> RequirementDesign:
+                            rel_tol: float = 1e-3, mu: float | None = None
+                            ) -> RequirementDesign:
     """Optimise ``objective`` subject to the other requirements (module docstring).
 
     Parameters
@@ -245,6 +254,10 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
     margin, fraction, digits, rel_tol
         Relative LMI margin, canonical-point fraction, significant digits of
         K, relative width of every bracket.
+    mu : float or None
+        Time-varying delay: every delay function h(t) in [0, H] with
+        |h'(t)| <= mu (0 <= mu < 1) is covered by the synthesis and by every
+        certificate of the gain; None: constant delays.
 
     Returns
     -------
@@ -258,7 +271,7 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
     bal = Loop(tuple(pts), None if not loop.l2 else Tinv @ loop.Bw,
                None if not loop.l2 else loop.Cz @ T, loop.Dz,
                None if not loop.limited else np.diag(Tinv) * loop.box, loop.u_max)
-    lmi = RequirementSynthesis(bal, margin=margin)
+    lmi = RequirementSynthesis(bal, mu=mu, margin=margin)
     tried: dict[float, Bracket] = {}
 
     def value(eps: float) -> float:
@@ -287,7 +300,7 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
     cert = certify_gain(bal, K @ T, h_min=h_min, H=H, alpha=alpha, gamma=gamma,
                         margin=margin, rel_tol=rel_tol,
                         alpha_guess=v if objective == "decay" else None,
-                        gamma_free=objective == "l2_gain")
+                        gamma_free=objective == "l2_gain", mu=mu)
     return RequirementDesign(objective, br, best, K, point, cert)
 
 
