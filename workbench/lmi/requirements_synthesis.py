@@ -31,7 +31,7 @@ from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, round_significant
 from .requirements_decay import certified_decay
 from .requirements import Loop, RequirementAnalysis, RequirementSynthesis
 from .robust import maximise_log_scalar
-from .scaling import balance_points
+from .scaling import balancing, gramian_scaling
 
 __all__ = ["Objective", "GainCertificate", "RequirementDesign", "certify_gain",
            "synthesize_requirements"]
@@ -237,8 +237,12 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
     Parameters
     ----------
     loop : Loop
-        Operating points and declared requirements (original coordinates;
-        balanced here by a power-of-two diagonal T, exact).
+        Operating points and declared requirements (original coordinates).
+        The synthesis runs in the coordinates of
+        :func:`~workbench.lmi.scaling.gramian_scaling` (they follow any
+        diagonal state scaling, so the gain does too); the rounded gain is
+        certified in power-of-two coordinates balanced from sum_i |A_i| +
+        |B_i K| (Osborne, exact).
     objective : {"decay", "l2_gain", "delay"}
     H : float
         Delay cap (s): every constant delay in [0, H] (for ``"delay"`` the
@@ -267,10 +271,9 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
         raise ValueError(f"objective = {objective!r}; expected 'decay', 'l2_gain' or 'delay'")
     if objective == "l2_gain" and not loop.l2:
         raise ValueError("objective = 'l2_gain' needs a disturbance input w and an output z")
-    T, Tinv, pts = balance_points(list(loop.points))
-    bal = Loop(tuple(pts), None if not loop.l2 else Tinv @ loop.Bw,
-               None if not loop.l2 else loop.Cz @ T, loop.Dz,
-               None if not loop.limited else np.diag(Tinv) * loop.box, loop.u_max)
+    T = gramian_scaling(list(loop.points), H)
+    bal = _scaled(loop, T)
+    Tinv = np.diag(1.0 / np.diag(T))
     lmi = RequirementSynthesis(bal, mu=mu, margin=margin)
     tried: dict[float, Bracket] = {}
 
@@ -297,11 +300,22 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
                                  reason="canonical point not certified (solver "
                                         f"{point.solver_status})")
     K = round_significant(lmi.gain(point.certificate) @ Tinv, digits)
-    cert = certify_gain(bal, K @ T, h_min=h_min, H=H, alpha=alpha, gamma=gamma,
+    # the rounded K is certified in exact (power-of-two) coordinates balanced from the
+    # loop it closes, sum_i |A_i| + |B_i K| (Osborne): they follow a state scaling too
+    Tc = balancing(sum(np.abs(A) + np.abs(B @ K) for A, B in loop.points))
+    cert = certify_gain(_scaled(loop, Tc), K @ Tc, h_min=h_min, H=H, alpha=alpha, gamma=gamma,
                         margin=margin, rel_tol=rel_tol,
                         alpha_guess=v if objective == "decay" else None,
                         gamma_free=objective == "l2_gain", mu=mu)
     return RequirementDesign(objective, br, best, K, point, cert)
+
+
+def _scaled(loop: Loop, T: np.ndarray) -> Loop:
+    """``loop`` in the coordinates x = T x~ (T diagonal)."""
+    Tinv = np.diag(1.0 / np.diag(T))
+    return Loop(tuple((Tinv @ A @ T, Tinv @ B) for A, B in loop.points),
+                None if not loop.l2 else Tinv @ loop.Bw, None if not loop.l2 else loop.Cz @ T,
+                loop.Dz, None if not loop.limited else np.diag(Tinv) * loop.box, loop.u_max)
 
 
 def _canonical(lmi, objective: str, v: float, *, H: float, alpha: float, gamma: float) -> Step:

@@ -75,7 +75,10 @@ def _what(r) -> dict:
     mu = getattr(r, "rate", None)
     if mu is None:
         return _WHAT
-    return _WHAT | {"decay": (
+    return _WHAT | {"delay": (
+        "certified: the largest cap H such that the rounded gain is certified stable for every "
+        f"delay function h(t) in [0, H] with |h′(t)| ≤ {fmt(mu)} (s, rounded down); exact: the "
+        "worst decay rate over the constant delays of the range (1/s, > 0: stable)"), "decay": (
         "certified: decay rate of the rounded gain for every delay function h(t) in "
         f"[0, h_max] with |h′(t)| ≤ {fmt(mu)} and every vertex: the exponentially weighted "
         "descriptor LMI with the (1 − μ) factor, P2, P3 free (1/s, rounded down); exact: the "
