@@ -121,3 +121,47 @@ def test_rate_loads(tmp_path):
     spec = load_design(write(tmp_path, extra='rate = { value = 0.25, unit = "1", '
                                              'source = "t" }\n')).spec
     assert spec.requirements.rate == 0.25
+
+
+SCHEDULE = '''
+[[scenarios]]
+name = "push"
+parameters = {{ w = {steps} }}
+t_end = 2.0
+dt = 0.01
+'''
+
+
+def test_scenario_parameter_schedule_loads_and_adds_min_error(tmp_path):
+    from workbench.design import load_design
+    d = load_design(write(tmp_path, extra=SCHEDULE.format(steps="[[0.0, 0.0], [0.5, 1.0]]")))
+    sc = d.spec.scenarios[0]
+    assert sc.parameters == {"w": ((0.0, 0.0), (0.5, 1.0))}
+    from workbench.studies.delay_feedback import DelayFeedback
+    names = DelayFeedback().quantity_names(d.spec)
+    assert "simulation.push.min_error.x" in names
+
+
+@pytest.mark.parametrize("steps, words", [
+    ("[[0.0, 0.0], [0.5, 1.0], [0.5, 2.0]]", ["scenarios[0].parameters.w", "increasing"]),
+    ("[[0.1, 0.0]]", ["scenarios[0].parameters.w", "from 0"]),
+    ("[[0.0, 0.0], [3.0, 1.0]]", ["scenarios[0].parameters.w", "t_end"]),
+    ("[[0.0, true]]", ["scenarios[0].parameters.w", "pairs"]),
+])
+def test_bad_schedule_exits_2(tmp_path, monkeypatch, capsys, steps, words):
+    from workbench.cli import main
+    monkeypatch.chdir(tmp_path)
+    code = main(["verify", str(write(tmp_path, extra=SCHEDULE.format(steps=steps)))])
+    err = capsys.readouterr().err
+    assert code == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    for w in words:
+        assert w in err, err
+
+
+def test_schedule_of_an_unknown_parameter_exits_2(tmp_path, monkeypatch, capsys):
+    from workbench.cli import main
+    monkeypatch.chdir(tmp_path)
+    text = SCHEDULE.format(steps="[[0.0, 0.0]]").replace("w = ", "q = ")
+    code = main(["verify", str(write(tmp_path, extra=text))])
+    err = capsys.readouterr().err
+    assert code == 2 and "scenarios[0].parameters.q" in err and "a parameter" in err
