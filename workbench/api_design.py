@@ -33,8 +33,8 @@ def design_gain(sys, B=None, *, delay: tuple[float, float], decay_rate: float | 
            l2_gain: float | None = None, input_limit: Sequence[float] | float | None = None,
            box: Sequence[float] | None = None,
            objective: Literal["decay", "l2_gain", "delay"] = "decay",
-           vertices: Sequence[tuple] | None = None, Bw=None, Cz=None, Dz=None
-           ) -> RequirementResult:
+           vertices: Sequence[tuple] | None = None, Bw=None, Cz=None, Dz=None,
+           rate: float | None = None) -> RequirementResult:
     """A gain u = K x(t - h) designed to requirements over a delay range.
 
     Parameters
@@ -59,6 +59,11 @@ def design_gain(sys, B=None, *, delay: tuple[float, float], decay_rate: float | 
     Bw, Cz, Dz : array_like, optional
         Disturbance input matrix and performance output z = Cz x + Dz u(t - h)
         (Dz defaults to 0).
+    rate : float, optional
+        A time-varying delay h(t) in ``delay`` with |h'(t)| <= rate
+        (0 <= rate < 1): every certificate then covers every such delay
+        function (h(t) in [0, h_max]); the exact checks stay on constant
+        delays, a special case.
 
     Returns
     -------
@@ -109,5 +114,9 @@ def design_gain(sys, B=None, *, delay: tuple[float, float], decay_rate: float | 
         box = tuple(float(b) for b in np.ravel(box))
         if not all(0 <= b < math.inf for b in box) or not any(box):
             raise ValueError(f"box = {box!r}; expected non-negative finite half-widths")
-    req = Requirements((lo, hi), decay_rate, l2_gain, limit, box if limit else None, objective)
+    if rate is not None and (isinstance(rate, bool) or not isinstance(
+            rate, (int, float, np.floating)) or not 0 <= rate < 1):
+        raise ValueError(f"rate = {rate!r}; expected a delay-derivative bound 0 <= rate < 1")
+    req = Requirements((lo, hi), decay_rate, l2_gain, limit, box if limit else None, objective,
+                       None if rate is None else float(rate))
     return design_to_requirements(points, req, Bw=Bw, Cz=Cz, Dz=Dz)

@@ -55,6 +55,10 @@ class Requirements:
     box : tuple of float or None
         Half-widths of the initial-deviation box (state units).
     objective : {"decay", "l2_gain", "delay"}
+    rate : float or None
+        Time-varying delay: every delay function h(t) in [h_min, h_max] with
+        |h'(t)| <= rate (0 <= rate < 1; the certificates cover h(t) in
+        [0, h_max]); None: constant delays.
     """
 
     delay: tuple[float, float]
@@ -63,6 +67,7 @@ class Requirements:
     input_limit: tuple[float, ...] | None = None
     box: tuple[float, ...] | None = None
     objective: str = "decay"
+    rate: float | None = None
 
 
 @dataclass(frozen=True)
@@ -96,6 +101,12 @@ class RequirementResult:
         Synthesis and certification time (not printed in reports).
     reason : str
         Why no gain was returned ("" otherwise).
+    rate : float or None
+        The delay-derivative bound the certificates hold for (None: constant
+        delays).
+    varying : VaryingDelayRun or None
+        With ``rate``: a simulation of the loop (first point) under a
+        triangle-wave delay in [h_min, h_max] with slope ``rate``.
     """
 
     K: np.ndarray | None
@@ -103,13 +114,15 @@ class RequirementResult:
     design: RequirementDesign = field(repr=False)
     seconds: float = 0.0
     reason: str = ""
+    rate: float | None = None
+    varying: object = field(default=None, repr=False)
 
     def row(self, name: str) -> RequirementRow:
         return next(r for r in self.rows if r.name == name)
 
     def as_dict(self) -> dict:
         return {"K": None if self.K is None else self.K.tolist(),
-                "objective": self.design.objective, "reason": self.reason,
+                "objective": self.design.objective, "reason": self.reason, "rate": self.rate,
                 "requirements": {r.name: r.as_dict() for r in self.rows}}
 
 
@@ -189,8 +202,9 @@ def design_to_requirements(points: Sequence[tuple[np.ndarray, np.ndarray]], req:
                 np.asarray(req.box, float) if limited else None,
                 np.asarray(req.input_limit, float) if limited else None)
     t0 = time.perf_counter()
+    mu = req.rate
     d = synthesize_requirements(loop, objective=req.objective, H=h_max, h_min=h_min,
-                                alpha=alpha, gamma=float(req.l2_gain or 1.0))
+                                alpha=alpha, gamma=float(req.l2_gain or 1.0), mu=mu)
     seconds = time.perf_counter() - t0
     K, c = d.K, d.certificate
     rows = []
@@ -202,23 +216,28 @@ def design_to_requirements(points: Sequence[tuple[np.ndarray, np.ndarray]], req:
             if need is not None:
                 rows.append(RequirementRow(name, need, None, None, "INCONCLUSIVE",
                                            f"no gain: {d.reason}"))
-        return RequirementResult(None, tuple(rows), d, seconds, d.reason)
+        return RequirementResult(None, tuple(rows), d, seconds, d.reason, mu)
     ad = [(A, B @ K) for A, B in loop.points]
     a_c = c.alpha_certified
     ex = worst_decay(ad, h_min, h_max, alpha=a_c)
     hk = c.h_certified
+    covers = (f"every constant delay in [{h_min:g}, {h_max:g}] s" if mu is None else
+              f"every delay function h(t) in [0, {h_max:g}] s with |h'| <= {mu:g} (certificate;"
+              " constant delays are the case h' = 0, the exact check's)")
     rows.append(RequirementRow(
-        "delay", f"[{h_min:g}, {h_max:g}] s", hk, ex.decay,
+        "delay", f"[{h_min:g}, {h_max:g}] s" + ("" if mu is None else f", |h'| <= {mu:g}"),
+        hk, ex.decay,
         _verdict(hk is not None and hk >= h_max, ex.decay > 0, True),
-        "certified: largest cap H with asymptotic stability for every delay in [0, H]; "
-        "exact: worst decay on the range (> 0: stable)"))
+        "certified: largest cap H with asymptotic stability for every delay in [0, H]"
+        + ("" if mu is None else f" (every h(t) with |h'| <= {mu:g})")
+        + "; exact: worst decay on the range of constant delays (> 0: stable)"))
     if req.decay_rate is not None or req.objective == "decay":
         ok_exact = ex.decay >= alpha if req.decay_rate is not None else True
         consistent = a_c is None or (ex.decay >= a_c and ex.clear)
         rows.append(RequirementRow(
             "decay", _opt(req.decay_rate, req.objective == "decay", ">="), a_c, ex.decay,
             _verdict(a_c is not None and a_c >= alpha, ok_exact, consistent),
-            f"every delay in [{h_min:g}, {h_max:g}] s; exact worst at h = {ex.h:.4g} s"
+            f"{covers}; exact worst at h = {ex.h:.4g} s"
             + ("" if ex.clear else "; a cell is not clear of crossings")))
     if l2:
         g_c = c.gamma_certified
@@ -243,7 +262,28 @@ def design_to_requirements(points: Sequence[tuple[np.ndarray, np.ndarray]], req:
             "certified: invariant ellipsoid containing the box of constant initial histories "
             f"(box {list(req.box)}), every delay in [0, {h_max:g}] s; exact: peak |u|/u_max of "
             "simulations from the box's vertices at h_min, mid, h_max"))
-    return RequirementResult(K, tuple(rows), d, seconds)
+    run = None
+    if mu is not None and mu > 0 and h_max > h_min:
+        run = simulate_varying(loop.points[0], K, (h_min, h_max), mu, a_c)
+    return RequirementResult(K, tuple(rows), d, seconds, "", mu, run)
+
+
+def simulate_varying(point, K, delay: tuple[float, float], mu: float,
+                     alpha: float | None, *, periods: int = 3):
+    """The loop x' = A x + B K x(t - h(t)) under the triangle-wave delay of
+    :func:`workbench.sim.varying_delay.triangle_delay` (h_min to h_max with
+    slope ``mu``), from the constant initial history x0 = (1, ..., 1) state
+    units, over ``periods`` delay periods or 8 / alpha (s), whichever is
+    longer: a time-domain illustration of the rate certificate (not a proof)."""
+    from .sim.varying_delay import simulate_varying_delay, triangle_delay
+    A, B = point
+    h_min, h_max = delay
+    period = 2.0 * (h_max - h_min) / mu
+    t_end = max(periods * period, 8.0 / alpha if alpha else 0.0, 20.0 * h_max)
+    dt = min(h_max / 40.0, t_end / 4000.0)
+    return simulate_varying_delay(A, B @ np.atleast_2d(K), triangle_delay(h_min, h_max, mu),
+                                  h_max, np.ones(A.shape[0]), t_end, dt,
+                                  record_every=max(1, int(t_end / dt / 2000)))
 
 
 def _opt(value, objective: bool, sense: str) -> str:

@@ -22,9 +22,21 @@ bounded by their value at H (``h^2 x''Rx' <= H^2 x''Rx'``,
 ``-h int e^{2 alpha (s-t)} x''Rx' <= -rho (x - x_d)'R(x - x_d)`` by Jensen, as
 R, S >= 0 and e^{-2 alpha h} >= rho). So one solve at H certifies the whole
 range [0, H], h = 0 included (a range [h_min, H] is certified through
-[0, H], which contains it). Psi <= 0 (w = 0) gives V(t) <= e^{-2 alpha t}
+[0, H], which contains it). Here rho_s = rho for constant delays.
+Psi <= 0 (w = 0) gives V(t) <= e^{-2 alpha t}
 V(0): every solution decays at least like e^{-alpha t}; with zero initial
 history it gives ||z||_2 <= gamma ||w||_2 (alpha >= 0).
+
+Time-varying delay (``mu``): for every delay function h(t) in [0, H] with
+|h'(t)| <= mu < 1 the same functional, its S integral taken over
+[t - h(t), t], has the derivative term -(1 - h'(t)) e^{-2 alpha h(t)}
+x_d'Sx_d <= -(1 - mu) rho x_d'Sx_d, and the R term (fixed window H, Jensen on
+[t - h(t), t] with h(t) <= H) is bounded as above; so the LMI with
+rho_s = (1 - mu) rho certifies every such delay function (Fridman 2014,
+sec. 3.6.2 and 4.x: the (1 - mu) factor of the descriptor method). mu = 0
+gives the constant-delay LMI exactly; a larger mu only shrinks the feasible
+set (S >= 0), so a certified value never grows with mu. Constant delays are
+the special case h' = 0.
 
 Synthesis (:class:`RequirementSynthesis`): P3 = eps P2, Y = P2^{-1}, V = K Y
 and the congruence diag(Y, Y, Y, I, I) (Fridman & Shaked 2002), decision
@@ -139,13 +151,17 @@ class _Requirement(MarginLMI):
 
     canonical_retry_settings = RETRY_SETTINGS
 
-    def __init__(self, loop: Loop, **kw):
+    def __init__(self, loop: Loop, *, mu: float | None = None, **kw):
+        if mu is not None and not (0 <= mu < 1):
+            raise ValueError(f"mu = {mu!r}; expected a delay-derivative bound 0 <= mu < 1")
         self.loop = loop
+        #: |h'(t)| <= mu (None: constant delays, the same LMI as mu = 0)
+        self.mu = mu
         super().__init__(**kw)
         self.set_rate(0.0)
 
     def parameters(self):
-        return ("two_alpha", "rho", "rho_iota", "gamma") + self.extra_parameters()
+        return ("two_alpha", "rho", "rho_s", "rho_iota", "gamma") + self.extra_parameters()
 
     def extra_parameters(self) -> tuple[str, ...]:
         return ()
@@ -162,7 +178,7 @@ class _Requirement(MarginLMI):
     def set_delay(self, h: float) -> None:
         super().set_delay(h)
         rho = math.exp(-2.0 * self._alpha * h)
-        self.set_parameters(rho=rho, rho_iota=rho / h)
+        self.set_parameters(rho=rho, rho_s=(1.0 - (self.mu or 0.0)) * rho, rho_iota=rho / h)
 
     def _psi(self, rows, wcol, zrow, p, bmat):
         """The block from its 3 x 3 core ``rows`` (lists), extended by the
@@ -229,7 +245,7 @@ class RequirementSynthesis(_Requirement):
             rows = [[AY + AY.T + p["two_alpha"] * P + S - p["rho_iota"] * R,
                      P - Y + eps * AY.T, BV + p["rho_iota"] * R],
                     [P - Y.T + eps * AY, -eps * (Y + Y.T) + p["h"] * R, eps * BV],
-                    [BV.T + p["rho_iota"] * R, eps * BV.T, -p["rho"] * S - p["rho_iota"] * R]]
+                    [BV.T + p["rho_iota"] * R, eps * BV.T, -p["rho_s"] * S - p["rho_iota"] * R]]
             if lp.l2:
                 self._c = x["c"]
                 out.append(Block(f"c_pos{i}", x["c"], "psd"))
@@ -293,7 +309,7 @@ class RequirementAnalysis(_Requirement):
             rows = [[P2.T @ A + A.T @ P2 + p["two_alpha"] * P + S - p["rho_iota"] * R,
                      P - P2.T + A.T @ P3, P2.T @ Ad + p["rho_iota"] * R],
                     [P.T - P2 + P3.T @ A, -P3 - P3.T + p["h"] * R, P3.T @ Ad],
-                    [Ad.T @ P2 + p["rho_iota"] * R, Ad.T @ P3, -p["rho"] * S - p["rho_iota"] * R]]
+                    [Ad.T @ P2 + p["rho_iota"] * R, Ad.T @ P3, -p["rho_s"] * S - p["rho_iota"] * R]]
             if lp.l2:
                 self._c = c = x["c"]
                 out.append(Block(f"c_pos{i}", c, "psd"))

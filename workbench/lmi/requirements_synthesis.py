@@ -31,7 +31,7 @@ from .gain import DEFAULT_DIGITS, DEFAULT_FRACTION, round_significant
 from .requirements_decay import MAX_SECONDS, certified_decay
 from .requirements import Loop, RequirementAnalysis, RequirementSynthesis
 from .robust import maximise_log_scalar
-from .scaling import balance_points
+from .scaling import balancing, gramian_scaling
 
 __all__ = ["Objective", "GainCertificate", "RequirementDesign", "certify_gain",
            "synthesize_requirements"]
@@ -196,31 +196,39 @@ def certify_gain(loop: Loop, K: np.ndarray, *, h_min: float | None = None, H: fl
                  alpha: float,
                  gamma: float, margin: float = DEFAULT_MARGIN, rel_tol: float = 1e-3,
                  alpha_guess: float | None = None, N: int = 2,
-                 gamma_free: bool = False) -> GainCertificate:
+                 gamma_free: bool = False, mu: float | None = None) -> GainCertificate:
     """What the gain ``K`` (coordinates of ``loop``) certifies on its own,
     one certificate per requirement (see :class:`GainCertificate`): the decay
     rate over [h_min, H] (Bessel-Legendre cells of order N), the L2 gain and
     the input limit over [0, H] and the largest stability cap (descriptor
-    analysis with P2, P3 free, at rate 0). ``alpha``, ``gamma`` and
-    ``gamma_free`` are kept for the callers' signature (unused)."""
+    analysis with P2, P3 free, at rate 0). With ``mu`` (|h'(t)| <= mu < 1)
+    every certificate is the descriptor analysis with the (1 - mu) factor
+    (:mod:`workbench.lmi.requirements`): it covers every delay function
+    h(t) in [0, H] with |h'| <= mu, the decay included (bisection on alpha).
+    ``alpha``, ``gamma`` and ``gamma_free`` are kept for the callers'
+    signature (unused)."""
     del alpha, gamma_free
     h_min = 0.0 if h_min is None else h_min
     plain = dataclasses.replace(loop, Bw=None, Cz=None, Dz=None, box=None, u_max=None)
-    a = certified_decay([(A, B @ K) for A, B in loop.points], h_lo=h_min, H=H,
-                        alpha_hi=_rate_scale(loop, H), N=N, margin=margin, rel_tol=rel_tol,
-                        guess=alpha_guess)
+    if mu is None:
+        a = certified_decay([(A, B @ K) for A, B in loop.points], h_lo=h_min, H=H,
+                            alpha_hi=_rate_scale(loop, H), N=N, margin=margin,
+                            rel_tol=rel_tol, guess=alpha_guess)
+    else:
+        a = _bisect(RequirementAnalysis(plain, K, mu=mu, margin=margin), "decay", H=H,
+                    alpha=0.0, gamma=1.0, rel_tol=rel_tol, guess=alpha_guess)
     g = None
     if loop.l2:
         lmi = RequirementAnalysis(dataclasses.replace(loop, box=None, u_max=None), K,
-                                  margin=margin)
+                                  mu=mu, margin=margin)
         g = _bisect(lmi, "l2_gain", H=H, alpha=0.0, gamma=gamma, rel_tol=rel_tol,
                     guess=1.0 / gamma)
-    d = _bisect(RequirementAnalysis(plain, K, margin=margin), "delay", H=H, alpha=0.0,
+    d = _bisect(RequirementAnalysis(plain, K, mu=mu, margin=margin), "delay", H=H, alpha=0.0,
                 gamma=1.0, rel_tol=rel_tol, guess=H)
     joint = None
     if loop.limited:
         lmi = RequirementAnalysis(dataclasses.replace(loop, Bw=None, Cz=None, Dz=None), K,
-                                  margin=margin)
+                                  mu=mu, margin=margin)
         lmi.set_rate(0.0)
         joint = lmi.solve_at(H)
     return GainCertificate(a, g, d, joint)
@@ -230,14 +238,19 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
                             h_min: float | None = None, alpha: float = 0.0,
                             gamma: float = 1.0, margin: float = DEFAULT_MARGIN,
                             fraction: float = REQUIREMENT_FRACTION, digits: int = DEFAULT_DIGITS,
-                            rel_tol: float = 1e-3) -> RequirementDesign:
+                            rel_tol: float = 1e-3, mu: float | None = None
+                            ) -> RequirementDesign:
     """Optimise ``objective`` subject to the other requirements (module docstring).
 
     Parameters
     ----------
     loop : Loop
-        Operating points and declared requirements (original coordinates;
-        balanced here by a power-of-two diagonal T, exact).
+        Operating points and declared requirements (original coordinates).
+        The synthesis runs in the coordinates of
+        :func:`~workbench.lmi.scaling.gramian_scaling` (they follow any
+        diagonal state scaling, so the gain does too); the rounded gain is
+        certified in power-of-two coordinates balanced from sum_i |A_i| +
+        |B_i K| (Osborne, exact).
     objective : {"decay", "l2_gain", "delay"}
     H : float
         Delay cap (s): every constant delay in [0, H] (for ``"delay"`` the
@@ -253,6 +266,10 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
     margin, fraction, digits, rel_tol
         Relative LMI margin, canonical-point fraction, significant digits of
         K, relative width of every bracket.
+    mu : float or None
+        Time-varying delay: every delay function h(t) in [0, H] with
+        |h'(t)| <= mu (0 <= mu < 1) is covered by the synthesis and by every
+        certificate of the gain; None: constant delays.
 
     Returns
     -------
@@ -262,11 +279,10 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
         raise ValueError(f"objective = {objective!r}; expected 'decay', 'l2_gain' or 'delay'")
     if objective == "l2_gain" and not loop.l2:
         raise ValueError("objective = 'l2_gain' needs a disturbance input w and an output z")
-    T, Tinv, pts = balance_points(list(loop.points))
-    bal = Loop(tuple(pts), None if not loop.l2 else Tinv @ loop.Bw,
-               None if not loop.l2 else loop.Cz @ T, loop.Dz,
-               None if not loop.limited else np.diag(Tinv) * loop.box, loop.u_max)
-    lmi = RequirementSynthesis(bal, margin=margin)
+    T = gramian_scaling(list(loop.points), H)
+    bal = _scaled(loop, T)
+    Tinv = np.diag(1.0 / np.diag(T))
+    lmi = RequirementSynthesis(bal, mu=mu, margin=margin)
     tried: dict[float, Bracket] = {}
 
     def value(eps: float) -> float:
@@ -292,11 +308,22 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
                                  reason="canonical point not certified (solver "
                                         f"{point.solver_status})")
     K = round_significant(lmi.gain(point.certificate) @ Tinv, digits)
-    cert = certify_gain(bal, K @ T, h_min=h_min, H=H, alpha=alpha, gamma=gamma,
+    # the rounded K is certified in exact (power-of-two) coordinates balanced from the
+    # loop it closes, sum_i |A_i| + |B_i K| (Osborne): they follow a state scaling too
+    Tc = balancing(sum(np.abs(A) + np.abs(B @ K) for A, B in loop.points))
+    cert = certify_gain(_scaled(loop, Tc), K @ Tc, h_min=h_min, H=H, alpha=alpha, gamma=gamma,
                         margin=margin, rel_tol=rel_tol,
                         alpha_guess=v if objective == "decay" else None,
-                        gamma_free=objective == "l2_gain")
+                        gamma_free=objective == "l2_gain", mu=mu)
     return RequirementDesign(objective, br, best, K, point, cert)
+
+
+def _scaled(loop: Loop, T: np.ndarray) -> Loop:
+    """``loop`` in the coordinates x = T x~ (T diagonal)."""
+    Tinv = np.diag(1.0 / np.diag(T))
+    return Loop(tuple((Tinv @ A @ T, Tinv @ B) for A, B in loop.points),
+                None if not loop.l2 else Tinv @ loop.Bw, None if not loop.l2 else loop.Cz @ T,
+                loop.Dz, None if not loop.limited else np.diag(Tinv) * loop.box, loop.u_max)
 
 
 def _canonical(lmi, objective: str, v: float, *, H: float, alpha: float, gamma: float) -> Step:

@@ -115,3 +115,51 @@ def balance_loop(A, Ad):
     T = balancing(np.abs(A) + np.abs(Ad))
     Tinv = np.diag(1 / np.diag(T))
     return T, Tinv, Tinv @ A @ T, Tinv @ Ad @ T
+
+
+def gramian_scaling(points: Sequence[tuple[np.ndarray, np.ndarray]], horizon: float
+                    ) -> np.ndarray:
+    """Diagonal state scaling of a *synthesis* (K unknown) that follows every
+    diagonal similarity of the plant: T = diag(sqrt(W_jj)) with W the
+    finite-horizon controllability Gramian int_0^tau e^{At} B B' e^{A't} dt
+    summed over the points (tau = ``horizon``), then Osborne balancing
+    (:func:`balancing`) of the normalised A of the first point.
+
+    Under x = D x^ (A^ = D^{-1} A D, B^ = D^{-1} B) the Gramian becomes
+    D^{-1} W D^{-1}, so T^ = D^{-1} T and T^^{-1} A^ T^ = T^{-1} A T: the
+    synthesis LMI, hence its gain in the original coordinates, does not see
+    D (up to rounding). A state with W_jj = 0 (no input reaches it within
+    tau) keeps scale 1. T is not a power of two: the synthesis only proposes
+    a gain, which is then rounded and certified in exact coordinates.
+
+    Parameters
+    ----------
+    points : sequence of (A, B)
+    horizon : float
+        tau (s), > 0: the problem's time scale (the delay cap).
+
+    Returns
+    -------
+    numpy.ndarray
+        T, diagonal, positive.
+
+    References
+    ----------
+    .. [VL78] Van Loan C. F., "Computing integrals involving the matrix
+       exponential", IEEE TAC 23(3), 395-404, 1978 (the Gramian by one
+       exponential of a block matrix).
+    """
+    n = points[0][0].shape[0]
+    W = np.zeros((n, n))
+    for A, B in points:
+        A, B = np.asarray(A, float), np.atleast_2d(np.asarray(B, float))
+        M = np.zeros((2 * n, 2 * n))
+        M[:n, :n], M[:n, n:], M[n:, n:] = -A, B @ B.T, A.T
+        E = sl.expm(M * horizon)
+        W += E[n:, n:].T @ E[:n, n:]
+    d = np.sqrt(np.clip(np.diag(W), 0.0, None))
+    ok = np.isfinite(d) & (d > 0)
+    d = np.where(ok, d, 1.0)
+    T = np.diag(d)
+    A0 = np.diag(1.0 / d) @ np.asarray(points[0][0], float) @ T
+    return T @ balancing(A0)

@@ -25,7 +25,9 @@ Tables (see ``designs/antiskid-cruise-dry-generic.toml`` for a full file)::
     [delay]        h = { value, unit = "s", source } | min = {...}, max = {...}
     [synthesis]    method = "free-weighting-003" | "wirtinger" | "bessel-legendre"
     [[vertices]]   name, source, parameter = value ...   (optional: robust gain)
-    [[scenarios]]  name, t_end, dt, x0 = {...}, setpoint = {...}, h, rtol, predictor
+    [[scenarios]]  name, t_end, dt, x0 = {...}, setpoint = {...}, h, rtol, predictor,
+                   parameters = { p = [[t, value], ...] }  (piecewise-constant schedule;
+                   adds the signed min_error.<state> metric)
     [basin]        enabled, domain = {...}, plane, seed     (optional: region of attraction,
                    :mod:`workbench.features.basin`)
     [implementation] sampling, network_delay, hold   (optional: digital implementation,
@@ -98,6 +100,7 @@ class Scenario:
     h: float
     rtol: float
     predictor: bool = False
+    parameters: dict = None  # parameter -> ((t, value), ...): piecewise-constant schedule
 
 
 @dataclass(frozen=True)
@@ -320,9 +323,31 @@ def _scenarios(root: Reader, plant: PlantSpec, delay: DelaySpec) -> tuple[Scenar
         h = r.number("h", default=delay.h_max, positive=True, hi=t_end, what="number (s)")
         rtol = r.number("rtol", default=1e-3, positive=True, hi=0.5)
         predictor = r.boolean("predictor", default=False)
+        pt = r.table("parameters", default=None)
+        sched = {}
+        for k in list(pt.data):
+            if k not in plant.parameters:
+                raise pt.fail(k, pt.data[k], "a parameter of [parameters]")
+            sched[k] = _steps(pt, k, t_end)
+        pt.finish()
         r.finish()
-        out.append(Scenario(name, x0, sp, t_end, dt, h, rtol, predictor))
+        out.append(Scenario(name, x0, sp, t_end, dt, h, rtol, predictor, sched or None))
     return tuple(out)
+
+
+def _steps(t: Reader, k: str, t_end: float) -> tuple[tuple[float, float], ...]:
+    """A list of [t (s), value] pairs, times increasing from 0 (a schedule)."""
+    steps = t.raw(k)
+    ok = (isinstance(steps, list) and steps and all(
+        isinstance(p, list) and len(p) == 2 and all(
+            isinstance(z, (int, float)) and not isinstance(z, bool) and abs(z) < 1e12
+            for z in p) for p in steps))
+    times = [p[0] for p in steps] if ok else []
+    if not ok or any(b <= a for a, b in zip(times, times[1:])) or times[0] != 0 \
+            or times[-1] > t_end:
+        raise t.fail(k, steps, "a list of [t (s), value] pairs, times increasing from 0 to "
+                     "at most t_end")
+    return tuple((float(a), float(b)) for a, b in steps)
 
 
 def _eps_key(eps: float) -> str:
@@ -387,6 +412,8 @@ class DelayFeedback:
             names |= {f"{b}.peak_error.{k}" for k in p.state_names}
             names |= {f"{b}.final_error.{k}" for k in p.state_names}
             names |= {f"{b}.peak_input_dev.{k}" for k in p.input_names}
+            if s.parameters:
+                names |= {f"{b}.min_error.{k}" for k in p.state_names}
         from .requirements import requirement_quantity_names
         names |= requirement_quantity_names(spec.requirements)
         if spec.basin is not None:

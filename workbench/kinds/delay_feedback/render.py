@@ -11,7 +11,7 @@ import numpy as np
 from ...report.markdown import Figure, Rendered, fmt, fmt_floor, latex_matrix, md_table
 from ...report.synthesis_text import (capped_text, closed_loop_eigs_text, exact_margin_text,
                                       recheck_table)
-from .requirements_render import gain_text, requirements_section
+from .requirements_render import gain_text, requirements_section, varying_section
 
 _METHOD = {
     "free-weighting-003": "paper 003's free-weighting problem (60) (Theorem 1 + Remark 3), "
@@ -78,8 +78,10 @@ def render(design, res) -> Rendered:
     spec, p = design.spec, design.spec.plant
     s, st = res.synthesis, spec.synthesis.settings
     sections = []
+    vfigs = []
     if s.requirements is not None:
         sections.append(requirements_section(spec, s.requirements))
+        vsec, vfigs = varying_section(spec, s.requirements)
     var = [[f"`{v.name}`", "state", v.unit, v.description, v.source] for v in p.states]
     var += [[f"`{v.name}`", "input", v.unit, v.description, v.source] for v in p.inputs]
     par = [[f"`{k}`", fmt(q.value, 6), q.unit, q.source] for k, q in p.parameters.items()]
@@ -118,6 +120,9 @@ def render(design, res) -> Rendered:
     if res.scenarios:
         sec, figs = _simulation_section(spec, res)
         sections.append(sec)
+    if vfigs:
+        sections.append(vsec)
+        figs = [*figs, *vfigs]
     if res.basin is not None:
         from ...features.basin_render import render_basin_section
         sec, bfigs = render_basin_section(spec, res, res.basin)

@@ -5,6 +5,7 @@
     [requirements]
     objective  = "decay"                  # "decay" | "l2_gain" | "delay"
     delay      = [0.3, 0.8]               # s (default: the [delay] table)
+    rate       = { value = 0.2, unit = "1", source = "..." }   # optional: |h'(t)| <= rate < 1
     decay_rate = { value = 0.3, unit = "1/s", source = "..." }
     input_limit = { u = { value = 1.0, unit = "m/s^2", source = "..." } }
     box         = { v = { value = 1.0, unit = "m/s", source = "..." } }
@@ -55,6 +56,7 @@ class RequirementsSpec:
     disturbance: str | None
     outputs: tuple[str, ...]
     sources: dict
+    rate: float | None = None    # |h'(t)| <= rate (None: constant delays)
 
 
 def _entry(t, name: str, unit: str | None, row: str | None = None):
@@ -94,6 +96,14 @@ def load_requirements(root, plant, delay) -> RequirementsSpec | None:
     objective = t.string("objective", default="decay", choices=("decay", "l2_gain", "delay"))
     rng = _delay_range(t, (delay.h_min, delay.h_max))
     sources = {"delay": t.string("delay_source", default=delay.source)}
+    rate = None
+    if t.has("rate"):
+        rate, sources["rate"] = _entry(t, "rate", "1")
+        if not rate < 1:
+            raise t.table("rate").fail("value", rate, "a delay-derivative bound below 1")
+        if not rng[1] > rng[0]:
+            raise t.fail("delay", list(rng), "h_min < h_max with a rate (a varying delay)")
+        sources["delay"] += f"; |h'| <= {rate:g}: {sources['rate']}"
     alpha = None
     if t.has("decay_rate"):
         alpha, sources["decay"] = _entry(t, "decay_rate", "1/s")
@@ -132,7 +142,7 @@ def load_requirements(root, plant, delay) -> RequirementsSpec | None:
         outputs = tuple(raw)
     t.finish()
     return RequirementsSpec(objective, (float(rng[0]), float(rng[1])), alpha, limit, box,
-                            gamma, dist, outputs, sources)
+                            gamma, dist, outputs, sources, rate)
 
 
 def load_rate_requirements(root) -> RequirementsSpec | None:
@@ -184,7 +194,8 @@ def run_requirements(spec, req: RequirementsSpec, model, values, op, A, B, point
     if req.input_limit is not None:
         limit = tuple(req.input_limit[k] for k in spec.plant.input_names)
         box = tuple(req.box.get(k, 0.0) for k in spec.plant.state_names)
-    r = Requirements(req.delay, req.decay_rate, req.l2_gain, limit, box, req.objective)
+    r = Requirements(req.delay, req.decay_rate, req.l2_gain, limit, box, req.objective,
+                     req.rate)
     return design_to_requirements([(A, B)] + list(points), r, **kw)
 
 

@@ -8,7 +8,8 @@ import numpy as np
 
 from ...report.markdown import fmt, fmt_floor, md_table
 
-__all__ = ["gain_text", "requirements_rows", "requirements_section", "requirements_table"]
+__all__ = ["gain_text", "requirements_rows", "requirements_section", "requirements_table",
+           "varying_section"]
 
 
 def gain_text(K, digits: int) -> str:
@@ -65,8 +66,25 @@ def requirements_rows(req, r, digits: int) -> str:
     return (md_table(["requirement", "required", "certified", "exact", "verdict", "source"],
                      rows, "llrrll") + f"\n\nGain (rounded, the gain every row is about): "
             f"K = {K}" + (f". No gain: {r.reason}" if r.K is None else "")
-            + ".\n\n" + "\n".join(f"- *{k}*: {v}" for k, v in _WHAT.items()
+            + ".\n\n" + "\n".join(f"- *{k}*: {v}" for k, v in _what(r).items()
                                    if any(row.name == k for row in r.rows)))
+
+
+def _what(r) -> dict:
+    """The notes under the table (with a rate the decay is the descriptor's)."""
+    mu = getattr(r, "rate", None)
+    if mu is None:
+        return _WHAT
+    return _WHAT | {"delay": (
+        "certified: the largest cap H such that the rounded gain is certified stable for every "
+        f"delay function h(t) in [0, H] with |h′(t)| ≤ {fmt(mu)} (s, rounded down); exact: the "
+        "worst decay rate over the constant delays of the range (1/s, > 0: stable)"), "decay": (
+        "certified: decay rate of the rounded gain for every delay function h(t) in "
+        f"[0, h_max] with |h′(t)| ≤ {fmt(mu)} and every vertex: the exponentially weighted "
+        "descriptor LMI with the (1 − μ) factor, P2, P3 free (1/s, rounded down); exact: the "
+        "worst rightmost root over the constant delays of the range (a special case, so it "
+        "must be ≥ the certified value), 61-point grid with no crossing of Re s = −certified "
+        "between grid points")}
 
 
 def requirements_section(spec, r) -> str:
@@ -75,6 +93,51 @@ def requirements_section(spec, r) -> str:
     box = ("" if q.box is None else " Input limit from the box of initial deviations "
            + ", ".join(f"|δ{k}| ≤ {fmt(v)}" for k, v in q.box.items())
            + " (constant initial history, w = 0).")
+    rate = getattr(q, "rate", None)
+    delays = (f"every constant delay in [{fmt(q.delay[0])}, {fmt(q.delay[1])}] s" if rate is None
+              else f"every time-varying delay h(t) in [{fmt(q.delay[0])}, {fmt(q.delay[1])}] s "
+              f"with |h′(t)| ≤ {fmt(rate)}. With this rate every certificate is the descriptor "
+              f"LMI with the (1 − μ) factor and covers every delay function h(t) in "
+              f"[0, {fmt(q.delay[1])}] s with |h′(t)| ≤ {fmt(rate)} (constant delays "
+              "included); the exact checks are on constant delays, a special case (h′ = 0): "
+              "a certified value must not exceed them")
     return (f"## Requirements\n\nObjective: **{q.objective}**, subject to the others; "
-            f"delays: every constant delay in [{fmt(q.delay[0])}, {fmt(q.delay[1])}] s."
+            f"delays: {delays}."
             + box + "\n\n" + requirements_table(spec, r))
+
+
+def varying_section(spec, r):
+    """The time-varying-delay simulation of a rate requirement: (Markdown, figures)."""
+    from ...report.markdown import Figure
+    run, q = r.varying, spec.requirements
+    if run is None:
+        return None, []
+    a_c = r.design.certificate.alpha_certified if r.design.certificate else None
+    norm = np.linalg.norm(run.x, axis=0)
+    fig = Figure("requirements-varying-delay",
+                 "Linear loop (operating point) under a triangle-wave delay",
+                 lambda f: _plot_varying(f, run, a_c))
+    md = ("## Time-varying delay\n\nThe linear loop δx' = A δx + B K δx(t − h(t)) at the "
+          f"operating point, from δx = (1, …, 1) held on [−{fmt(q.delay[1])}, 0] s, with h(t) a "
+          f"triangle wave from {fmt(q.delay[0])} to {fmt(q.delay[1])} s of slope ±{fmt(q.rate)} "
+          f"(`workbench/sim/varying_delay.py`, Heun, dt = {fmt(run.dt, 3)} s): one delay "
+          "function of the certified set, an illustration, not a proof. |δx(t)| / |δx(0)| at "
+          f"t = {fmt(float(run.t[-1]), 3)} s: {fmt(float(norm[-1] / norm[0]), 2)}"
+          + ("" if a_c is None else f"; the certified rate alone bounds the envelope by "
+             f"e^(−{fmt_floor(a_c, 2)} t) times a constant (the functional's conditioning)")
+          + ".\n\n![" + fig.caption + "]({figdir}/" + fig.name + ".png)")
+    return md, [fig]
+
+
+def _plot_varying(fig, run, alpha):
+    ax = fig.add_subplot(2, 1, 1)
+    norm = np.linalg.norm(run.x, axis=0)
+    ax.semilogy(run.t, norm / norm[0], label="|δx(t)| / |δx(0)|")
+    if alpha:
+        ax.semilogy(run.t, np.exp(-alpha * run.t), "--", label="e^(−α t), α certified")
+    ax.set_ylabel("relative norm")
+    ax.legend(loc="upper right", fontsize=8)
+    ax2 = fig.add_subplot(2, 1, 2, sharex=ax)
+    ax2.plot(run.t, run.h)
+    ax2.set_ylabel("h(t) (s)")
+    ax2.set_xlabel("t (s)")

@@ -298,7 +298,17 @@ def simulate(spec, model, values, op, K, scenario, dt: float):
     ``scenario.predictor`` the law acts on the predicted state instead,
     u = u_op + K (x_hat(t + h) - x_ref(t + h)) (:func:`predict`)."""
     from ...sim.delay import simulate_closed_loop
-    f = model.rhs(values)
+    f0 = model.rhs(values)
+    sched = scenario.parameters or {}
+    pieces = {}
+
+    def f_at(t: float):
+        """The plant with the scenario's parameter schedule at t (cached per value set)."""
+        key = tuple(vs[np.searchsorted([a for a, _ in vs], t + 1e-12, side="right") - 1][1]
+                    for vs in sched.values())
+        if key not in pieces:
+            pieces[key] = model.rhs(values | dict(zip(sched, key)))
+        return pieces[key]
     ref = reference(spec, op, scenario)
     names = spec.plant.state_names
     x0 = op.x.copy()
@@ -310,6 +320,7 @@ def simulate(spec, model, values, op, K, scenario, dt: float):
     def step(x, ua, t, h):
         x = np.asarray(x, float)
         ua = np.atleast_1d(ua)
+        f = f_at(t) if sched else f0
         k1 = f(x, ua)
         k2 = f(x + 0.5 * h * k1, ua)
         k3 = f(x + 0.5 * h * k2, ua)
@@ -318,7 +329,7 @@ def simulate(spec, model, values, op, K, scenario, dt: float):
 
     def control(t, x, line):
         if scenario.predictor:
-            xp = predict(f, x, line.pieces(), dt)
+            xp = predict(f_at(t) if sched else f0, x, line.pieces(), dt)
             return op.u + K @ (xp - ref(t + scenario.h)), 0
         return op.u + K @ (np.asarray(x, float) - ref(t)), 0
 
@@ -333,7 +344,8 @@ def simulate(spec, model, values, op, K, scenario, dt: float):
 
 
 def metrics(spec, op, scenario, r) -> dict:
-    """peak/final |x - x_ref| per state, peak |u - u_op| per input, diverged (0/1)."""
+    """peak/final |x - x_ref| per state, peak |u - u_op| per input, diverged (0/1);
+    with a parameter schedule also the signed min of x - x_ref per state."""
     ref = reference(spec, op, scenario)
     R = np.array([ref(t) for t in r.t]).T
     E = np.abs(r.x - R)
@@ -342,6 +354,8 @@ def metrics(spec, op, scenario, r) -> dict:
     for i, k in enumerate(spec.plant.state_names):
         out[f"peak_error.{k}"] = math.nan if diverged else float(np.max(E[i]))
         out[f"final_error.{k}"] = math.nan if diverged else float(E[i, -1])
+        if scenario.parameters:
+            out[f"min_error.{k}"] = math.nan if diverged else float(np.min(r.x[i] - R[i]))
     du = np.abs(input_history(r, op.u.size) - op.u.reshape(-1, 1))
     for i, k in enumerate(spec.plant.input_names):
         out[f"peak_input_dev.{k}"] = math.nan if diverged else float(np.max(du[i]))
