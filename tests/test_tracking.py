@@ -117,6 +117,19 @@ def test_objectives_on_a_known_history():
     assert q.energy[0] == pytest.approx(20.0)                     # J/kg, not per metre
     assert q.rms_speed_error[0] == pytest.approx(0.5)
     assert q.matrix().shape == (1, 4)
+    assert q.peak_jerk[0] == pytest.approx(1.0)                   # 1 s windows = one step here
+    # at Ts = 0.5 s a 1 s window spans two steps: (1 - 0) / 1 s, not the step jerk 2 m/s^3
+    run2 = TrackingRun(t / 2, np.ones((1, 5)), np.zeros((1, 5)),
+                       np.array([[0.0, 0.0, 1.0, 1.0, 1.0]]), np.zeros((1, 5)),
+                       np.ones((1, 5)), np.array([2.5]), np.array([100.0]), np.array([0.0]))
+    assert objectives(run2, 100.0, 2.5).peak_jerk[0] == pytest.approx(1.0)
+
+
+def test_grid_edges_name_parameters_at_either_end():
+    from workbench.studies.pareto import grid_edges
+    P = np.array([[a, b, 5.0] for a in (1.0, 2.0, 3.0) for b in (0.1, 0.2)])
+    assert grid_edges(P, 2, ("a", "b", "c")) == ("b",)       # a = 2 inside; c not searched
+    assert grid_edges(P, 5, ("a", "b", "c")) == ("a", "b")
 
 
 # -- design ---------------------------------------------------------------------------------
@@ -132,7 +145,9 @@ def _bad(tmp_path, old, new):
     ('Ts = { value = 0.1,', 'Ts = { value = 0.105,', "simulation.Ts"),
     ("rho = [0.2, 0.5, 1.0]", "rho = [0.2, 0.5, 1.5]", "plant_readings[0].mfac.rho"),
     ('name = "first-order"', 'name = "integrating"', "plant_readings"),
-    ("weights = [1.0, 1.0, 1.0, 1.0]", "weights = [1.0, 1.0, 1.0]", "tuning.weights"),
+    ("weights = [1.0, 1.0, 0.0, 1.0]", "weights = [1.0, 1.0, 1.0]", "tuning.weights"),
+    ('peak_jerk = { value = 0.75, unit = "m/s^3"', 'peak_jerk = { value = 0.75, unit = "m/s^2"',
+     "tuning.peak_jerk.unit"),
     ('run_time = { value = 114.9, unit = "s", source = "paper 002 §4 (planned)" }',
      'run_time = { value = 60.0, unit = "s", source = "x" }', "route.run_time"),
     ('delay = { value = 0.3, unit = "s"', 'delay = { value = 0.3, unit = "ms"', "train.delay.unit"),

@@ -77,7 +77,9 @@ state (a passing claim whose origin is the workbench). Each report opens with
 its findings, most severe first.
 
 Verdicts form a closed set: PASS, FAIL, INCONCLUSIVE. A claim is *ok* when it
-passes, is inconclusive and allows it, or fails and was expected to fail; a
+passes, is inconclusive and allows it (whether it was expected to pass or to
+fail: a finding whose metric has not converged, issue 33 item 4), or fails
+and was expected to fail; a
 claim expected to fail that passes is not ok (the discrepancy went away, so
 the design must be updated).
 """
@@ -178,10 +180,9 @@ class ClaimResult:
         c = self.claim
         if not self.severity_holds:
             return False
-        if c.expect == "fail":
-            return self.verdict is Verdict.FAIL
-        return self.verdict is Verdict.PASS or (
-            self.verdict is Verdict.INCONCLUSIVE and c.allow_inconclusive)
+        if self.verdict is Verdict.INCONCLUSIVE:
+            return c.allow_inconclusive
+        return self.verdict is (Verdict.FAIL if c.expect == "fail" else Verdict.PASS)
 
     def to_json(self) -> dict:
         c = self.claim
