@@ -342,8 +342,12 @@ def _closing(res) -> str:
     items = []
     for r in res.readings:
         s = r.ppd
+        edges = "; ".join(f"{c} in {', '.join(t.edges)}" for c, t in
+                          (("MFAC", r.mfac), ("PID", r.pid)) if t.edges)
+        who = (f"**not determined** (chosen points on their grids' edges: {edges}); at these "
+               f"points {r.verdict}" if edges else f"**{r.verdict}**")
         items.append(
-            f"- **{r.reading.name}** (`{r.reading.model}`): **{r.verdict}** has the smaller "
+            f"- **{r.reading.name}** (`{r.reading.model}`): {who} has the smaller "
             f"cost ({fmt(r.cost('MFAC'), 3)} MFAC, {fmt(r.cost('PID'), 3)} PID); MFAC is "
             f"better in {sum(r.main.winner(i) == 'MFAC' for i in OBJECTIVES)} of "
             f"{len(OBJECTIVES)} objectives at the chosen points. The published reset fires in "
@@ -353,6 +357,10 @@ def _closing(res) -> str:
             f"{_pct(s.data_sign_agreement)} of the samples where the command moves; the "
             f"frozen-PPD loop's spectral radius is {fmt(r.frozen_radius, 3)}.")
     verdicts = {r.verdict for r in res.readings}
+    if any(r.mfac.edges or r.pid.edges for r in res.readings):
+        return (f"## {H_END}\n\n" + "\n".join(items) + "\n\nWhether MFAC beats PID is not "
+                "determined: on a reading whose chosen points lie on their grids' edges the "
+                "tuning has not converged (extend the grids in the parameters named).")
     tail = ("On neither reading does MFAC beat PID under the stated rule: paper 002's "
             "conclusion is not reproduced, whichever way its lost eq 2 is read."
             if verdicts <= {"PID"} else
