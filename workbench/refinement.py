@@ -21,7 +21,8 @@ from dataclasses import dataclass
 from .claims import Claim, ClaimResult
 from .memo import run_study
 from .report.markdown import fmt
-from .sim.convergence import CONVERGED, NOT_CONVERGED, Refinement, refinement_check
+from .sim.convergence import (CONVERGED, NOT_CONVERGED, P_MAX, P_MIN, Refinement,
+                              refinement_check)
 
 __all__ = ["LEVELS", "RefinementRow", "RefinementTable", "claim_tolerance", "refine_findings"]
 
@@ -54,12 +55,15 @@ class RefinementRow:
 
 @dataclass(frozen=True)
 class RefinementTable:
-    """The refined parameter (name, unit, designed value) and one row per finding."""
+    """The refined parameter (name, unit, designed value), one row per
+    finding, and the guards of the observed order (for the report's text)."""
 
     field: str
     unit: str
     step: float
     rows: tuple[RefinementRow, ...]
+    p_min: float = P_MIN
+    p_max: float = P_MAX
 
 
 def claim_tolerance(c: Claim, got) -> float | None:

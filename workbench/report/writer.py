@@ -65,9 +65,10 @@ def refinement_section(table) -> list[str]:
             f"{table.field} = {fmt(table.step)} {table.unit} and at {table.field}/2 and "
             f"{table.field}/4 (every other parameter, the control period included, as "
             "designed). Observed order p = log2(|q1 − q2| / |q2 − q4|), Richardson estimate "
-            "of the error of q4 = |q2 − q4| / (2^p − 1); p above 4 is clipped to 4, and below 0.5 "
-            "(levels not in the asymptotic range) the estimate is max(|q1 − q2|, |q2 − q4|) / "
-            "(2^0.5 − 1), INCONCLUSIVE when above the tolerance. The tolerance is the error that could change "
+            f"of the error of q4 = |q2 − q4| / (2^p − 1); p above {fmt(table.p_max)} is clipped to "
+            f"{fmt(table.p_max)}, and below {fmt(table.p_min)} (levels not in the asymptotic "
+            f"range) the estimate is max(|q1 − q2|, |q2 − q4|) / (2^{fmt(table.p_min)} − 1), "
+            "INCONCLUSIVE when above the tolerance. The tolerance is the error that could change "
             "the finding: the claim's tolerance for `within`, the distance to the bound for "
             "`<=` / `>=`. A finding whose estimate exceeds it is INCONCLUSIVE.")
     if not table.rows:
