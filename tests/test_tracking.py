@@ -164,6 +164,7 @@ def evaluation():
     return evaluate_design(load_design(DESIGN))
 
 
+@pytest.mark.slow     # the design is run at dt, dt/2 and dt/4 (refinement of the findings)
 def test_study_runs_and_claims_are_ok(evaluation):
     from workbench.studies.tracking002_run import study_quantities
     assert evaluation.ok
@@ -178,5 +179,10 @@ def test_study_runs_and_claims_are_ok(evaluation):
         row = r.mfac.objectives[r.mfac.chosen]
         assert row[0] == pytest.approx(r.main.value("MFAC", "stop_error"), rel=1e-9)
         assert r.mfac.reset_rate[r.mfac.chosen] == pytest.approx(r.ppd.reset_rate, rel=1e-12)
+    # every finding's metric went through the three-level refinement, and converged
+    rows = evaluation.refinement.rows
+    assert {x.claim_id for x in rows} == {r.claim.id for r in evaluation.claims
+                                          if r.claim.is_finding and r.got is not None}
+    assert all(x.converged for x in rows)
     assert math.isclose(q["profile.v_cruise"], res.profile.v_cruise)
     assert res.to_json()["readings"][1]["name"] == "first-order"
