@@ -2,6 +2,7 @@
 of known order: explicit Euler (p = 1) and Heun's RK2 (p = 2) on x' = -x,
 x(0) = 1, whose exact value at t = 1 is exp(-1)."""
 import math
+from pathlib import Path
 
 import pytest
 
@@ -95,6 +96,22 @@ def _finding(cid, value, compare, tol=0.0, expect="pass", allow=False):
                  allow, expect, "why" if expect == "fail" else "", "minor", "workbench")
 
 
+def test_converged_instead_names_a_quantity_of_the_design(tmp_path):
+    from workbench.design import load_design
+    from workbench.errors import DesignError
+    src = (Path(__file__).resolve().parents[1] / "designs" / "stopping-line5.toml").read_text()
+    old = 'id = "smarc-under-8cm"'
+    assert old in src
+    p = tmp_path / "stopping-line5.toml"
+    p.write_text(src.replace(old, old + '\nconverged_instead = "smarc.nominal_m"'))
+    c = next(c for c in load_design(p).claims if c.id == "smarc-under-8cm")
+    assert c.converged_instead == "smarc.nominal_m"
+    p.write_text(src.replace(old, old + '\nconverged_instead = "no.such"'))
+    with pytest.raises(DesignError) as exc:
+        load_design(p)
+    assert exc.value.key.endswith("converged_instead")
+
+
 def test_claim_tolerance_is_what_could_change_the_verdict():
     from workbench.refinement import claim_tolerance
     assert claim_tolerance(_finding("a", 1.0, "within", 0.2), 1.1) == 0.2
@@ -130,7 +147,8 @@ def test_unconverged_finding_is_inconclusive(monkeypatch, tol, outcome):
 
     monkeypatch.setattr(studies, "REGISTRY", {"fake": _EulerStudy()})
     x = _euler(0.01)
-    claims = (_finding("f", x, "within", tol, expect="pass"),
+    from dataclasses import replace
+    claims = (replace(_finding("f", x, "within", tol, expect="pass"), converged_instead="y"),
               _finding("g", x + 1.0, "within", tol, expect="fail", allow=True))
     ev = verify.evaluate_design(Design("fake.toml", "fake", "fake", "t", "s", Spec(0.01), claims))
     row = {r.claim_id: r for r in ev.refinement.rows}
@@ -141,5 +159,6 @@ def test_unconverged_finding_is_inconclusive(monkeypatch, tol, outcome):
         assert f.verdict is Verdict.PASS and g.verdict is Verdict.FAIL and ev.ok
     else:
         assert f.verdict is Verdict.INCONCLUSIVE and "not converged: x estimate" in f.note
+        assert f.note.endswith("use `y` instead")
         assert not f.ok                       # a finding on an unconverged number fails the design
         assert g.verdict is Verdict.INCONCLUSIVE and g.ok     # allowed: shown, not failing

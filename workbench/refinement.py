@@ -90,11 +90,14 @@ def claim_tolerance(c: Claim, got) -> float | None:
 def _row(c: Claim, values: tuple, field: str, got) -> RefinementRow:
     tol = claim_tolerance(c, got)
     levels = f"{field}, {field}/2, {field}/4"
+    instead = (f"`{c.converged_instead}`" if c.converged_instead else
+               "a quantity that converges (the claim's `converged_instead`)")
     if tol is None or not all(isinstance(x, (int, float)) for x in values):
         same = len({str(x) for x in values}) == 1
         return RefinementRow(c.id, c.quantity, values, None, CONVERGED if same else NOT_CONVERGED,
                              None, "" if same else f"not converged: {c.quantity} is "
-                             f"{' / '.join(str(x) for x in values)} at {levels}")
+                             f"{' / '.join(str(x) for x in values)} at {levels}; "
+                             f"use {instead} instead")
     if not all(math.isfinite(float(x)) for x in values) and len(set(values)) == 1:
         return RefinementRow(c.id, c.quantity, values, tol, CONVERGED)
     r = refinement_check(*values, tolerance=tol)
@@ -104,10 +107,10 @@ def _row(c: Claim, values: tuple, field: str, got) -> RefinementRow:
     elif r.outcome == NOT_CONVERGED:
         reason = (f"not converged: {c.quantity} estimate {fmt(r.estimate, 2)} > tolerance "
                   f"{fmt(tol, 2)} ({shown} at {levels}, observed order {fmt(r.order, 2)}); "
-                  "use a quantity that converges")
+                  f"use {instead} instead")
     else:
         reason = (f"not converged: {c.quantity} {r.note} ({shown} at {levels}); "
-                  "use a quantity that converges")
+                  f"use {instead} instead")
     return RefinementRow(c.id, c.quantity, values, tol, r.outcome, r, reason)
 
 
