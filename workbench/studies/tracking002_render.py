@@ -203,7 +203,9 @@ def _tuning(spec, res) -> str:
         "out). The design point is chosen by one stated rule, the same for both: among the "
         f"runs within the stop requirement ({fmt(res.stop_tolerance)} m), the smallest "
         "normalised weighted sum Σ w_j J_j / s_j, with the scales s_j and weights w_j of "
-        "`[tuning]`. A minimiser of a positive weighted sum is always on the front.\n\n"
+        "`[tuning]`. A minimiser of a positive weighted sum is always on the front; with a zero "
+        "weight or the peak-jerk constraint below it need not be (a run off the front can be "
+        "the best one that meets the constraint).\n\n"
         + md_table(["objective", "scale s_j", "weight w_j", "why this scale"], srows, "lrrl")
         + "\n\n" + md_table(["reading", "MFAC runs", "on front", "MFAC chosen", "PID runs",
                              "on front", "PID chosen"], rows, "lrrlrrl")
