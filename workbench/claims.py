@@ -28,6 +28,8 @@ A claim in a design file::
     untested = "..."          # the check holds but cannot test the requirement (why):
                               #   the requirement counts as not tested
     severity_reason = "..."   # why this severity (shown with the finding)
+    converged_instead = "..." # a quantity of the design to use when this finding's
+                              #   metric has not converged (issue 33, item 4)
 
 Traceability (issue 33, item 2): a claim with no ``requirement`` traces to a
 requirement of its own, ``R-<claim id>``; with no ``criterion`` its
@@ -77,7 +79,9 @@ state (a passing claim whose origin is the workbench). Each report opens with
 its findings, most severe first.
 
 Verdicts form a closed set: PASS, FAIL, INCONCLUSIVE. A claim is *ok* when it
-passes, is inconclusive and allows it, or fails and was expected to fail; a
+passes, is inconclusive and allows it (whether it was expected to pass or to
+fail: a finding whose metric has not converged, issue 33 item 4), or fails
+and was expected to fail; a
 claim expected to fail that passes is not ok (the discrepancy went away, so
 the design must be updated).
 """
@@ -127,6 +131,7 @@ class Claim:
     derived: tuple[str, ...] = ()
     untested: str = ""
     severity_reason: str = ""
+    converged_instead: str = ""
 
     @property
     def is_finding(self) -> bool:
@@ -178,10 +183,9 @@ class ClaimResult:
         c = self.claim
         if not self.severity_holds:
             return False
-        if c.expect == "fail":
-            return self.verdict is Verdict.FAIL
-        return self.verdict is Verdict.PASS or (
-            self.verdict is Verdict.INCONCLUSIVE and c.allow_inconclusive)
+        if self.verdict is Verdict.INCONCLUSIVE:
+            return c.allow_inconclusive
+        return self.verdict is (Verdict.FAIL if c.expect == "fail" else Verdict.PASS)
 
     def to_json(self) -> dict:
         c = self.claim
@@ -292,9 +296,12 @@ def parse_claims(root: Reader, study, spec) -> list[Claim]:
             raise r.fail("severity", severity, 'no severity on a reproduced paper claim '
                          '(a finding is expect = "fail", or origin = "workbench")')
         meta = _traceability(r, cid, q, cmp_, value, tol, digits, rounding, origin, severity)
+        instead = r.string("converged_instead", default="")
+        if instead and instead not in names:
+            raise r.fail("converged_instead", instead, "a quantity this design computes")
         r.finish()
         out.append(Claim(cid, desc, q, cmp_, value, tol, digits, rounding, src, allow,
-                         expect, reason, severity, origin, **meta))
+                         expect, reason, severity, origin, **meta, converged_instead=instead))
     return out
 
 

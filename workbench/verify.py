@@ -5,7 +5,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from . import kinds
-from .claims import ClaimResult, check_claim, fill_claim
+from .claims import ClaimResult, Verdict, check_claim, fill_claim
 from .design import Design
 from .memo import run_study
 from .report.markdown import fmt
@@ -18,6 +18,7 @@ class Evaluation:
     design: Design
     result: Any
     claims: tuple[ClaimResult, ...]
+    refinement: Any = None      # RefinementTable of the findings, or None
 
     @property
     def ok(self) -> bool:
@@ -26,12 +27,28 @@ class Evaluation:
 
 def evaluate_design(design: Design) -> Evaluation:
     """Run the design's study (once per process for an equal spec,
-    :func:`workbench.memo.run_study`) and check each of its claims."""
+    :func:`workbench.memo.run_study`) and check each of its claims.
+
+    A study with a ``refine_field`` (the spec's numerical step) has every
+    finding's metric checked at the step, its half and its quarter (:func:`workbench.refinement.refine_findings`, issue 33 item 4):
+    a finding whose metric has not converged within the claim's tolerance
+    is INCONCLUSIVE ("not converged: ...")."""
     study = kinds.REGISTRY[design.kind]
     result = run_study(design, study.run)
     q = study.quantities(result)
-    return Evaluation(design, result, tuple(check_claim(fill_claim(c, q, fmt), q.get(c.quantity))
-                                            for c in design.claims))
+    checked = [check_claim(fill_claim(c, q, fmt), q.get(c.quantity)) for c in design.claims]
+    table = None
+    if hasattr(study, "refine_field"):
+        from .refinement import refine_findings
+        table = refine_findings(design, study, q, checked)
+        by_id = {row.claim_id: row for row in table.rows}
+        checked = [_unconverged(r, by_id[r.claim.id]) if r.claim.id in by_id
+                   and not by_id[r.claim.id].converged else r for r in checked]
+    return Evaluation(design, result, tuple(checked), table)
+
+
+def _unconverged(r: ClaimResult, row) -> ClaimResult:
+    return ClaimResult(r.claim, r.got, Verdict.INCONCLUSIVE, row.reason)
 
 
 def project_commit(root) -> str:

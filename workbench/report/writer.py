@@ -40,10 +40,11 @@ def claims_table(results: tuple[ClaimResult, ...]) -> str:
         verdict = r.verdict.value
         if not r.severity_holds:
             verdict += f" (not a rounding: more than {fmt(100 * ROUNDING_RTOL)} % off)"
-        elif c.expect == "fail":
-            verdict += " (expected)" if r.ok else " (expected FAIL, now passes: update the design)"
         elif r.verdict is Verdict.INCONCLUSIVE and c.allow_inconclusive:
-            verdict += " (allowed)"
+            verdict += " (allowed)" + (f": {r.note}" if r.note else "")
+        elif c.expect == "fail":
+            verdict += (" (expected)" if r.ok else
+                        f" (expected FAIL, now {r.verdict.value}: update the design)")
         note = c.description + (f" — known discrepancy ({c.severity}): {c.reason}"
                                 if c.expect == "fail" else
                                 f" — workbench finding ({c.severity})" if c.severity else "")
@@ -52,6 +53,36 @@ def claims_table(results: tuple[ClaimResult, ...]) -> str:
                      f"**{verdict}**", c.source])
     return md_table(["claim", "statement", "quantity", "expected", "got", "verdict", "source"],
                     rows, "lllrrll")
+
+
+def refinement_section(table) -> list[str]:
+    """The three-level refinement of the findings' metrics (issue 33, item
+    4), from a :class:`workbench.refinement.RefinementTable` (empty list
+    when the study has no refined step)."""
+    if table is None:
+        return []
+    head = (f"## Refinement of the findings\n\nEvery finding's metric at the designed step "
+            f"{table.field} = {fmt(table.step)} {table.unit} and at {table.field}/2 and "
+            f"{table.field}/4 (every other parameter, the control period included, as "
+            "designed). Observed order p = log2(|q1 − q2| / |q2 − q4|), Richardson estimate "
+            f"of the error of q4 = |q2 − q4| / (2^p − 1); p above {fmt(table.p_max)} is clipped to "
+            f"{fmt(table.p_max)}, and below {fmt(table.p_min)} (levels not in the asymptotic "
+            f"range) the estimate is max(|q1 − q2|, |q2 − q4|) / (2^{fmt(table.p_min)} − 1), "
+            "INCONCLUSIVE when above the tolerance. The tolerance is the error that could change "
+            "the finding: the claim's tolerance for `within`, the distance to the bound for "
+            "`<=` / `>=`. A finding whose estimate exceeds it is INCONCLUSIVE.")
+    if not table.rows:
+        return [head + "\n\n_No finding with a measured metric._"]
+    rows = []
+    for r in table.rows:
+        c = r.check
+        rows.append([f"`{r.claim_id}`", f"`{r.quantity}`", *(fmt(x, 5) for x in r.values),
+                     "—" if c is None or c.order is None else fmt(c.order, 2),
+                     "—" if c is None or c.estimate is None else fmt(c.estimate, 2),
+                     fmt(r.tolerance, 2), r.outcome + (f" ({c.note})" if c and c.note else "")])
+    return [head + "\n\n" + md_table(
+        ["finding", "metric", "q1", "q2", "q4", "p", "estimate", "tolerance", "outcome"],
+        rows, "llrrrrrrl")]
 
 
 def verdict_summary(results) -> str:
@@ -149,6 +180,7 @@ def render_report(ev, rendered: Rendered, figdir: str, solver: str | None,
              findings_section(ev.claims, rendered.anchors), *body,
              register_section(d.hazards, d.assumptions, [r.claim for r in ev.claims]),
              "## Claims\n\n" + verdict_summary(ev.claims) + ".\n\n" + claims_table(ev.claims),
+             *refinement_section(getattr(ev, "refinement", None)),
              provenance(solver, config.pins, ident),
              traceability_section(ev.claims, link)]
     return github_math("\n\n".join(parts).rstrip() + "\n"), rendered.figures

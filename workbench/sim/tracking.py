@@ -191,6 +191,10 @@ class Objectives:
         traction power per unit mass.
     rms_speed_error : numpy.ndarray
         sqrt(mean (v - v*)^2) over the planned run time (m/s); shown, not an objective.
+    peak_jerk : numpy.ndarray
+        Peak |jerk| over 1 s windows up to the stop (m/s^3), |a(k + m) - a(k)| / (m Ts)
+        with m Ts = 1 s: the comfort *constraint* of the tuning (issue 33, item 2;
+        EN 12299 rates comfort by peak events, the limit is the design's choice).
     """
 
     stop_error: np.ndarray
@@ -198,6 +202,7 @@ class Objectives:
     comfort: np.ndarray
     energy: np.ndarray
     rms_speed_error: np.ndarray
+    peak_jerk: np.ndarray
 
     NAMES = ("stop_error", "punctuality", "comfort", "energy")
 
@@ -208,7 +213,7 @@ class Objectives:
     def row(self, i: int) -> "Objectives":
         """Batch element ``i`` as a batch of one."""
         return Objectives(*(np.asarray(getattr(self, f))[i:i + 1] for f in
-                            (*self.NAMES, "rms_speed_error")))
+                            (*self.NAMES, "rms_speed_error", "peak_jerk")))
 
 
 def objectives(run: TrackingRun, distance: float, run_time: float) -> Objectives:
@@ -218,8 +223,12 @@ def objectives(run: TrackingRun, distance: float, run_time: float) -> Objectives
     rms_jerk = np.array([np.sqrt(np.mean((np.diff(a[run.t < ts]) / dt) ** 2))
                          if np.isfinite(ts) and np.sum(run.t < ts) > 1 else np.nan
                          for a, ts in zip(run.a, t_stop)])
+    m = max(1, int(round(1.0 / dt)))
+    peak = np.array([np.max(np.abs(a[m:][run.t[m:] < ts] - a[:-m][run.t[m:] < ts])) / (m * dt)
+                     if np.isfinite(ts) and np.sum(run.t[m:] < ts) > 0 else np.nan
+                     for a, ts in zip(run.a, t_stop)])
     planned = run.t <= run_time
     rms = np.sqrt(np.mean((run.v[:, planned] - run.target[:, planned]) ** 2, axis=1))
     energy = np.where(np.isfinite(t_stop), run.traction_work, np.nan)
     return Objectives(np.abs(run.stop_pos - distance), np.abs(t_stop - run_time), rms_jerk,
-                      energy, rms)
+                      energy, rms, peak)

@@ -52,6 +52,25 @@ def choose(points, scales, weights, admissible=None) -> int:
     return int(np.argmin(cost))
 
 
+def grid_edges(params, chosen: int, keys) -> tuple[str, ...]:
+    """Names of the parameters whose value at row ``chosen`` of the full
+    factorial grid ``params`` (shape (N, P)) is the smallest or the largest
+    value of that parameter's grid (parameters with a single value are not
+    searched and never count).
+
+    A tuning search whose optimum lies on the edge of its grid has not shown
+    that the optimum is inside it (issue 33, item 4): the grid must be
+    extended in those parameters, or the design point is INCONCLUSIVE.
+    """
+    P = np.asarray(params, float)
+    out = []
+    for j, k in enumerate(keys):
+        vals = np.unique(P[:, j])
+        if vals.size > 1 and P[chosen, j] in (vals[0], vals[-1]):
+            out.append(k)
+    return tuple(out)
+
+
 def dominated_share(front_a, front_b) -> float:
     """Share of the rows of ``front_b`` that some row of ``front_a`` dominates
     (0 when ``front_b`` is empty)."""

@@ -24,6 +24,8 @@ __all__ = ["STUDY", "StationStopping"]
 class StationStopping:
     kind = "station-stopping"
     uses_solver = False    # no convex solver runs: the report says so
+    #: numerical step refined (dt/2, dt/4) for the findings (workbench.refinement)
+    refine_field, refine_unit = "dt", "s"
 
     def load(self, root: Reader) -> StopSpec:
         return load_stop_spec(root)

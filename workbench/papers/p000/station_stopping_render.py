@@ -165,6 +165,7 @@ def _plot_cdf(fig, res):
                 label=LABEL[c])
     ax.axvline(100 * STOP_WINDOW_M, color="k", ls="--", lw=0.8, label=f"{fmt(STOP_WINDOW_M)} m")
     ax.set_xscale("symlog", linthresh=1.0)
+    ax.set_xlim(left=0.0)              # an |error| axis has no negative ticks
     ax.set_xlabel("|stop error| (cm)")
     ax.set_ylabel("fraction of stops")
     ax.legend(fontsize=8)

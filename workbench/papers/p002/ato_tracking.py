@@ -13,6 +13,8 @@ __all__ = ["ATOTracking", "STUDY"]
 
 class ATOTracking:
     kind = "ato-tracking"
+    #: numerical step refined (dt/2, dt/4) for the findings (workbench.refinement)
+    refine_field, refine_unit = "dt", "s"
     uses_solver = False    # no convex solver runs: the report says so
 
     def load(self, root) -> TrackingSpec:

@@ -75,6 +75,34 @@ def plot_tracking(fig, res: TrackingResult) -> None:
     axes[1, 0].legend(fontsize=7)
 
 
+def jerk_1s(run, i: int = 0):
+    """(t, jerk) of batch element ``i``: (a(k + m) - a(k)) / (m Ts) over 1 s
+    windows, the quantity of the peak-jerk constraint (``Objectives.peak_jerk``),
+    up to the stop, at the window's end."""
+    dt = run.t[1] - run.t[0]
+    m = max(1, int(round(1.0 / dt)))
+    keep = run.t[m:] < run.stop_time[i] if np.isfinite(run.stop_time[i]) else slice(None)
+    return run.t[m:][keep], ((run.a[i, m:] - run.a[i, :-m]) / (m * dt))[keep]
+
+
+def plot_jerk(fig, res: TrackingResult, limit: float | None) -> None:
+    """Jerk (1 s windows) of the chosen points against the comfort limit, one
+    panel per reading."""
+    axes = fig.subplots(1, len(res.readings), sharey=True, squeeze=False)[0]
+    for ax, r in zip(axes, res.readings):
+        for run, name in ((r.main.mfac, "MFAC"), (r.main.pid, "PID")):
+            t, j = jerk_1s(run)
+            ax.plot(t, j, lw=0.7, color=COLOURS[name], label=name)
+        if limit is not None:
+            for s in (1, -1):
+                ax.axhline(s * limit, color="r", ls="--", lw=0.9,
+                           label=f"limit ±{limit:g} m/s³" if s > 0 else None)
+        ax.set_title(f"reading '{r.reading.name}'", fontsize=9)
+        ax.set_xlabel("time (s)")
+    axes[0].set_ylabel("jerk, 1 s windows (m/s³)")
+    axes[0].legend(fontsize=7)
+
+
 def plot_ppd(fig, res: TrackingResult) -> None:
     """Per reading: the estimate in use and the realised PPD dy(k+1)/du(k) of
     the chosen MFAC run, with phi(1) and the plant's DC gain."""

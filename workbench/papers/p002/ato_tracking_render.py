@@ -1,6 +1,8 @@
 """Markdown and figures of the ``ato-tracking`` study (pure rendering)."""
 from __future__ import annotations
 
+import numpy as np
+
 from ...controllers.mfac import RESET_CONDITIONS, MFACGains, frozen_ppd_poles
 from ...plants.train002 import latex_equations
 from ...report.markdown import Figure, Rendered, fmt, md_table
@@ -201,12 +203,40 @@ def _tuning(spec, res) -> str:
         "out). The design point is chosen by one stated rule, the same for both: among the "
         f"runs within the stop requirement ({fmt(res.stop_tolerance)} m), the smallest "
         "normalised weighted sum Σ w_j J_j / s_j, with the scales s_j and weights w_j of "
-        "`[tuning]`. A minimiser of a positive weighted sum is always on the front.\n\n"
+        "`[tuning]`. A minimiser of a positive weighted sum is always on the front; with a zero "
+        "weight or the peak-jerk constraint below it need not be (a run off the front can be "
+        "the best one that meets the constraint).\n\n"
         + md_table(["objective", "scale s_j", "weight w_j", "why this scale"], srows, "lrrl")
         + "\n\n" + md_table(["reading", "MFAC runs", "on front", "MFAC chosen", "PID runs",
                              "on front", "PID chosen"], rows, "lrrlrrl")
         + "\n\nIn the figures: every run (dots), the 4-objective front (rings), the front of "
-        "the two objectives plotted (step line), the chosen points (stars).\n\n" + figs)
+        "the two objectives plotted (step line), the chosen points (stars).\n\n" + figs
+        + "\n\n" + _comfort_and_edges(spec, res))
+
+
+def _comfort_and_edges(spec, res) -> str:
+    """Peak jerk of the chosen points against the constraint, and whether a
+    chosen point lies on its grid's edge (issue 33, items 2 and 4)."""
+    lim = spec.peak_jerk
+    rows = []
+    for r in res.readings:
+        for c, tun in (("MFAC", r.mfac), ("PID", r.pid)):
+            pj = r.main.value(c, "peak_jerk")
+            ok = "—" if lim is None or not np.isfinite(pj) else (
+                "yes" if pj <= lim.value else "**no**")
+            rows.append([f"`{r.reading.name}`", c, fmt(pj, 3), ok,
+                         ", ".join(tun.edges) or "none"])
+    con = ("No peak-jerk constraint is set (`[tuning] peak_jerk`)." if lim is None else
+           f"Comfort is a **peak constraint**: only runs whose jerk over any 1 s window stays "
+           f"within {fmt(lim.value)} m/s³ ({lim.source}) may be chosen (a grid with no such "
+           "run keeps the stop requirement alone, and the table says no).")
+    return (
+        f"{con} A chosen point whose value of a parameter is the first or last of that "
+        "parameter's grid has not been shown to be an optimum inside the grid: the design "
+        "point is then INCONCLUSIVE until the grid is extended in that parameter.\n\n"
+        + md_table(["reading", "controller", "peak |jerk| (m/s³)", "within the limit",
+                    "on the grid's edge in"], rows, "llrll")
+        + "\n\n![jerk against its limit]({figdir}/jerk.png)")
 
 
 def _compare(res) -> str:
@@ -314,8 +344,12 @@ def _closing(res) -> str:
     items = []
     for r in res.readings:
         s = r.ppd
+        edges = "; ".join(f"{c} in {', '.join(t.edges)}" for c, t in
+                          (("MFAC", r.mfac), ("PID", r.pid)) if t.edges)
+        who = (f"**not determined** (chosen points on their grids' edges: {edges}); at these "
+               f"points {r.verdict}" if edges else f"**{r.verdict}**")
         items.append(
-            f"- **{r.reading.name}** (`{r.reading.model}`): **{r.verdict}** has the smaller "
+            f"- **{r.reading.name}** (`{r.reading.model}`): {who} has the smaller "
             f"cost ({fmt(r.cost('MFAC'), 3)} MFAC, {fmt(r.cost('PID'), 3)} PID); MFAC is "
             f"better in {sum(r.main.winner(i) == 'MFAC' for i in OBJECTIVES)} of "
             f"{len(OBJECTIVES)} objectives at the chosen points. The published reset fires in "
@@ -325,6 +359,10 @@ def _closing(res) -> str:
             f"{_pct(s.data_sign_agreement)} of the samples where the command moves; the "
             f"frozen-PPD loop's spectral radius is {fmt(r.frozen_radius, 3)}.")
     verdicts = {r.verdict for r in res.readings}
+    if any(r.mfac.edges or r.pid.edges for r in res.readings):
+        return (f"## {H_END}\n\n" + "\n".join(items) + "\n\nWhether MFAC beats PID is not "
+                "determined: on a reading whose chosen points lie on their grids' edges the "
+                "tuning has not converged (extend the grids in the parameters named).")
     tail = ("On neither reading does MFAC beat PID under the stated rule: paper 002's "
             "conclusion is not reproduced, whichever way its lost eq 2 is read."
             if verdicts <= {"PID"} else
@@ -342,6 +380,10 @@ def render(design, res) -> Rendered:
                    lambda fig, r=r: F.plot_pareto(fig, r), (8.0, 3.8)) for r in res.readings]
     figs += [Figure("tracking", "Speed error and acceleration at the chosen points.",
                     lambda fig: F.plot_tracking(fig, res), (8.0, 5.0)),
+             Figure("jerk", "Jerk (1 s windows) of the chosen points against the comfort "
+                    "limit.", lambda fig: F.plot_jerk(
+                        fig, res, None if spec.peak_jerk is None else spec.peak_jerk.value),
+                    (8.0, 3.2)),
              Figure("ppd", "PPD estimate and realised PPD of the chosen MFAC runs.",
                     lambda fig: F.plot_ppd(fig, res), (8.0, 3.8))]
     if res.readings[0].line:

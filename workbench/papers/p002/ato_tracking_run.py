@@ -39,7 +39,7 @@ from ...plants.train002 import dc_gain, linear_model, speed_time_constant
 from ...profiles import Profile, build_profile
 from ...report.markdown import fmt
 from ...sim.tracking import Objectives, TrackingRun, objectives, simulate_tracking
-from ...tuning.pareto import choose, dominated_share, pareto_mask, weighted_cost
+from ...tuning.pareto import choose, dominated_share, grid_edges, pareto_mask, weighted_cost
 from .ato_tracking_spec import MFAC_KEYS, OBJECTIVES, PID_KEYS, Reading, Section, TrackingSpec
 
 WINNER_DIGITS = 3   # significant digits at which two values count as a tie
@@ -102,6 +102,12 @@ class Tuning:
     cost: np.ndarray
     chosen: int
     reset_rate: np.ndarray | None = None
+
+    @property
+    def edges(self) -> tuple[str, ...]:
+        """Parameters whose chosen value is the first or last of its grid
+        (:func:`~workbench.tuning.pareto.grid_edges`)."""
+        return grid_edges(self.params, self.chosen, self.keys)
 
     def chosen_params(self) -> dict[str, float]:
         return {k: float(self.params[self.chosen, i]) for i, k in enumerate(self.keys)}
@@ -244,13 +250,18 @@ def _tune(spec, reading, sec, prof, kind: str) -> tuple[Tuning, TrackingRun, MFA
            _pid(spec, reading, gains, len(P)))
     run = _sim(spec, reading.train, sec, prof,
                lambda k, y, yn: ctl.step(y, yn) if kind == "mfac" else ctl.step(yn - y), len(P))
-    obj = objectives(run, sec.route.distance, sec.run_time).matrix()
+    qo = objectives(run, sec.route.distance, sec.run_time)
+    obj = qo.matrix()
     scales = [spec.scales[k].value for k in OBJECTIVES]
     rate = None
     if kind == "mfac":
         resets = ctl.record("reset")[:, :run.t.size - 1]
         rate = _mean_before_stop(resets, _before_stop(run)[:, 1:])
     admissible = obj[:, OBJECTIVES.index("stop_error")] <= spec.stop_tolerance.value
+    if spec.peak_jerk is not None:       # comfort: a peak constraint, not a weighted term
+        comfortable = admissible & (qo.peak_jerk <= spec.peak_jerk.value)
+        if comfortable.any():            # else: no run meets it; the claims say so
+            admissible = comfortable
     try:
         chosen = choose(obj, scales, spec.weights, admissible)
     except ValueError:
@@ -378,14 +389,21 @@ def study_quantities(res: TrackingResult) -> dict:
                 q[f"{p}.{lc}.{i}"] = _finite(r.main.value(c, i))
             q[f"{p}.{lc}.cost"] = _finite(r.cost(c))
             q[f"{p}.{lc}.front_size"] = int(tun.front.sum())
+            q[f"{p}.{lc}.peak_jerk"] = _finite(r.main.value(c, "peak_jerk"))
+            q[f"{p}.{lc}.grid_edge"] = ", ".join(tun.edges) or "none"
             for i in OBJECTIVES:
                 q[f"{p}.best.{lc}.{i}"] = _finite(tun.best(i))
             errs = [x.value(c, "stop_error") for x in r.line]
             q[f"{p}.line.{lc}.within_tolerance"] = sum(e <= res.stop_tolerance for e in errs)
             q[f"{p}.line.{lc}.max_stop_error"] = _finite(max(
                 errs, key=lambda e: e if np.isfinite(e) else np.inf)) if errs else None
-        q[f"{p}.verdict"] = r.verdict
-        q[f"{p}.mfac_wins"] = sum(r.main.winner(i) == "MFAC" for i in OBJECTIVES)
+        # a chosen point on its grid's edge is not a converged optimum (issue 33,
+        # item 4): the comparison of the design points is then not determined
+        edge = bool(r.mfac.edges or r.pid.edges)
+        q[f"{p}.design_points_interior"] = "no" if edge else "yes"
+        q[f"{p}.verdict"] = None if edge else r.verdict
+        q[f"{p}.mfac_wins"] = None if edge else sum(r.main.winner(i) == "MFAC"
+                                                    for i in OBJECTIVES)
         mf, pf = r.mfac.objectives[r.mfac.front], r.pid.objectives[r.pid.front]
         q[f"{p}.front.pid_dominated"] = dominated_share(mf, pf)
         q[f"{p}.front.mfac_dominated"] = dominated_share(pf, mf)

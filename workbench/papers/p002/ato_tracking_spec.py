@@ -84,6 +84,7 @@ class TrackingSpec:
     scales: dict            # objective -> Quantity
     weights: tuple[float, ...]
     stop_tolerance: Quantity
+    peak_jerk: Quantity | None = None   # comfort constraint of the tuning ([tuning]); None: none
 
     def profile_spec(self, sec: Section) -> ProfileSpec:
         return ProfileSpec(sec.route.distance, sec.v_limit, self.profile["accel"],
@@ -193,12 +194,13 @@ def load_spec(root: Reader) -> TrackingSpec:
     if len(weights) != len(OBJECTIVES) or min(weights) < 0 or not max(weights) > 0:
         raise tu.fail("weights", list(weights), f"{len(OBJECTIVES)} non-negative weights, "
                       "not all 0")
+    peak_jerk = tu.quantity("peak_jerk", "m/s^3", positive=True, hi=10.0, default=None)
     tu.finish()
     req = root.table("requirements")
     tol = req.quantity("stop_tolerance", "m", positive=True, hi=1e4)   # declared range (issue 32)
     req.finish()
     spec = TrackingSpec(main, line, prof, train, u_lim, Ts, dt, readings, scales, weights,
-                        tol)
+                        tol, peak_jerk)
     for i, sec in enumerate((main, *line)):
         try:
             build_profile(spec.profile_spec(sec), dt=Ts)
@@ -219,7 +221,7 @@ def quantity_names(spec: TrackingSpec) -> set[str]:
             names |= {f"{p}.{c}.front_size", f"{p}.line.{c}.within_tolerance",
                       f"{p}.line.{c}.max_stop_error"}
         names |= {f"{p}.{k}" for k in (
-            "verdict", "mfac_wins", "front.pid_dominated", "front.mfac_dominated",
+            "verdict", "mfac_wins", "design_points_interior", "front.pid_dominated", "front.mfac_dominated",
             "mfac.reset_rate", "mfac.reset_rate.small_du", "mfac.reset_rate.sign_change",
             "mfac.reset_rate.small_phi", "mfac.reset_rate.at_limit", "mfac.saturated",
             "grid.reset_rate_min", "grid.reset_rate_median", "ppd.phi_min", "ppd.phi_max",
@@ -227,5 +229,6 @@ def quantity_names(spec: TrackingSpec) -> set[str]:
             "ppd.median_to_dc_gain", "plant.dc_gain", "plant.time_constant",
             "frozen.spectral_radius", "sensitivity.most_sensitive")}
         names |= {f"{p}.best.{c}.{i}" for c in ("mfac", "pid") for i in OBJECTIVES}
+        names |= {f"{p}.{c}.{k}" for c in ("mfac", "pid") for k in ("peak_jerk", "grid_edge")}
         names |= {f"{p}.sensitivity.{k}" for k in ("eta", "mu", "rho", "lam")}
     return names

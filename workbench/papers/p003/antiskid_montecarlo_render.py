@@ -93,8 +93,12 @@ def draw_rates(fig, res: SweepResult) -> None:
 
 def draw_outcomes(fig, res: SweepResult) -> None:
     """Each run at its (adhesion s, true delay h) and (mass factor, v0),
-    marked by its outcome: stopped, diverged, or neither (pure)."""
+    marked by its outcome: stopped, diverged, or neither, with the count of
+    each in the legend; a diverged run is coloured by the time it diverged
+    (colour bar), so that a sweep where every run diverges still shows where
+    the draws make it diverge early or late (pure)."""
     d = {k: np.asarray(v, float) for k, v in res.samples.items()}
+    t_div = np.asarray(res.metrics.get("t_diverged", [np.nan] * res.n), float)
     div = np.asarray(res.violations["diverged"], bool)
     stuck = np.asarray(res.violations["not_stopped"], bool) & ~div
     groups = (("stopped", ~div & ~stuck, "tab:blue", "o"),
@@ -106,9 +110,15 @@ def draw_outcomes(fig, res: SweepResult) -> None:
             ("adhesion", delay[0], "adhesion s (0 wet, 1 dry)", delay[1]),
             ("mass", "v0", "plant mass / nominal", "v(0) (m/s)"))):
         for label, sel, color, marker in groups:
-            if sel.any():
+            if not sel.any():
+                continue
+            if label == "diverged" and np.isfinite(t_div[sel]).all():
+                sc = ax.scatter(d[kx][sel], d[ky][sel], s=16, c=t_div[sel], cmap="plasma",
+                                marker=marker, label=f"{label}: {int(sel.sum())} of {res.n}")
+                fig.colorbar(sc, ax=ax, label="diverged at t (s)")
+            else:
                 ax.scatter(d[kx][sel], d[ky][sel], s=14, c=color, marker=marker,
-                           label=f"{label}: {int(sel.sum())}")
+                           label=f"{label}: {int(sel.sum())} of {res.n}")
         ax.set_xlabel(lx)
         ax.set_ylabel(ly)
     fig.axes[0].legend(fontsize=7)

@@ -40,7 +40,8 @@ def plot_creep(fig, res):
         for c in res.cases:
             r = c.run
             ax.plot(r.t, np.clip(r.x[1], -1, 1), color=color_of(c.case.name), label=c.case.name)
-        ax.axhline(res.lambda_opt, color="k", ls="--", lw=0.8, label="lambda_opt")
+        ax.axhline(res.lambda_opt, color="k", ls="--", lw=0.8, label="lambda_opt (traction)")
+        ax.axhline(-res.lambda_opt, color="k", ls="-.", lw=0.8, label="−lambda_opt (braking)")
         ax.axhline(res.lambda_d, color="gray", ls=":", lw=0.8, label="lambda_d")
         ax.set_ylabel("creep ratio")
     t_c = min((c.metrics["t_cruise"] for c in res.cases

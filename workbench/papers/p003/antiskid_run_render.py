@@ -85,7 +85,7 @@ def render(design, res) -> Rendered:
     figs = (
         Figure("speed", "Train speed v and wheel speed v_w = omega r.",
                lambda fig, res=res: plot_speed(fig, res), (7.0, 4.0)),
-        Figure("creep-ratio", "Creep ratio against lambda_opt and lambda_d.",
+        Figure("creep-ratio", "Creep ratio against ±lambda_opt and lambda_d.",
                lambda fig, res=res: plot_creep(fig, res), (7.0, 5.5)),
         *extra_figs,
         Figure("creep-speed-error", "Creep-speed tracking error in braking.",

@@ -312,7 +312,8 @@ def sampled_quantity_names(spec: SampledSpec) -> set[str]:
                   f"{b}.mesh_converged"}
         names |= {f"{b}.gap_to_emulation.{m}" for m in GAP_METRICS}
         names |= {f"{b}.rate[{f:g}].{m}" for f in spec.rates
-                  for m in RATE_METRICS + ("stop_time_minus_emulation",)}
+                  for m in RATE_METRICS + ("stop_time_minus_emulation",
+                                           "stop_distance_minus_emulation")}
     return names
 
 
@@ -329,8 +330,11 @@ def sampled_quantities(res: SampledResult) -> dict:
         for m in GAP_METRICS:
             q[f"{b}.gap_to_emulation.{m}"] = _q(abs(top[m] - res.emulation.metrics[m]))
         emu_stop = res.emulation.metrics["braking_duration"]
+        emu_dist = res.emulation.metrics["stop_distance"]
         for r in v.rows:
             q.update({f"{b}.rate[{r.rate:g}].{m}": _q(r.metrics[m]) for m in RATE_METRICS})
             q[f"{b}.rate[{r.rate:g}].stop_time_minus_emulation"] = _q(
                 r.metrics["braking_duration"] - emu_stop)
+            q[f"{b}.rate[{r.rate:g}].stop_distance_minus_emulation"] = _q(
+                r.metrics["stop_distance"] - emu_dist)
     return q

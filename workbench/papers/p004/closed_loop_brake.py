@@ -279,6 +279,8 @@ def _key(x: float) -> str:
 
 class ClosedLoopBrake:
     kind = "closed-loop-brake"
+    #: numerical step refined (dt/2, dt/4) for the findings (workbench.refinement)
+    refine_field, refine_unit = "dt", "s"
     uses_solver = False    # no convex solver runs: the report says so
 
     def load(self, root: Reader) -> Spec004:

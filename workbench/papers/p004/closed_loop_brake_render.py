@@ -142,12 +142,25 @@ def _corner_details(res) -> str:
             + "\n\n</details>")
 
 
+def _error_colours(tol: float):
+    """A threshold colour map of |stop error|: greens within the tolerance,
+    orange to dark red beyond it (no failing cell can look green), and its
+    norm (bounds 0, tol/2, tol, 1.5 tol, 2 tol, 3 tol; darker above)."""
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    cmap = ListedColormap(["#1a9850", "#a6d96a", "#fdae61", "#f46d43", "#d73027"])
+    cmap.set_over("#67001f")
+    bounds = [0.0, tol / 2, tol, 1.5 * tol, 2 * tol, 3 * tol]
+    return cmap, BoundaryNorm(bounds, cmap.N)
+
+
 def _plot_grid(fig, res, spec):
+    cmap, norm = _error_colours(res.tolerance)
     speeds = list(res.distance)
     nf = len(spec.friction)
+    gs = fig.add_gridspec(len(speeds), nf + 1, width_ratios=[1.0] * nf + [0.06])
     for i, s in enumerate(speeds):
         for j, fr in enumerate(spec.friction):
-            ax = fig.add_subplot(len(speeds), nf, i * nf + j + 1)
+            ax = fig.add_subplot(gs[i, j])
             M = np.full((len(spec.force_error), len(spec.gradient)), np.nan)
             feas = np.ones(M.shape, bool)
             for a, fe in enumerate(spec.force_error):
@@ -156,12 +169,12 @@ def _plot_grid(fig, res, spec):
                                      electric=True, force_error=fe, gradient=gr, friction=fr)
                     M[a, b] = sel[0][1]
                     feas[a, b] = res.feasible[res.runs.index(sel[0][0])]
-            ax.imshow(np.clip(np.abs(M), 0, 3 * res.tolerance), cmap="RdYlGn_r", vmin=0,
-                      vmax=3 * res.tolerance, origin="lower", aspect="auto")
+            im = ax.imshow(np.abs(M), cmap=cmap, norm=norm, origin="lower", aspect="auto")
             for a in range(M.shape[0]):
                 for b in range(M.shape[1]):
                     ax.text(b, a, fmt(M[a, b], 2) + ("" if feas[a, b] else "\ninfeasible"),
-                            ha="center", va="center", fontsize=7)
+                            ha="center", va="center", fontsize=7,
+                            color="w" if abs(M[a, b]) > 2 * res.tolerance else "k")
             ax.set_xticks(range(len(spec.gradient)))
             ax.set_xticklabels([fmt(g) for g in spec.gradient])
             ax.set_yticks(range(len(spec.force_error)))
@@ -173,4 +186,6 @@ def _plot_grid(fig, res, spec):
             if j == 0:
                 ax.set_ylabel("force error (%)")
     fig.suptitle(f"closed-loop stop error (m); green: within ±{fmt(res.tolerance)} m, "
-                 f"red: ≥ {fmt(3 * res.tolerance)} m")
+                 f"orange to red: beyond it, dark red: ≥ {fmt(3 * res.tolerance)} m")
+    fig.colorbar(im, cax=fig.add_subplot(gs[:, nf]), extend="max",
+                 label=f"|stop error| (m); tolerance {fmt(res.tolerance)} m")
