@@ -137,7 +137,7 @@ class _EulerStudy:
 def test_unconverged_finding_is_inconclusive(monkeypatch, tol, outcome):
     from dataclasses import dataclass
 
-    from workbench import studies, verify
+    from workbench import kinds, verify
     from workbench.claims import Verdict
     from workbench.design import Design
 
@@ -145,7 +145,7 @@ def test_unconverged_finding_is_inconclusive(monkeypatch, tol, outcome):
     class Spec:
         dt: float
 
-    monkeypatch.setattr(studies, "REGISTRY", {"fake": _EulerStudy()})
+    monkeypatch.setattr(kinds, "REGISTRY", {"fake": _EulerStudy()})
     x = _euler(0.01)
     from dataclasses import replace
     claims = (replace(_finding("f", x, "within", tol, expect="pass"), converged_instead="y"),

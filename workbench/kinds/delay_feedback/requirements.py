@@ -40,7 +40,7 @@ FIELDS = ("certified", "exact", "verdict")
 #: characteristic roots (order ~ R h) loses every digit. Rates (1/s) and gains as stated.
 H_MIN, H_MAX = 1e-6, 1e3
 RANGES = {"decay_rate": (1e-6, 1e3), "l2_gain": (1e-6, 1e6), "input_limit": (1e-9, 1e9),
-          "box": (1e-9, 1e9)}
+          "box": (1e-9, 1e9), "rate": (0.0, 1e3)}
 
 
 @dataclass(frozen=True)
