@@ -68,7 +68,7 @@ def test_rightmost_roots_of_a_denormal_delay_is_not_converged():
 @pytest.mark.parametrize("old, new, words", [
     ("decay_rate = { value = 0.2,", "decay_rate = { value = 1e308,",
      ["requirements.decay_rate.value = 1e+308", "in [1e-06, 1000]"]),
-    ("input_limit = { u = { value = 1.0,", "input_limit = { u = { value = 1e-300,",
+    ("input_limit = { u = { value = 0.9,", "input_limit = { u = { value = 1e-300,",
      ["requirements.input_limit.u.value = 1e-300", "in [1e-09, 1e+09]"]),
     ("sampling = 0.1 ", "sampling = 1e-300 ",
      ["implementation.sampling = 1e-300", "in [1e-06, 1000]"]),

@@ -58,13 +58,13 @@ def _verify(tmp_path, capsys, design, old, new):
      ["parameters.T_b.unit = 'blorp'", "a unit pint knows"]),
     ('T_b   = { value = 0.65,       unit = "s"', 'T_b   = { value = 0.65,       unit = "degC"',
      ["parameters.T_b.unit = 'degC'", "OffsetUnitCalculusError"]),   # fuzz run 186
-    ('a = "(u - a)/T_b"', 'a = "(u - a)*T_b"', ["equations.a", "m / s ** 3", "found m / s"]),
-    ('a = "(u - a)/T_b"', 'a = "(u - a)/T_b + v"', ["equations.a", "terms of one unit"]),
+    ('a = "(max(u, -u_sb) - a)/T_b"', 'a = "(max(u, -u_sb) - a)*T_b"', ["equations.a", "m / s ** 3", "found m / s"]),
+    ('a = "(max(u, -u_sb) - a)/T_b"', 'a = "(max(u, -u_sb) - a)/T_b + v"', ["equations.a", "terms of one unit"]),
     ('F_rail = "F_max*tanh(m0*a/F_max)"', 'F_rail = "F_max*tanh(m0*a)"',
      ["definitions.F_rail", "dimensionless argument of tanh"]),
     # zero divisors and complex values, named by their expression
-    ('a = "(u - a)/T_b"', 'a = "(u - a)/T_b + a/0"', ["equations.a", "division by zero"]),
-    ('a = "(u - a)/T_b"', 'a = "(u - a)/T_b*log(-1)"', ["equations.a", "complex value"]),
+    ('a = "(max(u, -u_sb) - a)/T_b"', 'a = "(max(u, -u_sb) - a)/T_b + a/0"', ["equations.a", "division by zero"]),
+    ('a = "(max(u, -u_sb) - a)/T_b"', 'a = "(max(u, -u_sb) - a)/T_b*log(-1)"', ["equations.a", "complex value"]),
     # the search cap: a sane range, and not below the design's delay
     ("h_max = 1.5 ", "h_max = 0.5 ", ["synthesis.h_max = 0.5", "delay.max = 0.8 s"]),
     ("h_max = 1.5 ", "h_max = 1e308 ", ["synthesis.h_max", "[0.001, 10000]"]),
@@ -77,8 +77,8 @@ def test_train_design_bad_input_exits_2(tmp_path, capsys, old, new, words):
 
 
 def test_zero_divisor_at_the_parameter_values(tmp_path, capsys):
-    err = _verify(tmp_path, capsys, TRAIN, 'a = "(u - a)/T_b"',
-                  'a = "(u - a)/T_b + grade/(grade + 0.01)*a/T_b"')
+    err = _verify(tmp_path, capsys, TRAIN, 'a = "(max(u, -u_sb) - a)/T_b"',
+                  'a = "(max(u, -u_sb) - a)/T_b + grade/(grade + 0.01)*a/T_b"')
     assert "equations.a" in err and "division by zero" in err and "parameter values" in err
 
 
