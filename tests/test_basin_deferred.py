@@ -7,7 +7,7 @@ import pytest
 from workbench.plants.adhesion import NumericAdhesion
 from workbench.roa import LevelOutcome
 from workbench.roa.basin import falsified_top
-from workbench.kinds import antiskid_basin as AB
+from workbench.papers.p003 import antiskid_basin as AB
 
 # as tests/test_roa_antiskid.py: 003 Tables 1-2 (dry rail), the certified gain at eps = 0.35
 DRY = dict(a=0.3315, b=40.19, c=5.392, J=80.0, r=0.445, m=12000.0, zeta=0.01, c0=180.9,
@@ -77,7 +77,7 @@ def test_k2_sweep_is_shared_through_the_run_folder(tmp_path, monkeypatch):
     nominal model and so the k2 sweep: a second process of the same run reads
     it from the run folder (here: the same key, the in-process cache bypassed)."""
     from workbench import memo
-    from workbench.kinds import antiskid_basin_k2 as K2
+    from workbench.papers.p003 import antiskid_basin_k2 as K2
     calls = []
 
     def fake(*key):
