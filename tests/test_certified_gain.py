@@ -171,7 +171,12 @@ def test_claim_on_a_synthesis_without_gain_is_inconclusive():
                                                           u=np.zeros(1)),
                           A=np.array([[-1.0]]), B=np.array([[1.0]]), exact=None,
                           range_stable=None, names=("x", "u"), vertex_checks=(), scenarios=(),
-                          basin=None, implementation=None, delay=SimpleNamespace(h_max=0.5))
+                          basin=None, implementation=None, delay=SimpleNamespace(h_max=0.5),
+                          spec=SimpleNamespace(
+                              plant=SimpleNamespace(states=(SimpleNamespace(name="x", unit="m"),),
+                                                    inputs=(SimpleNamespace(name="u", unit="N"),)),
+                              synthesis=SimpleNamespace(eps=()), vertices=(), scenarios=(),
+                              requirements=None, basin=None, implementation=None))
     q = quantities(res)
     claim = Claim("h", "h", "synthesis.h_certified", ">=", 0.5, 0.0, None, "round", "", False,
                   "pass", "")

@@ -11,6 +11,10 @@ Each study module provides an object with
     Compute (a frozen dataclass with ``to_json()``).
 ``quantities(result) -> dict[str, float | str | None]``
     Values of the named quantities (``None``: not determined).
+``quantity_names`` and ``quantities`` are best both expanded from one table
+that declares each quantity once, with its unit and the function that reads
+it (:mod:`workbench.features.quantities`; ``delay-feedback`` does, in
+:mod:`workbench.kinds.delay_feedback.quantities`).
 ``uses_solver`` (optional attribute, default True)
     False when the study runs no convex solver (its report's provenance
     then names none).

@@ -350,10 +350,6 @@ def _steps(t: Reader, k: str, t_end: float) -> tuple[tuple[float, float], ...]:
     return tuple((float(a), float(b)) for a, b in steps)
 
 
-def _eps_key(eps: float) -> str:
-    return f"{eps:g}"
-
-
 class DelayFeedback:
     """The ``delay-feedback`` study (see the module docstring)."""
 
@@ -389,40 +385,15 @@ class DelayFeedback:
         return spec
 
     def quantity_names(self, spec: DelayFeedbackSpec) -> set[str]:
-        p = spec.plant
-        n, m = len(p.states), len(p.inputs)
-        names = {f"operating_point.{k}" for k in p.state_names + p.input_names}
-        names |= {"operating_point.residual", "open_loop.hurwitz", "exact_margin",
-                  "exact.agreement", "exact.delay_range_stable", "certificate.covers_delay_range",
-                  "synthesis.h_certified", "synthesis.h_refuted", "synthesis.h_gain",
-                  "synthesis.status", "synthesis.eps", "synthesis.h_analysis",
-                  "synthesis.at_cap", "closed_loop.hurwitz"}
-        names |= {f"linearisation.A[{i},{j}]" for i in range(1, n + 1) for j in range(1, n + 1)}
-        names |= {f"linearisation.B[{i},{j}]" for i in range(1, n + 1) for j in range(1, m + 1)}
-        names |= {f"synthesis.K[{i},{j}]" for i in range(1, m + 1) for j in range(1, n + 1)}
-        for e in spec.synthesis.eps:
-            for f in ("h_certified", "h_refuted", "h_gain", "status", "exact_margin"):
-                names.add(f"synthesis.rows[eps={_eps_key(e)}].{f}")
-        for v in spec.vertices:
-            for f in ("exact_margin", "h_analysis", "stable_at_zero", "abscissa_at_h_gain"):
-                names.add(f"vertices.{v.name}.{f}")
-        for s in spec.scenarios:
-            b = f"simulation.{s.name}"
-            names |= {f"{b}.diverged", f"{b}.converged"}
-            names |= {f"{b}.peak_error.{k}" for k in p.state_names}
-            names |= {f"{b}.final_error.{k}" for k in p.state_names}
-            names |= {f"{b}.peak_input_dev.{k}" for k in p.input_names}
-            if s.parameters:
-                names |= {f"{b}.min_error.{k}" for k in p.state_names}
-        from .requirements import requirement_quantity_names
-        names |= requirement_quantity_names(spec.requirements)
-        if spec.basin is not None:
-            from ...features.basin import basin_quantity_names
-            names |= basin_quantity_names(spec)
-        if spec.implementation is not None:
-            from ...features.sampled import implementation_quantity_names
-            names |= implementation_quantity_names(spec)
-        return names
+        from ...features.quantities import names
+        from .quantities import TABLE
+        return names(TABLE, spec)
+
+    def quantity_units(self, spec: DelayFeedbackSpec) -> dict[str, str]:
+        """name -> unit of every claimable quantity (:mod:`.quantities`)."""
+        from ...features.quantities import units
+        from .quantities import TABLE
+        return units(TABLE, spec)
 
     def run(self, design):
         from .run import run

@@ -204,7 +204,7 @@ def _exact_section(spec, res) -> str:
         return "## Exact delay margin\n\nNo gain was certified: nothing to check."
     w = ", ".join(f"({fmt(a, 5)}, {fmt(b, 5)})" for a, b in res.windows) or "none"
     rng = f"[{fmt(d.h_min)}, {fmt(d.h_max)}] s" if not d.constant else f"h = {fmt(d.h_max)} s"
-    from .run import covers
+    from .quantities import covers
     cov = {"yes": f"**yes**: the certificate holds for every constant delay in [0, "
                   f"{fmt(s.h_gain, 4)}] s ⊇ {rng}",
            "at-h-only": f"**at h only**: the certificate reaches {fmt(s.h_gain, 4)} s but is "

@@ -120,6 +120,7 @@ class DelayFeedbackResult:
     names: tuple = ()          # state names, then input names
     basin: object = None       # delay_feedback_basin.DelayFeedbackBasin or None
     implementation: object = None   # delay_feedback_implementation.DesignImplementation
+    spec: object = None        # DelayFeedbackSpec (indexes the declared quantities)
 
     def to_json(self) -> dict:
         s = self.synthesis
@@ -251,7 +252,8 @@ def run(spec) -> DelayFeedbackResult:
         impl = run_implementation(spec.implementation, spec.delay, A, B, syn.K)
     return DelayFeedbackResult(op, A, B, syn, exact, tuple(windows), stable, checks, scen,
                                points, spec.delay,
-                               spec.plant.state_names + spec.plant.input_names, basin, impl)
+                               spec.plant.state_names + spec.plant.input_names, basin, impl,
+                               spec)
 
 
 # -- simulation -----------------------------------------------------------------------
@@ -394,71 +396,8 @@ def simulate_scenario(spec, model, values, op, K, scenario) -> ScenarioResult:
 
 # -- quantities ---------------------------------------------------------------------------
 def quantities(res: DelayFeedbackResult) -> dict:
-    """Values of the claimable quantities (None: not determined)."""
-    s = res.synthesis
-    q = {"operating_point.residual": res.op.residual,
-         "synthesis.h_certified": s.h_certified if s.h_certified > 0 and s.K is not None
-         else None,                                   # no gain returned: not determined
-         "synthesis.h_refuted": s.h_refuted, "synthesis.h_gain": s.h_gain,
-         "synthesis.status": s.status, "synthesis.eps": s.eps,
-         "synthesis.h_analysis": s.h_analysis, "synthesis.at_cap": "yes" if s.at_cap else "no",
-         "open_loop.hurwitz": "yes" if np.max(np.linalg.eigvals(res.A).real) < 0 else "no",
-         "exact_margin": None if res.exact is None else res.exact.h,
-         "exact.agreement": None if res.exact is None else res.exact.outcome.value,
-         "exact.delay_range_stable": None if res.range_stable is None
-         else ("yes" if res.range_stable else "no")}
-    for k, v in zip(res.names, np.concatenate([res.op.x, res.op.u])):
-        q[f"operating_point.{k}"] = float(v)
-    n, m = res.B.shape
-    for i in range(n):
-        for j in range(n):
-            q[f"linearisation.A[{i + 1},{j + 1}]"] = float(res.A[i, j])
-        for j in range(m):
-            q[f"linearisation.B[{i + 1},{j + 1}]"] = float(res.B[i, j])
-    if s.K is not None:
-        for i in range(m):
-            for j in range(n):
-                q[f"synthesis.K[{i + 1},{j + 1}]"] = float(s.K[i, j])
-        q["closed_loop.hurwitz"] = ("yes" if np.max(np.linalg.eigvals(res.A + res.B @ s.K).real)
-                                    < 0 else "no")
-    for r in s.rows:
-        b = f"synthesis.rows[eps={r.eps:g}]"
-        q[f"{b}.h_certified"] = r.h_certified if r.status.value == "certified" else None
-        q[f"{b}.h_refuted"] = r.h_refuted
-        q[f"{b}.h_gain"] = r.h_gain
-        q[f"{b}.status"] = r.status.value
-        q[f"{b}.exact_margin"] = r.exact.h if r.exact else None
-    for v, c, ab in res.vertex_checks:
-        q[f"vertices.{v.name}.abscissa_at_h_gain"] = ab
-        q[f"vertices.{v.name}.exact_margin"] = c.exact.h
-        q[f"vertices.{v.name}.h_analysis"] = c.h_certified
-        q[f"vertices.{v.name}.stable_at_zero"] = "yes" if c.stable_at_zero else "no"
-    for sr in res.scenarios:
-        b = f"simulation.{sr.scenario.name}"
-        for k, v in sr.metrics.items():
-            if k != "diverged":
-                q[f"{b}.{k}"] = None if math.isnan(v) else v
-        q[f"{b}.diverged"] = "yes" if sr.metrics["diverged"] else "no"
-        q[f"{b}.converged"] = "yes" if sr.converged else "no"
-    q["certificate.covers_delay_range"] = covers(res)
-    if s.method == "requirements":
-        from .requirements import requirement_quantities
-        q.update(requirement_quantities(s.requirements))
-    if res.basin is not None:
-        from ...features.basin import basin_quantities
-        q.update(basin_quantities(res.basin))
-    if res.implementation is not None:
-        from ...features.sampled import implementation_quantities
-        q.update(implementation_quantities(res.implementation))
-    return q
-
-
-def covers(res: DelayFeedbackResult) -> str:
-    """``yes``: the certificate holds for every delay in [0, h_certified] and
-    that reaches the design's largest delay; ``at-h-only``: the bound
-    reaches it but the certificate is for the single delay h; else ``no``."""
-    s = res.synthesis
-    if s.status != "certified" or s.h_gain is None:
-        return "no"
-    return "no" if not s.h_gain >= res.delay.h_max else ("yes" if s.all_delays
-                                                            else "at-h-only")
+    """Values of the claimable quantities (None: not determined), read as
+    :data:`~workbench.kinds.delay_feedback.quantities.TABLE` declares them."""
+    from ...features.quantities import values
+    from .quantities import TABLE
+    return values(TABLE, res.spec, res)

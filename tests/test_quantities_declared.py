@@ -1,0 +1,45 @@
+"""Quantities declared once (issue 35, item 3): names, values and units all
+expand one table, so they cannot drift apart."""
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+from workbench.features.quantities import Declared, Group, names, units, values
+
+SPEC = SimpleNamespace(states=("v", "s"), basin=None)
+TABLE = (
+    Declared("gain", "1", lambda r: r.gain),
+    Declared("peak.{k}", "{unit}", lambda r, k, unit: r.peak.get(k),
+             over=lambda spec: [{"k": k, "unit": "m/s" if k == "v" else "m"}
+                                for k in spec.states]),
+    Group(lambda spec: {"basin.c"}, lambda r: {"basin.c": r.c},
+          present=lambda spec: spec.basin is not None),
+)
+
+
+def test_names_values_and_units_expand_the_same_table():
+    res = SimpleNamespace(gain=2.5, peak={"v": 0.1}, c=3.0)
+    assert names(TABLE, SPEC) == {"gain", "peak.v", "peak.s"}
+    q = values(TABLE, SPEC, res)
+    assert q == {"gain": 2.5, "peak.v": 0.1, "peak.s": None}     # None: not determined
+    assert set(q) == names(TABLE, SPEC)
+    assert units(TABLE, SPEC) == {"gain": "1", "peak.v": "m/s", "peak.s": "m"}
+
+
+def test_a_feature_group_counts_only_when_the_design_has_it():
+    spec = SimpleNamespace(states=(), basin=object())
+    res = SimpleNamespace(gain=1.0, peak={}, c=3.0)
+    assert names(TABLE, spec) == {"gain", "basin.c"}
+    assert values(TABLE, spec, res) == {"gain": 1.0, "basin.c": 3.0}
+    assert units(TABLE, spec)["basin.c"] == "?"                 # the group declares no unit
+
+
+def test_every_delay_feedback_quantity_has_a_unit():
+    from workbench.design import load_design
+    from workbench.kinds.delay_feedback import STUDY
+    d = load_design("tests/data/train-brake-lag-robust.toml")
+    got = STUDY.quantity_units(d.spec)
+    assert set(got) == STUDY.quantity_names(d.spec)
+    assert got["exact_margin"] == "s" and got["synthesis.h_gain"] == "s"
+    assert all(u != "?" for n, u in got.items() if not n.startswith(("basin.", "implementation.",
+                                                                        "requirements.")))
