@@ -178,9 +178,9 @@ def campaign(seed: int, n: int, work: Path, kinds=None, timeout: float = 120.0,
     """``n`` seeded mutations over :data:`DESIGNS`, commands in rotation."""
     import workbench.cli  # noqa: F401 - loaded once here, not in every forked child
     import workbench.design  # noqa: F401
-    from workbench import kinds
-    for kind in kinds.REGISTRY:   # the studies' modules too
-        kinds.REGISTRY[kind]
+    from workbench import kinds as registry
+    for kind in registry.REGISTRY:   # the studies' modules too
+        registry.REGISTRY[kind]
     rng = random.Random(seed)
     out = []
     for i in range(n):
