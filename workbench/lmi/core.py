@@ -346,6 +346,11 @@ def guarded_solve(problem: cp.Problem, settings: Mapping | None = None) -> tuple
     return status, time.perf_counter() - t0
 
 
+#: Probes above an inconclusive (solver-inaccurate) upper end of a bisection
+#: before it is accepted as the bracket's end (:func:`bisect_delay`).
+ISLAND_SKIPS = 2
+
+
 def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
                  rel_tol: float = 1e-4, max_solves: int = 60, guess: float | None = None,
                  secant: bool = True, max_seconds: float = 3600.0) -> Bracket:
@@ -360,7 +365,10 @@ def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
     geometric bisection step. Every point is still decided by a real solve,
     so the bracket's meaning does not depend on the proposals. Inconclusive
     steps shrink the search interval like refuted ones but never count as
-    refuted.
+    refuted; when the bracket closes on an inconclusive step, up to
+    :data:`ISLAND_SKIPS` probes between it and the refuted point (or the cap)
+    look past it (an inaccurate solve surrounded by certifiable delays), and a
+    certified probe reopens the search above.
 
     Parameters
     ----------
@@ -426,14 +434,29 @@ def bisect_delay(decide: Callable[[float], Step], *, h_lo: float, h_hi: float,
         else:
             break
         run(h)
-    stalls = 0
-    while budget() and lo > 0 and hi < math.inf and hi / lo > 1 + rel_tol:
-        width = math.log(hi / lo)
-        h = _secant_proposal(steps, lo, hi, rel_tol) if secant and stalls < 2 else None
-        if h is None:
-            h, stalls = math.sqrt(lo * hi), 0
-        run(h)
-        stalls = stalls + 1 if math.log(hi / lo) > 0.5 * width else 0
+    stalls, skips = 0, 0
+    while True:
+        while budget() and lo > 0 and hi < math.inf and hi / lo > 1 + rel_tol:
+            width = math.log(hi / lo)
+            h = _secant_proposal(steps, lo, hi, rel_tol) if secant and stalls < 2 else None
+            if h is None:
+                h, stalls = math.sqrt(lo * hi), 0
+            run(h)
+            stalls = stalls + 1 if math.log(hi / lo) > 0.5 * width else 0
+        # an inaccurate solve is not a refutation: when the bracket closed on an
+        # inconclusive step well below the refuted point (or the cap), probe above it
+        # (a certificate there covers the delays below, so skipping the island is sound)
+        top = min(refuted, h_hi)
+        if not (lo > 0 and hi < refuted and top / hi > 1 + rel_tol and skips < ISLAND_SKIPS
+                and budget()):
+            break
+        skips += 1
+        probe = math.sqrt(hi * top) if top < math.inf else 2.0 * hi
+        if run(probe).outcome is not Outcome.CERTIFIED:
+            break
+        hi = min((st.h for st in steps if st.h > lo and st.outcome is not Outcome.CERTIFIED),
+                 default=math.inf)
+        stalls = 0
     if time.perf_counter() - t0 >= max_seconds:   # the cap is a reason, kept with the steps
         steps.append(Step(h, Outcome.INCONCLUSIVE,
                           f"error: wall-clock cap of {max_seconds:g} s reached", None, {},

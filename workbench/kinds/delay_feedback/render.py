@@ -6,6 +6,8 @@ bounds, closed-loop eigenvalues, re-check decades) through
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ...report.markdown import Figure, Rendered, fmt, fmt_floor, latex_matrix, md_table
@@ -224,13 +226,32 @@ def _exact_section(spec, res) -> str:
               "is the sound claim, the exact set says how conservative it is.")
 
 
+#: A final or signed error below this fraction of its state's peak error is
+#: rounding noise of the integration (last bits: it differs between CPUs),
+#: printed as a bound, not as digits.
+NOISE_FLOOR = 1e-9
+
+
+def _metric_cell(metrics: dict, key: str) -> str:
+    """``metrics[key]`` to 4 digits, or "< 1e-9 × peak" when a final/min error is
+    below :data:`NOISE_FLOOR` times the same state's peak error."""
+    v = metrics[key]
+    kind, _, state = key.partition(".")
+    peak = metrics.get(f"peak_error.{state}")
+    if (kind in ("final_error", "min_error") and peak is not None and math.isfinite(v)
+            and math.isfinite(peak) and abs(v) < NOISE_FLOOR * peak):
+        return f"< {NOISE_FLOOR:g} × peak"
+    return fmt(v, 4)
+
+
 def _simulation_section(spec, res):
     p = spec.plant
     rows, figs, parts = [], [], []
     for r in res.scenarios:
         sc = r.scenario
         for k, v in r.metrics.items():
-            rows.append([sc.name, k, fmt(r.metrics_coarse[k], 4), fmt(v, 4)])
+            rows.append([sc.name, k, _metric_cell(r.metrics_coarse, k),
+                         _metric_cell(r.metrics, k)])
         parts.append(f"`{sc.name}`: " + ("**with the predictor** (paper 003, Lemma 1), "
                                           if sc.predictor else "")
                      + f"h = {fmt(sc.h)} s, dt = {fmt(sc.dt)} s and "
