@@ -240,7 +240,7 @@ def _metric_cell(metrics: dict, key: str) -> str:
     peak = metrics.get(f"peak_error.{state}")
     if (kind in ("final_error", "min_error") and peak is not None and math.isfinite(v)
             and math.isfinite(peak) and abs(v) < NOISE_FLOOR * peak):
-        return f"< {NOISE_FLOOR:g} × peak"
+        return f"< {fmt(NOISE_FLOOR)} × peak"
     return fmt(v, 4)
 
 
