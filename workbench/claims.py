@@ -87,22 +87,16 @@ the design must be updated).
 """
 from __future__ import annotations
 
-import enum
 import math
 import re
 from dataclasses import dataclass
 from decimal import ROUND_DOWN, ROUND_HALF_EVEN, Decimal
 from typing import Any
 
+from .outcome import Verdict
 from .reader import Reader
 
 COMPARES = (">=", "<=", "==", "within")
-
-
-class Verdict(str, enum.Enum):
-    PASS = "PASS"
-    FAIL = "FAIL"
-    INCONCLUSIVE = "INCONCLUSIVE"
 
 
 @dataclass(frozen=True)
