@@ -4,8 +4,8 @@ the answers are those of the full estimate (workbench.papers.p003.antiskid_basin
 import numpy as np
 import pytest
 
+from workbench.outcome import Outcome
 from workbench.plants.adhesion import NumericAdhesion
-from workbench.roa import LevelOutcome
 from workbench.roa.basin import falsified_top
 from workbench.papers.p003 import antiskid_basin as AB
 
@@ -31,7 +31,7 @@ def deferred(switch):
 
 def test_refuted_point_needs_no_cover(deferred, switch, monkeypatch):
     monkeypatch.delenv(AB.EAGER_ENV, raising=False)
-    assert deferred.outcome(switch) is LevelOutcome.REFUTED
+    assert deferred.outcome(switch) is Outcome.REFUTED
     assert deferred._est is None                       # the cover did not run
 
 

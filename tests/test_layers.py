@@ -3,7 +3,7 @@
 Every ``import`` counts, at module level, inside functions and under
 ``if TYPE_CHECKING:``. The rules are the layer map of the README:
 
-    errors, reader  <- plants <- symbolic, sim <- controllers
+    errors, reader, outcome (the closed sets of outcomes), jsonable  <- plants <- symbolic, sim <- controllers
     lmi (LMIs only)      margins (exact methods only)
     crosscheck, synthesis, benchmark: the layer that calls both
     report (rendering only) <- features, tuning <- kinds <- papers <- design, verify, cli
@@ -28,13 +28,13 @@ MAX_LINES = 500
 #: package -> the packages (first component under workbench/) it may import.
 ALLOWED = {
     "plants": {"plants", "errors"},
-    "symbolic": {"symbolic", "plants", "errors"},
-    "lmi": {"lmi", "errors", "printed_grid"},   # printed_grid: a leaf (math, numpy)
+    "symbolic": {"symbolic", "plants", "errors", "outcome", "jsonable"},
+    "lmi": {"lmi", "errors", "outcome", "printed_grid"},   # printed_grid: a leaf (math, numpy)
     "margins": {"margins", "errors"},
     "sim": {"sim", "plants", "errors"},
     "controllers": {"controllers", "sim", "plants", "errors"},
-    "report": {"report", "claims", "errors"},
-    "roa": {"roa", "errors"},
+    "report": {"report", "claims", "errors", "outcome"},
+    "roa": {"roa", "errors", "outcome"},
 }
 
 #: (importer package, imported package) pairs the issue names explicitly.

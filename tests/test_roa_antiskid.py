@@ -6,7 +6,7 @@ import pytest
 
 from workbench.papers.p003 import antiskid_basin as AB
 from workbench.plants.adhesion import NumericAdhesion
-from workbench.roa import LevelOutcome
+from workbench.outcome import Outcome
 
 # 003 Tables 1-2 (dry rail); the gain is the workbench's certified synthesis at
 # eps = 0.35 (reports/antiskid-run-dry.md: K = [-0.004575, 10.27])
@@ -22,19 +22,19 @@ def lam_opt():
 
 def test_printed_switch_is_refuted_and_diverges(lam_opt):
     v = AB.switch_in_basin(DRY, 70.0, K, (70.0, lam_opt))
-    assert v.outcome is LevelOutcome.REFUTED and v.hurwitz
+    assert v.outcome is Outcome.REFUTED and v.hurwitz
     assert v.fate == "diverges"
 
 
 def test_handover_state_is_certified_and_converges():
     # the compensated variant's handover state (reports/antiskid-run-dry.md)
     v = AB.switch_in_basin(DRY, 70.0, K, (70.29, 0.02145))
-    assert v.outcome is LevelOutcome.CERTIFIED and v.fate == "converges"
+    assert v.outcome is Outcome.CERTIFIED and v.fate == "converges"
 
 
 def test_small_k2_makes_the_printed_switch_safe(lam_opt):
     v = AB.switch_in_basin(DRY, 70.0, (K[0], 0.0), (70.0, lam_opt))
-    assert v.outcome is LevelOutcome.CERTIFIED and v.fate == "converges"
+    assert v.outcome is Outcome.CERTIFIED and v.fate == "converges"
 
 
 def test_cruise_loop_linearisation_matches_A_plus_BK():
@@ -103,7 +103,7 @@ def test_delay_feedback_design_gets_a_basin():
                                c_search=50.0)
     est = chk.estimate
     assert 0 < est.c_certified <= est.c_refuted
-    assert chk.points[0].verdict.outcome is LevelOutcome.CERTIFIED
+    assert chk.points[0].verdict.outcome is Outcome.CERTIFIED
 
 
 def test_brake_switch_at_lambda_d_is_in_no_basin_and_spins():
@@ -116,7 +116,7 @@ def test_brake_switch_at_lambda_d_is_in_no_basin_and_spins():
     from workbench.papers.p003.antiskid_basin_render import brake_text
     b = brake_switch(DRY, "compensated", (70.0126, 0.01954),
                      profile=CreepSpeedProfile(t_brake=300.0), k_de=10.0)
-    assert b.outcome is LevelOutcome.REFUTED and b.why == "no equilibrium up to spin"
+    assert b.outcome is Outcome.REFUTED and b.why == "no equilibrium up to spin"
     assert b.rate > 0 and b.fate == "diverges" and 0 < b.t_fate < 0.1
     text = brake_text([b])
     assert "frozen at the switch instant" in text and "| REFUTED |" in text
@@ -130,7 +130,7 @@ def test_brake_switch_on_the_braking_side_is_certified():
     from workbench.papers.p003.antiskid_basin_brake import brake_switch
     b = brake_switch(DRY, "later", (69.0, -0.01), profile=CreepSpeedProfile(t_brake=300.0),
                      k_de=10.0, t=301.0)
-    assert b.outcome is LevelOutcome.CERTIFIED and b.lam_star < 0 and b.fate == "tracks"
+    assert b.outcome is Outcome.CERTIFIED and b.lam_star < 0 and b.fate == "tracks"
     # the frozen equilibrium is the law's own: k_de (v lambda - v_s*) = -lambda z1
     assert abs(b.lam_star - b.vs_frozen / b.v) < 0.1 * abs(b.lam_star)
 

@@ -29,6 +29,7 @@ from typing import Literal, Sequence
 import numpy as np
 
 from .digital import ImplementationResult, implementation, synthesize_sampled  # noqa: F401
+from .jsonable import to_json as jsonable
 
 Method = Literal["bessel-legendre", "wirtinger", "free-weighting-003", "jensen",
                  "free-weighting", "delay-independent"]
@@ -182,19 +183,15 @@ class DelayBoundResult:
         import json
         return json.dumps(self.to_dict(), **kwargs)
 
+    #: The published fields (all but the matrices A, Ad), :func:`workbench.jsonable.to_json`.
+    JSON_FIELDS = {k: k for k in ("method", "N", "h_certified", "h_refuted", "status",
+                                  "certificate_kind", "K", "recheck", "recheck_passed",
+                                  "margin", "exact_margin", "exact_agreement", "windows",
+                                  "horizon", "at_cap", "certifies", "reason")}
+
     def to_dict(self) -> dict:
         """A JSON-ready dict (``"inf"`` for infinite values)."""
-        inf = lambda x: "inf" if isinstance(x, float) and math.isinf(x) else x
-        return {"method": self.method, "N": self.N, "h_certified": self.h_certified,
-                "h_refuted": inf(self.h_refuted), "status": self.status,
-                "certificate_kind": self.certificate_kind,
-                "K": None if self.K is None else self.K.tolist(),
-                "recheck": dict(self.recheck), "recheck_passed": self.recheck_passed,
-                "margin": self.margin, "exact_margin": inf(self.exact_margin),
-                "exact_agreement": self.exact_agreement,
-                "windows": [[inf(a), inf(b)] for a, b in self.windows],
-                "horizon": self.horizon, "at_cap": self.at_cap,
-                "certifies": self.certifies, "reason": self.reason}
+        return jsonable(self)
 
     def _repr_markdown_(self) -> str:
         from .report.markdown import fmt, margin_text, md_table

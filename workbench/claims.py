@@ -87,22 +87,17 @@ the design must be updated).
 """
 from __future__ import annotations
 
-import enum
 import math
 import re
 from dataclasses import dataclass
 from decimal import ROUND_DOWN, ROUND_HALF_EVEN, Decimal
 from typing import Any
 
+from .jsonable import json_method
+from .outcome import Verdict
 from .reader import Reader
 
 COMPARES = (">=", "<=", "==", "within")
-
-
-class Verdict(str, enum.Enum):
-    PASS = "PASS"
-    FAIL = "FAIL"
-    INCONCLUSIVE = "INCONCLUSIVE"
 
 
 @dataclass(frozen=True)
@@ -187,19 +182,13 @@ class ClaimResult:
             return c.allow_inconclusive
         return self.verdict is (Verdict.FAIL if c.expect == "fail" else Verdict.PASS)
 
-    def to_json(self) -> dict:
-        c = self.claim
-        return {"id": c.id, "quantity": c.quantity, "compare": c.compare,
-                "expected": _json_value(c.value), "tolerance": c.tolerance,
-                "got": _json_value(self.got), "verdict": self.verdict.value,
-                "ok": self.ok, "expect": c.expect, "source": c.source, "note": self.note,
-                "severity": c.severity, "origin": c.origin}
-
-
-def _json_value(v):
-    if isinstance(v, float) and math.isinf(v):
-        return "inf" if v > 0 else "-inf"
-    return v
+    #: The JSON of a checked claim (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"id": "claim.id", "quantity": "claim.quantity", "compare": "claim.compare",
+                   "expected": "claim.value", "tolerance": "claim.tolerance", "got": "got",
+                   "verdict": "verdict", "ok": "ok", "expect": "claim.expect",
+                   "source": "claim.source", "note": "note", "severity": "claim.severity",
+                   "origin": "claim.origin"}
+    to_json = json_method
 
 
 _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.=+-]*$")

@@ -44,6 +44,7 @@ from typing import Literal
 
 import numpy as np
 
+from .jsonable import to_json as jsonable
 from .lmi.core import DEFAULT_MARGIN, Outcome
 from .printed_grid import directed
 from .margins.sampled import PeriodicStableSet, alternating_radius, periodic_stable_set
@@ -144,20 +145,18 @@ class ImplementationResult:
         import json
         return json.dumps(self.to_dict(), **kwargs)
 
+    #: The published fields, :func:`workbench.jsonable.to_json`.
+    JSON_FIELDS = {**{k: k for k in ("method", "sampling", "periodic", "network_delay",
+                                     "decay_rate", "T_certified", "T_refuted", "outcome",
+                                     "reason", "recheck", "margin", "first_unstable")},
+                   "ratio": lambda r: None if math.isnan(r.ratio) else r.ratio,
+                   "stable_sets": lambda r: [{"tau": s.tau, "intervals": s.intervals}
+                                             for s in r.stable_sets],
+                   "jitter": "jitter", "K": "K"}
+
     def to_dict(self) -> dict:
         """A JSON-ready dict (``"inf"`` for infinite values)."""
-        inf = lambda x: "inf" if isinstance(x, float) and math.isinf(x) else x
-        return {"method": self.method, "sampling": self.sampling, "periodic": self.periodic,
-                "network_delay": list(self.network_delay), "decay_rate": self.decay_rate,
-                "T_certified": self.T_certified, "T_refuted": inf(self.T_refuted),
-                "outcome": self.outcome.value, "reason": self.reason,
-                "recheck": dict(self.recheck), "margin": self.margin,
-                "first_unstable": inf(self.first_unstable),
-                "ratio": None if math.isnan(self.ratio) else self.ratio,
-                "stable_sets": [{"tau": s.tau, "intervals": [list(i) for i in s.intervals]}
-                                for s in self.stable_sets],
-                "jitter": None if self.jitter is None else list(self.jitter),
-                "K": self.K.tolist()}
+        return jsonable(self)
 
     def _repr_markdown_(self) -> str:
         return render_markdown(self)

@@ -33,6 +33,7 @@ import numpy as np
 from .lmi.requirements import Loop, box_vertices
 from .lmi.requirements_synthesis import RequirementDesign, synthesize_requirements
 from .margins.decay import worst_decay, worst_hinf
+from .outcome import Verdict
 
 __all__ = ["Requirements", "RequirementRow", "RequirementResult", "design_to_requirements",
            "simulate_limit"]
@@ -165,10 +166,10 @@ def simulate_limit(points, K, box, h_values, *, t_end: float, steps_per_delay: i
 
 def _verdict(meets_cert: bool | None, meets_exact: bool, consistent: bool) -> str:
     if not consistent or not meets_exact:
-        return "FAIL"
+        return Verdict.FAIL.value
     if meets_cert:
-        return "PASS"
-    return "INCONCLUSIVE"
+        return Verdict.PASS.value
+    return Verdict.INCONCLUSIVE.value
 
 
 def design_to_requirements(points: Sequence[tuple[np.ndarray, np.ndarray]], req: Requirements,
@@ -214,7 +215,7 @@ def design_to_requirements(points: Sequence[tuple[np.ndarray, np.ndarray]], req:
                            ("l2_gain", _opt(req.l2_gain, req.objective == "l2_gain", "<=")),
                            ("input_limit", None if not limited else str(req.input_limit))):
             if need is not None:
-                rows.append(RequirementRow(name, need, None, None, "INCONCLUSIVE",
+                rows.append(RequirementRow(name, need, None, None, Verdict.INCONCLUSIVE.value,
                                            f"no gain: {d.reason}"))
         return RequirementResult(None, tuple(rows), d, seconds, d.reason, mu)
     ad = [(A, B @ K) for A, B in loop.points]

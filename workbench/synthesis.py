@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .jsonable import json_method
 from .lmi.core import DEFAULT_MARGIN, Bracket, Outcome, bisect_delay
 from .lmi.diagnosis import synthesis_reason, uncontrollable_mode
 from .lmi.freeweighting003 import FreeWeighting003, FreeWeighting003FixedK
@@ -162,19 +163,14 @@ class SynthesisRow:
             return None
         return 0.0 if math.isinf(self.exact.h) else self.h_certified / self.exact.h
 
-    def to_json(self) -> dict:
-        em = None if self.exact is None else ("inf" if math.isinf(self.exact.h) else self.exact.h)
-        return {"eps": self.eps, "h_certified": self.h_certified,
-                "h_refuted": "inf" if math.isinf(self.h_refuted) else self.h_refuted,
-                "K": None if self.K is None else list(self.K),
-                "h_gain": self.h_gain,
-                "h_design": None if self.gain is None else self.gain.h_design,
-                "exact_margin": em,
-                "stable_windows": [[a, "inf" if math.isinf(b) else b] for a, b in self.windows],
-                "certified_interval": None if self.certified_interval is None
-                else list(self.certified_interval),
-                "status": self.status.value, "solves": self.solves,
-                "seconds": round(self.seconds, 4), "reason": self.reason}
+    #: The JSON of a synthesis row (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"eps": "eps", "h_certified": "h_certified", "h_refuted": "h_refuted",
+                   "K": "K", "h_gain": "h_gain", "h_design": "gain.h_design",
+                   "exact_margin": "exact.h", "stable_windows": "windows",
+                   "certified_interval": "certified_interval", "status": "status",
+                   "solves": "solves", "seconds": lambda r: round(r.seconds, 4),
+                   "reason": "reason"}
+    to_json = json_method
 
 
 def _balanced(A, B):

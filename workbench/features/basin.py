@@ -250,7 +250,7 @@ def run_basin(settings: BasinSettings, spec, model, values: dict, op, K) -> Dela
         inside = tuple(_trajectory(fn, x0, V, c_cert, escape, horizon, full=True)
                        for x0 in X0)
         ok = all(_decays(tr.path, V) for tr in inside)
-    return DelayFeedbackBasin(chk, outcome.value, plane, (tuple(box[0]), tuple(box[1])), sampled,
+    return DelayFeedbackBasin(chk, outcome.name, plane, (tuple(box[0]), tuple(box[1])), sampled,
                               inside, ok, horizon, dict(settings.domain), tuple(names))
 
 
@@ -324,6 +324,6 @@ def basin_quantities(res: DelayFeedbackBasin) -> dict:
               "basin.inside_converge": None if res.inside_ok is None
               else ("yes" if res.inside_ok else "no")})
     for p in res.check.points:
-        q[f"basin.scenario[{p.label}].in_basin"] = p.verdict.outcome.value
+        q[f"basin.scenario[{p.label}].in_basin"] = p.verdict.outcome.name
         q[f"basin.scenario[{p.label}].level"] = est.level_bounds(p.x)[1]
     return q

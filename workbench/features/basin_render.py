@@ -131,8 +131,8 @@ def plot_basin(fig, basin, names) -> None:
                 label=lab)
     for p, tr in zip(basin.check.points, basin.sampled):
         ax.plot(tr.path[:, i], tr.path[:, j], color=_FATE_COLOR[tr.fate], lw=1.6)
-        ax.plot(p.x[i], p.x[j], _MARK[p.verdict.outcome.value], color="tab:blue", ms=8,
-                mec="k", label=f"scenario {p.label}: {p.verdict.outcome.value}")
+        ax.plot(p.x[i], p.x[j], _MARK[p.verdict.outcome.name], color="tab:blue", ms=8,
+                mec="k", label=f"scenario {p.label}: {p.verdict.outcome.name}")
     ax.plot(x_eq[i], x_eq[j], "k+", ms=10, label="operating point x*")
     pad_i, pad_j = 0.05 * (hi[i] - lo[i]), 0.05 * (hi[j] - lo[j])
     ax.set_xlim(lo[i] - pad_i, hi[i] + pad_i)

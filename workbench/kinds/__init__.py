@@ -8,7 +8,8 @@ Each study module provides an object with
     Every quantity a claim may name (known before running, so an unknown
     quantity is a design error, exit 2).
 ``run(design) -> result``
-    Compute (a frozen dataclass with ``to_json()``).
+    Compute (a frozen dataclass; its JSON is :func:`workbench.jsonable.to_json`,
+    with the keys its class names in ``JSON_FIELDS``).
 ``quantities(result) -> dict[str, float | str | None]``
     Values of the named quantities (``None``: not determined).
 ``quantity_names`` and ``quantities`` are best both expanded from one table

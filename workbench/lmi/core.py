@@ -39,7 +39,6 @@ Lyapunov matrix becomes singular.
 from __future__ import annotations
 
 import dataclasses
-import enum
 import math
 import time
 import warnings
@@ -48,6 +47,8 @@ from typing import Callable, Mapping, Sequence
 
 import cvxpy as cp
 import numpy as np
+
+from ..outcome import Outcome
 
 #: Named definiteness margin of every LMI, relative to the largest block norm
 #: of the certificate (see the module docstring).
@@ -58,17 +59,6 @@ DEFAULT_BOUND = 1e3
 #: Clarabel settings on top of its defaults (none: with relative margins the
 #: defaults suffice; :attr:`MarginLMI.retry_settings` handles inaccurate answers).
 CLARABEL_SETTINGS: dict = {}
-
-
-class Outcome(str, enum.Enum):
-    """Closed set of outcomes of a certificate or a claim about one."""
-
-    CERTIFIED = "certified"
-    REFUTED = "refuted"
-    INCONCLUSIVE = "inconclusive"
-    #: a diagnosis proves that nothing can be certified (e.g. an uncontrollable
-    #: unstable mode, :mod:`workbench.lmi.diagnosis`); never a solver's answer
-    INFEASIBLE = "infeasible"
 
 
 @dataclass(frozen=True)

@@ -25,22 +25,14 @@ References
 """
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..outcome import Outcome
 from .certify import ball_argument, verify_annulus
 from .falsify import Falsification, falsify
 from .problem import BasinProblem, quadratic_enclosure
-
-
-class LevelOutcome(str, enum.Enum):
-    """Closed set of answers for a level (or a point's level)."""
-
-    CERTIFIED = "CERTIFIED"
-    REFUTED = "REFUTED"
-    INCONCLUSIVE = "INCONCLUSIVE"
 
 
 @dataclass(frozen=True)
@@ -49,7 +41,7 @@ class LevelVerdict:
 
     Attributes
     ----------
-    outcome : LevelOutcome
+    outcome : Outcome
     level : float
         The level judged (for a point: an upper bound of V at the point when
         CERTIFIED, a lower bound when REFUTED).
@@ -57,7 +49,7 @@ class LevelVerdict:
         (c_certified, c_refuted) of the estimate.
     """
 
-    outcome: LevelOutcome
+    outcome: Outcome
     level: float
     bracket: tuple[float, float]
 
@@ -121,11 +113,11 @@ class BasinEstimate:
     def verdict(self, c: float) -> LevelVerdict:
         """CERTIFIED / REFUTED / INCONCLUSIVE for the level c."""
         if c <= self.c_certified:
-            out = LevelOutcome.CERTIFIED
+            out = Outcome.CERTIFIED
         elif c >= self.c_refuted:
-            out = LevelOutcome.REFUTED
+            out = Outcome.REFUTED
         else:
-            out = LevelOutcome.INCONCLUSIVE
+            out = Outcome.INCONCLUSIVE
         return LevelVerdict(out, float(c), self.bracket)
 
     def level_bounds(self, x) -> tuple[float, float]:
@@ -142,10 +134,10 @@ class BasinEstimate:
         INCONCLUSIVE otherwise."""
         lo, hi = self.level_bounds(x)
         if hi <= self.c_certified:
-            return LevelVerdict(LevelOutcome.CERTIFIED, hi, self.bracket)
+            return LevelVerdict(Outcome.CERTIFIED, hi, self.bracket)
         if lo >= self.c_refuted:
-            return LevelVerdict(LevelOutcome.REFUTED, lo, self.bracket)
-        return LevelVerdict(LevelOutcome.INCONCLUSIVE, hi, self.bracket)
+            return LevelVerdict(Outcome.REFUTED, lo, self.bracket)
+        return LevelVerdict(Outcome.INCONCLUSIVE, hi, self.bracket)
 
 
 def estimate_basin(problem: BasinProblem, c_search: float, *, seed: int = 0,

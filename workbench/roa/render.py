@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from .basin import LevelOutcome
+from ..outcome import Outcome
 from .check import BasinCheck
 
 
@@ -67,9 +67,9 @@ def render_basin_markdown(check: BasinCheck, *, heading: str = "### Region of at
                   "| --- |" + " --- |" * (len(est.names) + 2)]
         for p in check.points:
             v = p.verdict
-            shown = {LevelOutcome.CERTIFIED: "inside the certified basin (CERTIFIED)",
-                     LevelOutcome.REFUTED: "beyond the refuted level (REFUTED)",
-                     LevelOutcome.INCONCLUSIVE: "between the levels (INCONCLUSIVE)"}[v.outcome]
+            shown = {Outcome.CERTIFIED: "inside the certified basin (CERTIFIED)",
+                     Outcome.REFUTED: "beyond the refuted level (REFUTED)",
+                     Outcome.INCONCLUSIVE: "between the levels (INCONCLUSIVE)"}[v.outcome]
             coords = " | ".join(f"{c:.5g}" for c in p.x)
             lines.append(f"| {p.label} | {coords} | {fmt_level(v.level, 'up')} | {shown} |")
     return "\n".join(lines) + "\n"

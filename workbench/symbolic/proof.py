@@ -45,6 +45,7 @@ from typing import Literal
 
 import sympy as sp
 
+from ..jsonable import json_method
 from .falsify import apply_given, falsify
 from .positivity import is_identically_zero, prove_nonnegative, tex, with_slacks
 
@@ -230,17 +231,16 @@ class ProofResult:
         want = Verdict.REFUTED if self.claim.expect == "refuted" else Verdict.PROVED
         return self.verdict is want and self.severity_holds
 
-    def to_json(self) -> dict:
-        c = self.claim
-        return {"id": c.id, "paper": c.paper, "equations": c.equations,
-                "statement": c.statement, "kind": c.kind, "expect": c.expect,
-                "origin": c.origin, "severity": c.severity,
-                "verdict": self.verdict.value, "ok": self.ok,
-                "counterexample": (None if self.counterexample is None
-                                   else dict(self.counterexample)),
-                "violation": self.violation, "remaining": self.remaining,
-                "samples": self.samples,
-                "steps": [{"what": s.what, "latex": s.latex, "ok": s.ok} for s in self.steps]}
+    #: The JSON of a proof claim's result (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"id": "claim.id", "paper": "claim.paper", "equations": "claim.equations",
+                   "statement": "claim.statement", "kind": "claim.kind",
+                   "expect": "claim.expect", "origin": "claim.origin",
+                   "severity": "claim.severity", "verdict": "verdict", "ok": "ok",
+                   "counterexample": lambda r: (None if r.counterexample is None
+                                                else dict(r.counterexample)),
+                   "violation": "violation", "remaining": "remaining", "samples": "samples",
+                   "steps": "steps"}
+    to_json = json_method
 
 
 # -- symbolic helpers ---------------------------------------------------------------

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ...jsonable import OMIT, json_method
 from .model import OperatingPoint, PlantModel, linearise, solve_operating_point
 
 
@@ -122,19 +123,17 @@ class DelayFeedbackResult:
     implementation: object = None   # delay_feedback_implementation.DesignImplementation
     spec: object = None        # DelayFeedbackSpec (indexes the declared quantities)
 
-    def to_json(self) -> dict:
-        s = self.synthesis
-        inf = lambda x: "inf" if isinstance(x, float) and math.isinf(x) else x
-        return {"A": self.A.tolist(), "B": self.B.tolist(), "x_op": self.op.x.tolist(),
-                "u_op": self.op.u.tolist(), "method": s.method,
-                "h_certified": s.h_certified, "h_refuted": inf(s.h_refuted),
-                "K": None if s.K is None else s.K.tolist(), "status": s.status,
-                "reason": s.reason,
-                "exact_margin": None if self.exact is None else inf(self.exact.h),
-                "windows": [[inf(a), inf(b)] for a, b in self.windows],
-                "scenarios": {r.scenario.name: r.metrics for r in self.scenarios},
-                **({} if s.requirements is None
-                   else {"requirements": s.requirements.as_dict()["requirements"]})}
+    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"A": "A", "B": "B", "x_op": "op.x", "u_op": "op.u",
+                   "method": "synthesis.method", "h_certified": "synthesis.h_certified",
+                   "h_refuted": "synthesis.h_refuted", "K": "synthesis.K",
+                   "status": "synthesis.status", "reason": "synthesis.reason",
+                   "exact_margin": "exact.h", "windows": "windows",
+                   "scenarios": lambda r: {s.scenario.name: s.metrics for s in r.scenarios},
+                   "requirements": lambda r: (
+                       OMIT if r.synthesis.requirements is None
+                       else r.synthesis.requirements.as_dict()["requirements"])}
+    to_json = json_method
 
 
 def synthesise(spec, A, B, points=()) -> SynthesisOutcome:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...fit import FITTED, FitResult, existing_rmse, fit, model_speeds, synthetic_log
+from ...jsonable import json_method
 from ...reader import Reader
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .station_stopping_spec import load_plant
@@ -43,11 +44,16 @@ class FitStudyResult:
     rmse_existing: float
     curves: tuple      # per log: (t, logged, foa model, existing model)
 
-    def to_json(self) -> dict:
-        return {"truth": self.truth, "rmse_truth_cm_s": self.rmse_truth,
-                "rmse_existing_cm_s": self.rmse_existing,
-                **{r.method: {"values": dict(zip(FITTED, r.values)), "rmse_cm_s": r.rmse,
-                              "evaluations": r.evaluations} for r in (self.foa, self.de)}}
+    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"truth": "truth", "rmse_truth_cm_s": "rmse_truth",
+                   "rmse_existing_cm_s": "rmse_existing",
+                   **{m: (lambda res, m=m: _fit_json(getattr(res, m))) for m in ("foa", "de")}}
+    to_json = json_method
+
+
+def _fit_json(r: FitResult) -> dict:
+    return {"values": dict(zip(FITTED, r.values)), "rmse_cm_s": r.rmse,
+            "evaluations": r.evaluations}
 
 
 def _load(root: Reader) -> FitSpec:

@@ -35,6 +35,7 @@ import numpy as np
 from ...controllers.mfac import RESET_CONDITIONS, MFAC, MFACGains, frozen_loop_poles
 from ...controllers.pid import BatchPID
 from ...errors import ModelError
+from ...jsonable import finite_or_none, json_method
 from ...plants.train002 import dc_gain, linear_model, speed_time_constant
 from ...profiles import Profile, build_profile
 from ...report.markdown import fmt
@@ -199,22 +200,20 @@ class TrackingResult:
     def profile(self) -> Profile:
         return self.readings[0].main.profile
 
-    def to_json(self) -> dict:
-        out = {"scales": self.scales, "weights": list(self.weights), "readings": []}
-        for r in self.readings:
-            out["readings"].append({
-                "name": r.reading.name, "model": r.reading.model, "verdict": r.verdict,
-                "mfac": r.mfac.chosen_params(), "pid": r.pid.chosen_params(),
-                "objectives": {c: {k: _finite(r.main.value(c, k)) for k in OBJECTIVES}
-                               for c in ("MFAC", "PID")},
-                "cost": {c: r.cost(c) for c in ("MFAC", "PID")},
-                "reset_rate": r.ppd.reset_rate, "dc_gain": r.dc_gain,
-                "frozen_radius": r.frozen_radius})
-        return out
+    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"scales": "scales", "weights": "weights",
+                   "readings": lambda res: [_reading_json(r) for r in res.readings]}
+    to_json = json_method
 
 
-def _finite(x):
-    return float(x) if x is not None and np.isfinite(x) else None
+def _reading_json(r) -> dict:
+    return {"name": r.reading.name, "model": r.reading.model, "verdict": r.verdict,
+            "mfac": r.mfac.chosen_params(), "pid": r.pid.chosen_params(),
+            "objectives": {c: {k: finite_or_none(r.main.value(c, k)) for k in OBJECTIVES}
+                           for c in ("MFAC", "PID")},
+            "cost": {c: r.cost(c) for c in ("MFAC", "PID")},
+            "reset_rate": r.ppd.reset_rate, "dc_gain": r.dc_gain,
+            "frozen_radius": r.frozen_radius}
 
 
 # -- simulation --------------------------------------------------------------------
@@ -386,16 +385,16 @@ def study_quantities(res: TrackingResult) -> dict:
         for c, tun in (("MFAC", r.mfac), ("PID", r.pid)):
             lc = c.lower()
             for i in (*OBJECTIVES, "rms_speed_error"):
-                q[f"{p}.{lc}.{i}"] = _finite(r.main.value(c, i))
-            q[f"{p}.{lc}.cost"] = _finite(r.cost(c))
+                q[f"{p}.{lc}.{i}"] = finite_or_none(r.main.value(c, i))
+            q[f"{p}.{lc}.cost"] = finite_or_none(r.cost(c))
             q[f"{p}.{lc}.front_size"] = int(tun.front.sum())
-            q[f"{p}.{lc}.peak_jerk"] = _finite(r.main.value(c, "peak_jerk"))
+            q[f"{p}.{lc}.peak_jerk"] = finite_or_none(r.main.value(c, "peak_jerk"))
             q[f"{p}.{lc}.grid_edge"] = ", ".join(tun.edges) or "none"
             for i in OBJECTIVES:
-                q[f"{p}.best.{lc}.{i}"] = _finite(tun.best(i))
+                q[f"{p}.best.{lc}.{i}"] = finite_or_none(tun.best(i))
             errs = [x.value(c, "stop_error") for x in r.line]
             q[f"{p}.line.{lc}.within_tolerance"] = sum(e <= res.stop_tolerance for e in errs)
-            q[f"{p}.line.{lc}.max_stop_error"] = _finite(max(
+            q[f"{p}.line.{lc}.max_stop_error"] = finite_or_none(max(
                 errs, key=lambda e: e if np.isfinite(e) else np.inf)) if errs else None
         # a chosen point on its grid's edge is not a converged optimum (issue 33,
         # item 4): the comparison of the design points is then not determined
@@ -413,11 +412,11 @@ def study_quantities(res: TrackingResult) -> dict:
             q[f"{p}.mfac.reset_rate.{k}"] = s.by_condition[k]
         q[f"{p}.mfac.saturated"] = s.saturated
         stopped = r.mfac.reset_rate[np.isfinite(r.mfac.cost)]
-        q[f"{p}.grid.reset_rate_min"] = _finite(stopped.min()) if stopped.size else None
-        q[f"{p}.grid.reset_rate_median"] = _finite(np.median(stopped)) if stopped.size else None
+        q[f"{p}.grid.reset_rate_min"] = finite_or_none(stopped.min()) if stopped.size else None
+        q[f"{p}.grid.reset_rate_median"] = finite_or_none(np.median(stopped)) if stopped.size else None
         for k in ("phi_min", "phi_max", "data_sign_agreement", "data_median", "data_p95"):
-            q[f"{p}.ppd.{k}"] = _finite(getattr(s, k))
-        q[f"{p}.ppd.median_to_dc_gain"] = _finite(s.data_median / r.dc_gain)
+            q[f"{p}.ppd.{k}"] = finite_or_none(getattr(s, k))
+        q[f"{p}.ppd.median_to_dc_gain"] = finite_or_none(s.data_median / r.dc_gain)
         q[f"{p}.plant.dc_gain"] = r.dc_gain
         q[f"{p}.plant.time_constant"] = r.time_constant
         q[f"{p}.frozen.spectral_radius"] = r.frozen_radius

@@ -42,9 +42,10 @@ from scipy.integrate import solve_ivp
 
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import ModelError
+from ...outcome import Outcome
 from ...plants.adhesion import NumericAdhesion, adhesion_model
 from ...plants.lambdify_cache import lambdify
-from ...roa import BasinEstimate, BasinProblem, LevelOutcome, estimate_basin, modal_P
+from ...roa import BasinEstimate, BasinProblem, estimate_basin, modal_P
 from ...roa.basin import falsified_top
 from ...roa.check import BasinCheck, PointCheck, largest_level_in_box
 from ...roa.problem import quadratic_enclosure
@@ -188,7 +189,7 @@ class _Deferred:
             self._est = estimate_basin(self.prob, self._c, seed=self._seed, falsified=self.fal)
         return self._est
 
-    def outcome(self, x) -> LevelOutcome:
+    def outcome(self, x) -> Outcome:
         """``est.point_verdict(x).outcome``, without the cover when the
         falsifier settles it: with lo <= V(x) <= hi, lo >= c_refuted and
         hi > c_top >= c_certified, point_verdict's first test (hi <=
@@ -197,7 +198,7 @@ class _Deferred:
                                  np.asarray(x, float)[None, :])
         lo, hi = float(iv.lo[0]), float(iv.hi[0])
         if lo >= self.fal.c_refuted and hi > self.c_top:
-            return LevelOutcome.REFUTED
+            return Outcome.REFUTED
         return self.est.point_verdict(x).outcome
 
     def enters(self, path) -> bool:
@@ -317,7 +318,7 @@ class SwitchVerdict:
 
     Attributes
     ----------
-    outcome : LevelOutcome
+    outcome : Outcome
         CERTIFIED if some P of the grid certifies the state; REFUTED if each
         P that exists refutes its level, or A + B K is not Hurwitz (no basin).
     w : float or None
@@ -329,7 +330,7 @@ class SwitchVerdict:
         reaches 0.9: the wheel spins), "undecided" (neither within 10 s).
     """
 
-    outcome: LevelOutcome
+    outcome: Outcome
     w: float | None
     hurwitz: bool
     fate: str
@@ -343,19 +344,19 @@ def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0,
     vals = tuple(sorted((k, float(v)) for k, v in values.items()))
     lam_d = _loop_symbolic(vals, v_d)[6]
     x = (float(point[0]) - v_d, float(point[1]) - lam_d)
-    rank = {LevelOutcome.CERTIFIED: 2, LevelOutcome.INCONCLUSIVE: 1, LevelOutcome.REFUTED: 0}
-    best, sets = (LevelOutcome.REFUTED, None), []
+    rank = {Outcome.CERTIFIED: 2, Outcome.INCONCLUSIVE: 1, Outcome.REFUTED: 0}
+    best, sets = (Outcome.REFUTED, None), []
     for w in W_GRID:
         try:
             stage = _Deferred(vals, v_d, K, x, w, seed)
         except ModelError:
-            return SwitchVerdict(LevelOutcome.REFUTED, None, False,
+            return SwitchVerdict(Outcome.REFUTED, None, False,
                                  _fate(vals, v_d, K, x, lam_d, [], t_sim))
         sets.append(stage)
         out = stage.outcome(x)
         if rank[out] > rank[best[0]]:
             best = (out, w)
-        if out is LevelOutcome.CERTIFIED:
+        if out is Outcome.CERTIFIED:
             break
     return SwitchVerdict(best[0], best[1], True, _fate(vals, v_d, K, x, lam_d, sets, t_sim))
 

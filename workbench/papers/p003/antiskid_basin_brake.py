@@ -46,9 +46,10 @@ from functools import lru_cache
 import numpy as np
 import sympy as sp
 
+from ...outcome import Outcome
 from ...plants.adhesion import NumericAdhesion, adhesion_model
 from ...plants.lambdify_cache import lambdify
-from ...roa import BasinProblem, LevelOutcome, estimate_basin, lyapunov_P
+from ...roa import BasinProblem, estimate_basin, lyapunov_P
 from ...roa.interval import IntervalFunction
 from ...sim.wheel_slip import ScalarOps, wheel_speed
 
@@ -73,7 +74,7 @@ class BrakeSwitch:
         The state at t_brake.
     vs_frozen : float
         v_s*(t_brake) (m/s), frozen.
-    outcome : LevelOutcome
+    outcome : Outcome
     why : str
         "no equilibrium up to spin" / "no equilibrium down to lock" /
         "level set" / what left it INCONCLUSIVE.
@@ -95,7 +96,7 @@ class BrakeSwitch:
     v: float
     lam: float
     vs_frozen: float
-    outcome: LevelOutcome
+    outcome: Outcome
     why: str
     lam_star: float | None
     rate: float | None
@@ -197,14 +198,14 @@ def brake_switch(values: dict, label: str, point, *, profile, k_de: float,
         m = _prove_sign(g, lam, ends[0], ends[1], d)
         if m is not None:
             why = "no equilibrium up to spin" if d > 0 else "no equilibrium down to lock"
-            return BrakeSwitch(outcome=LevelOutcome.REFUTED, why=why, lam_star=None, rate=m,
+            return BrakeSwitch(outcome=Outcome.REFUTED, why=why, lam_star=None, rate=m,
                                level=None, **common)
-        return BrakeSwitch(outcome=LevelOutcome.INCONCLUSIVE, why="sign of lambda' not proven",
+        return BrakeSwitch(outcome=Outcome.INCONCLUSIVE, why="sign of lambda' not proven",
                            lam_star=None, rate=None, level=None, **common)
     star = min(eqs, key=lambda e: abs(e - lam_s))
     slope = (gn(star + 1e-7) - gn(star - 1e-7)) / 2e-7
     if not slope < 0:
-        return BrakeSwitch(outcome=LevelOutcome.INCONCLUSIVE, why="nearest equilibrium unstable",
+        return BrakeSwitch(outcome=Outcome.INCONCLUSIVE, why="nearest equilibrium unstable",
                            lam_star=star, rate=None, level=None, **common)
     P = lyapunov_P([[slope]])
     prob = BasinProblem([g], (lam,), (star,), P, P_source="lyapunov", names=("lambda",))
@@ -212,12 +213,12 @@ def brake_switch(values: dict, label: str, point, *, profile, k_de: float,
     c = min(4.0 * float(P[0, 0]) * (lam_s - star) ** 2, cap)
     est = estimate_basin(prob, c, seed=seed)
     pv = est.point_verdict((lam_s,))
-    if pv.outcome is not LevelOutcome.CERTIFIED and est.c_certified > 0:
+    if pv.outcome is not Outcome.CERTIFIED and est.c_certified > 0:
         # monotone approach: d g > 0 proven from lambda_s to the certified level's edge
         edge = star - d * math.sqrt(est.c_certified / float(P[0, 0])) * (1 - 1e-9)
         m = _prove_sign(g, lam, *sorted((lam_s, edge)), d)
         if m is not None:
-            return BrakeSwitch(outcome=LevelOutcome.CERTIFIED, why="monotone approach, level set",
+            return BrakeSwitch(outcome=Outcome.CERTIFIED, why="monotone approach, level set",
                                lam_star=star, rate=m, level=(pv.level, est.c_certified),
                                **common)
     return BrakeSwitch(outcome=pv.outcome, why="level set", lam_star=star, rate=None,

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 from ...memo import shared
-from ...roa import LevelOutcome
+from ...outcome import Outcome
 from .antiskid_basin import SwitchVerdict, switch_in_basin
 
 
@@ -71,7 +71,7 @@ class K2Sweep:
 
 
 def _ok(row: K2Row) -> bool:
-    return row.verdict.outcome is LevelOutcome.CERTIFIED
+    return row.verdict.outcome is Outcome.CERTIFIED
 
 
 @lru_cache(maxsize=8)

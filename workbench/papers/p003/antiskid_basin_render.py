@@ -50,7 +50,7 @@ def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—"
     for p, tr in zip(basin.check.points, basin.trajectories):
         v, lam = p.x[0] + basin.v_d, p.x[1] + basin.lambda_d
         rows.append([f"`{p.label}`", fmt(v, 4), fmt(lam, 4), fmt_level(p.verdict.level, "up"),
-                     p.verdict.outcome.value, tr.fate])
+                     p.verdict.outcome.name, tr.fate])
     sw = ("\n### Switch states (acceleration → cruise)\n\n"
           + md_table(["case", "v (m/s)", "lambda", "V", "in the certified basin?",
                       "delay-free trajectory"], rows, "lrrrll")
@@ -92,7 +92,7 @@ def brake_text(brake) -> str:
         fate = (f"diverges: |lambda| = {fmt(LAM_LIMIT)} at t_brake + {fmt(b.t_fate, 2)} s"
                 if b.fate == "diverges" else b.fate)
         rows.append([f"`{b.label}`", fmt(b.v, 4), fmt(b.lam, 4), fmt(b.vs_frozen, 4), frozen,
-                     b.outcome.value, fate])
+                     b.outcome.name, fate])
     if not rows:
         return ("\n### Switch states (cruise → braking)\n\nNo case reached the braking "
                 "phase.\n")
@@ -130,7 +130,7 @@ def brake_text(brake) -> str:
 
 def _k2_text(sweep, compare_source) -> str:
     v, lam = sweep.point
-    rows = [[fmt(r.k1, 4), fmt(r.k2, 5), r.source, r.verdict.outcome.value,
+    rows = [[fmt(r.k1, 4), fmt(r.k2, 5), r.source, r.verdict.outcome.name,
              "—" if r.verdict.w is None else fmt(r.verdict.w), r.verdict.fate]
             for r in (*sweep.rows, *sweep.compared)]
     if sweep.edge is None:
@@ -181,8 +181,8 @@ def plot_basin(fig, basin) -> None:
     for pt, tr in zip(basin.check.points, basin.trajectories):
         p = tr.path
         ax.plot(p[:, 0], np.clip(p[:, 1], -0.3, 0.5), color=_FATE_COLOR[tr.fate], lw=1.8)
-        ax.plot(*pt.x, _SWITCH_MARK[pt.verdict.outcome.value], color="tab:blue", ms=9,
-                mec="k", label=f"switch `{pt.label}`: {pt.verdict.outcome.value}")
+        ax.plot(*pt.x, _SWITCH_MARK[pt.verdict.outcome.name], color="tab:blue", ms=9,
+                mec="k", label=f"switch `{pt.label}`: {pt.verdict.outcome.name}")
     ax.axhline(basin.lambda_opt - basin.lambda_d, color="tab:purple", ls=":", lw=0.8,
                label="lambda = lambda_opt")
     ax.set_xlabel("v - v_d (m/s)")

@@ -150,15 +150,15 @@ def basin_quantities(basin, sweep, labels=(), brake=()) -> dict:
         q[f"switch.cruise[{lab}].in_basin"] = q[f"switch.cruise[{lab}].fate"] = None
         q[f"switch.brake[{lab}].in_basin"] = q[f"switch.brake[{lab}].fate"] = None
     for b in brake:
-        q[f"switch.brake[{b.label}].in_basin"] = b.outcome.value
+        q[f"switch.brake[{b.label}].in_basin"] = b.outcome.name
         q[f"switch.brake[{b.label}].fate"] = b.fate
     for p, tr in zip(basin.check.points, basin.trajectories):
-        q[f"switch.cruise[{p.label}].in_basin"] = p.verdict.outcome.value
+        q[f"switch.cruise[{p.label}].in_basin"] = p.verdict.outcome.name
         q[f"switch.cruise[{p.label}].fate"] = tr.fate
     if sweep is not None:
         q["basin.k2_safe_max"] = None if sweep.edge is None else sweep.edge[0]
         q["basin.k2_unsafe_min"] = None if sweep.edge is None else sweep.edge[1]
-        q["basin.compared_certified"] = sum(r.verdict.outcome.value == "CERTIFIED"
+        q["basin.compared_certified"] = sum(r.verdict.outcome.name == "CERTIFIED"
                                             for r in sweep.compared)
     return q
 

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ...errors import DesignError, ModelError
+from ...jsonable import json_method
 from ...plants.units import ADHESION_003 as PARAMETER_UNITS
 from ...reader import Quantity, Reader
 from .antiskid_cruise_gains import (GainCheck, OtherGain, check_other_gains, load_other_gains,
@@ -162,11 +163,11 @@ class CruiseResult:
     def row(self, eps: float) -> SynthesisRow:
         return next(r for r in self.rows if r.eps == eps)
 
-    def to_json(self) -> dict:
-        return {"lambda_opt": self.lambda_opt, "lambda_d_solved": self.lambda_d_solved,
-                "lambda_d_used": self.lambda_d_used,
-                "A": self.lin.A.tolist(), "B": self.lin.B.tolist(),
-                "rows": [r.to_json() for r in self.rows]}
+    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"lambda_opt": "lambda_opt", "lambda_d_solved": "lambda_d_solved",
+                   "lambda_d_used": "lambda_d_used", "A": "lin.A", "B": "lin.B",
+                   "rows": "rows"}
+    to_json = json_method
 
 
 def operating_point(spec: CruiseSpec) -> tuple[float, float, float, Linearisation]:

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import DesignError, ModelError
+from ...jsonable import json_method
 from ...plants.units import ADHESION_003 as PARAMETER_UNITS
 from ...reader import Quantity, Reader
 
@@ -84,10 +85,10 @@ class RobustResult:
     compared: tuple[tuple[PointCheck, ...], ...]
     requirements: object = None     # workbench.requirements.RequirementResult or None
 
-    def to_json(self) -> dict:
-        return {"eps": self.synthesis.eps, "h_certified": self.synthesis.bracket.h_certified,
-                "K": None if self.synthesis.K is None else self.synthesis.K.tolist(),
-                "reason": self.synthesis.reason}
+    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"eps": "synthesis.eps", "h_certified": "synthesis.bracket.h_certified",
+                   "K": "synthesis.K", "reason": "synthesis.reason"}
+    to_json = json_method
 
 
 def _points(path, common, rails, op: Reader) -> tuple[Point, ...]:

@@ -18,6 +18,7 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import DesignError
+from ...jsonable import OMIT, json_method
 from ...margins import DelayMargin, delay_margin_eig
 from ...reader import Reader
 from ...sim.batch import SchedulerUnreachable
@@ -93,12 +94,11 @@ class RunResult:
     def case(self, name: str) -> CaseResult:
         return next(c for c in self.cases if c.case.name == name)
 
-    def to_json(self) -> dict:
-        out = {"lambda_opt": self.lambda_opt, "lambda_d": self.lambda_d, "K": list(self.K),
-               "cases": {c.case.name: c.metrics for c in self.cases}}
-        if self.sampled is not None:
-            out["sampled"] = self.sampled.to_json()
-        return out
+    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"lambda_opt": "lambda_opt", "lambda_d": "lambda_d", "K": "K",
+                   "cases": lambda r: {c.case.name: c.metrics for c in r.cases},
+                   "sampled": lambda r: OMIT if r.sampled is None else r.sampled}
+    to_json = json_method
 
 
 def switch_check(cs: ControllerSettings, v: float, lam: float) -> SwitchCheck:

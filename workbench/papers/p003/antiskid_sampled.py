@@ -44,12 +44,12 @@ to :data:`MESH_CHECK_MAX_HZ` again at ``plant_step`` / 2
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from ...jsonable import json_method
 from ...reader import Quantity
 from .antiskid_sampled_check import RADAU_QUANTITIES, radau_checks, radau_quantities
 from .antiskid_sampled_kernel import Context, run_once
@@ -176,13 +176,17 @@ class SampledResult:
     def variant(self, name: str) -> Variant:
         return next(v for v in self.variants if v.name == name)
 
-    def to_json(self) -> dict:
-        rows = lambda rr: [{"rate_hz": r.rate, **r.metrics} for r in rr]
-        return {"emulation": self.emulation.metrics,
-                "variants": {v.name: {"q": v.q, "tau": v.tau, "rows": rows(v.rows),
-                                      "probes": rows(v.probes), "min_rate": v.min_rate,
-                                      "bracket": list(v.bracket)} for v in self.variants},
-                "radau": [dataclasses.asdict(c) for c in self.radau]}
+    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"emulation": "emulation.metrics",
+                   "variants": lambda r: {v.name: _variant_json(v) for v in r.variants},
+                   "radau": "radau"}
+    to_json = json_method
+
+
+def _variant_json(v) -> dict:
+    rows = lambda rr: [{"rate_hz": r.rate, **r.metrics} for r in rr]
+    return {"q": v.q, "tau": v.tau, "rows": rows(v.rows), "probes": rows(v.probes),
+            "min_rate": v.min_rate, "bracket": v.bracket}
 
 
 def rate_metrics(ctx: Context, trac: dict, brake: dict) -> dict:
