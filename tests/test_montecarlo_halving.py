@@ -52,6 +52,7 @@ def test_sweep_spec_has_halving_field():
     assert load_design("designs/antiskid-run-dry.toml").spec.montecarlo.halving >= 0
 
 
+@pytest.mark.slow   # the module's halving check fixture: ~22 s (issue 36: full tier)
 def test_draws_and_coarse_batch_are_the_sweeps(short, check):
     d, K = short
     ms = d.spec.montecarlo
@@ -73,6 +74,7 @@ def test_draws_and_coarse_batch_are_the_sweeps(short, check):
     assert check.atol["lam_max_over_opt"] == d.spec.conv_atol.get("lam_max_over_opt", 0.0)
 
 
+@pytest.mark.slow   # the module's halving check fixture: ~22 s (issue 36: full tier)
 def test_flags_follow_the_rule(check):
     # each metric's flag recomputed from the stored values at both steps
     for m in HALVING_METRICS:
@@ -127,6 +129,7 @@ def test_compare_steps_on_hand_made_values():
         assert ag["lam_max_over_opt"][3] == dropped     # 1.20 against 5.0 when compared
 
 
+@pytest.mark.slow   # the module's halving check fixture: ~22 s (issue 36: full tier)
 def test_deterministic_and_pool_independent(short, check):
     d, K = short
     again = start_halving(d, N, K=K, pool=False).result()
@@ -140,6 +143,7 @@ def test_deterministic_and_pool_independent(short, check):
     assert pooled.workers == 2 and check.workers == 1
 
 
+@pytest.mark.slow   # the module's halving check fixture: ~22 s (issue 36: full tier)
 def test_section_text(short, check):
     d, _ = short
     md = halving_section(check, d.spec)
@@ -158,6 +162,7 @@ def test_section_text(short, check):
     assert "Runs that disagree: none." not in halving_section(bad, d.spec)
 
 
+@pytest.mark.slow   # the module's halving check fixture: ~22 s (issue 36: full tier)
 def test_dt_side_taken_from_the_sweep_is_the_same_check(short, check):
     """The study reuses the sweep's first runs as the dt side (a batch run
     follows its single-run trajectory whatever its chunk mates): the check
