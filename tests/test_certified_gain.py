@@ -191,3 +191,26 @@ def test_design_reason_names_a_search_cap_below_the_required_delay():
     s = SynthesisOutcome("wirtinger", 0.0, math.inf, None, None, "inconclusive", 0.1, None,
                          False, False, required=0.5, h_cap=2.0)
     assert s.reason == "no reason recorded"      # (no result object attached here)
+
+
+def test_shared_fixed_gain_lmi_decides_like_a_fresh_one():
+    """One fixed-gain LMI with K and eps as parameters (set_gain / set_eps,
+    issue 36) gives the same steps as a new LMI built for that K and eps."""
+    from workbench.lmi.freeweighting003 import FreeWeighting003FixedK
+    A = np.array([[0.0, 1.0], [-2.0, -0.5]])
+    B = np.array([[0.0], [1.0]])
+    K1, K2 = np.array([[-0.3, -0.8]]), np.array([[-0.5, -0.6]])
+    shared = FreeWeighting003FixedK(A, B, 0.3, K=K1, shared=True)
+    shared.set_eps(0.5)
+    shared.set_gain(K2)
+    fresh = FreeWeighting003FixedK(A, B, 0.5, K=K2)
+    for h in (0.05, 0.5, 5.0):
+        a, b = shared.solve_at(h), fresh.solve_at(h)
+        assert a.outcome is b.outcome
+        assert (a.t_opt is None) == (b.t_opt is None)
+        if a.t_opt is not None:
+            assert a.t_opt == pytest.approx(b.t_opt, rel=1e-6, abs=1e-9)
+    with pytest.raises(ValueError):
+        shared.set_gain(np.zeros((2, 2)))
+    with pytest.raises(ValueError):
+        fresh.set_gain(K1)

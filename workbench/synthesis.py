@@ -17,7 +17,9 @@ runs in the same coordinates, and K is mapped back (K = K~ T^{-1}).
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -181,8 +183,33 @@ def _balanced(A, B):
     return Tinv @ A @ T, Tinv @ B, T, Tinv
 
 
+class _SharedFixedK:
+    """``fixed(K)`` of :func:`canonical_gain` for an eps sweep: ONE
+    :class:`FreeWeighting003FixedK` with the gain and eps as parameters, set
+    for each call, instead of a new LMI (and a new cvxpy compilation) per eps
+    (issue 36, item 4). Same LMI, same numpy re-check; only the compiled
+    problem is reused. ``WORKBENCH_SYNTH_UNSHARED=1`` selects the old path
+    (one new LMI per call; ``benchmarks/check_times.py --synthesize``)."""
+
+    def __init__(self, crit: FreeWeighting003, margin: float):
+        self.crit, self.margin, self.lmi = crit, margin, None
+        self.unshared = os.environ.get("WORKBENCH_SYNTH_UNSHARED") == "1"
+
+    def __call__(self, Kt) -> FreeWeighting003FixedK:
+        if self.unshared:
+            return FreeWeighting003FixedK(self.crit.A, self.crit.B, self.crit.eps, K=Kt,
+                                          margin=self.margin)
+        if self.lmi is None:
+            self.lmi = FreeWeighting003FixedK(self.crit.A, self.crit.B, self.crit.eps, K=Kt,
+                                              margin=self.margin, shared=True)
+        else:
+            self.lmi.set_eps(self.crit.eps)
+            self.lmi.set_gain(Kt)
+        return self.lmi
+
+
 def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, T,
-         settings: SynthesisSettings) -> SynthesisRow:
+         settings: SynthesisSettings, fixed: Callable | None = None) -> SynthesisRow:
     K = exact = exact_siso = rmin = gain = None
     windows = ()
     recheck, cert = {}, {}
@@ -190,9 +217,7 @@ def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, T,
     if br.certificate is not None:
         gain = canonical_gain(
             crit, br.h_certified,
-            lambda Kt: FreeWeighting003FixedK(crit.A, crit.B, crit.eps, K=Kt,
-                                              margin=settings.margin),
-            T, fraction=settings.gain_fraction, digits=settings.gain_digits,
+            fixed or _SharedFixedK(crit, settings.margin), T, fraction=settings.gain_fraction, digits=settings.gain_digits,
             **settings.bisection())
         steps.append(gain.point)
         if gain.analysis is not None:
@@ -242,13 +267,13 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
                                   None, 0, 0.0, (), reason=diag.reason) for e in eps_values)
     At, Bt, T, _ = _balanced(A, B)
     crit = FreeWeighting003(At, Bt, eps_values[0], margin=settings.margin)
-    rows, guess = [], None
+    rows, guess, fixed = [], None, _SharedFixedK(crit, settings.margin)
     for eps in eps_values:
         crit.set_eps(eps)
         br = bisect_delay(crit.solve_at, guess=guess, **settings.bisection())
         if br.h_certified > 0:
             guess = br.h_certified
-        rows.append(_row(eps, br, crit, A, B, T, settings))
+        rows.append(_row(eps, br, crit, A, B, T, settings, fixed))
     return tuple(rows)
 
 

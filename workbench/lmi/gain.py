@@ -32,6 +32,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
+import cvxpy as cp
 import numpy as np
 
 from .core import Bracket, MarginLMI, Outcome, Step, bisect_delay
@@ -150,13 +151,32 @@ class FixedGain:
     Use as ``class C(FixedGain, SomeSynthesis)`` with ``gain_basis`` naming X;
     the constructor takes the synthesis LMI's arguments and the gain as the
     keyword ``K``.
+
+    With ``shared=True`` the gain is a cvxpy Parameter of the built problem
+    (DPP: ``K X`` is a parameter times a variable), so :meth:`set_gain`
+    changes it without compiling the problem again: one LMI serves the
+    fixed-gain analyses of several gains (e.g. one per eps of a sweep,
+    issue 36). The numpy re-check always uses the numpy ``K``.
     """
 
     gain_basis: str = "L"
 
-    def __init__(self, *args, K, **kw):
+    def __init__(self, *args, K, shared: bool = False, **kw):
         self.K = np.atleast_2d(np.asarray(K, float))
+        self._K_param = cp.Parameter(self.K.shape, name="K") if shared else None
+        if shared:
+            self._K_param.value = self.K
         super().__init__(*args, **kw)
+
+    def set_gain(self, K) -> None:
+        """Fix the gain to ``K`` (same shape; only with ``shared=True``)."""
+        if self._K_param is None:
+            raise ValueError("set_gain needs an LMI built with shared=True")
+        K = np.atleast_2d(np.asarray(K, float))
+        if K.shape != self.K.shape:
+            raise ValueError(f"K of shape {K.shape}; expected {self.K.shape}")
+        self.K = K
+        self._K_param.value = K
 
     def variables(self):
         v = super().variables()
@@ -164,4 +184,5 @@ class FixedGain:
         return v
 
     def blocks(self, x, p, bmat):
-        return super().blocks({**x, "V": self.K @ x[self.gain_basis]}, p, bmat)
+        K = self.K if self._K_param is None or bmat is not cp.bmat else self._K_param
+        return super().blocks({**x, "V": K @ x[self.gain_basis]}, p, bmat)
