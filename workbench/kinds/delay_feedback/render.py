@@ -238,7 +238,8 @@ def _simulation_section(spec, res):
                      f"**{'yes' if r.converged else 'no'}**")
         figs.append(Figure(f"sim-{sc.name}", f"Scenario {sc.name} (h = {fmt(sc.h)} s, "
                            f"dt = {fmt(r.run.dt)} s)",
-                           lambda fig, r=r: _plot_run(fig, r, p)))
+                           lambda fig, r=r: _plot_run(fig, r, p),
+                           (6.4, 4.0 + 1.2 * len(sc.plot) + (0.8 if sc.lines else 0.0))))
     md = ("## Nonlinear closed loop with the input delay\n\nThe plant equations above "
           "(not the linearisation), u = u_op + K (x − x_ref(t)) applied after the delay h "
           "(exact ZOH averages of the delayed input, `workbench/sim/delay.py`), classical "
@@ -275,7 +276,8 @@ def _plot_run(fig, r, p):
         if name in lines:
             value, text = lines[name]
             ax.axhline(value, color="k", ls="--", lw=0.8, label=text)
-            ax.legend(loc="best", fontsize=7)
+            ax.margins(y=0.4)
+            ax.legend(loc="best", fontsize=7, framealpha=0.9)
         ax.set_ylabel(label)
     ax.set_xlabel("t (s)")
     fig.suptitle(f"{sc.name}: h = {sc.h:g} s, dt = {run.dt:g} s")
