@@ -67,6 +67,8 @@ def test_plot_and_lines_are_read_and_drawn(tmp_path, monkeypatch):
     ('lines = { u = { value = 1.0, label = "l" } }', ["scenarios[0].lines.u", "a state or"]),
     ('plot = ["s"]\nlines = { s = { value = 1.0 } }', ["scenarios[0].lines.s.label"]),
     ('lines = { x = { value = 1.0, label = "l", colour = "red" } }', ["lines.x.colour"]),
+    ('plot = ["s"]\nparameters = { a = [[0.0, 2.0], [0.5, 3.0]] }',
+     ["scenarios[0].plot", "parameter schedule"]),
 ])
 def test_bad_figure_keys_exit_2_with_one_line(tmp_path, monkeypatch, capsys, keys, words):
     monkeypatch.chdir(tmp_path)

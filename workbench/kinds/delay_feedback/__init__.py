@@ -335,6 +335,9 @@ def _scenarios(root: Reader, plant: PlantSpec, delay: DelaySpec) -> tuple[Scenar
             sched[k] = _steps(pt, k, t_end)
         pt.finish()
         plot, lines = _figure_keys(r, plant)
+        if plot and sched:      # a definition is drawn with the nominal parameter values
+            raise r.fail("plot", list(plot), "no plotted definition in a scenario with a "
+                         "parameter schedule (definitions are drawn at the nominal values)")
         r.finish()
         out.append(Scenario(name, x0, sp, t_end, dt, h, rtol, predictor, sched or None,
                             plot, lines or None))
