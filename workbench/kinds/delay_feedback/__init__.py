@@ -27,7 +27,9 @@ Tables (see ``designs/antiskid-cruise-dry-generic.toml`` for a full file)::
     [[vertices]]   name, source, parameter = value ...   (optional: robust gain)
     [[scenarios]]  name, t_end, dt, x0 = {...}, setpoint = {...}, h, rtol, predictor,
                    parameters = { p = [[t, value], ...] }  (piecewise-constant schedule;
-                   adds the signed min_error.<state> metric)
+                   adds the signed min_error.<state> metric),
+                   plot = ["definition", ...] (extra panels of the figure),
+                   lines = { name = { value, label } } (reference line on a panel)
     [basin]        enabled, domain = {...}, plane, seed     (optional: region of attraction,
                    :mod:`workbench.features.basin`)
     [implementation] sampling, network_delay, hold   (optional: digital implementation,
@@ -101,6 +103,8 @@ class Scenario:
     rtol: float
     predictor: bool = False
     parameters: dict = None  # parameter -> ((t, value), ...): piecewise-constant schedule
+    plot: tuple = ()         # definitions drawn as extra panels (issue 33, item 7)
+    lines: dict = None       # state or plotted definition -> (value, label): reference line
 
 
 @dataclass(frozen=True)
@@ -330,9 +334,35 @@ def _scenarios(root: Reader, plant: PlantSpec, delay: DelaySpec) -> tuple[Scenar
                 raise pt.fail(k, pt.data[k], "a parameter of [parameters]")
             sched[k] = _steps(pt, k, t_end)
         pt.finish()
+        plot, lines = _figure_keys(r, plant)
+        if plot and sched:      # a definition is drawn with the nominal parameter values
+            raise r.fail("plot", list(plot), "no plotted definition in a scenario with a "
+                         "parameter schedule (definitions are drawn at the nominal values)")
         r.finish()
-        out.append(Scenario(name, x0, sp, t_end, dt, h, rtol, predictor, sched or None))
+        out.append(Scenario(name, x0, sp, t_end, dt, h, rtol, predictor, sched or None,
+                            plot, lines or None))
     return tuple(out)
+
+
+def _figure_keys(r: Reader, plant: PlantSpec) -> tuple[tuple[str, ...], dict]:
+    """A scenario's ``plot`` (definitions drawn as extra panels) and ``lines``
+    (a labelled reference value on a state's or a plotted definition's panel)."""
+    defs = [n for n, _ in plant.definitions]
+    plot = r.raw("plot", default=[])
+    if (not isinstance(plot, list) or len(set(map(str, plot))) != len(plot)
+            or any(not isinstance(n, str) or n not in defs for n in plot)):
+        raise r.fail("plot", plot, "a list of distinct names of [definitions]: "
+                     + (", ".join(defs) or "(none)"))
+    lt = r.table("lines", default=None)
+    lines = {}
+    for k in list(lt.data):
+        if k not in plant.state_names and k not in plot:
+            raise lt.fail(k, lt.data[k], "a state or a name of `plot`")
+        one = lt.table(k)
+        lines[k] = (one.number("value", lo=-1e12, hi=1e12), one.string("label"))
+        one.finish()
+    lt.finish()
+    return tuple(plot), lines
 
 
 def _steps(t: Reader, k: str, t_end: float) -> tuple[tuple[float, float], ...]:

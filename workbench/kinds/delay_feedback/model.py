@@ -137,6 +137,12 @@ class PlantModel:
         import sympy as sp
         return sp.lambdify(self.x + self.u, self.substituted(expr, values), "numpy")
 
+    def definition_function(self, name: str, values: dict[str, float]):
+        """Numeric ``name`` of [definitions] as a function of (x, u) arrays
+        (states and inputs along the first axis), for the figures."""
+        fn = self._numeric(self.definitions[name], values)
+        return lambda X, U: np.broadcast_to(np.asarray(fn(*X, *U), float), X.shape[1:])
+
     @cached_property
     def jacobians(self):
         """(df/dx, df/du) as sympy matrices."""

@@ -257,8 +257,10 @@ def _simulation_section(spec, res):
                      + f"h = {fmt(sc.h)} s, dt = {fmt(sc.dt)} s and "
                      f"{fmt(sc.dt / 2)} s, metrics agree to rtol {fmt(sc.rtol)}: "
                      f"**{'yes' if r.converged else 'no'}**")
-        figs.append(Figure(f"sim-{sc.name}", f"Scenario {sc.name}",
-                           lambda fig, r=r: _plot_run(fig, r, p)))
+        figs.append(Figure(f"sim-{sc.name}", f"Scenario {sc.name} (h = {fmt(sc.h)} s, "
+                           f"dt = {fmt(r.run.dt)} s)",
+                           lambda fig, r=r: _plot_run(fig, r, p),
+                           (6.4, 4.0 + 1.2 * len(sc.plot) + (0.8 if sc.lines else 0.0))))
     md = ("## Nonlinear closed loop with the input delay\n\nThe plant equations above "
           "(not the linearisation), u = u_op + K (x − x_ref(t)) applied after the delay h "
           "(exact ZOH averages of the delayed input, `workbench/sim/delay.py`), classical "
@@ -272,22 +274,34 @@ def _simulation_section(spec, res):
 
 
 def _plot_run(fig, r, p):
-    run = r.run
-    n = len(p.states) + len(p.inputs)
+    run, sc = r.run, r.scenario
+    lines = sc.lines or {}
+    n = len(p.states) + len(sc.plot) + len(p.inputs)
     from .run import input_history
     U = input_history(run, len(p.inputs))
     step = max(1, run.t.size // 2000)
     t = run.t[::step]
-    for i, v in enumerate(p.states):
-        ax = fig.add_subplot(n, 1, i + 1)
-        ax.plot(t, run.x[i, ::step], color="C0")
-        ax.set_ylabel(f"{v.name} ({v.unit})")
-    for j, v in enumerate(p.inputs):
-        ax = fig.add_subplot(n, 1, len(p.states) + j + 1)
-        ax.plot(t, U[j, ::step], color="C1")
-        ax.set_ylabel(f"{v.name} ({v.unit})")
+    panels = [(v.name, f"{v.name} ({v.unit})", run.x[i, ::step], "C0")
+              for i, v in enumerate(p.states)]
+    if sc.plot:                          # definitions of the plant (e.g. the creep ratio)
+        from .model import PlantModel
+        model = PlantModel(p)
+        X, Us = run.x[:, ::step], U[:, ::step]
+        panels += [(d, d, model.definition_function(d, p.values())(X, Us), "C2")
+                   for d in sc.plot]
+    panels += [(v.name, f"{v.name} ({v.unit})", U[j, ::step], "C1")
+               for j, v in enumerate(p.inputs)]
+    for k, (name, label, y, colour) in enumerate(panels):
+        ax = fig.add_subplot(n, 1, k + 1)
+        ax.plot(t, y, color=colour)
+        if name in lines:
+            value, text = lines[name]
+            ax.axhline(value, color="k", ls="--", lw=0.8, label=text)
+            ax.margins(y=0.4)
+            ax.legend(loc="best", fontsize=7, framealpha=0.9)
+        ax.set_ylabel(label)
     ax.set_xlabel("t (s)")
-    fig.suptitle(f"{r.scenario.name}: h = {r.scenario.h:g} s, dt = {run.dt:g} s")
+    fig.suptitle(f"{sc.name}: h = {sc.h:g} s, dt = {run.dt:g} s")
 
 
 def _floor2(h, cap) -> str:
