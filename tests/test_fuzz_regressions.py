@@ -156,3 +156,20 @@ def test_antiskid_run_simulate_writes_csv(tmp_path, capsys):
     assert lines[0] == "t_s,v,lambda,u,u_applied" and len(lines) > 100
     t = [float(ln.split(",")[0]) for ln in lines[1:4]]
     assert t == pytest.approx([0.0, 0.01, 0.02])
+
+
+@pytest.mark.slow
+def test_run32_no_certified_row_draws_no_loop_figure(tmp_path, capsys):
+    """Seed-32 campaign of 2026-11-27, run 32: adhesion a = 2 leaves no eps row
+    with a certified gain; ``report`` raised ValueError (max of an empty
+    sequence) drawing the loop figure. Now the report has no loop figure."""
+    text = (ROOT / "designs" / "antiskid-cruise-dry.toml").read_text()
+    old = 'a    = { value = 0.3315,'
+    assert old in text
+    d = tmp_path / "d"
+    d.mkdir()
+    (d / "antiskid-cruise-dry.toml").write_text(text.replace(old, 'a    = { value = 2,', 1))
+    code = main(["report", str(d / "antiskid-cruise-dry.toml"), "--out", str(tmp_path / "r")])
+    assert code in (0, 1), capsys.readouterr().err
+    figs = sorted(p.name for p in (tmp_path / "r" / "antiskid-cruise-dry").iterdir())
+    assert figs == ["delay-bound-vs-eps.png"]
