@@ -149,7 +149,9 @@ def _check_name(t: Reader, name: str, taken: set[str]) -> None:
     taken.add(name)
 
 
-def _plant(root: Reader) -> PlantSpec:
+def _plant(root: Reader, *, operating_point: bool = True) -> PlantSpec:
+    """The plant tables; ``operating_point=False``: a kind that simulates only
+    (``switched-run``) reads no ``[operating_point]``."""
     from ...expr import check_expression
     taken: set[str] = set()
     states = _variables(root, "states", taken)
@@ -180,6 +182,8 @@ def _plant(root: Reader) -> PlantSpec:
         check_expression(text, taken, path=root.path, key=eq.key(s.name))
         texts.append(text)
     eq.finish()
+    if not operating_point:
+        return PlantSpec(root.path, states, inputs, params, tuple(defs), tuple(texts))
     op = root.table("operating_point")
     entries = []
     for v in states + inputs:
