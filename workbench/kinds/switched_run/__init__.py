@@ -141,12 +141,13 @@ def _phases(root: Reader, plant: PlantSpec, names: set[str]) -> tuple[Phase, ...
     tables = root.tables("phases")
     if not tables:
         raise root.fail("phases", [], "at least one [[phases]] table")
-    known = [t.raw("name", default=None) for t in tables]
-    out = []
-    for t in tables:
+    known, out = [], []
+    for t in tables:                       # every name first: a guard may point ahead
         name = t.string("name")
-        if not _NAME.match(name) or known.count(name) > 1:
+        if not _NAME.match(name) or name in known:
             raise t.fail("name", name, "a phase name of letters, digits and _, used once")
+        known.append(name)
+    for t, name in zip(tables, known):
         lt = t.table("law")
         laws = []
         for u in plant.input_names:

@@ -6,7 +6,10 @@ import math
 import numpy as np
 
 from ...report.markdown import Figure, Rendered, fmt, md_table
+from ...sim.convergence import P_MAX, P_MIN
 from .quantities import scenario_metrics
+from .simulate import BOUND
+from .study import ALPHA, P_SHOWN, runs_for
 
 __all__ = ["render"]
 
@@ -89,7 +92,8 @@ def _runs(spec, res):
           "`final`/`peak`/`min`: the state at the end, its largest and smallest value; "
           "`final_error`: the state minus its target at the end; `time_in`: seconds in a "
           "phase; `switch_time.a.b`: the first switch a → b (nan: none); `diverged`: a "
-          "non-finite state, a state beyond 1e6 (1 + |x0|), or more switches within one second "
+          f"non-finite state, a state beyond {fmt(BOUND)} (1 + |x0|), or more switches within "
+          "one second "
           "than the scenario's cap (chattering) — the run then stops there; "
           "`peak_abs_accel`/`peak_abs_jerk`: the largest |d speed/dt| (the plant's right-hand "
           "side) and |d² speed/dt²| (its step-to-step difference / dt).\n\n"
@@ -138,7 +142,8 @@ def _convergence(spec, res) -> str:
             "control period unchanged: they are whole numbers of the finest step). Observed "
             "order p = log2(|q1 − q2| / |q2 − q4|) and Richardson's estimate of the error "
             "left in q4 (`workbench/sim/convergence.py`, with its guards: p clipped to "
-            "[0.5, 4]; differences at rounding level count as converged). Switch instants lie "
+            f"[{fmt(P_MIN)}, {fmt(P_MAX)}]; differences at rounding level count as converged). "
+            "Switch instants lie "
             "on the controller's clock, so metrics that depend on them converge at first "
             "order.\n\n"
             + md_table(["scenario", "metric", "q1 (dt)", "q2 (dt/2)", "q4 (dt/4)", "p",
@@ -170,7 +175,8 @@ def _montecarlo(spec, res):
             f"ended by their terminal condition, {int(m.metrics['diverged'].sum())} diverged or "
             "chattered" + (" (first reasons: " + "; ".join(bad) + ")" if bad else "") + ".\n\n"
             + md_table(["metric", "min over runs", "max over runs", "unit"], rows, "lrrl"))
-        claimed = [c for c in spec.claims if c.scenario == sc.name][:4]
+        claimed = [c for c in spec.claims if c.scenario == sc.name     # continuous metrics
+                   and c.claim.digits is None][:4]
         if claimed:
             figs.append(Figure(f"montecarlo-{sc.name}",
                                f"Monte Carlo, scenario {sc.name} ({m.samples} runs, seed "
@@ -190,8 +196,9 @@ def _montecarlo(spec, res):
           + md_table(["parameter", "distribution", "source"], dist, "lll")
           + "\n\nShare of runs that pass each claim on a scenario metric, with its Wilson "
           "score 95 % interval. Success-run rule: with no failure in n runs, the pass "
-          "probability is at least 0.05^(1/n) with 95 % confidence (one-sided; rounded down "
-          "to 4 digits): 0 failures in n ≥ 299 runs show P ≥ 0.99.\n\n"
+          f"probability is at least {fmt(ALPHA)}^(1/n) with {fmt(100 * (1 - ALPHA))} % "
+          "confidence (one-sided; rounded down to 4 digits): 0 failures in n ≥ "
+          f"{runs_for(P_SHOWN)} runs show P ≥ {fmt(P_SHOWN)}.\n\n"
           + (md_table(["claim", "runs passing", "share", "Wilson 95 %",
                        "success-run lower bound"], rates, "lrrrr") if rates
              else "_No claim on a scenario metric._")

@@ -27,12 +27,23 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from ...jsonable import json_method
 from .simulate import Batch, Compiled, simulate
 
-__all__ = ["ClaimRate", "MonteCarloRun", "ScenarioRun", "SwitchedRunResult", "run"]
+__all__ = ["ALPHA", "ClaimRate", "MonteCarloRun", "P_SHOWN", "ScenarioRun", "SwitchedRunResult",
+           "run", "runs_for"]
+
+#: One-sided risk of the success-run bound (95 % confidence).
+ALPHA = 0.05
+#: The pass probability the report says how many failure-free runs show.
+P_SHOWN = 0.99
+
+
+def runs_for(p: float, alpha: float = ALPHA) -> int:
+    """Fewest runs without a failure that show a pass probability >= ``p``
+    with confidence 1 - ``alpha`` (success-run rule: p**n <= alpha); 299 for
+    p = 0.99 at 95 %."""
+    return math.ceil(math.log(alpha) / math.log(p))
 
 
 @dataclass(frozen=True)
@@ -145,15 +156,6 @@ def _rate(target, mc: MonteCarloRun) -> ClaimRate:
     v = mc.metrics[target.metric]
     passes = sum(check_claim(target.claim, float(x)).verdict is Verdict.PASS for x in v)
     k, n, p, lo, hi = wilson_interval(passes, len(v))
-    srl = 0.05 ** (1.0 / n) if passes == n else None
+    srl = ALPHA ** (1.0 / n) if passes == n else None
     return ClaimRate(target.claim.id, target.scenario, int(passes), n, p, lo, hi, srl)
 
-
-def describe_end(reason: str) -> str:
-    """A run's end reason in words."""
-    return {"until": "its terminal condition held", "t_end": "t_end reached"}.get(reason, reason)
-
-
-def share(x) -> float:
-    """Mean of a 0/1 array (nan-free)."""
-    return float(np.mean(np.asarray(x, float)))
