@@ -213,6 +213,10 @@ def _plant(root: Reader, *, operating_point: bool = True) -> PlantSpec:
                      tuple(entries), trim)
 
 
+#: The plant tables' reader and the name pattern, shared with ``switched-run``.
+read_plant, NAME_PATTERN = _plant, _NAME
+
+
 def _delay(root: Reader) -> DelaySpec:
     d = root.table("delay")
     if d.has("h"):

@@ -3,7 +3,7 @@ phases, each with its own control law, switch guards, an optional predictor
 over a constant input delay, and scenarios (issue 35, item 1).
 
 The plant tables are those of ``delay-feedback`` (read by its own reader,
-:func:`workbench.kinds.delay_feedback._plant`, without an operating point);
+:func:`workbench.kinds.delay_feedback.read_plant`, without an operating point);
 everything is parsed by :mod:`workbench.expr` (:mod:`ast` against a
 whitelist, never evaluated) and unit-checked with pint
 (:func:`workbench.kinds.delay_feedback.units.check_units`).
@@ -40,7 +40,8 @@ import re
 from dataclasses import dataclass
 
 from ...design import Reader
-from ..delay_feedback import _NAME, _plant
+from ..delay_feedback import NAME_PATTERN as _NAME
+from ..delay_feedback import read_plant
 from ..delay_feedback.spec import PlantSpec
 
 __all__ = ["Phase", "Scenario", "SwitchedRunSpec", "STUDY", "MAX_STEPS"]
@@ -280,7 +281,7 @@ class SwitchedRun:
     uses_solver = False
 
     def load(self, root: Reader) -> SwitchedRunSpec:
-        plant = _plant(root, operating_point=False)
+        plant = read_plant(root, operating_point=False)
         names, usable = _controller_names(plant)
         d = root.table("delay")
         hq = d.quantity("h", "s", nonneg=True, hi=1e3)

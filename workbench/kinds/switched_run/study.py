@@ -126,7 +126,7 @@ def run(spec) -> SwitchedRunResult:
 def _claim_rows(spec, scenario: str, levels) -> list:
     """The refinement row of every claim on a metric of ``scenario``
     (:mod:`workbench.refinement`: the claim's tolerance, the reason)."""
-    from ...refinement import _row
+    from ...refinement import refinement_row
     rows = []
     for c in spec.claims:
         if c.scenario != scenario:
@@ -134,7 +134,7 @@ def _claim_rows(spec, scenario: str, levels) -> list:
         vals = tuple(lv[c.metric] for lv in levels)
         if math.isnan(vals[0]):
             continue                       # not determined: INCONCLUSIVE already
-        rows.append(_row(c.claim, vals, "dt", vals[0]))
+        rows.append(refinement_row(c.claim, vals, "dt", vals[0]))
     return rows
 
 
