@@ -331,3 +331,67 @@ def test_a_law_may_not_use_a_definition_of_the_input(tmp_path, monkeypatch, caps
                                              "[equations]").replace('"0*speed"', '"w"')
     line = _cli_error(write(tmp_path, text), capsys)
     assert "phases[1].law.u" in line and "undeclared name 'w'" in line, line
+
+
+# -- [montecarlo] on a delay-feedback design (issue 35, "Done when") ------------------------
+DF = """
+[design]
+name = "df"
+kind = "delay-feedback"
+title = "test"
+source = "test"
+
+[states]
+x = { unit = "rad", source = "test" }
+
+[inputs]
+u = { unit = "rad/s", source = "test" }
+
+[parameters]
+a = { value = 2.0, unit = "1/s", source = "test" }
+
+[equations]
+x = "-a*sin(x) + u"
+
+[operating_point]
+x = { value = 0.5, unit = "rad", source = "test" }
+u = { solve = [-5.0, 5.0] }
+
+[delay]
+h = { value = 0.1, unit = "s", source = "test" }
+
+[synthesis]
+method = "wirtinger"
+
+[[scenarios]]
+name = "s"
+x0 = { x = 0.8 }
+t_end = 2.0
+dt = 0.01
+
+[montecarlo]
+samples = 20
+seed = 3
+[montecarlo.distributions]
+a = { dist = "uniform", lo = LO, hi = HI, source = "test" }
+"""
+
+
+def test_delay_feedback_montecarlo_reproduces_the_nominal_run(tmp_path):
+    """Draws all at the nominal a = 2: every run's metrics are the nominal
+    run's (same steps, same delayed ZOH averages); a wide draw spreads them."""
+    p = tmp_path / "df.toml"
+    p.write_text(DF.replace("LO", "1.9999999999").replace("HI", "2.0000000001"))
+    ev = evaluate_design(load_design(p))
+    nominal = ev.result.scenarios[0].metrics
+    mc = ev.result.montecarlo[0]
+    assert mc.samples == 20 and mc.metrics["diverged"].sum() == 0
+    for k in ("peak_error.x", "final_error.x", "peak_input_dev.u"):
+        assert np.allclose(mc.metrics[k], nominal[k], rtol=1e-6, atol=1e-12), k
+    p.write_text(DF.replace("LO", "0.5").replace("HI", "4.0"))
+    wide = evaluate_design(load_design(p)).result.montecarlo[0].metrics["final_error.x"]
+    assert np.ptp(wide) > 1e-3
+    from workbench import kinds
+    d = load_design(p)
+    names = kinds.REGISTRY["delay-feedback"].quantity_names(d.spec)
+    assert {"montecarlo.s.runs", "montecarlo.s.diverged", "montecarlo.s.max.final_error.x"} <= names
