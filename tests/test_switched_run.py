@@ -398,3 +398,14 @@ def test_delay_feedback_montecarlo_reproduces_the_nominal_run(tmp_path):
     assert np.ptp(wide[0].metrics["final_error.x"]) > 1e-3
     names = kinds.REGISTRY["delay-feedback"].quantity_names(d.spec)
     assert {"montecarlo.s.runs", "montecarlo.s.diverged", "montecarlo.s.max.final_error.x"} <= names
+
+
+@pytest.mark.parametrize("old, new, key, expected", [
+    ('law = { u = "speed" }', 'law = { u = "one" }', "phases[0].law.u", "in the unit of u"),
+    ('when = "x - one"', 'when = "x - speed"', "phases[0].next[0].when", "terms of one unit"),
+])
+def test_laws_and_guards_are_unit_checked(tmp_path, monkeypatch, capsys, old, new, key,
+                                          expected):
+    monkeypatch.chdir(tmp_path)
+    line = _cli_error(write(tmp_path, GUARD.replace("H", "0.0").replace(old, new)), capsys)
+    assert key in line and expected in line, line

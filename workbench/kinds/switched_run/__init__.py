@@ -274,6 +274,23 @@ def _claim_targets(root: Reader, scenarios, metrics_of) -> tuple[ClaimTarget, ..
     return tuple(out)
 
 
+def _check_law_units(plant: PlantSpec, model, phases, usable) -> None:
+    """Each law in its input's unit; guards and ``until`` of consistent units
+    (pint, :func:`workbench.kinds.delay_feedback.units.check_expression_units`)."""
+    from ...expr import parse_expression
+    from ..delay_feedback.units import check_expression_units
+    names = dict(zip(plant.state_names, model.x)) | dict(model.p)
+    names |= {k: model.definitions[k] for k in usable}
+    items = []
+    for i, ph in enumerate(phases):
+        texts = [(f"phases[{i}].law.{u}", t, u) for u, t in zip(plant.input_names, ph.law)]
+        texts += [(f"phases[{i}].next[{j}].when", w, None) for j, (_, w) in enumerate(ph.next)]
+        texts += [(f"phases[{i}].until", ph.until, None)] if ph.terminal else []
+        items += [(key, t, parse_expression(t, names, path=plant.path, key=key), want)
+                  for key, t, want in texts]
+    check_expression_units(plant, items)
+
+
 class SwitchedRun:
     """The ``switched-run`` study (see the module docstring)."""
 
@@ -313,6 +330,7 @@ class SwitchedRun:
         model = PlantModel(plant)
         check_units(model)
         model.check_finite(plant.values(), "parameters")
+        _check_law_units(plant, model, phases, usable)
         spec = SwitchedRunSpec(plant, hq.value, hq.source, predictor, phases, scenarios, speed,
                                mc, sampled, convergence, (), usable)
         from .quantities import scenario_metrics
