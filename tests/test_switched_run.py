@@ -409,3 +409,12 @@ def test_laws_and_guards_are_unit_checked(tmp_path, monkeypatch, capsys, old, ne
     monkeypatch.chdir(tmp_path)
     line = _cli_error(write(tmp_path, GUARD.replace("H", "0.0").replace(old, new)), capsys)
     assert key in line and expected in line, line
+
+
+def test_with_convergence_the_delay_is_a_multiple_of_the_designed_step(tmp_path, monkeypatch,
+                                                                       capsys):
+    """h = 0.25 s is 10 steps of dt/4 = 0.025 s but 2.5 of dt = 0.1 s: refused."""
+    monkeypatch.chdir(tmp_path)
+    text = GUARD.replace("H", "0.25").replace("dt = 0.125", "dt = 0.1") + "\n[convergence]\n"
+    line = _cli_error(write(tmp_path, text), capsys)
+    assert "scenarios[0].dt" in line and "2.5 steps" in line, line

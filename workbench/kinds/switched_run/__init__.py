@@ -205,9 +205,10 @@ def _scenarios(root: Reader, spec_plant: PlantSpec, phases, h: float, convergenc
         if t_end / dt * finest > MAX_STEPS:
             raise r.fail("dt", dt, f"at most {MAX_STEPS:g} steps over t_end"
                          + (" at dt/4 ([convergence])" if convergence else ""))
-        _multiple(r, "dt", h, dt / finest, f"a step with the delay h = {h:g} s") if h else None
+        if h:          # a multiple of dt is one of dt/2 and dt/4 too ([convergence])
+            _multiple(r, "dt", h, dt, f"a step with the delay h = {h:g} s")
         if sampled is not None:
-            _multiple(r, "dt", sampled.period, dt / finest,
+            _multiple(r, "dt", sampled.period, dt,
                       f"a step with the control period {sampled.period:g} s")
         phase = r.string("phase", choices=phase_names)
         pt = r.table("parameters", default=None)
