@@ -147,3 +147,12 @@ def refine_findings(design, study, quantities: dict,
     rows = tuple(_row(r.claim, tuple(q.get(r.claim.quantity) for q in levels), field, r.got)
                  for r in finds)
     return RefinementTable(field, getattr(study, "refine_unit", ""), step, rows)
+
+
+def refinement_row(c: Claim, values: tuple, field: str, got) -> RefinementRow:
+    """The three-level check of one claim's metric (``values`` at the step,
+    its half and its quarter; ``got`` the value the claim compared), with the
+    reason an unconverged claim shows: the check :func:`refine_findings`
+    applies to each finding, for a kind that refines every claim itself
+    (``switched-run``)."""
+    return _row(c, values, field, got)

@@ -44,6 +44,11 @@ def evaluate_design(design: Design) -> Evaluation:
         by_id = {row.claim_id: row for row in table.rows}
         checked = [_unconverged(r, by_id[r.claim.id]) if r.claim.id in by_id
                    and not by_id[r.claim.id].converged else r for r in checked]
+    if hasattr(study, "unconverged"):    # a kind that refines its own metrics (switched-run)
+        why = study.unconverged(result)
+        checked = [ClaimResult(r.claim, r.got, Verdict.INCONCLUSIVE, why[r.claim.id])
+                   if r.claim.id in why and r.verdict is not Verdict.INCONCLUSIVE else r
+                   for r in checked]
     return Evaluation(design, result, tuple(checked), table)
 
 

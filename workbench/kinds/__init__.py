@@ -53,6 +53,7 @@ STUDIES: dict[str, str] = {
     "ato-tracking": "workbench.papers.p002.ato_tracking:STUDY",
     "ntsm-platoon": "workbench.papers.p001.ntsm_platoon:STUDY",
     "delay-feedback": "workbench.kinds.delay_feedback:STUDY",
+    "switched-run": "workbench.kinds.switched_run:STUDY",
 }
 
 
@@ -68,6 +69,7 @@ RENDERERS: dict[str, str] = {
     "ato-tracking": "workbench.papers.p002.ato_tracking_render:render",
     "ntsm-platoon": "workbench.papers.p001.ntsm_platoon_render:render",
     "delay-feedback": "workbench.kinds.delay_feedback.render:render",
+    "switched-run": "workbench.kinds.switched_run.render:render",
 }
 
 

@@ -34,6 +34,8 @@ Tables (see ``designs/antiskid-cruise-dry-generic.toml`` for a full file)::
                    :mod:`workbench.features.basin`)
     [implementation] sampling, network_delay, hold   (optional: digital implementation,
                    :mod:`workbench.features.sampled`)
+    [montecarlo]   samples, seed, distributions   (optional: the scenarios with drawn
+                   plant parameters, :mod:`.montecarlo`)
 
 The design tables are read here (light: no sympy until the operating point
 is solved); :mod:`.run` computes, :mod:`.render`
@@ -118,6 +120,7 @@ class DelayFeedbackSpec:
     basin: object = None     # delay_feedback_basin.BasinSettings or None ([basin] table)
     requirements: object = None   # delay_feedback_requirements.RequirementsSpec or None
     implementation: object = None   # delay_feedback_implementation.ImplementationSettings
+    montecarlo: object = None   # features.montecarlo.MonteCarloSpec ([montecarlo], .montecarlo)
 
 
 def _variables(root: Reader, table: str, taken: set[str], min_len: int = 1
@@ -149,7 +152,9 @@ def _check_name(t: Reader, name: str, taken: set[str]) -> None:
     taken.add(name)
 
 
-def _plant(root: Reader) -> PlantSpec:
+def _plant(root: Reader, *, operating_point: bool = True) -> PlantSpec:
+    """The plant tables; ``operating_point=False``: a kind that simulates only
+    (``switched-run``) reads no ``[operating_point]``."""
     from ...expr import check_expression
     taken: set[str] = set()
     states = _variables(root, "states", taken)
@@ -180,6 +185,8 @@ def _plant(root: Reader) -> PlantSpec:
         check_expression(text, taken, path=root.path, key=eq.key(s.name))
         texts.append(text)
     eq.finish()
+    if not operating_point:
+        return PlantSpec(root.path, states, inputs, params, tuple(defs), tuple(texts))
     op = root.table("operating_point")
     entries = []
     for v in states + inputs:
@@ -207,6 +214,10 @@ def _plant(root: Reader) -> PlantSpec:
                         "or none (a given point)")
     return PlantSpec(root.path, states, inputs, params, tuple(defs), tuple(texts),
                      tuple(entries), trim)
+
+
+#: The plant tables' reader and the name pattern, shared with ``switched-run``.
+read_plant, NAME_PATTERN = _plant, _NAME
 
 
 def _delay(root: Reader) -> DelaySpec:
@@ -400,8 +411,10 @@ class DelayFeedback:
         from .requirements import load_requirements
         req = load_requirements(root, plant, delay)
         from ...features.sampled import load_implementation_settings
+        from .montecarlo import load_montecarlo_table
         spec = DelayFeedbackSpec(plant, delay, syn, vertices, scenarios, horizon, basin, req,
-                                 load_implementation_settings(root))
+                                 load_implementation_settings(root),
+                                 load_montecarlo_table(root, plant))
         from .model import PlantModel
         from .run import nominal_point
         from .units import check_units, physical_ranges

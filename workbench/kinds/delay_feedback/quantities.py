@@ -157,6 +157,16 @@ def _implementation_values(r):
     return {} if r.implementation is None else implementation_quantities(r.implementation)
 
 
+def _montecarlo_names(spec):
+    from .montecarlo import montecarlo_names
+    return montecarlo_names(spec)
+
+
+def _montecarlo_values(r):
+    from .montecarlo import montecarlo_values
+    return montecarlo_values(r)
+
+
 #: Every claimable quantity of a ``delay-feedback`` design.
 TABLE = (
     Declared("operating_point.{k}", "{unit}",
@@ -203,4 +213,6 @@ TABLE = (
     Group(_basin_names, _basin_values, present=lambda spec: spec.basin is not None),
     Group(_implementation_names, _implementation_values,
           present=lambda spec: spec.implementation is not None),
+    Group(_montecarlo_names, _montecarlo_values,
+          present=lambda spec: spec.montecarlo is not None),
 )

@@ -135,6 +135,9 @@ def render(design, res) -> Rendered:
         sec, ifigs = render_implementation_section(spec, res.implementation)
         sections.append(sec)
         figs = [*figs, *ifigs]
+    if spec.montecarlo is not None:
+        from .montecarlo import montecarlo_section
+        sections.append(montecarlo_section(spec, res))
     return Rendered(tuple(sections), tuple(figs))
 
 

@@ -122,6 +122,7 @@ class DelayFeedbackResult:
     basin: object = None       # delay_feedback_basin.DelayFeedbackBasin or None
     implementation: object = None   # delay_feedback_implementation.DesignImplementation
     spec: object = None        # DelayFeedbackSpec (indexes the declared quantities)
+    montecarlo: tuple | None = None   # montecarlo.MonteCarloScenario per drawn scenario
 
     #: The JSON of the result (:func:`workbench.jsonable.to_json`).
     JSON_FIELDS = {"A": "A", "B": "B", "x_op": "op.x", "u_op": "op.u",
@@ -249,10 +250,14 @@ def run(spec) -> DelayFeedbackResult:
     if spec.implementation is not None and syn.K is not None:
         from ...features.sampled import run_implementation
         impl = run_implementation(spec.implementation, spec.delay, A, B, syn.K)
+    mc = None
+    if spec.montecarlo is not None and syn.K is not None:
+        from .montecarlo import run_montecarlo
+        mc = run_montecarlo(spec, model, values, op, syn.K, reference, predict)
     return DelayFeedbackResult(op, A, B, syn, exact, tuple(windows), stable, checks, scen,
                                points, spec.delay,
                                spec.plant.state_names + spec.plant.input_names, basin, impl,
-                               spec)
+                               spec, mc)
 
 
 # -- simulation -----------------------------------------------------------------------

@@ -31,7 +31,7 @@ from functools import lru_cache
 
 from ...errors import DesignError
 
-__all__ = ["SANE", "check_units", "parse_unit", "physical_ranges"]
+__all__ = ["SANE", "check_expression_units", "check_units", "parse_unit", "physical_ranges"]
 
 #: Magnitudes (SI) a time or mass parameter may take.
 SANE = {"[time]": (1e-9, 1e9), "[mass]": (1e-9, 1e12)}
@@ -162,16 +162,40 @@ class _Walker:
                           f"derived (found {type(e).__name__})")
 
 
-def check_units(model) -> None:
-    """Parse every declared unit; check the definitions and equations of the
-    :class:`~workbench.kinds.delay_feedback.model.PlantModel` ``model``."""
-    spec = model.spec
-    units, shown = {}, {}
+def _declared(spec) -> dict:
+    """name -> pint quantity of every state, input and parameter."""
+    units = {}
     for table, items in (("states", spec.states), ("inputs", spec.inputs)):
         for v in items:
             units[v.name] = parse_unit(v.unit, spec.path, f"{table}.{v.name}.unit")
     for name, q in spec.parameters.items():
         units[name] = parse_unit(q.unit, spec.path, f"parameters.{name}.unit")
+    return units
+
+
+def check_expression_units(spec, items) -> None:
+    """Units of further expressions written over a plant's symbols (the laws
+    and guards of ``switched-run``): ``items`` are (key, text, sympy
+    expression, unit name or None); each must be consistent, and have the
+    unit of the named state or input when one is given."""
+    units = _declared(spec)
+    w = _Walker(spec.path, units, {key: text for key, text, _, _ in items})
+    for key, text, e, want in items:
+        got = w.unit(e, key)
+        if want is None or got is None:
+            continue
+        ref = units[want]
+        if got.dimensionality != ref.dimensionality or not math.isclose(
+                got.to(ref.units).magnitude, 1.0, rel_tol=_RTOL):
+            raise DesignError(spec.path, key, text, f"an expression in the unit of {want}, "
+                              f"{_show(ref)}; found {_show(got)}")
+
+
+def check_units(model) -> None:
+    """Parse every declared unit; check the definitions and equations of the
+    :class:`~workbench.kinds.delay_feedback.model.PlantModel` ``model``."""
+    spec = model.spec
+    units, shown = _declared(spec), {}
     shown.update({f"definitions.{n}": t for n, t in spec.definitions})
     shown.update({f"equations.{s}": t for s, t in zip(spec.state_names, spec.equations)})
     import pint

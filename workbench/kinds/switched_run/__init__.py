@@ -1,0 +1,368 @@
+"""Study ``switched-run``: a plant written as text equations, driven by named
+phases, each with its own control law, switch guards, an optional predictor
+over a constant input delay, and scenarios (issue 35, item 1).
+
+The plant tables are those of ``delay-feedback`` (read by its own reader,
+:func:`workbench.kinds.delay_feedback.read_plant`, without an operating point);
+everything is parsed by :mod:`workbench.expr` (:mod:`ast` against a
+whitelist, never evaluated) and unit-checked with pint
+(:func:`workbench.kinds.delay_feedback.units.check_units`).
+
+Tables::
+
+    [states] [inputs] [parameters] [definitions] [equations]   (as delay-feedback)
+    [delay]       h = { value, unit = "s", source }  (>= 0, a multiple of every dt),
+                  predictor = true | false  (the law sees x predicted h ahead)
+    [[phases]]    name, law = { input = "expression" } (one per input),
+                  next = [{ to = "phase", when = "expression" }]   (switch when >= 0;
+                  the first that holds, in order), terminal = true, until = "expression"
+    [[scenarios]] name, x0 = { state = value } (every state), t_end, dt, phase (initial),
+                  parameters = { p = value } (overrides), target = { state = value },
+                  max_switch_rate (1/s, default 10: more switches within 1 s is chattering)
+    [comfort]     speed = "state"          (optional: peak |acceleration| and |jerk|)
+    [montecarlo]  samples, seed, distributions = { parameter = { dist = ... } }
+    [sampled]     period (s, a multiple of dt), quantisation = { state = step }
+    [convergence] (no keys: every scenario metric at dt, dt/2, dt/4)
+
+Laws, guards and ``until`` use states, parameters and the definitions that
+do not depend on an input. The controller (laws, guards, predictor) uses the
+design's parameter values with the scenario's overrides; Monte Carlo draws
+change the plant only (the controller does not know them).
+
+The design tables are read here (light: no sympy, no numpy);
+:mod:`.simulate` runs, :mod:`.study` assembles, :mod:`.render` renders.
+"""
+from __future__ import annotations
+
+import ast
+import math
+import re
+from dataclasses import dataclass
+
+from ...design import Reader
+from ..delay_feedback import NAME_PATTERN as _NAME
+from ..delay_feedback import read_plant
+from ..delay_feedback.spec import PlantSpec
+
+__all__ = ["Phase", "Scenario", "SwitchedRunSpec", "STUDY", "MAX_STEPS"]
+
+#: Most integration steps of one run (t_end / dt, at the finest level).
+MAX_STEPS = 2_000_000
+#: Most Monte Carlo runs times steps (one batch).
+MAX_WORK = 2e9
+#: Refinement levels of ``[convergence]``: dt / 2**k.
+LEVELS = (0, 1, 2)
+
+
+@dataclass(frozen=True)
+class Phase:
+    """A named phase: a law per input, guards, and whether the run may end there."""
+
+    name: str
+    law: tuple[str, ...]                 # expression per input, in input order
+    next: tuple[tuple[str, str], ...]    # (to, when)
+    terminal: bool = False
+    until: str | None = None
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One run: initial state, horizon, step, initial phase, overrides, targets."""
+
+    name: str
+    x0: tuple[float, ...]
+    t_end: float
+    dt: float
+    phase: str
+    parameters: dict
+    target: dict
+    max_switch_rate: float = 10.0
+
+
+@dataclass(frozen=True)
+class SampledSpec:
+    """``[sampled]``: control period (s) and quantisation step per state."""
+
+    period: float
+    quantisation: dict
+
+
+@dataclass(frozen=True)
+class ClaimTarget:
+    """A claim on a scenario metric (read here for Monte Carlo pass rates and
+    the convergence tolerance; :func:`workbench.claims.parse_claims` validates
+    the full claim)."""
+
+    claim: object            # workbench.claims.Claim
+    scenario: str
+    metric: str
+
+
+@dataclass(frozen=True)
+class SwitchedRunSpec:
+    plant: PlantSpec
+    h: float
+    h_source: str
+    predictor: bool
+    phases: tuple[Phase, ...]
+    scenarios: tuple[Scenario, ...]
+    speed: str | None = None
+    montecarlo: object = None          # workbench.features.montecarlo.MonteCarloSpec
+    sampled: SampledSpec | None = None
+    convergence: bool = False
+    claims: tuple[ClaimTarget, ...] = ()
+    usable: tuple[str, ...] = ()       # definitions a law may use (no input in them)
+
+
+def _names_in(tree) -> set[str]:
+    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+
+
+def _controller_names(plant: PlantSpec) -> tuple[set[str], tuple[str, ...]]:
+    """Names a law or guard may use: states, parameters and the definitions
+    free of inputs (a definition using an input cannot be a controller's)."""
+    from ...expr import check_expression
+    inputs = set(plant.input_names)
+    uses_input: set[str] = set()
+    for name, text in plant.definitions:
+        used = _names_in(check_expression(text, _all(plant), path=plant.path, key=name))
+        if used & (inputs | uses_input):
+            uses_input.add(name)
+    usable = tuple(n for n, _ in plant.definitions if n not in uses_input)
+    return set(plant.state_names) | set(plant.parameters) | set(usable), usable
+
+
+def _all(plant: PlantSpec) -> set[str]:
+    return (set(plant.state_names) | set(plant.input_names) | set(plant.parameters)
+            | {n for n, _ in plant.definitions})
+
+
+def _phases(root: Reader, plant: PlantSpec, names: set[str]) -> tuple[Phase, ...]:
+    from ...expr import check_expression
+    tables = root.tables("phases")
+    if not tables:
+        raise root.fail("phases", [], "at least one [[phases]] table")
+    known, out = [], []
+    for t in tables:                       # every name first: a guard may point ahead
+        name = t.string("name")
+        if not _NAME.match(name) or name in known:
+            raise t.fail("name", name, "a phase name of letters, digits and _, used once")
+        known.append(name)
+    for t, name in zip(tables, known):
+        lt = t.table("law")
+        laws = []
+        for u in plant.input_names:
+            text = lt.raw(u)
+            check_expression(text, names, path=root.path, key=lt.key(u))
+            laws.append(text)
+        lt.finish()
+        nxt = []
+        for g in t.tables("next", default=[]):
+            to = g.string("to")
+            if to not in known or to == name:
+                raise g.fail("to", to, "another phase: " + ", ".join(
+                    str(k) for k in known if k != name))
+            nxt.append((to, g.raw("when")))
+            check_expression(nxt[-1][1], names, path=root.path, key=g.key("when"))
+            g.finish()
+        terminal = t.boolean("terminal", default=False)
+        until = None
+        if terminal:
+            until = t.raw("until")
+            check_expression(until, names, path=root.path, key=t.key("until"))
+        t.finish()
+        out.append(Phase(name, tuple(laws), tuple(nxt), terminal, until))
+    return tuple(out)
+
+
+def _multiple(r: Reader, key: str, value: float, dt: float, what: str) -> None:
+    k = value / dt
+    if not abs(k - round(k)) <= 1e-9 * max(k, 1.0):
+        raise r.fail(key, value, f"{what} a whole multiple of the step {dt:g} s "
+                     f"(found {k:.6g} steps)")
+
+
+def _scenarios(root: Reader, spec_plant: PlantSpec, phases, h: float, convergence: bool,
+               sampled) -> tuple[Scenario, ...]:
+    out, seen = [], set()
+    states, phase_names = spec_plant.state_names, [p.name for p in phases]
+    finest = 2 ** LEVELS[-1] if convergence else 1
+    tables = root.tables("scenarios")
+    if not tables:
+        raise root.fail("scenarios", [], "at least one [[scenarios]] table")
+    for r in tables:
+        name = r.string("name")
+        if not _NAME.match(name) or name in seen:
+            raise r.fail("name", name, "a new name of letters, digits and _")
+        seen.add(name)
+        xt = r.table("x0")
+        x0 = []
+        for s in states:
+            x0.append(xt.number(s, lo=-1e12, hi=1e12, what=f"number ({s})"))
+        xt.finish()
+        t_end = r.number("t_end", positive=True, hi=1e5, what="number (s)")
+        dt = r.number("dt", positive=True, hi=t_end / 10, what="number (s)")
+        if t_end / dt * finest > MAX_STEPS:
+            raise r.fail("dt", dt, f"at most {MAX_STEPS:g} steps over t_end"
+                         + (" at dt/4 ([convergence])" if convergence else ""))
+        if h:          # a multiple of dt is one of dt/2 and dt/4 too ([convergence])
+            _multiple(r, "dt", h, dt, f"a step with the delay h = {h:g} s")
+        if sampled is not None:
+            _multiple(r, "dt", sampled.period, dt,
+                      f"a step with the control period {sampled.period:g} s")
+        phase = r.string("phase", choices=phase_names)
+        pt = r.table("parameters", default=None)
+        over = {}
+        for k in list(pt.data):
+            if k not in spec_plant.parameters:
+                raise pt.fail(k, pt.data[k], "a parameter of [parameters]")
+            over[k] = pt.number(k, lo=-1e15, hi=1e15)
+        pt.finish()
+        tt = r.table("target", default=None)
+        target = {}
+        for k in list(tt.data):
+            if k not in states:
+                raise tt.fail(k, tt.data[k], "a state: " + ", ".join(states))
+            target[k] = tt.number(k, lo=-1e12, hi=1e12)
+        tt.finish()
+        rate = r.number("max_switch_rate", default=10.0, positive=True, hi=1e6,
+                        what="number of switches per second")
+        r.finish()
+        out.append(Scenario(name, tuple(x0), t_end, dt, phase, over, target, rate))
+    return tuple(out)
+
+
+def _sampled(root: Reader, plant: PlantSpec) -> SampledSpec | None:
+    if not root.has("sampled"):
+        return None
+    t = root.table("sampled")
+    period = t.number("period", positive=True, hi=1e3, what="control period (s)")
+    qt = t.table("quantisation", default=None)
+    q = {}
+    for k in list(qt.data):
+        if k not in plant.state_names:
+            raise qt.fail(k, qt.data[k], "a state: " + ", ".join(plant.state_names))
+        q[k] = qt.number(k, positive=True, hi=1e12, what="quantisation step")
+    qt.finish()
+    t.finish()
+    return SampledSpec(period, q)
+
+
+def _claim_targets(root: Reader, scenarios, metrics_of) -> tuple[ClaimTarget, ...]:
+    """The claims whose quantity is a scenario metric, built with the project's
+    :class:`~workbench.claims.Claim` (only well-typed ones: the others are
+    rejected by :func:`workbench.claims.parse_claims` after this)."""
+    from ...claims import Claim
+    raw = root.data.get("claims", [])
+    out = []
+    for c in raw if isinstance(raw, list) else []:
+        q, cid = (c.get("quantity"), c.get("id")) if isinstance(c, dict) else (None, None)
+        if not (isinstance(q, str) and isinstance(cid, str) and q.startswith("scenario.")):
+            continue
+        scen, _, metric = q[len("scenario."):].partition(".")
+        v, tol = c.get("value"), c.get("tolerance", 0.0)
+        cmp_, digits = c.get("compare"), c.get("digits")
+        ok = (scen in {s.name: s for s in scenarios} and metric in metrics_of(scen)
+              and isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+              and isinstance(tol, (int, float)) and not isinstance(tol, bool) and tol >= 0
+              and cmp_ in (">=", "<=", "==", "within")
+              and (digits is None or isinstance(digits, int) and not isinstance(digits, bool)))
+        if ok:
+            claim = Claim(cid, "", q, cmp_, float(v), float(tol), digits,
+                          c.get("rounding", "round") if c.get("rounding") in ("round", "truncate")
+                          else "round", "", False, "pass", "")
+            out.append(ClaimTarget(claim, scen, metric))
+    return tuple(out)
+
+
+def _check_law_units(plant: PlantSpec, model, phases, usable) -> None:
+    """Each law in its input's unit; guards and ``until`` of consistent units
+    (pint, :func:`workbench.kinds.delay_feedback.units.check_expression_units`)."""
+    from ...expr import parse_expression
+    from ..delay_feedback.units import check_expression_units
+    names = dict(zip(plant.state_names, model.x)) | dict(model.p)
+    names |= {k: model.definitions[k] for k in usable}
+    items = []
+    for i, ph in enumerate(phases):
+        texts = [(f"phases[{i}].law.{u}", t, u) for u, t in zip(plant.input_names, ph.law)]
+        texts += [(f"phases[{i}].next[{j}].when", w, None) for j, (_, w) in enumerate(ph.next)]
+        texts += [(f"phases[{i}].until", ph.until, None)] if ph.terminal else []
+        items += [(key, t, parse_expression(t, names, path=plant.path, key=key), want)
+                  for key, t, want in texts]
+    check_expression_units(plant, items)
+
+
+class SwitchedRun:
+    """The ``switched-run`` study (see the module docstring)."""
+
+    kind = "switched-run"
+    uses_solver = False
+
+    def load(self, root: Reader) -> SwitchedRunSpec:
+        plant = read_plant(root, operating_point=False)
+        names, usable = _controller_names(plant)
+        d = root.table("delay")
+        hq = d.quantity("h", "s", nonneg=True, hi=1e3)
+        predictor = d.boolean("predictor", default=False)
+        d.finish()
+        if predictor and not hq.value > 0:
+            raise root.fail("delay.predictor", True, "false when h = 0 (nothing to predict)")
+        phases = _phases(root, plant, names)
+        sampled = _sampled(root, plant)
+        convergence = root.has("convergence")
+        if convergence:
+            root.table("convergence").finish()
+        scenarios = _scenarios(root, plant, phases, hq.value, convergence, sampled)
+        speed = None
+        if root.has("comfort"):
+            ct = root.table("comfort")
+            speed = ct.string("speed", choices=plant.state_names)
+            ct.finish()
+        mc = None
+        if root.has("montecarlo"):
+            from ...features.montecarlo import load_montecarlo
+            mc = load_montecarlo(root, {k: False for k in plant.parameters}, max_samples=5000)
+            steps = max(s.t_end / s.dt for s in scenarios)
+            if mc.samples * steps > MAX_WORK:
+                raise root.fail("montecarlo.samples", mc.samples, f"at most {MAX_WORK:g} "
+                                "samples x steps (a Monte Carlo of hours is a study, not a check)")
+        from ..delay_feedback.model import PlantModel
+        from ..delay_feedback.units import check_units
+        model = PlantModel(plant)
+        check_units(model)
+        model.check_finite(plant.values(), "parameters")
+        _check_law_units(plant, model, phases, usable)
+        spec = SwitchedRunSpec(plant, hq.value, hq.source, predictor, phases, scenarios, speed,
+                               mc, sampled, convergence, (), usable)
+        from .quantities import scenario_metrics
+        claims = _claim_targets(root, scenarios, lambda s: scenario_metrics(spec, s))
+        from dataclasses import replace
+        return replace(spec, claims=claims)
+
+    def quantity_names(self, spec: SwitchedRunSpec) -> set[str]:
+        from ...features.quantities import names
+        from .quantities import TABLE
+        return names(TABLE, spec)
+
+    def quantity_units(self, spec: SwitchedRunSpec) -> dict[str, str]:
+        """name -> unit of every claimable quantity (:mod:`.quantities`)."""
+        from ...features.quantities import units
+        from .quantities import TABLE
+        return units(TABLE, spec)
+
+    def run(self, design):
+        from .study import run
+        return run(design.spec)
+
+    def quantities(self, res) -> dict:
+        from ...features.quantities import values
+        from .quantities import TABLE
+        return values(TABLE, res.spec, res)
+
+    def unconverged(self, res) -> dict[str, str]:
+        """claim id -> reason, for the claims whose metric did not converge
+        over dt, dt/2, dt/4 (``[convergence]``; used by :mod:`workbench.verify`)."""
+        return {r.claim_id: r.reason for r in res.refinement if not r.converged}
+
+
+STUDY = SwitchedRun()

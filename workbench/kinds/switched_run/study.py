@@ -1,0 +1,161 @@
+"""Compute a ``switched-run`` design: every scenario at its step, and the
+features the design names.
+
+* the nominal run of each scenario (recorded for the figures);
+* ``[convergence]``: the scenario again at dt/2 and dt/4; every metric's
+  three values go through :func:`workbench.sim.convergence.refinement_check`
+  (Richardson), and every claim on a scenario metric through
+  :func:`workbench.refinement` 's row check against the claim's tolerance (the
+  distance to the bound for ``<=``/``>=``), as the findings of other kinds
+  are: a claim whose metric has not converged is INCONCLUSIVE with the
+  reason (:meth:`workbench.kinds.switched_run.SwitchedRun.unconverged`);
+* ``[montecarlo]``: one batch of ``samples`` runs per scenario with the plant
+  parameters drawn (:func:`workbench.features.montecarlo.draw`, seeded; the
+  controller keeps the design's values), the metrics of every run, and per
+  claim on a scenario metric the share of runs that pass it with its Wilson
+  95 % interval (:func:`workbench.features.montecarlo.wilson_interval`) and,
+  with no failure, the success-run bound 0.05**(1/n): 0 failures in
+  n >= 299 runs show P >= 0.99 at 95 % confidence.
+
+References
+----------
+E. B. Wilson, J. Am. Stat. Assoc. 22:209-212, 1927 (score interval).
+L. F. Richardson, Phil. Trans. R. Soc. A 226:299-361, 1927.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from ...jsonable import json_method
+from .simulate import Batch, Compiled, simulate
+
+__all__ = ["ALPHA", "ClaimRate", "MonteCarloRun", "P_SHOWN", "ScenarioRun", "SwitchedRunResult",
+           "run", "runs_for"]
+
+#: One-sided risk of the success-run bound (95 % confidence).
+ALPHA = 0.05
+#: The pass probability the report says how many failure-free runs show.
+P_SHOWN = 0.99
+
+
+def runs_for(p: float, alpha: float = ALPHA) -> int:
+    """Fewest runs without a failure that show a pass probability >= ``p``
+    with confidence 1 - ``alpha`` (success-run rule: p**n <= alpha); 299 for
+    p = 0.99 at 95 %."""
+    return math.ceil(math.log(alpha) / math.log(p))
+
+
+@dataclass(frozen=True)
+class MonteCarloRun:
+    """The Monte Carlo batch of one scenario: draws and metrics per run."""
+
+    samples: int
+    seed: int
+    draws: dict = field(repr=False)       # parameter -> array of the drawn values
+    metrics: dict = field(repr=False)     # metric -> array over the runs
+    reasons: tuple = field(repr=False)
+
+
+@dataclass(frozen=True)
+class ClaimRate:
+    """Runs of a Monte Carlo that pass one claim, and their Wilson interval."""
+
+    claim_id: str
+    scenario: str
+    passes: int
+    n: int
+    p: float
+    lo: float
+    hi: float
+    success_run_lower: float | None
+
+
+@dataclass(frozen=True)
+class ScenarioRun:
+    """One scenario: the nominal run, its metrics, and the features' results."""
+
+    scenario: object
+    nominal: Batch = field(repr=False)
+    values: dict = field(default_factory=dict)      # metric -> float (designed step)
+    levels: tuple = ()                               # metric dicts at dt, dt/2, dt/4
+    checks: tuple = ()                               # (metric, Refinement) of every metric
+    montecarlo: MonteCarloRun | None = None
+
+
+@dataclass(frozen=True)
+class SwitchedRunResult:
+    spec: object
+    scenarios: tuple[ScenarioRun, ...]
+    refinement: tuple = ()          # RefinementRow of every claim on a scenario metric
+    claim_rates: tuple[ClaimRate, ...] = ()
+
+    JSON_FIELDS = {"scenarios": lambda r: {s.scenario.name: s.values for s in r.scenarios},
+                   "refinement": lambda r: {x.claim_id: x.outcome for x in r.refinement},
+                   "montecarlo": lambda r: {c.claim_id: [c.passes, c.n] for c in r.claim_rates}}
+    to_json = json_method
+
+
+def _values(batch: Batch) -> dict:
+    return {k: float(v[0]) for k, v in batch.metrics.items()}
+
+
+def run(spec) -> SwitchedRunResult:
+    """Compute a design (see the module docstring)."""
+    from ...sim.convergence import refinement_check
+    comp = Compiled(spec)
+    out, rows, rates = [], [], []
+    for sc in spec.scenarios:
+        nominal = simulate(spec, comp, sc, sc.dt, record=True)
+        values = _values(nominal)
+        levels, checks = (), ()
+        if spec.convergence:
+            levels = (values,) + tuple(_values(simulate(spec, comp, sc, sc.dt / 2 ** k))
+                                       for k in (1, 2))
+            checks = tuple((m, refinement_check(*(lv[m] for lv in levels), tolerance=math.inf))
+                           for m in values)
+            rows += _claim_rows(spec, sc.name, levels)
+        mc = None
+        if spec.montecarlo is not None:
+            mc = _montecarlo(spec, comp, sc)
+            rates += [_rate(c, mc) for c in spec.claims if c.scenario == sc.name]
+        out.append(ScenarioRun(sc, nominal, values, levels, checks, mc))
+    return SwitchedRunResult(spec, tuple(out), tuple(rows), tuple(rates))
+
+
+def _claim_rows(spec, scenario: str, levels) -> list:
+    """The refinement row of every claim on a metric of ``scenario``
+    (:mod:`workbench.refinement`: the claim's tolerance, the reason)."""
+    from ...refinement import refinement_row
+    rows = []
+    for c in spec.claims:
+        if c.scenario != scenario:
+            continue
+        vals = tuple(lv[c.metric] for lv in levels)
+        if math.isnan(vals[0]):
+            continue                       # not determined: INCONCLUSIVE already
+        rows.append(refinement_row(c.claim, vals, "dt", vals[0]))
+    return rows
+
+
+def _montecarlo(spec, comp, sc) -> MonteCarloRun:
+    from ...features.montecarlo import draw
+    mc = spec.montecarlo
+    drawn = draw(mc, tuple(spec.plant.parameters), spec.plant.values(sc.parameters))
+    draws = {k: drawn[k] for k in mc.distributions}
+    batch = simulate(spec, comp, sc, sc.dt, plant_params=draws)
+    return MonteCarloRun(mc.samples, mc.seed, draws, batch.metrics, batch.reasons)
+
+
+def _rate(target, mc: MonteCarloRun) -> ClaimRate:
+    """The share of runs passing ``target``'s claim (a run whose metric is not
+    determined, e.g. a diverged one, counts as a failure)."""
+    from ...claims import check_claim
+    from ...features.montecarlo import wilson_interval
+    from ...outcome import Verdict
+    v = mc.metrics[target.metric]
+    passes = sum(check_claim(target.claim, float(x)).verdict is Verdict.PASS for x in v)
+    k, n, p, lo, hi = wilson_interval(passes, len(v))
+    srl = ALPHA ** (1.0 / n) if passes == n else None
+    return ClaimRate(target.claim.id, target.scenario, int(passes), n, p, lo, hi, srl)
+
