@@ -23,6 +23,8 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import os
 import sys
 import time
@@ -47,7 +49,8 @@ def capture(path: str):
         raise _Captured()
     rs.certified_decay = hook
     try:
-        main(["verify", path])
+        with contextlib.redirect_stdout(io.StringIO()):
+            main(["verify", path])
     except _Captured:
         pass
     finally:

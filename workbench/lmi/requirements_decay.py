@@ -62,7 +62,7 @@ from .interval import IntervalLMI
 from .legendre import blockdiag_S
 from .scaling import balancing
 
-__all__ = ["CellLMI", "CellFamily", "decay_cells", "certified_decay"]
+__all__ = ["CellLMI", "CellFamily", "cell_family", "decay_cells", "certified_decay"]
 
 #: Largest alpha (h_b - h_a) of a cell: e^{alpha h} varies by at most 10 %
 #: across a cell.
