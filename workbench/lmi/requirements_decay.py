@@ -69,10 +69,10 @@ __all__ = ["CellLMI", "CellFamily", "cell_family", "decay_cells", "certified_dec
 CELL_LOG_SPAN = 0.1
 #: Caps (issues 32, 36): cells per point at one rate and cells solved in one
 #: decay search (counts: these decide, the same on every machine; the shipped
-#: searches solve 147-344 cells), and wall-clock seconds of a decay search, a
-#: last-resort safety only (MAX_SEARCH_CELLS cells take about 70 s on the shared
-#: 2-core machine, 0.05 s a cell, so it acts on a machine over 8x slower).
-#: Beyond any of them a rate is INCONCLUSIVE with the cap as its reason.
+#: searches solve 31-346 cells), and wall-clock seconds of a decay search, a
+#: last-resort safety only (MAX_SEARCH_CELLS cells take about 30 s of CPU on the
+#: shared 2-core machine, 0.02 s a cell, so it acts on a machine or a load about
+#: 20x slower). Beyond any of them a rate is INCONCLUSIVE with the cap as its reason.
 MAX_CELLS, MAX_SEARCH_CELLS, MAX_SECONDS = 400, 1500, 600.0
 
 
