@@ -161,6 +161,11 @@ class MarginLMI:
         Relative definiteness margin (see module docstring).
     bound : float
         Bound on every decision variable entry (at unit block size).
+    build : bool
+        Build the cvxpy problem now (default); False defers it to the first
+        solve, for an object used only for its numpy blocks and re-check
+        (e.g. the frame and ends of a decay cell,
+        :mod:`workbench.lmi.requirements_decay`).
     """
 
     #: Clarabel settings tried in order after an ``optimal_inaccurate`` answer
@@ -171,7 +176,8 @@ class MarginLMI:
     #: other than ``optimal`` (None: :attr:`retry_settings`).
     canonical_retry_settings: tuple[dict, ...] | None = None
 
-    def __init__(self, *, margin: float = DEFAULT_MARGIN, bound: float = DEFAULT_BOUND):
+    def __init__(self, *, margin: float = DEFAULT_MARGIN, bound: float = DEFAULT_BOUND,
+                 build: bool = True):
         if not 0 < margin < 1:
             raise ValueError(f"margin = {margin!r}; expected a relative margin in (0, 1)")
         self.margin, self.bound = float(margin), float(bound)
@@ -179,7 +185,7 @@ class MarginLMI:
                         for k in ("h", "iota") + tuple(self.parameters())}
         self._vars = self.variables()
         self._t = cp.Variable(name="t")
-        self._problem = self._build()
+        self._problem = self._build() if build else None
         self._canonical: cp.Problem | None = None
 
     # -- to be written by each criterion -----------------------------------
@@ -261,6 +267,8 @@ class MarginLMI:
                     margins, values if ok else None, seconds)
 
     def _solve_once(self, h: float, settings: Mapping) -> Step:
+        if self._problem is None:          # deferred (``build=False``)
+            self._problem = self._build()
         status, seconds = self._run(self._problem, h, settings)
         t_opt = self._t.value if status == cp.OPTIMAL else None
         if t_opt is None:

@@ -93,16 +93,18 @@ class IntervalLMI(MarginLMI):
         A criterion with an ``h_blocks`` mapping {block name: "h" or "1"}.
     from_zero : bool
         Lower end h_a = 0.
+    build : bool
+        Build the cvxpy problem now (:class:`~workbench.lmi.core.MarginLMI`).
     """
 
-    def __init__(self, base: MarginLMI, *, from_zero: bool):
+    def __init__(self, base: MarginLMI, *, from_zero: bool, build: bool = True):
         weights = getattr(base, "h_blocks", None)
         if weights is None or any(w not in WEIGHTS for w in weights.values()):
             raise ValueError(f"criterion {type(base).__name__}: h_blocks = {weights!r}; "
                              "expected a mapping of block names to 'h' or '1'")
         self.base, self.from_zero, self.weights = base, bool(from_zero), dict(weights)
         self.h_a = 0.0
-        super().__init__(margin=base.margin, bound=base.bound)
+        super().__init__(margin=base.margin, bound=base.bound, build=build)
 
     def parameters(self):
         return () if self.from_zero else ("h_a", "iota_a")
