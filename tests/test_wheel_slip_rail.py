@@ -27,10 +27,10 @@ def spec():
     return load_design(DESIGN).spec
 
 
-def _a11(spec, lam0: float) -> float:
-    """A11 = d omega'/d omega of the design's model at creep ``lam0`` (1/s)."""
+def _a11(spec, lam_0: float) -> float:
+    """A11 = d omega'/d omega of the design's model at creep ``lam_0`` (1/s)."""
     from workbench.kinds.delay_feedback import Vertex
-    return float(nominal_point(spec, Vertex("x", {"lam0": lam0}, "test"))[3][0, 0])
+    return float(nominal_point(spec, Vertex("x", {"lam_0": lam_0}, "test"))[3][0, 0])
 
 
 def test_band_brackets_the_adhesion_peak(spec):
@@ -39,7 +39,7 @@ def test_band_brackets_the_adhesion_peak(spec):
     p = {k: v.value for k, v in spec.plant.parameters.items()}
     lam_opt = math.log(p["a"] * p["b"] * p["c"]) / p["b"]
     assert lam_opt == pytest.approx(0.106, abs=5e-4)        # 003 Table 2, 3 digits
-    creeps = sorted(v.values["lam0"] for v in spec.vertices)
+    creeps = sorted(v.values["lam_0"] for v in spec.vertices)
     assert creeps[0] < lam_opt < creeps[-1]
 
 
@@ -55,7 +55,7 @@ def test_vertex_creep_poles(spec):
     assert poles["creep_0_090"] == pytest.approx(-0.5938, abs=1e-4)
     assert poles["peak_0_106"] == pytest.approx(-0.00898, abs=1e-5)
     assert poles["creep_0_125"] == pytest.approx(0.3112, abs=1e-4)
-    assert _a11(spec, spec.plant.parameters["lam0"].value) == pytest.approx(0.0831, abs=1e-4)
+    assert _a11(spec, spec.plant.parameters["lam_0"].value) == pytest.approx(0.0831, abs=1e-4)
 
 
 def test_a11_monotone_over_the_band(spec):
