@@ -1,0 +1,65 @@
+"""The rail wheel-slip design at the adhesion peak (issue 31, item 6): what its
+header states about the creep band, checked from the design's own model.
+
+The design holds paper 003's dry-rail adhesion law (eq 6, a, b, c = 0.3315,
+40.19, 5.392) near its peak lambda_opt = 0.106 (003 Table 2) over the creep
+band 0.09 .. 0.125. Its claims cover the operating point (creep 0.110); these
+tests cover the vertices, which no claimable quantity of a requirements design
+reads: the stable edge, the peak and the past-peak edge (open-loop unstable),
+and the monotone A11 that makes the points bracket the band.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from workbench.design import load_design
+from workbench.kinds.delay_feedback.run import nominal_point
+
+DESIGN = Path(__file__).resolve().parents[1] / "designs" / "wheel-slip-rail-delay-feedback.toml"
+
+
+@pytest.fixture(scope="module")
+def spec():
+    return load_design(DESIGN).spec
+
+
+def _a11(spec, lam_0: float) -> float:
+    """A11 = d omega'/d omega of the design's model at creep ``lam_0`` (1/s)."""
+    from workbench.kinds.delay_feedback import Vertex
+    return float(nominal_point(spec, Vertex("x", {"lam_0": lam_0}, "test"))[3][0, 0])
+
+
+def test_band_brackets_the_adhesion_peak(spec):
+    """lambda_opt = ln(a b c) / b (d mu/d lambda = 0 in eq 6) lies inside the
+    vertices' creep band; 003 prints it as 0.106 (Table 2)."""
+    p = {k: v.value for k, v in spec.plant.parameters.items()}
+    lam_opt = math.log(p["a"] * p["b"] * p["c"]) / p["b"]
+    assert lam_opt == pytest.approx(0.106, abs=5e-4)        # 003 Table 2, 3 digits
+    creeps = sorted(v.values["lam_0"] for v in spec.vertices)
+    assert creeps[0] < lam_opt < creeps[-1]
+
+
+def test_vertex_creep_poles(spec):
+    """Open-loop creep pole A11 per vertex: stable at 0.09, about zero at the
+    peak 0.106 (-0.009 1/s), unstable past it at 0.125 (+0.311 1/s, the
+    header's table); the torque-lag pole stays at -1/tau."""
+    poles = {}
+    for v in spec.vertices:
+        A = nominal_point(spec, v)[3]
+        poles[v.name] = A[0, 0]
+        assert A[1, 1] == pytest.approx(-1.0 / spec.plant.parameters["tau"].value)
+    assert poles["creep_0_090"] == pytest.approx(-0.5938, abs=1e-4)
+    assert poles["peak_0_106"] == pytest.approx(-0.00898, abs=1e-5)
+    assert poles["creep_0_125"] == pytest.approx(0.3112, abs=1e-4)
+    assert _a11(spec, spec.plant.parameters["lam_0"].value) == pytest.approx(0.0831, abs=1e-4)
+
+
+def test_a11_monotone_over_the_band(spec):
+    """A11 rises with the creep on [0.09, 0.125] (mu'' < 0), so the
+    linearisation at any creep of the band lies between the vertices'."""
+    a = [_a11(spec, x) for x in np.linspace(0.09, 0.125, 5)]
+    assert all(x < y for x, y in zip(a, a[1:]))
