@@ -157,3 +157,42 @@ def test_verify_attaches_the_peak(monkeypatch):
         _claim("a", "s.final_error.w", "<=", 0.01), _claim("b", "other", "<=", 2.0))))
     assert [r.peak for r in ev.claims] == [0.5, None]
     assert replace(ev.claims[0], verdict=Verdict.FAIL).peak == 0.5
+
+
+# -- paper 003: the compensated case at dt/4 (a real run: ~20-40 s) -------------------------
+@pytest.mark.slow
+def test_dry_stop_duration_levels_and_the_converged_instead():
+    """The stop duration of designs/antiskid-run-dry.toml at dt, dt/2, dt/4 is
+    what benchmarks/stop_refinement.py measured (85.96 / 86.68 / 86.14 s): not
+    converged within 0.5 s; the time to omega = 3 rad/s, the quantity the
+    finding names instead, converges (50.34 s)."""
+    from pathlib import Path
+
+    from workbench.design import load_design
+    from workbench.papers.p003.antiskid_refine import refine_levels
+    from workbench.papers.p003.antiskid_run import RECORD_DT, STUDY, RunResult, linear_check
+    from workbench.papers.p003.antiskid_run_spec import gain_for, nominal_cruise
+    from workbench.refinement import _own_row
+
+    design = load_design(Path(__file__).resolve().parents[1] / "designs/antiskid-run-dry.toml")
+    spec = replace(design.spec, cases=tuple(c for c in design.spec.cases
+                                            if c.name == "compensated"))
+    K = gain_for(spec)[0]
+    lin = nominal_cruise(spec)[2]
+    res = RunResult(0.0, 0.0, tuple(K), "", None, tuple(STUDY._cases(spec, K)),
+                    linear_check(spec, lin.A, lin.B, K), spec.dt)
+    stop = next(c for c in design.claims if c.id == "stop-duration")
+    assert stop.converged_instead == "cases[compensated].omega3_after_brake"
+    omega3 = replace(stop, id="omega3", quantity=stop.converged_instead, value=50.0,
+                     tolerance=1.0, expect="pass")
+    q = STUDY.quantities(res)
+    found = [ClaimResult(c, q[c.quantity], Verdict.FAIL) for c in (stop, omega3)]
+    lv = refine_levels(replace(design, spec=spec), res, found, quantities=STUDY.quantities,
+                       record_dt=RECORD_DT)
+    assert [round(x, 2) for x in lv["stop-duration"].values] == list(STOP_LEVELS)
+    row = _own_row(found[0], lv["stop-duration"], "dt")
+    assert row.outcome == INCONCLUSIVE and row.check.estimate > 0.5
+    assert "use `cases[compensated].omega3_after_brake` instead" in row.reason
+    ok = _own_row(found[1], lv["omega3"], "dt")
+    assert ok.outcome == CONVERGED and ok.check.estimate < 0.01
+    assert lv["omega3"].values[1] == pytest.approx(50.34, abs=0.01)

@@ -82,7 +82,7 @@ def refine_levels(design, result, findings, *, quantities, record_dt: float) -> 
         qn = r.claim.quantity
         m_case, m_sw, m_rate = _CASE.match(qn), _SWITCH.match(qn), _RATE.match(qn)
         if m_sw:
-            lv = _switch_levels(spec, result, cache, m_sw.group(1), m_sw.group(2))
+            lv = _switch_levels(spec, result, cache, m_sw.group(1), m_sw.group(2), r.got)
         elif m_case:
             qs = _case_quantities(spec, result, cache, m_case.group(1))
             lv = Levels(tuple(q.get(qn) for q in qs), "dt", spec.dt)
@@ -132,31 +132,40 @@ def _case_quantities(spec, result, cache, name) -> tuple:
                  for c in _case_levels(spec, result, cache, name))
 
 
-def _switch_levels(spec, result, cache, which: str, name: str) -> Levels:
-    """The basin verdict of the case's switch state at dt, dt/2, dt/4."""
+def _switch_levels(spec, result, cache, which: str, name: str, got) -> Levels:
+    """The basin verdict of the case's switch state at dt, dt/2, dt/4, by
+    the study's own method: the cruise switch judged in one
+    :func:`~workbench.papers.p003.antiskid_basin.cruise_basin` call with the
+    study's switch states (the weight is chosen over all of them, as in the
+    study) plus this case's at dt and dt/4; the brake switch by
+    :func:`~workbench.papers.p003.antiskid_basin_brake.brake_switch` at dt and
+    dt/4 (dt/2: the study's verdict, ``got``)."""
     if spec.basin is None:
         return Levels((), reason="the design has no basin check")
     from .antiskid_basin_run import brake_points, switch_points
     from .antiskid_run_spec import controller_settings, plant_values
     levels = _case_levels(spec, result, cache, name)
-    got = []
-    for c in levels:
-        pts = (switch_points([c]) if which == "cruise"
-               else brake_points([c], spec.scenario["v_d"]))
-        if not pts:
-            got.append("none")
-            continue
-        pt = pts[0][1]
-        if which == "cruise":
-            from .antiskid_basin import switch_in_basin
-            got.append(switch_in_basin(plant_values(spec), spec.scenario["v_d"], result.K, pt,
-                                       seed=spec.basin.seed).outcome.name)
-        else:
-            from .antiskid_basin_brake import brake_switch
-            prof = controller_settings(spec, result.K, spec.cases[0]).profile
-            got.append(brake_switch(plant_values(spec), name, pt, profile=prof, k_de=spec.k_de,
-                                    seed=spec.basin.seed).outcome.name)
-    return Levels(tuple(got), "dt", spec.dt)
+    v_d = spec.scenario["v_d"]
+    pick = (lambda c: switch_points([c])) if which == "cruise" else (
+        lambda c: brake_points([c], v_d))
+    pts = [pick(c) for c in levels]
+    if which == "cruise":
+        from .antiskid_basin import cruise_basin
+        extra = [(f"{name}@{k}", p[0][1]) for k, p in zip(("dt", "dt/4"), (pts[0], pts[2]))
+                 if p]
+        basin = cruise_basin(plant_values(spec), v_d, result.K,
+                             switch_points(result.cases) + extra, seed=spec.basin.seed,
+                             n_traj=0)
+        by = {p.label: p.verdict.outcome.name for p in basin.check.points}
+        vals = (by.get(f"{name}@dt", "none"), by.get(name, "none"), by.get(f"{name}@dt/4", "none"))
+    else:
+        from .antiskid_basin_brake import brake_switch
+        prof = controller_settings(spec, result.K, spec.cases[0]).profile
+        judge = lambda p: "none" if not p else brake_switch(
+            plant_values(spec), name, p[0][1], profile=prof, k_de=spec.k_de,
+            seed=spec.basin.seed).outcome.name
+        vals = (judge(pts[0]), got, judge(pts[2]))
+    return Levels(vals, "dt", spec.dt)
 
 
 def _rate_levels(spec, result, cache, variant: str, rate: float, qn: str) -> Levels:
