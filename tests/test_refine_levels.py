@@ -87,8 +87,9 @@ def test_stop_duration_is_inconclusive_with_its_levels_and_estimate(monkeypatch)
     # does not refine is INCONCLUSIVE, not silently passed
     assert rows["word"].outcome == NOT_CONVERGED and res["word"].verdict is Verdict.INCONCLUSIVE
     assert "yes / yes / no at dt, dt/2, dt/4" in res["word"].note
-    assert rows["bare"].outcome == NOT_CONVERGED and not res["bare"].ok
-    assert "its study has no three-level check of it" in res["bare"].note
+    assert rows["bare"].outcome == INCONCLUSIVE and not res["bare"].ok
+    assert res["bare"].note == ("not converged: no three-level check (its study has no "
+                                "three-level check of it)")
 
 
 def test_refinement_section_names_each_parameter(monkeypatch):
@@ -100,7 +101,7 @@ def test_refinement_section_names_each_parameter(monkeypatch):
     text = refinement_section(ev.refinement)[0]
     assert "| finding | metric | parameter | q1 | q2 | q4 |" in text
     assert "| `s` | `stop` | dt = 0.01 s | 85.96 | 86.68 | 86.14 | 0.42 | 1.7 | 0.5 |" in text
-    assert "| `b` | `bare` | — | — | — | — | — | — | — | NOT_CONVERGED: not converged" in text
+    assert "| `b` | `bare` | — | — | — | — | — | — | — | INCONCLUSIVE: not converged: no" in text
 
 
 def test_designs_without_own_levels_keep_their_table():

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 from .claims import Claim, ClaimResult
 from .memo import run_study
 from .report.markdown import fmt
-from .sim.convergence import (CONVERGED, NOT_CONVERGED, P_MAX, P_MIN, Refinement,
-                              refinement_check)
+from .sim.convergence import (CONVERGED, INCONCLUSIVE, NOT_CONVERGED, P_MAX, P_MIN,
+                              Refinement, refinement_check)
 
 __all__ = ["LEVELS", "Levels", "RefinementRow", "RefinementTable", "claim_tolerance",
            "refine_findings"]
@@ -201,6 +201,7 @@ def _own_row(r: ClaimResult, lv: Levels | None, field: str) -> RefinementRow:
     finding the study does not refine is INCONCLUSIVE."""
     if lv is None or not lv.values:
         why = lv.reason if lv is not None else "its study has no three-level check of it"
-        return RefinementRow(r.claim.id, r.claim.quantity, (), None, NOT_CONVERGED, None,
-                             f"not converged: {why}", lv.label if lv else "")
+        return RefinementRow(r.claim.id, r.claim.quantity, (), None, INCONCLUSIVE, None,
+                             f"not converged: no three-level check ({why})",
+                             lv.label if lv else "")
     return _row(r.claim, lv.values, field, r.got, lv.label)
