@@ -197,3 +197,26 @@ def test_dry_stop_duration_levels_and_the_converged_instead():
     ok = _own_row(found[1], lv["omega3"], "dt")
     assert ok.outcome == CONVERGED and ok.check.estimate < 0.01
     assert lv["omega3"].values[1] == pytest.approx(50.34, abs=0.01)
+
+
+def test_antiskid_refine_maps_findings_without_running():
+    """Findings whose metric has no step (the k2 sweep's certificate) get the
+    same value at every level; a metric the study does not refine gets a
+    reason (INCONCLUSIVE), and mc-converged's two-step comparison too."""
+    from types import SimpleNamespace
+
+    from workbench.papers.p003.antiskid_refine import last_refine_seconds, refine_levels
+    design = SimpleNamespace(name="fake-run", spec=SimpleNamespace(dt=0.01))
+    found = [ClaimResult(_claim("cert", "basin.compared_certified", "==", 0.0), 0.0,
+                         Verdict.PASS),
+             ClaimResult(_claim("lin", "linear.paper.exact_margin", ">=", 1.0), 2.0,
+                         Verdict.PASS),
+             ClaimResult(_claim("mc", "montecarlo.halving.fraction_agree", ">=", 1.0), 0.9,
+                         Verdict.FAIL)]
+    lv = refine_levels(design, SimpleNamespace(halving=None), found, quantities=None,
+                       record_dt=0.05)
+    assert lv["cert"].values == ("0", "0", "0") and "no step" in lv["cert"].parameter
+    assert lv["lin"].values == () and "linear.paper.exact_margin" in lv["lin"].reason
+    assert lv["mc"].values == () and "no step check" in lv["mc"].reason
+    wall, cpu = last_refine_seconds("fake-run")
+    assert wall >= 0 and cpu >= 0
