@@ -5,8 +5,9 @@ the design named), the braking time to v <= v_stop, the time to omega <= 3
 rad/s and the largest creep ratio in traction over lambda_opt at dt, dt/2 and dt/4, with the observed
 order and Richardson's error estimate of the dt/4 value
 (:func:`workbench.sim.convergence.refinement_check`) against a tolerance
-(:data:`TOLERANCES`). A measurement for the report's text, not a claim: the report
-still checks the cases at dt and dt/2 only.
+(:data:`TOLERANCES`). A measurement, not a claim: the report refines the metrics of its
+findings itself (workbench/papers/p003/antiskid_refine.py, the "Refinement of the
+findings" table); this script also shows metrics that enter no finding.
 
 Usage: .venv/bin/python benchmarks/stop_refinement.py [design.toml] [--case NAME]
 """

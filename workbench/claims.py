@@ -162,6 +162,9 @@ class ClaimResult:
     got: float | str | None
     verdict: Verdict
     note: str = ""
+    #: Peak error that sets the noise floor of ``got`` when it is a final or
+    #: minimum error (:func:`workbench.report.markdown.noise_cell`), else None.
+    peak: float | None = None
 
     @property
     def severity_holds(self) -> bool:

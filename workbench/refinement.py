@@ -21,13 +21,41 @@ from dataclasses import dataclass
 from .claims import Claim, ClaimResult
 from .memo import run_study
 from .report.markdown import fmt
-from .sim.convergence import (CONVERGED, NOT_CONVERGED, P_MAX, P_MIN, Refinement,
-                              refinement_check)
+from .sim.convergence import (CONVERGED, INCONCLUSIVE, NOT_CONVERGED, P_MAX, P_MIN,
+                              Refinement, refinement_check)
 
-__all__ = ["LEVELS", "RefinementRow", "RefinementTable", "claim_tolerance", "refine_findings"]
+__all__ = ["LEVELS", "Levels", "RefinementRow", "RefinementTable", "claim_tolerance",
+           "refine_findings", "refinement_row"]
 
 #: Refinement levels: the step divided by 2**k.
 LEVELS = (0, 1, 2)
+
+
+@dataclass(frozen=True)
+class Levels:
+    """A finding's metric at three refinement levels, from a study that
+    refines its own numerical parameters (``refine_levels``, see
+    :func:`refine_findings`).
+
+    ``values``: (q1, q2, q4), numbers or words; ``parameter``: the name of
+    the refined parameter (e.g. ``"dt"``, ``"plant_step"``) and ``step``
+    its designed value (the levels are it, its half, its quarter; ``unit``
+    its unit); ``reason``: set (and ``values`` empty) when the metric has
+    no three-level check, which makes the finding INCONCLUSIVE.
+    """
+
+    values: tuple
+    parameter: str = ""
+    step: float | None = None
+    unit: str = "s"
+    reason: str = ""
+
+    @property
+    def label(self) -> str:
+        """``"name = step unit"`` (empty without a parameter)."""
+        if not self.parameter:
+            return ""
+        return self.parameter + ("" if self.step is None else f" = {fmt(self.step)} {self.unit}")
 
 
 @dataclass(frozen=True)
@@ -47,6 +75,7 @@ class RefinementRow:
     outcome: str
     check: Refinement | None = None
     reason: str = ""
+    parameter: str = ""
 
     @property
     def converged(self) -> bool:
@@ -87,11 +116,19 @@ def claim_tolerance(c: Claim, got) -> float | None:
     return 0.5 * 10.0 ** -c.digits if c.digits is not None else c.tolerance
 
 
-def _row(c: Claim, values: tuple, field: str, got) -> RefinementRow:
+def _row(c: Claim, values: tuple, field: str, got, parameter: str = "") -> RefinementRow:
     tol = claim_tolerance(c, got)
     levels = f"{field}, {field}/2, {field}/4"
+    if parameter:
+        name = parameter.split(" = ")[0]
+        levels = f"{name}, {name}/2, {name}/4"
     instead = (f"`{c.converged_instead}`" if c.converged_instead else
                "a quantity that converges (the claim's `converged_instead`)")
+    row = _check(c, values, levels, tol, instead)
+    return dataclasses.replace(row, parameter=parameter) if parameter else row
+
+
+def _check(c: Claim, values: tuple, levels: str, tol, instead: str) -> RefinementRow:
     if tol is None or not all(isinstance(x, (int, float)) for x in values):
         same = len({str(x) for x in values}) == 1
         return RefinementRow(c.id, c.quantity, values, None, CONVERGED if same else NOT_CONVERGED,
@@ -109,13 +146,14 @@ def _row(c: Claim, values: tuple, field: str, got) -> RefinementRow:
                   f"{fmt(tol, 2)} ({shown} at {levels}, observed order {fmt(r.order, 2)}); "
                   f"use {instead} instead")
     else:
-        reason = (f"not converged: {c.quantity} {r.note} ({shown} at {levels}); "
+        est = "" if r.estimate is None else f", estimate {fmt(r.estimate, 2)} > tolerance {fmt(tol, 2)}"
+        reason = (f"not converged: {c.quantity} {r.note} ({shown} at {levels}{est}); "
                   f"use {instead} instead")
     return RefinementRow(c.id, c.quantity, values, tol, r.outcome, r, reason)
 
 
 def refine_findings(design, study, quantities: dict,
-                    checked: list[ClaimResult]) -> RefinementTable:
+                    checked: list[ClaimResult], result=None) -> RefinementTable:
     """Three-level refinement of the metric of every finding of ``design``.
 
     Parameters
@@ -127,6 +165,11 @@ def refine_findings(design, study, quantities: dict,
         The study's quantities at the designed step.
     checked : list of ClaimResult
         The claims' results at the designed step.
+    result : object, optional
+        The study's result at the designed step. A study with a
+        ``refine_levels(design, result, findings)`` method refines its own
+        parameters (it returns ``claim id -> Levels``, reusing the levels it
+        has computed); the others are run again at step/2 and step/4.
 
     Returns
     -------
@@ -139,6 +182,10 @@ def refine_findings(design, study, quantities: dict,
     finds = [r for r in checked if r.claim.is_finding and r.got is not None]
     if not finds:
         return RefinementTable(field, getattr(study, "refine_unit", ""), step, ())
+    if hasattr(study, "refine_levels"):
+        own = study.refine_levels(design, result, finds)
+        return RefinementTable(field, getattr(study, "refine_unit", ""), step,
+                               tuple(_own_row(r, own.get(r.claim.id), field) for r in finds))
     levels = [quantities]
     for k in LEVELS[1:]:
         spec = dataclasses.replace(design.spec, **{field: step / 2 ** k})
@@ -156,3 +203,15 @@ def refinement_row(c: Claim, values: tuple, field: str, got) -> RefinementRow:
     applies to each finding, for a kind that refines every claim itself
     (``switched-run``)."""
     return _row(c, values, field, got)
+
+
+def _own_row(r: ClaimResult, lv: Levels | None, field: str) -> RefinementRow:
+    """The row of a finding refined by its study (:class:`Levels`); a
+    finding the study does not refine is INCONCLUSIVE."""
+    if lv is None or not lv.values:
+        why = lv.reason if lv is not None else "its study has no three-level check of it"
+        return RefinementRow(r.claim.id, r.claim.quantity, (), None, INCONCLUSIVE, None,
+                             f"not converged: no three-level check ({why})",
+                             lv.label if lv else "")
+    return _row(r.claim, lv.values, field, r.got, lv.label)
+

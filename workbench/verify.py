@@ -1,14 +1,14 @@
 """Claims -> verdicts: run a design's study and check every claim."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from . import kinds
 from .claims import ClaimResult, Verdict, check_claim, fill_claim
 from .design import Design
 from .memo import run_study
-from .report.markdown import fmt
+from .report.markdown import fmt, noise_peak
 
 
 @dataclass(frozen=True)
@@ -36,11 +36,12 @@ def evaluate_design(design: Design) -> Evaluation:
     study = kinds.REGISTRY[design.kind]
     result = run_study(design, study.run)
     q = study.quantities(result)
-    checked = [check_claim(fill_claim(c, q, fmt), q.get(c.quantity)) for c in design.claims]
+    checked = [replace(check_claim(fill_claim(c, q, fmt), q.get(c.quantity)),
+                       peak=noise_peak(c.quantity, q)) for c in design.claims]
     table = None
     if hasattr(study, "refine_field"):
         from .refinement import refine_findings
-        table = refine_findings(design, study, q, checked)
+        table = refine_findings(design, study, q, checked, result)
         by_id = {row.claim_id: row for row in table.rows}
         checked = [_unconverged(r, by_id[r.claim.id]) if r.claim.id in by_id
                    and not by_id[r.claim.id].converged else r for r in checked]
@@ -53,7 +54,7 @@ def evaluate_design(design: Design) -> Evaluation:
 
 
 def _unconverged(r: ClaimResult, row) -> ClaimResult:
-    return ClaimResult(r.claim, r.got, Verdict.INCONCLUSIVE, row.reason)
+    return replace(r, verdict=Verdict.INCONCLUSIVE, note=row.reason)
 
 
 def project_commit(root) -> str:

@@ -17,7 +17,7 @@ import re
 from dataclasses import dataclass
 
 from ..claims import SEVERITIES, ClaimResult, Verdict
-from .markdown import fmt, md_table, slug
+from .markdown import fmt, md_table, noise_cell, slug
 from .verdict import HAZARD_HEADING, DesignVerdict
 
 #: Label of a finding whose severity nobody assessed (listed after the others).
@@ -139,7 +139,7 @@ def _evidence(r: ClaimResult, anchors) -> str:
     if c.compare == "within" or (c.compare != "==" and c.tolerance):
         want += f" ± {fmt(c.tolerance)}"
     link = section_link(c.quantity, anchors)
-    return (f"expected {want}, got {fmt(r.got, 5)} ({r.verdict.value}); claim `{c.id}`"
+    return (f"expected {want}, got {noise_cell(r.got, r.peak, 5)} ({r.verdict.value}); claim `{c.id}`"
             + (f"; shown in {link}" if link else ""))
 
 

@@ -91,6 +91,38 @@ def fmt(x, sig: int = 4) -> str:
     return s
 
 
+#: A final or minimum error below this fraction of the same state's peak error
+#: is rounding noise of the integration (its last bits differ between CPUs and
+#: under a few-ulp change of the inputs): printed as a bound, not as digits
+#: (issue 36, item 5). The one source of the floor: the claims table and the
+#: studies' own tables use :func:`noise_cell`.
+NOISE_FLOOR = 1e-9
+#: ``<prefix>.final_error.<state>`` / ``<prefix>.min_error.<state>``: a metric
+#: :func:`noise_peak` finds the peak of (``<prefix>.peak_error.<state>``).
+_ERROR_METRIC = re.compile(r"^(?P<pre>(?:.*\.)?)(?:final_error|min_error)\.(?P<state>[^.]+)$")
+
+
+def noise_peak(name: str, values: dict) -> float | None:
+    """The peak error that sets the noise floor of metric ``name``: for
+    ``<prefix>.final_error.<state>`` or ``<prefix>.min_error.<state>``, the
+    value of ``<prefix>.peak_error.<state>`` in ``values``; else None."""
+    m = _ERROR_METRIC.match(name)
+    if m is None:
+        return None
+    peak = values.get(f"{m['pre']}peak_error.{m['state']}")
+    return float(peak) if isinstance(peak, (int, float)) and not isinstance(peak, bool) \
+        else None
+
+
+def noise_cell(v, peak: float | None, sig: int = 4) -> str:
+    """``fmt(v, sig)``, or "< 1e-9 × peak" when ``v`` is below
+    :data:`NOISE_FLOOR` times ``peak`` (both finite; None: no floor)."""
+    if (peak is not None and isinstance(v, (int, float)) and not isinstance(v, bool)
+            and math.isfinite(v) and math.isfinite(peak) and abs(v) < NOISE_FLOOR * peak):
+        return f"< {fmt(NOISE_FLOOR)} × peak"
+    return fmt(v, sig)
+
+
 def md_table(header: Sequence[str], rows: Sequence[Sequence[object]],
              align: str | None = None) -> str:
     """A GitHub Markdown table; ``align`` is a string of l/r/c per column."""

@@ -17,7 +17,7 @@ from pathlib import Path
 from ..claims import ROUNDING_RTOL, ClaimResult, Verdict
 from .files import atomic_write, check_name, replace_set
 from .findings import findings_section, index_cells, section_link, summarise, tool_status
-from .markdown import Figure, Rendered, fmt, github_math, md_table
+from .markdown import Figure, Rendered, fmt, github_math, md_table, noise_cell
 from .verdict import (decide, design_items, hazard_entries, hazards_markdown, register_section,
                       render_verdict, traceability_section)
 
@@ -49,7 +49,7 @@ def claims_table(results: tuple[ClaimResult, ...]) -> str:
                                 if c.expect == "fail" else
                                 f" — workbench finding ({c.severity})" if c.severity else "")
         note += f" — does not test its requirement: {c.untested}" if c.untested else ""
-        rows.append([f"`{c.id}`", note, f"`{c.quantity}`", exp, fmt(r.got, 5),
+        rows.append([f"`{c.id}`", note, f"`{c.quantity}`", exp, noise_cell(r.got, r.peak, 5),
                      f"**{verdict}**", c.source])
     return md_table(["claim", "statement", "quantity", "expected", "got", "verdict", "source"],
                     rows, "lllrrll")
@@ -74,15 +74,23 @@ def refinement_section(table) -> list[str]:
     if not table.rows:
         return [head + "\n\n_No finding with a measured metric._"]
     rows = []
+    own = any(r.parameter for r in table.rows)
     for r in table.rows:
         c = r.check
-        rows.append([f"`{r.claim_id}`", f"`{r.quantity}`", *(fmt(x, 5) for x in r.values),
-                     "—" if c is None or c.order is None else fmt(c.order, 2),
+        vals = tuple(fmt(x, 5) for x in r.values) if r.values else ("—",) * 3
+        rows.append([f"`{r.claim_id}`", f"`{r.quantity}`", *([r.parameter or "—"] if own else []),
+                     *vals, "—" if c is None or c.order is None else fmt(c.order, 2),
                      "—" if c is None or c.estimate is None else fmt(c.estimate, 2),
-                     fmt(r.tolerance, 2), r.outcome + (f" ({c.note})" if c and c.note else "")])
+                     "—" if r.tolerance is None else fmt(r.tolerance, 2),
+                     r.outcome + (f" ({c.note})" if c and c.note else "")
+                     + (f": {r.reason}" if not r.values and r.reason else "")])
+    if own:
+        head += (" Here each finding names the parameter refined (q1 at its designed value, q2 "
+                 "at its half, q4 at its quarter); where the study reports a metric from a "
+                 "refined level (the cases from dt/2), the finding's value is that level's.")
     return [head + "\n\n" + md_table(
-        ["finding", "metric", "q1", "q2", "q4", "p", "estimate", "tolerance", "outcome"],
-        rows, "llrrrrrrl")]
+        ["finding", "metric", *(["parameter"] if own else []), "q1", "q2", "q4", "p",
+         "estimate", "tolerance", "outcome"], rows, "ll" + ("l" if own else "") + "rrrrrrl")]
 
 
 def verdict_summary(results) -> str:

@@ -10,7 +10,8 @@ import math
 
 import numpy as np
 
-from ...report.markdown import Figure, Rendered, fmt, fmt_floor, latex_matrix, md_table
+from ...report.markdown import (Figure, Rendered, fmt, fmt_floor, latex_matrix, md_table,
+                               noise_cell, noise_peak)
 from ...report.synthesis_text import (capped_text, closed_loop_eigs_text, exact_margin_text,
                                       recheck_table)
 from .requirements_render import gain_text, requirements_section, varying_section
@@ -229,22 +230,11 @@ def _exact_section(spec, res) -> str:
               "is the sound claim, the exact set says how conservative it is.")
 
 
-#: A final or signed error below this fraction of its state's peak error is
-#: rounding noise of the integration (last bits: it differs between CPUs),
-#: printed as a bound, not as digits.
-NOISE_FLOOR = 1e-9
-
-
 def _metric_cell(metrics: dict, key: str) -> str:
     """``metrics[key]`` to 4 digits, or "< 1e-9 × peak" when a final/min error is
-    below :data:`NOISE_FLOOR` times the same state's peak error."""
-    v = metrics[key]
-    kind, _, state = key.partition(".")
-    peak = metrics.get(f"peak_error.{state}")
-    if (kind in ("final_error", "min_error") and peak is not None and math.isfinite(v)
-            and math.isfinite(peak) and abs(v) < NOISE_FLOOR * peak):
-        return f"< {fmt(NOISE_FLOOR)} × peak"
-    return fmt(v, 4)
+    below :data:`~workbench.report.markdown.NOISE_FLOOR` times the same state's
+    peak error (:func:`~workbench.report.markdown.noise_cell`)."""
+    return noise_cell(metrics[key], noise_peak(key, metrics), 4)
 
 
 def _simulation_section(spec, res):

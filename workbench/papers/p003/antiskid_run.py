@@ -309,6 +309,15 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
 
 class AntiskidRun:
     kind = "antiskid-run"
+    #: Findings' metrics refined three levels (issue 33, item 4) by :meth:`refine_levels`.
+    refine_field, refine_unit = "dt", "s"
+
+    def refine_levels(self, design, result, findings) -> dict:
+        """The findings' metrics at three levels of their numerical parameter
+        (:func:`workbench.papers.p003.antiskid_refine.refine_levels`)."""
+        from .antiskid_refine import refine_levels
+        return refine_levels(design, result, findings, quantities=self.quantities,
+                             record_dt=RECORD_DT)
 
     def load(self, root: Reader) -> RunSpec:
         return load_run_spec(root)

@@ -45,7 +45,7 @@ to :data:`MESH_CHECK_MAX_HZ` again at ``plant_step`` / 2
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -135,7 +135,9 @@ class Variant:
     ``min_rate``: lowest grid rate from which every higher grid rate passes
     (None: the highest fails); ``bracket``: (highest failing, lowest passing)
     rate known after bisection (None on a side with no rate);
-    ``mesh``: (rate, agree, {metric: |difference|}) of the mesh check."""
+    ``mesh``: (rate, agree, {metric: |difference|}) of the mesh check;
+    ``mesh_rows``: its RateRows at plant_step / 2 (reused by the three-level
+    refinement of the findings, :mod:`workbench.papers.p003.antiskid_refine`)."""
 
     name: str
     q: float
@@ -145,6 +147,7 @@ class Variant:
     min_rate: float | None
     bracket: tuple
     mesh: tuple
+    mesh_rows: tuple = field(default=(), compare=False)
 
     def row(self, rate: float) -> RateRow:
         return next(r for r in self.rows if r.rate == rate)
@@ -236,13 +239,15 @@ def _bisect(ctx, spec: SampledSpec, q, tau, lo: float, hi: float) -> tuple:
 
 def _mesh_check(ctx, spec, q, tau, rows) -> tuple:
     """Grid rates up to MESH_CHECK_MAX_HZ again at plant_step / 2:
-    (rate, agree, {metric: |difference|})."""
-    out = []
+    ((rate, agree, {metric: |difference|}), ...) and the RateRows at
+    plant_step / 2."""
+    out, fines = [], []
     for row in rows:
         if row.rate > MESH_CHECK_MAX_HZ:
             continue
         fine = rate_row(ctx, row.rate, dt_p=spec.plant_step / 2,
                         predictor_step=spec.predictor_step, q=q, tau=tau)
+        fines.append(fine)
         diffs, agree = {}, fine.metrics["ok"] == row.metrics["ok"]
         for k, tol in MESH_ATOL.items():
             a, b = row.metrics[k], fine.metrics[k]
@@ -251,7 +256,7 @@ def _mesh_check(ctx, spec, q, tau, rows) -> tuple:
             diffs[k] = d
             agree = agree and (same_nan or d <= tol)
         out.append((row.rate, agree, diffs))
-    return tuple(out)
+    return tuple(out), tuple(fines)
 
 
 def run_variant(ctx: Context, spec: SampledSpec, name: str, q: float, tau: float) -> Variant:
@@ -271,7 +276,7 @@ def run_variant(ctx: Context, spec: SampledSpec, name: str, q: float, tau: float
     elif min_rate is None:
         bracket = (spec.rates[-1], None)
     return Variant(name, q, tau, rows, probes, min_rate, bracket,
-                   _mesh_check(ctx, spec, q, tau, rows))
+                   *_mesh_check(ctx, spec, q, tau, rows))
 
 
 def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:

@@ -1,0 +1,227 @@
+"""Three-level refinement of the findings of an ``antiskid-run`` design
+(issue 33, item 4).
+
+The study computes every case at dt and dt/2 (reporting dt/2), its
+sampled-data rates on a plant mesh of sub-step ``plant_step`` (checked at
+``plant_step / 2`` up to 1 kHz) and its Monte Carlo runs at the sweep's dt
+(its first runs again at dt/2). :func:`refine_levels` adds the one missing
+level of what enters a finding, and only that:
+
+* ``cases[<case>].*``: the case once more at dt/4 (the same scenario, the
+  same mesh rule); the three levels are dt, dt/2 (reported) and dt/4, the
+  comfort peaks included;
+* ``switch.cruise[<case>].in_basin`` / ``switch.brake[<case>].in_basin``:
+  the basin verdict of the switch state of the run at each of the three
+  levels;
+* ``sampled.<variant>.rate[<f>].*``: the rate once more at plant_step/4;
+  the levels are plant_step (reported), plant_step/2 and plant_step/4;
+* ``montecarlo.*``: the first ``halving_samples`` runs of the sweep once
+  more at the sweep's dt/4 (compiled kernel when the sweep uses it); a
+  share claim is refined on the outcome behind it, per run: the row shows
+  how many of those runs have it at dt, dt/2, dt/4 (our choice: the whole
+  sample at dt/4 would cost four sweeps);
+* ``basin.*`` of the k2 sweep: no step (a certificate at the printed switch
+  state (v_d, lambda_opt)), the same value at every level.
+
+A finding whose metric is not among these is INCONCLUSIVE
+(:func:`workbench.refinement.refine_findings`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+import time
+
+import numpy as np
+
+from ...refinement import Levels
+from ...report.markdown import fmt
+
+__all__ = ["refine_levels", "last_refine_seconds"]
+
+_CASE = re.compile(r"^cases\[([^\]]+)\]\.")
+_SWITCH = re.compile(r"^switch\.(cruise|brake)\[([^\]]+)\]\.in_basin$")
+_RATE = re.compile(r"^sampled\.([a-z_]+)\.rate\[([^\]]+)\]\.")
+#: Monte Carlo quantity -> per-run outcome behind it (HalvingCheck keys).
+MC_OUTCOMES = {"montecarlo.fraction.diverged": "diverged",
+               "montecarlo.wilson.diverged.lo": "diverged",
+               "montecarlo.fraction.above_lambda_opt": "above_lambda_opt"}
+
+_SECONDS: dict = {}
+
+
+def last_refine_seconds(name: str) -> tuple:
+    """(wall, CPU) seconds :func:`refine_levels` last spent on design
+    ``name`` in this process ((NaN, NaN) if never; for benchmarks, not
+    printed in reports)."""
+    return _SECONDS.get(name, (math.nan, math.nan))
+
+
+def refine_levels(design, result, findings, *, quantities, record_dt: float) -> dict:
+    """claim id -> :class:`workbench.refinement.Levels` for every finding
+    of an ``antiskid-run`` design (module docstring).
+
+    Parameters
+    ----------
+    design : workbench.design.Design
+    result : RunResult
+        The study's result (its dt and dt/2 runs are reused).
+    findings : list of ClaimResult
+        The findings (claims with a severity) and their values.
+    quantities : callable
+        The study's ``RunResult -> quantities`` (applied to one case per level).
+    record_dt : float
+        Record step (s) of the study's runs (the comfort peaks).
+    """
+    t0, c0 = time.perf_counter(), time.process_time()
+    spec = design.spec
+    cache: dict = {"quantities": quantities, "record_dt": record_dt}
+    out = {}
+    for r in findings:
+        qn = r.claim.quantity
+        m_case, m_sw, m_rate = _CASE.match(qn), _SWITCH.match(qn), _RATE.match(qn)
+        if m_sw:
+            lv = _switch_levels(spec, result, cache, m_sw.group(1), m_sw.group(2), r.got)
+        elif m_case:
+            qs = _case_quantities(spec, result, cache, m_case.group(1))
+            lv = Levels(tuple(q.get(qn) for q in qs), "dt", spec.dt)
+        elif m_rate:
+            lv = _rate_levels(spec, result, cache, m_rate.group(1), float(m_rate.group(2)), qn)
+        elif qn in MC_OUTCOMES or qn == "montecarlo.halving.fraction_agree":
+            lv = _mc_levels(design, result, cache, qn)
+        elif qn.startswith("basin."):
+            v = fmt(r.got, 6)
+            lv = Levels((v, v, v), "none (a certificate at the printed switch state, no step)")
+        else:
+            lv = Levels((), reason=f"no three-level check of `{qn}` in this study")
+        out[r.claim.id] = lv
+    _SECONDS[design.name] = (time.perf_counter() - t0, time.process_time() - c0)
+    return out
+
+
+def _case_levels(spec, result, cache, name):
+    """The case at dt, dt/2 (the study's) and dt/4 (run here) as CaseResults."""
+    key = ("case", name)
+    if key in cache:
+        return cache[key]
+    from .antiskid_run_spec import case_mesh, case_metrics, controller_settings, run_settings
+    from .antiskid_scenario import simulate_antiskid
+    cr = result.case(name)
+    cs = controller_settings(spec, result.K, cr.case)
+    rec = cache["record_dt"]
+    run4, m4 = simulate_antiskid(run_settings(spec, cs), spec.dt / 4, record_dt=rec,
+                                 mesh=case_mesh(spec, cr.case))
+    q4 = case_metrics(m4, cs, spec.scenario["t_brake"])
+    c4 = None
+    if spec.comfort is not None:
+        from .antiskid_comfort import comfort_of
+        c4 = comfort_of(run4, spec.comfort, cs.u_range / spec.torque_range, rec)
+    coarse = dataclasses.replace(cr, metrics=cr.metrics_coarse, switch=None,
+                                 comfort=cr.comfort_coarse)
+    quarter = dataclasses.replace(cr, metrics=q4, metrics_coarse=q4, run=run4, switch=None,
+                                  comfort=c4, comfort_coarse=c4)
+    cache[key] = (coarse, cr, quarter)
+    return cache[key]
+
+
+def _case_quantities(spec, result, cache, name) -> tuple:
+    """The study's quantities of one case at dt, dt/2, dt/4."""
+    bare = dataclasses.replace(result, montecarlo=None, halving=None, basin=None, sampled=None)
+    return tuple(cache["quantities"](dataclasses.replace(bare, cases=(c,)))
+                 for c in _case_levels(spec, result, cache, name))
+
+
+def _switch_levels(spec, result, cache, which: str, name: str, got) -> Levels:
+    """The basin verdict of the case's switch state at dt, dt/2, dt/4, by
+    the study's own method: the cruise switch judged in one
+    :func:`~workbench.papers.p003.antiskid_basin.cruise_basin` call with the
+    study's switch states (the weight is chosen over all of them, as in the
+    study) plus this case's at dt and dt/4; the brake switch by
+    :func:`~workbench.papers.p003.antiskid_basin_brake.brake_switch` at dt and
+    dt/4 (dt/2: the study's verdict, ``got``)."""
+    if spec.basin is None:
+        return Levels((), reason="the design has no basin check")
+    from .antiskid_basin_run import brake_points, switch_points
+    from .antiskid_run_spec import controller_settings, plant_values
+    levels = _case_levels(spec, result, cache, name)
+    v_d = spec.scenario["v_d"]
+    pick = (lambda c: switch_points([c])) if which == "cruise" else (
+        lambda c: brake_points([c], v_d))
+    pts = [pick(c) for c in levels]
+    if which == "cruise":
+        from .antiskid_basin import cruise_basin
+        extra = [(f"{name}@{k}", p[0][1]) for k, p in zip(("dt", "dt/4"), (pts[0], pts[2]))
+                 if p]
+        basin = cruise_basin(plant_values(spec), v_d, result.K,
+                             switch_points(result.cases) + extra, seed=spec.basin.seed,
+                             n_traj=0)
+        by = {p.label: p.verdict.outcome.name for p in basin.check.points}
+        vals = (by.get(f"{name}@dt", "none"), by.get(name, "none"), by.get(f"{name}@dt/4", "none"))
+    else:
+        from .antiskid_basin_brake import brake_switch
+        prof = controller_settings(spec, result.K, spec.cases[0]).profile
+        judge = lambda p: "none" if not p else brake_switch(
+            plant_values(spec), name, p[0][1], profile=prof, k_de=spec.k_de,
+            seed=spec.basin.seed).outcome.name
+        vals = (judge(pts[0]), got, judge(pts[2]))
+    return Levels(vals, "dt", spec.dt)
+
+
+def _rate_levels(spec, result, cache, variant: str, rate: float, qn: str) -> Levels:
+    """A sampled rate's metric at plant_step (reported), /2 and /4."""
+    from .antiskid_run_spec import sampled_context
+    from .antiskid_sampled import rate_row, sampled_quantities
+    sp = spec.sampled
+    res = result.sampled
+    v = res.variant(variant)
+    if rate not in sp.rates:
+        return Levels((), reason=f"rate {rate:g} Hz is not a grid rate")
+    ctx = cache.get("ctx") or cache.setdefault("ctx", sampled_context(spec, result.K))
+    half = next((r for r in v.mesh_rows if r.rate == rate), None)   # the mesh check's
+    rows = []
+    for k in (1, 2):
+        key = ("rate", variant, rate, k)
+        if key not in cache:
+            cache[key] = half if k == 1 and half is not None else rate_row(
+                ctx, rate, dt_p=sp.plant_step / 2 ** k, predictor_step=sp.predictor_step,
+                q=v.q, tau=v.tau)
+        rows.append(cache[key])
+    vals = [sampled_quantities(res).get(qn)]
+    for row in rows:
+        alt = dataclasses.replace(v, rows=tuple(row if x.rate == rate else x for x in v.rows))
+        alt_res = dataclasses.replace(res, variants=tuple(alt if x.name == variant else x
+                                                          for x in res.variants))
+        vals.append(sampled_quantities(alt_res).get(qn))
+    return Levels(tuple(vals), "plant_step", sp.plant_step)
+
+
+def _mc_levels(design, result, cache, qn: str) -> Levels:
+    """A Monte Carlo share on the first runs at the sweep's dt, dt/2, dt/4."""
+    hc = result.halving
+    if hc is None:
+        return Levels((), reason="the design has no step check of its Monte Carlo runs")
+    if "mc" not in cache:
+        cache["mc"] = _mc_quarter(design, result, hc.n)
+    quarter = cache["mc"]
+    if qn == "montecarlo.halving.fraction_agree":
+        return Levels((), reason="a comparison of two steps, not a metric of the runs; the "
+                      "outcomes behind the Monte Carlo findings are refined three levels in "
+                      "the rows of the share findings (first runs at dt, dt/2, dt/4)")
+    key = MC_OUTCOMES[qn]
+    vals = tuple(f"{sum(bool(x) for x in lv[key])} of {hc.n} {key.replace('_', ' ')}"
+                 for lv in (hc.coarse, hc.fine, quarter))
+    return Levels(vals, f"montecarlo.dt (first {hc.n} runs)", hc.dt)
+
+
+def _mc_quarter(design, result, n: int) -> dict:
+    """Outcomes of the first n sweep runs at the sweep's dt/4."""
+    from .antiskid_halving import _step_values
+    from .antiskid_kernel import default_kernel
+    from .antiskid_montecarlo import chunk_payload, chunk_worker, per_run, run_lambda_opt, \
+        sweep_inputs
+    inp = sweep_inputs(design, n, design.spec.montecarlo.seed, result.K)
+    o = chunk_worker(chunk_payload(inp, 0, n, inp["dt"] / 4, default_kernel()))
+    raw = {k: np.asarray(v, float) for k, v in o["metrics"].items()}
+    vals = _step_values(*per_run(raw, run_lambda_opt(inp), inp["scenario"]["t_brake"]))
+    return {k: tuple(bool(x) for x in vals[k]) for k in ("diverged", "above_lambda_opt")}
