@@ -297,6 +297,14 @@ def synthesize_requirements(loop: Loop, *, objective: Objective, H: float,
     first = _pass(loop, T, objective, H=H, alpha=alpha, gamma=gamma, margin=margin,
                   fraction=fraction, rel_tol=rel_tol, mu=mu)
     if first.point is None or first.point.outcome is not Outcome.CERTIFIED:
+        # the balancing step of the coordinates can defeat the synthesis (a nearly
+        # decoupled state scaled by 2^12): once more with the Gramian normalisation alone
+        T = gramian_scaling(list(loop.points), H, balance=False)
+        retry = _pass(loop, T, objective, H=H, alpha=alpha, gamma=gamma, margin=margin,
+                      fraction=fraction, rel_tol=rel_tol, mu=mu)
+        if retry.point is not None and retry.point.outcome is Outcome.CERTIFIED:
+            first = retry
+    if first.point is None or first.point.outcome is not Outcome.CERTIFIED:
         return RequirementDesign(objective, first.bracket, first.eps, None, first.point, None,
                                  reason=first.reason)
     # second pass, in coordinates re-balanced from the first gain's closed loop

@@ -117,8 +117,8 @@ def balance_loop(A, Ad):
     return T, Tinv, Tinv @ A @ T, Tinv @ Ad @ T
 
 
-def gramian_scaling(points: Sequence[tuple[np.ndarray, np.ndarray]], horizon: float
-                    ) -> np.ndarray:
+def gramian_scaling(points: Sequence[tuple[np.ndarray, np.ndarray]], horizon: float,
+                    balance: bool = True) -> np.ndarray:
     """Diagonal state scaling of a *synthesis* (K unknown) that follows every
     diagonal similarity of the plant: T = diag(sqrt(W_jj)) with W the
     finite-horizon controllability Gramian int_0^tau e^{At} B B' e^{A't} dt
@@ -137,6 +137,13 @@ def gramian_scaling(points: Sequence[tuple[np.ndarray, np.ndarray]], horizon: fl
     points : sequence of (A, B)
     horizon : float
         tau (s), > 0: the problem's time scale (the delay cap).
+    balance : bool
+        False: the Gramian normalisation alone, without the final balancing
+        (it also follows every diagonal similarity). The balancing can blow a
+        nearly decoupled state up by 2^12 when a diagonal entry of A is near
+        0 (a triangular A at an adhesion peak), and the synthesis then fails;
+        :func:`~workbench.lmi.requirements_synthesis.synthesize_requirements`
+        retries without it.
 
     Returns
     -------
@@ -161,6 +168,8 @@ def gramian_scaling(points: Sequence[tuple[np.ndarray, np.ndarray]], horizon: fl
     ok = np.isfinite(d) & (d > 0)
     d = np.where(ok, d, 1.0)
     T = np.diag(d)
+    if not balance:
+        return T
     A0 = np.diag(1.0 / d) @ np.asarray(points[0][0], float) @ T
     return T @ balancing(A0)
 
