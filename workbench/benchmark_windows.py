@@ -8,10 +8,12 @@ independent picture of the figure.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import replace
 
 import numpy as np
 
+from .lmi.analysis import make_criterion
 from .lmi.core import Outcome
 from .lmi.interval import IntervalCertificate, IntervalLMI, IntervalSearch, Link, certified_interval
 from .margins import SpectrumNotConverged, spectral_abscissa, stability_windows
@@ -90,7 +92,8 @@ def settle_point(lmi, h: float, h_refuted: float, sig: int = POINT_DIGITS) -> fl
 
 
 def settle_interval(lmi, c: IntervalCertificate, h_max: float,
-                    sig: int = PRINTED_DIGITS) -> IntervalCertificate:
+                    sig: int = PRINTED_DIGITS, win: IntervalLMI | None = None
+                    ) -> IntervalCertificate:
     """The interval ``c`` with its ends decided on the grid of printed values.
 
     A search ends within its tolerance of the criterion's boundary, and where
@@ -104,8 +107,10 @@ def settle_interval(lmi, c: IntervalCertificate, h_max: float,
     value, decided by a solve *at* that value: a last-bit difference can
     change it only where the criterion's own boundary lies within solver
     noise of the grid value, not wherever the search happened to stop.
+    ``win``: the interval LMI [h_a, h_b] of ``lmi`` to solve (default: built
+    here).
     """
-    win = IntervalLMI(lmi, from_zero=False)
+    win = win or IntervalLMI(lmi, from_zero=False)
     links, lo, hi = list(c.links), c.lo, c.hi
     if 0 < lo:
         down, up = directed(lo, up=False, sig=sig), directed(lo, up=True, sig=sig)
@@ -135,11 +140,12 @@ def settle_interval(lmi, c: IntervalCertificate, h_max: float,
 
 
 def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: float,
-                    guess=None) -> dict:
+                    guess=None, compiled: "Compiled | None" = None) -> dict:
     """Interval search of one criterion and its comparison with the exact windows:
     ``interval``, ``intervals``, ``interval_solves``, ``interval_ratio``, ``point_sound``,
     ``interval_sound`` (keyword fields of a benchmark row). ``lmi`` None: the
-    point comparison only."""
+    point comparison only. ``compiled``: the example's :class:`Compiled`
+    (default: interval LMIs built here)."""
     h = bound.h_certified
     point = None if not h > 0 else (
         windows == ((0.0, math.inf),) if math.isinf(h) else in_window(h, windows))
@@ -147,11 +153,16 @@ def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: f
     if lmi is None:
         return out
     starts = [middle(a, b, h_max) for a, b in windows if a > 0]
+    comp = compiled or Compiled(lmi.A, lmi.Ad, lmi.margin)
+    zero = None if getattr(lmi, "range_from_zero", False) or not getattr(lmi, "h_blocks", 1) \
+        else comp.interval(lmi, from_zero=True)
     search = certified_interval(lmi, h_hi=h_max, starts=starts, rel_tol=rel_tol,
                                 guess=guess or (h if 0 < h < h_max else None),
-                                max_solves=260)
+                                max_solves=260, zero=zero,
+                                lower=comp.interval(lmi, from_zero=False))
     if search.interval is not None:
-        settled = tuple(settle_interval(lmi, c, h_max) for c in search.intervals)
+        settled = tuple(settle_interval(lmi, c, h_max, win=comp.interval(lmi, from_zero=False))
+                        for c in search.intervals)
         pick = search.intervals.index(search.interval)
         search = IntervalSearch(settled[pick], settled, search.outcome, search.steps)
     iv = search.bounds
@@ -165,6 +176,44 @@ def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: f
                                      (1.0 if math.isinf(iv[1]) and math.isinf(h_star)
                                       else None))
     return out
+
+
+class Compiled:
+    """The criteria of one example and their interval LMIs, each compiled once.
+
+    The first request of a criterion (method, N) or of an interval LMI of a
+    criterion returns a new one; every later request a fork
+    (:meth:`~workbench.lmi.core.MarginLMI.fork`): the same compiled problem
+    with a solver state of its own, so every solve is bit for bit that of a
+    newly built criterion (the cvxpy compilation is the larger part of the
+    suite's time: issue 36, item 4). ``A``, ``Ad``: the example's matrices.
+    ``WORKBENCH_BENCHMARK_UNSHARED=1`` selects the old path (a new criterion,
+    hence a new compilation, for every request;
+    ``benchmarks/delay_benchmarks_times.py``).
+    """
+
+    def __init__(self, A, Ad, margin: float):
+        self.A, self.Ad, self.margin = A, Ad, margin
+        self._criteria: dict = {}
+        self._intervals: dict = {}
+        self.unshared = os.environ.get("WORKBENCH_BENCHMARK_UNSHARED") == "1"
+
+    def criterion(self, method: str, N: int | None = None):
+        """The criterion of ``method`` (order ``N``), new or a fork."""
+        key = (method, N)
+        if key not in self._criteria or self.unshared:
+            self._criteria[key] = make_criterion(method, self.A, self.Ad, N=N,
+                                                 margin=self.margin)
+            return self._criteria[key]
+        return self._criteria[key].fork()
+
+    def interval(self, base, *, from_zero: bool) -> IntervalLMI:
+        """The interval LMI of ``base`` (a criterion or a fork of one), new or a fork."""
+        key = (id(base._problem), from_zero)
+        if key not in self._intervals or self.unshared:
+            self._intervals[key] = (base, IntervalLMI(base, from_zero=from_zero))
+            return self._intervals[key][1]
+        return self._intervals[key][1].fork()
 
 
 def middle(a: float, b: float, h_max: float) -> float:
