@@ -5,13 +5,17 @@ delay-benchmark design (default ``designs/delay-benchmarks.toml``) in two
 fresh processes: one on the old path, selected by
 ``WORKBENCH_BENCHMARK_UNSHARED=1`` (a new criterion, hence a new cvxpy
 compilation, for every point search, interval search and settled interval
-end), and one on the current path (each criterion and interval LMI of an
-example compiled once, later uses are forks with a solver state of their
-own: :class:`workbench.benchmark_windows.Compiled`). Prints the CPU seconds
-per example and in total, the number of cvxpy compilations and solves, and
-whether both paths gave the same results: every field of ``--json`` except
-the seconds (they must: only compilations are shared, each solve is the one
-a new criterion would make). Nothing here asserts a time.
+end; every Bessel-Legendre order's interval searched), and one on the
+current path (each criterion and interval LMI of an example compiled once,
+later uses are forks with a solver state of their own:
+:class:`workbench.benchmark_windows.Compiled`; order N + 1's interval not
+searched when order N's already fills the one exact window on the printed
+grid: :func:`workbench.benchmark_windows.implies_next`). Prints the CPU
+seconds per example and in total, the number of cvxpy compilations, solves
+and interval searches implied, and whether both paths gave the same results:
+every field of ``--json`` except the seconds and the interval solve counts
+(they must: each solve made is the one a new criterion would make, and an
+implied row is the row a search gives). Nothing here asserts a time.
 
 Usage::
 
@@ -58,12 +62,16 @@ def worker(path: str, names: list[str]) -> None:
         results.append(run_example(ex, spec.settings))
         times[ex.name] = _cpu() - c0
     data = BenchmarkResult(spec.settings, tuple(results)).to_json()
+    solves, implied = 0, 0
     for e in data["examples"]:
         for m in e["methods"]:
             m.pop("seconds")
-    print(json.dumps({"times": times, "compiles": compiles[0],
-                      "solves": sum(m["solves"] + m["interval_solves"] for e in data["examples"]
-                                    for m in e["methods"]),
+            solves += m["solves"] + m["interval_solves"]
+            implied += m["interval_solves"] == 0 and m["certified_interval"] is not None \
+                and m["method"] == "bessel-legendre" and m["N"] > 0
+            m.pop("interval_solves")
+    print(json.dumps({"times": times, "compiles": compiles[0], "solves": solves,
+                      "implied": implied,
                       "result": json.dumps(data, sort_keys=True)}), flush=True)
 
 
@@ -99,8 +107,9 @@ def main() -> None:
     t, u = sum(old["times"].values()), sum(new["times"].values())
     print(f"| total | {t:.1f} | {u:.1f} | {u / t:.2f} |")
     print(f"\ncvxpy compilations: {old['compiles']} before, {new['compiles']} after; "
-          f"solves: {old['solves']} before, {new['solves']} after")
-    print(f"same results on both paths (every --json field but seconds): "
+          f"solves: {old['solves']} before, {new['solves']} after; Bessel-Legendre interval "
+          f"searches implied by the order below: {old['implied']} before, {new['implied']} after")
+    print(f"same results on both paths (every --json field but seconds and interval_solves): "
           f"{old['result'] == new['result']}")
 
 

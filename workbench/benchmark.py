@@ -28,8 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .benchmark_windows import (Compiled, abscissa_curve, directed, exact_windows, interval_fields,
-                                middle, monotone, settle_point, show_window)
+from .benchmark_windows import (Compiled, abscissa_curve, directed, exact_windows,
+                                implies_next, interval_fields, middle, monotone, settle_point,
+                                show_window)
 from .errors import DesignError
 from .lmi.analysis import METHODS, certified_delay
 from .lmi.core import DEFAULT_MARGIN
@@ -372,9 +373,16 @@ def run_example(ex: Example, s: BenchmarkSettings) -> ExampleResult:
                 lmi = comp.criterion("bessel-legendre", b.N)
                 by = comp.criterion("bessel-legendre", b.certified_by
                                     ) if b.certified_by is not None else lmi
-                rows.append(monotone(by_N.get(b.N - 1), _row(
-                    s, b.method, b.N, b, h_star, b.solves, b.seconds,
-                    _check(by, b, s.exact_check), lmi, windows, point_lmi=by, compiled=comp)))
+                prev = by_N.get(b.N - 1)
+                implied = not comp.unshared and implies_next(prev, windows, s.h_max)
+                row = _row(s, b.method, b.N, b, h_star, b.solves, b.seconds,
+                           _check(by, b, s.exact_check), None if implied else lmi, windows,
+                           point_lmi=by, compiled=comp)
+                if implied:      # order N - 1's interval, maximal on the grid: not searched
+                    row = replace(row, interval=prev.interval, intervals=prev.intervals,
+                                  interval_sound=prev.interval_sound,
+                                  interval_ratio=prev.interval_ratio)
+                rows.append(monotone(prev, row))
                 by_N[b.N] = rows[-1]
         best = auto.best
         used = [b for b in auto.bounds if b.N <= best.N]

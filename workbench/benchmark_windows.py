@@ -188,7 +188,8 @@ class Compiled:
     newly built criterion (the cvxpy compilation is the larger part of the
     suite's time: issue 36, item 4). ``A``, ``Ad``: the example's matrices.
     ``WORKBENCH_BENCHMARK_UNSHARED=1`` selects the old path (a new criterion,
-    hence a new compilation, for every request;
+    hence a new compilation, for every request, and every Bessel-Legendre
+    order's interval searched, see :func:`implies_next`;
     ``benchmarks/delay_benchmarks_times.py``).
     """
 
@@ -245,6 +246,33 @@ def abscissa_curve(A, Ad, windows, h_star: float, h_max: float, intervals
             alpha = math.nan
         out.append((float(h), float(alpha)))
     return tuple(out)
+
+
+def implies_next(prev, windows, h_max: float, sig: int = PRINTED_DIGITS) -> bool:
+    """Order N's interval certificate ``prev`` (a benchmark row, settled on
+    the printed grid) already gives order N + 1's row: the exact stability set
+    in [0, h_max] is one window (a, b) and ``prev`` certifies it as far as the
+    grid goes — lo = a = 0 or the grid value below lo is at most a, and hi
+    reaches h_max or the grid value above hi is at least b (each with the
+    windows' relative slack :data:`WINDOW_RTOL`).
+
+    Why the row is then the same as a search would give: order N + 1's
+    settled ends are grid values (or, narrower than one grid step, not a
+    superset of ``prev``), and a certified interval lies inside an exact
+    window (the criterion's functional proves stability there; claim
+    ``suite-sound``), so its interval cannot strictly contain ``prev``; an
+    interval that does not contain ``prev`` is replaced by ``prev`` in any case
+    (:func:`monotone`). One window holds one certified interval, so the
+    ``intervals`` agree too. (Point bounds are searched as before.)
+    """
+    if prev is None or prev.interval is None or len(windows) != 1 or len(prev.intervals) != 1:
+        return False
+    (a, b), (lo, hi) = windows[0], prev.interval
+    lo_max = lo == a == 0 or (a > 0 and 0 < lo and
+                              directed(lo * (1 - 1e-9), up=False, sig=sig) <= a * (1 - WINDOW_RTOL))
+    hi_max = hi >= h_max or (math.isfinite(b) and
+                             directed(hi * (1 + 1e-9), up=True, sig=sig) >= b * (1 + WINDOW_RTOL))
+    return bool(lo_max and hi_max and interval_inside(lo, hi, windows))
 
 
 def monotone(prev, row):
