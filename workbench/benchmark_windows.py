@@ -7,6 +7,7 @@ independent picture of the figure.
 """
 from __future__ import annotations
 
+import copy
 import math
 import os
 from dataclasses import replace
@@ -178,12 +179,40 @@ def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: f
     return out
 
 
+def _fresh(problem):
+    """The cvxpy problem ``problem`` with its compilation (``_cache``: the
+    parametrised program) shared and no solver: a shallow copy whose Clarabel
+    solver cache starts empty. (cvxpy hands a re-solved problem's previous
+    Clarabel solver back for a data update, so the last bits of a solve depend
+    on what that problem object solved before.)"""
+    if problem is None:
+        return None
+    twin = object.__new__(type(problem))
+    twin.__dict__.update(problem.__dict__)
+    twin._solver_cache, twin._status, twin._value, twin._solution = {}, None, None, None
+    return twin
+
+
+def fork(lmi):
+    """A copy of the criterion ``lmi`` that shares its compiled problems (no
+    new cvxpy compilation) and has a solver state of its own: it solves bit
+    for bit as a newly built criterion would, and ``lmi`` as if never forked
+    (``tests/test_benchmark_compiled.py``). Variables and parameters are
+    shared: each solve sets the delay, other parameters (an interval's lower
+    end) must be set before each solve, as every caller here does."""
+    twin = copy.copy(lmi)
+    twin._problem, twin._canonical = _fresh(lmi._problem), _fresh(lmi._canonical)
+    if hasattr(twin, "_twin_lmi"):     # a retry's twin criterion: built again when needed
+        twin._twin_lmi = None
+    return twin
+
+
 class Compiled:
     """The criteria of one example and their interval LMIs, each compiled once.
 
     The first request of a criterion (method, N) or of an interval LMI of a
     criterion returns a new one; every later request a fork
-    (:meth:`~workbench.lmi.core.MarginLMI.fork`): the same compiled problem
+    (:func:`fork`): the same compiled problem
     with a solver state of its own, so every solve is bit for bit that of a
     newly built criterion (the cvxpy compilation is the larger part of the
     suite's time: issue 36, item 4). ``A``, ``Ad``: the example's matrices.
@@ -206,15 +235,15 @@ class Compiled:
             self._criteria[key] = make_criterion(method, self.A, self.Ad, N=N,
                                                  margin=self.margin)
             return self._criteria[key]
-        return self._criteria[key].fork()
+        return fork(self._criteria[key])
 
     def interval(self, base, *, from_zero: bool) -> IntervalLMI:
         """The interval LMI of ``base`` (a criterion or a fork of one), new or a fork."""
-        key = (id(base._problem), from_zero)
+        key = (id(base._problem._cache), from_zero)
         if key not in self._intervals or self.unshared:
             self._intervals[key] = (base, IntervalLMI(base, from_zero=from_zero))
             return self._intervals[key][1]
-        return self._intervals[key][1].fork()
+        return fork(self._intervals[key][1])
 
 
 def middle(a: float, b: float, h_max: float) -> float:

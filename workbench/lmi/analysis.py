@@ -130,13 +130,6 @@ class _DelayAnalysis(MarginLMI):
         again = MarginLMI.solve_at(self._twin_lmi, h)
         return dataclasses.replace(again, seconds=step.seconds + again.seconds)
 
-    def fork(self):
-        """:meth:`MarginLMI.fork`, without the twin of :meth:`solve_at` (built
-        again when needed, as for a new criterion)."""
-        twin = super().fork()
-        twin._twin_lmi = None
-        return twin
-
     N = None          # Bessel-Legendre order (None for the other criteria)
 
 

@@ -38,7 +38,6 @@ Lyapunov matrix becomes singular.
 """
 from __future__ import annotations
 
-import copy
 import dataclasses
 import math
 import time
@@ -250,29 +249,8 @@ class MarginLMI:
             spent += step.seconds
         return dataclasses.replace(step, seconds=spent)
 
-    def fork(self) -> "MarginLMI":
-        """A copy that shares this criterion's compiled cvxpy problems (no new
-        compilation) but keeps its own solver state.
-
-        cvxpy hands a re-solved problem's previous Clarabel solver back for a
-        data update, so a solve's last bits depend on what that problem solved
-        before. A fork starts with no solver (like a newly built criterion) and
-        the original keeps its own, so each solves exactly as a separately built
-        criterion would, bit for bit. Parameters other than the delay (set with
-        :meth:`set_parameters`) are shared: set them before each solve.
-        """
-        if "_solver_caches" not in self.__dict__:
-            self._solver_caches = {id(p): p._solver_cache for p in
-                                   (self._problem, self._canonical) if p is not None}
-        twin = copy.copy(self)
-        twin._solver_caches = {}
-        return twin
-
     def _run(self, problem: cp.Problem, h: float, settings: Mapping) -> tuple[str, float]:
         self.set_delay(h)
-        own = self.__dict__.get("_solver_caches")
-        if own is not None:              # a forked criterion: its own solver (see fork)
-            problem._solver_cache = own.setdefault(id(problem), {})
         return guarded_solve(problem, settings)
 
     def _checked(self, h: float, status: str, t_opt: float, seconds: float) -> Step:

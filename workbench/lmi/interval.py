@@ -324,8 +324,8 @@ def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] =
         one a start (0: no scan).
     lower, zero : IntervalLMI, optional
         The interval LMIs of ``lmi`` to solve, [h_a, h_b] and [0, h_b]
-        (default: built here), e.g. forks sharing a compiled problem
-        (:meth:`~workbench.lmi.core.MarginLMI.fork`).
+        (default: built here), e.g. copies sharing a compiled problem
+        (:func:`workbench.benchmark_windows.fork`).
 
     Returns
     -------
