@@ -106,7 +106,9 @@ class MethodRow:
     disjoint certified interval (one per window reached); ``interval_ratio`` its
     end over h* when it starts at 0. ``point_sound`` / ``interval_sound``:
     the point lies in an exact stable window / the interval lies inside one
-    (None when nothing was certified).
+    (None when nothing was certified). ``interval_solves`` is 0 for a
+    Bessel-Legendre order whose interval is order N - 1's, implied without a
+    search (:func:`~workbench.benchmark_windows.implies_next`).
     """
 
     method: str
