@@ -44,6 +44,14 @@ def test_compiled_hands_out_forks():
     assert comp.interval(a, from_zero=True)._problem._cache is not w1._problem._cache
 
 
+def test_wirtinger_is_bessel_legendre_of_order_one():
+    comp = Compiled(A, AD, 1e-10)
+    w, bl = comp.criterion("wirtinger"), comp.criterion("bessel-legendre", 1)
+    assert (w.method, bl.method, bl.N) == ("wirtinger", "bessel-legendre", 1)
+    assert bl._problem._cache is w._problem._cache
+    assert _same(bl.solve_at(5.0), make_criterion("bessel-legendre", A, AD, N=1).solve_at(5.0))
+
+
 def _row(lo, hi, n=1):
     return SimpleNamespace(interval=(lo, hi), intervals=((lo, hi),) * n)
 

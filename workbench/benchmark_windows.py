@@ -14,7 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .lmi.analysis import make_criterion
+from .lmi.analysis import BesselLegendreLMI, WirtingerLMI, make_criterion
 from .lmi.core import Outcome
 from .lmi.interval import IntervalCertificate, IntervalLMI, IntervalSearch, Link, certified_interval
 from .margins import SpectrumNotConverged, spectral_abscissa, stability_windows
@@ -228,14 +228,23 @@ class Compiled:
         self._intervals: dict = {}
         self.unshared = os.environ.get("WORKBENCH_BENCHMARK_UNSHARED") == "1"
 
+    #: Criteria that are one LMI (the same blocks, hence the same compiled
+    #: problem) under another name: Wirtinger is Bessel-Legendre of order 1.
+    SAME = {("wirtinger", None): ("bessel-legendre", 1)}
+    #: The class a fork is given for a name of :data:`SAME`.
+    CLASS = {"wirtinger": WirtingerLMI, "bessel-legendre": BesselLegendreLMI}
+
     def criterion(self, method: str, N: int | None = None):
         """The criterion of ``method`` (order ``N``), new or a fork."""
-        key = (method, N)
+        key = self.SAME.get((method, N), (method, N))
         if key not in self._criteria or self.unshared:
             self._criteria[key] = make_criterion(method, self.A, self.Ad, N=N,
                                                  margin=self.margin)
             return self._criteria[key]
-        return fork(self._criteria[key])
+        twin = fork(self._criteria[key])
+        if twin.method != method:        # the same LMI under the other name (SAME)
+            twin.__class__ = self.CLASS[method]
+        return twin
 
     def interval(self, base, *, from_zero: bool) -> IntervalLMI:
         """The interval LMI of ``base`` (a criterion or a fork of one), new or a fork."""
