@@ -28,10 +28,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .benchmark_windows import (abscissa_curve, directed, exact_windows, interval_fields, middle,
-                                monotone, settle_point, show_window)
+from .benchmark_windows import (Compiled, abscissa_curve, directed, exact_windows,
+                                implies_next, interval_fields, middle, monotone, settle_point,
+                                show_window)
 from .errors import DesignError
-from .lmi.analysis import METHODS, certified_delay, make_criterion
+from .lmi.analysis import METHODS, certified_delay
 from .lmi.core import DEFAULT_MARGIN
 from .lmi.hierarchy import bessel_legendre_auto
 from .margins import (AGREEMENT_RTOL, Agreement, DelayMargin, compare_margins, delay_margin_eig,
@@ -105,7 +106,9 @@ class MethodRow:
     disjoint certified interval (one per window reached); ``interval_ratio`` its
     end over h* when it starts at 0. ``point_sound`` / ``interval_sound``:
     the point lies in an exact stable window / the interval lies inside one
-    (None when nothing was certified).
+    (None when nothing was certified). ``interval_solves`` is 0 for a
+    Bessel-Legendre order whose interval is order N - 1's, implied without a
+    search (:func:`~workbench.benchmark_windows.implies_next`).
     """
 
     method: str
@@ -318,11 +321,12 @@ def load_settings(r: Reader) -> BenchmarkSettings:
 # -- running -------------------------------------------------------------------------
 def _row(s: BenchmarkSettings, method: str, N: int | None, b, h_star: float, solves: int,
          seconds: float, check: str | None, lmi, windows, guess=None,
-         point_lmi=None) -> MethodRow:
+         point_lmi=None, compiled=None) -> MethodRow:
     h = settle_point(point_lmi or lmi, b.h_certified, b.bracket.h_refuted)
     return MethodRow(method, N, h, b.bracket.h_refuted, _ratio(h, h_star), solves, seconds,
                      check, b.bracket.outcome.value, bool(s.h_max <= h < math.inf),
-                     **interval_fields(lmi, b, windows, h_star, s.h_max, s.rel_tol, guess))
+                     **interval_fields(lmi, b, windows, h_star, s.h_max, s.rel_tol, guess,
+                                       compiled))
 
 
 def _ratio(h: float, exact: float) -> float | None:
@@ -343,11 +347,13 @@ def run_example(ex: Example, s: BenchmarkSettings) -> ExampleResult:
     """Exact margins and windows, then every method of ``s`` on one example: its
     point bound (:func:`~workbench.lmi.analysis.certified_delay`) and its
     interval (:func:`~workbench.lmi.interval.certified_interval`, grown from
-    0 and from the middle of every exact window)."""
+    0 and from the middle of every exact window). Each criterion and interval
+    LMI is compiled once (:class:`~workbench.benchmark_windows.Compiled`)."""
     A, Ad = np.array(ex.A), np.array(ex.Ad)
     exact, sweep = delay_margin_eig(A, Ad), delay_margin_sweep(A, Ad)
     h_star = exact.h
     windows = exact_windows(A, Ad, s.h_max)
+    comp = Compiled(A, Ad, s.margin)
     rows: list[MethodRow] = []
     kw = dict(rel_tol=s.rel_tol, h_hi=s.h_max)
     # unstable at h = 0: the point search starts inside the first window
@@ -355,29 +361,37 @@ def run_example(ex: Example, s: BenchmarkSettings) -> ExampleResult:
     for m in s.methods:
         if m == "bessel-legendre":
             continue
-        lmi = make_criterion(m, A, Ad, margin=s.margin)
+        lmi = comp.criterion(m)
         b = certified_delay(lmi, guess=guess, **kw)
         rows.append(_row(s, m, None, b, h_star, b.solves, b.seconds,
-                         _check(lmi, b, s.exact_check), lmi, windows))
+                         _check(lmi, b, s.exact_check), lmi, windows, compiled=comp))
     if "bessel-legendre" in s.methods:
         auto = bessel_legendre_auto(A, Ad, h_star, gap_tol=s.gap_tol, N_max=s.N_max,
-                                    N_through=s.orders, margin=s.margin, guess=guess, **kw)
+                                    N_through=s.orders, margin=s.margin, guess=guess,
+                                    make=lambda N: comp.criterion("bessel-legendre", N), **kw)
         by_N = {}
         for b in auto.bounds:
             if b.N <= s.orders:
-                lmi = make_criterion("bessel-legendre", A, Ad, N=b.N, margin=s.margin)
-                by = make_criterion("bessel-legendre", A, Ad, N=b.certified_by, margin=s.margin
+                lmi = comp.criterion("bessel-legendre", b.N)
+                by = comp.criterion("bessel-legendre", b.certified_by
                                     ) if b.certified_by is not None else lmi
-                rows.append(monotone(by_N.get(b.N - 1), _row(
-                    s, b.method, b.N, b, h_star, b.solves, b.seconds,
-                    _check(by, b, s.exact_check), lmi, windows, point_lmi=by)))
+                prev = by_N.get(b.N - 1)
+                implied = not comp.unshared and implies_next(prev, windows, s.h_max)
+                row = _row(s, b.method, b.N, b, h_star, b.solves, b.seconds,
+                           _check(by, b, s.exact_check), None if implied else lmi, windows,
+                           point_lmi=by, compiled=comp)
+                if implied:      # order N - 1's interval, maximal on the grid: not searched
+                    row = replace(row, interval=prev.interval, intervals=prev.intervals,
+                                  interval_sound=prev.interval_sound,
+                                  interval_ratio=prev.interval_ratio)
+                rows.append(monotone(prev, row))
                 by_N[b.N] = rows[-1]
         best = auto.best
         used = [b for b in auto.bounds if b.N <= best.N]
-        lmi = make_criterion("bessel-legendre", A, Ad, N=best.N, margin=s.margin)
+        lmi = comp.criterion("bessel-legendre", best.N)
         row = _row(s, AUTO, best.N, best, h_star, sum(b.solves for b in used),
                    sum(b.seconds for b in used), _check(lmi, best, s.exact_check),
-                   lmi if best.N not in by_N else None, windows)
+                   lmi if best.N not in by_N else None, windows, compiled=comp)
         if best.N in by_N:          # the same order's interval, not searched twice
             t = by_N[best.N]
             row = replace(row, h_certified=t.h_certified, ratio=t.ratio,

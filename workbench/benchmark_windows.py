@@ -7,11 +7,14 @@ independent picture of the figure.
 """
 from __future__ import annotations
 
+import copy
 import math
+import os
 from dataclasses import replace
 
 import numpy as np
 
+from .lmi.analysis import BesselLegendreLMI, WirtingerLMI, make_criterion
 from .lmi.core import Outcome
 from .lmi.interval import IntervalCertificate, IntervalLMI, IntervalSearch, Link, certified_interval
 from .margins import SpectrumNotConverged, spectral_abscissa, stability_windows
@@ -90,7 +93,8 @@ def settle_point(lmi, h: float, h_refuted: float, sig: int = POINT_DIGITS) -> fl
 
 
 def settle_interval(lmi, c: IntervalCertificate, h_max: float,
-                    sig: int = PRINTED_DIGITS) -> IntervalCertificate:
+                    sig: int = PRINTED_DIGITS, win: IntervalLMI | None = None
+                    ) -> IntervalCertificate:
     """The interval ``c`` with its ends decided on the grid of printed values.
 
     A search ends within its tolerance of the criterion's boundary, and where
@@ -104,8 +108,10 @@ def settle_interval(lmi, c: IntervalCertificate, h_max: float,
     value, decided by a solve *at* that value: a last-bit difference can
     change it only where the criterion's own boundary lies within solver
     noise of the grid value, not wherever the search happened to stop.
+    ``win``: the interval LMI [h_a, h_b] of ``lmi`` to solve (default: built
+    here).
     """
-    win = IntervalLMI(lmi, from_zero=False)
+    win = win or IntervalLMI(lmi, from_zero=False)
     links, lo, hi = list(c.links), c.lo, c.hi
     if 0 < lo:
         down, up = directed(lo, up=False, sig=sig), directed(lo, up=True, sig=sig)
@@ -135,11 +141,12 @@ def settle_interval(lmi, c: IntervalCertificate, h_max: float,
 
 
 def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: float,
-                    guess=None) -> dict:
+                    guess=None, compiled: "Compiled | None" = None) -> dict:
     """Interval search of one criterion and its comparison with the exact windows:
     ``interval``, ``intervals``, ``interval_solves``, ``interval_ratio``, ``point_sound``,
     ``interval_sound`` (keyword fields of a benchmark row). ``lmi`` None: the
-    point comparison only."""
+    point comparison only. ``compiled``: the example's :class:`Compiled`
+    (default: interval LMIs built here)."""
     h = bound.h_certified
     point = None if not h > 0 else (
         windows == ((0.0, math.inf),) if math.isinf(h) else in_window(h, windows))
@@ -147,11 +154,16 @@ def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: f
     if lmi is None:
         return out
     starts = [middle(a, b, h_max) for a, b in windows if a > 0]
+    comp = compiled or Compiled(lmi.A, lmi.Ad, lmi.margin)
+    zero = None if getattr(lmi, "range_from_zero", False) or not getattr(lmi, "h_blocks", 1) \
+        else comp.interval(lmi, from_zero=True)
     search = certified_interval(lmi, h_hi=h_max, starts=starts, rel_tol=rel_tol,
                                 guess=guess or (h if 0 < h < h_max else None),
-                                max_solves=260)
+                                max_solves=260, zero=zero,
+                                lower=comp.interval(lmi, from_zero=False))
     if search.interval is not None:
-        settled = tuple(settle_interval(lmi, c, h_max) for c in search.intervals)
+        settled = tuple(settle_interval(lmi, c, h_max, win=comp.interval(lmi, from_zero=False))
+                        for c in search.intervals)
         pick = search.intervals.index(search.interval)
         search = IntervalSearch(settled[pick], settled, search.outcome, search.steps)
     iv = search.bounds
@@ -165,6 +177,82 @@ def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: f
                                      (1.0 if math.isinf(iv[1]) and math.isinf(h_star)
                                       else None))
     return out
+
+
+def _fresh(problem):
+    """The cvxpy problem ``problem`` with its compilation (``_cache``: the
+    parametrised program) shared and no solver: a shallow copy whose Clarabel
+    solver cache starts empty. (cvxpy hands a re-solved problem's previous
+    Clarabel solver back for a data update, so the last bits of a solve depend
+    on what that problem object solved before.)"""
+    if problem is None:
+        return None
+    twin = object.__new__(type(problem))
+    twin.__dict__.update(problem.__dict__)
+    twin._solver_cache, twin._status, twin._value, twin._solution = {}, None, None, None
+    return twin
+
+
+def fork(lmi):
+    """A copy of the criterion ``lmi`` that shares its compiled problems (no
+    new cvxpy compilation) and has a solver state of its own: it solves bit
+    for bit as a newly built criterion would, and ``lmi`` as if never forked
+    (``tests/test_benchmark_compiled.py``). Variables and parameters are
+    shared: each solve sets the delay, other parameters (an interval's lower
+    end) must be set before each solve, as every caller here does."""
+    twin = copy.copy(lmi)
+    twin._problem, twin._canonical = _fresh(lmi._problem), _fresh(lmi._canonical)
+    if hasattr(twin, "_twin_lmi"):     # a retry's twin criterion: built again when needed
+        twin._twin_lmi = None
+    return twin
+
+
+class Compiled:
+    """The criteria of one example and their interval LMIs, each compiled once.
+
+    The first request of a criterion (method, N) or of an interval LMI of a
+    criterion returns a new one; every later request a fork
+    (:func:`fork`): the same compiled problem
+    with a solver state of its own, so every solve is bit for bit that of a
+    newly built criterion (the cvxpy compilation is the larger part of the
+    suite's time: issue 36, item 4). ``A``, ``Ad``: the example's matrices.
+    ``WORKBENCH_BENCHMARK_UNSHARED=1`` selects the old path (a new criterion,
+    hence a new compilation, for every request, and every Bessel-Legendre
+    order's interval searched, see :func:`implies_next`;
+    ``benchmarks/delay_benchmarks_times.py``).
+    """
+
+    def __init__(self, A, Ad, margin: float):
+        self.A, self.Ad, self.margin = A, Ad, margin
+        self._criteria: dict = {}
+        self._intervals: dict = {}
+        self.unshared = os.environ.get("WORKBENCH_BENCHMARK_UNSHARED") == "1"
+
+    #: Criteria that are one LMI (the same blocks, hence the same compiled
+    #: problem) under another name: Wirtinger is Bessel-Legendre of order 1.
+    SAME = {("wirtinger", None): ("bessel-legendre", 1)}
+    #: The class a fork is given for a name of :data:`SAME`.
+    CLASS = {"wirtinger": WirtingerLMI, "bessel-legendre": BesselLegendreLMI}
+
+    def criterion(self, method: str, N: int | None = None):
+        """The criterion of ``method`` (order ``N``), new or a fork."""
+        key = self.SAME.get((method, N), (method, N))
+        if key not in self._criteria or self.unshared:
+            self._criteria[key] = make_criterion(method, self.A, self.Ad, N=N,
+                                                 margin=self.margin)
+            return self._criteria[key]
+        twin = fork(self._criteria[key])
+        if twin.method != method:        # the same LMI under the other name (SAME)
+            twin.__class__ = self.CLASS[method]
+        return twin
+
+    def interval(self, base, *, from_zero: bool) -> IntervalLMI:
+        """The interval LMI of ``base`` (a criterion or a fork of one), new or a fork."""
+        key = (id(base._problem._cache), from_zero)
+        if key not in self._intervals or self.unshared:
+            self._intervals[key] = (base, IntervalLMI(base, from_zero=from_zero))
+            return self._intervals[key][1]
+        return fork(self._intervals[key][1])
 
 
 def middle(a: float, b: float, h_max: float) -> float:
@@ -196,6 +284,33 @@ def abscissa_curve(A, Ad, windows, h_star: float, h_max: float, intervals
             alpha = math.nan
         out.append((float(h), float(alpha)))
     return tuple(out)
+
+
+def implies_next(prev, windows, h_max: float, sig: int = PRINTED_DIGITS) -> bool:
+    """Order N's interval certificate ``prev`` (a benchmark row, settled on
+    the printed grid) already gives order N + 1's row: the exact stability set
+    in [0, h_max] is one window (a, b) and ``prev`` certifies it as far as the
+    grid goes — lo = a = 0 or the grid value below lo is at most a, and hi
+    reaches h_max or the grid value above hi is at least b (each with the
+    windows' relative slack :data:`WINDOW_RTOL`).
+
+    Why the row is then the same as a search would give: order N + 1's
+    settled ends are grid values (or, narrower than one grid step, not a
+    superset of ``prev``), and a certified interval lies inside an exact
+    window (the criterion's functional proves stability there; claim
+    ``suite-sound``), so its interval cannot strictly contain ``prev``; an
+    interval that does not contain ``prev`` is replaced by ``prev`` in any case
+    (:func:`monotone`). One window holds one certified interval, so the
+    ``intervals`` agree too. (Point bounds are searched as before.)
+    """
+    if prev is None or prev.interval is None or len(windows) != 1 or len(prev.intervals) != 1:
+        return False
+    (a, b), (lo, hi) = windows[0], prev.interval
+    lo_max = lo == a == 0 or (a > 0 and 0 < lo and
+                              directed(lo * (1 - 1e-9), up=False, sig=sig) <= a * (1 - WINDOW_RTOL))
+    hi_max = hi >= h_max or (math.isfinite(b) and
+                             directed(hi * (1 + 1e-9), up=True, sig=sig) >= b * (1 + WINDOW_RTOL))
+    return bool(lo_max and hi_max and interval_inside(lo, hi, windows))
 
 
 def monotone(prev, row):

@@ -40,7 +40,7 @@ class AutoOrder:
 def bessel_legendre_auto(A, Ad, exact: float, *, gap_tol: float = 1e-4, N_max: int = 6,
                          N_through: int = 0, rel_tol: float = 1e-5,
                          margin: float = DEFAULT_MARGIN, h_hi: float | None = None,
-                         guess: float | None = None) -> AutoOrder:
+                         guess: float | None = None, make=None) -> AutoOrder:
     """Raise the Bessel-Legendre order N = 0, 1, ... until
     ``1 - h_N / exact < gap_tol`` or N = ``N_max``.
 
@@ -53,14 +53,16 @@ def bessel_legendre_auto(A, Ad, exact: float, *, gap_tol: float = 1e-4, N_max: i
     The hierarchy never goes backwards: when order N's own search certifies
     less than order N - 1 (an inaccurate solve there), order N reports the
     lower order's certificate (``certified_by``), which proves order N
-    feasible at that delay.
+    feasible at that delay. ``make(N)``, optional, gives order N's criterion
+    (default: a new :class:`BesselLegendreLMI`; e.g. one kept for reuse).
     """
     out: list[DelayBound] = []
     reached = None
     for N in range(0, max(N_max, N_through) + 1):
         if N > N_through and (reached is not None or N > N_max):
             break
-        b = certified_delay(BesselLegendreLMI(A, Ad, N, margin=margin), rel_tol=rel_tol,
+        lmi = make(N) if make else BesselLegendreLMI(A, Ad, N, margin=margin)
+        b = certified_delay(lmi, rel_tol=rel_tol,
                             guess=guess, h_hi=h_hi)
         if out and b.h_certified < out[-1].h_certified:
             prev = out[-1]

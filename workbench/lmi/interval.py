@@ -295,7 +295,8 @@ LOWER_FRACTION = 1e-6
 def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] = (),
                        from_zero: bool = True, guess: float | None = None,
                        rel_tol: float = 1e-5, max_solves: int = 120,
-                       scan: int = SCAN_POINTS) -> IntervalSearch:
+                       scan: int = SCAN_POINTS, lower: IntervalLMI | None = None,
+                       zero: MarginLMI | None = None) -> IntervalSearch:
     """Largest interval of constant delays the criterion certifies, by shared variables.
 
     Parameters
@@ -323,6 +324,10 @@ def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] =
         When neither h = 0 nor any start gave an interval: point solves on a
         geometric grid from 0.01 time scales to ``h_hi``, the first certified
         one a start (0: no scan).
+    lower, zero : IntervalLMI, optional
+        The interval LMIs of ``lmi`` to solve, [h_a, h_b] and [0, h_b]
+        (default: built here), e.g. copies sharing a compiled problem
+        (:func:`workbench.benchmark_windows.fork`).
 
     Returns
     -------
@@ -342,11 +347,12 @@ def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] =
         return _result(iv, [iv] if iv else [], steps)
     tau = time_scale(lmi.A, lmi.Ad)
     floor = min(FLOOR_FRACTION * tau, h_hi)
-    win = IntervalLMI(lmi, from_zero=False)
+    win = lower or IntervalLMI(lmi, from_zero=False)
     found: list[IntervalCertificate] = []
     if from_zero:
         # a delay-range criterion's point certificate is already one on [0, h]
-        zero = lmi if getattr(lmi, "range_from_zero", False) else IntervalLMI(lmi, from_zero=True)
+        zero = lmi if getattr(lmi, "range_from_zero", False) else (
+            zero or IntervalLMI(lmi, from_zero=True))
         first = min(h_hi, guess if guess else tau)
         hit = _find(zero.solve_at, first, floor, budget, steps)
         if hit is not None:
