@@ -178,9 +178,16 @@ class Antiskid003:
         braking form (eq 70) in braking; exponential Euler in lambda.
         ``masks``: :meth:`_model_masks` of ``ph`` (computed when None)."""
         s, xp, p, c = self.s, self.xp, self.s.params, self.s.lin
-        if not xp.batch and ph != CRUISE:     # a single run: the same operations, less Python
-            return _scalar_stiff_step(v, lam, u, dt, self.fns["braking" if ph == BRAKE else
-                                                              "traction"], s.v_floor, p, 0)
+        if not xp.batch:     # a single run: the same operations as below, less Python
+            if ph != CRUISE:
+                return _scalar_stiff_step(v, lam, u, dt, self.fns["braking" if ph == BRAKE else
+                                                                  "traction"], s.v_floor, p, 0)
+            ve, le = v - s.v_d, lam - s.lambda_d
+            den = c["d4"] * ve + c["d5"] * le + c["d6"]
+            f2 = c["d1"] * ve + c["d2"] * le + c["d3"] + den * u
+            z = (c["d2"] + c["d5"] * u) * dt
+            return v + dt * (c["a1"] * ve + c["a2"] * le), lam + dt * (
+                math.expm1(z) / z if abs(z) > 1e-8 else 1.0 + 0.5 * z) * f2
         m_tr, m_br, m_cr = self._model_masks(ph) if masks is None else masks
         out_v, out_l = v, lam
         for forms, m in (("traction", m_tr), ("braking", m_br)):
