@@ -75,13 +75,13 @@ def cache_dir() -> Path | None:
 
 @lru_cache(maxsize=None)
 def _writable_dir(explicit: str, xdg: str) -> Path | None:
-    base = Path(explicit) if explicit else Path(xdg or Path.home() / ".cache") / "workbench"
-    d = base / "numba" / source_stamp()[:32]
     try:
+        base = Path(explicit) if explicit else Path(xdg or Path.home() / ".cache") / "workbench"
+        d = base / "numba" / source_stamp()[:32]
         d.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=d):
             pass
-    except OSError:
+    except (OSError, RuntimeError):     # RuntimeError: no home directory
         return None
     return d
 
