@@ -12,10 +12,10 @@ backend, common subexpressions eliminated) of
 numpy path performs, in the same order, so a compiled run follows its batched
 numpy trajectory up to the last bit of the library functions (exp, expm1).
 
-Importing this module needs numba (:func:`available` says whether it is
-installed); the functions compile at first use in each process (a few
-seconds; the lambdified model has no source file, so nothing is cached on
-disk).
+Importing this module needs numba; the functions compile at first use (a
+few seconds). The kernels that call them are kept on disk once compiled
+(:mod:`workbench.sim.jit_cache`: numba's own ``cache=True`` cannot, the
+lambdified model has no source file), so a machine compiles them once.
 
 Parameters ``p`` are float arrays in :data:`~workbench.sim.wheel_slip.PARAM_ORDER`;
 ``form`` selects the model: :data:`BY_SIGN` (eq 12 for lambda >= 0, eq 15
