@@ -60,8 +60,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..sim.history import DelayLine, TimedDelayLine
-from ..sim.wheel_slip import (PARAM_ORDER, ArrayOps, ScalarOps, exp_euler, model_functions, phi1,
-                              plant_forms, plant_step, stiff_step, wheel_speed)
+from ..sim.wheel_slip import (MAX_DLAMBDA, MAX_HALVINGS, PARAM_ORDER, ArrayOps, ScalarOps,
+                              exp_euler, model_functions, phi1, plant_forms, plant_step,
+                              stiff_step, wheel_speed)
 from .antiskid003_settings import (ACCEL, BRAKE, BRAKE_IN, CRUISE, DIVERGED, DIVERGED_HOW,  # noqa: F401
                                    HANDOVER, PHASE_NAMES, STOPPED, ControllerSettings,
                                    CreepSpeedProfile)
@@ -177,6 +178,16 @@ class Antiskid003:
         braking form (eq 70) in braking; exponential Euler in lambda.
         ``masks``: :meth:`_model_masks` of ``ph`` (computed when None)."""
         s, xp, p, c = self.s, self.xp, self.s.params, self.s.lin
+        if not xp.batch:     # a single run: the same operations as below, less Python
+            if ph != CRUISE:
+                return _scalar_stiff_step(v, lam, u, dt, self.fns["braking" if ph == BRAKE else
+                                                                  "traction"], s.v_floor, p, 0)
+            ve, le = v - s.v_d, lam - s.lambda_d
+            den = c["d4"] * ve + c["d5"] * le + c["d6"]
+            f2 = c["d1"] * ve + c["d2"] * le + c["d3"] + den * u
+            z = (c["d2"] + c["d5"] * u) * dt
+            return v + dt * (c["a1"] * ve + c["a2"] * le), lam + dt * (
+                math.expm1(z) / z if abs(z) > 1e-8 else 1.0 + 0.5 * z) * f2
         m_tr, m_br, m_cr = self._model_masks(ph) if masks is None else masks
         out_v, out_l = v, lam
         for forms, m in (("traction", m_tr), ("braking", m_br)):
@@ -203,7 +214,8 @@ class Antiskid003:
         the inputs of the last h seconds (exact ZOH weights of the window; on
         a refined mesh, in pieces of the current step with the exact average
         input over each)."""
-        line, masks = self.uline, self._model_masks(ph)
+        line = self.uline
+        masks = self._model_masks(ph) if self.xp.batch else None
         for u, d in (line.pieces() if self._base is None else line.pieces(self._ticks)):
             v, lam = self._model_step(v, lam, u, d, ph, masks)
         return v, lam
@@ -346,6 +358,17 @@ class Antiskid003:
             Pv, Pl = self._rollout(v, lam, ph)
         else:
             Pv, Pl = v + self.fv.window_integral(), lam + self.fl.window_integral()
+        if not xp.batch:     # a single run: its one law (as the loop below, without masks)
+            if ph == ACCEL:
+                return self._accel(Pv, Pl, s.lambda_opt)
+            if ph == HANDOVER:
+                return self._accel(Pv, Pl, s.lambda_d)
+            if ph == CRUISE:
+                return self._cruise(v, lam, Pv, Pl)
+            if ph == BRAKE_IN:
+                return self._accel(Pv, Pl, -s.handover_band)
+            if ph == BRAKE:
+                return self._brake(t, Pv, Pl)
         u = fv = fl = 0.0 * v
         for code, law in ((ACCEL, lambda: self._accel(Pv, Pl, s.lambda_opt)),
                           (HANDOVER, lambda: self._accel(Pv, Pl, s.lambda_d)),
@@ -357,3 +380,18 @@ class Antiskid003:
                 uc, fvc, flc = law()
                 u, fv, fl = xp.where(sel, uc, u), xp.where(sel, fvc, fv), xp.where(sel, flc, fl)
         return u, fv, fl
+
+
+def _scalar_stiff_step(v, lam, u, dt, fn, v_floor, p, depth):
+    """:func:`~workbench.sim.wheel_slip.stiff_step` of a single run with the
+    model ``fn`` (speed floored at ``v_floor``): the same operations in the
+    same order (bit for bit), written out for floats (the predictor's
+    rollout calls it every piece of every sample)."""
+    f1, f20, f2u, j0, ju = fn(max(v, v_floor), lam, *p)
+    z = (j0 + ju * u) * dt
+    nv = v + dt * f1
+    nl = lam + dt * (math.expm1(z) / z if abs(z) > 1e-8 else 1.0 + 0.5 * z) * (f20 + f2u * u)
+    if depth < MAX_HALVINGS and not abs(nl - lam) <= MAX_DLAMBDA:
+        hv, hl = _scalar_stiff_step(v, lam, u, dt / 2, fn, v_floor, p, depth + 1)
+        return _scalar_stiff_step(hv, hl, u, dt / 2, fn, v_floor, p, depth + 1)
+    return nv, nl

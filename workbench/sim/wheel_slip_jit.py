@@ -12,10 +12,10 @@ backend, common subexpressions eliminated) of
 numpy path performs, in the same order, so a compiled run follows its batched
 numpy trajectory up to the last bit of the library functions (exp, expm1).
 
-Importing this module needs numba (:func:`available` says whether it is
-installed); the functions compile at first use in each process (a few
-seconds; the lambdified model has no source file, so nothing is cached on
-disk).
+Importing this module needs numba; the functions compile at first use (a
+few seconds). The kernels that call them are kept on disk once compiled
+(:mod:`workbench.sim.jit_cache`: numba's own ``cache=True`` cannot, the
+lambdified model has no source file), so a machine compiles them once.
 
 Parameters ``p`` are float arrays in :data:`~workbench.sim.wheel_slip.PARAM_ORDER`;
 ``form`` selects the model: :data:`BY_SIGN` (eq 12 for lambda >= 0, eq 15
@@ -120,18 +120,32 @@ def phi1(z):
 
 
 @numba.njit(**_JIT)
-def _halved(v, lam, u, dt, p, v_floor, form, depth):
-    """The recursion of :func:`stiff_step` (kept apart: a recursive numba
-    function is called, never inlined, and most steps need no halving)."""
-    f1, f20, f2u, j0, ju = forms(fmax(v, v_floor), lam, p, form)
-    nv = v + dt * f1
-    nl = lam + dt * phi1((j0 + ju * u) * dt) * (f20 + f2u * u)
-    big = not abs(nl - lam) <= MAX_DLAMBDA
-    if depth < MAX_HALVINGS and big:
-        hv, hl, bad1 = _halved(v, lam, u, dt / 2, p, v_floor, form, depth + 1)
-        nv2, nl2, bad2 = _halved(hv, hl, u, dt / 2, p, v_floor, form, depth + 1)
-        return nv2, nl2, bad1 or bad2
-    return nv, nl, big
+def _halved(v, lam, u, dt, p, v_floor, form):
+    """The halvings of :func:`stiff_step` once the whole step ``dt`` moved
+    lambda too far: the recursion of
+    :func:`workbench.sim.wheel_slip.stiff_step_flagged` (each half halved
+    again while it moves lambda too far, up to MAX_HALVINGS levels), run as
+    a loop over its sub-steps in the recursion's order, with the same
+    operations (a recursive numba function cannot be loaded from the disk
+    cache of :mod:`workbench.sim.jit_cache`: the loaded code crashes). Bit
+    ``k`` of ``pending``: the second half at level ``k`` is still to do;
+    ``d`` is dt / 2**k (halving and doubling are exact)."""
+    k, d, pending, bad = 1, dt / 2, 2, False
+    while True:
+        f1, f20, f2u, j0, ju = forms(fmax(v, v_floor), lam, p, form)
+        nv = v + d * f1
+        nl = lam + d * phi1((j0 + ju * u) * d) * (f20 + f2u * u)
+        big = not abs(nl - lam) <= MAX_DLAMBDA
+        if k < MAX_HALVINGS and big:       # halve: its first half next
+            k, d = k + 1, d / 2
+            pending |= 1 << k
+            continue
+        v, lam, bad = nv, nl, bad or big
+        while k > 0 and not (pending >> k) & 1:     # up to a level with a half to do
+            k, d = k - 1, d * 2
+        if k == 0:
+            return v, lam, bad
+        pending &= ~(1 << k)
 
 
 @numba.njit(**_JITI)
@@ -151,9 +165,7 @@ def stiff_step_at(v, lam, u, dt, p, v_floor, form, fm):
     nl = lam + dt * phi1((j0 + ju * u) * dt) * (f20 + f2u * u)
     big = not abs(nl - lam) <= MAX_DLAMBDA
     if MAX_HALVINGS > 0 and big:
-        hv, hl, bad1 = _halved(v, lam, u, dt / 2, p, v_floor, form, 1)
-        nv2, nl2, bad2 = _halved(hv, hl, u, dt / 2, p, v_floor, form, 1)
-        return nv2, nl2, bad1 or bad2
+        return _halved(v, lam, u, dt, p, v_floor, form)
     return nv, nl, big
 
 

@@ -80,6 +80,7 @@ def _build():
 
     from ...controllers import antiskid003_jit as C
     from ...sim.counter_rng import jit_functions
+    from ...sim.jit_cache import cached
     from ...sim.wheel_slip_jit import (BY_SIGN, GRADED, creep_speed, delay_at, fmax, fmin, forms,
                                        measured_state, split_delay, stiff_step_at, wheel_speed)
 
@@ -282,7 +283,7 @@ def _build():
                     T[j] += 1
                     go[j] = False
 
-    return run_batch
+    return cached(run_batch, "antiskid_kernel.run_batch")
 
 
 def _tuples(jit):
@@ -308,9 +309,10 @@ _KERNEL = None
 
 
 def compile_kernel() -> None:
-    """Compile the kernel in this process now (a few seconds, once). A
-    process pool started afterwards by ``fork`` inherits the compiled code,
-    so its workers do not compile it again."""
+    """Compile the kernel in this process now (a few seconds, once per
+    machine: later processes load it from the disk cache of
+    :mod:`workbench.sim.jit_cache`). A process pool started afterwards by
+    ``fork`` inherits the compiled code."""
     global _KERNEL
     if _KERNEL is None:
         from numba import float64, int64, uint64

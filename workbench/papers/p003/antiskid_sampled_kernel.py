@@ -68,6 +68,7 @@ def _build():
     import numba
 
     from ...controllers import antiskid003_jit as C
+    from ...sim.jit_cache import cached
     from ...sim.wheel_slip_jit import BY_SIGN, creep_speed, stiff_step, wheel_speed
 
     jit = numba.njit(nogil=True, error_model="numpy")
@@ -185,14 +186,15 @@ def _build():
         out[V_END], out[L_END] = v, lam
         return nrec, nrecu
 
-    return run
+    return cached(run, "antiskid_sampled_kernel.run")
 
 
 def kernel():
     """The compiled loop ``run(p, cfg, pc, v0, lam0, t0, Tc, h, tau_m, q, dt_p,
     u_init, st, ubuf, ev, scenario, t_cap, tail, lam_thr, lam_peak, v_d,
     v_stop, lam_div, omega_sw, r, t_brake, settle, rec_t0, rec_t1, rec, rec_u,
-    out)`` (compiled in this process on first use, about 10 s).
+    out)`` (compiled on first use, about 10 s, once per machine: the disk cache of
+    :mod:`workbench.sim.jit_cache`).
 
     ``p``, ``pc``: plant and controller parameters (PARAM_ORDER); ``cfg``,
     ``st``, ``ubuf``, ``ev``: the compiled controller's settings (step T_c),
