@@ -7,6 +7,11 @@ from pathlib import Path
 
 import pytest
 import xmlschema
+# pytester runs pytest in this process and drops the modules the inner run imported;
+# numpy's C extensions (numpy.fft's, which scipy.sparse loads) cannot be loaded twice in
+# one process, so they are imported here first (the test failed when it ran first on a worker)
+import numpy.fft  # noqa: F401, E402
+import scipy.sparse  # noqa: F401, E402
 
 from workbench.ci import VerifyRun, design_cases
 from workbench.claims import check_claim

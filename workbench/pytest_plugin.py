@@ -113,7 +113,7 @@ class _ClaimFile(pytest.File):
         from .errors import WorkbenchError
         if isinstance(excinfo.value, WorkbenchError):
             return f"error: {excinfo.value}"
-        return super().repr_failure(excinfo, style)
+        return super().repr_failure(excinfo)    # a Collector's takes no style
 
     def case(self, claim_id: str):
         """The :class:`workbench.ci.Case` of one claim (the study runs once)."""
