@@ -54,6 +54,7 @@ STUDIES: dict[str, str] = {
     "ntsm-platoon": "workbench.papers.p001.ntsm_platoon:STUDY",
     "delay-feedback": "workbench.kinds.delay_feedback:STUDY",
     "switched-run": "workbench.kinds.switched_run:STUDY",
+    "stop-accuracy": "workbench.kinds.stop_accuracy:STUDY",
 }
 
 
@@ -70,6 +71,7 @@ RENDERERS: dict[str, str] = {
     "ntsm-platoon": "workbench.papers.p001.ntsm_platoon_render:render",
     "delay-feedback": "workbench.kinds.delay_feedback.render:render",
     "switched-run": "workbench.kinds.switched_run.render:render",
+    "stop-accuracy": "workbench.kinds.stop_accuracy.render:render",
 }
 
 

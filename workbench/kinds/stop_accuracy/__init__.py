@@ -1,0 +1,292 @@
+"""Study ``stop-accuracy``: station stops of a braking plant under named
+controllers, with disturbances, faults and the stop-error statistics
+(issue 35, item 1).
+
+Each controller brakes the plant from every initial speed to the stopping
+point D; the stop error is the standstill position minus D (+ = overshoot).
+
+Tables::
+
+    [plant]        model = "brake-000" and its parameters, SI units
+                   (:func:`.pipeline.read_brake_plant`; why a named model: see there)
+    [target]       speeds_kmh = [...], tolerance = { value, unit = "m" },
+                   c_max = { value, unit = "m/s^2" } (full service; commands clip to [0, c_max]),
+                   and the stopping point: distance = { value, unit = "m" }, or
+                   command = { value, unit = "m/s^2" } (D = the nominal stopping distance
+                   of that command held, as paper 004 section 1)
+    [constants]    name = { value, unit, source }  (numbers the laws use)
+    [[controllers]] name, law = "expression" (brake command, m/s^2),
+                   definitions = { name = "expression", ... } (in order, optional)
+    [disturbances] name = { effect = "scale", parameters = ["T1", ...] } | { effect =
+                   "gradient" } (permille) | { effect = "force_error" } | { effect = "mass_ratio" }
+                   (the factors, in this order: a Monte Carlo draw's stream is its position)
+    [[faults]]     name, parameters = { brake parameter = value }, speed_ratio (the speed
+                   the law sees / the true speed), disturbance = { factor = value }
+    [montecarlo]   samples, seed, distributions = { factor = { dist = ... } }
+                   (:mod:`workbench.features.montecarlo`)
+    [convergence]  (no keys: every nominal and fault stop error at dt, dt/2, dt/4,
+                   :func:`workbench.sim.convergence.refinement_check`)
+    [sim]          dt, dt_ctrl, t_end (s)
+
+A law sees ``x`` (m since braking began), ``v`` (the measured speed, m/s),
+``decel`` (the measured deceleration, m/s^2, >= 0), ``d_go = D - x`` (m),
+``D`` (m), ``v0`` (m/s), ``t`` (s), the constants and its definitions; it is
+parsed by :mod:`workbench.expr` (never evaluated as Python) and must have the
+unit m/s^2 (pint). A controller with internal state (an integrator, a fuzzy
+increment, a sensor fusion) is not an expression; such laws stay in their
+paper's module (paper 004's command generator, paper 000's SMARC).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ...reader import Quantity, Reader
+from .pipeline import EFFECTS, Factor, read_brake_plant
+
+__all__ = ["Controller", "Fault", "STUDY", "StopAccuracySpec", "LAW_NAMES"]
+
+#: Names every law may use: name -> unit.
+LAW_NAMES = {"x": "m", "v": "m/s", "decel": "m/s^2", "d_go": "m", "D": "m", "v0": "m/s",
+             "t": "s"}
+#: Refinement levels of ``[convergence]``: dt / 2**k.
+LEVELS = (0, 1, 2)
+
+
+@dataclass(frozen=True)
+class Controller:
+    name: str
+    law: str
+    definitions: tuple[tuple[str, str], ...] = ()
+
+
+@dataclass(frozen=True)
+class Fault:
+    name: str
+    parameters: dict
+    speed_ratio: float = 1.0
+    disturbance: dict | None = None
+
+
+@dataclass(frozen=True)
+class StopAccuracySpec:
+    path: str
+    params: dict                   # name -> Quantity
+    speeds_kmh: tuple[float, ...]
+    tolerance: float
+    c_max: float
+    distance: float | None         # m, or None: from ``command``
+    command: float | None          # m/s^2
+    constants: dict                # name -> Quantity
+    controllers: tuple[Controller, ...]
+    factors: tuple[Factor, ...]
+    faults: tuple[Fault, ...]
+    dt: float
+    dt_ctrl: float
+    t_end: float
+    montecarlo: object = None      # MonteCarloSpec
+    convergence: bool = False
+
+    def base(self) -> dict:
+        return {k: q.value for k, q in self.params.items()}
+
+
+def _name(t: Reader, key: str, taken) -> str:
+    from ..delay_feedback import NAME_PATTERN
+    name = t.string(key)
+    if not NAME_PATTERN.match(name) or name in taken:
+        raise t.fail(key, name, "a new name of letters, digits and _ (not " + ", ".join(
+            sorted(taken)) + ")")
+    return name
+
+
+def _constants(root: Reader, taken: set) -> dict:
+    from ..delay_feedback.units import parse_unit
+    out = {}
+    if not root.has("constants"):
+        return out
+    t = root.table("constants")
+    for k in list(t.data):
+        if k in taken or not isinstance(t.data[k], dict):
+            raise t.fail(k, t.data[k], "a new name with { value, unit, source }")
+        sub = t.table(k)
+        unit = sub.string("unit")
+        parse_unit(unit, root.path, t.key(k) + ".unit")
+        out[k] = Quantity(sub.number("value", lo=-1e12, hi=1e12), unit, sub.string("source"))
+        sub.finish()
+    t.finish()
+    return out
+
+
+def _controllers(root: Reader, names: set) -> tuple[Controller, ...]:
+    from ...expr import check_expression
+    tables = root.tables("controllers")
+    if not tables:
+        raise root.fail("controllers", [], "at least one [[controllers]] table")
+    out, seen = [], set()
+    for t in tables:
+        name = _name(t, "name", seen)
+        seen.add(name)
+        defs, known = [], set(names)
+        dt = t.table("definitions", default=None)
+        for k in list(dt.data):
+            if k in known:
+                raise dt.fail(k, dt.data[k], "a new name (not a law name or constant)")
+            text = dt.raw(k)
+            check_expression(text, known, path=root.path, key=dt.key(k))
+            defs.append((k, text))
+            known.add(k)
+        dt.finish()
+        law = t.raw("law")
+        check_expression(law, known, path=root.path, key=t.key("law"))
+        t.finish()
+        out.append(Controller(name, law, tuple(defs)))
+    return tuple(out)
+
+
+def _factors(root: Reader, params: dict) -> tuple[Factor, ...]:
+    if not root.has("disturbances"):
+        return ()
+    t, out = root.table("disturbances"), []
+    for k in list(t.data):
+        sub = t.table(k)
+        effect = sub.string("effect", choices=EFFECTS)
+        ps = ()
+        if effect == "scale":
+            ps = tuple(sub.raw("parameters"))
+            if not ps or any(p not in params for p in ps) or len(set(ps)) < len(ps):
+                raise sub.fail("parameters", list(ps), "brake parameters of [plant], each once")
+        unit = "permille" if effect == "gradient" else "1"
+        out.append(Factor(k, effect, ps, sub.string("what", default=k), unit))
+        sub.finish()
+    t.finish()
+    if sum(f.effect in ("force_error", "mass_ratio") for f in out) > 1:
+        raise root.fail("disturbances", list(t.data), "at most one factor on the load-weighing "
+                        "gain (force_error or mass_ratio)")
+    if sum(f.effect == "gradient" for f in out) > 1:
+        raise root.fail("disturbances", list(t.data), "at most one gradient factor")
+    return tuple(out)
+
+
+def _faults(root: Reader, params: dict, factors) -> tuple[Fault, ...]:
+    out, seen = [], set()
+    for t in root.tables("faults", default=[]):
+        name = _name(t, "name", seen)
+        seen.add(name)
+        pt = t.table("parameters", default=None)
+        over = {}
+        for k in list(pt.data):
+            if k not in params:
+                raise pt.fail(k, pt.data[k], "a brake parameter of [plant]")
+            over[k] = pt.number(k, nonneg=True, hi=1e6)
+        pt.finish()
+        dt = t.table("disturbance", default=None)
+        dist = {}
+        for k in list(dt.data):
+            if k not in {f.name for f in factors}:
+                raise dt.fail(k, dt.data[k], "a factor of [disturbances]")
+            dist[k] = dt.number(k, lo=-1e3, hi=1e3)
+        dt.finish()
+        ratio = t.number("speed_ratio", default=1.0, lo=0.0, hi=2.0)
+        t.finish()
+        out.append(Fault(name, over, ratio, dist))
+    return tuple(out)
+
+
+def _check_units(path: str, constants: dict, controllers) -> None:
+    """Every law in m/s^2 and every definition of consistent units (pint,
+    :func:`workbench.kinds.delay_feedback.units.check_expression_units`)."""
+    import sympy as sp
+    from types import SimpleNamespace as NS
+
+    from ...expr import parse_expression
+    from ..delay_feedback.units import check_expression_units
+    units = dict(LAW_NAMES) | {k: q.unit for k, q in constants.items()}
+    plant = NS(path=path, states=(), inputs=(),
+               parameters={k: NS(unit=u) for k, u in units.items()})
+    for i, c in enumerate(controllers):
+        syms, items = {k: sp.Symbol(k, real=True) for k in units}, []
+        for k, text in c.definitions:
+            key = f"controllers[{i}].definitions.{k}"
+            syms[k] = parse_expression(text, syms, path=path, key=key)
+            items.append((key, text, syms[k], None))
+        items.append((f"controllers[{i}].law", c.law,
+                      parse_expression(c.law, syms, path=path, key=f"controllers[{i}].law"),
+                      "decel"))
+        check_expression_units(plant, items)
+
+
+class StopAccuracy:
+    """The ``stop-accuracy`` study (see the module docstring)."""
+
+    kind = "stop-accuracy"
+    uses_solver = False
+
+    def load(self, root: Reader) -> StopAccuracySpec:
+        params = read_brake_plant(root)
+        tg = root.table("target")
+        speeds = tg.numbers("speeds_kmh", positive=True, what="speeds (km/h)")
+        if not speeds or any(s > 400 for s in speeds) or len(set(speeds)) < len(speeds):
+            raise tg.fail("speeds_kmh", list(speeds), "distinct speeds in (0, 400] km/h")
+        tol = tg.quantity("tolerance", "m", positive=True, hi=10.0).value
+        c_max = tg.quantity("c_max", "m/s^2", positive=True, hi=3.0).value
+        dist = tg.quantity("distance", "m", positive=True, hi=1e5, default=None)
+        cmd = tg.quantity("command", "m/s^2", positive=True, hi=3.0, default=None)
+        if (dist is None) == (cmd is None):
+            raise tg.fail("distance", None if dist is None else dist.value,
+                          "exactly one of distance (m) and command (m/s^2)")
+        tg.finish()
+        constants = _constants(root, set(LAW_NAMES))
+        controllers = _controllers(root, set(LAW_NAMES) | set(constants))
+        factors = _factors(root, params)
+        faults = _faults(root, params, factors)
+        mc = None
+        if root.has("montecarlo"):
+            if not factors:
+                raise root.fail("disturbances", None, "the factors [montecarlo] draws")
+            from ...features.montecarlo import load_montecarlo
+            mc = load_montecarlo(root, {f.name: f.positive for f in factors}, max_samples=5000)
+        convergence = root.has("convergence")
+        if convergence:
+            root.table("convergence").finish()
+        sim = root.table("sim")
+        dt = sim.number("dt", positive=True, hi=0.05, what="step (s)")
+        dt_ctrl = sim.number("dt_ctrl", positive=True, hi=1.0, what="control period (s)")
+        k = dt_ctrl / dt
+        if abs(k - round(k)) > 1e-9 * k:
+            raise sim.fail("dt_ctrl", dt_ctrl, f"a whole multiple of dt = {dt:g} s")
+        t_end = sim.number("t_end", positive=True, hi=3600.0, what="horizon (s)")
+        if t_end / dt * (4 if convergence else 1) > 2_000_000:
+            raise sim.fail("t_end", t_end, "at most 2e6 steps (at dt/4 with [convergence])")
+        sim.finish()
+        _check_units(root.path, constants, controllers)
+        return StopAccuracySpec(root.path, params, tuple(speeds), tol, c_max,
+                                None if dist is None else dist.value,
+                                None if cmd is None else cmd.value, constants, controllers,
+                                factors, faults, dt, dt_ctrl, t_end, mc, convergence)
+
+    def quantity_names(self, spec: StopAccuracySpec) -> set[str]:
+        from ...features.quantities import names
+        from .quantities import TABLE
+        return names(TABLE, spec)
+
+    def quantity_units(self, spec: StopAccuracySpec) -> dict[str, str]:
+        from ...features.quantities import units
+        from .quantities import TABLE
+        return units(TABLE, spec)
+
+    def run(self, design):
+        from .run import run
+        return run(design.spec, design.claims)
+
+    def quantities(self, res) -> dict:
+        from ...features.quantities import values
+        from .quantities import TABLE
+        return values(TABLE, res.spec, res)
+
+    def unconverged(self, res) -> dict[str, str]:
+        """claim id -> reason, for the claims on a stop error that did not
+        converge over dt, dt/2, dt/4 (``[convergence]``)."""
+        return {r.claim_id: r.reason for r in res.refinement if not r.converged}
+
+
+STUDY = StopAccuracy()

@@ -1,0 +1,117 @@
+"""Markdown of a ``stop-accuracy`` design (pure rendering).
+
+Stop errors are printed to the millimetre (3 significant digits of a
+sub-metre error): a last-bit difference of the simulation (numpy kernels)
+cannot reach that digit except on an exact tie.
+"""
+from __future__ import annotations
+
+from ...report.markdown import Rendered, fmt, md_table
+
+__all__ = ["render"]
+
+
+def _mm(x) -> str:
+    if x is None or x != x:
+        return "no stop"
+    return f"{x:+.3f}"
+
+
+def render(design, res) -> Rendered:
+    """The report sections of a ``stop-accuracy`` design."""
+    spec = design.spec
+    sections = [_problem(spec), _stops(spec, res)]
+    if spec.montecarlo is not None:
+        sections.append(_montecarlo(spec, res))
+    if spec.convergence:
+        sections.append(_convergence(spec, res))
+    anchors = ((r"v[0-9.]+\.[A-Za-z0-9_]+\.mc\.", "Monte Carlo"),
+               (r"v[0-9.]+\.[A-Za-z0-9_]+\.convergence\.", "Convergence"),
+               (r"v[0-9.]+\.", "Stops"))
+    return Rendered(tuple(sections), (), anchors)
+
+
+def _problem(spec) -> str:
+    par = [[f"`{k}`", fmt(q.value, 6), q.unit, q.source] for k, q in spec.params.items()]
+    const = [[f"`{k}`", fmt(q.value, 6), q.unit, q.source] for k, q in spec.constants.items()]
+    ctl = [[f"`{c.name}`", "; ".join(f"{k} = `{t}`" for k, t in c.definitions) or "—",
+            f"`{c.law}`"] for c in spec.controllers]
+    target = (f"D = {fmt(spec.distance, 6)} m" if spec.distance is not None else
+              f"D = the nominal stopping distance of the command {fmt(spec.command)} m/s² held")
+    out = ("## Problem\n\nA `stop-accuracy` design: each controller brakes the paper-000 "
+           "brake plant (`[plant]`, two transmission delays and the electric/air hand-over) "
+           f"from {', '.join(fmt(s) for s in spec.speeds_kmh)} km/h to the stopping point; "
+           f"{target}. Commands clip to [0, {fmt(spec.c_max)}] m/s², act every "
+           f"{fmt(spec.dt_ctrl)} s (ZOH); the plant steps at dt = {fmt(spec.dt)} s. Laws are "
+           "the design's text, parsed by `workbench/expr.py` (never evaluated) and checked "
+           "to be in m/s². Stop error = standstill position − D (+ = overshoot); "
+           f"platform tolerance ±{fmt(spec.tolerance)} m.\n\n"
+           + md_table(["parameter", "value", "unit", "source"], par, "lrll"))
+    if const:
+        out += "\n\n" + md_table(["constant", "value", "unit", "source"], const, "lrll")
+    out += "\n\n" + md_table(["controller", "definitions", "brake command (m/s²)"], ctl, "lll")
+    if spec.factors:
+        rows = [[f"`{f.name}`", f.effect + (" " + ", ".join(f.parameters) if f.parameters
+                                            else ""), f.what] for f in spec.factors]
+        out += "\n\n" + md_table(["factor", "acts on", "what"], rows, "lll")
+    if spec.faults:
+        rows = [[f"`{f.name}`", ", ".join(f"{k} = {fmt(v)}" for k, v in f.parameters.items())
+                 or "—", fmt(f.speed_ratio), ", ".join(
+                     f"{k} = {fmt(v)}" for k, v in (f.disturbance or {}).items()) or "—"]
+                for f in spec.faults]
+        out += "\n\n" + md_table(["fault", "brake parameters", "speed read / true",
+                                  "disturbance"], rows, "llrl")
+    return out
+
+
+def _stops(spec, res) -> str:
+    head = ["speed (km/h)", "D (m)", "controller", "nominal (m)"] + [
+        f"{f.name} (m)" for f in spec.faults]
+    rows = []
+    for s in spec.speeds_kmh:
+        for c in spec.controllers:
+            rows.append([fmt(s), f"{res.distance[s]:.2f}", f"`{c.name}`",
+                         _mm(res.nominal[s, c.name])]
+                        + [_mm(res.faults[s, c.name, f.name]) for f in spec.faults])
+    return ("## Stops\n\nStop errors (m) of one stop per speed and controller, on the nominal "
+            "plant and under each fault (quantities `v<speed>.<controller>.nominal_m`, "
+            "`...fault[<f>].error_m`).\n\n" + md_table(head, rows, "rrl" + "r" * (len(head) - 3)))
+
+
+def _montecarlo(spec, res) -> str:
+    m = spec.montecarlo
+    dist = [[f"`{k}`", d.describe(), d.source] for k, d in m.distributions.items()]
+    rows = []
+    for s in spec.speeds_kmh:
+        for c in spec.controllers:
+            st = res.mc[s, c.name]
+            rows.append([fmt(s), f"`{c.name}`", f"{st.k}/{st.n}",
+                         f"[{st.lo:.3f}, {st.hi:.3f}]", f"{st.p95:.2f}", f"{st.mean:+.2f}",
+                         f"{st.overshoot:.3f}"])
+    return ("## Monte Carlo\n\n"
+            f"{m.samples} draws (seed {m.seed}); every speed and controller meets the same "
+            "draws; factors without a distribution stay nominal.\n\n"
+            + md_table(["factor", "distribution", "source"], dist, "lll") + "\n\n"
+            + md_table(["speed (km/h)", "controller", f"within ±{fmt(spec.tolerance)} m",
+                        "Wilson 95 %", "p95 |error| (m)", "mean (m)", "overshoot share"],
+                       rows, "rlrrrrr"))
+
+
+def _convergence(spec, res) -> str:
+    rows = []
+    for k, lv in res.levels.items():
+        chk = res.checks.get(k)
+        rows.append([f"`{k}`", *(_mm(x) for x in lv),
+                     "—" if chk is None or chk.estimate is None else f"{chk.estimate:.1e}",
+                     chk.outcome if chk else "not determined"])
+    out = ("## Convergence\n\nEvery stop error at dt, dt/2 and dt/4 (control period fixed), "
+           "with the Richardson estimate of the error at dt/4 "
+           "(`workbench/sim/convergence.py`).\n\n"
+           + md_table(["quantity", "dt", "dt/2", "dt/4", "estimate (m)", "outcome"], rows,
+                      "lrrrrl"))
+    if res.refinement:
+        out += "\n\n" + md_table(["claim", "converged", "note"], [
+            [r.claim_id, "yes" if r.converged else "no", r.reason or "—"]
+            for r in res.refinement], "lll")
+    return out
+

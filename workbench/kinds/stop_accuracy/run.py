@@ -1,0 +1,169 @@
+"""Compute a ``stop-accuracy`` design: every controller from every speed on
+the nominal plant and under every fault, the Monte Carlo, and the step
+refinement.
+
+* nominal and faults: one batch (:func:`workbench.sim.stopping.simulate`),
+  the laws compiled once from the design's sympy expressions (``lambdify``);
+* ``[montecarlo]``: one batch of ``samples`` runs per (speed, controller),
+  every case meeting the same draws (common random numbers), the factors
+  acting through :func:`.pipeline.apply_factors`; statistics by
+  :func:`.pipeline.group_statistics` (share within the tolerance with its
+  Wilson 95 % interval, 95th percentile of |error|, mean, overshoot share);
+* ``[convergence]``: the nominal and fault batch again at dt/2 and dt/4, every
+  stop error through :func:`workbench.sim.convergence.refinement_check`, and
+  every claim on one through :func:`workbench.refinement.refinement_row`
+  (a claim whose error has not converged is INCONCLUSIVE).
+
+References
+----------
+L. F. Richardson, Phil. Trans. R. Soc. A 226:299-361, 1927 (step refinement).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...jsonable import json_method
+from .pipeline import apply_factors, group_statistics, open_loop_distance
+
+__all__ = ["StopAccuracyResult", "compile_laws", "run", "speed_key"]
+
+
+def speed_key(s: float) -> str:
+    """``v50`` for 50 km/h: the prefix of a speed's quantities."""
+    return f"v{s:g}"
+
+
+@dataclass(frozen=True)
+class StopAccuracyResult:
+    spec: object
+    distance: dict                                  # speed -> D (m)
+    nominal: dict                                   # (speed, controller) -> error (m)
+    faults: dict                                    # (speed, controller, fault) -> error (m)
+    mc: dict = field(default_factory=dict)          # (speed, controller) -> StopStatistics
+    levels: dict = field(default_factory=dict)      # quantity -> (dt, dt/2, dt/4) errors
+    checks: dict = field(default_factory=dict)      # quantity -> Refinement
+    refinement: tuple = ()                          # RefinementRow of claims on errors
+    traces: dict = field(default_factory=dict, repr=False)  # (speed, ctl) -> (x - D, v)
+
+    JSON_FIELDS = {"distance": lambda r: {speed_key(s): d for s, d in r.distance.items()},
+                   "nominal": lambda r: {f"{speed_key(s)}.{c}": e
+                                         for (s, c), e in r.nominal.items()},
+                   "montecarlo": lambda r: {f"{speed_key(s)}.{c}": [m.k, m.n]
+                                            for (s, c), m in r.mc.items()},
+                   "refinement": lambda r: {x.claim_id: x.outcome for x in r.refinement}}
+    to_json = json_method
+
+
+def compile_laws(spec) -> list:
+    """law(values) -> command, per controller: the design's expressions as numpy
+    functions of the law names, the constants and the definitions."""
+    import sympy as sp
+
+    from ...expr import parse_expression
+    from . import LAW_NAMES
+    names = tuple(LAW_NAMES) + tuple(spec.constants)
+    out = []
+    for i, c in enumerate(spec.controllers):
+        syms = {k: sp.Symbol(k, real=True) for k in names}
+        args = tuple(syms[k] for k in names)
+        for k, text in c.definitions:
+            syms[k] = parse_expression(text, syms, path=spec.path,
+                                       key=f"controllers[{i}].definitions.{k}")
+        e = parse_expression(c.law, syms, path=spec.path, key=f"controllers[{i}].law")
+        out.append(sp.lambdify(args, e, "numpy"))
+    return out
+
+
+def _simulate(spec, laws, dt, cases, draws=None, record=False):
+    """Stop errors (m) of ``cases`` [(speed, controller index, fault or None)],
+    each repeated over the Monte Carlo ``draws`` (dict of arrays) when given."""
+    from ...sim.stopping import batch_params, simulate
+    N = 1 if draws is None else len(next(iter(draws.values())))
+    n = len(cases) * N
+    base = spec.base()
+    rep = lambda f: np.repeat(np.array([f(c) for c in cases], float), N)
+    D = rep(lambda c: c[3])
+    values = {} if draws is None else {k: np.tile(v, len(cases)) for k, v in draws.items()}
+    for j, (_, _, fault, _) in enumerate(cases):
+        for k, x in (fault.disturbance if fault else {}).items():
+            values.setdefault(k, np.full(n, next(f.nominal for f in spec.factors
+                                                 if f.name == k)))
+            values[k][j * N:(j + 1) * N] = x
+    over, theta, kappa = apply_factors(base, spec.factors, values, n)
+    p = batch_params(base, n, over)
+    for j, (_, _, fault, _) in enumerate(cases):
+        for k, x in (fault.parameters if fault else {}).items():
+            p[k][j * N:(j + 1) * N] = x
+    ratio = rep(lambda c: c[2].speed_ratio if c[2] else 1.0)
+    ctl = np.repeat([c[1] for c in cases], N)
+    groups = [(laws[i], np.flatnonzero(ctl == i)) for i in range(len(laws))]
+    v0 = rep(lambda c: c[0] / 3.6)
+    const = {k: np.full(n, q.value) for k, q in spec.constants.items()}
+
+    def policy(t, o):
+        vals = {"x": o.x, "v": o.v * ratio, "decel": np.maximum(-o.a, 0.0), "d_go": D - o.x,
+                "D": D, "v0": v0, "t": np.full(n, t)} | const
+        c = np.zeros(n)
+        for law, idx in groups:
+            if idx.size:
+                c[idx] = np.broadcast_to(law(*(vals[k][idx] for k in vals)), idx.shape)
+        return np.clip(c, 0.0, spec.c_max)
+
+    tr = simulate(p, policy, n=n, t_end=spec.t_end, dt=dt, dt_ctrl=spec.dt_ctrl,
+                  dt_rec=spec.dt_ctrl, v0=v0, theta=theta, kappa=kappa, c_min=0.0,
+                  c_max=spec.c_max)
+    traces = {}
+    if record:
+        traces = {(c[0], spec.controllers[c[1]].name): (tr.x[:, k] - D[k], tr.v[:, k])
+                  for k, c in enumerate(cases) if c[2] is None}
+    return tr.x_stop - D, traces
+
+
+def _deterministic(spec, laws, dt, D, record=False):
+    cases = [(s, i, f, D[s]) for s in spec.speeds_kmh for i in range(len(laws))
+             for f in (None, *spec.faults)]
+    err, traces = _simulate(spec, laws, dt, cases, record=record)
+    q = {}
+    for (s, i, f, _), e in zip(cases, err):
+        name = f"{speed_key(s)}.{spec.controllers[i].name}."
+        q[name + ("nominal_m" if f is None else f"fault[{f.name}].error_m")] = float(e)
+    return q, traces
+
+
+def run(spec, claims=()) -> StopAccuracyResult:
+    """Compute a design (see the module docstring)."""
+    laws = compile_laws(spec)
+    base = spec.base()
+    D = {s: spec.distance if spec.distance is not None else
+         open_loop_distance(base, spec.command, s / 3.6, dt=spec.dt, dt_ctrl=spec.dt_ctrl)
+         for s in spec.speeds_kmh}
+    q, traces = _deterministic(spec, laws, spec.dt, D, record=True)
+    nominal = {(s, c.name): q[f"{speed_key(s)}.{c.name}.nominal_m"]
+               for s in spec.speeds_kmh for c in spec.controllers}
+    faults = {(s, c.name, f.name): q[f"{speed_key(s)}.{c.name}.fault[{f.name}].error_m"]
+              for s in spec.speeds_kmh for c in spec.controllers for f in spec.faults}
+    mc = {}
+    if spec.montecarlo is not None:
+        from ...features.montecarlo import draw
+        m = spec.montecarlo
+        d = draw(m, tuple(f.name for f in spec.factors), {f.name: f.nominal for f in spec.factors})
+        d = {k: v for k, v in d.items() if k in m.distributions}
+        cases = [(s, i, None, D[s]) for s in spec.speeds_kmh for i in range(len(laws))]
+        err, _ = _simulate(spec, laws, spec.dt, cases, draws=d)
+        mc = group_statistics(err, [(s, spec.controllers[i].name) for s, i, _, _ in cases],
+                              m.samples, spec.tolerance)
+    levels, checks, rows = {}, {}, ()
+    if spec.convergence:
+        from ...refinement import refinement_row
+        from ...sim.convergence import refinement_check
+        finer = [_deterministic(spec, laws, spec.dt / 2 ** k, D)[0] for k in (1, 2)]
+        levels = {k: (v, finer[0][k], finer[1][k]) for k, v in q.items()}
+        checks = {k: refinement_check(*lv, tolerance=math.inf) for k, lv in levels.items()
+                  if all(math.isfinite(x) for x in lv)}
+        rows = tuple(refinement_row(c, levels[c.quantity], "dt", levels[c.quantity][0])
+                     for c in claims if c.quantity in levels
+                     and math.isfinite(levels[c.quantity][0]))
+    return StopAccuracyResult(spec, D, nominal, faults, mc, levels, checks, rows, traces)
