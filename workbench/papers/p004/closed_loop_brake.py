@@ -34,10 +34,9 @@ import sympy as sp
 
 from ...controllers.fuzzy import FuzzyIncrement
 from ...features.montecarlo import MC_QUANTITIES, MonteCarloSpec, load_montecarlo
+from ...kinds.stop_accuracy.pipeline import open_loop_distance, read_brake_plant
 from ...reader import Quantity, Reader
-from ...sim.stopping import batch_params, simulate
 from ...tuning.pid import Damping, damping, deceleration_loop
-from ..p000.station_stopping_spec import load_plant
 from .closed_loop_brake_run import (CHANNELS, FAULTS, FULL, MC_FACTORS, MC_MODES, MODES,
                                     run_horizon_sweep, run_montecarlo, simulate_brake)
 
@@ -94,7 +93,7 @@ class Spec004:
 
 
 def _load(root: Reader) -> Spec004:
-    params = load_plant(root)
+    params = read_brake_plant(root)
     w = root.table("worked")
     shares = []
     for s in w.tables("shares"):
@@ -138,7 +137,7 @@ def _load(root: Reader) -> Spec004:
     if not all(0 <= x <= 5.0 for x in spec.t_predict_sweep):
         raise ct.fail("t_predict_sweep", list(spec.t_predict_sweep), "horizons in [0, 5] s")
     ct.finish()
-    mc = load_montecarlo(root, {k: v[2] for k, v in MC_FACTORS.items()})
+    mc = load_montecarlo(root, {k: f.positive for k, f in MC_FACTORS.items()})
     sim = root.table("sim")
     spec = Spec004(**{**spec.__dict__, "dt": sim.number("dt", positive=True, hi=0.05),
                       "dt_ctrl": sim.number("dt_ctrl", positive=True, hi=1.0), "montecarlo": mc})
@@ -223,10 +222,8 @@ def _cases(spec: Spec004) -> list[Run]:
 
 def stopping_point(spec: Spec004, v0: float) -> float:
     """Nominal open-loop stopping distance of the single command (m)."""
-    p = batch_params({k: q.value for k, q in spec.params.items()}, 1)
-    tr = simulate(p, lambda t, o: np.full(1, spec.a_target), n=1, t_end=200.0, dt=spec.dt,
-                  dt_ctrl=spec.dt_ctrl, v0=v0)
-    return float(tr.x_stop[0])
+    return open_loop_distance({k: q.value for k, q in spec.params.items()}, spec.a_target, v0,
+                              dt=spec.dt, dt_ctrl=spec.dt_ctrl)
 
 
 def run_grid(spec: Spec004, *, debug: dict | None = None,

@@ -60,7 +60,7 @@ def fault_text(spec) -> str:
 
 def mc_section(spec, res) -> str:
     mc = spec.montecarlo
-    drows = [[f"`{k}`", MC_FACTORS[k][0], d.describe(), MC_FACTORS[k][1], d.source]
+    drows = [[f"`{k}`", MC_FACTORS[k].what, d.describe(), MC_FACTORS[k].unit, d.source]
              for k, d in mc.distributions.items()]
     rows = []
     for (s, m), st in res.mc.items():

@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...controllers.pid import PID
-from ...features.montecarlo import StopStatistics, draw, stop_statistics
+from ...features.montecarlo import draw
+from ...kinds.stop_accuracy.pipeline import Factor, apply_factors, group_statistics
 from ...sim.stopping import batch_params, simulate
 
 MODES = ("open", "ato-open", "closed")
@@ -26,15 +27,14 @@ FAULTS = {"healthy": "oooo", "1 sliding": "sooo", "3 failed": "fffo",
           "1 reading high": "hooo", "1 stuck": "zooo"}
 #: states the command generator detects (falls back to the ATO open loop when all 4 are)
 DETECTED = ("s", "f")
-#: Monte Carlo factors: name -> (what, unit, positive ratio)
-MC_FACTORS = {
-    "delay": ("factor on the transmission delays T1, T3", "1", True),
-    "force_error": ("brake-force error (load weighing, force computation): kappa - 1", "1",
-                    False),
-    "friction": ("factor on K1 (air-brake friction)", "1", True),
-    "gradient": ("station gradient (‰, + uphill)", "permille", False),
-}
-MC_NOMINAL = {"delay": 1.0, "force_error": 0.0, "friction": 1.0, "gradient": 0.0}
+#: Monte Carlo factors in draw order (a factor's stream is its position), and how each
+#: acts on the plant (the stop-accuracy pipeline, :mod:`workbench.kinds.stop_accuracy.pipeline`)
+MC_FACTORS = {f.name: f for f in (
+    Factor("delay", "scale", ("T1", "T3"), "factor on the transmission delays T1, T3"),
+    Factor("force_error", "force_error", (),
+           "brake-force error (load weighing, force computation): kappa - 1"),
+    Factor("friction", "scale", ("K1",), "factor on K1 (air-brake friction)"),
+    Factor("gradient", "gradient", (), "station gradient (‰, + uphill)", "permille"))}
 #: modes of the Monte Carlo
 MC_MODES = ("ato-open", "closed")
 
@@ -134,22 +134,19 @@ def run_montecarlo(spec, distance: dict) -> dict:
     (analogue channel, healthy sensors; every mode and speed meets the same
     draws): {(speed, mode): StopStatistics}."""
     mc = spec.montecarlo
-    d = draw(mc, tuple(MC_FACTORS), MC_NOMINAL)
+    d = draw(mc, tuple(MC_FACTORS), {k: f.nominal for k, f in MC_FACTORS.items()})
     N = mc.samples
     cases = [(s, m) for s in spec.speeds_kmh for m in MC_MODES]
-    rep = lambda x: np.tile(x, len(cases))
-    base = {k: q.value for k, q in spec.params.items()}
-    tr = simulate_brake(
-        spec, v0=np.repeat([s / 3.6 for s, _ in cases], N),
-        dist=np.repeat([distance[s] for s, _ in cases], N),
-        mode=np.repeat([MODES.index(m) for _, m in cases], N), bits=np.zeros(N * len(cases), bool),
-        states=np.full((N * len(cases), 4), "o"),
-        overrides={"T1": base["T1"] * rep(d["delay"]), "T3": base["T3"] * rep(d["delay"]),
-                   "K1": base["K1"] * rep(d["friction"])},
-        theta=rep(d["gradient"]), kappa=1 + rep(d["force_error"]))
-    err = tr.x_stop - np.repeat([distance[s] for s, _ in cases], N)
-    return {c: stop_statistics(err[i * N:(i + 1) * N], spec.tolerance)
-            for i, c in enumerate(cases)}
+    n = N * len(cases)
+    over, theta, kappa = apply_factors({k: q.value for k, q in spec.params.items()},
+                                       MC_FACTORS.values(),
+                                       {k: np.tile(x, len(cases)) for k, x in d.items()}, n)
+    dist = np.repeat([distance[s] for s, _ in cases], N)
+    tr = simulate_brake(spec, v0=np.repeat([s / 3.6 for s, _ in cases], N), dist=dist,
+                        mode=np.repeat([MODES.index(m) for _, m in cases], N),
+                        bits=np.zeros(n, bool), states=np.full((n, 4), "o"), overrides=over,
+                        theta=theta, kappa=kappa)
+    return group_statistics(tr.x_stop - dist, cases, N, spec.tolerance)
 
 
 def run_horizon_sweep(spec, distance: dict) -> tuple:
