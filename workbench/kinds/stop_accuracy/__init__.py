@@ -200,7 +200,8 @@ def _check_units(path: str, constants: dict, controllers) -> None:
 
     from ...expr import parse_expression
     from ..delay_feedback.units import check_expression_units
-    units = dict(LAW_NAMES) | {k: q.unit for k, q in constants.items()}
+    units = dict(LAW_NAMES) | {k: q.unit for k, q in constants.items()} | {
+        "brake_command": "m/s^2"}          # not a law name: the unit a law must have
     plant = NS(path=path, states=(), inputs=(),
                parameters={k: NS(unit=u) for k, u in units.items()})
     for i, c in enumerate(controllers):
@@ -211,7 +212,7 @@ def _check_units(path: str, constants: dict, controllers) -> None:
             items.append((key, text, syms[k], None))
         items.append((f"controllers[{i}].law", c.law,
                       parse_expression(c.law, syms, path=path, key=f"controllers[{i}].law"),
-                      "decel"))
+                      "brake_command"))
         check_expression_units(plant, items)
 
 
@@ -235,7 +236,7 @@ class StopAccuracy:
             raise tg.fail("distance", None if dist is None else dist.value,
                           "exactly one of distance (m) and command (m/s^2)")
         tg.finish()
-        constants = _constants(root, set(LAW_NAMES))
+        constants = _constants(root, set(LAW_NAMES) | {"brake_command"})
         controllers = _controllers(root, set(LAW_NAMES) | set(constants))
         factors = _factors(root, params)
         faults = _faults(root, params, factors)

@@ -13,9 +13,9 @@ import numpy as np
 
 from ...fit import FITTED, FitResult, existing_rmse, fit, model_speeds, synthetic_log
 from ...jsonable import json_method
+from ...kinds.stop_accuracy.pipeline import read_brake_plant
 from ...reader import Reader
 from ...report.markdown import Figure, Rendered, fmt, md_table
-from .station_stopping_spec import load_plant
 
 
 @dataclass(frozen=True)
@@ -57,7 +57,7 @@ def _fit_json(r: FitResult) -> dict:
 
 
 def _load(root: Reader) -> FitSpec:
-    params = load_plant(root)
+    params = read_brake_plant(root)
     logs = []
     for lg in root.tables("logs"):
         v0 = lg.quantity("v0", "m/s", positive=True, hi=40.0).value

@@ -117,7 +117,7 @@ def _nominal_part(res) -> str:
 
 def _mc_part(spec, res, tol: float) -> str:
     mc = spec.montecarlo
-    drows = [[f"`{k}`", MC_FACTORS[k][0], d.describe(), MC_FACTORS[k][1], d.source]
+    drows = [[f"`{k}`", MC_FACTORS[k].what, d.describe(), MC_FACTORS[k].unit, d.source]
              for k, d in mc.distributions.items()]
     rows = []
     for c in MC_CONTROLLERS:

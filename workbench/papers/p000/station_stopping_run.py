@@ -18,10 +18,11 @@ from ...controllers.smarc import AdaptiveSlidingModeController
 from ...controllers.smc import SlidingModeController
 from ...controllers.stop_predictor import NominalBrakeModel
 from ...features.montecarlo import StopStatistics, draw, stop_statistics
+from ...kinds.stop_accuracy.pipeline import apply_factors
 from ...sim.stopping import TargetCurve, batch_params, simulate
 from ...tuning.pid import Damping, damping, speed_loop
-from .station_stopping_spec import (ABLATION, CONTROLLERS, DAMPING, MC_CONTROLLERS, MC_FACTORS,
-                                    NOMINAL, UNCERTAIN, VARIANTS, Section, StopSpec)
+from .station_stopping_spec import (ABLATION, CONTROLLERS, DAMPING, FACTORS, MC_CONTROLLERS,
+                                    MC_FACTORS, NOMINAL, UNCERTAIN, VARIANTS, Section, StopSpec)
 
 #: Speed errors below this (m/s; 0.18 km/h, below a speedometer's resolution) do not
 #: count as a sign change (oscillation count).
@@ -144,12 +145,8 @@ def simulate_runs(spec: StopSpec, rs: dict):
     var = [VARIANTS[v] for v in rs["variant"]]
     law = np.array([v.law for v in var], object)
     base = {k: q.value for k, q in spec.params.items()}
-    p = batch_params(base, n, {
-        "T1": base["T1"] * f["delay"], "T3": base["T3"] * f["delay"],
-        "T2": base["T2"] * f["lag"], "T4": base["T4"] * f["lag"],
-        "K1": base["K1"] * f["air_gain"] * f["brake_gain"], "P1": base["P1"] * f["brake_gain"],
-        "d0": base["d0"] * f["resistance"], "d1": base["d1"] * f["resistance"],
-        "d2": base["d2"] * f["resistance"]})
+    over, theta, kappa = apply_factors(base, FACTORS, f, n)
+    p = batch_params(base, n, over)
     lengths = rs["length"]
     tc = TargetCurve.build(lengths, v_max=spec.v_max.value, a_acc=spec.a_acc.value,
                            a_dec=spec.a_dec.value)
@@ -203,8 +200,8 @@ def simulate_runs(spec: StopSpec, rs: dict):
 
     t_end = float((tc.t_final - tb).max()) + 30.0
     tr = simulate(p, policy, n=n, t_end=t_end, dt=spec.dt, dt_ctrl=spec.dt_ctrl,
-                  dt_rec=spec.dt_ctrl, x0=x0, v0=v0, theta=f["gradient"],
-                  kappa=1.0 / f["mass_ratio"], c_init=0.0, t_arm=0.0, c_min=spec.c_min,
+                  dt_rec=spec.dt_ctrl, x0=x0, v0=v0, theta=theta,
+                  kappa=kappa, c_init=0.0, t_arm=0.0, c_min=spec.c_min,
                   c_max=spec.c_max)
     rep_smarc = (rs["kind"][idx["smarc"]] == "rep") & (rs["variant"][idx["smarc"]] == "smarc")
     return tr, smarc.theta_hat[rep_smarc], tc, tb

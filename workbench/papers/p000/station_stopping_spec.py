@@ -37,7 +37,7 @@ from dataclasses import dataclass, replace
 
 from ...controllers.smc import SlidingGains
 from ...features.montecarlo import MonteCarloSpec, load_montecarlo
-from ...plants.brake000 import PARAMETER_UNITS
+from ...kinds.stop_accuracy.pipeline import Factor, read_brake_plant
 from ...reader import Quantity, Reader
 
 #: Paper 000's three controllers, then SMARC with the discontinuous sgn of eq 22
@@ -54,16 +54,22 @@ UNCERTAIN = {
     "air_gain": ("factor on K1 (air-brake gain)", "1"),
     "gradient": ("station gradient theta (+ uphill)", "permille"),
 }
-#: Factors of the Monte Carlo: name -> (what, unit, positive ratio)
-MC_FACTORS = {
-    "delay": ("factor on the transmission delays T1, T3", "1", True),
-    "lag": ("factor on the lags T2, T4", "1", True),
-    "mass_ratio": ("true / estimated mass (load-weighing error)", "1", True),
-    "brake_gain": ("factor on the brake gains P1 and K1 (both stages)", "1", True),
-    "resistance": ("factor on the Davis coefficients", "1", True),
-    "gradient": ("station gradient theta (+ uphill)", "permille", False),
-}
-NOMINAL = {k: (0.0 if k == "gradient" else 1.0) for k in (*MC_FACTORS, "air_gain")}
+#: Factors of the Monte Carlo in draw order (a factor's stream is its position), and
+#: how each acts on the plant (:mod:`workbench.kinds.stop_accuracy.pipeline`)
+MC_FACTORS = {f.name: f for f in (
+    Factor("delay", "scale", ("T1", "T3"), "factor on the transmission delays T1, T3"),
+    Factor("lag", "scale", ("T2", "T4"), "factor on the lags T2, T4"),
+    Factor("mass_ratio", "mass_ratio", (), "true / estimated mass (load-weighing error)"),
+    Factor("brake_gain", "scale", ("K1", "P1"),
+           "factor on the brake gains P1 and K1 (both stages)"),
+    Factor("resistance", "scale", ("d0", "d1", "d2"), "factor on the Davis coefficients"),
+    Factor("gradient", "gradient", (), "station gradient theta (+ uphill)", "permille"))}
+#: Every factor of the repeats and the Monte Carlo in the order they act: K1 is
+#: base * air_gain * brake_gain.
+FACTORS = (MC_FACTORS["delay"], MC_FACTORS["lag"],
+           Factor("air_gain", "scale", ("K1",), "factor on K1 (air-brake gain)"),
+           *(MC_FACTORS[k] for k in ("brake_gain", "resistance", "gradient", "mass_ratio")))
+NOMINAL = {f.name: f.nominal for f in (*MC_FACTORS.values(), FACTORS[2])}
 
 
 @dataclass(frozen=True)
@@ -187,18 +193,8 @@ class StopSpec:
                 "pid_compensated": self.pid_compensated}[name]
 
 
-def load_plant(root: Reader) -> dict:
-    """The ``[plant]`` table: every brake parameter with its SI unit."""
-    plant = root.table("plant")
-    plant.string("model", choices=("brake-000",))
-    params = {k: plant.quantity(k, u, nonneg=k in ("v_ho", "d1", "d2"), positive=k not in
-                                ("v_ho", "d1", "d2")) for k, u in PARAMETER_UNITS.items()}
-    plant.finish()
-    return params
-
-
 def load_stop_spec(root: Reader) -> StopSpec:
-    params = load_plant(root)
+    params = read_brake_plant(root)
     unc = root.table("uncertainty")
     ranges = {}
     for k in UNCERTAIN:
@@ -252,7 +248,7 @@ def load_stop_spec(root: Reader) -> StopSpec:
     comp = Compensation(cp.number("d_terminal", positive=True, hi=500.0),
                         cp.number("gain_tau", nonneg=True, hi=60.0), (b[0], b[1]))
     cp.finish()
-    mc = load_montecarlo(root, {k: v[2] for k, v in MC_FACTORS.items()})
+    mc = load_montecarlo(root, {k: f.positive for k, f in MC_FACTORS.items()})
     sim = root.table("sim")
     spec = StopSpec(params, ranges, v_max, a_acc, a_dec, tuple(sections), pid, sliding, smarc,
                     dt=sim.number("dt", positive=True, hi=0.05),

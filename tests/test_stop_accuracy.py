@@ -1,0 +1,125 @@
+"""The ``stop-accuracy`` kind (issue 35, items 1-2): the shared stop-error
+pipeline, laws written in the design file (units checked, never evaluated),
+faults, Monte Carlo, convergence, bad input (exit 2), and paper 004's ATO open
+loop as a configuration that reproduces the ``closed-loop-brake`` study."""
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from workbench.cli import main
+from workbench.design import load_design
+from workbench.kinds import REGISTRY
+from workbench.kinds.stop_accuracy.pipeline import Factor, apply_factors, group_statistics
+from workbench.kinds.stop_accuracy.run import run
+
+ROOT = Path(__file__).resolve().parent.parent
+ATO = ROOT / "designs" / "stop-accuracy-004-ato.toml"
+SYNTH = ROOT / "designs" / "stop-accuracy-synthetic.toml"
+
+
+def _small(spec, samples=None, speeds=None, convergence=False):
+    mc = spec.montecarlo
+    if samples is not None:
+        mc = dataclasses.replace(mc, samples=samples)
+    return dataclasses.replace(spec, montecarlo=mc if samples != 0 else None,
+                               speeds_kmh=speeds or spec.speeds_kmh, convergence=convergence)
+
+
+def test_apply_factors_order_and_effects():
+    base = {"K1": 2.0, "P1": 3.0, "T1": 0.5}
+    fs = (Factor("air", "scale", ("K1",)), Factor("gain", "scale", ("K1", "P1")),
+          Factor("grad", "gradient"), Factor("mass", "mass_ratio"))
+    x = lambda v: np.array([v, 1.0])
+    over, theta, kappa = apply_factors(base, fs, {"air": x(3.0), "gain": x(5.0),
+                                                  "grad": x(-2.0), "mass": x(4.0)}, 2)
+    assert over["K1"].tolist() == [2.0 * 3.0 * 5.0, 2.0] and over["P1"].tolist() == [15.0, 3.0]
+    assert "T1" not in over and theta.tolist() == [-2.0, 1.0] and kappa.tolist() == [0.25, 1.0]
+    over, theta, kappa = apply_factors(base, (Factor("fe", "force_error"),),
+                                       {"fe": x(0.1)}, 2)
+    assert over == {} and theta.tolist() == [0.0, 0.0] and kappa.tolist() == [1.1, 2.0]
+    st = group_statistics([0.1, 0.5, np.nan, -0.2], ["a", "b"], 2, 0.3)
+    assert (st["a"].k, st["a"].n, st["b"].k) == (1, 2, 1) and st["b"].overshoot == 0.5
+
+
+def test_ato_open_reproduces_closed_loop_brake():
+    """The configuration's laws, factors and stopping points give paper 004's
+    ATO open-loop stop errors draw by draw (10 draws, 50 km/h)."""
+    from workbench.papers.p004.closed_loop_brake import stopping_point
+    from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
+    d = load_design(ATO)
+    spec = _small(d.spec, samples=10, speeds=(50.0,))
+    res = run(spec)
+    p4 = load_design(ROOT / "designs" / "closed-loop-brake-004.toml").spec
+    p4 = dataclasses.replace(p4, speeds_kmh=(50.0,),
+                             montecarlo=dataclasses.replace(p4.montecarlo, samples=10))
+    D = stopping_point(p4, 50 / 3.6)
+    assert res.distance[50.0] == D
+    ref = run_montecarlo(p4, {50.0: D})[50.0, "ato-open"]
+    got = res.mc[50.0, "ato_open"]
+    np.testing.assert_allclose(got.errors, ref.errors, rtol=0, atol=1e-9)
+    assert (got.k, got.n) == (ref.k, ref.n)
+    assert res.nominal[50.0, "open"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_synthetic_design_claims_and_features():
+    d = load_design(SYNTH)
+    study = REGISTRY["stop-accuracy"]
+    res = study.run(dataclasses.replace(d, spec=_small(d.spec, samples=6, convergence=True)))
+    q = study.quantities(res)
+    assert set(q) == study.quantity_names(d.spec)
+    # the held command does not read the speed: a sensor fault cannot move its stop
+    assert q["v60.held.fault[speed_high].change_m"] == 0.0
+    assert q["v60.held.fault[electric_loss].error_m"] > 10.0
+    assert abs(q["v60.profile.nominal_m"]) < 0.5
+    assert res.mc[60.0, "profile"].n == 6
+    assert len(res.levels) == 2 * 3 and all(len(v) == 3 for v in res.levels.values())
+    assert q["v60.profile.convergence.estimate_m"] < 0.01
+    units = study.quantity_units(d.spec)
+    assert units["v60.profile.mc.p95_abs_m"] == "m" and units["v60.held.mc.p_within"] == "1"
+
+
+def _design(tmp_path, text: str, old: str, new: str) -> Path:
+    assert old in text, old
+    p = tmp_path / "stop-accuracy-synthetic.toml"
+    p.write_text(text.replace(old, new, 1))
+    return p
+
+
+BAD = [
+    ('law = "a_ref"', 'law = "a_ref*k_v"', "brake_command, m / s ** 2; found m / s ** 3"),
+    ('law = "a_ref"', 'law = "__import__(1)"', "__import__"),             # not whitelisted
+    ('law = "a_ref"', 'law = "a_ref + speed"', "speed"),                  # unknown name
+    ('speeds_kmh = [60.0]', 'speeds_kmh = [60.0, 60.0]', "distinct"),
+    ('distance = { value = 200.0, unit = "m"', 'distance = { value = 200.0, unit = "km"', '"m"'),
+    ('parameters = ["T1", "T3"]', 'parameters = ["T9"]', "brake parameters"),
+    ('parameters = { v_ho = 1000.0 }', 'parameters = { v_hx = 1000.0 }', "brake parameter"),
+    ('dt_ctrl = 0.1', 'dt_ctrl = 0.015', "multiple"),
+    ('effect = "mass_ratio"', 'effect = "force_error"', None),            # fine alone
+]
+
+
+@pytest.mark.parametrize("old,new,word", BAD)
+def test_bad_input_exit_2(tmp_path, capsys, old, new, word):
+    p = _design(tmp_path, SYNTH.read_text(), old, new)
+    if word is None:
+        load_design(p)
+        return
+    assert main(["verify", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert word in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_mc_factor_must_be_declared(tmp_path, capsys):
+    p = _design(tmp_path, SYNTH.read_text(), 'gradient   = { dist = "uniform"',
+                'wind = { dist = "uniform"')
+    assert main(["verify", str(p)]) == 2 and "wind" in capsys.readouterr().err
+
+
+def test_distance_or_command_exactly_one(tmp_path, capsys):
+    p = _design(tmp_path, SYNTH.read_text(), 'c_max =',
+                'command = { value = 0.7, unit = "m/s^2", source = "x" }\nc_max =')
+    assert main(["verify", str(p)]) == 2 and "exactly one" in capsys.readouterr().err
