@@ -41,13 +41,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ...reader import Quantity, Reader
-from .pipeline import EFFECTS, Factor, read_brake_plant
+from .pipeline import EFFECTS, LAW_NAMES, Factor, read_brake_plant
 
 __all__ = ["Controller", "Fault", "STUDY", "StopAccuracySpec", "LAW_NAMES"]
 
-#: Names every law may use: name -> unit.
-LAW_NAMES = {"x": "m", "v": "m/s", "decel": "m/s^2", "d_go": "m", "D": "m", "v0": "m/s",
-             "t": "s"}
 #: Refinement levels of ``[convergence]``: dt / 2**k.
 LEVELS = (0, 1, 2)
 

@@ -31,9 +31,12 @@ from ...features.montecarlo import stop_statistics
 from ...plants.brake000 import PARAMETER_UNITS
 from ...reader import Reader
 
-__all__ = ["EFFECTS", "Factor", "apply_factors", "group_statistics", "open_loop_distance",
+__all__ = ["EFFECTS", "LAW_NAMES", "Factor", "apply_factors", "group_statistics", "open_loop_distance",
            "read_brake_plant"]
 
+#: Names every law of the ``stop-accuracy`` kind may use: name -> unit.
+LAW_NAMES = {"x": "m", "v": "m/s", "decel": "m/s^2", "d_go": "m", "D": "m", "v0": "m/s",
+             "t": "s"}
 #: How a factor acts: scales brake parameters (ratio, nominal 1), is the station
 #: gradient (permille, nominal 0), adds to the load-weighing gain (kappa = 1 + x,
 #: nominal 0), or divides it (true / estimated mass: kappa = 1 / x, nominal 1).

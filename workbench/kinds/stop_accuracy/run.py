@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...jsonable import json_method
-from .pipeline import apply_factors, group_statistics, open_loop_distance
+from .pipeline import LAW_NAMES, apply_factors, group_statistics, open_loop_distance
 
 __all__ = ["StopAccuracyResult", "compile_laws", "run", "speed_key"]
 
@@ -63,7 +63,6 @@ def compile_laws(spec) -> list:
     import sympy as sp
 
     from ...expr import parse_expression
-    from . import LAW_NAMES
     names = tuple(LAW_NAMES) + tuple(spec.constants)
     out = []
     for i, c in enumerate(spec.controllers):
