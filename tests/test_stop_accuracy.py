@@ -93,7 +93,10 @@ BAD = [
     ('law = "a_ref"', 'law = "a_ref*k_v"', "brake_command, m / s ** 2; found m / s ** 3"),
     ('law = "a_ref"', 'law = "__import__(1)"', "__import__"),             # not whitelisted
     ('law = "a_ref"', 'law = "a_ref + speed"', "speed"),                  # unknown name
+    ('law = "a_ref"', 'law = "a_ref*log(0)"', "real, finite"),
+    ('law = "a_ref"', 'law = "a_ref*sqrt(0 - 1)"', "real, finite"),
     ('speeds_kmh = [60.0]', 'speeds_kmh = [60.0, 60.0]', "distinct"),
+    ('parameters = ["T1", "T3"]', 'parameters = 3', "brake parameters"),
     ('distance = { value = 200.0, unit = "m"', 'distance = { value = 200.0, unit = "km"', '"m"'),
     ('parameters = ["T1", "T3"]', 'parameters = ["T9"]', "brake parameters"),
     ('parameters = { v_ho = 1000.0 }', 'parameters = { v_hx = 1000.0 }', "brake parameter"),

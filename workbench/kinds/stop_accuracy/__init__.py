@@ -45,6 +45,8 @@ from .pipeline import EFFECTS, LAW_NAMES, Factor, read_brake_plant
 
 __all__ = ["Controller", "Fault", "STUDY", "StopAccuracySpec", "LAW_NAMES"]
 
+#: Most Monte Carlo runs of one design (samples x speeds x controllers): one batch.
+MAX_RUNS = 20000
 #: Refinement levels of ``[convergence]``: dt / 2**k.
 LEVELS = (0, 1, 2)
 
@@ -149,11 +151,12 @@ def _factors(root: Reader, params: dict) -> tuple[Factor, ...]:
         effect = sub.string("effect", choices=EFFECTS)
         ps = ()
         if effect == "scale":
-            ps = tuple(sub.raw("parameters"))
-            if not ps or any(p not in params for p in ps) or len(set(ps)) < len(ps):
-                raise sub.fail("parameters", list(ps), "brake parameters of [plant], each once")
+            ps = sub.raw("parameters")
+            if (not isinstance(ps, list) or not ps or any(p not in params for p in ps)
+                    or len(set(ps)) < len(ps)):
+                raise sub.fail("parameters", ps, "brake parameters of [plant], each once")
         unit = "permille" if effect == "gradient" else "1"
-        out.append(Factor(k, effect, ps, sub.string("what", default=k), unit))
+        out.append(Factor(k, effect, tuple(ps), sub.string("what", default=k), unit))
         sub.finish()
     t.finish()
     if sum(f.effect in ("force_error", "mass_ratio") for f in out) > 1:
@@ -195,6 +198,7 @@ def _check_units(path: str, constants: dict, controllers) -> None:
     import sympy as sp
     from types import SimpleNamespace as NS
 
+    from ...errors import DesignError
     from ...expr import parse_expression
     from ..delay_feedback.units import check_expression_units
     units = dict(LAW_NAMES) | {k: q.unit for k, q in constants.items()} | {
@@ -210,6 +214,10 @@ def _check_units(path: str, constants: dict, controllers) -> None:
         items.append((f"controllers[{i}].law", c.law,
                       parse_expression(c.law, syms, path=path, key=f"controllers[{i}].law"),
                       "brake_command"))
+        for key, text, e, _ in items:
+            if e.has(sp.I, sp.zoo, sp.oo, -sp.oo, sp.nan):
+                raise DesignError(path, key, text, "a real, finite expression (this one has "
+                                  "a complex, infinite or undefined constant)")
         check_expression_units(plant, items)
 
 
@@ -243,6 +251,10 @@ class StopAccuracy:
                 raise root.fail("disturbances", None, "the factors [montecarlo] draws")
             from ...features.montecarlo import load_montecarlo
             mc = load_montecarlo(root, {f.name: f.positive for f in factors}, max_samples=5000)
+            work = mc.samples * len(speeds) * len(controllers)
+            if work > MAX_RUNS:
+                raise root.fail("montecarlo.samples", mc.samples, f"at most {MAX_RUNS} runs in "
+                                f"all (samples x speeds x controllers = {work})")
         convergence = root.has("convergence")
         if convergence:
             root.table("convergence").finish()

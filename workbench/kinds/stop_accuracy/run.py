@@ -106,9 +106,10 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
         vals = {"x": o.x, "v": o.v * ratio, "decel": np.maximum(-o.a, 0.0), "d_go": D - o.x,
                 "D": D, "v0": v0, "t": np.full(n, t)} | const
         c = np.zeros(n)
-        for law, idx in groups:
-            if idx.size:
-                c[idx] = np.broadcast_to(law(*(vals[k][idx] for k in vals)), idx.shape)
+        with np.errstate(all="ignore"):    # a law's nan (e.g. sqrt(-1)) is a run without a stop
+            for law, idx in groups:
+                if idx.size:
+                    c[idx] = np.broadcast_to(law(*(vals[k][idx] for k in vals)), idx.shape)
         return np.clip(c, 0.0, spec.c_max)
 
     tr = simulate(p, policy, n=n, t_end=spec.t_end, dt=dt, dt_ctrl=spec.dt_ctrl,
