@@ -67,18 +67,45 @@ def test_ato_open_reproduces_closed_loop_brake():
     assert res.nominal[50.0, "open"] == pytest.approx(0.0, abs=1e-9)
 
 
-def test_synthetic_design_claims_and_features():
-    d = load_design(SYNTH)
-    study = REGISTRY["stop-accuracy"]
-    res = study.run(dataclasses.replace(d, spec=_small(d.spec, samples=6, convergence=True)))
+TIGHT = """
+[[claims]]
+id = "held-tight"
+description = "a tolerance below the step's error: not converged"
+quantity = "v60.held.nominal_m"
+compare = "within"
+value = 2.936
+tolerance = 0.00001
+source = "test"
+
+[[faults]]
+name = "downhill"
+disturbance = { gradient = -10.0 }
+"""
+
+
+def test_synthetic_design_claims_and_features(tmp_path):
+    from workbench.outcome import Verdict
+    from workbench.verify import evaluate_design
+    p = tmp_path / SYNTH.name
+    p.write_text(SYNTH.read_text() + TIGHT)
+    d = load_design(p)
+    d = dataclasses.replace(d, spec=_small(d.spec, samples=6, convergence=True))
+    ev = evaluate_design(d)
+    verdict = {r.claim.id: r for r in ev.claims}
+    assert verdict["held-tight"].verdict is Verdict.INCONCLUSIVE
+    assert "not converged" in verdict["held-tight"].note
+    assert verdict["profile-nominal"].verdict is Verdict.PASS
+    study, res = REGISTRY["stop-accuracy"], ev.result
     q = study.quantities(res)
     assert set(q) == study.quantity_names(d.spec)
     # the held command does not read the speed: a sensor fault cannot move its stop
     assert q["v60.held.fault[speed_high].change_m"] == 0.0
     assert q["v60.held.fault[electric_loss].error_m"] > 10.0
+    # a down-grade lengthens the held command's stop
+    assert q["v60.held.fault[downhill].error_m"] > q["v60.held.nominal_m"] + 1.0
     assert abs(q["v60.profile.nominal_m"]) < 0.5
     assert res.mc[60.0, "profile"].n == 6
-    assert len(res.levels) == 2 * 3 and all(len(v) == 3 for v in res.levels.values())
+    assert len(res.levels) == 2 * 4 and all(len(v) == 3 for v in res.levels.values())
     assert q["v60.profile.convergence.estimate_m"] < 0.01
     units = study.quantity_units(d.spec)
     assert units["v60.profile.mc.p95_abs_m"] == "m" and units["v60.held.mc.p_within"] == "1"
