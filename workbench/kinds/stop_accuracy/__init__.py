@@ -47,6 +47,8 @@ __all__ = ["Controller", "Fault", "STUDY", "StopAccuracySpec", "LAW_NAMES"]
 
 #: Most Monte Carlo runs of one design (samples x speeds x controllers): one batch.
 MAX_RUNS = 20000
+#: Most Monte Carlo runs x integration steps.
+MAX_WORK = 2e9
 #: Refinement levels of ``[convergence]``: dt / 2**k.
 LEVELS = (0, 1, 2)
 
@@ -268,6 +270,9 @@ class StopAccuracy:
         if t_end / dt * (4 if convergence else 1) > 2_000_000:
             raise sim.fail("t_end", t_end, "at most 2e6 steps (at dt/4 with [convergence])")
         sim.finish()
+        if mc is not None and mc.samples * len(speeds) * len(controllers) * t_end / dt > MAX_WORK:
+            raise root.fail("montecarlo.samples", mc.samples, f"at most {MAX_WORK:g} runs x "
+                            "steps (a Monte Carlo of hours is a study, not a check)")
         _check_units(root.path, constants, controllers)
         return StopAccuracySpec(root.path, params, tuple(speeds), tol, c_max,
                                 None if dist is None else dist.value,

@@ -101,6 +101,12 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
     groups = [(laws[i], np.flatnonzero(ctl == i)) for i in range(len(laws))]
     v0 = rep(lambda c: c[0] / 3.6)
     const = {k: np.full(n, q.value) for k, q in spec.constants.items()}
+    names = tuple(LAW_NAMES) + tuple(const)
+    longest = max(float(p["T1"].max()), float(p["T3"].max()))
+    if not longest <= spec.t_end:       # the delay line would outgrow the run (memory)
+        from ...errors import DesignError
+        raise DesignError(spec.path, "sim.t_end", spec.t_end, "a horizon above every "
+                          f"transmission delay a fault or draw gives (longest {longest:.4g} s)")
 
     def policy(t, o):
         vals = {"x": o.x, "v": o.v * ratio, "decel": np.maximum(-o.a, 0.0), "d_go": D - o.x,
@@ -109,7 +115,7 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
         with np.errstate(all="ignore"):    # a law's nan (e.g. sqrt(-1)) is a run without a stop
             for law, idx in groups:
                 if idx.size:
-                    c[idx] = np.broadcast_to(law(*(vals[k][idx] for k in vals)), idx.shape)
+                    c[idx] = np.broadcast_to(law(*(vals[k][idx] for k in names)), idx.shape)
         return np.clip(c, 0.0, spec.c_max)
 
     tr = simulate(p, policy, n=n, t_end=spec.t_end, dt=dt, dt_ctrl=spec.dt_ctrl,
