@@ -80,6 +80,9 @@ source = "test"
 [[faults]]
 name = "downhill"
 disturbance = { gradient = -10.0 }
+
+[grid]
+gradient = [-10.0, 0.0]
 """
 
 
@@ -104,6 +107,11 @@ def test_synthetic_design_claims_and_features(tmp_path):
     # a down-grade lengthens the held command's stop
     assert q["v60.held.fault[downhill].error_m"] > q["v60.held.nominal_m"] + 1.0
     assert abs(q["v60.profile.nominal_m"]) < 0.5
+    # the grid's corners are the nominal run and the down-grade fault again
+    assert res.grid[60.0, "held"] == (q["v60.held.fault[downhill].error_m"],
+                                      q["v60.held.nominal_m"])
+    assert q["v60.held.grid.failing_corners"] == 2.0
+    assert q["v60.held.grid.max_abs_m"] == q["v60.held.fault[downhill].error_m"]
     assert res.mc[60.0, "profile"].n == 6
     assert len(res.levels) == 2 * 4 and all(len(v) == 3 for v in res.levels.values())
     assert q["v60.profile.convergence.estimate_m"] < 0.01
@@ -130,6 +138,8 @@ BAD = [
     ('parameters = ["T1", "T3"]', 'parameters = ["T9"]', "brake parameters"),
     ('parameters = { v_ho = 1000.0 }', 'parameters = { v_hx = 1000.0 }', "brake parameter"),
     ('dt_ctrl = 0.1', 'dt_ctrl = 0.015', "multiple"),
+    ('[convergence]', '[grid]\nwind = [1.0]\n\n[convergence]', "a factor of [disturbances]"),
+    ('[convergence]', '[grid]\ngradient = [1.0, 1.0]\n\n[convergence]', "distinct"),
     ('effect = "mass_ratio"', 'effect = "force_error"', None),            # fine alone
 ]
 

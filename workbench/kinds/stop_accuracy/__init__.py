@@ -22,6 +22,8 @@ Tables::
                    (the factors, in this order: a Monte Carlo draw's stream is its position)
     [[faults]]     name, parameters = { brake parameter = value }, speed_ratio (the speed
                    the law sees / the true speed), disturbance = { factor = value }
+    [grid]         factor = [values, ...]  (every combination, in the order written: the
+                   corners of an error grid, as paper 004 section 1.3)
     [montecarlo]   samples, seed, distributions = { factor = { dist = ... } }
                    (:mod:`workbench.features.montecarlo`)
     [convergence]  (no keys: every nominal and fault stop error at dt, dt/2, dt/4,
@@ -86,6 +88,7 @@ class StopAccuracySpec:
     t_end: float
     montecarlo: object = None      # MonteCarloSpec
     convergence: bool = False
+    grid: tuple = ()               # ((factor, (values, ...)), ...)
 
     def base(self) -> dict:
         return {k: q.value for k, q in self.params.items()}
@@ -194,6 +197,24 @@ def _faults(root: Reader, params: dict, factors) -> tuple[Fault, ...]:
     return tuple(out)
 
 
+def _grid(root: Reader, factors) -> tuple:
+    if not root.has("grid"):
+        return ()
+    t, out, corners = root.table("grid"), [], 1
+    for k in list(t.data):
+        if k not in {f.name for f in factors}:
+            raise t.fail(k, t.data[k], "a factor of [disturbances]")
+        vals = t.numbers(k, lo=-1e3, hi=1e3, what="values")
+        if not vals or len(set(vals)) < len(vals):
+            raise t.fail(k, list(vals), "distinct values")
+        out.append((k, tuple(vals)))
+        corners *= len(vals)
+    t.finish()
+    if not out or corners > 10000:
+        raise root.fail("grid", {k: list(v) for k, v in out}, "1 to 10000 corners")
+    return tuple(out)
+
+
 def _check_units(path: str, constants: dict, controllers) -> None:
     """Every law in m/s^2 and every definition of consistent units (pint,
     :func:`workbench.kinds.delay_feedback.units.check_expression_units`)."""
@@ -257,6 +278,7 @@ class StopAccuracy:
             if work > MAX_RUNS:
                 raise root.fail("montecarlo.samples", mc.samples, f"at most {MAX_RUNS} runs in "
                                 f"all (samples x speeds x controllers = {work})")
+        grid = _grid(root, factors)
         convergence = root.has("convergence")
         if convergence:
             root.table("convergence").finish()
@@ -277,7 +299,7 @@ class StopAccuracy:
         return StopAccuracySpec(root.path, params, tuple(speeds), tol, c_max,
                                 None if dist is None else dist.value,
                                 None if cmd is None else cmd.value, constants, controllers,
-                                factors, faults, dt, dt_ctrl, t_end, mc, convergence)
+                                factors, faults, dt, dt_ctrl, t_end, mc, convergence, grid)
 
     def quantity_names(self, spec: StopAccuracySpec) -> set[str]:
         from ...features.quantities import names

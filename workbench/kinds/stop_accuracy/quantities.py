@@ -7,6 +7,9 @@ Per speed ``v<s>`` (km/h, e.g. ``v50``) and controller ``c``::
     v<s>.<c>.nominal_m                    stop error on the nominal plant (m, + = overshoot)
     v<s>.<c>.fault[<f>].error_m           ... under fault f
     v<s>.<c>.fault[<f>].change_m          |fault error - nominal error| (m)
+    v<s>.<c>.grid.max_abs_m               with [grid]: largest |error| over the corners (m)
+    v<s>.<c>.grid.failing_corners         ... corners outside the tolerance (a run without
+                                          a stop counts)
     v<s>.<c>.mc.<stat>                    with [montecarlo]: p_within, within_lo, within_hi
                                           (Wilson 95 %), p95_abs_m, mean_m, overshoot_share
     v<s>.<c>.convergence.estimate_m       with [convergence]: Richardson error estimate of
@@ -45,6 +48,15 @@ def _mc(spec):
     return [x | {"k": k, "u": _MC_UNITS[k]} for x in _cases(spec) for k in MC_QUANTITIES]
 
 
+def _grid(spec):
+    return _cases(spec) if spec.grid else []
+
+
+def _grid_max(r, s, speed, c):
+    e = [abs(x) for x in r.grid[speed, c]]
+    return max(e) if all(math.isfinite(x) for x in e) else None
+
+
 def _conv(spec):
     return _cases(spec) if spec.convergence else []
 
@@ -69,5 +81,8 @@ TABLE = (
              over=_faults),
     Declared("{s}.{c}.mc.{k}", "{u}", lambda r, s, speed, c, k, u: getattr(
         r.mc[speed, c], MC_QUANTITIES[k]), over=_mc),
+    Declared("{s}.{c}.grid.max_abs_m", "m", _grid_max, over=_grid),
+    Declared("{s}.{c}.grid.failing_corners", "1", lambda r, s, speed, c: float(sum(
+        not abs(x) <= r.spec.tolerance for x in r.grid[speed, c])), over=_grid),
     Declared("{s}.{c}.convergence.estimate_m", "m", _estimate, over=_conv),
 )

@@ -21,11 +21,14 @@ def render(design, res) -> Rendered:
     """The report sections of a ``stop-accuracy`` design."""
     spec = design.spec
     sections = [_problem(spec), _stops(spec, res)]
+    if spec.grid:
+        sections.append(_grid(spec, res))
     if spec.montecarlo is not None:
         sections.append(_montecarlo(spec, res))
     if spec.convergence:
         sections.append(_convergence(spec, res))
     anchors = ((r"v[0-9.]+\.[A-Za-z0-9_]+\.mc\.", "Monte Carlo"),
+               (r"v[0-9.]+\.[A-Za-z0-9_]+\.grid\.", "Error grid"),
                (r"v[0-9.]+\.[A-Za-z0-9_]+\.convergence\.", "Convergence"),
                (r"v[0-9.]+\.", "Stops"))
     return Rendered(tuple(sections), (), anchors)
@@ -76,6 +79,24 @@ def _stops(spec, res) -> str:
     return ("## Stops\n\nStop errors (m) of one stop per speed and controller, on the nominal "
             "plant and under each fault (quantities `v<speed>.<controller>.nominal_m`, "
             "`...fault[<f>].error_m`).\n\n" + md_table(head, rows, "rrl" + "r" * (len(head) - 3)))
+
+
+def _grid(spec, res) -> str:
+    n = 1
+    for _, v in spec.grid:
+        n *= len(v)
+    rows = []
+    for s in spec.speeds_kmh:
+        for c in spec.controllers:
+            e = res.grid[s, c.name]
+            worst = max(abs(x) for x in e) if all(x == x for x in e) else None
+            rows.append([fmt(s), f"`{c.name}`", "no stop" if worst is None else f"{worst:.3f}",
+                         f"{sum(not abs(x) <= spec.tolerance for x in e)} of {n}"])
+    axes = " × ".join(f"{k} {list(v)}" for k, v in spec.grid)
+    return ("## Error grid\n\n"
+            f"Every corner of {axes} ({n} corners) per speed and controller.\n\n"
+            + md_table(["speed (km/h)", "controller", "max |error| (m)",
+                        f"outside ±{fmt(spec.tolerance)} m"], rows, "rlrr"))
 
 
 def _montecarlo(spec, res) -> str:

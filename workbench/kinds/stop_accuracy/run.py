@@ -9,6 +9,8 @@ refinement.
   acting through :func:`.pipeline.apply_factors`; statistics by
   :func:`.pipeline.group_statistics` (share within the tolerance with its
   Wilson 95 % interval, 95th percentile of |error|, mean, overshoot share);
+* ``[grid]``: every corner of the error grid per (speed, controller), in one
+  batch (itertools.product of the factors' values, in the order written);
 * ``[convergence]``: the nominal and fault batch again at dt/2 and dt/4, every
   stop error through :func:`workbench.sim.convergence.refinement_check`, and
   every claim on one through :func:`workbench.refinement.refinement_row`
@@ -47,6 +49,7 @@ class StopAccuracyResult:
     checks: dict = field(default_factory=dict)      # quantity -> Refinement
     refinement: tuple = ()                          # RefinementRow of claims on errors
     traces: dict = field(default_factory=dict, repr=False)  # (speed, ctl) -> (x - D, v)
+    grid: dict = field(default_factory=dict)        # (speed, controller) -> errors per corner
 
     JSON_FIELDS = {"distance": lambda r: {speed_key(s): d for s, d in r.distance.items()},
                    "nominal": lambda r: {f"{speed_key(s)}.{c}": e
@@ -161,6 +164,16 @@ def run(spec, claims=()) -> StopAccuracyResult:
         err, _ = _simulate(spec, laws, spec.dt, cases, draws=d)
         mc = group_statistics(err, [(s, spec.controllers[i].name) for s, i, _, _ in cases],
                               m.samples, spec.tolerance)
+    grid = {}
+    if spec.grid:
+        import itertools
+        corners = list(itertools.product(*(v for _, v in spec.grid)))
+        g = {k: np.array([c[j] for c in corners], float) for j, (k, _) in enumerate(spec.grid)}
+        cases = [(s, i, None, D[s]) for s in spec.speeds_kmh for i in range(len(laws))]
+        err, _ = _simulate(spec, laws, spec.dt, cases, draws=g)
+        N = len(corners)
+        grid = {(s, spec.controllers[i].name): tuple(float(e) for e in err[j * N:(j + 1) * N])
+                for j, (s, i, _, _) in enumerate(cases)}
     levels, checks, rows = {}, {}, ()
     if spec.convergence:
         from ...refinement import refinement_row
@@ -172,4 +185,4 @@ def run(spec, claims=()) -> StopAccuracyResult:
         rows = tuple(refinement_row(c, levels[c.quantity], "dt", levels[c.quantity][0])
                      for c in claims if c.quantity in levels
                      and math.isfinite(levels[c.quantity][0]))
-    return StopAccuracyResult(spec, D, nominal, faults, mc, levels, checks, rows, traces)
+    return StopAccuracyResult(spec, D, nominal, faults, mc, levels, checks, rows, traces, grid)
