@@ -140,6 +140,7 @@ BAD = [
     ('dt_ctrl = 0.1', 'dt_ctrl = 0.015', "multiple"),
     ('[convergence]', '[grid]\nwind = [1.0]\n\n[convergence]', "a factor of [disturbances]"),
     ('[convergence]', '[grid]\ngradient = [1.0, 1.0]\n\n[convergence]', "distinct"),
+    ('[convergence]', '[grid]\nmass_ratio = [0.0, 1.0]\n\n[convergence]', "above 0"),
     ('effect = "mass_ratio"', 'effect = "force_error"', None),            # fine alone
 ]
 

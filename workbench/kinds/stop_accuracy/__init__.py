@@ -189,7 +189,8 @@ def _faults(root: Reader, params: dict, factors) -> tuple[Fault, ...]:
         for k in list(dt.data):
             if k not in {f.name for f in factors}:
                 raise dt.fail(k, dt.data[k], "a factor of [disturbances]")
-            dist[k] = dt.number(k, lo=-1e3, hi=1e3)
+            positive = next(f.positive for f in factors if f.name == k)
+            dist[k] = dt.number(k, lo=-1e3, hi=1e3, positive=positive)
         dt.finish()
         ratio = t.number("speed_ratio", default=1.0, lo=0.0, hi=2.0)
         t.finish()
@@ -204,9 +205,11 @@ def _grid(root: Reader, factors) -> tuple:
     for k in list(t.data):
         if k not in {f.name for f in factors}:
             raise t.fail(k, t.data[k], "a factor of [disturbances]")
+        positive = next(f.positive for f in factors if f.name == k)
         vals = t.numbers(k, lo=-1e3, hi=1e3, what="values")
-        if not vals or len(set(vals)) < len(vals):
-            raise t.fail(k, list(vals), "distinct values")
+        if not vals or len(set(vals)) < len(vals) or positive and min(vals) <= 0:
+            raise t.fail(k, list(vals), "distinct values" + (" above 0 (a ratio)" if positive
+                                                             else ""))
         out.append((k, tuple(vals)))
         corners *= len(vals)
     t.finish()
