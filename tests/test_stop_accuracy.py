@@ -113,8 +113,18 @@ def test_synthetic_design_claims_and_features(tmp_path):
     assert q["v60.held.grid.failing_corners"] == 2.0
     assert q["v60.held.grid.max_abs_m"] == q["v60.held.fault[downhill].error_m"]
     assert res.mc[60.0, "profile"].n == 6
-    assert len(res.levels) == 2 * 4 and all(len(v) == 3 for v in res.levels.values())
+    assert len(res.levels) == 3 * 4 and all(len(v) == 3 for v in res.levels.values())
     assert q["v60.profile.convergence.estimate_m"] < 0.01
+    # the named module pid: with zero gains it is the law alone
+    zero = dataclasses.replace(d.spec, speeds_kmh=(60.0,), montecarlo=None, convergence=False,
+                               faults=(), grid=(), constants=d.spec.constants | {
+                                   k: dataclasses.replace(d.spec.constants[k], value=0.0)
+                                   for k in ("k_v", "k_i")})
+    plain = dataclasses.replace(zero, controllers=tuple(
+        dataclasses.replace(c, pid=None) for c in zero.controllers))
+    a, b = run(zero), run(plain)
+    assert a.nominal[60.0, "profile_pid"] == b.nominal[60.0, "profile_pid"]
+    assert res.nominal[60.0, "profile_pid"] != res.nominal[60.0, "profile"]
     units = study.quantity_units(d.spec)
     assert units["v60.profile.mc.p95_abs_m"] == "m" and units["v60.held.mc.p_within"] == "1"
 
@@ -138,6 +148,8 @@ BAD = [
     ('parameters = ["T1", "T3"]', 'parameters = ["T9"]', "brake parameters"),
     ('parameters = { v_ho = 1000.0 }', 'parameters = { v_hx = 1000.0 }', "brake parameter"),
     ('dt_ctrl = 0.1', 'dt_ctrl = 0.015', "multiple"),
+    ('kp = "k_v"', 'kp = "k_q"', "k_q"),                                  # not a constant
+    ('ki = "k_i"', 'ki = "k_v"', "controllers[2].pid.ki"),                # gain of a wrong unit
     ('[convergence]', '[grid]\nwind = [1.0]\n\n[convergence]', "a factor of [disturbances]"),
     ('[convergence]', '[grid]\ngradient = [1.0, 1.0]\n\n[convergence]', "distinct"),
     ('[convergence]', '[grid]\nmass_ratio = [0.0, 1.0]\n\n[convergence]', "above 0"),

@@ -16,7 +16,10 @@ Tables::
                    of that command held, as paper 004 section 1)
     [constants]    name = { value, unit, source }  (numbers the laws use)
     [[controllers]] name, law = "expression" (brake command, m/s^2),
-                   definitions = { name = "expression", ... } (in order, optional)
+                   definitions = { name = "expression", ... } (in order, optional),
+                   pid = { error = "expression", kp = "constant", ki = ..., kd = ... }
+                   (optional: the named module ``pid`` adds a sampled PID of the error,
+                   :class:`workbench.controllers.pid.BatchPID`, to the law)
     [disturbances] name = { effect = "scale", parameters = ["T1", ...] } | { effect =
                    "gradient" } (permille) | { effect = "force_error" } | { effect = "mass_ratio" }
                    (the factors, in this order: a Monte Carlo draw's stream is its position)
@@ -34,9 +37,13 @@ A law sees ``x`` (m since braking began), ``v`` (the measured speed, m/s),
 ``decel`` (the measured deceleration, m/s^2, >= 0), ``d_go = D - x`` (m),
 ``D`` (m), ``v0`` (m/s), ``t`` (s), the constants and its definitions; it is
 parsed by :mod:`workbench.expr` (never evaluated as Python) and must have the
-unit m/s^2 (pint). A controller with internal state (an integrator, a fuzzy
-increment, a sensor fusion) is not an expression; such laws stay in their
-paper's module (paper 004's command generator, paper 000's SMARC).
+unit m/s^2 (pint). A controller with internal state is not an expression:
+an integrator is the one named module a design may reference (``pid``: its
+gains are constants of the design, unit-checked as ``kp*error``,
+``ki*error*t`` and ``kd*error/t`` in m/s^2; the PID output is limited to
+±c_max with conditional integration). Other stateful laws (paper 004's
+fuzzy/PID command generator on four axle sensors, paper 000's SMARC and its
+predictive terminal law) stay in their paper's module.
 """
 from __future__ import annotations
 
@@ -60,6 +67,7 @@ class Controller:
     name: str
     law: str
     definitions: tuple[tuple[str, str], ...] = ()
+    pid: tuple[str, str, str, str] | None = None     # (error, kp, ki, kd constant names)
 
 
 @dataclass(frozen=True)
@@ -121,7 +129,7 @@ def _constants(root: Reader, taken: set) -> dict:
     return out
 
 
-def _controllers(root: Reader, names: set) -> tuple[Controller, ...]:
+def _controllers(root: Reader, names: set, constants) -> tuple[Controller, ...]:
     from ...expr import check_expression
     tables = root.tables("controllers")
     if not tables:
@@ -142,8 +150,18 @@ def _controllers(root: Reader, names: set) -> tuple[Controller, ...]:
         dt.finish()
         law = t.raw("law")
         check_expression(law, known, path=root.path, key=t.key("law"))
+        pid = None
+        if t.has("pid"):
+            pt = t.table("pid")
+            err = pt.raw("error")
+            check_expression(err, known, path=root.path, key=pt.key("error"))
+            if not constants:
+                raise pt.fail("kp", pt.raw("kp", None), "a constant of [constants] (none)")
+            gains = tuple(pt.string(k, choices=sorted(constants)) for k in ("kp", "ki", "kd"))
+            pt.finish()
+            pid = (err, *gains)
         t.finish()
-        out.append(Controller(name, law, tuple(defs)))
+        out.append(Controller(name, law, tuple(defs), pid))
     return tuple(out)
 
 
@@ -240,6 +258,14 @@ def _check_units(path: str, constants: dict, controllers) -> None:
         items.append((f"controllers[{i}].law", c.law,
                       parse_expression(c.law, syms, path=path, key=f"controllers[{i}].law"),
                       "brake_command"))
+        if c.pid is not None:
+            err, kp, ki, kd = c.pid
+            key = f"controllers[{i}].pid.error"
+            e = parse_expression(err, syms, path=path, key=key)
+            items.append((key, err, e, None))
+            t = syms["t"]
+            for k, g, term in (("kp", kp, e), ("ki", ki, e * t), ("kd", kd, e / t)):
+                items.append((f"controllers[{i}].pid.{k}", g, syms[g] * term, "brake_command"))
         for key, text, e, _ in items:
             if e.has(sp.I, sp.zoo, sp.oo, -sp.oo, sp.nan):
                 raise DesignError(path, key, text, "a real, finite expression (this one has "
@@ -268,7 +294,7 @@ class StopAccuracy:
                           "exactly one of distance (m) and command (m/s^2)")
         tg.finish()
         constants = _constants(root, set(LAW_NAMES) | {"brake_command"})
-        controllers = _controllers(root, set(LAW_NAMES) | set(constants))
+        controllers = _controllers(root, set(LAW_NAMES) | set(constants), constants)
         factors = _factors(root, params)
         faults = _faults(root, params, factors)
         mc = None

@@ -38,7 +38,9 @@ def _problem(spec) -> str:
     par = [[f"`{k}`", fmt(q.value, 6), q.unit, q.source] for k, q in spec.params.items()]
     const = [[f"`{k}`", fmt(q.value, 6), q.unit, q.source] for k, q in spec.constants.items()]
     ctl = [[f"`{c.name}`", "; ".join(f"{k} = `{t}`" for k, t in c.definitions) or "—",
-            f"`{c.law}`"] for c in spec.controllers]
+            f"`{c.law}`" + ("" if c.pid is None else f" + PID(`{c.pid[0]}`; kp = {c.pid[1]}, "
+                                                      f"ki = {c.pid[2]}, kd = {c.pid[3]})")]
+           for c in spec.controllers]
     target = (f"D = {fmt(spec.distance, 6)} m" if spec.distance is not None else
               f"D = the nominal stopping distance of the command {fmt(spec.command)} m/s² held")
     out = ("## Problem\n\nA `stop-accuracy` design: each controller brakes the paper-000 "

@@ -62,7 +62,9 @@ class StopAccuracyResult:
 
 def compile_laws(spec) -> list:
     """law(values) -> command, per controller: the design's expressions as numpy
-    functions of the law names, the constants and the definitions."""
+    functions of the law names, the constants and the definitions; with the
+    named module ``pid``, (law, error, (kp, ki, kd)) (a PID is stateful: one
+    :class:`~workbench.controllers.pid.BatchPID` per simulation)."""
     import sympy as sp
 
     from ...expr import parse_expression
@@ -75,7 +77,13 @@ def compile_laws(spec) -> list:
             syms[k] = parse_expression(text, syms, path=spec.path,
                                        key=f"controllers[{i}].definitions.{k}")
         e = parse_expression(c.law, syms, path=spec.path, key=f"controllers[{i}].law")
-        out.append(sp.lambdify(args, e, "numpy"))
+        law = sp.lambdify(args, e, "numpy")
+        if c.pid is not None:
+            e = parse_expression(c.pid[0], syms, path=spec.path,
+                                 key=f"controllers[{i}].pid.error")
+            law = (law, sp.lambdify(args, e, "numpy"),
+                   tuple(spec.constants[g].value for g in c.pid[1:]))
+        out.append(law)
     return out
 
 
@@ -101,7 +109,16 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
             p[k][j * N:(j + 1) * N] = x
     ratio = rep(lambda c: c[2].speed_ratio if c[2] else 1.0)
     ctl = np.repeat([c[1] for c in cases], N)
-    groups = [(laws[i], np.flatnonzero(ctl == i)) for i in range(len(laws))]
+    groups = []
+    for i, law in enumerate(laws):
+        idx = np.flatnonzero(ctl == i)
+        pid = None
+        if isinstance(law, tuple):         # the named module ``pid``: law + PID(error)
+            from ...controllers.pid import BatchPID
+            law, err, (kp, ki, kd) = law
+            pid = (err, BatchPID(kp, ki, kd, idx.size, dt=spec.dt_ctrl, u_min=-spec.c_max,
+                                 u_max=spec.c_max))
+        groups.append((law, idx, pid))
     v0 = rep(lambda c: c[0] / 3.6)
     const = {k: np.full(n, q.value) for k, q in spec.constants.items()}
     names = tuple(LAW_NAMES) + tuple(const)
@@ -116,9 +133,12 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
                 "D": D, "v0": v0, "t": np.full(n, t)} | const
         c = np.zeros(n)
         with np.errstate(all="ignore"):    # a law's nan (e.g. sqrt(-1)) is a run without a stop
-            for law, idx in groups:
+            for law, idx, pid in groups:
                 if idx.size:
-                    c[idx] = np.broadcast_to(law(*(vals[k][idx] for k in names)), idx.shape)
+                    args = [vals[k][idx] for k in names]
+                    c[idx] = np.broadcast_to(law(*args), idx.shape)
+                    if pid is not None:
+                        c[idx] += pid[1].step(np.broadcast_to(pid[0](*args), idx.shape))
         return np.clip(c, 0.0, spec.c_max)
 
     tr = simulate(p, policy, n=n, t_end=spec.t_end, dt=dt, dt_ctrl=spec.dt_ctrl,
