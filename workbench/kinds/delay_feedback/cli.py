@@ -126,7 +126,7 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
     import time
 
     from ...errors import DesignError
-    from ...report.markdown import fmt, md_table
+    from ...report.markdown import fmt
     from .run import design_synthesis, metrics, nominal_point, simulate
     spec = design.spec
     if not spec.scenarios:
@@ -159,12 +159,21 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
         from ...report.markdown import Figure
         save_figure(Figure(Path(plot).stem, f"{design.name}: {sc.name}",
                            lambda fig: _draw_run(fig, spec, r), (8.0, 4.5)), Path(plot))
+    return print_run({"design": design.name, "case": sc.name, "dt": dt or sc.dt,
+                      "metrics": m, "wall_s": round(wall, 3)},
+                     f"{design.name}: scenario {sc.name}, h = {fmt(sc.h)} s, dt = "
+                     f"{fmt(dt or sc.dt)} s, K = "
+                     f"{gain_text(s.K, spec.synthesis.settings.gain_digits)}", m, as_json)
+
+
+def print_run(payload: dict, header: str, m: dict, as_json: bool) -> int:
+    """The output of ``simulate``: ``payload`` as JSON, or ``header`` and the
+    metrics ``m`` as a table; exit 0."""
+    from ...report.markdown import fmt, md_table
     if as_json:
-        print(json.dumps({"design": design.name, "case": sc.name, "dt": dt or sc.dt,
-                          "metrics": m, "wall_s": round(wall, 3)}, indent=2))
+        print(json.dumps(payload, indent=2))
         return 0
-    print(f"{design.name}: scenario {sc.name}, h = {fmt(sc.h)} s, dt = {fmt(dt or sc.dt)} s, "
-          f"K = {gain_text(s.K, spec.synthesis.settings.gain_digits)}")
+    print(header)
     print(md_table(["metric", "value"], [[k, fmt(v, 6)] for k, v in m.items()], "lr"))
     return 0
 
@@ -177,10 +186,18 @@ def trajectory_csv(spec, r) -> str:
 
     from .run import input_history
     U = input_history(r, len(spec.plant.input_names))
+    return csv_text(spec, r.t, r.x, U)
+
+
+def csv_text(spec, t, x, u, phases=None) -> str:
+    """Columns ``t``, the states, the inputs (and ``phase``, the names in
+    ``phases``), ``repr`` floats: the CSV of ``simulate --csv``."""
+    import numpy as np
     cols = ["t", *spec.plant.state_names, *spec.plant.input_names]
-    rows = np.vstack([r.t, r.x, U]).T
-    return ",".join(cols) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n"
-                                           for row in rows)
+    rows = np.vstack([t, x, u]).T
+    tail = [""] * len(t) if phases is None else [f",{p}" for p in phases]
+    return ",".join(cols + ([] if phases is None else ["phase"])) + "\n" + "".join(
+        ",".join(repr(float(v)) for v in row) + end + "\n" for row, end in zip(rows, tail))
 
 
 def _draw_run(fig, spec, r) -> None:
