@@ -49,7 +49,7 @@ def test_cli_names_no_kind():
     (["simulate", "designs/delay-benchmarks.toml"],
      "design delay-benchmarks (kind delay-benchmark) has no simulate: it needs [[scenarios]]"),
     (["sweep", "designs/delay-benchmarks.toml", "--samples", "2", "--seed", "1"],
-     "kinds with sweep: antiskid-run, switched-run"),
+     "kinds with sweep: antiskid-run, delay-feedback, switched-run"),
     (["synthesize", "delay-bound", "designs/emu-speed-switched-run.toml"],
      "(kind switched-run) has no synthesize delay-bound"),
     (["simulate", "designs/emu-speed-switched-run.toml", "--plot", "x.png"],
@@ -109,3 +109,28 @@ def test_switched_run_sweep_is_seeded_chunked_and_resumable(tmp_path, capsys):
     assert main(other) == 2                                       # another sweep's folder
     assert "sweep.json" in capsys.readouterr().err
     assert main(["sweep", str(p), "--samples", "120", "--seed", "3", "--resume"]) == 2
+
+
+def test_delay_feedback_sweep_draws_the_plant(tmp_path, capsys):
+    """x' = -a sin(x) + u at x = 0.5 rad, a drawn: the sweep's largest errors
+    are those of its draws (the same numbers for the same seed; others for
+    another), and a design without [montecarlo] has no sweep."""
+    from test_delay_feedback import write as write_feedback
+    scen = ('\n[[scenarios]]\nname = "kick"\nx0 = { x = 0.7 }\nt_end = 2.0\ndt = 0.02\n')
+    mc = ('\n[montecarlo]\nsamples = 5\nseed = 1\n[montecarlo.distributions]\n'
+          'a = { dist = "uniform", lo = 1.5, hi = 2.5, source = "test" }\n')
+    p = write_feedback(tmp_path, extra=scen + mc)
+    args = ["sweep", str(p), "--samples", "8", "--seed", "3", "--json"]
+    assert main(args) == 0
+    one = json.loads(capsys.readouterr().out)["quantities"]
+    assert one["montecarlo.kick.runs"] == 8 and one["montecarlo.kick.diverged"] == 0
+    assert 0.19 < one["montecarlo.kick.max.peak_error.x"] <= 0.2 + 1e-12
+    assert main(args) == 0
+    assert json.loads(capsys.readouterr().out)["quantities"] == one
+    assert main(args[:-2] + ["4", "--json"]) == 0
+    other = json.loads(capsys.readouterr().out)["quantities"]
+    assert other["montecarlo.kick.max.final_error.x"] != one["montecarlo.kick.max.final_error.x"]
+    bare = write_feedback(tmp_path, name="bare", extra=scen)
+    assert main(["sweep", str(bare), "--samples", "8", "--seed", "3"]) == 2
+    assert "(kind delay-feedback) has no sweep: it needs a [montecarlo] table" in \
+        capsys.readouterr().err

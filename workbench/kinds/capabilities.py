@@ -23,12 +23,14 @@ import inspect
 
 from ..errors import DesignError
 
-__all__ = ["CAPABILITIES", "CapabilityError", "NEEDS", "command", "kinds_with", "run"]
+__all__ = ["CAPABILITIES", "CapabilityError", "NEEDS", "command", "kinds_with", "run",
+           "sweep_draws"]
 
 #: kind -> verb -> "module:function" of the command.
 CAPABILITIES: dict[str, dict[str, str]] = {
     "delay-feedback": {
         "simulate": "workbench.kinds.delay_feedback.cli:simulate_command",
+        "sweep": "workbench.kinds.delay_feedback.cli:sweep_command",
         "synthesize delay-bound": "workbench.kinds.delay_feedback.cli:synthesize_command",
         "synthesize sampled": "workbench.kinds.delay_feedback.sampled_cli:sampled_command"},
     "switched-run": {
@@ -99,3 +101,19 @@ def run(design, verb: str, **options) -> int:
             raise CapabilityError(design, f"{verb} {flag}", f"a kind whose {verb} takes "
                                   f"{flag}")
     return fn(design, **{k: v for k, v in options.items() if k in takes})
+
+
+def sweep_draws(design, samples: int, seed: int, max_samples: int):
+    """The design's ``[montecarlo]`` with ``--samples`` and ``--seed`` (a
+    :class:`~workbench.features.montecarlo.MonteCarloSpec`); a design
+    without the table has no sweep (:class:`CapabilityError`)."""
+    from dataclasses import replace
+    mc = design.spec.montecarlo
+    if mc is None:
+        raise CapabilityError(design, "sweep", "a [montecarlo] table (the distributions "
+                              "of the plant parameters)")
+    if isinstance(samples, bool) or not 2 <= samples <= max_samples:
+        raise DesignError("<cli>", "--samples", samples, f"an integer in [2, {max_samples}]")
+    if not seed >= 0:
+        raise DesignError("<cli>", "--seed", seed, "a non-negative integer")
+    return replace(mc, samples=samples, seed=seed)

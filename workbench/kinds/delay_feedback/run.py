@@ -223,6 +223,20 @@ def design_synthesis(spec, model, values, op, A, B, points=()) -> SynthesisOutco
                    h_cap=spec.synthesis.settings.h_max)
 
 
+def designed_gain(design, spec=None, what: str = "to do"):
+    """(model, values, op, A, B, synthesis) of a design's own synthesis for a
+    command, or None after printing that no gain was certified (``what``:
+    what the command then does not do)."""
+    spec = design.spec if spec is None else spec
+    model, values, op, A, B = nominal_point(spec)
+    points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
+    s = design_synthesis(spec, model, values, op, A, B, points)
+    if s.K is None:
+        print(f"{design.name}: no gain was certified; nothing {what}")
+        return None
+    return model, values, op, A, B, s
+
+
 def run(spec) -> DelayFeedbackResult:
     """Compute a design (see the module docstring)."""
     from ...margins import exact_margin, stability_windows

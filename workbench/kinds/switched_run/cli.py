@@ -21,7 +21,6 @@ import csv
 import io
 import json
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -105,24 +104,17 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool, case: str |
     reported, not an error)."""
     from ...errors import DesignError
     from ...features.montecarlo import draw
-    from ..capabilities import CapabilityError
+    from ..capabilities import sweep_draws
     from . import MAX_WORK
     from .study import MonteCarloRun
     spec = design.spec
-    if spec.montecarlo is None:
-        raise CapabilityError(design, "sweep", "a [montecarlo] table (the distributions "
-                              "of the plant parameters)")
-    if isinstance(samples, bool) or not 2 <= samples <= 100_000:
-        raise DesignError("<cli>", "--samples", samples, "an integer in [2, 100000]")
-    if not seed >= 0:
-        raise DesignError("<cli>", "--seed", seed, "a non-negative integer")
+    mc = sweep_draws(design, samples, seed, 100_000)
     if resume and not out:
         raise DesignError("<cli>", "--resume", True, "with --out DIR (the folder to resume)")
     sc = _scenario(design, case)
     if samples * sc.t_end / sc.dt > MAX_WORK:
         raise DesignError("<cli>", "--samples", samples, f"at most {MAX_WORK:g} samples x "
                           "steps")
-    mc = replace(spec.montecarlo, samples=samples, seed=seed)
     drawn = draw(mc, tuple(spec.plant.parameters), spec.plant.values(sc.parameters))
     draws = {k: drawn[k] for k in mc.distributions}
     if out:
