@@ -55,42 +55,20 @@ def _designs(paths: list[str]) -> list:
 
 
 # -- verbs ------------------------------------------------------------------------
-def cmd_synthesize(args) -> int:
+def _verb(verb: str, path: str, **options) -> int:
+    """Run ``verb`` on the design at ``path`` if its kind declares it
+    (:mod:`workbench.kinds.capabilities`; otherwise one line, exit 2)."""
     from .design import load_design
-    from .report.markdown import fmt
-    from .synthesis import synthesize_delay_bound
-    from .papers.p003 import antiskid_cruise
-    from .kinds.delay_feedback.cli import synthesis_table
+    from .kinds.capabilities import run
+    return run(load_design(path), verb, **options)
 
-    design = load_design(args.design)
-    if args.what == "sampled":
-        from .kinds.delay_feedback.sampled_cli import sampled_command
-        return sampled_command(design, as_json=args.json)
-    kinds = (antiskid_cruise.STUDY.kind, "delay-feedback")
-    if design.kind not in kinds:
-        raise DesignError(design.path, "design.kind", design.kind,
-                          "a design with a delay-bound synthesis ("
-                          + " or ".join(f'"{k}"' for k in kinds) + ")")
+
+def cmd_synthesize(args) -> int:
     if args.eps:
         for e in args.eps:
             if not (math.isfinite(e) and e > 0):
                 raise DesignError("<cli>", "--eps", e, "a positive number")
-    if design.kind == "delay-feedback":
-        from .kinds.delay_feedback.cli import synthesize_command
-        return synthesize_command(design, eps=args.eps, as_json=args.json)
-    spec = design.spec
-    eps = tuple(args.eps) if args.eps else spec.eps
-    _, lam_solved, lam, lin = antiskid_cruise.operating_point(spec)
-    rows = synthesize_delay_bound(lin.A, lin.B, eps, spec.settings)
-    ok = all(r.status.value == "certified" for r in rows)
-    if args.json:
-        print(json.dumps({"design": design.name, "rows": [r.to_json() for r in rows]}, indent=2))
-        return 0 if ok else 1
-    print(f"{design.name}: problem (60) of paper 003 at v_d = {fmt(spec.v_d.value)} m/s, "
-          f"lambda_d = {fmt(lam, 5)} ({'pinned' if spec.lambda_d_pinned else 'solved'}; "
-          f"solved {fmt(lam_solved, 6)})")
-    print(synthesis_table(rows, spec.settings))
-    return 0 if ok else 1
+    return _verb(f"synthesize {args.what}", args.design, eps=args.eps, as_json=args.json)
 
 
 def cmd_verify(args) -> int:
@@ -246,19 +224,8 @@ def _cmd_prove(args) -> int:
     return cmd_prove(args)
 
 
-def _load_kind(path: str, kind: str):
-    """Load a design for a verb that needs one kind (else a design error, exit 2)."""
-    from .design import load_design
-    from .errors import DesignError
-    design = load_design(path)
-    if design.kind != kind:
-        raise DesignError(design.path, "design.kind", design.kind, f'a "{kind}" design')
-    return design
-
-
 def _cmd_fit(args) -> int:
-    from .papers.p000.brake_fit import fit_command
-    return fit_command(_load_kind(args.design, "brake-fit"), as_json=args.json)
+    return _verb("fit", args.design, as_json=args.json)
 
 
 def cmd_init(args) -> int:
@@ -279,39 +246,24 @@ def cmd_new(args) -> int:
 
 
 def cmd_benchmark(args) -> int:
-    from .benchmark import benchmark_delay
-    return benchmark_delay(_load_kind(args.design, "delay-benchmark"), as_json=args.json,
-                           exact_check=args.exact_check)
+    return _verb(f"benchmark {args.what}", args.design, as_json=args.json,
+                 exact_check=args.exact_check)
 
 
 def cmd_simulate(args) -> int:
-    from .design import load_design
-    design = load_design(args.design)
-    if design.kind == "delay-feedback":
-        from .kinds.delay_feedback.cli import simulate_command as simulate_feedback
-        return simulate_feedback(design, case=args.case, dt=args.dt, as_json=args.json,
-                                 csv=args.csv, plot=args.plot)
-    if args.plot:
-        raise DesignError("<cli>", "--plot", args.plot, "a delay-feedback design (the "
-                          "antiskid-run trajectory is in its report's figures; --csv writes it)")
-    if design.kind != "antiskid-run":
-        raise DesignError(design.path, "design.kind", design.kind,
-                          'an "antiskid-run" or "delay-feedback" design')
-    from .papers.p003.antiskid_run import simulate_command
-    return simulate_command(design, case=args.case, dt=args.dt, as_json=args.json,
-                            csv=args.csv)
+    return _verb("simulate", args.design, case=args.case, dt=args.dt, as_json=args.json,
+                 csv=args.csv, plot=args.plot)
 
 
 def cmd_sweep(args) -> int:
-    from .papers.p003.antiskid_run import sweep_command
-    return sweep_command(_load_kind(args.design, "antiskid-run"), samples=args.samples, seed=args.seed,
-                         workers=args.workers, figure=args.figure, as_json=args.json,
-                         kernel=args.kernel, scheduler=args.scheduler, out=args.out,
-                         resume=args.resume)
+    return _verb("sweep", args.design, samples=args.samples, seed=args.seed,
+                 workers=args.workers, figure=args.figure, as_json=args.json,
+                 kernel=args.kernel, scheduler=args.scheduler, out=args.out,
+                 resume=args.resume, case=args.case)
 
 
 COMMANDS: dict[str, tuple[str, Callable]] = {
-    "simulate": ("simulate one case of an antiskid-run design (simulate DESIGN [--case C])",
+    "simulate": ("simulate one scenario of a design (simulate DESIGN [--case C])",
                  cmd_simulate),
     "sweep": ("Monte Carlo robustness sweep (sweep DESIGN --samples N --seed S)", cmd_sweep),
     "benchmark": ("delay LMIs vs exact margins (benchmark delay [DESIGN] [--json])",
@@ -362,20 +314,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dt", type=float, help="step (s; default: the design's dt)")
     p.add_argument("--json", action="store_true")
     p.add_argument("--csv", metavar="FILE", help="also write the trajectory (t, states, "
-                   "controller outputs) to FILE (antiskid-run: every 0.01 s)")
+                   "controller outputs; switched-run: and the phase) to FILE (antiskid-run: "
+                   "every 0.01 s)")
     p.add_argument("--plot", metavar="PNG", help="also plot the states and inputs against "
                    "time to PNG (delay-feedback designs)")
     p = sub.add_parser("sweep", help=COMMANDS["sweep"][0])
     p.add_argument("design")
     p.add_argument("--samples", type=int, required=True)
     p.add_argument("--seed", type=int, required=True)
+    p.add_argument("--case", help="scenario (switched-run; default: the design's first)")
     p.add_argument("--workers", type=int, help="processes (default: the CPUs granted to this process)")
     p.add_argument("--kernel", help="stepping path: compiled (numba; the default when "
                    "installed) or numpy (the reference)")
     p.add_argument("--scheduler", help="run the chunks on Dask: 'local' (a LocalCluster of "
                    "--workers processes) or a scheduler address, tcp://host:8786")
-    p.add_argument("--out", metavar="DIR", help="write each chunk's runs to DIR/chunk-*.npz "
-                   "as it finishes; the summaries are read back from the files")
+    p.add_argument("--out", metavar="DIR", help="write each chunk's runs to DIR "
+                   "(antiskid-run: chunk-*.npz; switched-run: <scenario>-chunk-*.csv) as it "
+                   "finishes; the summaries are read back from the files")
     p.add_argument("--resume", action="store_true",
                    help="with --out: skip the chunks already written in DIR")
     p.add_argument("--figure", help="write the histogram PNG here")

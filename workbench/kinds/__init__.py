@@ -26,7 +26,8 @@ study module, never the other way round), a function
     Markdown sections and figures (pure).
 
 New capabilities add a module here and one line to :data:`STUDIES` and to
-:data:`RENDERERS`.
+:data:`RENDERERS`; the command-line verbs a kind has (``simulate``,
+``sweep``, ``synthesize ...``) are declared in :mod:`.capabilities`.
 
 Loading is lazy: :data:`REGISTRY` imports a study's module the first time
 its kind is looked up, so reading (or rejecting) a design imports only its

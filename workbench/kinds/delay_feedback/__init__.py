@@ -36,6 +36,8 @@ Tables (see ``designs/antiskid-cruise-dry-generic.toml`` for a full file)::
                    :mod:`workbench.features.sampled`)
     [montecarlo]   samples, seed, distributions   (optional: the scenarios with drawn
                    plant parameters, :mod:`.montecarlo`)
+    [convergence]  (no keys; optional: every scenario also at dt/4, and every claim on
+                   a scenario metric refined over dt, dt/2, dt/4, :mod:`..convergence`)
 
 The design tables are read here (light: no sympy until the operating point
 is solved); :mod:`.run` computes, :mod:`.render`
@@ -121,6 +123,8 @@ class DelayFeedbackSpec:
     requirements: object = None   # delay_feedback_requirements.RequirementsSpec or None
     implementation: object = None   # delay_feedback_implementation.ImplementationSettings
     montecarlo: object = None   # features.montecarlo.MonteCarloSpec ([montecarlo], .montecarlo)
+    convergence: bool = False   # [convergence]: dt, dt/2, dt/4 (..convergence)
+    claims: tuple = ()          # ..convergence.ClaimTarget of every claim on a scenario metric
 
 
 def _variables(root: Reader, table: str, taken: set[str], min_len: int = 1
@@ -391,6 +395,35 @@ def _steps(t: Reader, k: str, t_end: float) -> tuple[tuple[float, float], ...]:
     return tuple((float(a), float(b)) for a, b in steps)
 
 
+def scenario_metrics(plant: PlantSpec, scenario: Scenario) -> set[str]:
+    """The numeric metrics of a scenario (``simulation.<scenario>.<metric>``)."""
+    out = {f"{m}.{k}" for m in ("peak_error", "final_error") for k in plant.state_names}
+    if scenario.parameters:
+        out |= {f"min_error.{k}" for k in plant.state_names}
+    return out | {f"peak_input_dev.{u}" for u in plant.input_names}
+
+
+#: Most integration steps of the finest ([convergence]: dt/4) run of a scenario.
+MAX_FINE_STEPS = 4e6
+
+
+def _with_convergence(root: Reader, spec: DelayFeedbackSpec) -> DelayFeedbackSpec:
+    """The spec with ``[convergence]`` and the claims it refines (:mod:`..convergence`)."""
+    from dataclasses import replace
+
+    from ..convergence import claim_targets, load_convergence
+    if not load_convergence(root):
+        return spec
+    for i, s in enumerate(spec.scenarios):
+        if 4 * s.t_end / s.dt > MAX_FINE_STEPS:
+            raise root.fail(f"scenarios[{i}].dt", s.dt, f"at most {MAX_FINE_STEPS / 4:g} "
+                            "steps over t_end with [convergence] (it runs dt/4 too)")
+    by_name = {s.name: s for s in spec.scenarios}
+    claims = claim_targets(root, "simulation.", lambda n: scenario_metrics(
+        spec.plant, by_name[n]) if n in by_name else set())
+    return replace(spec, convergence=True, claims=claims)
+
+
 class DelayFeedback:
     """The ``delay-feedback`` study (see the module docstring)."""
 
@@ -415,6 +448,7 @@ class DelayFeedback:
         spec = DelayFeedbackSpec(plant, delay, syn, vertices, scenarios, horizon, basin, req,
                                  load_implementation_settings(root),
                                  load_montecarlo_table(root, plant))
+        spec = _with_convergence(root, spec)
         from .model import PlantModel
         from .run import nominal_point
         from .units import check_units, physical_ranges
@@ -445,6 +479,12 @@ class DelayFeedback:
     def quantities(self, res) -> dict:
         from .run import quantities
         return quantities(res)
+
+    def unconverged(self, res) -> dict[str, str]:
+        """claim id -> reason, for the claims whose metric did not converge
+        over dt, dt/2, dt/4 (``[convergence]``; used by :mod:`workbench.verify`)."""
+        from ..convergence import unconverged
+        return unconverged(res.refinement)
 
 
 STUDY = DelayFeedback()

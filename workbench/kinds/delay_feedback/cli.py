@@ -126,8 +126,8 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
     import time
 
     from ...errors import DesignError
-    from ...report.markdown import fmt, md_table
-    from .run import design_synthesis, metrics, nominal_point, simulate
+    from ...report.markdown import fmt
+    from .run import designed_gain, metrics, simulate
     spec = design.spec
     if not spec.scenarios:
         raise DesignError(design.path, "scenarios", "<missing>", "at least one [[scenarios]]")
@@ -137,12 +137,10 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
     sc = spec.scenarios[names.index(case) if case else 0]
     if dt is not None and not (math.isfinite(dt) and 0 < dt <= sc.t_end / 10):
         raise DesignError("<cli>", "--dt", dt, f"a step in (0, {sc.t_end / 10:g}] s")
-    model, values, op, A, B = nominal_point(spec)
-    points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
-    s = design_synthesis(spec, model, values, op, A, B, points)
-    if s.K is None:
-        print(f"{design.name}: no gain was certified; nothing to simulate")
+    got = designed_gain(design, what="to simulate")
+    if got is None:
         return 1
+    model, values, op, A, B, s = got
     t0 = time.perf_counter()
     r = simulate(spec, model, values, op, s.K, sc, dt or sc.dt)
     wall = time.perf_counter() - t0
@@ -159,12 +157,21 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
         from ...report.markdown import Figure
         save_figure(Figure(Path(plot).stem, f"{design.name}: {sc.name}",
                            lambda fig: _draw_run(fig, spec, r), (8.0, 4.5)), Path(plot))
+    return print_run({"design": design.name, "case": sc.name, "dt": dt or sc.dt,
+                      "metrics": m, "wall_s": round(wall, 3)},
+                     f"{design.name}: scenario {sc.name}, h = {fmt(sc.h)} s, dt = "
+                     f"{fmt(dt or sc.dt)} s, K = "
+                     f"{gain_text(s.K, spec.synthesis.settings.gain_digits)}", m, as_json)
+
+
+def print_run(payload: dict, header: str, m: dict, as_json: bool) -> int:
+    """The output of ``simulate``: ``payload`` as JSON, or ``header`` and the
+    metrics ``m`` as a table; exit 0."""
+    from ...report.markdown import fmt, md_table
     if as_json:
-        print(json.dumps({"design": design.name, "case": sc.name, "dt": dt or sc.dt,
-                          "metrics": m, "wall_s": round(wall, 3)}, indent=2))
+        print(json.dumps(payload, indent=2))
         return 0
-    print(f"{design.name}: scenario {sc.name}, h = {fmt(sc.h)} s, dt = {fmt(dt or sc.dt)} s, "
-          f"K = {gain_text(s.K, spec.synthesis.settings.gain_digits)}")
+    print(header)
     print(md_table(["metric", "value"], [[k, fmt(v, 6)] for k, v in m.items()], "lr"))
     return 0
 
@@ -173,14 +180,19 @@ def trajectory_csv(spec, r) -> str:
     """A simulated run as CSV: ``t`` (s), each state, each input as the
     controller outputs it at t (it acts h later), in the design's units, one
     row per recorded step (``repr`` floats: the file reads back bit for bit)."""
-    import numpy as np
-
     from .run import input_history
     U = input_history(r, len(spec.plant.input_names))
+    return csv_text(spec, r.t, r.x, U)
+
+
+def csv_text(spec, t, x, u, phases=None) -> str:
+    """Columns ``t``, the states, the inputs (and ``phase``, the names in
+    ``phases``), ``repr`` floats: the CSV of ``simulate --csv``."""
     cols = ["t", *spec.plant.state_names, *spec.plant.input_names]
-    rows = np.vstack([r.t, r.x, U]).T
-    return ",".join(cols) + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n"
-                                           for row in rows)
+    rows = np.vstack([t, x, u]).T
+    tail = [""] * len(t) if phases is None else [f",{p}" for p in phases]
+    return ",".join(cols + ([] if phases is None else ["phase"])) + "\n" + "".join(
+        ",".join(repr(float(v)) for v in row) + end + "\n" for row, end in zip(rows, tail))
 
 
 def _draw_run(fig, spec, r) -> None:
@@ -196,3 +208,29 @@ def _draw_run(fig, spec, r) -> None:
         ax.legend(loc="best", fontsize=8)
         ax.grid(True, alpha=0.3)
     ax.set_xlabel("t (s)")
+
+
+def sweep_command(design, *, samples: int, seed: int, as_json: bool = False) -> int:
+    """``workbench sweep`` of a ``delay-feedback`` design with ``[montecarlo]``:
+    its distributions with ``samples`` draws and ``seed``, on every scenario
+    without a parameter schedule, the gain and operating point nominal
+    (:func:`.montecarlo.run_montecarlo`, as in the report); prints the
+    diverged runs and every metric's largest value; exit 0 (1 when no gain
+    was certified)."""
+    from types import SimpleNamespace
+
+    from ..capabilities import sweep_draws
+    from .montecarlo import montecarlo_values, run_montecarlo
+    from .run import designed_gain, predict, reference
+    spec = replace(design.spec, montecarlo=sweep_draws(design, samples, seed, 2000))
+    got = designed_gain(design, spec, "to sweep")
+    if got is None:
+        return 1
+    model, values, op, A, B, s = got
+    res = run_montecarlo(spec, model, values, op, s.K, reference, predict)
+    q = montecarlo_values(SimpleNamespace(montecarlo=res))
+    return print_run({"design": design.name, "samples": samples, "seed": seed,
+                      "quantities": q},
+                     f"{design.name}: Monte Carlo, {samples} runs per scenario, seed {seed}, "
+                     f"K = {gain_text(s.K, spec.synthesis.settings.gain_digits)}",
+                     {k: math.nan if v is None else v for k, v in q.items()}, as_json)

@@ -123,6 +123,8 @@ def render(design, res) -> Rendered:
     if res.scenarios:
         sec, figs = _simulation_section(spec, res)
         sections.append(sec)
+        if spec.convergence:
+            sections.append(_convergence_section(res))
     if vfigs:
         sections.append(vsec)
         figs = [*figs, *vfigs]
@@ -264,6 +266,27 @@ def _simulation_section(spec, res):
           + md_table(["scenario", "metric", "at dt", "at dt/2 (reported)"], rows, "llrr")
           + "\n\n" + "\n\n".join(f"![{f.caption}]({{figdir}}/{f.name}.png)" for f in figs))
     return md, figs
+
+
+def _convergence_section(res) -> str:
+    """``[convergence]``: every claimed scenario metric at dt, dt/2, dt/4."""
+    from ...sim.convergence import P_MAX, P_MIN
+    from ..convergence import claim_table
+    rows = [[f"`{x.quantity}`", *(fmt(v, 5) for v in x.values),
+             "—" if x.check is None or x.check.order is None or not math.isfinite(
+                 x.check.order) else fmt(x.check.order, 2)] for x in res.refinement]
+    return ("## Convergence\n\n`[convergence]`: every scenario also at dt/4 (the delay "
+            "unchanged), and every claim on a scenario metric refined over dt, dt/2, dt/4 "
+            "(the claim compares the dt/2 value). Observed order p = log2(|q1 − q2| / "
+            "|q2 − q4|) and Richardson's estimate of the error left in q4 "
+            f"(`workbench/sim/convergence.py`: p clipped to [{fmt(P_MIN)}, {fmt(P_MAX)}]; "
+            "differences at rounding level count as converged); the tolerance is the claim's "
+            "for `within`, the distance from the value to the bound for `<=`/`>=` "
+            "(`workbench/refinement.py`). A claim whose metric has not converged is "
+            "INCONCLUSIVE with this reason.\n\n"
+            + (md_table(["quantity", "q1 (dt)", "q2 (dt/2)", "q4 (dt/4)", "p"], rows, "lrrrr")
+               + "\n\n" if rows else "")
+            + claim_table(res.refinement))
 
 
 def _plot_run(fig, r, p):

@@ -94,13 +94,15 @@ class SynthesisOutcome:
 
 @dataclass(frozen=True)
 class ScenarioResult:
-    """One scenario: metrics at dt/2 (reported), at dt, and their agreement."""
+    """One scenario: metrics at dt/2 (reported), at dt, and their agreement;
+    with ``[convergence]`` also at dt/4."""
 
     scenario: object
     metrics: dict
     metrics_coarse: dict
     converged: bool
     run: object = field(repr=False)     # SimResult at dt/2
+    metrics_fine: dict | None = None    # at dt/4 ([convergence])
 
 
 @dataclass(frozen=True)
@@ -123,6 +125,7 @@ class DelayFeedbackResult:
     implementation: object = None   # delay_feedback_implementation.DesignImplementation
     spec: object = None        # DelayFeedbackSpec (indexes the declared quantities)
     montecarlo: tuple | None = None   # montecarlo.MonteCarloScenario per drawn scenario
+    refinement: tuple = ()     # refinement.RefinementRow per claim on a metric ([convergence])
 
     #: The JSON of the result (:func:`workbench.jsonable.to_json`).
     JSON_FIELDS = {"A": "A", "B": "B", "x_op": "op.x", "u_op": "op.u",
@@ -133,7 +136,10 @@ class DelayFeedbackResult:
                    "scenarios": lambda r: {s.scenario.name: s.metrics for s in r.scenarios},
                    "requirements": lambda r: (
                        OMIT if r.synthesis.requirements is None
-                       else r.synthesis.requirements.as_dict()["requirements"])}
+                       else r.synthesis.requirements.as_dict()["requirements"]),
+                   "refinement": lambda r: ({x.claim_id: x.outcome for x in r.refinement}
+                                            if r.spec is not None and r.spec.convergence
+                                            else OMIT)}
     to_json = json_method
 
 
@@ -217,6 +223,20 @@ def design_synthesis(spec, model, values, op, A, B, points=()) -> SynthesisOutco
                    h_cap=spec.synthesis.settings.h_max)
 
 
+def designed_gain(design, spec=None, what: str = "to do"):
+    """(model, values, op, A, B, synthesis) of a design's own synthesis for a
+    command, or None after printing that no gain was certified (``what``:
+    what the command then does not do)."""
+    spec = design.spec if spec is None else spec
+    model, values, op, A, B = nominal_point(spec)
+    points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
+    s = design_synthesis(spec, model, values, op, A, B, points)
+    if s.K is None:
+        print(f"{design.name}: no gain was certified; nothing {what}")
+        return None
+    return model, values, op, A, B, s
+
+
 def run(spec) -> DelayFeedbackResult:
     """Compute a design (see the module docstring)."""
     from ...margins import exact_margin, stability_windows
@@ -254,10 +274,16 @@ def run(spec) -> DelayFeedbackResult:
     if spec.montecarlo is not None and syn.K is not None:
         from .montecarlo import run_montecarlo
         mc = run_montecarlo(spec, model, values, op, syn.K, reference, predict)
+    rows = ()
+    if spec.convergence:
+        from ..convergence import claim_rows
+        rows = tuple(x for s in scen for x in claim_rows(
+            spec.claims, s.scenario.name, (s.metrics_coarse, s.metrics, s.metrics_fine),
+            reported=1))
     return DelayFeedbackResult(op, A, B, syn, exact, tuple(windows), stable, checks, scen,
                                points, spec.delay,
                                spec.plant.state_names + spec.plant.input_names, basin, impl,
-                               spec, mc)
+                               spec, mc, rows)
 
 
 # -- simulation -----------------------------------------------------------------------
@@ -391,11 +417,16 @@ def agree(coarse: dict, fine: dict, rtol: float) -> bool:
 
 
 def simulate_scenario(spec, model, values, op, K, scenario) -> ScenarioResult:
-    """The scenario at dt and dt/2; metrics of the finer run are reported."""
+    """The scenario at dt and dt/2 (and dt/4 with ``[convergence]``); metrics
+    of the dt/2 run are reported."""
     r1 = simulate(spec, model, values, op, K, scenario, scenario.dt)
     r2 = simulate(spec, model, values, op, K, scenario, scenario.dt / 2)
     m1, m2 = metrics(spec, op, scenario, r1), metrics(spec, op, scenario, r2)
-    return ScenarioResult(scenario, m2, m1, agree(m1, m2, scenario.rtol), r2)
+    m4 = None
+    if spec.convergence:
+        m4 = metrics(spec, op, scenario, simulate(spec, model, values, op, K, scenario,
+                                                  scenario.dt / 4))
+    return ScenarioResult(scenario, m2, m1, agree(m1, m2, scenario.rtol), r2, m4)
 
 
 # -- quantities ---------------------------------------------------------------------------

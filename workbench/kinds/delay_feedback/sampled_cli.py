@@ -14,19 +14,13 @@ def sampled_command(design, *, as_json: bool = False) -> int:
     import json
 
     from ...digital import render_markdown
-    from ...errors import DesignError
-    from .run import design_synthesis, nominal_point
-    if design.kind != "delay-feedback":
-        raise DesignError(design.path, "design.kind", design.kind,
-                          'a "delay-feedback" design (synthesize sampled)')
+    from .run import designed_gain
     spec = design.spec
     settings = spec.implementation or ImplementationSettings(None, (0.0, 0.0), "zoh")
-    model, values, op, A, B = nominal_point(spec)
-    points = tuple(nominal_point(spec, v)[3:] for v in spec.vertices)
-    syn = design_synthesis(spec, model, values, op, A, B, points)
-    if syn.K is None:
-        print(f"{design.name}: no gain was certified; nothing to implement")
+    got = designed_gain(design, what="to implement")
+    if got is None:
         return 1
+    A, B, syn = got[3], got[4], got[5]
     di = run_implementation(settings, spec.delay, A, B, syn.K)
     if as_json:
         print(json.dumps({"design": design.name, "delays": list(di.delays),

@@ -35,11 +35,10 @@ The design tables are read here (light: no sympy, no numpy);
 from __future__ import annotations
 
 import ast
-import math
-import re
 from dataclasses import dataclass
 
 from ...design import Reader
+from ..convergence import LEVELS, ClaimTarget, claim_targets, load_convergence
 from ..delay_feedback import NAME_PATTERN as _NAME
 from ..delay_feedback import read_plant
 from ..delay_feedback.spec import PlantSpec
@@ -50,8 +49,6 @@ __all__ = ["Phase", "Scenario", "SwitchedRunSpec", "STUDY", "MAX_STEPS"]
 MAX_STEPS = 2_000_000
 #: Most Monte Carlo runs times steps (one batch).
 MAX_WORK = 2e9
-#: Refinement levels of ``[convergence]``: dt / 2**k.
-LEVELS = (0, 1, 2)
 
 
 @dataclass(frozen=True)
@@ -85,17 +82,6 @@ class SampledSpec:
 
     period: float
     quantisation: dict
-
-
-@dataclass(frozen=True)
-class ClaimTarget:
-    """A claim on a scenario metric (read here for Monte Carlo pass rates and
-    the convergence tolerance; :func:`workbench.claims.parse_claims` validates
-    the full claim)."""
-
-    claim: object            # workbench.claims.Claim
-    scenario: str
-    metric: str
 
 
 @dataclass(frozen=True)
@@ -248,33 +234,6 @@ def _sampled(root: Reader, plant: PlantSpec) -> SampledSpec | None:
     return SampledSpec(period, q)
 
 
-def _claim_targets(root: Reader, scenarios, metrics_of) -> tuple[ClaimTarget, ...]:
-    """The claims whose quantity is a scenario metric, built with the project's
-    :class:`~workbench.claims.Claim` (only well-typed ones: the others are
-    rejected by :func:`workbench.claims.parse_claims` after this)."""
-    from ...claims import Claim
-    raw = root.data.get("claims", [])
-    out = []
-    for c in raw if isinstance(raw, list) else []:
-        q, cid = (c.get("quantity"), c.get("id")) if isinstance(c, dict) else (None, None)
-        if not (isinstance(q, str) and isinstance(cid, str) and q.startswith("scenario.")):
-            continue
-        scen, _, metric = q[len("scenario."):].partition(".")
-        v, tol = c.get("value"), c.get("tolerance", 0.0)
-        cmp_, digits = c.get("compare"), c.get("digits")
-        ok = (scen in {s.name: s for s in scenarios} and metric in metrics_of(scen)
-              and isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-              and isinstance(tol, (int, float)) and not isinstance(tol, bool) and tol >= 0
-              and cmp_ in (">=", "<=", "==", "within")
-              and (digits is None or isinstance(digits, int) and not isinstance(digits, bool)))
-        if ok:
-            claim = Claim(cid, "", q, cmp_, float(v), float(tol), digits,
-                          c.get("rounding", "round") if c.get("rounding") in ("round", "truncate")
-                          else "round", "", False, "pass", "")
-            out.append(ClaimTarget(claim, scen, metric))
-    return tuple(out)
-
-
 def _check_law_units(plant: PlantSpec, model, phases, usable) -> None:
     """Each law in its input's unit; guards and ``until`` of consistent units
     (pint, :func:`workbench.kinds.delay_feedback.units.check_expression_units`)."""
@@ -309,9 +268,7 @@ class SwitchedRun:
             raise root.fail("delay.predictor", True, "false when h = 0 (nothing to predict)")
         phases = _phases(root, plant, names)
         sampled = _sampled(root, plant)
-        convergence = root.has("convergence")
-        if convergence:
-            root.table("convergence").finish()
+        convergence = load_convergence(root)
         scenarios = _scenarios(root, plant, phases, hq.value, convergence, sampled)
         speed = None
         if root.has("comfort"):
@@ -335,7 +292,9 @@ class SwitchedRun:
         spec = SwitchedRunSpec(plant, hq.value, hq.source, predictor, phases, scenarios, speed,
                                mc, sampled, convergence, (), usable)
         from .quantities import scenario_metrics
-        claims = _claim_targets(root, scenarios, lambda s: scenario_metrics(spec, s))
+        known = {s.name for s in scenarios}
+        claims = claim_targets(root, "scenario.", lambda s: scenario_metrics(spec, s)
+                               if s in known else set())
         from dataclasses import replace
         return replace(spec, claims=claims)
 
@@ -362,7 +321,8 @@ class SwitchedRun:
     def unconverged(self, res) -> dict[str, str]:
         """claim id -> reason, for the claims whose metric did not converge
         over dt, dt/2, dt/4 (``[convergence]``; used by :mod:`workbench.verify`)."""
-        return {r.claim_id: r.reason for r in res.refinement if not r.converged}
+        from ..convergence import unconverged
+        return unconverged(res.refinement)
 
 
 STUDY = SwitchedRun()

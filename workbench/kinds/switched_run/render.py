@@ -7,6 +7,7 @@ import numpy as np
 
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...sim.convergence import P_MAX, P_MIN
+from ..convergence import claim_table
 from .quantities import scenario_metrics
 from .simulate import BOUND
 from .study import ALPHA, P_SHOWN, runs_for
@@ -134,10 +135,6 @@ def _convergence(spec, res) -> str:
             rows.append([f"`{r.scenario.name}`", f"`{m}`", *(fmt(x, 5) for x in c.values),
                          "—" if c.order is None or not math.isfinite(c.order) else fmt(c.order, 2),
                          "—" if c.estimate is None else fmt(c.estimate, 2)])
-    crow = [[f"`{x.claim_id}`", f"`{x.quantity}`", fmt(x.tolerance, 2),
-             "—" if x.check is None or x.check.estimate is None else fmt(x.check.estimate, 2),
-             f"**{x.outcome}**" + (f": {x.reason}" if x.reason else "")]
-            for x in res.refinement]
     return ("## Convergence\n\nEvery scenario again at dt/2 and dt/4 (the delay and the "
             "control period unchanged: they are whole numbers of the finest step). Observed "
             "order p = log2(|q1 − q2| / |q2 − q4|) and Richardson's estimate of the error "
@@ -152,8 +149,7 @@ def _convergence(spec, res) -> str:
             "tolerance for `within`, the distance from the value to the bound for `<=`/`>=`, "
             "half a printed unit for `==` with digits; `workbench/refinement.py`): a claim "
             "whose metric has not converged is INCONCLUSIVE with this reason.\n\n"
-            + (md_table(["claim", "quantity", "tolerance", "estimate", "outcome"], crow,
-                        "llrrl") if crow else "_No claim on a scenario metric._"))
+            + claim_table(res.refinement))
 
 
 def _montecarlo(spec, res):

@@ -103,6 +103,7 @@ def _values(batch: Batch) -> dict:
 def run(spec) -> SwitchedRunResult:
     """Compute a design (see the module docstring)."""
     from ...sim.convergence import refinement_check
+    from ..convergence import claim_rows
     comp = Compiled(spec)
     out, rows, rates = [], [], []
     for sc in spec.scenarios:
@@ -114,28 +115,13 @@ def run(spec) -> SwitchedRunResult:
                                        for k in (1, 2))
             checks = tuple((m, refinement_check(*(lv[m] for lv in levels), tolerance=math.inf))
                            for m in values)
-            rows += _claim_rows(spec, sc.name, levels)
+            rows += claim_rows(spec.claims, sc.name, levels)
         mc = None
         if spec.montecarlo is not None:
             mc = _montecarlo(spec, comp, sc)
             rates += [_rate(c, mc) for c in spec.claims if c.scenario == sc.name]
         out.append(ScenarioRun(sc, nominal, values, levels, checks, mc))
     return SwitchedRunResult(spec, tuple(out), tuple(rows), tuple(rates))
-
-
-def _claim_rows(spec, scenario: str, levels) -> list:
-    """The refinement row of every claim on a metric of ``scenario``
-    (:mod:`workbench.refinement`: the claim's tolerance, the reason)."""
-    from ...refinement import refinement_row
-    rows = []
-    for c in spec.claims:
-        if c.scenario != scenario:
-            continue
-        vals = tuple(lv[c.metric] for lv in levels)
-        if math.isnan(vals[0]):
-            continue                       # not determined: INCONCLUSIVE already
-        rows.append(refinement_row(c.claim, vals, "dt", vals[0]))
-    return rows
 
 
 def _montecarlo(spec, comp, sc) -> MonteCarloRun:

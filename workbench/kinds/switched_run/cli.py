@@ -1,0 +1,220 @@
+"""``workbench simulate`` and ``workbench sweep`` for ``switched-run`` designs
+(issue 35, items 1 and 3; printing and files only, the computing is
+:mod:`.simulate` and :mod:`.study`).
+
+``simulate``: one scenario at its step (or ``--dt``), its metrics, and with
+``--csv`` its trajectory (t, states, commands, phase), as the
+``delay-feedback`` command.
+
+``sweep``: the design's ``[montecarlo]`` with ``--samples`` and ``--seed``
+(the same draws as the report for the design's own values,
+:func:`workbench.features.montecarlo.draw`), one scenario (``--case``). With
+``--out DIR`` the runs are computed in chunks of :data:`CHUNK` and each
+chunk is written, as it finishes, to ``DIR/<scenario>-chunk-NNNN.csv`` (one
+row per run: its draws, its metrics, why it ended); ``--resume`` skips the
+chunks already in DIR (``DIR/sweep.json`` records the design, samples and
+seed a resumed sweep must match); the summary is read back from the files.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["CHUNK", "simulate_command", "sweep_command", "trajectory_csv"]
+
+#: Runs per chunk file of ``sweep --out``.
+CHUNK = 50
+
+
+def _scenario(design, case):
+    from ...errors import DesignError
+    names = [s.name for s in design.spec.scenarios]
+    if case is not None and case not in names:
+        raise DesignError("<cli>", "--case", case, "one of " + ", ".join(names))
+    return design.spec.scenarios[names.index(case) if case else 0]
+
+
+def _step(spec, sc, dt) -> float:
+    """``--dt`` checked: a step of the scenario's horizon of which the delay
+    and the control period are whole multiples (as the design's own)."""
+    from ...errors import DesignError
+    from . import MAX_STEPS
+    if dt is None:
+        return sc.dt
+    ok = isinstance(dt, float) and math.isfinite(dt) and 0 < dt <= sc.t_end / 10 \
+        and sc.t_end / dt <= MAX_STEPS
+    for what, v in (("the delay h", spec.h),
+                    ("the control period", spec.sampled.period if spec.sampled else 0.0)):
+        k = v / dt if ok else 0.0
+        if ok and v and not abs(k - round(k)) <= 1e-9 * max(k, 1.0):
+            raise DesignError("<cli>", "--dt", dt, f"a step of which {what} {v:g} s is a "
+                              "whole multiple")
+    if not ok:
+        raise DesignError("<cli>", "--dt", dt, f"a step in (0, {sc.t_end / 10:g}] s with at "
+                          f"most {MAX_STEPS:g} steps over t_end")
+    return dt
+
+
+def simulate_command(design, *, case: str | None, dt: float | None, as_json: bool,
+                     csv: str | None = None) -> int:
+    """``workbench simulate`` of one scenario: its metrics (with ``csv`` its
+    trajectory, :func:`trajectory_csv`); exit 0."""
+    import time
+
+    from ...report.markdown import fmt
+    from ..delay_feedback.cli import print_run
+    from .simulate import Compiled, simulate
+    spec = design.spec
+    sc = _scenario(design, case)
+    step = _step(spec, sc, dt)
+    t0 = time.perf_counter()
+    b = simulate(spec, Compiled(spec), sc, step, record=True)
+    wall = time.perf_counter() - t0
+    m = {k: float(v[0]) for k, v in b.metrics.items()}
+    if csv:
+        from ...report.files import atomic_write
+        atomic_write(Path(csv), trajectory_csv(spec, b))
+    return print_run({"design": design.name, "case": sc.name, "dt": step,
+                      "ended": b.reasons[0],
+                      "metrics": {k: None if math.isnan(v) else v for k, v in m.items()},
+                      "wall_s": round(wall, 3)},
+                     f"{design.name}: scenario {sc.name}, h = {fmt(spec.h)} s, dt = "
+                     f"{fmt(step)} s, ended: {b.reasons[0]}", m, as_json)
+
+
+def trajectory_csv(spec, b) -> str:
+    """A recorded run as CSV: ``t`` (s), each state, each command as the
+    controller outputs it (it acts h later), in the design's units, and the
+    phase's name; ``repr`` floats (the file reads back bit for bit)."""
+    from ..delay_feedback.cli import csv_text
+    names = [p.name for p in spec.phases]
+    return csv_text(spec, b.t, b.x, b.u, [names[int(p)] for p in b.phase])
+
+
+def sweep_command(design, *, samples: int, seed: int, as_json: bool, case: str | None = None,
+                  out: str | None = None, resume: bool = False) -> int:
+    """``workbench sweep`` of a ``switched-run`` design (see the module
+    docstring): print the share of runs passing each claim on the scenario
+    (Wilson 95 %) and the range of every metric; exit 0 (failing runs are
+    reported, not an error)."""
+    from ...errors import DesignError
+    from ...features.montecarlo import draw
+    from ..capabilities import sweep_draws
+    from . import MAX_WORK
+    from .study import MonteCarloRun
+    spec = design.spec
+    mc = sweep_draws(design, samples, seed, 100_000)
+    if resume and not out:
+        raise DesignError("<cli>", "--resume", True, "with --out DIR (the folder to resume)")
+    sc = _scenario(design, case)
+    if samples * sc.t_end / sc.dt > MAX_WORK:
+        raise DesignError("<cli>", "--samples", samples, f"at most {MAX_WORK:g} samples x "
+                          "steps")
+    drawn = draw(mc, tuple(spec.plant.parameters), spec.plant.values(sc.parameters))
+    draws = {k: drawn[k] for k in mc.distributions}
+    if out:
+        metrics, reasons = _chunked(design, sc, draws, samples, seed, Path(out), resume)
+    else:
+        metrics, reasons = _run(spec, sc, draws)
+    res = MonteCarloRun(samples, seed, draws, metrics, tuple(reasons))
+    _print_summary(design, sc, res, as_json)
+    return 0
+
+
+def _run(spec, sc, draws):
+    from .simulate import Compiled, simulate
+    b = simulate(spec, Compiled(spec), sc, sc.dt, plant_params=draws)
+    return b.metrics, list(b.reasons)
+
+
+def _chunked(design, sc, draws, samples, seed, folder: Path, resume: bool):
+    """Run and write the chunks not yet in ``folder``; read every chunk back."""
+    from ...errors import DesignError
+    from ...report.files import atomic_write
+    manifest = {"design": design.name, "scenario": sc.name, "samples": samples,
+                "seed": seed, "chunk": CHUNK}
+    mpath = folder / "sweep.json"
+    try:
+        if folder.exists() and any(folder.iterdir()):
+            if not resume:
+                raise DesignError("<cli>", "--out", str(folder), "a new or empty folder, "
+                                  "or --resume")
+            try:
+                old = json.loads(mpath.read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                old = None
+            if old != manifest:
+                raise DesignError("<cli>", "--out", str(folder), f"a folder of this sweep "
+                                  f"to resume ({mpath.name}: {json.dumps(manifest)})")
+        folder.mkdir(parents=True, exist_ok=True)
+        atomic_write(mpath, json.dumps(manifest, indent=2) + "\n")
+        files = []
+        for k, lo in enumerate(range(0, samples, CHUNK)):
+            path = folder / f"{sc.name}-chunk-{k:04d}.csv"
+            files.append(path)
+            if path.is_file():
+                continue
+            part = {p: v[lo:lo + CHUNK] for p, v in draws.items()}
+            m, why = _run(design.spec, sc, part)
+            atomic_write(path, _chunk_csv(part, m, why))
+        return _read_chunks(files, list(draws))
+    except OSError as e:
+        raise DesignError("<cli>", "--out", str(folder), f"a folder the chunks can be "
+                          f"written to ({type(e).__name__}: {e})") from None
+
+
+def _chunk_csv(draws, metrics, reasons) -> str:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow([*draws, *metrics, "ended"])
+    n = len(reasons)
+    for j in range(n):
+        w.writerow([*(repr(float(v[j])) for v in draws.values()),
+                    *(repr(float(v[j])) for v in metrics.values()), reasons[j]])
+    return buf.getvalue()
+
+
+def _read_chunks(files, drawn):
+    metrics, reasons = {}, []
+    for path in files:
+        rows = list(csv.reader(path.read_text(encoding="utf-8").splitlines()))
+        head = rows[0]
+        for row in rows[1:]:
+            for name, v in zip(head[len(drawn):-1], row[len(drawn):-1]):
+                metrics.setdefault(name, []).append(float(v))
+            reasons.append(row[-1])
+    return {k: np.array(v) for k, v in metrics.items()}, reasons
+
+
+def _print_summary(design, sc, res, as_json: bool) -> None:
+    from ...report.markdown import fmt, md_table
+    from .quantities import scenario_metrics
+    from .study import _rate
+    rates = [_rate(c, res) for c in design.spec.claims if c.scenario == sc.name]
+    units = scenario_metrics(design.spec, sc.name)
+    span = {}
+    for k, v in res.metrics.items():
+        ok = ~np.isnan(v)
+        span[k] = (float(np.min(v[ok])), float(np.max(v[ok]))) if ok.any() else (None, None)
+    if as_json:
+        print(json.dumps({"design": design.name, "case": sc.name, "samples": res.samples,
+                          "seed": res.seed, "diverged": int(np.nansum(res.metrics["diverged"])),
+                          "claims": {c.claim_id: {"passes": c.passes, "n": c.n, "lo": c.lo,
+                                                  "hi": c.hi} for c in rates},
+                          "metrics": {k: {"min": a, "max": b} for k, (a, b) in span.items()}},
+                         indent=2))
+        return
+    print(f"{design.name}: Monte Carlo of scenario {sc.name}, {res.samples} runs, seed "
+          f"{res.seed}: {int(np.nansum(res.metrics['diverged']))} diverged or chattered")
+    if rates:
+        print(md_table(["claim", "runs passing", "Wilson 95 %"],
+                       [[c.claim_id, f"{c.passes} / {c.n}", f"[{fmt(c.lo, 4)}, {fmt(c.hi, 4)}]"]
+                        for c in rates], "lrr"))
+    print(md_table(["metric", "min over runs", "max over runs", "unit"],
+                   [[k, fmt(a, 5), fmt(b, 5), units[k]] for k, (a, b) in span.items()],
+                   "lrrl"))
