@@ -9,7 +9,13 @@ table gives both and their ratio:
 
 * ``WORKBENCH_BASIN_EAGER=1``: the basin k2 sweep computes every certificate
   (Taylor ball and box cover) as before, instead of only those whose value can
-  change a verdict or a fate (:mod:`workbench.papers.p003.antiskid_basin`).
+  change a verdict or a fate, and the cruise basin covers every weight of its
+  grid, instead of only those whose falsifier bound can beat the best score
+  (the coarse pass; :mod:`workbench.papers.p003.antiskid_basin`).
+
+With ``--cold``, each process starts on an empty disk cache of the compiled
+kernels (``WORKBENCH_CACHE_DIR``: numba compiles them, as on a fresh clone).
+Each study's row is also printed to stderr as soon as it is done.
 
 The CPU seconds are the figure to compare on a loaded machine; nothing here
 asserts a time. ``--check [--jobs N]`` instead times ``workbench check
@@ -17,7 +23,7 @@ asserts a time. ``--check [--jobs N]`` instead times ``workbench check
 
 Usage::
 
-    python benchmarks/check_times.py [--before] [designs/X.toml ...]
+    python benchmarks/check_times.py [--before] [--cold] [designs/X.toml ...]
     python benchmarks/check_times.py --check [--jobs N]
 """
 from __future__ import annotations
@@ -27,6 +33,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -34,6 +41,8 @@ ROOT = Path(__file__).resolve().parents[1]
 WB = [sys.executable, "-m", "workbench"]
 #: Environment of the old code paths (module docstring).
 BEFORE_ENV = {"WORKBENCH_BASIN_EAGER": "1"}
+#: --cold: every process on an empty kernel cache.
+COLD = False
 
 
 def _cpu() -> float:
@@ -61,11 +70,23 @@ def run_studies(paths: list[str], env_extra: dict) -> dict:
     """{design: row} of a worker process (no run folder: every study computed)."""
     env = {k: v for k, v in os.environ.items() if k != "WORKBENCH_STUDY_CACHE"}
     env.update(env_extra)
-    p = subprocess.run([sys.executable, __file__, "--worker", *paths], cwd=ROOT, env=env,
-                       capture_output=True, text=True)
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="numba-cold-") as cold:
+        if COLD:
+            env["WORKBENCH_CACHE_DIR"] = cold
+        with subprocess.Popen([sys.executable, __file__, "--worker", *paths], cwd=ROOT,
+                              env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True) as p:
+            for line in p.stdout:
+                if line.startswith("{"):
+                    rows.append(json.loads(line))
+                    r = rows[-1]
+                    print(f"  {'before' if env_extra else 'after'}: {r['design']} "
+                          f"{r['wall']:.1f} s wall, {r['cpu']:.1f} s CPU", file=sys.stderr,
+                          flush=True)
+            err = p.stderr.read()
     if p.returncode:
-        sys.exit(f"worker exited {p.returncode}:\n{p.stderr[-3000:]}")
-    rows = [json.loads(line) for line in p.stdout.splitlines() if line.startswith("{")]
+        sys.exit(f"worker exited {p.returncode}:\n{err[-3000:]}")
     return {r["design"]: r for r in rows}
 
 
@@ -129,8 +150,12 @@ def main() -> None:
     ap.add_argument("--before", action="store_true", help="also time the old code paths")
     ap.add_argument("--check", action="store_true", help="time workbench check --jobs 1 and N")
     ap.add_argument("--jobs", type=int, default=len(os.sched_getaffinity(0)))
+    ap.add_argument("--cold", action="store_true",
+                    help="each process on an empty compiled-kernel cache (a fresh clone)")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
+    global COLD
+    COLD = args.cold
     if args.worker:
         worker(args.designs)
         return

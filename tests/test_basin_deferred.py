@@ -92,3 +92,37 @@ def test_k2_sweep_is_shared_through_the_run_folder(tmp_path, monkeypatch):
     assert a == b and len(calls) == 1 and len(list(tmp_path.glob("*.pickle"))) == 1
     K2.safe_k2_range(DRY, 70.0, K[0], (70.0, 0.1), **dict(args, seed=1))
     assert len(calls) == 2                               # another key: computed
+
+
+def test_score_bound_bounds_the_score(deferred, switch):
+    """The coarse pass of cruise_basin skips a P's box cover when this bound
+    cannot beat the best score: it must bound the score the cover gives."""
+    est = deferred.est
+    for pts in ([switch], [switch, (0.0, 0.0), (-1.0, 0.001)], []):
+        assert AB._score(est, pts) <= AB._score_bound(deferred.prob, deferred.c_top, pts)
+    # c_certified = c_top: the bound is the score itself (it is not loose)
+    from dataclasses import replace
+    top = replace(est, c_certified=deferred.c_top)
+    assert AB._score(top, [switch]) == AB._score_bound(deferred.prob, deferred.c_top, [switch])
+
+
+@pytest.mark.slow
+def test_cruise_basin_coarse_pass_equals_every_cover(monkeypatch):
+    """cruise_basin with the coarse pass (covers skipped) chooses the same P
+    and gives the same estimate, verdicts and trajectories as with every
+    weight's cover computed (the path before issue 36), and skips some."""
+    lam_opt = NumericAdhesion.from_dict(DRY).lambda_opt()
+    pts = [("printed", (70.0, lam_opt)), ("near", (69.5, AB.cruise_lambda_d(VALS, 70.0) + 0.002))]
+    calls = []
+    orig = AB.estimate_basin
+    monkeypatch.setattr(AB, "estimate_basin", lambda *a, **k: calls.append(1) or orig(*a, **k))
+    monkeypatch.delenv(AB.EAGER_ENV, raising=False)
+    fast = AB.cruise_basin(DRY, 70.0, K, pts, n_traj=2)
+    n_fast = len(calls)
+    monkeypatch.setenv(AB.EAGER_ENV, "1")
+    eager = AB.cruise_basin(DRY, 70.0, K, pts, n_traj=2)
+    assert n_fast < len(calls) - n_fast == len(AB.W_GRID)
+    assert (fast.q, fast.check, fast.K, fast.lambda_d) == (eager.q, eager.check, eager.K,
+                                                           eager.lambda_d)
+    for a, b in zip(fast.trajectories, eager.trajectories, strict=True):
+        assert (a.x0, a.fate) == (b.x0, b.fate) and np.array_equal(a.path, b.path)

@@ -130,3 +130,24 @@ def test_two_functions_cannot_share_a_cache_name():
     jit_cache.cached(a, "test.shared-name")
     with pytest.raises(RuntimeError, match="share the cache name"):
         jit_cache.cached(b, "test.shared-name")
+
+
+_WAITING_CHILD = _CHILD.replace("r = f(0.25)", "print('ready', flush=True)\nr = f(0.25)")
+
+
+def test_two_processes_at_once_compile_once(tmp_path):
+    """Two processes that miss the cache together: the second waits on the
+    first's lock and loads what it compiled (issue 36: the two workers of
+    `workbench check --jobs 2` start the antiskid runs together)."""
+    import fcntl
+    d = tmp_path / "numba" / jit_cache.source_stamp()[:32]
+    d.mkdir(parents=True)
+    with open(d / "test.f.lock", "a") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)     # both children miss and queue behind this
+        kids = [subprocess.Popen([sys.executable, "-c", _WAITING_CHILD], env=_env(tmp_path),
+                                 stdout=subprocess.PIPE, text=True) for _ in range(2)]
+        assert [k.stdout.readline().strip() for k in kids] == ["ready", "ready"]
+    outs = [k.communicate(timeout=120)[0].split() for k in kids]
+    assert [k.returncode for k in kids] == [0, 0]
+    assert outs[0][0] == outs[1][0] == repr(math.expm1(0.25) / 0.25 + 0.5)
+    assert sorted((outs[0][1], outs[1][1])) == ["0", "1"]   # one compiled, one loaded

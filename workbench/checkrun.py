@@ -30,6 +30,8 @@ __all__ = ["TaskTime", "check_parallel", "prefetch", "report_parallel", "run_fol
 
 #: Kinds whose studies take longest, started first (the rest by file size).
 _SLOW_KINDS = ("antiskid-run", "delay-benchmark", "antiskid-robust", "ntsm-platoon")
+#: Kinds whose studies compile the numba kernels on a cold disk cache.
+_COMPILED_KINDS = ("antiskid-run",)
 
 
 @dataclass(frozen=True)
@@ -88,14 +90,25 @@ def _proof_task(module: str):
     return name, [], TaskTime(name, "proof", time.perf_counter() - w0, _cpu() - c0)
 
 
+def _task_order(designs, jobs: int) -> list:
+    """Slow kinds first, larger files first; but only one compiled-kernel
+    study among the first ``jobs`` tasks: on a cold disk cache the others
+    would wait on its compilation (the lock of :mod:`workbench.sim.jit_cache`)
+    instead of running another study."""
+    order = sorted(designs, key=lambda d: (d.kind not in _SLOW_KINDS,
+                                            -Path(d.path).stat().st_size, d.name))
+    head = [d for d in order if d.kind in _COMPILED_KINDS][:1]
+    head += [d for d in order if d.kind not in _COMPILED_KINDS][:max(jobs - 1, 0)]
+    return head + [d for d in order if not any(d is h for h in head)]
+
+
 def prefetch(designs, proof_modules, out: Path, jobs: int, *, write: bool = False):
     """Run every design's study and report check (``write``: its report
     written), and every proof module, on ``jobs`` processes. Returns (names
     of designs whose reports were checked or written, their problems or the
     paths written, task times)."""
     import multiprocessing as mp
-    order = sorted(designs, key=lambda d: (d.kind not in _SLOW_KINDS,
-                                            -Path(d.path).stat().st_size, d.name))
+    order = _task_order(designs, jobs)
     checked, problems, times = set(), [], []
     from .sim.batch import die_with_parent   # workers die with the check (issue 32)
     with ProcessPoolExecutor(jobs, mp_context=mp.get_context("fork"),

@@ -22,8 +22,15 @@ later process. This module gives such a function a cache of its own:
   directory shared by different machines serves each its own code;
 * **concurrency**: numba writes every file under a unique temporary name
   and renames it into place (:meth:`numba.core.caching.IndexDataCacheFile._open_for_write`),
-  so processes that compile the same kernel at once each write a complete
-  file and the last rename wins (both are the same code).
+  so processes that compile the same kernel at once would each write a
+  complete file and the last rename wins (both are the same code). They do
+  not compile it at once: a process that misses the cache takes an
+  exclusive ``flock`` on ``<name>.lock`` in the directory, looks again
+  (another process may have written the kernel while it waited) and only
+  then compiles, releasing the lock once the kernel is saved (or when the
+  process ends, if the compilation failed). Two workers of ``workbench
+  check --jobs 2`` that start the antiskid runs together thus compile each
+  kernel once (about 20 CPU-s each, issue 36): the second loads it.
 
 A loaded kernel is the machine code the first process compiled, so its
 results are bit-identical to compiling it again on the same machine.
@@ -117,6 +124,7 @@ def _cache_class():
     class Cache(FunctionCache):
         def __init__(self, py_func, name: str, path: Path):   # as numba's Cache.__init__
             self._name, self._py_func = f"{name} ({py_func!r})", py_func
+            self._lock_name, self._held = name, None
             self._impl = Impl(py_func, name, path)
             self._cache_path = str(path)
             self._cache_file = IndexDataCacheFile(cache_path=self._cache_path,
@@ -129,7 +137,47 @@ def _cache_class():
             code = hashlib.sha256(self._py_func.__code__.co_code).hexdigest()
             return sig, codegen.magic_tuple(), code
 
+        def load_overload(self, sig, target_context):
+            # a miss: wait for a process compiling it now, look again; the
+            # lock stays held through this process's compilation (module docstring)
+            self._release()
+            got = super().load_overload(sig, target_context)
+            if got is None:
+                self._held = _lock(Path(self._cache_path) / f"{self._lock_name}.lock")
+                got = super().load_overload(sig, target_context)
+                if got is not None:
+                    self._release()
+            return got
+
+        def save_overload(self, sig, data):
+            try:
+                super().save_overload(sig, data)
+            finally:
+                self._release()
+
+        def _release(self):
+            fd, self._held = getattr(self, "_held", None), None
+            if fd is not None:
+                fd.close()          # closing the file releases its flock
+
     return Cache
+
+
+def _lock(path: Path):
+    """An open file holding an exclusive ``flock`` on ``path`` (blocks until
+    granted); None where locking is unavailable (the cache still works, a
+    kernel may then be compiled by two processes at once)."""
+    try:
+        import fcntl
+        fd = open(path, "a")
+    except (ImportError, OSError):
+        return None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+    except OSError:
+        fd.close()
+        return None
+    return fd
 
 
 _NAMES: dict[str, bytes] = {}    # cache name -> bytecode

@@ -160,8 +160,9 @@ def estimate_cruise(values, v_d, K, points, w, *, seed=0, c_search=None):
     return prob, estimate_basin(prob, c, seed=seed)
 
 
-#: Set (to anything) to run every certificate of :func:`switch_in_basin` as
-#: before issue 36 (benchmarks/check_times.py compares the two paths).
+#: Set (to anything) to run every certificate of :func:`switch_in_basin` and
+#: :func:`cruise_basin` as before issue 36 (benchmarks/check_times.py compares
+#: the two paths).
 EAGER_ENV = "WORKBENCH_BASIN_EAGER"
 
 
@@ -221,6 +222,31 @@ def _score(est: BasinEstimate, points) -> tuple:
     return (ok, min(est.c_certified / l if l > 0 else math.inf for l in lv))
 
 
+def _score_bound(prob: BasinProblem, c_top: float, points) -> tuple:
+    """An upper bound of ``_score(estimate_basin(prob, c, falsified=fal), points)``
+    from the falsifier's stage alone (``(fal, c_top) = falsified_top(prob, c)``),
+    the coarse pass of :func:`cruise_basin` (issue 36, item 4).
+
+    The estimate certifies c_certified <= c_top (:func:`~workbench.roa.basin.falsified_top`),
+    and its level bounds of a point depend on P and x* only, so the count
+    of certified points and the worst margin c_certified / level of
+    :func:`_score` are each at most their value at c_certified = c_top:
+    the score is lexicographically <= this bound. A P whose bound does not
+    exceed the best score so far cannot replace it (the sweep keeps the
+    first of equal scores), and its box cover is skipped: the chosen P, its
+    estimate and so every printed number are those of the full sweep.
+    """
+    P, x_eq = np.array(prob.P, float), np.array(prob.x_eq, float)
+    lv = []
+    for x in points:
+        x = np.asarray(x, float)[None, :]
+        lv.append(float(quadratic_enclosure(P, x_eq, x, x).hi[0]))
+    if not points:
+        return (0, c_top)
+    ok = sum(l <= c_top for l in lv)
+    return (ok, min(c_top / l if l > 0 else math.inf for l in lv))
+
+
 def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
                  n_traj: int = 24, t_traj: float = 3.0) -> CruiseBasin:
     """Certified basin of law (61) and the verdict for each switch state.
@@ -246,13 +272,18 @@ def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
     vals = tuple(sorted((k, float(v)) for k, v in values.items()))
     lam_d, lam_opt = _loop_symbolic(vals, v_d)[6:8]
     pts = [(lab, (float(v) - v_d, float(l) - lam_d)) for lab, (v, l) in switch_points]
-    best = None
+    best, xs = None, [x for _, x in pts]
     for q in W_GRID:
         try:
-            prob, est = estimate_cruise(vals, v_d, K, [x for _, x in pts], q, seed=seed)
+            prob, c = _cruise_problem(vals, v_d, K, xs, q)
+            fal, c_top = falsified_top(prob, c, seed=seed)
+            if best is not None and not os.environ.get(EAGER_ENV) \
+                    and _score_bound(prob, c_top, xs) <= best[0]:
+                continue        # coarse pass: this P cannot be chosen (_score_bound)
+            est = estimate_basin(prob, c, seed=seed, falsified=fal)
         except ModelError:
             continue
-        key = _score(est, [x for _, x in pts])
+        key = _score(est, xs)
         if best is None or key > best[0]:
             best = (key, q, prob, est)
     if best is None:
