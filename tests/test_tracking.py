@@ -178,6 +178,8 @@ def test_study_runs_and_claims_are_ok(evaluation):
         lim = evaluation.design.spec.peak_jerk.value
         for c, tun in (("MFAC", r.mfac), ("PID", r.pid)):
             assert tun.front[tun.chosen] or r.main.value(c, "peak_jerk") <= lim
+            # only reproducible runs (+-3 ulp on the train) are chosen or on a front
+            assert tun.reproducible[tun.chosen] and not (tun.front & ~tun.reproducible).any()
         # the grid row of the chosen point and its re-run agree (same batch arithmetic)
         row = r.mfac.objectives[r.mfac.chosen]
         assert row[0] == pytest.approx(r.main.value("MFAC", "stop_error"), rel=1e-9)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...features.reproducible import window
 from ...report.markdown import Figure, fmt, latex_matrix, md_table
 from .ntsm_platoon_realism import CASES, CONTROLLERS, SWEEP_FACTORS
 
@@ -183,7 +184,7 @@ def _plot_gaps(fig, rz):
             ax = axes[i, j]
             e = rz.emergency[case, law]
             r = e.run
-            keep = (r.t >= t0 - 5.0) & (r.t <= t0 + 35.0)
+            keep = window(r.t, t0 - 5.0, t0 + 35.0)   # ends on sample times
             for f in range(r.gap.shape[1]):
                 ax.plot(r.t[keep] - t0, r.gap[keep, f], color=f"C{f}", lw=1.2,
                         label=f"gap, train {f + 2}")

@@ -1,6 +1,9 @@
 """Markdown and figures of the ``ntsm-platoon`` study (pure rendering)."""
 from __future__ import annotations
 
+import numpy as np
+
+from ...features.reproducible import window
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from . import ntsm_platoon_realism_render as realism
 
@@ -160,7 +163,7 @@ def _plot_errors(fig, res):
 def _plot_convergence(fig, res):
     r = res.runs["ntsm_offset"]
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
-    keep = r.t <= 30.0
+    keep = window(r.t, -np.inf, 30.0)   # 30 s is a sample time
     for i in range(r.e.shape[1]):
         ax1.plot(r.t[keep], r.e[keep, i], lw=1, label=f"e{i + 2}")
         ax2.plot(r.t[keep], r.s[keep, i], lw=1, label=f"s{i + 2}")
