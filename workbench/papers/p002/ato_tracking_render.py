@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...controllers.mfac import RESET_CONDITIONS, MFACGains, frozen_ppd_poles
-from ...features.reproducible import NUDGE, RTOL
+from ...features.reproducible import NUDGE, RTOL, count_text
 from ...plants.train002 import latex_equations
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...tuning.pareto import dominated_share
@@ -154,17 +154,19 @@ def _why(spec, res) -> str:
     roots = (f"{fmt(re[0], 3)} ± {fmt(abs(z[0].imag), 2)} j" if abs(z[0].imag) > 1e-6
              else f"{fmt(re[0], 3)} and {fmt(re[1], 3)}")
     tun = integ.mfac
-    ok = (tun.objectives[:, OBJECTIVES.index("stop_error")] <= res.stop_tolerance) \
-        & tun.reproducible
-    adm = (f"Of its {int(tun.reproducible.sum())} reproducible MFAC runs, {int(ok.sum())} stop "
-           f"within {fmt(res.stop_tolerance)} m; their reset rates span "
+    ok = (tun.stops == -1) & tun.reproducible
+    near = int(((tun.stops == 0) & tun.reproducible).sum())
+    adm = (f"Of its {int(tun.reproducible.sum())} reproducible MFAC runs, "
+           f"{count_text(int(ok.sum()), near)} stop within {fmt(res.stop_tolerance)} m"
+           + (f" ({near} with a stop error within its band of the limit: undecided)"
+              if near else "") + "; their reset rates span "
            f"{_span(tun.reset_rate[ok])}"
            if ok.any() else f"None of its {int(tun.reproducible.sum())} reproducible MFAC runs "
            f"stops within {fmt(res.stop_tolerance)} m")
     return (
         f"## {H_WHY}\n\nThe reset of eq 9 fires on any of three conditions. Counted over the "
         "samples of the chosen MFAC run up to its stop (a sample may meet several conditions; "
-        "the last column is the range over every run of the reading's grid):\n\n"
+        "the last column is the range over every reproducible run of the reading's grid):\n\n"
         + md_table(["reading", "samples", "reset"] + [COND[k] for k in (*RESET_CONDITIONS,
                                                                         "at_limit")]
                    + ["command at a limit", "grid range"], rows, "lrrrrrrrr")

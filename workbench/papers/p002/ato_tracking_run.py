@@ -39,7 +39,7 @@ import numpy as np
 from ...controllers.mfac import RESET_CONDITIONS, MFAC, MFACGains, frozen_loop_poles
 from ...controllers.pid import BatchPID
 from ...errors import ModelError
-from ...features.reproducible import NUDGE, nudged, reproducible
+from ...features.reproducible import NUDGE, decide, nudged, reproducible
 from ...jsonable import finite_or_none, json_method
 from ...plants.train002 import dc_gain, linear_model, speed_time_constant
 from ...profiles import Profile, build_profile
@@ -115,6 +115,7 @@ class Tuning:
     chosen: int
     reset_rate: np.ndarray | None = None
     reproducible: np.ndarray | None = None
+    stops: np.ndarray | None = None
 
     @property
     def usable(self) -> np.ndarray:
@@ -281,12 +282,16 @@ def _tune(spec, reading, sec, prof, kind: str) -> tuple[Tuning, TrackingRun, MFA
     again = [_grid_run(spec, reading, nudged(reading.train, s * NUDGE, keep=("delay",)), sec,
                        prof, kind, P)[2].matrix() for s in (1, -1)]
     repro = reproducible([obj, *again])
+    col = OBJECTIVES.index("stop_error")
+    errs = np.stack([x[:, col] for x in (obj, *again)])
+    # within the stop requirement: decided on the band (a band across it is undecided)
+    stops = decide(errs.min(axis=0), errs.max(axis=0), spec.stop_tolerance.value, 0.0)
     scales = [spec.scales[k].value for k in OBJECTIVES]
     rate = None
     if kind == "mfac":
         resets = ctl.record("reset")[:, :run.t.size - 1]
         rate = _mean_before_stop(resets, _before_stop(run)[:, 1:])
-    admissible = (obj[:, OBJECTIVES.index("stop_error")] <= spec.stop_tolerance.value) & repro
+    admissible = (stops == -1) & repro
     if spec.peak_jerk is not None:       # comfort: a peak constraint, not a weighted term
         comfortable = admissible & (qo.peak_jerk <= spec.peak_jerk.value)
         if comfortable.any():            # else: no run meets it; the claims say so
@@ -300,7 +305,7 @@ def _tune(spec, reading, sec, prof, kind: str) -> tuple[Tuning, TrackingRun, MFA
     front = np.zeros(len(P), bool)
     front[repro] = pareto_mask(obj[repro])
     tuning = Tuning(keys, P, obj, front, weighted_cost(obj, scales, spec.weights),
-                    chosen, rate, repro)
+                    chosen, rate, repro, stops)
     return tuning, run, (ctl if kind == "mfac" else None)
 
 
