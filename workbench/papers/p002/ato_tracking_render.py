@@ -9,6 +9,7 @@ from ...plants.train002 import latex_equations
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...tuning.pareto import dominated_share
 from . import ato_tracking_figures as F
+from .ato_tracking_run import most_sensitive
 from .ato_tracking_spec import OBJECTIVE_UNITS, OBJECTIVES
 
 LABEL = {"stop_error": "stop error (m)", "punctuality": "punctuality (s)",
@@ -354,13 +355,15 @@ def _line(spec, res) -> str:
 
 def _sensitivity(res) -> str:
     keys = ("eta", "mu", "rho", "lam")
-    rows = [[f"`{r.reading.name}`"] + [fmt(r.sensitivity[k], 3) for k in keys]
-            + [SYMBOL[max(r.sensitivity, key=r.sensitivity.get)]] for r in res.readings]
+    rows = [[f"`{r.reading.name}`"] + ["—" if np.isnan(r.sensitivity[k]) else
+                                       fmt(r.sensitivity[k], 3) for k in keys]
+            + [SYMBOL[most_sensitive(r.sensitivity)]] for r in res.readings]
     return (
         f"## {H_SENS}\n\nPaper 002 §3 says λ is the parameter the controller is most "
         "sensitive to. From the grid itself (no extra run): the largest relative change of "
         "the weighted cost when one parameter alone moves to a neighbouring grid value "
-        "(∞: a neighbour never stops).\n\n"
+        "(∞: a neighbour never stops; a neighbour that is not reproducible is left out, "
+        "— when none is left).\n\n"
         + md_table(["reading"] + [SYMBOL[k] for k in keys] + ["most sensitive"], rows,
                    "lrrrrl"))
 

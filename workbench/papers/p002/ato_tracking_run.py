@@ -369,7 +369,7 @@ def _frozen(spec, reading: Reading, v_ref: float, mg: dict, phi: float):
 def _sensitivity(tun: Tuning) -> dict:
     """Per parameter: the largest relative change of the weighted cost when that
     parameter alone moves to a neighbouring grid value (inf: a neighbour did not
-    stop; a neighbour that is not reproducible is left out)."""
+    stop; a neighbour that is not reproducible is left out, nan when none is left)."""
     i = tun.chosen
     base = tun.cost[i]
     out = {}
@@ -382,8 +382,14 @@ def _sensitivity(tun: Tuning) -> dict:
         nb = [vals[p] for p in (pos - 1, pos + 1) if 0 <= p < len(vals)]
         rows = [np.flatnonzero(same & (tun.params[:, j] == x))[0] for x in nb]
         rows = [r for r in rows if tun.reproducible is None or tun.reproducible[r]]
-        out[key] = max((abs(tun.cost[r] - base) / base for r in rows), default=0.0)
+        out[key] = max((abs(tun.cost[r] - base) / base for r in rows),
+                       default=math.nan if nb else 0.0)   # nan: no reproducible neighbour
     return out
+
+
+def most_sensitive(sens: dict) -> str:
+    """The parameter with the largest finite sensitivity (nan: not measured)."""
+    return max(sens, key=lambda k: sens[k] if not math.isnan(sens[k]) else -math.inf)
 
 
 def run_reading(spec: TrackingSpec, reading: Reading) -> ReadingResult:
@@ -462,6 +468,6 @@ def study_quantities(res: TrackingResult) -> dict:
         q[f"{p}.plant.time_constant"] = r.time_constant
         q[f"{p}.frozen.spectral_radius"] = r.frozen_radius
         for k, v in r.sensitivity.items():
-            q[f"{p}.sensitivity.{k}"] = float(v)
-        q[f"{p}.sensitivity.most_sensitive"] = max(r.sensitivity, key=r.sensitivity.get)
+            q[f"{p}.sensitivity.{k}"] = finite_or_none(v)
+        q[f"{p}.sensitivity.most_sensitive"] = most_sensitive(r.sensitivity)
     return q
