@@ -191,3 +191,9 @@ def test_study_runs_and_claims_are_ok(evaluation):
     assert all(x.converged for x in rows)
     assert math.isclose(q["profile.v_cruise"], res.profile.v_cruise)
     assert res.to_json()["readings"][1]["name"] == "first-order"
+
+
+def test_most_sensitive_ignores_parameters_without_a_reproducible_neighbour():
+    from workbench.papers.p002.ato_tracking_run import most_sensitive
+    assert most_sensitive({"eta": 0.01, "rho": math.nan, "lam": 0.09}) == "lam"
+    assert most_sensitive({"eta": 0.2, "rho": math.nan, "lam": 0.09}) == "eta"
