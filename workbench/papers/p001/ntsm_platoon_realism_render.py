@@ -177,6 +177,10 @@ def margin_section(spec, rz) -> str:
         "oscillation moves by about 3e-4 (relative) when the inputs move by 3 ulp.\n\n![delay sweep]({figdir}/delay-sweep.png)")
 
 
+# No tight_layout in the drawing functions: laid out before the data are snapped
+# (workbench.report.figures), the axes positions keep last-bit differences of the
+# unsnapped limits, and every line moves by a fraction of a subpixel; figure_png
+# lays out after snapping.
 def figures(rz) -> tuple[Figure, ...]:
     return (Figure("emergency-gaps", "Gaps and the safe braking-distance envelope under the "
                    "leader's emergency brake.", lambda fig: _plot_gaps(fig, rz), (8.0, 7.5)),
@@ -206,7 +210,6 @@ def _plot_gaps(fig, rz):
             if i == len(CONTROLLERS) - 1:
                 ax.set_xlabel("time after the emergency brake (s)")
     axes[0, 0].legend(fontsize=6, ncol=2, loc="center right")
-    fig.tight_layout()
 
 
 def _plot_sweep(fig, rz):
@@ -222,4 +225,3 @@ def _plot_sweep(fig, rz):
                      fontsize=9)
         ax.legend(fontsize=7, ncol=2)
     np.atleast_1d(axes)[-1].set_xlabel("time (s)")
-    fig.tight_layout()
