@@ -135,7 +135,14 @@ def _profile(spec, res) -> str:
         f"`workbench/profiles.py`): acceleration {fmt(spec.profile['accel'])} m/s², braking "
         f"{fmt(spec.profile['brake'])} m/s², jerk {fmt(spec.profile['jerk'])} m/s³; the cruise "
         f"speed solves T(v) = T_o: **{fmt(prof.v_cruise * 3.6, 4)} km/h** (end position error "
-        f"of the sampled curve {fmt(abs(prof.s[-1] - prof.spec.distance), 2)} m).")
+        f"of the sampled curve {_end_error(prof)}).")
+
+
+def _end_error(prof) -> str:
+    """The profile's end error to 1 nm: below, it is rounding of the closed-form
+    integration whose digits move under a few-ulp change of the inputs."""
+    e = round(abs(prof.s[-1] - prof.spec.distance), 9)
+    return "below 1 nm" if e == 0.0 else f"{fmt(e, 2)} m"
 
 
 def _why(spec, res) -> str:
