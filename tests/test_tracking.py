@@ -123,6 +123,9 @@ def test_objectives_on_a_known_history():
                        np.array([[0.0, 0.0, 1.0, 1.0, 1.0]]), np.zeros((1, 5)),
                        np.ones((1, 5)), np.array([2.5]), np.array([100.0]), np.array([0.0]))
     assert objectives(run2, 100.0, 2.5).peak_jerk[0] == pytest.approx(1.0)
+    # a stop on the planned time is exactly 0 late, not its last-bit rounding
+    # (Pareto ties at 0 must not depend on it)
+    assert objectives(run2, 100.0, math.nextafter(2.5, 3.0)).punctuality[0] == 0.0
 
 
 def test_grid_edges_name_parameters_at_either_end():
