@@ -297,7 +297,7 @@ def _tune(spec, reading, sec, prof, kind: str) -> tuple[Tuning, TrackingRun, MFA
         if comfortable.any():            # else: no run meets it; the claims say so
             admissible = comfortable
     try:
-        chosen = choose(np.where(repro[:, None], obj, np.inf), scales, spec.weights, admissible)
+        chosen = choose(obj, scales, spec.weights, admissible if admissible.any() else repro)
     except ValueError:
         raise ModelError(f"reading {reading.name!r}: no reproducible run of the "
                          f"{kind.upper()} grid ({len(P)} parameter sets) stops on {sec.name}; "
