@@ -123,6 +123,9 @@ def test_objectives_on_a_known_history():
                        np.array([[0.0, 0.0, 1.0, 1.0, 1.0]]), np.zeros((1, 5)),
                        np.ones((1, 5)), np.array([2.5]), np.array([100.0]), np.array([0.0]))
     assert objectives(run2, 100.0, 2.5).peak_jerk[0] == pytest.approx(1.0)
+    # a stop on the planned time is exactly 0 late, not its last-bit rounding
+    # (Pareto ties at 0 must not depend on it)
+    assert objectives(run2, 100.0, math.nextafter(2.5, 3.0)).punctuality[0] == 0.0
 
 
 def test_grid_edges_name_parameters_at_either_end():
@@ -178,6 +181,8 @@ def test_study_runs_and_claims_are_ok(evaluation):
         lim = evaluation.design.spec.peak_jerk.value
         for c, tun in (("MFAC", r.mfac), ("PID", r.pid)):
             assert tun.front[tun.chosen] or r.main.value(c, "peak_jerk") <= lim
+            # only reproducible runs (+-3 ulp on the train) are chosen or on a front
+            assert tun.reproducible[tun.chosen] and not (tun.front & ~tun.reproducible).any()
         # the grid row of the chosen point and its re-run agree (same batch arithmetic)
         row = r.mfac.objectives[r.mfac.chosen]
         assert row[0] == pytest.approx(r.main.value("MFAC", "stop_error"), rel=1e-9)
@@ -189,3 +194,9 @@ def test_study_runs_and_claims_are_ok(evaluation):
     assert all(x.converged for x in rows)
     assert math.isclose(q["profile.v_cruise"], res.profile.v_cruise)
     assert res.to_json()["readings"][1]["name"] == "first-order"
+
+
+def test_most_sensitive_ignores_parameters_without_a_reproducible_neighbour():
+    from workbench.papers.p002.ato_tracking_run import most_sensitive
+    assert most_sensitive({"eta": 0.01, "rho": math.nan, "lam": 0.09}) == "lam"
+    assert most_sensitive({"eta": 0.2, "rho": math.nan, "lam": 0.09}) == "eta"

@@ -230,5 +230,8 @@ def objectives(run: TrackingRun, distance: float, run_time: float) -> Objectives
     planned = run.t <= run_time
     rms = np.sqrt(np.mean((run.v[:, planned] - run.target[:, planned]) ** 2, axis=1))
     energy = np.where(np.isfinite(t_stop), run.traction_work, np.nan)
-    return Objectives(np.abs(run.stop_pos - distance), np.abs(t_stop - run_time), rms_jerk,
-                      energy, rms, peak)
+    # a stop on the planned time is 0, not the 1e-14 s rounding of k dt - T: the
+    # Pareto dominance of runs tied at 0 must not depend on last bits (issue 36)
+    late = np.abs(t_stop - run_time)
+    late = np.where(late <= 1e-9 * abs(run_time), 0.0, late)
+    return Objectives(np.abs(run.stop_pos - distance), late, rms_jerk, energy, rms, peak)

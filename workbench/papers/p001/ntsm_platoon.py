@@ -15,6 +15,7 @@ import numpy as np
 
 from ...controllers.ntsm import (convergence_time, linear_member, ntsm_force, pd_ff_force, pd_force,
                                  surface)
+from ...features.reproducible import window as window_mask
 from ...plants.platoon001 import TrainParams, external_force, perturbed
 from ...profiles import Profile, build_profile, spec_for_cruise
 from ...reader import Reader
@@ -222,7 +223,7 @@ class NTSMPlatoon:
 
 
 def _metrics(r: PlatoonRun, window, m: float, bound: float) -> RunMetrics:
-    cw = (r.t >= window[0]) & (r.t <= window[1])
+    cw = window_mask(r.t, *window)         # ends on sample times: half a step to spare
     du = np.abs(np.diff(r.u[:, 1:], axis=0)) / m
     span = r.t[-1] - r.t[0]
     sgn = np.sign(r.s[cw])

@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...controllers.ntsm import linear_member
+from ...features.reproducible import window as window_mask
 from ...margins import Agreement, DelayMargin, compare_margins, delay_margin_eig, delay_margin_siso
 from ...sim.platoon import Actuator, Link, PlatoonRun, packet_delays, received_steps
 
@@ -239,7 +240,8 @@ def emergency_run(sc, law: str, lk: Link) -> EmergencyRun:
     kg = np.unravel_index(np.argmin(gap), gap.shape)
     km = np.unravel_index(np.argmin(margin), margin.shape)
     t_after = run.t[after]
-    cw = (run.t >= accel_end(sc.profile) + 10.0) & (run.t < t_e)
+    # window ends on sample times (t_e is one, excluded): half a step to spare
+    cw = window_mask(run.t, accel_end(sc.profile) + 10.0, t_e - sc.spec.T)
     return EmergencyRun(run, env, float(gap[kg]), float(t_after[kg[0]]), float(margin[km]),
                         float(t_after[km[0]]), int(km[1]) + 2,
                         float(np.abs(run.e[cw]).max()) if cw.any() else math.nan,
@@ -263,7 +265,7 @@ def delay_margin_model(lag: float, k_e: float, k_d: float):
 def _sweep_row(sc, law: str, factor, h: float, act: Actuator, window, K: int) -> SweepRow:
     run = sc.simulate(law, horizon=K * sc.spec.T, link=link(sc.spec, "sweep", K, delay=h)[0],
                       actuator=act)
-    w = (run.t >= window[0]) & (run.t <= window[1])
+    w = window_mask(run.t, *window)         # ends on sample times: half a step to spare
     e = np.abs(run.e[w])
     u = run.u[w, 1]
     sat = ((u < act.f_min) | (u > act.f_max)).mean()

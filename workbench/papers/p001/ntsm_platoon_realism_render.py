@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...features.reproducible import window
 from ...report.markdown import Figure, fmt, latex_matrix, md_table
 from .ntsm_platoon_realism import CASES, CONTROLLERS, SWEEP_FACTORS
 
@@ -63,6 +64,12 @@ def scenario_section(spec, rz) -> str:
         "limit:\n\n" + ENVELOPE)
 
 
+def _on_steps(t: float, T: float) -> str:
+    """A time on the step grid T, printed to the step: 2.85 s, not 2.8 or 2.9
+    by the last bit of 2.85 (a sample time at a rounding boundary)."""
+    return fmt(round(t / T) * T, 6)
+
+
 def gap_section(spec, rz) -> str:
     rows = []
     for law in CONTROLLERS:
@@ -70,7 +77,7 @@ def gap_section(spec, rz) -> str:
         for case in CASES:
             e = rz.emergency[case, law]
             row += [f"**{e.min_gap:.1f}**", f"{e.min_margin:.1f}",
-                    f"{fmt(e.t_min_margin - rz.t_emergency, 2)} s, train {e.train_min_margin}"]
+                    f"{_on_steps(e.t_min_margin - rz.t_emergency, spec.T)} s, train {e.train_min_margin}"]
         row.append(" / ".join(fmt(rz.emergency[c, law].cruise_abs_e, 3) for c in CASES))
         rows.append(row)
     head = ["law"]
@@ -118,7 +125,8 @@ def margin_section(spec, rz) -> str:
     for r in m.sweep:
         srows.append([LABEL[r.law], "design's V2V delay" if r.factor is None else fmt(r.factor),
                       fmt(r.h, 3), fmt(r.h / m.eig.h, 3), fmt(r.amp_first, 3),
-                      fmt(r.amp_worst, 3), fmt(r.saturated * 100, 3)])
+                      fmt(r.amp_worst, 2 if r.law == "ntsm" else 3),
+                      fmt(r.saturated * 100, 3)])
     lag = spec.actuator.lag.value
     state = "(e, ė, a_f)" if lag > 0 else "(e, ė)"
     return (
@@ -165,9 +173,14 @@ def margin_section(spec, rz) -> str:
         "bound it). The NTSM has no threshold: its gain at ė = 0 is infinite, so with any "
         "delay in the loop it settles into an oscillation whose size grows with the delay. "
         "Followers further back oscillate more (their predecessor's oscillating acceleration "
-        "is fed forward).\n\n![delay sweep]({figdir}/delay-sweep.png)")
+        "is fed forward). The NTSM's \"any follower\" column has 2 digits: that chattering "
+        "oscillation moves by about 3e-4 (relative) when the inputs move by 3 ulp.\n\n![delay sweep]({figdir}/delay-sweep.png)")
 
 
+# No tight_layout in the drawing functions: laid out before the data are snapped
+# (workbench.report.figures), the axes positions keep last-bit differences of the
+# unsnapped limits, and every line moves by a fraction of a subpixel; figure_png
+# lays out after snapping.
 def figures(rz) -> tuple[Figure, ...]:
     return (Figure("emergency-gaps", "Gaps and the safe braking-distance envelope under the "
                    "leader's emergency brake.", lambda fig: _plot_gaps(fig, rz), (8.0, 7.5)),
@@ -183,7 +196,7 @@ def _plot_gaps(fig, rz):
             ax = axes[i, j]
             e = rz.emergency[case, law]
             r = e.run
-            keep = (r.t >= t0 - 5.0) & (r.t <= t0 + 35.0)
+            keep = window(r.t, t0 - 5.0, t0 + 35.0)   # ends on sample times
             for f in range(r.gap.shape[1]):
                 ax.plot(r.t[keep] - t0, r.gap[keep, f], color=f"C{f}", lw=1.2,
                         label=f"gap, train {f + 2}")
@@ -197,7 +210,6 @@ def _plot_gaps(fig, rz):
             if i == len(CONTROLLERS) - 1:
                 ax.set_xlabel("time after the emergency brake (s)")
     axes[0, 0].legend(fontsize=6, ncol=2, loc="center right")
-    fig.tight_layout()
 
 
 def _plot_sweep(fig, rz):
@@ -213,4 +225,3 @@ def _plot_sweep(fig, rz):
                      fontsize=9)
         ax.legend(fontsize=7, ncol=2)
     np.atleast_1d(axes)[-1].set_xlabel("time (s)")
-    fig.tight_layout()

@@ -29,20 +29,21 @@ def _front_2d(P: np.ndarray) -> np.ndarray:
 
 
 def plot_pareto(fig, r: ReadingResult) -> None:
-    """Two projections of both controllers' grids: every run (dots), the 4-D
-    Pareto front (rings), its 2-D front (step line) and the chosen point (star)."""
+    """Two projections of both controllers' grids: every reproducible run (dots;
+    the others' objectives are no results), the 4-D Pareto front (rings), its
+    2-D front (step line) and the chosen point (star)."""
     axes = fig.subplots(1, len(PROJECTIONS))
     for ax, (x, y) in zip(axes, PROJECTIONS):
         ix, iy = OBJECTIVES.index(x), OBJECTIVES.index(y)
         for name, tun in (("MFAC", r.mfac), ("PID", r.pid)):
             c = COLOURS[name]
             P = tun.objectives[:, [ix, iy]]
-            ok = np.all(np.isfinite(P), axis=1)
+            ok = np.all(np.isfinite(P), axis=1) & tun.reproducible
             ax.scatter(P[ok, 0], P[ok, 1], s=4, color=c, alpha=0.15, lw=0)
             F = P[tun.front]
             ax.scatter(F[:, 0], F[:, 1], s=14, facecolors="none", edgecolors=c, lw=0.6,
                        label=f"{name} front (4-D)")
-            f2 = _front_2d(P)
+            f2 = _front_2d(P[tun.reproducible])
             ax.step(f2[:, 0], f2[:, 1], where="post", color=c, lw=1)
             ax.scatter(*P[tun.chosen], marker="*", s=160, color=c, edgecolors="k", lw=0.6,
                        zorder=5, label=f"{name} chosen")

@@ -11,7 +11,11 @@ Per reading (:class:`~.ato_tracking.Reading`):
    controller its Pareto front (:func:`workbench.tuning.pareto.pareto_mask`), and the design
    point is the run with the smallest weighted sum sum_j w_j x_j / s_j (scales
    and weights from ``[tuning]``) among the runs that stop within the stop
-   requirement (all runs if none does); it lies on the front;
+   requirement (all runs if none does); it lies on the front. Only
+   reproducible runs take part: the grid is run again on the train moved
+   by +-1e-9 (relative), and a run whose objectives move more than
+   :data:`~workbench.features.reproducible.RTOL` is left out of fronts,
+   choice and counts (a relay-like loop turns last bits into another run);
 3. the chosen MFAC run is examined against the CFDL assumptions: the share of
    samples where eq 9's reset fired, by condition; the range of the estimate;
    the *realised* PPD dy(k+1) / du(k) of the run (samples with |du| > epsilon),
@@ -35,6 +39,7 @@ import numpy as np
 from ...controllers.mfac import RESET_CONDITIONS, MFAC, MFACGains, frozen_loop_poles
 from ...controllers.pid import BatchPID
 from ...errors import ModelError
+from ...features.reproducible import NUDGE, decide, nudged, reproducible
 from ...jsonable import finite_or_none, json_method
 from ...plants.train002 import dc_gain, linear_model, speed_time_constant
 from ...profiles import Profile, build_profile
@@ -94,6 +99,12 @@ class Tuning:
         Row of the design point.
     reset_rate : numpy.ndarray or None
         (N,) MFAC: share of samples up to the stop where eq 9's reset fired.
+    reproducible : numpy.ndarray or None
+        (N,) bool: the run's objectives move at most
+        :data:`~workbench.features.reproducible.RTOL` (relative) when the train's
+        parameters move by +-:data:`~workbench.features.reproducible.NUDGE`. Only these runs form the front, are chosen,
+        and enter the counts, bests and utopia point: the others' metrics
+        differ between CPUs.
     """
 
     keys: tuple[str, ...]
@@ -103,6 +114,14 @@ class Tuning:
     cost: np.ndarray
     chosen: int
     reset_rate: np.ndarray | None = None
+    reproducible: np.ndarray | None = None
+    stops: np.ndarray | None = None
+
+    @property
+    def usable(self) -> np.ndarray:
+        """(N,) bool: runs that stopped and are reproducible."""
+        ok = np.isfinite(self.cost)
+        return ok if self.reproducible is None else ok & self.reproducible
 
     @property
     def edges(self) -> tuple[str, ...]:
@@ -116,7 +135,7 @@ class Tuning:
     def best(self, name: str) -> float:
         """Smallest value of one objective over the runs that stopped."""
         col = self.objectives[:, OBJECTIVES.index(name)]
-        col = col[np.isfinite(self.cost)]
+        col = col[self.usable]
         return float(col.min()) if col.size else math.nan
 
 
@@ -240,35 +259,53 @@ def _before_stop(run: TrackingRun) -> np.ndarray:
     return run.t[None, :] < stop[:, None]
 
 
+def _grid_run(spec, reading, train, sec, prof, kind: str, P: np.ndarray):
+    """Every combination ``P`` of one controller's grid on ``train``, one batch."""
+    keys = MFAC_KEYS if kind == "mfac" else PID_KEYS
+    gains = dict(zip(keys, P.T))
+    ctl = (_mfac(reading, gains, len(P)) if kind == "mfac" else
+           _pid(spec, reading, gains, len(P)))
+    run = _sim(spec, train, sec, prof,
+               lambda k, y, yn: ctl.step(y, yn) if kind == "mfac" else ctl.step(yn - y), len(P))
+    return run, ctl, objectives(run, sec.route.distance, sec.run_time)
+
+
 def _tune(spec, reading, sec, prof, kind: str) -> tuple[Tuning, TrackingRun, MFAC | None]:
     keys = MFAC_KEYS if kind == "mfac" else PID_KEYS
     grid = reading.mfac_grid if kind == "mfac" else reading.pid_grid
     P = np.array(list(itertools.product(*(grid[k] for k in keys))))
-    gains = dict(zip(keys, P.T))
-    ctl = (_mfac(reading, gains, len(P)) if kind == "mfac" else
-           _pid(spec, reading, gains, len(P)))
-    run = _sim(spec, reading.train, sec, prof,
-               lambda k, y, yn: ctl.step(y, yn) if kind == "mfac" else ctl.step(yn - y), len(P))
-    qo = objectives(run, sec.route.distance, sec.run_time)
+    run, ctl, qo = _grid_run(spec, reading, reading.train, sec, prof, kind, P)
     obj = qo.matrix()
+    # each run's reproducibility band: the grid again on the train moved by +-NUDGE
+    # (relative; the delay stays whole steps); a run whose objectives move more than
+    # RTOL is no result (issue 36, item 5)
+    again = [_grid_run(spec, reading, nudged(reading.train, s * NUDGE, keep=("delay",)), sec,
+                       prof, kind, P)[2].matrix() for s in (1, -1)]
+    repro = reproducible([obj, *again])
+    col = OBJECTIVES.index("stop_error")
+    errs = np.stack([x[:, col] for x in (obj, *again)])
+    # within the stop requirement: decided on the band (a band across it is undecided)
+    stops = decide(errs.min(axis=0), errs.max(axis=0), spec.stop_tolerance.value, 0.0)
     scales = [spec.scales[k].value for k in OBJECTIVES]
     rate = None
     if kind == "mfac":
         resets = ctl.record("reset")[:, :run.t.size - 1]
         rate = _mean_before_stop(resets, _before_stop(run)[:, 1:])
-    admissible = obj[:, OBJECTIVES.index("stop_error")] <= spec.stop_tolerance.value
+    admissible = (stops == -1) & repro
     if spec.peak_jerk is not None:       # comfort: a peak constraint, not a weighted term
         comfortable = admissible & (qo.peak_jerk <= spec.peak_jerk.value)
         if comfortable.any():            # else: no run meets it; the claims say so
             admissible = comfortable
     try:
-        chosen = choose(obj, scales, spec.weights, admissible)
+        chosen = choose(obj, scales, spec.weights, admissible if admissible.any() else repro)
     except ValueError:
-        raise ModelError(f"reading {reading.name!r}: no run of the {kind.upper()} grid "
-                         f"({len(P)} parameter sets) stops on {sec.name}; widen the grid "
-                         f"in plant_readings.{kind}") from None
-    tuning = Tuning(keys, P, obj, pareto_mask(obj), weighted_cost(obj, scales, spec.weights),
-                    chosen, rate)
+        raise ModelError(f"reading {reading.name!r}: no reproducible run of the "
+                         f"{kind.upper()} grid ({len(P)} parameter sets) stops on {sec.name}; "
+                         f"widen the grid in plant_readings.{kind}") from None
+    front = np.zeros(len(P), bool)
+    front[repro] = pareto_mask(obj[repro])
+    tuning = Tuning(keys, P, obj, front, weighted_cost(obj, scales, spec.weights),
+                    chosen, rate, repro, stops)
     return tuning, run, (ctl if kind == "mfac" else None)
 
 
@@ -331,7 +368,8 @@ def _frozen(spec, reading: Reading, v_ref: float, mg: dict, phi: float):
 
 def _sensitivity(tun: Tuning) -> dict:
     """Per parameter: the largest relative change of the weighted cost when that
-    parameter alone moves to a neighbouring grid value (inf: a neighbour did not stop)."""
+    parameter alone moves to a neighbouring grid value (inf: a neighbour did not
+    stop; a neighbour that is not reproducible is left out, nan when none is left)."""
     i = tun.chosen
     base = tun.cost[i]
     out = {}
@@ -343,8 +381,15 @@ def _sensitivity(tun: Tuning) -> dict:
         pos = int(np.searchsorted(vals, tun.params[i, j]))
         nb = [vals[p] for p in (pos - 1, pos + 1) if 0 <= p < len(vals)]
         rows = [np.flatnonzero(same & (tun.params[:, j] == x))[0] for x in nb]
-        out[key] = max((abs(tun.cost[r] - base) / base for r in rows), default=0.0)
+        rows = [r for r in rows if tun.reproducible is None or tun.reproducible[r]]
+        out[key] = max((abs(tun.cost[r] - base) / base for r in rows),
+                       default=math.nan if nb else 0.0)   # nan: no reproducible neighbour
     return out
+
+
+def most_sensitive(sens: dict) -> str:
+    """The parameter with the largest finite sensitivity (nan: not measured)."""
+    return max(sens, key=lambda k: sens[k] if not math.isnan(sens[k]) else -math.inf)
 
 
 def run_reading(spec: TrackingSpec, reading: Reading) -> ReadingResult:
@@ -358,7 +403,7 @@ def run_reading(spec: TrackingSpec, reading: Reading) -> ReadingResult:
     v_ref = prof.v_cruise
     G, radius = _frozen(spec, reading, v_ref, mg, float(np.median(ppd.phi)))
     line = tuple(_compare(spec, reading, sec, mg, pg)[0] for sec in spec.line)
-    both = np.vstack([t.objectives[np.isfinite(t.cost)] for t in (mt, pt)])
+    both = np.vstack([t.objectives[t.usable] for t in (mt, pt)])
     scales = [spec.scales[k].value for k in OBJECTIVES]
     utopia = float(weighted_cost(both.min(axis=0)[None, :], scales, spec.weights)[0])
     return ReadingResult(reading, mt, pt, main, ppd, utopia, v_ref, dc_gain(reading.train, v_ref),
@@ -378,7 +423,9 @@ def study_quantities(res: TrackingResult) -> dict:
     """Values of every quantity :meth:`~.ato_tracking.ATOTracking.quantity_names` lists."""
     m0 = res.readings[0].main
     q = {"profile.v_cruise": m0.profile.v_cruise,
-         "profile.end_error": abs(m0.profile.s[-1] - m0.section.route.distance),
+         # to 1 nm: below, the closed-form profile's end error (about 2e-11 m over
+         # 1.6 km) is rounding whose digits move under a few-ulp input change
+         "profile.end_error": round(abs(m0.profile.s[-1] - m0.section.route.distance), 9),
          "line.sections": len(res.readings[0].line)}
     for r in res.readings:
         p = f"reading[{r.reading.name}]"
@@ -411,7 +458,7 @@ def study_quantities(res: TrackingResult) -> dict:
         for k in (*RESET_CONDITIONS, "at_limit"):
             q[f"{p}.mfac.reset_rate.{k}"] = s.by_condition[k]
         q[f"{p}.mfac.saturated"] = s.saturated
-        stopped = r.mfac.reset_rate[np.isfinite(r.mfac.cost)]
+        stopped = r.mfac.reset_rate[r.mfac.usable]
         q[f"{p}.grid.reset_rate_min"] = finite_or_none(stopped.min()) if stopped.size else None
         q[f"{p}.grid.reset_rate_median"] = finite_or_none(np.median(stopped)) if stopped.size else None
         for k in ("phi_min", "phi_max", "data_sign_agreement", "data_median", "data_p95"):
@@ -421,6 +468,6 @@ def study_quantities(res: TrackingResult) -> dict:
         q[f"{p}.plant.time_constant"] = r.time_constant
         q[f"{p}.frozen.spectral_radius"] = r.frozen_radius
         for k, v in r.sensitivity.items():
-            q[f"{p}.sensitivity.{k}"] = float(v)
-        q[f"{p}.sensitivity.most_sensitive"] = max(r.sensitivity, key=r.sensitivity.get)
+            q[f"{p}.sensitivity.{k}"] = finite_or_none(v)
+        q[f"{p}.sensitivity.most_sensitive"] = most_sensitive(r.sensitivity)
     return q
