@@ -1,0 +1,74 @@
+"""Findings of the fuzz campaign re-run (issue 32, seed 3202,
+``benchmarks/fuzz_campaign.py``) on the newer kinds and tables, one fast
+regression each: the Python API of the Monte Carlo statistics and of the
+switched-run kind, and design-file mutations of phases, guards, laws,
+[montecarlo], [sampled] and [convergence].
+"""
+import math
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import fuzz_designs as fz  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: API misuses cheap enough for the default tier (no LMI solve).
+FAST = ("runs_for", "wilson", "stop_statistics", "percentile", "load_design")
+
+
+def test_api_misuse_of_the_newer_kinds_raises_one_line_value_errors():
+    seen = 0
+    for name, call in fz.api_cases():
+        if not name.startswith(FAST):
+            continue
+        seen += 1
+        try:
+            call()
+        except ValueError as exc:
+            msg = str(exc)
+            assert "\n" not in msg and len(msg) < 400, (name, msg)
+            assert "math domain error" not in msg and "NaN to integer" not in msg, (name, msg)
+        except BaseException as exc:   # noqa: BLE001 - any other exception is the failure
+            pytest.fail(f"{name}: {type(exc).__name__}: {str(exc)[:300]}")
+    assert seen >= 10
+
+
+def test_runs_for_refuses_a_certain_pass_and_keeps_299():
+    """runs_for(1.0) was a ZeroDivisionError, runs_for(0) 'math domain error'."""
+    from workbench.kinds.switched_run.study import runs_for
+    assert runs_for(0.99) == 299
+    for p in (1.0, 0.0, -0.5, math.nan, math.inf):
+        with pytest.raises(ValueError, match=r"runs_for: p = .*expected a probability in \(0, 1\)"):
+            runs_for(p)
+    with pytest.raises(ValueError, match="alpha = 0.0"):
+        runs_for(0.99, 0.0)
+
+
+def test_wilson_interval_names_impossible_counts():
+    from workbench.features.montecarlo import wilson_interval
+    assert wilson_interval(10, 10)[2] == 1.0
+    assert math.isnan(wilson_interval(0, 0)[2])
+    for k, n in ((11, 10), (-1, 10), (0.5, 10)):
+        with pytest.raises(ValueError, match="expected whole numbers 0 <= k <= n"):
+            wilson_interval(k, n)
+
+
+def test_stop_statistics_of_no_runs_is_nan_not_index_error():
+    """stop_statistics([]) and percentile([]) were IndexErrors."""
+    from workbench.features.montecarlo import percentile, stop_statistics
+    st = stop_statistics([], 0.5)
+    assert st.n == 0 and math.isnan(st.p) and math.isnan(st.p95)
+    assert math.isnan(percentile([], 50.0))
+    assert percentile([1.0, 3.0], 50.0) == 2.0
+    with pytest.raises(ValueError, match=r"q = 200.0; expected a number in \[0, 100\]"):
+        percentile([1.0], 200.0)
+
+
+def test_load_design_of_a_folder_says_folder():
+    from workbench.design import load_design
+    from workbench.errors import DesignError
+    with pytest.raises(DesignError, match="<a folder>"):
+        load_design(ROOT / "designs")
