@@ -72,3 +72,27 @@ def test_load_design_of_a_folder_says_folder():
     from workbench.errors import DesignError
     with pytest.raises(DesignError, match="<a folder>"):
         load_design(ROOT / "designs")
+
+
+def _exit2(tmp_path, capsys, design, old, new):
+    from workbench.cli import main
+    text = (ROOT / "designs" / f"{design}.toml").read_text(encoding="utf-8")
+    assert old in text, old
+    p = tmp_path / f"{design}.toml"
+    p.write_text(text.replace(old, new, 1), encoding="utf-8")
+    code = main(["verify", str(p)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert len(err.splitlines()) == 1 and err.startswith("error: ") and "Traceback" not in err
+    return err
+
+
+@pytest.mark.parametrize("old, new, what", [
+    ("period = 0.1", "period = 1e-300", "the control period 1e-300 s"),
+    ("h = { value = 0.2,", "h = { value = 1e-300,", "the delay h = 1e-300 s"),
+])
+def test_a_period_or_delay_of_zero_steps_is_refused(tmp_path, capsys, old, new, what):
+    """[sampled] period = 1e-300 passed the whole-multiple check (0 steps) and the
+    run ended in ZeroDivisionError (step % 0) in switched_run/simulate._loop."""
+    err = _exit2(tmp_path, capsys, "emu-speed-switched-run", old, new)
+    assert "scenarios[0].dt = 0.05" in err and what in err and "whole multiple (>= 1)" in err
