@@ -96,3 +96,34 @@ def test_a_period_or_delay_of_zero_steps_is_refused(tmp_path, capsys, old, new, 
     run ended in ZeroDivisionError (step % 0) in switched_run/simulate._loop."""
     err = _exit2(tmp_path, capsys, "emu-speed-switched-run", old, new)
     assert "scenarios[0].dt = 0.05" in err and what in err and "whole multiple (>= 1)" in err
+
+
+def test_an_equality_claim_on_1e308_compares_without_decimal_error():
+    """Run 88: value = 1e308 with digits = 0 on a Monte Carlo claim raised
+    decimal.InvalidOperation (28-digit context) in claims._printed."""
+    import dataclasses
+
+    from workbench.claims import check_claim
+    from workbench.design import load_design
+    from workbench.outcome import Verdict
+    claim = next(c for c in load_design(ROOT / "designs" / "emu-speed-switched-run.toml").claims
+                 if c.id == "run-completes")
+    big = dataclasses.replace(claim, value=1e308, digits=0)
+    assert check_claim(big, 1.0).verdict is Verdict.FAIL
+    assert check_claim(big, 1e308).verdict is Verdict.PASS
+    assert check_claim(dataclasses.replace(claim, value=-1e308, digits=12), -1e308).verdict \
+        is Verdict.PASS
+
+
+def test_a_denormal_tight_delay_cap_exits_2(tmp_path, capsys):
+    """Run 114: [tight] h_max = 5e-324 underflowed to 0 in lmi/scaling.time_unit
+    (ValueError: math domain error) under ``verify``."""
+    err = _exit2(tmp_path, capsys, "antiskid-cruise-dry", "h_max = 10.0", "h_max = 5e-324")
+    assert "tight.h_max = 5e-324; expected a number (s) in [0.001, 1000]" in err
+
+
+@pytest.mark.parametrize("new", ["2.5", "1e-9", "nan"])
+def test_a_fractional_sample_count_says_whole_number(tmp_path, capsys, new):
+    """Run 118: samples = 1e-9 said 'expected a number' (it is one)."""
+    err = _exit2(tmp_path, capsys, "emu-speed-switched-run", "samples = 299", f"samples = {new}")
+    assert "montecarlo.samples" in err and "expected a whole number in [2, 5000]" in err
