@@ -127,3 +127,11 @@ def test_a_fractional_sample_count_says_whole_number(tmp_path, capsys, new):
     """Run 118: samples = 1e-9 said 'expected a number' (it is one)."""
     err = _exit2(tmp_path, capsys, "emu-speed-switched-run", "samples = 299", f"samples = {new}")
     assert "montecarlo.samples" in err and "expected a whole number in [2, 5000]" in err
+
+
+def test_a_zero_divisor_is_named_as_one_not_as_a_complex_value(tmp_path, capsys):
+    """Runs 135 and 146: e = 1/(dv - dv) said 'found a complex value' (sympy's
+    zoo is not real); it is a division by zero."""
+    err = _exit2(tmp_path, capsys, "two-train-spacing-delay-feedback", 'e = "dv"',
+                 'e = "1/(dv - dv)"')
+    assert "equations.e = '1/(dv - dv)'" in err and "division by zero" in err, err
