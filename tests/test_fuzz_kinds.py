@@ -36,6 +36,26 @@ def test_api_misuse_of_the_newer_kinds_raises_one_line_value_errors():
     assert seen >= 10
 
 
+#: API findings of the re-run: each must now raise a ValueError before any solve.
+RAISE = {"design_gain delay 1e308": "h_max in [1e-06, 1000] (s)",
+         "implementation sampling 1e308": "expected a period T (s) in [1e-06, 1000]",
+         "implementation T_hi 1e-300": "at least the required T_max = 0.1",
+         "synthesize_sampled T_max 1e308": "expected a sampling interval (s) in [1e-06, 1000]",
+         "synthesize_sampled digits 0": "significant digits in [1, 12]",
+         "synthesize_sampled digits 400": "significant digits in [1, 12]"}
+
+
+def test_api_findings_of_the_rerun_raise_with_the_range():
+    """design_gain(delay=(0, 1e308)) said 'eps = nan'; implementation(sampling=1e308)
+    named an internal h_lo; T_hi = 1e-300 and synthesize_sampled(T_max=1e308,
+    digits=0) returned results; digits = 400 was an OverflowError."""
+    cases = dict(fz.api_cases())
+    for name, text in RAISE.items():
+        with pytest.raises(ValueError) as exc:
+            cases[name]()
+        assert text in str(exc.value) and "\n" not in str(exc.value), (name, str(exc.value))
+
+
 def test_runs_for_refuses_a_certain_pass_and_keeps_299():
     """runs_for(1.0) was a ZeroDivisionError, runs_for(0) 'math domain error'."""
     from workbench.kinds.switched_run.study import runs_for
