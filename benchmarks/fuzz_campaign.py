@@ -9,7 +9,9 @@ re-run's campaign: the six designs of ``CAMPAIGN_DESIGNS`` (the switched-run
 and rail wheel-slip designs added) with the mutations of the newer tables
 (phases, guards, laws, [montecarlo], [convergence], [sampled]), then the
 Python API misuses of ``fuzz_designs.api_cases``. ``START`` skips the first
-runs (their mutations are still drawn, so run i is the same mutation).
+runs (their mutations are still drawn, so run i is the same mutation); a
+fifth argument ``ONLY`` (run numbers, comma-separated) runs just those, then
+the API misuses (a re-check of the findings after their fixes).
 Prints one line per run (class, wall s, CPU s, command, design, mutation,
 last message line) and the class counts, the largest CPU time and the runs
 over 120 CPU s at the end.
@@ -28,7 +30,7 @@ import fuzz_designs as fz  # noqa: E402
 LIMIT = 120.0
 
 
-def main(n: int = 300, log=sys.stdout, seed: int = 32, start: int = 0) -> int:
+def main(n: int = 300, log=sys.stdout, seed: int = 32, start: int = 0, only=None) -> int:
     import workbench.cli  # noqa: F401 - loaded once, not in every forked child
     import workbench.design  # noqa: F401
     from workbench import kinds as registry
@@ -37,7 +39,8 @@ def main(n: int = 300, log=sys.stdout, seed: int = 32, start: int = 0) -> int:
     rng, counts, cpus = random.Random(seed), Counter(), []
     old = seed == 32
     designs = fz.DESIGNS if old else fz.CAMPAIGN_DESIGNS
-    print(f"seed {seed}, runs {start}..{n - 1}, designs {', '.join(designs)}", file=log)
+    print(f"seed {seed}, runs {start}..{n - 1}" + (f" (only {sorted(only)})" if only else "") +
+          f", designs {', '.join(designs)}", file=log)
 
     def timed(i, run):
         r0, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.time()
@@ -54,7 +57,7 @@ def main(n: int = 300, log=sys.stdout, seed: int = 32, start: int = 0) -> int:
             m = fz.mutate(rng, design, None if old else "tables")
             command = fz.COMMANDS[(i // len(designs)) % len(fz.COMMANDS)] if old else \
                 fz.command_of(design, i)
-            if i < start:
+            if i < start or only is not None and i not in only:
                 continue
             cls, msg, wall, cpu = timed(i, lambda: fz.run_one(m, command, Path(work), 900.0,
                                                               tag=str(i)))
@@ -78,6 +81,7 @@ if __name__ == "__main__":
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 300
     seed = int(sys.argv[3]) if len(sys.argv) > 3 else 32
     start = int(sys.argv[4]) if len(sys.argv) > 4 else 0
-    with open(sys.argv[2], "a" if start else "w") if len(sys.argv) > 2 and sys.argv[2] != "-" \
-            else sys.stdout as out:
-        sys.exit(main(n, out, seed, start))
+    only = {int(x) for x in sys.argv[5].split(",")} if len(sys.argv) > 5 else None
+    to_file = len(sys.argv) > 2 and sys.argv[2] != "-"
+    with open(sys.argv[2], "a" if start or only else "w") if to_file else sys.stdout as out:
+        sys.exit(main(n, out, seed, start, only))

@@ -42,7 +42,8 @@ RAISE = {"design_gain delay 1e308": "h_max in [1e-06, 1000] (s)",
          "implementation T_hi 1e-300": "at least the required T_max = 0.1",
          "synthesize_sampled T_max 1e308": "expected a sampling interval (s) in [1e-06, 1000]",
          "synthesize_sampled digits 0": "significant digits in [1, 12]",
-         "synthesize_sampled digits 400": "significant digits in [1, 12]"}
+         "synthesize_sampled digits 400": "significant digits in [1, 12]",
+         "design_gain input_limit 0": "input_limit[0] = 0.0; expected a positive"}
 
 
 def test_api_findings_of_the_rerun_raise_with_the_range():

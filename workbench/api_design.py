@@ -29,7 +29,8 @@ def _positive(name: str, v, *, allow_none: bool = True) -> float | None:
         return None
     if isinstance(v, bool) or not isinstance(v, (int, float, np.floating)) or not (
             0 < v < math.inf):
-        raise ValueError(f"{name} = {v!r}; expected a positive finite number")
+        shown = float(v) if isinstance(v, np.floating) else v     # not "np.float64(0.0)"
+        raise ValueError(f"{name} = {shown!r}; expected a positive finite number")
     return float(v)
 
 
