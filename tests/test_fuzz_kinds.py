@@ -156,3 +156,11 @@ def test_a_zero_divisor_is_named_as_one_not_as_a_complex_value(tmp_path, capsys)
     err = _exit2(tmp_path, capsys, "two-train-spacing-delay-feedback", 'e = "dv"',
                  'e = "1/(dv - dv)"')
     assert "equations.e = '1/(dv - dv)'" in err and "division by zero" in err, err
+
+
+def test_a_denormal_delay_drift_rate_exits_2(tmp_path, capsys):
+    """Seed 32 re-run, run 75: [requirements] rate = 5e-324 was an OverflowError
+    (float infinity to integer) in requirements.simulate_varying (``synthesize``)."""
+    err = _exit2(tmp_path, capsys, "two-train-spacing-delay-feedback",
+                 'rate = { value = 0.1,', 'rate = { value = 5e-324,')
+    assert "requirements.rate.value = 5e-324" in err and "[1e-06, 1)" in err, err
