@@ -9,6 +9,7 @@ than one line or with "Traceback"), ``timeout`` (killed after the limit).
 """
 from __future__ import annotations
 
+import math
 import multiprocessing as mp
 import os
 import random
@@ -22,6 +23,13 @@ ROOT = Path(__file__).resolve().parents[1]
 DESIGNS = ("antiskid-cruise-dry", "train-brake-lag-delay-feedback",
            "wheel-slip-burckhardt-delay-feedback", "two-train-spacing-delay-feedback")
 COMMANDS = ("synthesize", "verify", "report")
+#: The designs of the kinds and tables added after the first campaign (issue 32 re-run):
+#: a switched-run design (phases, guards, laws, [montecarlo], [sampled], [convergence])
+#: and the rail wheel-slip design; two-train-spacing (above) has [montecarlo].
+NEW_DESIGNS = ("emu-speed-switched-run", "wheel-slip-rail-delay-feedback")
+CAMPAIGN_DESIGNS = DESIGNS + NEW_DESIGNS
+#: Commands of a design whose kind has no delay-bound synthesis.
+COMMANDS_OF = {"emu-speed-switched-run": ("verify", "report", "verify")}
 
 NUMBERS = ["0", "-0.0", "-1", "1e-300", "5e-324", "1e308", "-1e308", "nan", "inf", "-inf",
            "1" * 1900, "\"12\"", "true", "[1, 2]", "{}", "1e-9", "1e9", "-0.65", "2"]
@@ -34,6 +42,42 @@ STRUCTURAL = ["delete_line", "duplicate_header", "deep_nesting", "huge_int", "tr
               "bad_utf8", "dotdot_name", "deep_dotted", "empty", "big_matrix"]
 LOAD_TIME = ["delete_line", "duplicate_header", "deep_nesting", "huge_int", "truncate",
              "bad_utf8", "dotdot_name", "deep_dotted", "empty"]
+
+#: Mutations of the newer tables: (pattern with one group, replacements).
+TABLES = [
+    (r'\bto = "(\w+)"', ["nowhere", "accelerate", "cruise", "", "brake"]),
+    (r'\bwhen = "([^"]*)"', ["0", "1", "-1", "v", "nan", "omega/0", "1e308*1e308", "(",
+                            "v - v_set + 1e-300", "__import__('os')", "u"]),
+    (r'\blaw = \{ u = "([^"]*)"', ["0", "1e308", "-1e308", "F_max*1e12", "u", "s/0",
+                                  "log(-1)*v", "sqrt(-1)", "v**99999", "F_max + s_stop"]),
+    (r'\bterminal = (true)', ["false", "1", '"yes"', "[]"]),
+    (r'\buntil = "([^"]*)"', ["1", "-1", "0", "v_stop - v + 0/0", "m"]),
+    (r'^(phase) = "', ["phases", "Phase", "phase.x"]),
+    (r'^phase = "(\w+)"', ["nowhere", "brake", "cruise", ""]),
+    (r'^name = "(accelerate|cruise|brake)"', ["cruise", "brake", "", "a b", "x" * 300]),
+    (r'^predictor = (true)', ["false", "1", '"true"']),
+    (r'^samples = (\d+)', ["0", "1", "-1", "2", "10000000", "1e9", "2.5", '"299"', "1" * 60]),
+    (r'^seed = (\d+)', ["-1", "1" + "0" * 30, "2.5", "nan", '"35"', "0"]),
+    (r'\bdist = "(\w+)"', ["cauchy", "", "normal", "uniform", "lognormal", "Normal"]),
+    (r'\bsd = ([\d.e]+)', ["0", "-1", "nan", "inf", "1e308", "5e-324"]),
+    (r'\bmean = ([\d.e]+)', ["0", "-1", "nan", "1e308", "-1e308"]),
+    (r'\blo = ([\d.e]+)', ["1e308", "-1e308", "-1", "0", "nan", "1e9"]),
+    (r'\bhi = ([\d.e]+)', ["0", "-1", "1e308", "nan", "5e-324"]),
+    (r'^(\w+)\s*= \{ dist', ["v", "nope", "g", "u", "s", "m_eff", "h"]),
+    (r'^\[(convergence)\]', ["convergence]\nlevels = 9\n[x", "convergence.deep",
+                             "convergence]\n["]),
+    (r'^(\[convergence\])', ["", "[convergence]\ntolerance = -1"]),
+    (r'^period = ([\d.e]+)', ["0", "-1", "1e-300", "1e9", "0.07", "0.05", "nan", "1000"]),
+    (r'\bquantisation = \{ (s) =', ["nope", "u", "F", "v"]),
+    (r'\bquantisation = \{ s = ([\d.e]+)', ["0", "-1", "1e308", "nan", "5e-324", "1e12"]),
+    (r'^max_switch_rate = ([\d.e]+)', ["0", "1e-300"]),
+    (r'^(t_end) = ', ["max_switch_rate = 1e-9\nt_end", "max_switch_rate = 0\nt_end"]),
+    (r'^(x0) = \{', ["x0 = { s = 1e12, v = 1e12, F = 1e12 }\nzz", "parameters = { m = 0 }\nzz",
+                    "parameters = { m = -1 }\nzz", "parameters = { tau = 1e-300 }\nzz",
+                    "parameters = { v = 1 }\nzz", "target = { u = 1 }\nzz"]),
+    (r'^(\[montecarlo\])', ["[montecarlo]\nworkers = 9", "[montecarlo.x]", "[[montecarlo]]"]),
+]
+_TABLES = [(re.compile(p, re.M), new) for p, new in TABLES]
 
 _NUM = re.compile(r"(?<=[=\[,{ ])(-?\d+(\.\d+)?([eE][-+]?\d+)?)(?=[\s,\]}])")
 _UNIT = re.compile(r'unit *= *"([^"]*)"')
@@ -57,10 +101,22 @@ def _is_value(text: str, pos: int) -> bool:
 def mutate(rng: random.Random, design: str, kinds=None) -> Mutation:
     """One seeded mutation of ``design``'s file."""
     text = (ROOT / "designs" / f"{design}.toml").read_text(encoding="utf-8")
-    kind = rng.choice(kinds or ["number"] * 5 + ["unit"] * 2 + ["expression"] * 2 +
-                      ["structural"])
+    tables = [(p, new) for p, new in _TABLES if p.search(text)]
+    default = ["number"] * 5 + ["unit"] * 2 + ["expression"] * 2 + ["structural"]
+    # the re-run's campaign (benchmarks/fuzz_campaign.py): the newer tables' mutations too
+    if kinds == "tables" and tables and (design in NEW_DESIGNS or "[montecarlo]" in text):
+        default += ["table"] * (4 if design == "emu-speed-switched-run" else 2)
+    kind = rng.choice(kinds if kinds and kinds != "tables" else default)
+    if kind == "table" and not tables:
+        kind = "number"
     if kind == "structural":
         kind = rng.choice(STRUCTURAL)
+    if kind == "table":
+        p, choices = rng.choice(tables)
+        m = rng.choice(list(p.finditer(text)))
+        new = rng.choice(choices)
+        return Mutation(design, kind, f"{m.group(1)[:20]} -> {new[:30]} at {m.start(1)}",
+                        (text[:m.start(1)] + new + text[m.end(1):]).encode())
     if kind == "number":
         m = rng.choice([m for m in _NUM.finditer(text) if _is_value(text, m.start())])
         new = rng.choice(NUMBERS)
@@ -121,6 +177,122 @@ def mutate(rng: random.Random, design: str, kinds=None) -> Mutation:
     return Mutation(design, kind, "", b"")
 
 
+def api_cases():
+    """(name, call) misuses of the Python API of the newer kinds and features:
+    requirement synthesis (:func:`workbench.design_gain`), the digital
+    implementation (:func:`workbench.implementation`,
+    :func:`workbench.synthesize_sampled`), the Monte Carlo statistics and the
+    switched-run success-run count, and loading a design by path."""
+    import numpy as np
+
+    import workbench
+    from workbench.design import load_design
+    from workbench.features import montecarlo as mc
+    from workbench.kinds.switched_run.study import runs_for
+    A, B = np.array([[0.0, 1.0], [-2.0, -3.0]]), np.array([[0.0], [1.0]])
+    K = np.array([[-1.0, -1.0]])
+    yield "design_gain delay reversed", lambda: workbench.design_gain(A, B, delay=(0.5, 0.1))
+    yield "design_gain delay nan", lambda: workbench.design_gain(A, B, delay=(0.0, math.nan))
+    yield "design_gain delay 1e308", lambda: workbench.design_gain(A, B, delay=(0.0, 1e308))
+    yield "design_gain delay scalar", lambda: workbench.design_gain(A, B, delay=0.1)
+    yield "design_gain decay -1", lambda: workbench.design_gain(A, B, delay=(0, .1),
+                                                                decay_rate=-1.0)
+    yield "design_gain objective", lambda: workbench.design_gain(A, B, delay=(0, .1),
+                                                                 objective="magic")
+    yield "design_gain input_limit 0", lambda: workbench.design_gain(
+        A, B, delay=(0, .1), input_limit=0.0, box=[1.0, 1.0])
+    yield "design_gain box short", lambda: workbench.design_gain(
+        A, B, delay=(0, .1), input_limit=1.0, box=[1.0])
+    yield "design_gain vertices junk", lambda: workbench.design_gain(
+        A, B, delay=(0, .1), vertices=[("a", "b")])
+    yield "design_gain l2 no Bw", lambda: workbench.design_gain(A, B, delay=(0, .1),
+                                                                l2_gain=1.0)
+    yield "design_gain rate -1", lambda: workbench.design_gain(A, B, delay=(0, .1), rate=-1.0)
+    yield "design_gain huge A", lambda: workbench.design_gain(A * 1e300, B, delay=(0, .1))
+    yield "implementation sampling nan", lambda: workbench.implementation(A, K, B=B,
+                                                                          sampling=math.nan)
+    yield "implementation sampling 1e308", lambda: workbench.implementation(A, K, B=B,
+                                                                            sampling=1e308)
+    yield "implementation sampling reversed", lambda: workbench.implementation(
+        A, K, B=B, sampling=(0.2, 0.1))
+    yield "implementation network delay -1", lambda: workbench.implementation(
+        A, K, B=B, sampling=0.1, network_delay=(-1.0, 0.0))
+    yield "implementation hold foh", lambda: workbench.implementation(A, K, B=B, sampling=0.1,
+                                                                      hold="foh")
+    yield "implementation K shape", lambda: workbench.implementation(A, np.ones((2, 3)), B=B,
+                                                                     sampling=0.1)
+    yield "implementation T_hi 1e-300", lambda: workbench.implementation(
+        A, K, B=B, sampling=0.1, T_hi=1e-300)
+    yield "synthesize_sampled T_max 0", lambda: workbench.synthesize_sampled(A, B=B, T_max=0.0)
+    yield "synthesize_sampled T_max 1e308", lambda: workbench.synthesize_sampled(
+        A, B=B, T_max=1e308)
+    yield "synthesize_sampled digits 0", lambda: workbench.synthesize_sampled(
+        A, B=B, T_max=0.1, digits=0)
+    yield "synthesize_sampled digits 400", lambda: workbench.synthesize_sampled(
+        A, B=B, T_max=0.1, digits=400)
+    yield "runs_for p 1", lambda: runs_for(1.0)
+    yield "runs_for p 0", lambda: runs_for(0.0)
+    yield "runs_for alpha 0", lambda: runs_for(0.99, 0.0)
+    yield "runs_for nan", lambda: runs_for(math.nan)
+    yield "wilson k > n", lambda: mc.wilson_interval(11, 10)
+    yield "wilson negative", lambda: mc.wilson_interval(-1, 10)
+    yield "stop_statistics empty", lambda: mc.stop_statistics([], 0.5)
+    yield "percentile q 200", lambda: mc.percentile([1.0, 2.0], 200.0)
+    yield "percentile empty", lambda: mc.percentile([], 50.0)
+    yield "load_design missing", lambda: load_design("/nonexistent/x.toml")
+    yield "load_design folder", lambda: load_design(ROOT / "designs")
+
+
+def _api_child(name, err_path):
+    fd = os.open(err_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+    os.dup2(fd, 2)
+    sys.stderr = os.fdopen(2, "w", buffering=1)
+    sys.stdout = open(os.devnull, "w")
+    call = dict(api_cases())[name]
+    try:
+        call()
+    except ValueError as exc:
+        print(f"ValueError: {exc}", file=sys.stderr)
+        sys.stderr.flush()
+        os._exit(2)
+    except BaseException:   # noqa: BLE001 - any other exception is the finding
+        traceback.print_exc()
+        sys.stderr.flush()
+        os._exit(99)
+    os._exit(0)
+
+
+def _forked(target, args, timeout: float) -> int | None:
+    """Exit code of ``target(*args)`` in a forked child; None if killed after ``timeout`` s."""
+    proc = mp.get_context("fork").Process(target=target, args=args)
+    proc.start()
+    proc.join(timeout)
+    if proc.is_alive():
+        proc.kill()
+        proc.join()
+        return None
+    return proc.exitcode
+
+
+def run_api(name: str, work: Path, timeout: float = 120.0, tag: str = "0") -> tuple[str, str]:
+    """Classify one API misuse: ``exit2`` (a ValueError of one line), ``ok``
+    (returned), ``traceback`` (another exception, or a message of several
+    lines or over 400 characters), ``timeout``."""
+    folder = work / f"api-{tag}"
+    folder.mkdir(parents=True, exist_ok=True)
+    err = folder / "stderr.txt"
+    code = _forked(_api_child, (name, str(err)), timeout)
+    if code is None:
+        return "timeout", f"over {timeout:g} s"
+    msg = err.read_text(errors="replace").strip() if err.exists() else ""
+    msg = "\n".join(ln for ln in msg.splitlines() if "Warning" not in ln and ln.strip())
+    if code == 2:
+        return ("exit2", msg) if "\n" not in msg and len(msg) < 400 else ("traceback", msg)
+    if code == 0:
+        return "ok", ""
+    return "traceback", msg[-2000:]
+
+
 def _child(argv, err_path):
     fd = os.open(err_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
     os.dup2(fd, 2)
@@ -150,17 +322,12 @@ def run_one(m: Mutation, command: str, work: Path, timeout: float = 120.0, tag: 
             "verify": ["verify", str(path)],
             "report": ["report", str(path), "--out", str(folder / "reports")]}[command]
     err = folder / "stderr.txt"
-    proc = mp.get_context("fork").Process(target=_child, args=(argv, str(err)))
-    proc.start()
-    proc.join(timeout)
-    if proc.is_alive():
-        proc.kill()
-        proc.join()
+    code = _forked(_child, (argv, str(err)), timeout)
+    if code is None:
         return "timeout", f"over {timeout:g} s"
     msg = err.read_text(errors="replace") if err.exists() else ""
     lines = [ln for ln in msg.splitlines() if ln.strip() and not ln.startswith(
         ("| design", "|---", "| "))]
-    code = proc.exitcode
     if code == 99 or "Traceback" in msg or "PanicException" in msg:
         return "traceback", msg[-2000:]
     if code == 2:
@@ -171,6 +338,12 @@ def run_one(m: Mutation, command: str, work: Path, timeout: float = 120.0, tag: 
     if code == 0:
         return "ok", ""
     return "traceback", f"exit code {code}: {msg[-1000:]}"
+
+
+def command_of(design: str, i: int) -> str:
+    """The command of run ``i`` (rotating over the design's commands)."""
+    cmds = COMMANDS_OF.get(design, COMMANDS)
+    return cmds[(i // len(CAMPAIGN_DESIGNS)) % len(cmds)]
 
 
 def campaign(seed: int, n: int, work: Path, kinds=None, timeout: float = 120.0,

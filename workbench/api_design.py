@@ -19,13 +19,18 @@ from .requirements import RequirementResult, Requirements, design_to_requirement
 
 __all__ = ["design_gain"]
 
+#: Declared range of h_max (s), as a design's ``[requirements] delay``
+#: (:data:`workbench.kinds.delay_feedback.requirements.H_MIN`, ``H_MAX``; issue 32).
+H_RANGE = (1e-6, 1e3)
+
 
 def _positive(name: str, v, *, allow_none: bool = True) -> float | None:
     if v is None and allow_none:
         return None
     if isinstance(v, bool) or not isinstance(v, (int, float, np.floating)) or not (
             0 < v < math.inf):
-        raise ValueError(f"{name} = {v!r}; expected a positive finite number")
+        shown = float(v) if isinstance(v, np.floating) else v     # not "np.float64(0.0)"
+        raise ValueError(f"{name} = {shown!r}; expected a positive finite number")
     return float(v)
 
 
@@ -88,8 +93,9 @@ def design_gain(sys, B=None, *, delay: tuple[float, float], decay_rate: float | 
         lo, hi = (float(v) for v in delay)
     except (TypeError, ValueError):
         raise ValueError(f"delay = {delay!r}; expected [h_min, h_max] (s)") from None
-    if not (0 <= lo <= hi < math.inf and hi > 0):
-        raise ValueError(f"delay = {delay!r}; expected 0 <= h_min <= h_max, h_max > 0 (s)")
+    if not (0 <= lo <= hi and H_RANGE[0] <= hi <= H_RANGE[1]):
+        raise ValueError(f"delay = {delay!r}; expected 0 <= h_min <= h_max, h_max in "
+                         f"[{H_RANGE[0]:g}, {H_RANGE[1]:g}] (s)")
     if objective not in ("decay", "l2_gain", "delay"):
         raise ValueError(f"objective = {objective!r}; expected 'decay', 'l2_gain' or 'delay'")
     decay_rate = _positive("decay_rate", decay_rate)

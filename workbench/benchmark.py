@@ -312,7 +312,7 @@ def load_settings(r: Reader) -> BenchmarkSettings:
         gap_tol=r.number("gap_tol", default=d.gap_tol, positive=True, hi=0.5),
         margin=r.number("margin", default=d.margin, positive=True, hi=1e-2),
         rel_tol=r.number("rel_tol", default=d.rel_tol, positive=True, hi=0.1),
-        h_max=r.number("h_max", default=d.h_max, positive=True),
+        h_max=r.number("h_max", default=d.h_max, lo=1e-3, hi=1e4, what="number (s)"),
         exact_check=r.boolean("exact_check", default=d.exact_check))
     r.finish()
     return s

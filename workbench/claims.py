@@ -90,7 +90,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
-from decimal import ROUND_DOWN, ROUND_HALF_EVEN, Decimal
+from decimal import ROUND_DOWN, ROUND_HALF_EVEN, Decimal, localcontext
 from typing import Any
 
 from .jsonable import json_method
@@ -391,7 +391,9 @@ def parse_register(root: Reader, claims) -> tuple[tuple[Hazard, ...], tuple[Assu
 
 def _printed(x: float, digits: int, rounding: str) -> Decimal:
     mode = ROUND_DOWN if rounding == "truncate" else ROUND_HALF_EVEN
-    return Decimal(repr(x)).quantize(Decimal(1).scaleb(-digits), rounding=mode)
+    with localcontext() as ctx:     # 1e308 at 12 decimals: 321 digits (default 28 raises)
+        ctx.prec = 340
+        return Decimal(repr(x)).quantize(Decimal(1).scaleb(-digits), rounding=mode)
 
 
 def check_claim(claim: Claim, got: Any) -> ClaimResult:

@@ -108,7 +108,8 @@ def load_design(path: str | Path) -> Design:
     shown = display_path(path)
     p = Path(path)
     if not p.is_file():
-        raise DesignError(shown, "<file>", "<missing>", "an existing design file (.toml)")
+        raise DesignError(shown, "<file>", "<a folder>" if p.is_dir() else "<missing>",
+                          "an existing design file (.toml)")
     data = load_toml(p, shown)
     raw = p.read_bytes()
     ulps = os.environ.get(PERTURB_ENV, "").strip()

@@ -60,6 +60,9 @@ MAX_QUEUE = 48
 #: there, else the end, printed rounded down), so a last-bit difference in the
 #: search cannot move the printed digit (issue 36).
 PRINTED_DIGITS = 3
+#: Declared range of a sampling period (s), as a design's ``[implementation]``
+#: (:data:`workbench.features.sampled.T_RANGE`, issue 32).
+T_RANGE = (1e-6, 1e3)
 
 
 @dataclass(frozen=True)
@@ -240,15 +243,16 @@ def _ratio_text(r: ImplementationResult) -> str:
 def _sampling(sampling) -> tuple[tuple[float, float] | None, bool]:
     if sampling is None:
         return None, False
+    a, b = T_RANGE
     if np.ndim(sampling) == 0:
         T = float(sampling)
-        if not (T > 0 and math.isfinite(T)):
-            raise ValueError(f"sampling = {sampling!r}; expected a positive period T (s)")
+        if not a <= T <= b:
+            raise ValueError(f"sampling = {sampling!r}; expected a period T (s) in [{a:g}, {b:g}]")
         return (0.0, T), True
     lo, hi = (float(v) for v in sampling)
-    if not (0 <= lo <= hi and hi > 0 and math.isfinite(hi)):
+    if not (0 <= lo <= hi and a <= hi <= b):
         raise ValueError(f"sampling = {sampling!r}; expected [T_min, T_max] with "
-                         "0 <= T_min <= T_max")
+                         f"0 <= T_min <= T_max, T_max in [{a:g}, {b:g}] (s)")
     return (lo, hi), False
 
 
@@ -352,6 +356,10 @@ def implementation(sys, K, *, B=None, sampling=None, network_delay=(0.0, 0.0),
     scale = 1.0 / (np.linalg.norm(A, 2) + np.linalg.norm(B @ K, 2))
     if T_hi is None:
         T_hi = max(100 * scale, 4 * req[1]) if req else 100 * scale
+    elif not (isinstance(T_hi, (int, float, np.floating)) and not isinstance(T_hi, bool) and
+              0 < T_hi < math.inf and (req is None or T_hi >= req[1])):
+        raise ValueError(f"T_hi = {T_hi!r}; expected a finite search cap (s)" +
+                         (f" at least the required T_max = {req[1]:g}" if req else " above 0"))
     T_min = 0.0 if (req is None or periodic) else req[0]
     method, T_cert, T_ref, rc, note = _certify(A, B, K, T_min, taus, decay_rate, margin,
                                                T_hi, rel_tol)
@@ -421,6 +429,13 @@ def synthesize_sampled(sys, *, T_max: float, B=None, digits: int = 4,
     ImplementationResult
     """
     from .lmi.sampled_synthesis import synthesize_sampled_gain
+    if isinstance(T_max, bool) or not isinstance(T_max, (int, float, np.floating)) or \
+            not T_RANGE[0] <= T_max <= T_RANGE[1]:
+        raise ValueError(f"T_max = {T_max!r}; expected a sampling interval (s) in "
+                         f"[{T_RANGE[0]:g}, {T_RANGE[1]:g}]")
+    if isinstance(digits, bool) or not isinstance(digits, int) or not 1 <= digits <= 12:
+        raise ValueError(f"digits = {digits!r}; expected a whole number of significant "
+                         "digits in [1, 12]")
     A, B = _plant(sys, B)
     K, status, t = synthesize_sampled_gain(A, B, T_max, digits=digits)
     if K is None:

@@ -71,7 +71,14 @@ class Reader:
         if val is default and default is not _MISSING:
             return val
         ok_type = isinstance(val, int) if integer else isinstance(val, (int, float))
+        where = (f"in [{lo:g}, {hi:g}]" if lo is not None and hi is not None else
+                 f"at most {hi:g}" if hi is not None else
+                 f"at least {lo:g}" if lo is not None else "")
         if isinstance(val, bool) or not ok_type:
+            if integer:     # 2.5, nan or 1e-9 where a count is expected
+                raise self.fail(name, val, "a whole number" + (
+                    "" if what in ("number", "integer") else f" ({what})") +
+                    (f" {where}" if where else ""))
             raise self.fail(name, val, f"a {what}")
         try:
             x = int(val) if integer else float(val)
@@ -85,9 +92,7 @@ class Reader:
         if nonneg and not x >= 0:
             raise self.fail(name, val, f"a non-negative {what}")
         if lo is not None and not x >= lo or hi is not None and not x <= hi:
-            where = (f"in [{lo:g}, {hi:g}]" if lo is not None and hi is not None else
-                     f"at most {hi:g}" if lo is None else f"at least {lo:g}")
-            raise self.fail(name, val, f"a {what} {where}")
+            raise self.fail(name, val, f"{'an' if what[:1] in 'aeiou' else 'a'} {what} {where}")
         return x
 
     def string(self, name: str, *, default: Any = _MISSING,

@@ -169,6 +169,10 @@ def wilson_interval(k: int, n: int, z: float = Z95):
     .. [W27] Wilson E. B., "Probable inference, the law of succession, and
        statistical inference", J. Am. Stat. Assoc. 22(158):209-212, 1927.
     """
+    if not (isinstance(k, (int, np.integer)) and isinstance(n, (int, np.integer))
+            and 0 <= k <= n):
+        raise ValueError(f"wilson_interval: k = {k!r}, n = {n!r}; expected whole numbers "
+                         "0 <= k <= n")
     if n == 0:
         return 0, 0, math.nan, math.nan, math.nan
     p = k / n
@@ -221,13 +225,21 @@ def stop_statistics(errors, tol: float) -> StopStatistics:
     e_in = np.where(np.isfinite(e), e, np.inf)
     k, n, p, lo, hi = within_rate(e_in, tol)
     return StopStatistics(k, n, p, lo, hi, percentile(np.abs(e_in), 95.0),
-                          float(np.mean(e)), float(np.mean(e_in > 0)), tuple(float(x) for x in e))
+                          float(np.mean(e)) if e.size else math.nan,
+                          float(np.mean(e_in > 0)) if e.size else math.nan,
+                          tuple(float(x) for x in e))
 
 
 def percentile(x, q: float) -> float:
     """The q-th percentile of ``x`` by linear interpolation between order
-    statistics (numpy's default), inf when an infinite value takes part."""
+    statistics (numpy's default), inf when an infinite value takes part, nan
+    for no values (as :func:`wilson_interval` for n = 0); ValueError unless
+    0 <= q <= 100."""
+    if not 0 <= q <= 100:
+        raise ValueError(f"percentile: q = {q!r}; expected a number in [0, 100]")
     s = np.sort(np.asarray(x, float))
+    if s.size == 0:
+        return math.nan
     if np.all(np.isfinite(s)):
         return float(np.percentile(s, q))
     pos = q / 100 * (len(s) - 1)

@@ -111,8 +111,8 @@ class PlantModel:
         for key, text, e in self._texts():
             v = e if values is None else self.substituted(e, values)
             if v.has(*bad) or (values is not None and v.is_real is False):
-                kind = ("a complex value" if v.has(sp.I) or v.is_real is False
-                        else "a division by zero or an infinity")
+                kind = ("a division by zero or an infinity" if v.has(*bad[:4])   # zoo: not real
+                        else "a complex value")
                 at = "" if values is None else f" at the parameter values of {where}"
                 raise DesignError(self.spec.path, key, text, f"a finite real expression{at} "
                                   f"(found {kind})")

@@ -99,8 +99,9 @@ def load_requirements(root, plant, delay) -> RequirementsSpec | None:
     rate = None
     if t.has("rate"):
         rate, sources["rate"] = _entry(t, "rate", "1")
-        if not rate < 1:
-            raise t.table("rate").fail("value", rate, "a delay-derivative bound below 1")
+        if not (rate == 0 or 1e-6 <= rate < 1):     # 5e-324: the drift period overflows
+            raise t.table("rate").fail("value", rate, "a delay-derivative bound below 1: 0 "
+                                       "or in [1e-06, 1)")
         if not rng[1] > rng[0]:
             raise t.fail("delay", list(rng), "h_min < h_max with a rate (a varying delay)")
         sources["delay"] += f"; |h'| <= {rate:g}: {sources['rate']}"

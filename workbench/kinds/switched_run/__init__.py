@@ -163,8 +163,8 @@ def _phases(root: Reader, plant: PlantSpec, names: set[str]) -> tuple[Phase, ...
 
 def _multiple(r: Reader, key: str, value: float, dt: float, what: str) -> None:
     k = value / dt
-    if not abs(k - round(k)) <= 1e-9 * max(k, 1.0):
-        raise r.fail(key, value, f"{what} a whole multiple of the step {dt:g} s "
+    if not (round(k) >= 1 and abs(k - round(k)) <= 1e-9 * max(k, 1.0)):   # 1e-300 s: 0 steps
+        raise r.fail(key, dt, f"a step of which {what} is a whole multiple (>= 1) "
                      f"(found {k:.6g} steps)")
 
 
@@ -192,10 +192,9 @@ def _scenarios(root: Reader, spec_plant: PlantSpec, phases, h: float, convergenc
             raise r.fail("dt", dt, f"at most {MAX_STEPS:g} steps over t_end"
                          + (" at dt/4 ([convergence])" if convergence else ""))
         if h:          # a multiple of dt is one of dt/2 and dt/4 too ([convergence])
-            _multiple(r, "dt", h, dt, f"a step with the delay h = {h:g} s")
+            _multiple(r, "dt", h, dt, f"the delay h = {h:g} s")
         if sampled is not None:
-            _multiple(r, "dt", sampled.period, dt,
-                      f"a step with the control period {sampled.period:g} s")
+            _multiple(r, "dt", sampled.period, dt, f"the control period {sampled.period:g} s")
         phase = r.string("phase", choices=phase_names)
         pt = r.table("parameters", default=None)
         over = {}

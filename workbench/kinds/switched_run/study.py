@@ -42,7 +42,10 @@ P_SHOWN = 0.99
 def runs_for(p: float, alpha: float = ALPHA) -> int:
     """Fewest runs without a failure that show a pass probability >= ``p``
     with confidence 1 - ``alpha`` (success-run rule: p**n <= alpha); 299 for
-    p = 0.99 at 95 %."""
+    p = 0.99 at 95 %; ValueError unless 0 < p < 1 and 0 < alpha < 1."""
+    for name, x in (("p", p), ("alpha", alpha)):
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not 0 < x < 1:
+            raise ValueError(f"runs_for: {name} = {x!r}; expected a probability in (0, 1)")
     return math.ceil(math.log(alpha) / math.log(p))
 
 

@@ -252,7 +252,7 @@ class AntiskidCruise:
     def _load_tight(root: Reader, eps: tuple[float, ...]) -> TightSettings | None:
         t = root.table("tight")
         enable = t.boolean("enable", default=True)
-        h_max = t.number("h_max", default=10.0, positive=True, hi=1e3, what="number (s)")
+        h_max = t.number("h_max", default=10.0, lo=1e-3, hi=1e3, what="number (s)")
         grid = t.numbers("grid", default=(0.01, 0.1, 1.0, 10.0, 100.0), positive=True,
                          min_len=2, what="eps values", lo=1e-6, hi=1e6)
         if list(grid) != sorted(set(grid)):

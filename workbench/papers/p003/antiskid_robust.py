@@ -145,7 +145,7 @@ class AntiskidRobust:
                                  lo=1e-6, hi=1e6),
             golden_steps=int(syn.number("golden_steps", default=3, integer=True, lo=0, hi=20)),
             rel_tol=syn.number("rel_tol", default=1e-2, positive=True, hi=0.1),
-            h_max=syn.number("h_max", default=10.0, positive=True),
+            h_max=syn.number("h_max", default=10.0, lo=1e-3, hi=1e4, what="number (s)"),
             margin=syn.number("margin", default=DEFAULT_MARGIN, positive=True, hi=1e-2),
             order=int(syn.number("analysis_order", default=2, integer=True, lo=0, hi=6)),
             gain_fraction=syn.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
