@@ -237,5 +237,5 @@ def test_a_grid_where_nothing_stops_is_a_model_error(small_reading):
     # a command pinned at a demanded speed of 2 cm/s: the train creeps and never stands still
     creep = dataclasses.replace(r.train, u_min=0.02, u_max=0.02)
     bad = dataclasses.replace(r, train=creep)
-    with pytest.raises(ModelError, match="no run of the MFAC grid"):
+    with pytest.raises(ModelError, match="no reproducible run of the MFAC grid"):
         run_study(dataclasses.replace(small_reading, readings=(bad,)))

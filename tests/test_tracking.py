@@ -200,3 +200,20 @@ def test_most_sensitive_ignores_parameters_without_a_reproducible_neighbour():
     from workbench.papers.p002.ato_tracking_run import most_sensitive
     assert most_sensitive({"eta": 0.01, "rho": math.nan, "lam": 0.09}) == "lam"
     assert most_sensitive({"eta": 0.2, "rho": math.nan, "lam": 0.09}) == "eta"
+
+
+def test_dominance_ties_within_the_relative_band_are_equal():
+    """Two runs whose objectives differ only in the last bits dominate neither
+    way (the front and the dominated share must not rest on them); a real
+    improvement beyond the band still dominates."""
+    from workbench.tuning.pareto import TIE_REL, dominated_share, dominates, pareto_mask
+    a = np.array([0.25, 0.0, 1.0, 3.0])
+    b = np.nextafter(a, np.inf)          # one ulp worse in every objective
+    b[1] = 0.0                           # (rounding-level punctuality is exactly 0 upstream)
+    assert not dominates(a, b) and not dominates(b, a)
+    assert pareto_mask(np.vstack([a, b])).tolist() == [True, True]
+    assert dominated_share([a], [b]) == 0.0
+    c = a.copy()
+    c[0] *= 1 + 10 * TIE_REL             # worse beyond the band
+    assert dominates(a, c) and not dominates(c, a)
+    assert pareto_mask(np.vstack([a, c])).tolist() == [True, False]

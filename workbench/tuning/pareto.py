@@ -9,24 +9,41 @@ from __future__ import annotations
 
 import numpy as np
 
+#: Relative tie band of a dominance comparison: two objective values within
+#: ``TIE_REL * max(|a|, |b|)`` of each other are equal. A reproducible run's
+#: objectives move less than 1e-7 relative under a last-bit change of its inputs
+#: (:mod:`workbench.features.reproducible`), so an exact ``<`` between near-equal
+#: values (two relay runs stopping at the same point, a punctuality of 0 against
+#: 1e-16) would decide dominance on the last bits; 1e-6 is ten times that.
+TIE_REL = 1e-6
+
+
+def _no_worse_better(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(no worse in every objective, better in one) of rows ``A`` against ``B``
+    (broadcast), each comparison with the tie band :data:`TIE_REL`."""
+    tol = TIE_REL * np.maximum(np.abs(A), np.abs(B))
+    return np.all(A <= B + tol, axis=-1), np.any(A < B - tol, axis=-1)
+
 
 def dominates(a: np.ndarray, b: np.ndarray) -> bool:
-    """True when ``a`` is no worse than ``b`` in every objective and better in one."""
-    return bool(np.all(a <= b) and np.any(a < b))
+    """True when ``a`` is no worse than ``b`` in every objective and better in
+    one, values within the relative band :data:`TIE_REL` counting as equal."""
+    no_worse, better = _no_worse_better(np.asarray(a, float), np.asarray(b, float))
+    return bool(no_worse and better)
 
 
 def pareto_mask(points) -> np.ndarray:
     """Boolean mask of the non-dominated rows of ``points`` (shape (N, M),
-    minimised). Rows with a non-finite entry are excluded; equal rows are all
-    kept (none dominates the other)."""
+    minimised). Rows with a non-finite entry are excluded; equal rows (within
+    :data:`TIE_REL`) are all kept (none dominates the other)."""
     P = np.asarray(points, float)
     ok = np.all(np.isfinite(P), axis=1)
     mask = ok.copy()
     idx = np.flatnonzero(ok)
     for i in idx:
         others = P[idx]
-        dominated = np.all(others <= P[i], axis=1) & np.any(others < P[i], axis=1)
-        mask[i] = not dominated.any()
+        no_worse, better = _no_worse_better(others, P[i])
+        mask[i] = not (no_worse & better).any()
     return mask
 
 
