@@ -174,7 +174,7 @@ def margin_section(spec, rz) -> str:
         "delay in the loop it settles into an oscillation whose size grows with the delay. "
         "Followers further back oscillate more (their predecessor's oscillating acceleration "
         "is fed forward). The NTSM's \"any follower\" column has 2 digits: that chattering "
-        "oscillation moves by about 3e-4 (relative) when the inputs move by 3 ulp.\n\n![delay sweep]({figdir}/delay-sweep.png)")
+        "oscillation moves in its fourth digit when the inputs move by a few ulp.\n\n![delay sweep]({figdir}/delay-sweep.png)")
 
 
 # No tight_layout in the drawing functions: laid out before the data are snapped
