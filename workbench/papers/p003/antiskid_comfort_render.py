@@ -51,8 +51,10 @@ def comfort_section(res, spec) -> str:
     rows = []
     for c in res.cases:
         m = c.comfort
-        agree = comfort_quantities(c.case.name, m, c.comfort_coarse)[
+        agree = comfort_quantities(c.case.name, m, c.comfort_coarse,
+                                   None if c.quarter is None else c.quarter[2])[
             f"cases[{c.case.name}].comfort_converged"]
+        agree = "—" if c.quarter is None else (agree or "**not converged**")
         rows.append([f"`{c.case.name}`", fmt(m.a_max_abs, 3), fmt(m.time_above_a, 3),
                      fmt(m.jerk_max_abs, 2), fmt(m.time_above_jerk, 2),
                      fmt(m.u_max_over_peak, 3), agree])
@@ -79,8 +81,12 @@ def comfort_section(res, spec) -> str:
         f"{fmt(spec.torque_range)} T_adh, is its divergence test).\n\n"
         + md_table(["case", "max |a| (m/s²)", f"time |a| > {fmt(cf.a_max.value)} (s)",
                     "max |jerk| (m/s³)", f"time |jerk| > {fmt(cf.jerk_max.value)} (s)",
-                    "max |u| / T_adh", f"dt and dt/2 agree ({fmt(100 * COMFORT_RTOL)} %)"],
+                    "max |u| / T_adh", f"converged, dt to dt/4 ({fmt(100 * COMFORT_RTOL)} %)"],
                    rows, "lrrrrrl")
+        + "\n\nConverged: the |a| and |jerk| peaks at dt, dt/2 and dt/4 have a Richardson "
+        f"error estimate within {fmt(100 * COMFORT_RTOL)} % of the peak (levels whose "
+        "differences change sign: the larger difference at order 0.5); — : no dt/4 run "
+        "(no claim states the case's convergence)."
         + where
         + "\n\n![comfort]({figdir}/comfort.png)\n\nAcceleration (top) and jerk (bottom) "
         "against time with the comfort limits (dashed); dotted: the phase switches of the "
