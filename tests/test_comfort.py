@@ -53,3 +53,15 @@ def test_converged_flag_refines_the_peaks_three_levels():
     assert q(fine, run(2.2), run(1.8)) is None
     # no dt/4 run: a two-level agreement is no convergence
     assert q(fine, fine) is None
+
+
+@pytest.mark.parametrize("t_show", [300.0000000001, 299.99999999])
+def test_switch_to_braking_is_given_at_t_brake(t_show):
+    # which record sample first shows braking (300 or 300.05 s) depends on
+    # the last bit of the accumulated time: the text gives t_brake either way
+    from workbench.papers.p003.antiskid_comfort_render import _switches
+    ph = [2, 2, 4, 4] if t_show > 300 else [2, 2, 2, 4]
+    run = SimpleNamespace(t=np.array([299.9, 299.95, t_show, 300.05]), phase=ph)
+    c = SimpleNamespace(run=run, metrics={"t_brake": 300.0, "omega3_after_brake": np.nan})
+    assert _switches(c, SimpleNamespace(profile={"omega_switch": 3.0})) == [
+        (300.0, "cruise → braking")]

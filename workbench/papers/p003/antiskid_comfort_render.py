@@ -17,13 +17,25 @@ HEADING = "Passenger comfort and wheel torque"
 PATTERN = r"cases\[[^\]]+\]\.(a_max_abs|jerk_max_abs|time_above_|u_max_over_peak|comfort_)"
 
 
+#: Phases of braking (their start is t_brake, :func:`_switches`).
+_BRAKING = ("handover to braking", "braking")
+
+
 def _switches(c, spec) -> list[tuple[float, str]]:
     """(time, what) of each change of the controller phase in a case's run,
     and of the step of eq (76) at omega <= omega_switch (v_s* jumps to 0)."""
     run = c.run
     ph = np.asarray(run.phase)
     k = np.flatnonzero(ph[1:] != ph[:-1]) + 1
-    out = [(float(run.t[i]), f"{PHASE_NAMES[ph[i - 1]]} → {PHASE_NAMES[ph[i]]}") for i in k]
+    t_b = c.metrics["t_brake"]
+    # Braking starts at the first step at or after t_brake, an input that is
+    # also a record sample: which sample first shows it (300 or 300.05 s)
+    # depends on the last bit of the accumulated time, so that switch is
+    # given at t_brake itself (it lies within one step, dt, after it).
+    at = lambda i: (t_b if PHASE_NAMES[ph[i]] in _BRAKING and PHASE_NAMES[ph[i - 1]] not in
+                    _BRAKING and np.isfinite(t_b) and abs(run.t[i] - t_b) <= 2 * RECORD_DT
+                    else float(run.t[i]))
+    out = [(float(at(i)), f"{PHASE_NAMES[ph[i - 1]]} → {PHASE_NAMES[ph[i]]}") for i in k]
     t3 = c.metrics["t_brake"] + c.metrics["omega3_after_brake"]
     if np.isfinite(t3):
         out.append((float(t3), f"omega <= {fmt(spec.profile['omega_switch'])} rad/s, where "
