@@ -71,3 +71,17 @@ def test_only_cases_with_a_claimed_convergence_get_a_quarter_run():
                                      claim("cases[paper].comfort_converged"),
                                      claim("cases[uncompensated].diverged")))
     assert quarter_cases(design) == {"compensated", "paper"}
+
+
+@pytest.mark.parametrize("ulps", ["3", "-3"])
+def test_t_brake_stays_on_its_step_under_a_last_bit_move(monkeypatch, ulps):
+    # t_brake = 300 s is a step time: moved 3 ulp, the braking law fired one
+    # step later and the braking run moved by 1 s (issue 36 item 5)
+    from workbench.design import PERTURB_ENV, load_design
+    from workbench.papers.p003.antiskid_run_spec import event_time
+    assert event_time(math.nextafter(math.nextafter(300.0, 400.0), 400.0)) == 300.0
+    assert event_time(299.99999999999994) == 300.0 and event_time(300.25) == 300.25
+    monkeypatch.setenv(PERTURB_ENV, ulps)
+    spec = load_design("designs/antiskid-run-dry.toml").spec
+    assert spec.scenario["t_brake"] == 300.0 and spec.scenario["t_end"] == 420.0
+    assert spec.scenario["v_d"] != 70.0          # the other inputs did move

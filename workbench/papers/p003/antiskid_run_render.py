@@ -266,10 +266,7 @@ def _convergence_section(res, spec) -> str:
             "estimated from the larger difference at order 0.5) is within "
             f"rtol = {fmt(spec.conv_rtol)} of the largest |value| plus the design's atol. "
             "A case without a dt/4 run shows only whether dt and dt/2 agree within that "
-            "tolerance, which is no convergence. The digits of the braking phase are not "
-            "reproducible: a move of the inputs by 3 ulp moves the braking time by about "
-            "1 s and the largest creep-speed error several-fold (the braking law's "
-            "switching makes the run sensitive to its last bits).\n\n"
+            "tolerance, which is no convergence.\n\n"
             + md_table(["case", "metric", "dt", "dt/2", "dt/4", "converged"], rows, "llrrrl"))
 
 
