@@ -85,3 +85,22 @@ def test_t_brake_stays_on_its_step_under_a_last_bit_move(monkeypatch, ulps):
     spec = load_design("designs/antiskid-run-dry.toml").spec
     assert spec.scenario["t_brake"] == 300.0 and spec.scenario["t_end"] == 420.0
     assert spec.scenario["v_d"] != 70.0          # the other inputs did move
+
+
+def test_creep_speed_error_at_the_stop_is_floored_at_rounding_noise():
+    from workbench.papers.p003.antiskid_run_spec import EVS_FLOOR, evs_floor
+    # 9.4734e-17 as designed, 9.4832e-17 with the inputs moved 3 ulp: both 0
+    assert evs_floor(9.4734e-17) == evs_floor(-9.4832e-17) == 0.0
+    assert evs_floor(2 * EVS_FLOOR) == 2 * EVS_FLOOR
+    assert math.isnan(evs_floor(math.nan))
+
+
+def test_sampled_rate_row_prints_a_tie_of_sub_steps_with_one_more_digit():
+    from workbench.papers.p003.antiskid_sampled import RATE_METRICS
+    from workbench.papers.p003.antiskid_sampled_render import _row
+    m = {k: math.nan for k in RATE_METRICS}
+    m.update(traction_diverged=math.nan, braking_diverged=math.nan, traction_ok="yes",
+             braking_ok="yes", ok="yes")
+    # 21 sub-steps of 0.5 ms above the requirement: 0.0105 s, a 2-digit tie
+    cells = [_row("50", dict(m, time_above=t))[2] for t in (0.0105, math.nextafter(0.0105, 1))]
+    assert cells == ["0.0105", "0.0105"]
