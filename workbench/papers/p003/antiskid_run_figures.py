@@ -9,6 +9,7 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, CreepSpeedProfile
 from ...sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
+from ...printed_grid import quantised
 
 _COLORS = {"paper": "tab:red", "compensated": "tab:blue", "uncompensated": "tab:orange",
            "recursive": "tab:purple"}
@@ -19,15 +20,24 @@ def color_of(name: str) -> str:
     return _COLORS.get(name, "tab:green")
 
 
+#: Plotted speeds and creep ratios are snapped to 1e-5 of their decade
+#: (:func:`workbench.printed_grid.quantised`): a cruise at constant v and
+#: lambda is a run of values equal to their last bits, and matplotlib's path
+#: simplification resolved those ties differently under a 3-ulp move of the
+#: inputs (the runs agree to 1e-13); a step of 1e-5 is far below a pixel.
+PLOT_DIGITS = 6
+
+
 def plot_speed(fig, res):
     ax = fig.add_subplot(111)
+    vmax = max(float(np.nanmax(c.run.x[0])) for c in res.cases)
+    snap = lambda x: quantised(x, PLOT_DIGITS, scale=vmax)
     for c in res.cases:
         r = c.run
         v, lam = r.x
         vw = np.where(lam >= 0, v / (1 - np.minimum(lam, 0.999)), v * (1 + lam))
-        ax.plot(r.t, v, color=color_of(c.case.name), label=f"{c.case.name}: v")
-        ax.plot(r.t, vw, color=color_of(c.case.name), ls=":", label=f"{c.case.name}: v_w")
-    vmax = max(float(np.nanmax(c.run.x[0])) for c in res.cases)
+        ax.plot(r.t, snap(v), color=color_of(c.case.name), label=f"{c.case.name}: v")
+        ax.plot(r.t, snap(vw), color=color_of(c.case.name), ls=":", label=f"{c.case.name}: v_w")
     ax.set_ylim(-5.0, 1.3 * vmax)
     ax.set_xlabel("t (s)")
     ax.set_ylabel("speed (m/s), clipped")
@@ -39,7 +49,8 @@ def plot_creep(fig, res):
     for ax in (ax1, ax2):
         for c in res.cases:
             r = c.run
-            ax.plot(r.t, np.clip(r.x[1], -1, 1), color=color_of(c.case.name), label=c.case.name)
+            ax.plot(r.t, quantised(np.clip(r.x[1], -1, 1), PLOT_DIGITS, scale=1.0),
+                    color=color_of(c.case.name), label=c.case.name)
         ax.axhline(res.lambda_opt, color="k", ls="--", lw=0.8, label="lambda_opt (traction)")
         ax.axhline(-res.lambda_opt, color="k", ls="-.", lw=0.8, label="−lambda_opt (braking)")
         ax.axhline(res.lambda_d, color="gray", ls=":", lw=0.8, label="lambda_d")
