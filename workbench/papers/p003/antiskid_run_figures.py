@@ -8,8 +8,8 @@ import math
 import numpy as np
 
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, CreepSpeedProfile
-from ...sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
 from ...printed_grid import quantised
+from ...sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
 
 _COLORS = {"paper": "tab:red", "compensated": "tab:blue", "uncompensated": "tab:orange",
            "recursive": "tab:purple"}
