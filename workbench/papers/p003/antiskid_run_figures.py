@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, CreepSpeedProfile
-from ...printed_grid import quantised
+from ...printed_grid import axis_end, quantised
 from ...sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
 
 _COLORS = {"paper": "tab:red", "compensated": "tab:blue", "uncompensated": "tab:orange",
@@ -38,7 +38,7 @@ def plot_speed(fig, res):
         vw = np.where(lam >= 0, v / (1 - np.minimum(lam, 0.999)), v * (1 + lam))
         ax.plot(r.t, snap(v), color=color_of(c.case.name), label=f"{c.case.name}: v")
         ax.plot(r.t, snap(vw), color=color_of(c.case.name), ls=":", label=f"{c.case.name}: v_w")
-    ax.set_ylim(-5.0, 1.3 * vmax)
+    ax.set_ylim(-5.0, axis_end(1.3 * vmax))   # a data-derived end moves every pixel
     ax.set_xlabel("t (s)")
     ax.set_ylabel("speed (m/s), clipped")
     ax.legend(fontsize=7, ncol=2)
@@ -58,7 +58,8 @@ def plot_creep(fig, res):
     t_c = min((c.metrics["t_cruise"] for c in res.cases
                if not math.isnan(c.metrics["t_cruise"])), default=0.0)
     ax1.set_ylim(-0.2, 0.3)
-    ax2.set_xlim(t_c - 1.0, t_c + 3.0)
+    t0 = math.floor(t_c - 1.0)    # whole seconds: a data-derived end moves every pixel
+    ax2.set_xlim(t0, t0 + 4.0)
     ax2.set_ylim(-0.1, 1.0)
     ax2.set_xlabel("t (s)")
     ax1.legend(fontsize=7, ncol=3)
