@@ -21,10 +21,10 @@ def color_of(name: str) -> str:
 
 
 #: Plotted speeds and creep ratios are snapped to 1e-5 of their decade
-#: (:func:`workbench.printed_grid.quantised`): a cruise at constant v and
-#: lambda is a run of values equal to their last bits, and matplotlib's path
-#: simplification resolved those ties differently under a 3-ulp move of the
-#: inputs (the runs agree to 1e-13); a step of 1e-5 is far below a pixel.
+#: (:func:`workbench.printed_grid.quantised`; a step far below a pixel, far
+#: above the runs' last-bit noise of 1e-13). The figures that differed under
+#: a 3-ulp move of the inputs were fixed by the axis ends on a grid (below);
+#: the snap alone did not fix them and is kept as a guard for the data.
 PLOT_DIGITS = 6
 
 
