@@ -40,10 +40,28 @@ def test_within_the_limits_nothing_is_flagged():
     assert c.jerk_max_abs == pytest.approx(1 / 60, rel=1e-6) and c.jerk_windows == ()
 
 
-def test_converged_flag_compares_the_peaks():
+def test_converged_flag_refines_the_peaks_three_levels():
     t = np.arange(0.0, 30.0 + 1e-9, 0.05)
-    fine = comfort_of(_run(t, np.where(t < 10, 2 * t, 20.0), np.ones_like(t)), SPEC, 1.0, 0.05)
-    coarse = comfort_of(_run(t, np.where(t < 10, 2.1 * t, 21.0), np.ones_like(t)), SPEC, 1.0,
-                        0.05)
-    assert comfort_quantities("x", fine, fine)["cases[x].comfort_converged"] == "yes"
-    assert comfort_quantities("x", fine, coarse)["cases[x].comfort_converged"] == "no"
+    run = lambda k: comfort_of(_run(t, np.where(t < 10, k * t, 10 * k), np.ones_like(t)),
+                               SPEC, 1.0, 0.05)
+    fine = run(2.0)
+    q = lambda *lv: comfort_quantities("x", *lv)["cases[x].comfort_converged"]
+    assert q(fine, fine, fine) == "yes"
+    # peaks 2.1 / 2.0 / 1.995: first order, estimate 0.005 < 1 % of 2.1
+    assert q(fine, run(2.1), run(1.995)) == "yes"
+    # 2.2 / 2.0 / 1.8: order 0 (not in the asymptotic range), 0.2 / (sqrt 2 - 1) > 1 %
+    assert q(fine, run(2.2), run(1.8)) is None
+    # no dt/4 run: a two-level agreement is no convergence
+    assert q(fine, fine) is None
+
+
+@pytest.mark.parametrize("t_show", [300.0000000001, 299.99999999])
+def test_switch_to_braking_is_given_at_t_brake(t_show):
+    # which record sample first shows braking (300 or 300.05 s) depends on
+    # the last bit of the accumulated time: the text gives t_brake either way
+    from workbench.papers.p003.antiskid_comfort_render import _switches
+    ph = [2, 2, 4, 4] if t_show > 300 else [2, 2, 2, 4]
+    run = SimpleNamespace(t=np.array([299.9, 299.95, t_show, 300.05]), phase=ph)
+    c = SimpleNamespace(run=run, metrics={"t_brake": 300.0, "omega3_after_brake": np.nan})
+    assert _switches(c, SimpleNamespace(profile={"omega_switch": 3.0})) == [
+        (300.0, "cruise → braking")]

@@ -30,3 +30,19 @@ def test_quantised_keeps_nan_and_drops_noise():
     assert np.array_equal(np.nan_to_num(q, nan=-9), np.nan_to_num(noisy, nan=-9))
     assert np.allclose(quantised([0.98765], scale=1.0), [0.988])
     assert np.array_equal(quantised([np.nan]), [np.nan], equal_nan=True)
+
+
+def test_a_value_on_a_rounding_tie_gets_one_more_digit():
+    from workbench.printed_grid import printed_digits
+    from workbench.report.markdown import fmt
+    # antiskid-cruise-dry-generic's peak_input_dev.w is 0.0022875 (repr
+    # 0.002287499999999998): 0.002287 as designed, 0.002288 moved +3 ulp
+    x = 0.002287499999999998
+    up = math.nextafter(0.0022875, 1.0)
+    assert fmt(x, 4) != fmt(up, 4)
+    assert printed_digits(x) == printed_digits(up) == 5
+    assert fmt(x, printed_digits(x)) == fmt(up, printed_digits(up)) == "0.0022875"
+    # away from a tie, and for non-numbers, nothing changes
+    assert printed_digits(0.0022871) == 4 and printed_digits(-2.5e-3) == 4
+    assert printed_digits(float("nan")) == printed_digits(0.0) == printed_digits("yes") == 4
+    assert printed_digits(-0.12345) == 5

@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from ...printed_grid import printed_digits
 from ...report.markdown import (Figure, Rendered, fmt, fmt_floor, latex_matrix, md_table,
                                noise_cell, noise_peak)
 from ...report.synthesis_text import (capped_text, closed_loop_eigs_text, exact_margin_text,
@@ -233,10 +234,12 @@ def _exact_section(spec, res) -> str:
 
 
 def _metric_cell(metrics: dict, key: str) -> str:
-    """``metrics[key]`` to 4 digits, or "< 1e-9 × peak" when a final/min error is
+    """``metrics[key]`` to 4 digits (5 on a rounding tie,
+    :func:`~workbench.printed_grid.printed_digits`), or "< 1e-9 × peak" when a final/min error is
     below :data:`~workbench.report.markdown.NOISE_FLOOR` times the same state's
     peak error (:func:`~workbench.report.markdown.noise_cell`)."""
-    return noise_cell(metrics[key], noise_peak(key, metrics), 4)
+    v = metrics[key]
+    return noise_cell(v, noise_peak(key, metrics), printed_digits(v, 4))
 
 
 def _simulation_section(spec, res):

@@ -35,10 +35,10 @@ import time
 
 import numpy as np
 
-from ...refinement import Levels
+from ...refinement import Levels, screen
 from ...report.markdown import fmt
 
-__all__ = ["refine_levels", "last_refine_seconds"]
+__all__ = ["last_refine_seconds", "quarter_cases", "refine_levels", "three_level_metrics"]
 
 _CASE = re.compile(r"^cases\[([^\]]+)\]\.")
 _SWITCH = re.compile(r"^switch\.(cruise|brake)\[([^\]]+)\]\.in_basin$")
@@ -108,19 +108,22 @@ def _case_levels(spec, result, cache, name):
     from .antiskid_run_spec import case_mesh, case_metrics, controller_settings, run_settings
     from .antiskid_scenario import simulate_antiskid
     cr = result.case(name)
-    cs = controller_settings(spec, result.K, cr.case)
-    rec = cache["record_dt"]
-    run4, m4 = simulate_antiskid(run_settings(spec, cs), spec.dt / 4, record_dt=rec,
-                                 mesh=case_mesh(spec, cr.case))
-    q4 = case_metrics(m4, cs, spec.scenario["t_brake"])
-    c4 = None
-    if spec.comfort is not None:
-        from .antiskid_comfort import comfort_of
-        c4 = comfort_of(run4, spec.comfort, cs.u_range / spec.torque_range, rec)
+    if cr.quarter is not None:   # the study's own dt/4 run (a claimed convergence)
+        q4, run4, c4 = cr.quarter
+    else:
+        cs = controller_settings(spec, result.K, cr.case)
+        rec = cache["record_dt"]
+        run4, m4 = simulate_antiskid(run_settings(spec, cs), spec.dt / 4, record_dt=rec,
+                                     mesh=case_mesh(spec, cr.case))
+        q4 = case_metrics(m4, cs, spec.scenario["t_brake"])
+        c4 = None
+        if spec.comfort is not None:
+            from .antiskid_comfort import comfort_of
+            c4 = comfort_of(run4, spec.comfort, cs.u_range / spec.torque_range, rec)
     coarse = dataclasses.replace(cr, metrics=cr.metrics_coarse, switch=None,
-                                 comfort=cr.comfort_coarse)
+                                 comfort=cr.comfort_coarse, quarter=None)
     quarter = dataclasses.replace(cr, metrics=q4, metrics_coarse=q4, run=run4, switch=None,
-                                  comfort=c4, comfort_coarse=c4)
+                                  comfort=c4, comfort_coarse=c4, quarter=None)
     cache[key] = (coarse, cr, quarter)
     return cache[key]
 
@@ -225,3 +228,28 @@ def _mc_quarter(design, result, n: int) -> dict:
     raw = {k: np.asarray(v, float) for k, v in o["metrics"].items()}
     vals = _step_values(*per_run(raw, run_lambda_opt(inp), inp["scenario"]["t_brake"]))
     return {k: tuple(bool(x) for x in vals[k]) for k in ("diverged", "above_lambda_opt")}
+
+
+def quarter_cases(design) -> frozenset:
+    """Names of the cases whose convergence a claim of ``design`` states
+    (``cases[NAME].converged`` or ``.comfort_converged``): only they are run
+    a third time, at dt / 4 (the refinement of the findings reuses that run)."""
+    out = set()
+    for c in design.claims:
+        m = re.fullmatch(r"cases\[([^\]]+)\]\.(converged|comfort_converged)", c.quantity)
+        if m:
+            out.add(m.group(1))
+    return frozenset(out)
+
+
+def three_level_metrics(spec, coarse: dict, fine: dict, quarter: dict) -> tuple:
+    """(metric -> converged, metrics not converged) over dt, dt/2, dt/4:
+    :func:`workbench.refinement.screen` with the tolerance of the design's
+    two-level screen, atol + rtol max(|q|) of the three levels, as the bound
+    of each metric's Richardson estimate (issue 33 item 4)."""
+    from .antiskid_run_spec import METRICS
+    vals = {k: (coarse[k], fine[k], quarter[k]) for k in METRICS}
+    tol = {k: spec.conv_atol.get(k, 0.0) + spec.conv_rtol * max(
+        (abs(x) for x in vals[k] if math.isfinite(x)), default=0.0) for k in METRICS}
+    _, bad = screen(vals, tol)
+    return {k: k not in bad for k in METRICS}, bad

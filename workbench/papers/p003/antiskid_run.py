@@ -60,6 +60,10 @@ class CaseResult:
     switch: SwitchCheck | None
     comfort: object = None         # antiskid_comfort.Comfort at dt / 2 (design with [comfort])
     comfort_coarse: object = None  # the same at dt
+    #: The case at dt / 4 (:func:`quarter_cases`): (metrics, run, comfort), or None.
+    quarter: tuple | None = None
+    #: Metrics not converged over dt, dt/2, dt/4 (:func:`workbench.refinement.screen`).
+    unconverged: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -378,7 +382,8 @@ class AntiskidRun:
             started = self.start(design)
         pending, halving = started or (None, None)
         try:
-            cases = self._cases(spec, K)
+            from .antiskid_refine import quarter_cases
+            cases = self._cases(spec, K, quarter_cases(design))
             lc = linear_check(spec, lin.A, lin.B, K)
             sampled = None
             if spec.sampled is not None:
@@ -400,7 +405,7 @@ class AntiskidRun:
         return RunResult(nominal.lambda_opt(), lam_d, tuple(K), how, h_cert, tuple(cases), lc,
                          spec.dt, mc, hc, bs, sampled)
 
-    def _cases(self, spec: RunSpec, K) -> list[CaseResult]:
+    def _cases(self, spec: RunSpec, K, quarter: frozenset = frozenset()) -> list[CaseResult]:
         cases = []
         for case in spec.cases:
             cs = controller_settings(spec, K, case)
@@ -412,6 +417,10 @@ class AntiskidRun:
             coarse, fine = case_metrics(m1, cs, t_b), case_metrics(m2, cs, t_b)
             conv = {k: agree(coarse[k], fine[k], spec.conv_rtol, spec.conv_atol.get(k, 0.0))
                     for k in METRICS}
+            q4 = None
+            if case.name in quarter:   # a claimed convergence: the third level, dt / 4
+                run4, m4 = simulate_antiskid(rs, spec.dt / 4, record_dt=RECORD_DT, mesh=mesh)
+                q4 = (case_metrics(m4, cs, t_b), run4)
             sw = None   # state where the cruise law (61) takes over
             key = "handover" if case.cruise_entry == "creep" else "cruise"
             if math.isfinite(fine[f"lam_at_{key}"]):
@@ -421,8 +430,14 @@ class AntiskidRun:
                 from .antiskid_comfort import comfort_of
                 u_peak = cs.u_range / spec.torque_range
                 comfort = tuple(comfort_of(r, spec.comfort, u_peak, RECORD_DT)
-                                for r in (run2, run1))
-            cases.append(CaseResult(case, fine, coarse, conv, run2, sw, *comfort))
+                                for r in (run2, run1) + ((q4[1],) if q4 else ()))
+            bad = ()
+            if q4 is not None:
+                from .antiskid_refine import three_level_metrics
+                conv, bad = three_level_metrics(spec, coarse, fine, q4[0])
+                q4 = (q4[0], q4[1], comfort[2] if spec.comfort is not None else None)
+            cases.append(CaseResult(case, fine, coarse, conv, run2, sw, *comfort[:2],
+                                    quarter=q4, unconverged=bad))
         return cases
 
     def quantities(self, res: RunResult) -> dict:
@@ -440,14 +455,15 @@ class AntiskidRun:
                 q[f"{b}.{k}"] = nan2none(c.metrics[k])
             q[f"{b}.diverged"] = "no" if math.isnan(c.metrics["t_diverged"]) else "yes"
             q[f"{b}.stopped"] = "yes" if math.isfinite(c.metrics["braking_duration"]) else "no"
-            q[f"{b}.converged"] = "yes" if all(c.converged.values()) else "no"
+            q[f"{b}.converged"] = (None if c.quarter is None or c.unconverged else "yes")
             sw = c.switch
             q[f"{b}.switch.abscissa"] = None if sw is None else sw.abscissa
             q[f"{b}.switch.margin"] = None if sw is None else sw.margin.h
             q[f"{b}.switch.dmu_dlam"] = None if sw is None else sw.dmu_dlam
             if c.comfort is not None:
                 from .antiskid_comfort import comfort_quantities
-                q.update(comfort_quantities(c.case.name, c.comfort, c.comfort_coarse))
+                q.update(comfort_quantities(c.case.name, c.comfort, c.comfort_coarse,
+                                            None if c.quarter is None else c.quarter[2]))
         if res.montecarlo is not None:
             from .antiskid_halving import halving_quantities
             from .antiskid_montecarlo import montecarlo_quantities

@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, CreepSpeedProfile
+from ...printed_grid import axis_end, quantised
 from ...sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
 
 _COLORS = {"paper": "tab:red", "compensated": "tab:blue", "uncompensated": "tab:orange",
@@ -19,16 +20,25 @@ def color_of(name: str) -> str:
     return _COLORS.get(name, "tab:green")
 
 
+#: Plotted speeds and creep ratios are snapped to 1e-5 of their decade
+#: (:func:`workbench.printed_grid.quantised`; a step far below a pixel, far
+#: above the runs' last-bit noise of 1e-13). The figures that differed under
+#: a 3-ulp move of the inputs were fixed by the axis ends on a grid (below);
+#: the snap alone did not fix them and is kept as a guard for the data.
+PLOT_DIGITS = 6
+
+
 def plot_speed(fig, res):
     ax = fig.add_subplot(111)
+    vmax = max(float(np.nanmax(c.run.x[0])) for c in res.cases)
+    snap = lambda x: quantised(x, PLOT_DIGITS, scale=vmax)
     for c in res.cases:
         r = c.run
         v, lam = r.x
         vw = np.where(lam >= 0, v / (1 - np.minimum(lam, 0.999)), v * (1 + lam))
-        ax.plot(r.t, v, color=color_of(c.case.name), label=f"{c.case.name}: v")
-        ax.plot(r.t, vw, color=color_of(c.case.name), ls=":", label=f"{c.case.name}: v_w")
-    vmax = max(float(np.nanmax(c.run.x[0])) for c in res.cases)
-    ax.set_ylim(-5.0, 1.3 * vmax)
+        ax.plot(r.t, snap(v), color=color_of(c.case.name), label=f"{c.case.name}: v")
+        ax.plot(r.t, snap(vw), color=color_of(c.case.name), ls=":", label=f"{c.case.name}: v_w")
+    ax.set_ylim(-5.0, axis_end(1.3 * vmax))   # a data-derived end moves every pixel
     ax.set_xlabel("t (s)")
     ax.set_ylabel("speed (m/s), clipped")
     ax.legend(fontsize=7, ncol=2)
@@ -39,7 +49,8 @@ def plot_creep(fig, res):
     for ax in (ax1, ax2):
         for c in res.cases:
             r = c.run
-            ax.plot(r.t, np.clip(r.x[1], -1, 1), color=color_of(c.case.name), label=c.case.name)
+            ax.plot(r.t, quantised(np.clip(r.x[1], -1, 1), PLOT_DIGITS, scale=1.0),
+                    color=color_of(c.case.name), label=c.case.name)
         ax.axhline(res.lambda_opt, color="k", ls="--", lw=0.8, label="lambda_opt (traction)")
         ax.axhline(-res.lambda_opt, color="k", ls="-.", lw=0.8, label="−lambda_opt (braking)")
         ax.axhline(res.lambda_d, color="gray", ls=":", lw=0.8, label="lambda_d")
@@ -47,7 +58,8 @@ def plot_creep(fig, res):
     t_c = min((c.metrics["t_cruise"] for c in res.cases
                if not math.isnan(c.metrics["t_cruise"])), default=0.0)
     ax1.set_ylim(-0.2, 0.3)
-    ax2.set_xlim(t_c - 1.0, t_c + 3.0)
+    t0 = math.floor(t_c - 1.0)    # whole seconds: a data-derived end moves every pixel
+    ax2.set_xlim(t0, t0 + 4.0)
     ax2.set_ylim(-0.1, 1.0)
     ax2.set_xlabel("t (s)")
     ax1.legend(fontsize=7, ncol=3)

@@ -108,7 +108,11 @@ def radau_checks(ctx, spec) -> tuple:
             if math.isnan(t0):
                 continue
             cap = int(length / spec.plant_step * 1.5) + 4 * int(length * rate) + 16
-            _, (rec, _) = run_once(ctx, rate, scen, record=(t0, t0 + length, cap), **kw)
+            # the traction window ends on a sample time (h + 40 samples): whether that
+            # mesh point is recorded depended on the last bit of h, so every window
+            # ends half a mesh step earlier (issue 36 item 5)
+            end = t0 + length - 0.5 * min(spec.plant_step, 1.0 / rate)
+            _, (rec, _) = run_once(ctx, rate, scen, record=(t0, end, cap), **kw)
             if len(rec) < 2:
                 continue
             dl, dv, pieces = replay(ctx.plant, rec)

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from ...printed_grid import printed_digits
 from ...report.markdown import Figure, fmt, md_table
 from .antiskid_sampled import MESH_ATOL, MESH_CHECK_MAX_HZ, TRACE_SECONDS
 from .antiskid_sampled_check import RTOL, WINDOW_SAMPLES
@@ -43,7 +44,8 @@ def _outcome(m: dict, which: str) -> str:
 
 
 def _row(label: str, m: dict) -> list:
-    n = lambda k, sig: fmt(None if math.isnan(m[k]) else m[k], sig)
+    # a sum of equal sub-steps (time above) lands on rounding ties: one more digit there
+    n = lambda k, sig: fmt(None if math.isnan(m[k]) else m[k], printed_digits(m[k], sig))
     return [label, n("lam_max_over_opt", 7), n("time_above", 2), n("t_cruise", 5),
             _outcome(m, "traction"), n("braking_duration", 3), n("stop_distance", 4),
             n("lam_min_brake", 3), n("evs_max_tracking", 2), n("u_max_over_peak", 3),
