@@ -108,11 +108,12 @@ def radau_checks(ctx, spec) -> tuple:
             if math.isnan(t0):
                 continue
             cap = int(length / spec.plant_step * 1.5) + 4 * int(length * rate) + 16
-            # the traction window ends on a sample time (h + 40 samples): whether that
-            # mesh point is recorded depended on the last bit of h, so every window
-            # ends half a mesh step earlier (issue 36 item 5)
-            end = t0 + length - 0.5 * min(spec.plant_step, 1.0 / rate)
-            _, (rec, _) = run_once(ctx, rate, scen, record=(t0, end, cap), **kw)
+            # the traction window starts and ends on sample times (h, h + 40 samples):
+            # whether those mesh points are recorded depended on the last bit of h, so
+            # every window starts and ends half a mesh step earlier (issue 36 item 5)
+            half = 0.5 * min(spec.plant_step, 1.0 / rate)
+            _, (rec, _) = run_once(ctx, rate, scen, record=(t0 - half, t0 + length - half, cap),
+                                   **kw)
             if len(rec) < 2:
                 continue
             dl, dv, pieces = replay(ctx.plant, rec)
