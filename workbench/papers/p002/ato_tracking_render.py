@@ -7,7 +7,7 @@ from ...controllers.mfac import RESET_CONDITIONS, MFACGains, frozen_ppd_poles
 from ...features.reproducible import NUDGE, RTOL, count_text
 from ...plants.train002 import latex_equations
 from ...report.markdown import Figure, Rendered, fmt, md_table
-from ...tuning.pareto import dominated_share
+from ...tuning.pareto import TIE_REL, dominated_share
 from . import ato_tracking_figures as F
 from .ato_tracking_run import most_sensitive
 from .ato_tracking_spec import OBJECTIVE_UNITS, OBJECTIVES
@@ -301,8 +301,8 @@ def _compare(res) -> str:
         + md_table(["reading"] + [LABEL[i] for i in OBJECTIVES], brows, "lrrrr")
         + "\n\nWeight-free comparison of the fronts: the share of one controller's front that "
         "a point of the other's front dominates (better or equal in all four, better in "
-        "one; values within 1e-6 relative of each other count as equal, so that no share "
-        "rests on the last bits of two near-equal runs):\n\n"
+        f"one; values within {TIE_REL:g} relative of each other count as equal, so that no "
+        "share rests on the last bits of two near-equal runs):\n\n"
         + md_table(["reading", "PID front dominated by MFAC", "MFAC front dominated by PID"],
                    drows, "lrr")
         + "\n\n![tracking at the chosen points]({figdir}/tracking.png)")

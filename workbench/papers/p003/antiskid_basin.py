@@ -67,7 +67,7 @@ class Trajectory:
     """A sampled delay-free trajectory in the (v_e, lambda_e) plane."""
 
     x0: tuple
-    path: np.ndarray          # (N, 2)
+    path: np.ndarray          # (N, 2): the drawn path (dense output every PATH_DT)
     fate: str                 # "converges" (enters the certified set), "diverges", "undecided"
 
 
@@ -314,7 +314,28 @@ def _delay_free(fn, x0, lam_d: float, T: float):
     spin.terminal = True
     with np.errstate(all="ignore"):
         return solve_ivp(rhs, (0.0, T), np.array(x0, float), method="Radau", rtol=1e-8,
-                         atol=1e-10, events=spin, max_step=0.05)
+                         atol=1e-10, events=spin, max_step=0.05, dense_output=True)
+
+
+#: Time step (s) of a trajectory's drawn path. The fate is decided on the
+#: solver's own steps; the path is the dense output on this fixed grid, because
+#: the adaptive steps themselves move with the last bits of the inputs, and a
+#: polyline with other vertices antialiases differently (issue 36 item 5).
+PATH_DT = 0.01
+
+
+def _drawn_path(sol, inside_at) -> np.ndarray:
+    """The dense output of ``sol`` at multiples of :data:`PATH_DT` up to its end
+    time (plus the end point), cut after the first grid point where
+    ``inside_at`` is true when it is given."""
+    t_end = float(sol.t[-1])
+    ts = np.arange(0.0, t_end, PATH_DT)
+    path = np.vstack([sol.sol(ts).T, sol.y[:, -1]]) if len(ts) else sol.y.T[-1:]
+    if inside_at is not None:
+        hit = inside_at(path[:-1]) if len(path) > 1 else np.zeros(0, bool)
+        if hit.any():
+            path = path[:int(np.argmax(hit)) + 1]
+    return path
 
 
 def _trajectories(prob, est, pts, seed, n, T, lam_d):
@@ -334,12 +355,15 @@ def _trajectories(prob, est, pts, seed, n, T, lam_d):
         path = sol.y.T
         inside = prob.V(path) <= est.c_certified
         if inside.any():
-            fate, path = "converges", path[:int(np.argmax(inside)) + 1]
+            fate = "converges"
+            drawn = _drawn_path(sol, lambda p: prob.V(p) <= est.c_certified)
         elif sol.status != 0 or not np.all(np.isfinite(path)):
-            fate = "diverges"
+            fate, drawn = "diverges", path
         else:
-            fate = "undecided"
-        out.append(Trajectory(tuple(float(v) for v in x0), path, fate))
+            fate, drawn = "undecided", _drawn_path(sol, None)
+        if fate == "diverges" and sol.status == 1:     # ended at the spin event
+            drawn = _drawn_path(sol, None)
+        out.append(Trajectory(tuple(float(v) for v in x0), drawn, fate))
     return tuple(out)
 
 

@@ -6,6 +6,7 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import PHASE_NAMES
 from ...report.markdown import Figure, fmt, md_table
+from ...refinement import P_MIN
 from .antiskid_comfort import COMFORT_RTOL, comfort_quantities
 from .antiskid_run import RECORD_DT
 from .antiskid_run_figures import color_of
@@ -97,7 +98,7 @@ def comfort_section(res, spec) -> str:
                    rows, "lrrrrrl")
         + "\n\nConverged: the |a| and |jerk| peaks at dt, dt/2 and dt/4 have a Richardson "
         f"error estimate within {fmt(100 * COMFORT_RTOL)} % of the peak (levels whose "
-        "differences change sign: the larger difference at order 0.5); — : no dt/4 run "
+        f"differences change sign: the larger difference at order {fmt(P_MIN)}); — : no dt/4 run "
         "(no claim states the case's convergence)."
         + where
         + "\n\n![comfort]({figdir}/comfort.png)\n\nAcceleration (top) and jerk (bottom) "

@@ -7,6 +7,7 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
 from ...printed_grid import quantised
+from ...refinement import P_MIN
 from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
 from ...sim.wheel_slip import MAX_DLAMBDA, MAX_HALVINGS
 from .antiskid_basin_render import HEADING as BASIN_HEADING
@@ -263,7 +264,7 @@ def _convergence_section(res, spec) -> str:
             "case whose convergence a claim states. Converged: the Richardson error "
             "estimate of the three levels (`workbench.refinement.guarded_check`; levels "
             "whose differences change sign are not in the asymptotic range and are "
-            "estimated from the larger difference at order 0.5) is within "
+            f"estimated from the larger difference at order {fmt(P_MIN)}) is within "
             f"rtol = {fmt(spec.conv_rtol)} of the largest |value| plus the design's atol. "
             "A case without a dt/4 run shows only whether dt and dt/2 agree within that "
             "tolerance, which is no convergence.\n\n"
