@@ -26,16 +26,8 @@ ROOT = Path(__file__).resolve().parents[1]
 def _first_call(which: str) -> dict:
     """In this process: (wall, CPU) of importing and first-calling ``which``."""
     w0, c0 = time.perf_counter(), time.process_time()
-    if which == "batch":
-        from workbench.papers.p003.antiskid_kernel import compile_kernel
-        compile_kernel()
-    else:
-        from workbench.design import load_design
-        from workbench.papers.p003 import antiskid_sampled as S
-        from workbench.papers.p003.antiskid_run_spec import sampled_context
-        d = load_design(ROOT / "designs" / "antiskid-run-dry.toml")
-        ctx = sampled_context(d.spec, d.spec.K_table)
-        S.run_once(ctx, 100.0, 0, dt_p=1e-4, predictor_step=1e-3, t_cap=0.05)
+    from workbench.papers.p003.antiskid_warm import warm
+    warm(which)
     return {"kernel": which, "wall": time.perf_counter() - w0, "cpu": time.process_time() - c0}
 
 

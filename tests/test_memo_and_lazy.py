@@ -127,6 +127,27 @@ def test_run_folder_shares_results_between_processes(tmp_path, monkeypatch):
         memo.clear()
 
 
+def test_computed_once_per_process_and_per_run(tmp_path, monkeypatch):
+    """The findings' refinement (verify.py) is computed once per run: kept in
+    the process, and read back from the run folder by the next process."""
+    calls = []
+    compute = lambda: calls.append(1) or {"levels": (1.0, 0.5)}   # noqa: E731
+    memo.clear()
+    try:
+        assert memo.computed_once("refine", ("k", 1), compute) == {"levels": (1.0, 0.5)}
+        assert memo.computed_once("refine", ("k", 1), compute) is not None and len(calls) == 1
+        memo.computed_once("refine", ("k", 2), compute)          # another key: computed
+        assert len(calls) == 2
+        monkeypatch.setenv(memo.CACHE_ENV, str(tmp_path))
+        memo.clear()
+        memo.computed_once("refine", ("k", 1), compute)          # folder empty: computed
+        memo.clear()                                              # "another process"
+        assert memo.computed_once("refine", ("k", 1), compute) == {"levels": (1.0, 0.5)}
+        assert len(calls) == 3
+    finally:
+        memo.clear()
+
+
 def test_perturbed_moves_physical_values_only():
     from workbench.design import perturbed
     data = {"parameters": {"m": {"value": 1.0, "unit": "kg"}, "n": {"value": 3, "unit": "-"}},

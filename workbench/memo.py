@@ -199,6 +199,14 @@ def shared(name: str, key, compute: Callable[[], Any]) -> Any:
     return result
 
 
+def computed_once(name: str, key, compute: Callable[[], Any]) -> Any:
+    """:func:`shared`, and kept in this process too (forgotten by :func:`clear`)."""
+    mine = ("computed_once", name, key)
+    if mine not in _RESULTS:
+        _RESULTS[mine] = shared(name, key, compute)
+    return _RESULTS[mine]
+
+
 def _load(path):
     import pickle
     try:

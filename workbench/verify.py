@@ -40,8 +40,7 @@ def evaluate_design(design: Design) -> Evaluation:
                        peak=noise_peak(c.quantity, q)) for c in design.claims]
     table = None
     if hasattr(study, "refine_field"):
-        from .refinement import refine_findings
-        table = refine_findings(design, study, q, checked, result)
+        table = _refined(design, study, q, checked, result)
         by_id = {row.claim_id: row for row in table.rows}
         checked = [_unconverged(r, by_id[r.claim.id]) if r.claim.id in by_id
                    and not by_id[r.claim.id].converged else r for r in checked]
@@ -51,6 +50,21 @@ def evaluate_design(design: Design) -> Evaluation:
                    if r.claim.id in why and r.verdict is not Verdict.INCONCLUSIVE else r
                    for r in checked]
     return Evaluation(design, result, tuple(checked), table)
+
+
+def _refined(design, study, q, checked, result):
+    """:func:`workbench.refinement.refine_findings`, computed once per run: kept
+    in this process and in the run folder (:func:`workbench.memo.shared`) under
+    the exact key of the design's kind, spec and claim results (the refinement
+    reads nothing else), so the verify phase of ``workbench check`` and the
+    test session reuse what the check's workers computed."""
+    from .memo import computed_once, spec_key
+    from .refinement import refine_findings
+    spec, claims = spec_key(design.spec), spec_key(tuple(checked))
+    compute = lambda: refine_findings(design, study, q, checked, result)   # noqa: E731
+    if spec is None or claims is None:
+        return compute()
+    return computed_once("refine_findings", (design.kind, spec, claims), compute)
 
 
 def _unconverged(r: ClaimResult, row) -> ClaimResult:

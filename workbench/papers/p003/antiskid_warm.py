@@ -1,0 +1,61 @@
+"""Compile the two antiskid kernels into the machine's disk cache now.
+
+``make install`` runs ``python -m workbench.papers.p003.antiskid_warm`` (issue 36,
+item 3: the compiled kernels compile once per machine, and that once belongs to
+the install, not to the five-minute check). Each kernel is compiled in its own
+process, both at once; with a warm cache (:mod:`workbench.sim.jit_cache`) each
+is only loaded, a few seconds. Nothing is computed that a study reads: the
+cache holds machine code, and its key is the package's source, so a kernel
+compiled here is the one a study would have compiled.
+"""
+from __future__ import annotations
+
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+__all__ = ["warm", "main"]
+
+KERNELS = ("batch", "sampled")
+
+
+def warm(which: str) -> float:
+    """Compile (or load) kernel ``which`` ("batch": Monte Carlo and halving;
+    "sampled": ``[sampled]`` runs) in this process; CPU seconds spent."""
+    c0 = time.process_time()
+    if which == "batch":
+        from .antiskid_kernel import compile_kernel
+        compile_kernel()
+    elif which == "sampled":
+        from pathlib import Path
+
+        from ...design import load_design
+        from . import antiskid_sampled as S
+        from .antiskid_run_spec import sampled_context
+        path = Path(__file__).resolve().parents[3] / "designs" / "antiskid-run-dry.toml"
+        if not path.is_file():           # an installed package without the repository
+            return 0.0
+        d = load_design(path)
+        ctx = sampled_context(d.spec, d.spec.K_table)
+        S.run_once(ctx, 100.0, 0, dt_p=1e-4, predictor_step=1e-3, t_cap=0.05)
+    else:
+        raise ValueError(f"kernel {which!r}: expected one of {KERNELS}")
+    return time.process_time() - c0
+
+
+def main() -> int:
+    """Warm both kernels on two processes; one line of figures on stdout."""
+    from importlib.util import find_spec
+    if find_spec("numba") is None:
+        print("compiled kernels: numba not installed, nothing to compile")
+        return 0
+    w0 = time.perf_counter()
+    with ProcessPoolExecutor(len(KERNELS)) as ex:
+        cpu = list(ex.map(warm, KERNELS))
+    print(f"compiled kernels ready in the disk cache: {time.perf_counter() - w0:.0f} s wall, "
+          + ", ".join(f"{k} {c:.0f} CPU s" for k, c in zip(KERNELS, cpu)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
