@@ -347,18 +347,23 @@ def command_of(design: str, i: int) -> str:
 
 
 def campaign(seed: int, n: int, work: Path, kinds=None, timeout: float = 120.0,
-             log=None) -> list[tuple[Mutation, str, str, str]]:
-    """``n`` seeded mutations over :data:`DESIGNS`, commands in rotation."""
+             log=None, newer: bool = False) -> list[tuple[Mutation, str, str, str]]:
+    """``n`` seeded mutations, commands in rotation: over :data:`DESIGNS`
+    (the first campaign), or with ``newer`` over :data:`CAMPAIGN_DESIGNS`
+    with the newer tables' mutations (the re-run's campaign,
+    benchmarks/fuzz_campaign.py)."""
     import workbench.cli  # noqa: F401 - loaded once here, not in every forked child
     import workbench.design  # noqa: F401
     from workbench import kinds as registry
     for kind in registry.REGISTRY:   # the studies' modules too
         registry.REGISTRY[kind]
     rng = random.Random(seed)
+    designs = CAMPAIGN_DESIGNS if newer else DESIGNS
     out = []
     for i in range(n):
-        m = mutate(rng, DESIGNS[i % len(DESIGNS)], kinds)
-        command = COMMANDS[(i // len(DESIGNS)) % len(COMMANDS)]
+        design = designs[i % len(designs)]
+        m = mutate(rng, design, (kinds or "tables") if newer else kinds)
+        command = command_of(design, i) if newer else COMMANDS[(i // len(DESIGNS)) % len(COMMANDS)]
         cls, msg = run_one(m, command, work, timeout, tag=str(i))
         out.append((m, command, cls, msg))
         if log:

@@ -171,6 +171,17 @@ def test_undeclared_name_lists_the_declared(tmp_path):
         parse("x + q")
 
 
+def test_undeclared_name_among_many_names_is_one_short_line():
+    """Issue 32: with 40 declared names the message names the count and the
+    closest spellings, not all 40 (it was 400 characters in switched-run)."""
+    names = [f"gain_{i}" for i in range(38)] + ["v_ref", "lam_d"]
+    with pytest.raises(DesignError) as e:
+        check_expression("v_rf + 1", names, path="d.toml", key="laws.cruise")
+    msg = str(e.value)
+    assert "40 names declared; did you mean v_ref?" in msg and "gain_3" not in msg, msg
+    assert len(msg) < 320, msg        # the whitelist itself is ~270 characters
+
+
 def test_definition_may_not_use_a_later_definition(tmp_path, monkeypatch):
     from workbench.design import load_design
     monkeypatch.chdir(tmp_path)

@@ -1,12 +1,15 @@
 """No input reaches a panic, a traceback or a hang (issue 32, item 1).
 
-``test_fuzz_full``: 300 seeded mutations of four shipped designs (numbers,
-units, expressions, structure) through ``synthesize``, ``verify`` and
-``report`` in rotation, each in a forked child with a 120 s limit
-(:mod:`tests.fuzz_designs`); every run must exit 0, 1 (a claim failed or is
-INCONCLUSIVE, with its reason) or 2 with one line. It took 438 s here (load
-~6 on 2 cores), so it is ``slow`` and runs only when the slow tier is selected
-(``pytest -m slow tests/test_fuzz.py`` or ``WORKBENCH_FULL_TIER=1``).
+``test_fuzz_full``: the re-run's campaign (seed 3202,
+benchmarks/fuzz-campaign-3202.log): 300 seeded mutations of six shipped designs
+(numbers, units, expressions, structure, and the newer tables: phases, guards,
+laws, ``[montecarlo]``, ``[convergence]``, ``[sampled]``) through
+``synthesize``, ``verify`` and ``report`` in rotation, each in a forked child
+with a 120 s limit (:mod:`tests.fuzz_designs`), then the Python API misuses of
+``fuzz_designs.api_cases``; every run must exit 0, 1 (a claim failed or is
+INCONCLUSIVE, with its reason) or 2 with one line. The first campaign's four
+designs are among the six. It is ``slow`` and runs only when the slow tier is
+selected (``pytest -m slow tests/test_fuzz.py`` or ``WORKBENCH_FULL_TIER=1``).
 ``test_fuzz_smoke``: 20 mutations that fail while the file is read (a few
 seconds), in the default tier.
 """
@@ -50,11 +53,15 @@ def _slow_selected(config) -> bool:
 def test_fuzz_full(tmp_path, request):
     if not _slow_selected(request.config):
         pytest.skip("the full tier: pytest -m slow tests/test_fuzz.py (about 8 minutes)")
-    res = fz.campaign(32, 300, tmp_path, timeout=120.0)
+    res = fz.campaign(3202, 300, tmp_path, timeout=120.0, newer=True)
     counts = Counter(cls for _, _, cls, _ in res)
     print("fuzz classes:", dict(counts))
     assert counts["traceback"] == 0 and counts["timeout"] == 0, _report(res)
     assert sum(counts.values()) == 300
+    api = [(name, *fz.run_api(name, tmp_path, 120.0, tag=str(k)))
+           for k, (name, _) in enumerate(fz.api_cases())]
+    bad = [(name, cls, msg[-300:]) for name, cls, msg in api if cls not in ("exit2", "ok")]
+    assert not bad and len(api) >= 30, bad
 
 
 # -- the Python API, misused ------------------------------------------------------------

@@ -101,6 +101,23 @@ def _parse(text: Any, path: str, key: str) -> ast.Expression:
                           f"{MAX_DEPTH} levels deep") from None
 
 
+def _declared_note(name: str, names) -> str:
+    """The declared names after an undeclared one: all of them when there are
+    at most :data:`NAMES_SHOWN`, else their count and the closest spellings
+    (issue 32: one line, not a list of every name)."""
+    import difflib
+    names = sorted(names)
+    if len(names) <= NAMES_SHOWN:
+        return " (declared: " + ", ".join(names) + ")"
+    close = difflib.get_close_matches(name, names, n=3, cutoff=0.5)
+    return (f" ({len(names)} names declared" + (f"; did you mean {', '.join(close)}?" if close
+                                                else "") + ")")
+
+
+#: Declared names listed in full after an undeclared one (more: the closest).
+NAMES_SHOWN = 8
+
+
 class _Checker:
     """Walks a parsed expression and rejects every node outside the whitelist."""
 
@@ -128,8 +145,7 @@ class _Checker:
             if node.id in FUNCTIONS:
                 raise self.fail(node, "a function name used as a value")
             if node.id not in self.names:
-                raise self.fail(node, "an undeclared name", note=" (declared: "
-                                + ", ".join(sorted(self.names)) + ")")
+                raise self.fail(node, "an undeclared name", note=_declared_note(node.id, self.names))
         elif isinstance(node, ast.BinOp):
             if type(node.op) not in _BINOPS:
                 op = {ast.BitXor: "^ (write ** for a power)", ast.Mod: "%",
