@@ -36,6 +36,9 @@ CAPABILITIES: dict[str, dict[str, str]] = {
     "switched-run": {
         "simulate": "workbench.kinds.switched_run.cli:simulate_command",
         "sweep": "workbench.kinds.switched_run.cli:sweep_command"},
+    "stop-accuracy": {
+        "simulate": "workbench.kinds.stop_accuracy.cli:simulate_command",
+        "sweep": "workbench.kinds.stop_accuracy.cli:sweep_command"},
     "antiskid-run": {
         "simulate": "workbench.papers.p003.antiskid_run:simulate_command",
         "sweep": "workbench.papers.p003.antiskid_run:sweep_command"},

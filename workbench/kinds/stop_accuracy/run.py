@@ -30,7 +30,8 @@ import numpy as np
 from ...jsonable import json_method
 from .pipeline import LAW_NAMES, apply_factors, group_statistics, open_loop_distance
 
-__all__ = ["StopAccuracyResult", "compile_laws", "run", "speed_key"]
+__all__ = ["StopAccuracyResult", "compile_laws", "montecarlo_draws", "run", "simulate_cases",
+           "stopping_points", "speed_key"]
 
 
 def speed_key(s: float) -> str:
@@ -88,8 +89,29 @@ def compile_laws(spec) -> list:
 
 
 def _simulate(spec, laws, dt, cases, draws=None, record=False):
-    """Stop errors (m) of ``cases`` [(speed, controller index, fault or None)],
+    """Stop errors (m) of ``cases`` [(speed, controller index, fault or None, D)],
     each repeated over the Monte Carlo ``draws`` (dict of arrays) when given."""
+    tr, D = simulate_cases(spec, laws, dt, cases, draws)
+    traces = {}
+    if record:
+        traces = {(c[0], spec.controllers[c[1]].name): (tr.x[:, k] - D[k], tr.v[:, k])
+                  for k, c in enumerate(cases) if c[2] is None}
+    return tr.x_stop - D, traces
+
+
+def simulate_cases(spec, laws, dt, cases, draws=None):
+    """Simulate ``cases`` [(speed km/h, controller index, fault or None, D m)],
+    each repeated over the Monte Carlo ``draws`` (factor -> array) when given,
+    in one batch (every operation is elementwise over runs: a run's result
+    does not depend on the others in its batch).
+
+    Returns
+    -------
+    tr : workbench.sim.stopping.Traces
+        Recorded every control period.
+    D : ndarray
+        The stopping point of each run (m).
+    """
     from ...sim.stopping import batch_params, simulate
     N = 1 if draws is None else len(next(iter(draws.values())))
     n = len(cases) * N
@@ -144,11 +166,7 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
     tr = simulate(p, policy, n=n, t_end=spec.t_end, dt=dt, dt_ctrl=spec.dt_ctrl,
                   dt_rec=spec.dt_ctrl, v0=v0, theta=theta, kappa=kappa, c_min=0.0,
                   c_max=spec.c_max)
-    traces = {}
-    if record:
-        traces = {(c[0], spec.controllers[c[1]].name): (tr.x[:, k] - D[k], tr.v[:, k])
-                  for k, c in enumerate(cases) if c[2] is None}
-    return tr.x_stop - D, traces
+    return tr, D
 
 
 def _deterministic(spec, laws, dt, D, record=False):
@@ -162,13 +180,28 @@ def _deterministic(spec, laws, dt, D, record=False):
     return q, traces
 
 
+def stopping_points(spec) -> dict:
+    """speed (km/h) -> the stopping point D (m): the design's distance, or the
+    nominal stopping distance of its held command (paper 004 section 1)."""
+    base = spec.base()
+    return {s: spec.distance if spec.distance is not None else
+            open_loop_distance(base, spec.command, s / 3.6, dt=spec.dt, dt_ctrl=spec.dt_ctrl)
+            for s in spec.speeds_kmh}
+
+
+def montecarlo_draws(spec, mc) -> dict:
+    """The drawn factors of ``mc`` (a MonteCarloSpec): factor -> array over
+    its samples (:func:`workbench.features.montecarlo.draw`, every factor's
+    stream at its position in ``[disturbances]``)."""
+    from ...features.montecarlo import draw
+    d = draw(mc, tuple(f.name for f in spec.factors), {f.name: f.nominal for f in spec.factors})
+    return {k: v for k, v in d.items() if k in mc.distributions}
+
+
 def run(spec, claims=()) -> StopAccuracyResult:
     """Compute a design (see the module docstring)."""
     laws = compile_laws(spec)
-    base = spec.base()
-    D = {s: spec.distance if spec.distance is not None else
-         open_loop_distance(base, spec.command, s / 3.6, dt=spec.dt, dt_ctrl=spec.dt_ctrl)
-         for s in spec.speeds_kmh}
+    D = stopping_points(spec)
     q, traces = _deterministic(spec, laws, spec.dt, D, record=True)
     nominal = {(s, c.name): q[f"{speed_key(s)}.{c.name}.nominal_m"]
                for s in spec.speeds_kmh for c in spec.controllers}
@@ -176,10 +209,8 @@ def run(spec, claims=()) -> StopAccuracyResult:
               for s in spec.speeds_kmh for c in spec.controllers for f in spec.faults}
     mc = {}
     if spec.montecarlo is not None:
-        from ...features.montecarlo import draw
         m = spec.montecarlo
-        d = draw(m, tuple(f.name for f in spec.factors), {f.name: f.nominal for f in spec.factors})
-        d = {k: v for k, v in d.items() if k in m.distributions}
+        d = montecarlo_draws(spec, m)
         cases = [(s, i, None, D[s]) for s in spec.speeds_kmh for i in range(len(laws))]
         err, _ = _simulate(spec, laws, spec.dt, cases, draws=d)
         mc = group_statistics(err, [(s, spec.controllers[i].name) for s, i, _, _ in cases],
