@@ -61,6 +61,11 @@ class StopAccuracyResult:
     to_json = json_method
 
 
+def _law_names(spec) -> tuple:
+    from .modules import REFERENCE_NAMES
+    return tuple(LAW_NAMES) + (tuple(REFERENCE_NAMES) if spec.reference else ())
+
+
 def compile_laws(spec) -> list:
     """law(values) -> command, per controller: the design's expressions as numpy
     functions of the law names, the constants and the definitions; with the
@@ -69,9 +74,12 @@ def compile_laws(spec) -> list:
     import sympy as sp
 
     from ...expr import parse_expression
-    names = tuple(LAW_NAMES) + tuple(spec.constants)
+    names = _law_names(spec) + tuple(spec.constants)
     out = []
     for i, c in enumerate(spec.controllers):
+        if c.law is None:                  # the named module ``smarc`` is the whole law
+            out.append(None)
+            continue
         syms = {k: sp.Symbol(k, real=True) for k in names}
         args = tuple(syms[k] for k in names)
         for k, text in c.definitions:
@@ -132,18 +140,23 @@ def simulate_cases(spec, laws, dt, cases, draws=None):
     ratio = rep(lambda c: c[2].speed_ratio if c[2] else 1.0)
     ctl = np.repeat([c[1] for c in cases], N)
     groups = []
+    from .modules import Tracking
+    track = Tracking(spec, [(spec.controllers[i], np.flatnonzero(ctl == i))
+                            for i in range(len(laws))], D)
     for i, law in enumerate(laws):
         idx = np.flatnonzero(ctl == i)
         pid = None
         if isinstance(law, tuple):         # the named module ``pid``: law + PID(error)
             from ...controllers.pid import BatchPID
             law, err, (kp, ki, kd) = law
-            pid = (err, BatchPID(kp, ki, kd, idx.size, dt=spec.dt_ctrl, u_min=-spec.c_max,
-                                 u_max=spec.c_max))
-        groups.append((law, idx, pid))
-    v0 = rep(lambda c: c[0] / 3.6)
+            lim = spec.c_max if spec.controllers[i].pid_limited else np.inf
+            pid = (err, BatchPID(kp, ki, kd, idx.size, dt=spec.dt_ctrl, u_min=-lim, u_max=lim))
+        groups.append((law, idx, pid, spec.controllers[i].name))
+    v0, x0 = rep(lambda c: c[0] / 3.6), 0.0
+    if spec.reference is not None:    # start where the target starts braking
+        x0, v0 = (rep(lambda c, k=k: spec.reference.start(c[3])[k]) for k in (0, 1))
     const = {k: np.full(n, q.value) for k, q in spec.constants.items()}
-    names = tuple(LAW_NAMES) + tuple(const)
+    names = _law_names(spec) + tuple(const)
     longest = max(float(p["T1"].max()), float(p["T3"].max()))
     if not longest <= spec.t_end:       # the delay line would outgrow the run (memory)
         from ...errors import DesignError
@@ -151,21 +164,24 @@ def simulate_cases(spec, laws, dt, cases, draws=None):
                           f"transmission delay a fault or draw gives (longest {longest:.4g} s)")
 
     def policy(t, o):
-        vals = {"x": o.x, "v": o.v * ratio, "decel": np.maximum(-o.a, 0.0), "d_go": D - o.x,
-                "D": D, "v0": v0, "t": np.full(n, t)} | const
+        x, v, ref = track.state(t, o)          # measured, or predicted (module predictor)
+        vals = {"x": x, "v": v * ratio, "decel": np.maximum(-o.a, 0.0), "d_go": D - x,
+                "D": D, "v0": v0, "t": np.full(n, t)} | ref | const
         c = np.zeros(n)
         with np.errstate(all="ignore"):    # a law's nan (e.g. sqrt(-1)) is a run without a stop
-            for law, idx, pid in groups:
-                if idx.size:
+            for law, idx, pid, name in groups:
+                if idx.size and law is None:
+                    c[idx] = track.smarc_command(name, idx, vals["x"], vals["v"], ref)
+                elif idx.size:
                     args = [vals[k][idx] for k in names]
                     c[idx] = np.broadcast_to(law(*args), idx.shape)
                     if pid is not None:
                         c[idx] += pid[1].step(np.broadcast_to(pid[0](*args), idx.shape))
-        return np.clip(c, 0.0, spec.c_max)
+        return track.finish(np.clip(c, spec.c_min, spec.c_max), o)
 
     tr = simulate(p, policy, n=n, t_end=spec.t_end, dt=dt, dt_ctrl=spec.dt_ctrl,
-                  dt_rec=spec.dt_ctrl, v0=v0, theta=theta, kappa=kappa, c_min=0.0,
-                  c_max=spec.c_max)
+                  dt_rec=spec.dt_ctrl, x0=x0, v0=v0, theta=theta, kappa=kappa,
+                  c_min=spec.c_min, c_max=spec.c_max)
     return tr, D
 
 
