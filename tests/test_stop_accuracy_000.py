@@ -29,7 +29,10 @@ def test_line5_configuration_is_stopping_line5():
     paper study's stops, to the last bit (all 200 draws are equal too:
     reports/stop-accuracy-000-line5.md prints stopping-line5's rates). The
     PID with feed-forward and the SMC of eq 22 are expressions here, SMARC
-    and the compensation named modules."""
+    and the compensation named modules. The study runs its laws through the
+    kind too (``station_stopping_run.kind_spec``), so this checks that the
+    design file (constants, factor order, modules, start, clip range)
+    configures what the study runs."""
     from workbench.papers.p000.station_stopping_run import _runset, _concat, simulate_runs
     from workbench.features.montecarlo import draw
     from workbench.papers.p000.station_stopping_spec import MC_FACTORS, NOMINAL

@@ -31,7 +31,7 @@ from ...jsonable import json_method
 from .pipeline import LAW_NAMES, apply_factors, group_statistics, open_loop_distance
 
 __all__ = ["StopAccuracyResult", "compile_laws", "montecarlo_draws", "run", "simulate_cases",
-           "stopping_points", "speed_key"]
+           "simulate_runs", "stopping_points", "speed_key"]
 
 
 def speed_key(s: float) -> str:
@@ -120,7 +120,7 @@ def simulate_cases(spec, laws, dt, cases, draws=None):
     D : ndarray
         The stopping point of each run (m).
     """
-    from ...sim.stopping import batch_params, simulate
+    from ...sim.stopping import batch_params
     N = 1 if draws is None else len(next(iter(draws.values())))
     n = len(cases) * N
     base = spec.base()
@@ -139,6 +139,29 @@ def simulate_cases(spec, laws, dt, cases, draws=None):
             p[k][j * N:(j + 1) * N] = x
     ratio = rep(lambda c: c[2].speed_ratio if c[2] else 1.0)
     ctl = np.repeat([c[1] for c in cases], N)
+    v0, x0 = rep(lambda c: c[0] / 3.6), 0.0
+    if spec.reference is not None:    # start where the target starts braking
+        x0, v0 = (rep(lambda c, k=k: spec.reference.start(c[3])[k]) for k in (0, 1))
+    tr, _ = simulate_runs(spec, laws, dt, p, ctl, D, x0=x0, v0=v0, ratio=ratio, theta=theta,
+                          kappa=kappa)
+    return tr, D
+
+
+def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa):
+    """Simulate a batch of runs, each its own: brake parameters ``p``
+    (:func:`workbench.sim.stopping.batch_params`), controller index ``ctl``,
+    stopping point ``D`` (m), start ``x0`` (m), ``v0`` (m/s), speed-sensor
+    ``ratio``, gradient ``theta`` and load-weighing gain ``kappa`` (arrays
+    over the runs, or scalars).
+
+    Returns
+    -------
+    tr : workbench.sim.stopping.Traces
+    track : .modules.Tracking
+        The modules' state at the end (e.g. each SMARC's estimates).
+    """
+    from ...sim.stopping import simulate
+    n = D.size
     groups = []
     from .modules import Tracking
     track = Tracking(spec, [(spec.controllers[i], np.flatnonzero(ctl == i))
@@ -152,9 +175,6 @@ def simulate_cases(spec, laws, dt, cases, draws=None):
             lim = spec.c_max if spec.controllers[i].pid_limited else np.inf
             pid = (err, BatchPID(kp, ki, kd, idx.size, dt=spec.dt_ctrl, u_min=-lim, u_max=lim))
         groups.append((law, idx, pid, spec.controllers[i].name))
-    v0, x0 = rep(lambda c: c[0] / 3.6), 0.0
-    if spec.reference is not None:    # start where the target starts braking
-        x0, v0 = (rep(lambda c, k=k: spec.reference.start(c[3])[k]) for k in (0, 1))
     const = {k: np.full(n, q.value) for k, q in spec.constants.items()}
     names = _law_names(spec) + tuple(const)
     longest = max(float(p["T1"].max()), float(p["T3"].max()))
@@ -182,7 +202,7 @@ def simulate_cases(spec, laws, dt, cases, draws=None):
     tr = simulate(p, policy, n=n, t_end=spec.t_end, dt=dt, dt_ctrl=spec.dt_ctrl,
                   dt_rec=spec.dt_ctrl, x0=x0, v0=v0, theta=theta, kappa=kappa,
                   c_min=spec.c_min, c_max=spec.c_max)
-    return tr, D
+    return tr, track
 
 
 def _deterministic(spec, laws, dt, D, record=False):
