@@ -77,7 +77,19 @@ class Reference:
 
 @dataclass(frozen=True)
 class Compensation:
-    """``[compensation]``: d_terminal (m), gain_tau (s), gain_bounds."""
+    """``[compensation]``: the known-delay compensation of the modules
+    ``predictor`` and ``terminal`` (paper 000's ``station-stopping`` reads
+    its own table into this too).
+
+    Attributes
+    ----------
+    d_terminal : float
+        Distance to go (m) at which the predictive terminal stopping law takes over.
+    gain_tau : float
+        Time constant (s) of the model's brake-gain correction (0: none).
+    gain_bounds : (float, float)
+        Bounds of that correction.
+    """
 
     d_terminal: float
     gain_tau: float

@@ -146,7 +146,7 @@ def kind_spec(spec: StopSpec, t_end: float):
     """``spec`` as a ``stop-accuracy`` spec: one controller per variant of
     :data:`VARIANTS` (in order), the ATO curve as its ``[reference]``."""
     from ...kinds.stop_accuracy import Controller, StopAccuracySpec
-    from ...kinds.stop_accuracy.modules import Compensation, Reference, SmarcGains
+    from ...kinds.stop_accuracy.modules import Reference, SmarcGains
     from ...reader import Quantity
     g = spec.sliding
     const = {"c_s": g.c, "k_s": g.k_s, "eta": g.eta, "phi": g.phi, "phi_0": 0.0,
@@ -167,14 +167,13 @@ def kind_spec(spec: StopSpec, t_end: float):
                                 "theta_min": "th_min", "theta_max": "th_max"})
         ctls.append(Controller(name.replace("-", "_").replace("+", "_"), law, defs, pid, smarc,
                                v.predictor, v.terminal, v.gain_correction, pid_limited=False))
-    comp = spec.compensation
     return StopAccuracySpec(
         "<station-stopping>", spec.params, (spec.v_max.value * 3.6,), spec.tolerance.value,
         spec.c_max, spec.sections[0].length, None,
         {k: Quantity(x, "1", "") for k, x in const.items()}, tuple(ctls), FACTORS, (),
         spec.dt, spec.dt_ctrl, t_end,
         reference=Reference(spec.v_max.value, spec.a_acc.value, spec.a_dec.value),
-        compensation=Compensation(comp.d_terminal, comp.gain_tau, comp.gain_bounds),
+        compensation=spec.compensation,
         c_min=spec.c_min)
 
 
