@@ -49,7 +49,7 @@ def test_cli_names_no_kind():
     (["simulate", "designs/delay-benchmarks.toml"],
      "design delay-benchmarks (kind delay-benchmark) has no simulate: it needs [[scenarios]]"),
     (["sweep", "designs/delay-benchmarks.toml", "--samples", "2", "--seed", "1"],
-     "kinds with sweep: antiskid-run, delay-feedback, switched-run"),
+     "kinds with sweep: antiskid-run, delay-feedback, stop-accuracy, switched-run"),
     (["synthesize", "delay-bound", "designs/emu-speed-switched-run.toml"],
      "(kind switched-run) has no synthesize delay-bound"),
     (["simulate", "designs/emu-speed-switched-run.toml", "--plot", "x.png"],

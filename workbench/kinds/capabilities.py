@@ -9,7 +9,7 @@ it the options it takes, and otherwise says what is missing with a
 
     designs/x.toml: design x (kind brake-fit) has no simulate: it needs
     [[scenarios]] to simulate (kinds with simulate: antiskid-run, delay-feedback,
-    switched-run)
+    stop-accuracy, switched-run)
 
 A command function has the signature ``f(design, *, option=..., ...) -> int``
 (the exit code); an option the user set that it does not take (e.g.
