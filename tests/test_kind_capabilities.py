@@ -49,7 +49,7 @@ def test_cli_names_no_kind():
     (["simulate", "designs/delay-benchmarks.toml"],
      "design delay-benchmarks (kind delay-benchmark) has no simulate: it needs [[scenarios]]"),
     (["sweep", "designs/delay-benchmarks.toml", "--samples", "2", "--seed", "1"],
-     "kinds with sweep: antiskid-run, delay-feedback, switched-run"),
+     "kinds with sweep: antiskid-run, delay-feedback, stop-accuracy, switched-run"),
     (["synthesize", "delay-bound", "designs/emu-speed-switched-run.toml"],
      "(kind switched-run) has no synthesize delay-bound"),
     (["simulate", "designs/emu-speed-switched-run.toml", "--plot", "x.png"],
@@ -134,3 +134,37 @@ def test_delay_feedback_sweep_draws_the_plant(tmp_path, capsys):
     assert main(["sweep", str(bare), "--samples", "8", "--seed", "3"]) == 2
     assert "(kind delay-feedback) has no sweep: it needs a [montecarlo] table" in \
         capsys.readouterr().err
+
+
+def test_delay_feedback_sweep_is_chunked_and_resumable(tmp_path, capsys):
+    """``sweep --out/--resume`` of a delay-feedback design: 120 draws in
+    three chunk files per scenario, the summary equal to the one-batch
+    sweep's (to 1e-12: the gain's matrix product may round differently for
+    another batch width), a deleted chunk rewritten byte for byte."""
+    from test_delay_feedback import write as write_feedback
+    scen = ('\n[[scenarios]]\nname = "kick"\nx0 = { x = 0.7 }\nt_end = 1.0\ndt = 0.05\n')
+    mc = ('\n[montecarlo]\nsamples = 5\nseed = 1\n[montecarlo.distributions]\n'
+          'a = { dist = "uniform", lo = 1.5, hi = 2.5, source = "test" }\n')
+    p = write_feedback(tmp_path, extra=scen + mc)
+    args = ["sweep", str(p), "--samples", "120", "--seed", "3", "--json"]
+    assert main(args) == 0
+    whole = json.loads(capsys.readouterr().out)["quantities"]
+    folder = tmp_path / "out"
+    assert main(args + ["--out", str(folder)]) == 0
+    got = json.loads(capsys.readouterr().out)["quantities"]
+    assert got.keys() == whole.keys() and got["montecarlo.kick.runs"] == 120
+    assert all(got[k] == pytest.approx(v, rel=1e-12, abs=0.0) for k, v in whole.items())
+    chunks = sorted(folder.glob("*.csv"))
+    assert [c.name for c in chunks] == [f"kick-chunk-000{k}.csv" for k in range(3)]
+    assert chunks[0].read_text(encoding="utf-8").splitlines()[0].startswith("a,peak_error.x,")
+    kept = chunks[2].read_text(encoding="utf-8")
+    chunks[2].unlink()
+    assert main(args + ["--out", str(folder)]) == 2              # not empty, no --resume
+    capsys.readouterr()
+    assert main(args + ["--out", str(folder), "--resume"]) == 0
+    assert json.loads(capsys.readouterr().out)["quantities"] == got
+    assert chunks[2].read_text(encoding="utf-8") == kept
+    assert main(["sweep", str(p), "--samples", "120", "--seed", "4", "--out", str(folder),
+                 "--resume"]) == 2                                # another sweep's folder
+    assert "sweep.json" in capsys.readouterr().err
+    assert main(["sweep", str(p), "--samples", "120", "--seed", "3", "--resume"]) == 2

@@ -322,14 +322,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("design")
     p.add_argument("--samples", type=int, required=True)
     p.add_argument("--seed", type=int, required=True)
-    p.add_argument("--case", help="scenario (switched-run; default: the design's first)")
+    p.add_argument("--case", help="scenario (switched-run; default: the design's first) or "
+                   "case (stop-accuracy: v<speed>.<controller>; default: every one)")
     p.add_argument("--workers", type=int, help="processes (default: the CPUs granted to this process)")
     p.add_argument("--kernel", help="stepping path: compiled (numba; the default when "
                    "installed) or numpy (the reference)")
     p.add_argument("--scheduler", help="run the chunks on Dask: 'local' (a LocalCluster of "
                    "--workers processes) or a scheduler address, tcp://host:8786")
     p.add_argument("--out", metavar="DIR", help="write each chunk's runs to DIR "
-                   "(antiskid-run: chunk-*.npz; switched-run: <scenario>-chunk-*.csv) as it "
+                   "(antiskid-run: chunk-*.npz; switched-run, delay-feedback: "
+                   "<scenario>-chunk-*.csv; stop-accuracy: <case>-chunk-*.csv) as it "
                    "finishes; the summaries are read back from the files")
     p.add_argument("--resume", action="store_true",
                    help="with --out: skip the chunks already written in DIR")

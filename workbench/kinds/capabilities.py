@@ -9,7 +9,7 @@ it the options it takes, and otherwise says what is missing with a
 
     designs/x.toml: design x (kind brake-fit) has no simulate: it needs
     [[scenarios]] to simulate (kinds with simulate: antiskid-run, delay-feedback,
-    switched-run)
+    stop-accuracy, switched-run)
 
 A command function has the signature ``f(design, *, option=..., ...) -> int``
 (the exit code); an option the user set that it does not take (e.g.
@@ -36,6 +36,9 @@ CAPABILITIES: dict[str, dict[str, str]] = {
     "switched-run": {
         "simulate": "workbench.kinds.switched_run.cli:simulate_command",
         "sweep": "workbench.kinds.switched_run.cli:sweep_command"},
+    "stop-accuracy": {
+        "simulate": "workbench.kinds.stop_accuracy.cli:simulate_command",
+        "sweep": "workbench.kinds.stop_accuracy.cli:sweep_command"},
     "antiskid-run": {
         "simulate": "workbench.papers.p003.antiskid_run:simulate_command",
         "sweep": "workbench.papers.p003.antiskid_run:sweep_command"},

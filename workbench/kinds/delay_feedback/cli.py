@@ -210,27 +210,59 @@ def _draw_run(fig, spec, r) -> None:
     ax.set_xlabel("t (s)")
 
 
-def sweep_command(design, *, samples: int, seed: int, as_json: bool = False) -> int:
+def sweep_command(design, *, samples: int, seed: int, as_json: bool = False,
+                  out: str | None = None, resume: bool = False) -> int:
     """``workbench sweep`` of a ``delay-feedback`` design with ``[montecarlo]``:
     its distributions with ``samples`` draws and ``seed``, on every scenario
     without a parameter schedule, the gain and operating point nominal
     (:func:`.montecarlo.run_montecarlo`, as in the report); prints the
     diverged runs and every metric's largest value; exit 0 (1 when no gain
-    was certified)."""
+    was certified).
+
+    With ``out`` the runs are computed in chunks and written to
+    ``out/<scenario>-chunk-NNNN.csv`` (one row per run: its drawn parameters
+    and its metrics), ``resume`` skipping the chunks already there
+    (:mod:`workbench.kinds.sweep_out`); the summary is read back from the
+    files. A chunk's runs equal the one-batch sweep's up to the last bits of
+    the gain's matrix product (the only operation not elementwise over runs)."""
+    from pathlib import Path
     from types import SimpleNamespace
 
     from ..capabilities import sweep_draws
+    from ..sweep_out import check_resume
     from .montecarlo import montecarlo_values, run_montecarlo
     from .run import designed_gain, predict, reference
     spec = replace(design.spec, montecarlo=sweep_draws(design, samples, seed, 2000))
+    check_resume(out, resume)
     got = designed_gain(design, spec, "to sweep")
     if got is None:
         return 1
     model, values, op, A, B, s = got
-    res = run_montecarlo(spec, model, values, op, s.K, reference, predict)
+    if out:
+        res = _chunked_montecarlo(design, spec, model, values, op, s.K, Path(out), resume)
+    else:
+        res = run_montecarlo(spec, model, values, op, s.K, reference, predict)
     q = montecarlo_values(SimpleNamespace(montecarlo=res))
     return print_run({"design": design.name, "samples": samples, "seed": seed,
                       "quantities": q},
                      f"{design.name}: Monte Carlo, {samples} runs per scenario, seed {seed}, "
                      f"K = {gain_text(s.K, spec.synthesis.settings.gain_digits)}",
                      {k: math.nan if v is None else v for k, v in q.items()}, as_json)
+
+
+def _chunked_montecarlo(design, spec, model, values, op, K, folder, resume):
+    """The Monte Carlo of :func:`sweep_command` through the chunk files."""
+    from ...features.montecarlo import draw
+    from ..sweep_out import Group, run_chunks
+    from .montecarlo import MonteCarloScenario, drawn_scenarios, montecarlo_batch
+    from .run import predict, reference
+    mc = spec.montecarlo
+    drawn = draw(mc, tuple(spec.plant.parameters), values)
+    draws = {k: drawn[k] for k in mc.distributions}
+    batch = montecarlo_batch(spec, model, values, op, K, reference, predict)
+    scen = {sc.name: sc for sc in drawn_scenarios(spec)}
+    got = run_chunks(folder, {"design": design.name, "scenarios": list(scen),
+                              "samples": mc.samples, "seed": mc.seed},
+                     [Group(name, draws) for name in scen],
+                     lambda g, d: (batch(scen[g.name], d).metrics, None), resume)
+    return tuple(MonteCarloScenario(name, mc.samples, got[name].metrics) for name in scen)

@@ -26,8 +26,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["MonteCarloScenario", "load_montecarlo_table", "montecarlo_names",
-           "montecarlo_values", "run_montecarlo", "montecarlo_section"]
+__all__ = ["MonteCarloScenario", "drawn_scenarios", "load_montecarlo_table",
+           "montecarlo_batch", "montecarlo_names", "montecarlo_values", "run_montecarlo",
+           "montecarlo_section"]
 
 #: A run whose error passes this factor of (1 + |x_op| + |x0|) has diverged (as the nominal run).
 SCALE = 1e6
@@ -88,24 +89,41 @@ def run_montecarlo(spec, model, values, op, K, reference, predict
     """Every scenario without a parameter schedule, with the plant's
     parameters drawn (see the module docstring); ``reference`` and
     ``predict`` are the nominal run's (:mod:`.run`, which calls this)."""
-    import sympy as sp
-
     from ...features.montecarlo import draw
-    mc = spec.montecarlo
+    drawn = draw(spec.montecarlo, tuple(spec.plant.parameters), values)
+    batch = montecarlo_batch(spec, model, values, op, K, reference, predict)
+    return tuple(batch(s, drawn) for s in drawn_scenarios(spec))
+
+
+def drawn_scenarios(spec) -> list:
+    """The scenarios a Monte Carlo draws (those without a parameter schedule)."""
+    return _drawn(spec)
+
+
+def montecarlo_batch(spec, model, values, op, K, reference, predict):
+    """``batch(scenario, drawn) -> MonteCarloScenario``: the runs of one
+    scenario for the drawn parameters ``drawn`` (name -> array over the
+    runs; a parameter left out is nominal), the model compiled once.
+    Every operation but the gain's matrix product is elementwise over the
+    runs (``sweep --out`` cuts a sweep into such batches,
+    :mod:`workbench.kinds.sweep_out`)."""
+    import sympy as sp
     names = tuple(spec.plant.parameters)
     fn = sp.lambdify(model.x + model.u + tuple(model.p[k] for k in names), list(model.f),
                      "numpy")
-    drawn = draw(mc, names, values)
-    P = [drawn[k] for k in names]
     Pn = [values[k] for k in names]
-    N = mc.samples
+    K = np.atleast_2d(K)
 
-    def stack(out):
-        return np.array([np.broadcast_to(np.asarray(o, float), (N,)) for o in out])
-    f = lambda x, u: stack(fn(*x, *u, *P))
-    f_nom = lambda x, u: stack(fn(*x, *u, *Pn))
-    return tuple(_batch(spec, op, np.atleast_2d(K), s, f, f_nom, N, reference(spec, op, s),
-                        predict) for s in _drawn(spec))
+    def batch(sc, drawn) -> MonteCarloScenario:
+        N = len(next(iter(drawn.values())))
+        P = [drawn.get(k, values[k]) for k in names]
+
+        def stack(out):
+            return np.array([np.broadcast_to(np.asarray(o, float), (N,)) for o in out])
+        f = lambda x, u: stack(fn(*x, *u, *P))
+        f_nom = lambda x, u: stack(fn(*x, *u, *Pn))
+        return _batch(spec, op, K, sc, f, f_nom, N, reference(spec, op, sc), predict)
+    return batch
 
 
 def _rk4(f, x, u, h):

@@ -11,15 +11,26 @@ Tables::
                    (:func:`.pipeline.read_brake_plant`; why a named model: see there)
     [target]       speeds_kmh = [...], tolerance = { value, unit = "m" },
                    c_max = { value, unit = "m/s^2" } (full service; commands clip to [0, c_max]),
+                   traction_max = { value, unit = "m/s^2" } (optional: clip to
+                   [-traction_max, c_max], a law may call for traction),
                    and the stopping point: distance = { value, unit = "m" }, or
                    command = { value, unit = "m/s^2" } (D = the nominal stopping distance
                    of that command held, as paper 004 section 1)
     [constants]    name = { value, unit, source }  (numbers the laws use)
     [[controllers]] name, law = "expression" (brake command, m/s^2),
                    definitions = { name = "expression", ... } (in order, optional),
-                   pid = { error = "expression", kp = "constant", ki = ..., kd = ... }
-                   (optional: the named module ``pid`` adds a sampled PID of the error,
-                   :class:`workbench.controllers.pid.BatchPID`, to the law)
+                   pid = { error = "expression", kp = "constant", ki = ..., kd = ...,
+                   limited = true } (optional: the named module ``pid`` adds a sampled PID
+                   of the error, :class:`workbench.controllers.pid.BatchPID`, to the law;
+                   its output limited to ±c_max unless ``limited = false``),
+                   or smarc = { c = "constant", ... } (the named module ``smarc``: the whole
+                   law), compensation = { predictor = true, terminal = true,
+                   gain_correction = true } (optional, with [compensation]; :mod:`.modules`)
+    [reference]    model = "ato-trapezoid", v_max, a_acc, a_dec (optional: the target a
+                   tracking law follows; laws see x_d, v_d, a_d; runs start where it starts
+                   braking, [target] has no speeds_kmh and distance is the section length)
+    [compensation] d_terminal (m), gain_tau (s), gain_bounds = [lo, hi] (the named modules
+                   predictor and terminal, :mod:`.modules`)
     [disturbances] name = { effect = "scale", parameters = ["T1", ...] } | { effect =
                    "gradient" } (permille) | { effect = "force_error" } | { effect = "mass_ratio" }
                    (the factors, in this order: a Monte Carlo draw's stream is its position)
@@ -41,9 +52,10 @@ unit m/s^2 (pint). A controller with internal state is not an expression:
 an integrator is the one named module a design may reference (``pid``: its
 gains are constants of the design, unit-checked as ``kp*error``,
 ``ki*error*t`` and ``kd*error/t`` in m/s^2; the PID output is limited to
-±c_max with conditional integration). Other stateful laws (paper 004's
-fuzzy/PID command generator on four axle sensors, paper 000's SMARC and its
-predictive terminal law) stay in their paper's module.
+±c_max with conditional integration, or unlimited). Paper 000's SMARC, the
+Smith predictor and the predictive terminal law are the other named modules
+(:mod:`.modules`, which says why each is not an expression). Paper 004's
+fuzzy/PID command generator on four axle sensors stays in its paper's module.
 """
 from __future__ import annotations
 
@@ -65,9 +77,14 @@ LEVELS = (0, 1, 2)
 @dataclass(frozen=True)
 class Controller:
     name: str
-    law: str
+    law: str | None                                  # None: the named module smarc
     definitions: tuple[tuple[str, str], ...] = ()
     pid: tuple[str, str, str, str] | None = None     # (error, kp, ki, kd constant names)
+    smarc: object = None                             # modules.SmarcGains
+    predictor: bool = False                          # compensation = { predictor = true }
+    terminal: bool = False                           # ... terminal = true
+    gain_correction: bool = True                     # ... gain_correction = false: none
+    pid_limited: bool = True                         # pid = { limited = false }: no limit
 
 
 @dataclass(frozen=True)
@@ -97,6 +114,9 @@ class StopAccuracySpec:
     montecarlo: object = None      # MonteCarloSpec
     convergence: bool = False
     grid: tuple = ()               # ((factor, (values, ...)), ...)
+    reference: object = None       # modules.Reference ([reference])
+    compensation: object = None    # modules.Compensation ([compensation])
+    c_min: float = 0.0             # m/s^2: -traction_max (the law may call for traction)
 
     def base(self) -> dict:
         return {k: q.value for k, q in self.params.items()}
@@ -148,8 +168,26 @@ def _controllers(root: Reader, names: set, constants) -> tuple[Controller, ...]:
             defs.append((k, text))
             known.add(k)
         dt.finish()
-        law = t.raw("law")
-        check_expression(law, known, path=root.path, key=t.key("law"))
+        smarc, law = None, None
+        if t.has("smarc"):
+            from .modules import read_smarc
+            if t.has("law") or t.has("pid") or defs:
+                raise t.fail("smarc", t.raw("smarc"), "a smarc table without law, "
+                             "definitions or pid (the module is the whole law)")
+            if "x_d" not in names:
+                raise t.fail("smarc", t.raw("smarc"), "a [reference] for SMARC to track")
+            smarc = read_smarc(t, constants)
+        else:
+            law = t.raw("law")
+            check_expression(law, known, path=root.path, key=t.key("law"))
+        limited = True
+        comp = t.table("compensation", default=None)
+        flags = (comp.boolean("predictor", default=False), comp.boolean("terminal", default=False),
+                 comp.boolean("gain_correction", default=True))
+        comp.finish()
+        if (flags[0] or flags[1]) and not root.has("compensation"):
+            raise t.fail("compensation", t.raw("compensation"), "a [compensation] table "
+                         "(d_terminal, gain_tau, gain_bounds) for the predictor's model")
         pid = None
         if t.has("pid"):
             pt = t.table("pid")
@@ -158,10 +196,11 @@ def _controllers(root: Reader, names: set, constants) -> tuple[Controller, ...]:
             if not constants:
                 raise pt.fail("kp", pt.raw("kp", None), "a constant of [constants] (none)")
             gains = tuple(pt.string(k, choices=sorted(constants)) for k in ("kp", "ki", "kd"))
+            limited = pt.boolean("limited", default=True)
             pt.finish()
             pid = (err, *gains)
         t.finish()
-        out.append(Controller(name, law, tuple(defs), pid))
+        out.append(Controller(name, law, tuple(defs), pid, smarc, *flags, limited))
     return tuple(out)
 
 
@@ -236,7 +275,7 @@ def _grid(root: Reader, factors) -> tuple:
     return tuple(out)
 
 
-def _check_units(path: str, constants: dict, controllers) -> None:
+def _check_units(path: str, constants: dict, controllers, law_names=LAW_NAMES) -> None:
     """Every law in m/s^2 and every definition of consistent units (pint,
     :func:`workbench.kinds.delay_feedback.units.check_expression_units`)."""
     import sympy as sp
@@ -245,7 +284,7 @@ def _check_units(path: str, constants: dict, controllers) -> None:
     from ...errors import DesignError
     from ...expr import parse_expression
     from ..delay_feedback.units import check_expression_units
-    units = dict(LAW_NAMES) | {k: q.unit for k, q in constants.items()} | {
+    units = dict(law_names) | {k: q.unit for k, q in constants.items()} | {
         "brake_command": "m/s^2"}          # not a law name: the unit a law must have
     plant = NS(path=path, states=(), inputs=(),
                parameters={k: NS(unit=u) for k, u in units.items()})
@@ -255,9 +294,10 @@ def _check_units(path: str, constants: dict, controllers) -> None:
             key = f"controllers[{i}].definitions.{k}"
             syms[k] = parse_expression(text, syms, path=path, key=key)
             items.append((key, text, syms[k], None))
-        items.append((f"controllers[{i}].law", c.law,
-                      parse_expression(c.law, syms, path=path, key=f"controllers[{i}].law"),
-                      "brake_command"))
+        if c.law is not None:
+            items.append((f"controllers[{i}].law", c.law,
+                          parse_expression(c.law, syms, path=path, key=f"controllers[{i}].law"),
+                          "brake_command"))
         if c.pid is not None:
             err, kp, ki, kd = c.pid
             key = f"controllers[{i}].pid.error"
@@ -280,21 +320,33 @@ class StopAccuracy:
     uses_solver = False
 
     def load(self, root: Reader) -> StopAccuracySpec:
+        from .modules import REFERENCE_NAMES, read_compensation, read_reference
         params = read_brake_plant(root)
+        reference = read_reference(root)
         tg = root.table("target")
-        speeds = tg.numbers("speeds_kmh", positive=True, what="speeds (km/h)")
-        if not speeds or any(s > 400 for s in speeds) or len(set(speeds)) < len(speeds):
-            raise tg.fail("speeds_kmh", list(speeds), "distinct speeds in (0, 400] km/h")
         tol = tg.quantity("tolerance", "m", positive=True, hi=10.0).value
         c_max = tg.quantity("c_max", "m/s^2", positive=True, hi=3.0).value
+        traction = tg.quantity("traction_max", "m/s^2", positive=True, hi=3.0, default=None)
         dist = tg.quantity("distance", "m", positive=True, hi=1e5, default=None)
         cmd = tg.quantity("command", "m/s^2", positive=True, hi=3.0, default=None)
-        if (dist is None) == (cmd is None):
+        if (dist is None) == (cmd is None) or reference is not None and dist is None:
             raise tg.fail("distance", None if dist is None else dist.value,
+                          "the section length (m) with [reference]" if reference else
                           "exactly one of distance (m) and command (m/s^2)")
+        if reference is None:
+            speeds = tg.numbers("speeds_kmh", positive=True, what="speeds (km/h)")
+            if not speeds or any(s > 400 for s in speeds) or len(set(speeds)) < len(speeds):
+                raise tg.fail("speeds_kmh", list(speeds), "distinct speeds in (0, 400] km/h")
+        elif tg.has("speeds_kmh"):
+            raise tg.fail("speeds_kmh", tg.raw("speeds_kmh"), "no speeds with [reference] "
+                          "(a run starts where the target starts braking)")
+        else:
+            speeds = (reference.start(dist.value)[1] * 3.6,)
         tg.finish()
-        constants = _constants(root, set(LAW_NAMES) | {"brake_command"})
-        controllers = _controllers(root, set(LAW_NAMES) | set(constants), constants)
+        law_names = LAW_NAMES | (REFERENCE_NAMES if reference else {})
+        constants = _constants(root, set(law_names) | {"brake_command"})
+        controllers = _controllers(root, set(law_names) | set(constants), constants)
+        compensation = read_compensation(root)
         factors = _factors(root, params)
         faults = _faults(root, params, factors)
         mc = None
@@ -324,11 +376,13 @@ class StopAccuracy:
         if mc is not None and mc.samples * len(speeds) * len(controllers) * t_end / dt > MAX_WORK:
             raise root.fail("montecarlo.samples", mc.samples, f"at most {MAX_WORK:g} runs x "
                             "steps (a Monte Carlo of hours is a study, not a check)")
-        _check_units(root.path, constants, controllers)
+        _check_units(root.path, constants, controllers, law_names)
         return StopAccuracySpec(root.path, params, tuple(speeds), tol, c_max,
                                 None if dist is None else dist.value,
                                 None if cmd is None else cmd.value, constants, controllers,
-                                factors, faults, dt, dt_ctrl, t_end, mc, convergence, grid)
+                                factors, faults, dt, dt_ctrl, t_end, mc, convergence, grid,
+                                reference, compensation,
+                                0.0 if traction is None else -traction.value)
 
     def quantity_names(self, spec: StopAccuracySpec) -> set[str]:
         from ...features.quantities import names

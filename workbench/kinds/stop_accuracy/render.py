@@ -38,15 +38,14 @@ def _problem(spec) -> str:
     par = [[f"`{k}`", fmt(q.value, 6), q.unit, q.source] for k, q in spec.params.items()]
     const = [[f"`{k}`", fmt(q.value, 6), q.unit, q.source] for k, q in spec.constants.items()]
     ctl = [[f"`{c.name}`", "; ".join(f"{k} = `{t}`" for k, t in c.definitions) or "—",
-            f"`{c.law}`" + ("" if c.pid is None else f" + PID(`{c.pid[0]}`; kp = {c.pid[1]}, "
-                                                      f"ki = {c.pid[2]}, kd = {c.pid[3]})")]
-           for c in spec.controllers]
+            _law_text(c)] for c in spec.controllers]
     target = (f"D = {fmt(spec.distance, 6)} m" if spec.distance is not None else
               f"D = the nominal stopping distance of the command {fmt(spec.command)} m/s² held")
     out = ("## Problem\n\nA `stop-accuracy` design: each controller brakes the paper-000 "
            "brake plant (`[plant]`, two transmission delays and the electric/air hand-over) "
            f"from {', '.join(fmt(s) for s in spec.speeds_kmh)} km/h to the stopping point; "
-           f"{target}. Commands clip to [0, {fmt(spec.c_max)}] m/s², act every "
+           f"{target}.{_reference_text(spec)} Commands clip to [{fmt(-spec.c_min)}, "
+           f"{fmt(spec.c_max)}] m/s², act every "
            f"{fmt(spec.dt_ctrl)} s (ZOH); the plant steps at dt = {fmt(spec.dt)} s. Laws are "
            "the design's text, parsed by `workbench/expr.py` (never evaluated) and checked "
            "to be in m/s². Stop error = standstill position − D (+ = overshoot); "
@@ -66,6 +65,45 @@ def _problem(spec) -> str:
                 for f in spec.faults]
         out += "\n\n" + md_table(["fault", "brake parameters", "speed read / true",
                                   "disturbance"], rows, "llrl")
+    return out
+
+
+def _law_text(c) -> str:
+    """A controller's law: its expression (with the ``pid`` module) or the
+    ``smarc`` module, and its compensation modules."""
+    if c.smarc is not None:
+        text = "SMARC (module `smarc`, eqs 22, 26-27: " + ", ".join(
+            f"{k} = {v}" for k, v in c.smarc.names.items()) + ")"
+    else:
+        text = f"`{c.law}`" + ("" if c.pid is None else
+                               f" + PID(`{c.pid[0]}`; kp = {c.pid[1]}, ki = {c.pid[2]}, "
+                               f"kd = {c.pid[3]}" + ("" if c.pid_limited else ", no limit")
+                               + ")")
+    mods = [m for m, on in (("predictor", c.predictor), ("terminal", c.terminal)) if on]
+    if mods:
+        text += " with modules " + " and ".join(f"`{m}`" for m in mods) + (
+            "" if c.gain_correction else " (no gain correction)")
+    return text
+
+
+def _reference_text(spec) -> str:
+    if spec.reference is None and spec.compensation is None:
+        return ""
+    out = ""
+    r = spec.reference
+    if r is not None:
+        out += (f" The laws track the ATO target curve (`[reference]`, module `ato-trapezoid`: "
+                f"accelerate at {fmt(r.a_acc)} m/s², cruise at {fmt(r.v_max, 6)} m/s, brake "
+                f"at {fmt(r.a_dec)} m/s² to stop at D; `x_d`, `v_d`, `a_d`); each run starts "
+                "where the target starts braking, x counted from the section's start.")
+    cp = spec.compensation
+    if cp is not None:
+        out += (" Known-delay compensation (`[compensation]`, "
+                "`workbench/kinds/stop_accuracy/modules.py`): module `predictor` feeds the law "
+                "the state one dead time ahead from the nominal brake model (brake-gain "
+                f"correction low-passed over {fmt(cp.gain_tau)} s within "
+                f"[{fmt(cp.gain_bounds[0])}, {fmt(cp.gain_bounds[1])}]); module `terminal` holds, "
+                f"from {fmt(cp.d_terminal)} m to go, the command the model predicts stops at D.")
     return out
 
 

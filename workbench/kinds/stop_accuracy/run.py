@@ -30,7 +30,8 @@ import numpy as np
 from ...jsonable import json_method
 from .pipeline import LAW_NAMES, apply_factors, group_statistics, open_loop_distance
 
-__all__ = ["StopAccuracyResult", "compile_laws", "run", "speed_key"]
+__all__ = ["StopAccuracyResult", "compile_laws", "montecarlo_draws", "run", "simulate_cases",
+           "simulate_runs", "stopping_points", "speed_key"]
 
 
 def speed_key(s: float) -> str:
@@ -60,6 +61,11 @@ class StopAccuracyResult:
     to_json = json_method
 
 
+def _law_names(spec) -> tuple:
+    from .modules import REFERENCE_NAMES
+    return tuple(LAW_NAMES) + (tuple(REFERENCE_NAMES) if spec.reference else ())
+
+
 def compile_laws(spec) -> list:
     """law(values) -> command, per controller: the design's expressions as numpy
     functions of the law names, the constants and the definitions; with the
@@ -68,9 +74,12 @@ def compile_laws(spec) -> list:
     import sympy as sp
 
     from ...expr import parse_expression
-    names = tuple(LAW_NAMES) + tuple(spec.constants)
+    names = _law_names(spec) + tuple(spec.constants)
     out = []
     for i, c in enumerate(spec.controllers):
+        if c.law is None:                  # the named module ``smarc`` is the whole law
+            out.append(None)
+            continue
         syms = {k: sp.Symbol(k, real=True) for k in names}
         args = tuple(syms[k] for k in names)
         for k, text in c.definitions:
@@ -88,9 +97,30 @@ def compile_laws(spec) -> list:
 
 
 def _simulate(spec, laws, dt, cases, draws=None, record=False):
-    """Stop errors (m) of ``cases`` [(speed, controller index, fault or None)],
+    """Stop errors (m) of ``cases`` [(speed, controller index, fault or None, D)],
     each repeated over the Monte Carlo ``draws`` (dict of arrays) when given."""
-    from ...sim.stopping import batch_params, simulate
+    tr, D = simulate_cases(spec, laws, dt, cases, draws)
+    traces = {}
+    if record:
+        traces = {(c[0], spec.controllers[c[1]].name): (tr.x[:, k] - D[k], tr.v[:, k])
+                  for k, c in enumerate(cases) if c[2] is None}
+    return tr.x_stop - D, traces
+
+
+def simulate_cases(spec, laws, dt, cases, draws=None):
+    """Simulate ``cases`` [(speed km/h, controller index, fault or None, D m)],
+    each repeated over the Monte Carlo ``draws`` (factor -> array) when given,
+    in one batch (every operation is elementwise over runs: a run's result
+    does not depend on the others in its batch).
+
+    Returns
+    -------
+    tr : workbench.sim.stopping.Traces
+        Recorded every control period.
+    D : ndarray
+        The stopping point of each run (m).
+    """
+    from ...sim.stopping import batch_params
     N = 1 if draws is None else len(next(iter(draws.values())))
     n = len(cases) * N
     base = spec.base()
@@ -109,19 +139,44 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
             p[k][j * N:(j + 1) * N] = x
     ratio = rep(lambda c: c[2].speed_ratio if c[2] else 1.0)
     ctl = np.repeat([c[1] for c in cases], N)
+    v0, x0 = rep(lambda c: c[0] / 3.6), 0.0
+    if spec.reference is not None:    # start where the target starts braking
+        x0, v0 = (rep(lambda c, k=k: spec.reference.start(c[3])[k]) for k in (0, 1))
+    tr, _ = simulate_runs(spec, laws, dt, p, ctl, D, x0=x0, v0=v0, ratio=ratio, theta=theta,
+                          kappa=kappa)
+    return tr, D
+
+
+def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa):
+    """Simulate a batch of runs, each its own: brake parameters ``p``
+    (:func:`workbench.sim.stopping.batch_params`), controller index ``ctl``,
+    stopping point ``D`` (m), start ``x0`` (m), ``v0`` (m/s), speed-sensor
+    ``ratio``, gradient ``theta`` and load-weighing gain ``kappa`` (arrays
+    over the runs, or scalars).
+
+    Returns
+    -------
+    tr : workbench.sim.stopping.Traces
+    track : .modules.Tracking
+        The modules' state at the end (e.g. each SMARC's estimates).
+    """
+    from ...sim.stopping import simulate
+    n = D.size
     groups = []
+    from .modules import Tracking
+    track = Tracking(spec, [(spec.controllers[i], np.flatnonzero(ctl == i))
+                            for i in range(len(laws))], D)
     for i, law in enumerate(laws):
         idx = np.flatnonzero(ctl == i)
         pid = None
         if isinstance(law, tuple):         # the named module ``pid``: law + PID(error)
             from ...controllers.pid import BatchPID
             law, err, (kp, ki, kd) = law
-            pid = (err, BatchPID(kp, ki, kd, idx.size, dt=spec.dt_ctrl, u_min=-spec.c_max,
-                                 u_max=spec.c_max))
-        groups.append((law, idx, pid))
-    v0 = rep(lambda c: c[0] / 3.6)
+            lim = spec.c_max if spec.controllers[i].pid_limited else np.inf
+            pid = (err, BatchPID(kp, ki, kd, idx.size, dt=spec.dt_ctrl, u_min=-lim, u_max=lim))
+        groups.append((law, idx, pid, spec.controllers[i].name))
     const = {k: np.full(n, q.value) for k, q in spec.constants.items()}
-    names = tuple(LAW_NAMES) + tuple(const)
+    names = _law_names(spec) + tuple(const)
     longest = max(float(p["T1"].max()), float(p["T3"].max()))
     if not longest <= spec.t_end:       # the delay line would outgrow the run (memory)
         from ...errors import DesignError
@@ -129,26 +184,25 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
                           f"transmission delay a fault or draw gives (longest {longest:.4g} s)")
 
     def policy(t, o):
-        vals = {"x": o.x, "v": o.v * ratio, "decel": np.maximum(-o.a, 0.0), "d_go": D - o.x,
-                "D": D, "v0": v0, "t": np.full(n, t)} | const
+        x, v, ref = track.state(t, o)          # measured, or predicted (module predictor)
+        vals = {"x": x, "v": v * ratio, "decel": np.maximum(-o.a, 0.0), "d_go": D - x,
+                "D": D, "v0": v0, "t": np.full(n, t)} | ref | const
         c = np.zeros(n)
         with np.errstate(all="ignore"):    # a law's nan (e.g. sqrt(-1)) is a run without a stop
-            for law, idx, pid in groups:
-                if idx.size:
+            for law, idx, pid, name in groups:
+                if idx.size and law is None:
+                    c[idx] = track.smarc_command(name, idx, vals["x"], vals["v"], ref)
+                elif idx.size:
                     args = [vals[k][idx] for k in names]
                     c[idx] = np.broadcast_to(law(*args), idx.shape)
                     if pid is not None:
                         c[idx] += pid[1].step(np.broadcast_to(pid[0](*args), idx.shape))
-        return np.clip(c, 0.0, spec.c_max)
+        return track.finish(np.clip(c, spec.c_min, spec.c_max), o)
 
     tr = simulate(p, policy, n=n, t_end=spec.t_end, dt=dt, dt_ctrl=spec.dt_ctrl,
-                  dt_rec=spec.dt_ctrl, v0=v0, theta=theta, kappa=kappa, c_min=0.0,
-                  c_max=spec.c_max)
-    traces = {}
-    if record:
-        traces = {(c[0], spec.controllers[c[1]].name): (tr.x[:, k] - D[k], tr.v[:, k])
-                  for k, c in enumerate(cases) if c[2] is None}
-    return tr.x_stop - D, traces
+                  dt_rec=spec.dt_ctrl, x0=x0, v0=v0, theta=theta, kappa=kappa,
+                  c_min=spec.c_min, c_max=spec.c_max)
+    return tr, track
 
 
 def _deterministic(spec, laws, dt, D, record=False):
@@ -162,13 +216,28 @@ def _deterministic(spec, laws, dt, D, record=False):
     return q, traces
 
 
+def stopping_points(spec) -> dict:
+    """speed (km/h) -> the stopping point D (m): the design's distance, or the
+    nominal stopping distance of its held command (paper 004 section 1)."""
+    base = spec.base()
+    return {s: spec.distance if spec.distance is not None else
+            open_loop_distance(base, spec.command, s / 3.6, dt=spec.dt, dt_ctrl=spec.dt_ctrl)
+            for s in spec.speeds_kmh}
+
+
+def montecarlo_draws(spec, mc) -> dict:
+    """The drawn factors of ``mc`` (a MonteCarloSpec): factor -> array over
+    its samples (:func:`workbench.features.montecarlo.draw`, every factor's
+    stream at its position in ``[disturbances]``)."""
+    from ...features.montecarlo import draw
+    d = draw(mc, tuple(f.name for f in spec.factors), {f.name: f.nominal for f in spec.factors})
+    return {k: v for k, v in d.items() if k in mc.distributions}
+
+
 def run(spec, claims=()) -> StopAccuracyResult:
     """Compute a design (see the module docstring)."""
     laws = compile_laws(spec)
-    base = spec.base()
-    D = {s: spec.distance if spec.distance is not None else
-         open_loop_distance(base, spec.command, s / 3.6, dt=spec.dt, dt_ctrl=spec.dt_ctrl)
-         for s in spec.speeds_kmh}
+    D = stopping_points(spec)
     q, traces = _deterministic(spec, laws, spec.dt, D, record=True)
     nominal = {(s, c.name): q[f"{speed_key(s)}.{c.name}.nominal_m"]
                for s in spec.speeds_kmh for c in spec.controllers}
@@ -176,10 +245,8 @@ def run(spec, claims=()) -> StopAccuracyResult:
               for s in spec.speeds_kmh for c in spec.controllers for f in spec.faults}
     mc = {}
     if spec.montecarlo is not None:
-        from ...features.montecarlo import draw
         m = spec.montecarlo
-        d = draw(m, tuple(f.name for f in spec.factors), {f.name: f.nominal for f in spec.factors})
-        d = {k: v for k, v in d.items() if k in m.distributions}
+        d = montecarlo_draws(spec, m)
         cases = [(s, i, None, D[s]) for s in spec.speeds_kmh for i in range(len(laws))]
         err, _ = _simulate(spec, laws, spec.dt, cases, draws=d)
         mc = group_statistics(err, [(s, spec.controllers[i].name) for s, i, _, _ in cases],

@@ -9,26 +9,22 @@
 ``sweep``: the design's ``[montecarlo]`` with ``--samples`` and ``--seed``
 (the same draws as the report for the design's own values,
 :func:`workbench.features.montecarlo.draw`), one scenario (``--case``). With
-``--out DIR`` the runs are computed in chunks of :data:`CHUNK` and each
-chunk is written, as it finishes, to ``DIR/<scenario>-chunk-NNNN.csv`` (one
-row per run: its draws, its metrics, why it ended); ``--resume`` skips the
-chunks already in DIR (``DIR/sweep.json`` records the design, samples and
-seed a resumed sweep must match); the summary is read back from the files.
+``--out DIR`` the runs are computed in chunks and written to
+``DIR/<scenario>-chunk-NNNN.csv`` (one row per run: its draws, its metrics,
+why it ended), ``--resume`` skipping the chunks already there
+(:mod:`workbench.kinds.sweep_out`, the machinery of every kind's sweep).
 """
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["CHUNK", "simulate_command", "sweep_command", "trajectory_csv"]
+from ..sweep_out import CHUNK
 
-#: Runs per chunk file of ``sweep --out``.
-CHUNK = 50
+__all__ = ["CHUNK", "simulate_command", "sweep_command", "trajectory_csv"]
 
 
 def _scenario(design, case):
@@ -105,12 +101,12 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool, case: str |
     from ...errors import DesignError
     from ...features.montecarlo import draw
     from ..capabilities import sweep_draws
+    from ..sweep_out import check_resume
     from . import MAX_WORK
     from .study import MonteCarloRun
     spec = design.spec
     mc = sweep_draws(design, samples, seed, 100_000)
-    if resume and not out:
-        raise DesignError("<cli>", "--resume", True, "with --out DIR (the folder to resume)")
+    check_resume(out, resume)
     sc = _scenario(design, case)
     if samples * sc.t_end / sc.dt > MAX_WORK:
         raise DesignError("<cli>", "--samples", samples, f"at most {MAX_WORK:g} samples x "
@@ -118,7 +114,11 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool, case: str |
     drawn = draw(mc, tuple(spec.plant.parameters), spec.plant.values(sc.parameters))
     draws = {k: drawn[k] for k in mc.distributions}
     if out:
-        metrics, reasons = _chunked(design, sc, draws, samples, seed, Path(out), resume)
+        from ..sweep_out import Group, run_chunks
+        got = run_chunks(Path(out), {"design": design.name, "scenario": sc.name,
+                                     "samples": samples, "seed": seed},
+                         [Group(sc.name, draws)], lambda g, d: _run(spec, sc, d), resume)
+        metrics, reasons = got[sc.name].metrics, got[sc.name].reasons
     else:
         metrics, reasons = _run(spec, sc, draws)
     res = MonteCarloRun(samples, seed, draws, metrics, tuple(reasons))
@@ -130,65 +130,6 @@ def _run(spec, sc, draws):
     from .simulate import Compiled, simulate
     b = simulate(spec, Compiled(spec), sc, sc.dt, plant_params=draws)
     return b.metrics, list(b.reasons)
-
-
-def _chunked(design, sc, draws, samples, seed, folder: Path, resume: bool):
-    """Run and write the chunks not yet in ``folder``; read every chunk back."""
-    from ...errors import DesignError
-    from ...report.files import atomic_write
-    manifest = {"design": design.name, "scenario": sc.name, "samples": samples,
-                "seed": seed, "chunk": CHUNK}
-    mpath = folder / "sweep.json"
-    try:
-        if folder.exists() and any(folder.iterdir()):
-            if not resume:
-                raise DesignError("<cli>", "--out", str(folder), "a new or empty folder, "
-                                  "or --resume")
-            try:
-                old = json.loads(mpath.read_text(encoding="utf-8"))
-            except (OSError, ValueError):
-                old = None
-            if old != manifest:
-                raise DesignError("<cli>", "--out", str(folder), f"a folder of this sweep "
-                                  f"to resume ({mpath.name}: {json.dumps(manifest)})")
-        folder.mkdir(parents=True, exist_ok=True)
-        atomic_write(mpath, json.dumps(manifest, indent=2) + "\n")
-        files = []
-        for k, lo in enumerate(range(0, samples, CHUNK)):
-            path = folder / f"{sc.name}-chunk-{k:04d}.csv"
-            files.append(path)
-            if path.is_file():
-                continue
-            part = {p: v[lo:lo + CHUNK] for p, v in draws.items()}
-            m, why = _run(design.spec, sc, part)
-            atomic_write(path, _chunk_csv(part, m, why))
-        return _read_chunks(files, list(draws))
-    except OSError as e:
-        raise DesignError("<cli>", "--out", str(folder), f"a folder the chunks can be "
-                          f"written to ({type(e).__name__}: {e})") from None
-
-
-def _chunk_csv(draws, metrics, reasons) -> str:
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow([*draws, *metrics, "ended"])
-    n = len(reasons)
-    for j in range(n):
-        w.writerow([*(repr(float(v[j])) for v in draws.values()),
-                    *(repr(float(v[j])) for v in metrics.values()), reasons[j]])
-    return buf.getvalue()
-
-
-def _read_chunks(files, drawn):
-    metrics, reasons = {}, []
-    for path in files:
-        rows = list(csv.reader(path.read_text(encoding="utf-8").splitlines()))
-        head = rows[0]
-        for row in rows[1:]:
-            for name, v in zip(head[len(drawn):-1], row[len(drawn):-1]):
-                metrics.setdefault(name, []).append(float(v))
-            reasons.append(row[-1])
-    return {k: np.array(v) for k, v in metrics.items()}, reasons
 
 
 def _print_summary(design, sc, res, as_json: bool) -> None:

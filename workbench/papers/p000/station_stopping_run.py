@@ -9,17 +9,13 @@ section at a time (the benchmark's baseline).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from ...controllers.pid import PID
-from ...controllers.smarc import AdaptiveSlidingModeController
-from ...controllers.smc import SlidingModeController
-from ...controllers.stop_predictor import NominalBrakeModel
 from ...features.montecarlo import StopStatistics, draw, stop_statistics
 from ...kinds.stop_accuracy.pipeline import apply_factors
-from ...sim.stopping import TargetCurve, batch_params, simulate
+from ...sim.stopping import TargetCurve, batch_params
 from ...tuning.pid import Damping, damping, speed_loop
 from .station_stopping_spec import (ABLATION, CONTROLLERS, DAMPING, FACTORS, MC_CONTROLLERS,
                                     MC_FACTORS, NOMINAL, UNCERTAIN, VARIANTS, Section, StopSpec)
@@ -137,74 +133,70 @@ def _extra_runs(spec: StopSpec) -> dict:
     return _concat(*sets)
 
 
+#: The laws as a ``stop-accuracy`` configuration (designs/stop-accuracy-000-line5.toml
+#: writes the same): the speed PID with feed-forward and eq 22's SMC are expressions,
+#: SMARC, the predictor and the terminal law named modules
+#: (:mod:`workbench.kinds.stop_accuracy.modules`).
+_PID = ("-a_d", ("v - v_d", "kp_{g}", "ki_{g}", "kd_{g}"))
+_SMC = ((("e", "x - x_d"), ("de", "v - v_d"), ("z", "c_s*e + de")),
+        "-((a_d - c_s*de) - k_s*z - eta*min(max(z/phi, -1), 1))")
+
+
+def kind_spec(spec: StopSpec, t_end: float):
+    """``spec`` as a ``stop-accuracy`` spec: one controller per variant of
+    :data:`VARIANTS` (in order), the ATO curve as its ``[reference]``."""
+    from ...kinds.stop_accuracy import Controller, StopAccuracySpec
+    from ...kinds.stop_accuracy.modules import Reference, SmarcGains
+    from ...reader import Quantity
+    g = spec.sliding
+    const = {"c_s": g.c, "k_s": g.k_s, "eta": g.eta, "phi": g.phi, "phi_0": 0.0,
+             "lam": spec.smarc["lam"], "th_min": spec.smarc["theta_min"],
+             "th_max": spec.smarc["theta_max"]}
+    for name in ("pid", "pid_damped", "pid_compensated"):
+        const |= {f"{k}_{name}": v for k, v in spec.gains(name).items()}
+    ctls = []
+    for name, v in VARIANTS.items():
+        law, defs, pid, smarc = None, (), None, None
+        if v.law == "pid":
+            law, pid = _PID[0], tuple(x.format(g=v.gains) for x in _PID[1])
+        elif v.law == "smc":
+            defs, law = _SMC
+        else:
+            smarc = SmarcGains({"c": "c_s", "k_s": "k_s", "eta": "eta",
+                                "phi": "phi_0" if v.law == "smarc-sgn" else "phi", "lam": "lam",
+                                "theta_min": "th_min", "theta_max": "th_max"})
+        ctls.append(Controller(name.replace("-", "_").replace("+", "_"), law, defs, pid, smarc,
+                               v.predictor, v.terminal, v.gain_correction, pid_limited=False))
+    return StopAccuracySpec(
+        "<station-stopping>", spec.params, (spec.v_max.value * 3.6,), spec.tolerance.value,
+        spec.c_max, spec.sections[0].length, None,
+        {k: Quantity(x, "1", "") for k, x in const.items()}, tuple(ctls), FACTORS, (),
+        spec.dt, spec.dt_ctrl, t_end,
+        reference=Reference(spec.v_max.value, spec.a_acc.value, spec.a_dec.value),
+        compensation=spec.compensation,
+        c_min=spec.c_min)
+
+
 def simulate_runs(spec: StopSpec, rs: dict):
-    """Simulate the run set ``rs``: (traces, SMARC estimates of the repeats,
-    target curves, braking start times)."""
+    """Simulate the run set ``rs`` through the ``stop-accuracy`` kind's runs
+    (:func:`workbench.kinds.stop_accuracy.run.simulate_runs`): (traces, SMARC
+    estimates of the repeats, target curves, braking start times)."""
+    from ...kinds.stop_accuracy.run import compile_laws
+    from ...kinds.stop_accuracy.run import simulate_runs as run_batch
     n = len(rs["variant"])
-    f = rs["factors"]
-    var = [VARIANTS[v] for v in rs["variant"]]
-    law = np.array([v.law for v in var], object)
     base = {k: q.value for k, q in spec.params.items()}
-    over, theta, kappa = apply_factors(base, FACTORS, f, n)
-    p = batch_params(base, n, over)
+    over, theta, kappa = apply_factors(base, FACTORS, rs["factors"], n)
     lengths = rs["length"]
     tc = TargetCurve.build(lengths, v_max=spec.v_max.value, a_acc=spec.a_acc.value,
                            a_dec=spec.a_dec.value)
     tb = tc.t_brake
     x0, v0, _ = tc.at(tb)
-    idx = {k: np.flatnonzero(law == k) for k in ("pid", "smc", "smarc", "smarc-sgn")}
-    smc = SlidingModeController(spec.sliding)
-    smarc = AdaptiveSlidingModeController(spec.sliding, dt=spec.dt_ctrl,
-                                          theta0=np.ones(idx["smarc"].size), **spec.smarc)
-    smarc_sgn = AdaptiveSlidingModeController(replace(spec.sliding, phi=0.0), dt=spec.dt_ctrl,
-                                              theta0=np.ones(idx["smarc-sgn"].size), **spec.smarc)
-    pids = [PID(**spec.gains(var[j].gains), dt=spec.dt_ctrl) for j in idx["pid"]]
-    pred = np.array([v.predictor for v in var])
-    term = np.array([v.terminal for v in var])
-    M = np.flatnonzero(pred | term)                         # runs with the nominal model
-    pm, tm = np.flatnonzero(pred[M]), term[M]
-    comp = spec.compensation
-    tau = np.array([comp.gain_tau if var[j].gain_correction else 0.0 for j in M])
-    model = NominalBrakeModel(base, M.size, dt_ctrl=spec.dt_ctrl, gain_tau=tau,
-                              gain_bounds=comp.gain_bounds)
-    st = {"in_term": np.zeros(M.size, bool), "last": np.zeros(M.size)}
-
-    def policy(t, obs):
-        xp, vp, h = obs.x.copy(), obs.v.copy(), np.zeros(n)
-        if M.size:
-            model.update(obs.v[M], obs.a[M])
-            if pm.size:
-                mx, mv, mh = model.predict(obs.x[M], obs.v[M])
-                xp[M[pm]], vp[M[pm]], h[M[pm]] = mx[pm], mv[pm], mh[pm]
-        xd, vd, ad = tc.at(t + tb + h)
-        e, de = xp - xd, vp - vd
-        c = np.zeros(n)
-        for k, ctl in (("smc", smc), ("smarc", smarc), ("smarc-sgn", smarc_sgn)):
-            j = idx[k]
-            if j.size:
-                c[j] = -ctl.step(e[j], de[j], ad[j])
-        j = idx["pid"]
-        c[j] = -ad[j] + np.array([pid.step(err) for pid, err in zip(pids, de[j])])
-        c = np.clip(c, spec.c_min, spec.c_max)
-        if M.size:
-            st["in_term"] |= tm & (lengths[M] - obs.x[M] < comp.d_terminal)
-            rows = np.flatnonzero(st["in_term"] & ~obs.stopped[M])
-            if rows.size:
-                guess = np.where(st["last"][rows] > 0, st["last"][rows], c[M[rows]])
-                c[M[rows]] = model.stopping_command(obs.x[M], obs.v[M], lengths[M], rows, guess,
-                                                    c_lo=0.0, c_hi=spec.c_max)
-            c = np.where(obs.stopped, 0.0, c)
-            st["last"] = np.where(st["in_term"], c[M], 0.0)
-            model.sent(c[M])
-        return c
-
-    t_end = float((tc.t_final - tb).max()) + 30.0
-    tr = simulate(p, policy, n=n, t_end=t_end, dt=spec.dt, dt_ctrl=spec.dt_ctrl,
-                  dt_rec=spec.dt_ctrl, x0=x0, v0=v0, theta=theta,
-                  kappa=kappa, c_init=0.0, t_arm=0.0, c_min=spec.c_min,
-                  c_max=spec.c_max)
-    rep_smarc = (rs["kind"][idx["smarc"]] == "rep") & (rs["variant"][idx["smarc"]] == "smarc")
-    return tr, smarc.theta_hat[rep_smarc], tc, tb
+    ks = kind_spec(spec, float((tc.t_final - tb).max()) + 30.0)
+    ctl = np.array([list(VARIANTS).index(v) for v in rs["variant"]])
+    tr, track = run_batch(ks, compile_laws(ks), spec.dt, batch_params(base, n, over), ctl,
+                          lengths, x0=x0, v0=v0, ratio=np.ones(n), theta=theta, kappa=kappa)
+    rep = rs["kind"][ctl == list(VARIANTS).index("smarc")] == "rep"
+    return tr, track.smarc["smarc"].theta_hat[rep], tc, tb
 
 
 def run_station_stops(spec: StopSpec, *, batch: str = "all", extras: bool = True) -> StopResult:

@@ -37,6 +37,7 @@ from dataclasses import dataclass, replace
 
 from ...controllers.smc import SlidingGains
 from ...features.montecarlo import MonteCarloSpec, load_montecarlo
+from ...kinds.stop_accuracy.modules import Compensation   # [compensation]: the kind's modules
 from ...kinds.stop_accuracy.pipeline import Factor, read_brake_plant
 from ...reader import Quantity, Reader
 
@@ -141,25 +142,6 @@ class Section:
     name: str
     length: float
     source: str
-
-
-@dataclass(frozen=True)
-class Compensation:
-    """``[compensation]``: the known-delay compensation of the compensated rows.
-
-    Attributes
-    ----------
-    d_terminal : float
-        Distance to go (m) at which the predictive terminal stopping law takes over.
-    gain_tau : float
-        Time constant (s) of the model's brake-gain correction (0: none).
-    gain_bounds : (float, float)
-        Bounds of that correction.
-    """
-
-    d_terminal: float
-    gain_tau: float
-    gain_bounds: tuple[float, float]
 
 
 @dataclass(frozen=True)
