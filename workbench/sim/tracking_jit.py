@@ -64,7 +64,9 @@ def _substeps(n_sub, head, fifo, demand, v, s, a, work, stopped, stop_time, stop
         st = stopped[i]
         for j in range(n_sub):
             fifo[h, i] = demand[i]
-            h = (h + 1) % size
+            h += 1
+            if h == size:      # (h + 1) % size without a division
+                h = 0
             A = fifo[h, i]
             if first_order:
                 a_int = _min(_max((A - vi) * (1.0 - decay[i]), lo[i]), hi[i])
