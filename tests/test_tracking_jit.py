@@ -72,3 +72,10 @@ def test_trains_of_different_delays_are_refused(spec):
         simulate_tracking((tr, other), spec.main.route, lambda t: np.zeros_like(t),
                           lambda k, y, yn: np.zeros(2), 2, Ts=0.1, dt=0.01, horizon=1.0,
                           brake_start=1e9)
+
+
+def test_an_unknown_kernel_is_refused(spec):
+    with pytest.raises(ValueError, match="expected 'compiled' or 'numpy'"):
+        simulate_tracking(spec.readings[0].train, spec.main.route, lambda t: np.zeros_like(t),
+                          lambda k, y, yn: np.zeros(1), 1, Ts=0.1, dt=0.01, horizon=1.0,
+                          brake_start=1e9, kernel="fortran")

@@ -127,6 +127,8 @@ def simulate_tracking(train: Train002 | Sequence[Train002], route: Route,
     if not trains or n % len(trains) or len({(type(x), x.delay) for x in trains}) != 1:
         raise ValueError(f"{len(trains)} trains for a batch of {n}: expected trains of one "
                          f"model and one delay, and a batch that is a multiple of their number")
+    if kernel not in (None, "compiled", "numpy"):
+        raise ValueError(f"kernel = {kernel!r}; expected 'compiled' or 'numpy'")
     train = trains[0]
     n_sub = int(round(Ts / dt))
     n_delay = int(round(train.delay / dt))
