@@ -18,11 +18,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Literal, Sequence
 
 import numpy as np
 
-from ..plants.train002 import FirstOrderTrain002, Train002
+from ..plants.train002 import FirstOrderTrain002, Train002, davis, static_map
 
 
 @dataclass(frozen=True)
@@ -89,14 +89,20 @@ Controller = Callable[[int, np.ndarray, np.ndarray], np.ndarray]
 """``control(k, y, y_target_next) -> u`` for a batch (arrays of shape (N,))."""
 
 
-def simulate_tracking(train: Train002, route: Route, target: Callable[[np.ndarray], np.ndarray],
-                      control: Controller, n: int, *, Ts: float, dt: float,
-                      horizon: float, brake_start: float) -> TrackingRun:
-    """Track ``target(t)`` with ``control`` on a batch of ``n`` identical trains.
+def simulate_tracking(train: Train002 | Sequence[Train002], route: Route,
+                      target: Callable[[np.ndarray], np.ndarray], control: Controller, n: int,
+                      *, Ts: float, dt: float, horizon: float, brake_start: float,
+                      kernel: Literal["compiled", "numpy"] | None = None) -> TrackingRun:
+    """Track ``target(t)`` with ``control`` on a batch of ``n`` trains.
 
     Parameters
     ----------
-    train : Train002
+    train : Train002 or sequence of Train002
+        One train for the whole batch, or G trains of one model and one delay
+        (e.g. a train and copies with nudged parameters,
+        :func:`workbench.features.reproducible.nudged`): the batch is then G
+        consecutive blocks of ``n / G`` runs, block g on train g. Every run
+        does the arithmetic it does in a batch of its own train.
     route : Route
     target : callable
         Target speed (m/s) as a function of time (s), vectorised.
@@ -112,20 +118,30 @@ def simulate_tracking(train: Train002, route: Route, target: Callable[[np.ndarra
         Longest simulated time (s).
     brake_start : float
         Time (s) after which a standstill counts as the stop.
+    kernel : {"compiled", "numpy"}, optional
+        How the plant steps between two samples run: the numba kernel of
+        :mod:`workbench.sim.tracking_jit` (the default when numba is
+        installed) or numpy arrays; both give the same bits.
     """
+    trains = (train,) if isinstance(train, Train002) else tuple(train)
+    if not trains or n % len(trains) or len({(type(x), x.delay) for x in trains}) != 1:
+        raise ValueError(f"{len(trains)} trains for a batch of {n}: expected trains of one "
+                         f"model and one delay, and a batch that is a multiple of their number")
+    if kernel not in (None, "compiled", "numpy"):
+        raise ValueError(f"kernel = {kernel!r}; expected 'compiled' or 'numpy'")
+    train = trains[0]
     n_sub = int(round(Ts / dt))
     n_delay = int(round(train.delay / dt))
     if not math.isclose(n_sub * dt, Ts) or not math.isclose(n_delay * dt, train.delay,
                                                             abs_tol=1e-12):
         raise ValueError(f"Ts = {Ts} and delay = {train.delay} must be multiples of dt = {dt}")
+    step = _substeps_numpy if kernel == "numpy" else _compiled_or_numpy(kernel)
     K = int(math.ceil(horizon / Ts))
     first_order = isinstance(train, FirstOrderTrain002)
-    decay = math.exp(-dt / train.lag)
-    gain_int = train.lag * (1.0 - decay)          # integral of (1 - e^{-t/T}) weight
+    p = _per_run(trains, n, dt, first_order, np.asarray(route.grade))
     fifo = np.zeros((n_delay + 1, n))              # demands of the last n_delay steps
     head = 0
-    edges = np.asarray(route.grade_from[1:])
-    grade_acc = train.grade(np.asarray(route.grade))   # per section (m/s^2)
+    edges = np.asarray(route.grade_from[1:], float)
     v = np.zeros(n); s = np.zeros(n); a = np.zeros(n)
     work = np.zeros(n)
     stopped = np.zeros(n, bool)
@@ -138,26 +154,11 @@ def simulate_tracking(train: Train002, route: Route, target: Callable[[np.ndarra
         u = np.where(stopped, 0.0, control(k, v.copy(), y_next))
         H["v"][:, k], H["s"][:, k], H["u"][:, k] = v, s, u
         H["target"][:, k] = target(np.array(t))
-        demand = train.demand(u)
-        for j in range(n_sub):
-            fifo[head] = demand
-            head = (head + 1) % (n_delay + 1)
-            A = fifo[head]                          # demand of n_delay steps ago
-            if first_order:     # exact lag increment of v, within the acceleration limits
-                a_int = np.clip((A - v) * (1.0 - decay), train.a_min * dt, train.a_max * dt)
-            else:               # exact lag over the step with A held: a(t+dt) and its integral
-                a_int = A * dt + (a - A) * gain_int
-                a = A + (a - A) * decay
-            acc_ext = train.resistance(v) + grade_acc[np.searchsorted(edges, s, side="right")]
-            v_new = np.maximum(v + a_int - acc_ext * dt, 0.0)   # no rolling back
-            work += np.where(stopped, 0.0, np.maximum(a_int, 0.0) * v)
-            s = s + np.where(stopped, 0.0, 0.5 * (v + v_new) * dt)
-            v = np.where(stopped, 0.0, v_new)
-            t_now = t + (j + 1) * dt
-            now_stopped = ~stopped & (v <= 0.0) & (t_now >= brake_start)
-            stop_time = np.where(now_stopped, t_now, stop_time)
-            stop_pos = np.where(now_stopped, s, stop_pos)
-            stopped |= now_stopped
+        demand = static_map(np.clip(u, p["u_min"], p["u_max"]), p["f"], p["e"])
+        head = step(n_sub, head, fifo, np.ascontiguousarray(demand, float), v, s, a, work,
+                    stopped, stop_time, stop_pos, t, dt, brake_start, first_order, p["decay"],
+                    p["gain_int"], p["lo"], p["hi"], p["c0"], p["c1"], p["c2"], edges,
+                    p["grade_acc"])
         if stopped.all():
             K = k + 1
             break
@@ -165,6 +166,62 @@ def simulate_tracking(train: Train002, route: Route, target: Callable[[np.ndarra
     acc = np.diff(np.concatenate([v_hist, v[:, None]], axis=1), axis=1) / Ts
     return TrackingRun(t_hist[:K], v_hist, H["s"][:, :K], acc, H["u"][:, :K],
                        H["target"][:, :K], stop_time, stop_pos, work)
+
+
+def _per_run(trains, n: int, dt: float, first_order: bool, grade) -> dict:
+    """Each train's constants of the plant step, one entry per run (block g of
+    the batch on train g), computed per train as the one-train loop does."""
+    def col(fn):
+        return np.repeat(np.array([fn(x) for x in trains], float), n // len(trains), axis=0)
+    decay = [math.exp(-dt / x.lag) for x in trains]
+    return {"decay": col(lambda x: decay[trains.index(x)]),
+            "gain_int": col(lambda x: x.lag * (1.0 - decay[trains.index(x)])),
+            "lo": col(lambda x: x.a_min * dt if first_order else -math.inf),
+            "hi": col(lambda x: x.a_max * dt if first_order else math.inf),
+            "grade_acc": col(lambda x: x.grade(grade)),     # per section (m/s^2)
+            **{k: col(lambda x, k=k: getattr(x, k))
+               for k in ("c0", "c1", "c2", "f", "e", "u_min", "u_max")}}
+
+
+def _substeps_numpy(n_sub, head, fifo, demand, v, s, a, work, stopped, stop_time, stop_pos,
+                    t, dt, brake_start, first_order, decay, gain_int, lo, hi, c0, c1, c2,
+                    edges, grade_acc):
+    """The plant steps between two samples on numpy arrays (state updated in
+    place; returns the FIFO's new head): the reference of
+    :func:`workbench.sim.tracking_jit.substeps`."""
+    rows = np.arange(v.size)
+    for j in range(n_sub):
+        fifo[head] = demand
+        head = (head + 1) % fifo.shape[0]
+        A = fifo[head]                          # demand of n_delay steps ago
+        if first_order:     # exact lag increment of v, within the acceleration limits
+            a_int = np.clip((A - v) * (1.0 - decay), lo, hi)
+        else:               # exact lag over the step with A held: a(t+dt) and its integral
+            a_int = A * dt + (a - A) * gain_int
+            a[:] = A + (a - A) * decay
+        acc_ext = davis(v, c0, c1, c2) + grade_acc[rows, np.searchsorted(edges, s, side="right")]
+        v_new = np.maximum(v + a_int - acc_ext * dt, 0.0)   # no rolling back
+        work += np.where(stopped, 0.0, np.maximum(a_int, 0.0) * v)
+        s[:] = s + np.where(stopped, 0.0, 0.5 * (v + v_new) * dt)
+        v[:] = np.where(stopped, 0.0, v_new)
+        t_now = t + (j + 1) * dt
+        now_stopped = ~stopped & (v <= 0.0) & (t_now >= brake_start)
+        stop_time[:] = np.where(now_stopped, t_now, stop_time)
+        stop_pos[:] = np.where(now_stopped, s, stop_pos)
+        stopped |= now_stopped
+    return head
+
+
+def _compiled_or_numpy(kernel):
+    """The compiled sub-step kernel, or the numpy one when numba is missing
+    (``kernel="compiled"`` then raises)."""
+    try:
+        from .tracking_jit import substeps
+    except ImportError:
+        if kernel == "compiled":
+            raise
+        return _substeps_numpy
+    return substeps
 
 
 @dataclass(frozen=True)

@@ -259,14 +259,17 @@ def _before_stop(run: TrackingRun) -> np.ndarray:
     return run.t[None, :] < stop[:, None]
 
 
-def _grid_run(spec, reading, train, sec, prof, kind: str, P: np.ndarray):
-    """Every combination ``P`` of one controller's grid on ``train``, one batch."""
+def _grid_run(spec, reading, trains, sec, prof, kind: str, P: np.ndarray):
+    """Every combination ``P`` of one controller's grid on each of ``trains``,
+    one batch (block g of the batch: the grid on train g; runs are independent,
+    so each gets the bits of a batch of its own train)."""
     keys = MFAC_KEYS if kind == "mfac" else PID_KEYS
-    gains = dict(zip(keys, P.T))
-    ctl = (_mfac(reading, gains, len(P)) if kind == "mfac" else
-           _pid(spec, reading, gains, len(P)))
-    run = _sim(spec, train, sec, prof,
-               lambda k, y, yn: ctl.step(y, yn) if kind == "mfac" else ctl.step(yn - y), len(P))
+    PP = np.tile(P, (len(trains), 1))
+    gains = dict(zip(keys, PP.T))
+    ctl = (_mfac(reading, gains, len(PP)) if kind == "mfac" else
+           _pid(spec, reading, gains, len(PP)))
+    run = _sim(spec, trains, sec, prof,
+               lambda k, y, yn: ctl.step(y, yn) if kind == "mfac" else ctl.step(yn - y), len(PP))
     return run, ctl, objectives(run, sec.route.distance, sec.run_time)
 
 
@@ -274,13 +277,15 @@ def _tune(spec, reading, sec, prof, kind: str) -> tuple[Tuning, TrackingRun, MFA
     keys = MFAC_KEYS if kind == "mfac" else PID_KEYS
     grid = reading.mfac_grid if kind == "mfac" else reading.pid_grid
     P = np.array(list(itertools.product(*(grid[k] for k in keys))))
-    run, ctl, qo = _grid_run(spec, reading, reading.train, sec, prof, kind, P)
-    obj = qo.matrix()
     # each run's reproducibility band: the grid again on the train moved by +-NUDGE
     # (relative; the delay stays whole steps); a run whose objectives move more than
-    # RTOL is no result (issue 36, item 5)
-    again = [_grid_run(spec, reading, nudged(reading.train, s * NUDGE, keep=("delay",)), sec,
-                       prof, kind, P)[2].matrix() for s in (1, -1)]
+    # RTOL is no result (issue 36, item 5). One batch of the three: one time loop
+    trains = (reading.train, *(nudged(reading.train, s * NUDGE, keep=("delay",)) for s in (1, -1)))
+    run3, ctl, q3 = _grid_run(spec, reading, trains, sec, prof, kind, P)
+    N = len(P)
+    obj, *again = (q3.matrix()[g * N:(g + 1) * N] for g in range(len(trains)))
+    run = run3.rows(slice(0, N))
+    peak_jerk = q3.peak_jerk[:N]
     repro = reproducible([obj, *again])
     col = OBJECTIVES.index("stop_error")
     errs = np.stack([x[:, col] for x in (obj, *again)])
@@ -289,11 +294,11 @@ def _tune(spec, reading, sec, prof, kind: str) -> tuple[Tuning, TrackingRun, MFA
     scales = [spec.scales[k].value for k in OBJECTIVES]
     rate = None
     if kind == "mfac":
-        resets = ctl.record("reset")[:, :run.t.size - 1]
+        resets = ctl.record("reset")[:N, :run.t.size - 1]
         rate = _mean_before_stop(resets, _before_stop(run)[:, 1:])
     admissible = (stops == -1) & repro
     if spec.peak_jerk is not None:       # comfort: a peak constraint, not a weighted term
-        comfortable = admissible & (qo.peak_jerk <= spec.peak_jerk.value)
+        comfortable = admissible & (peak_jerk <= spec.peak_jerk.value)
         if comfortable.any():            # else: no run meets it; the claims say so
             admissible = comfortable
     try:
