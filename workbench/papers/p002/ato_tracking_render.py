@@ -301,7 +301,7 @@ def _compare(res) -> str:
         + md_table(["reading"] + [LABEL[i] for i in OBJECTIVES], brows, "lrrrr")
         + "\n\nWeight-free comparison of the fronts: the share of one controller's front that "
         "a point of the other's front dominates (better or equal in all four, better in "
-        f"one; values within {TIE_REL:g} relative of each other count as equal, so that no "
+        f"one; values within {fmt(TIE_REL)} relative of each other count as equal, so that no "
         "share rests on the last bits of two near-equal runs):\n\n"
         + md_table(["reading", "PID front dominated by MFAC", "MFAC front dominated by PID"],
                    drows, "lrr")
