@@ -93,12 +93,32 @@ def test_claim_semantics():
     assert check_claim(xf, 0.5).ok and not check_claim(xf, 2.0).ok
 
 
-def test_golden_report(tmp_path, request):
+@pytest.fixture(scope="module")
+def small_report(tmp_path_factory):
+    """A folder holding ``workbench report tests/data/small-cruise.toml``, written
+    once for the tests of this file that read it or copy it (the tests that
+    write into a report folder work on their own copy)."""
+    out = tmp_path_factory.mktemp("small-report")
+    import os
+    cwd = os.getcwd()
+    os.chdir(Path(__file__).resolve().parents[1])      # DATA is relative to the root
+    try:
+        assert main(["report", str(DATA / "small-cruise.toml"), "--out", str(out)]) == 0
+    finally:
+        os.chdir(cwd)
+    return out
+
+
+def _copy_report(src, dst):
+    import shutil
+    shutil.copytree(src, dst, dirs_exist_ok=True)
+
+
+def test_golden_report(tmp_path, request, small_report):
     """The report of a small design, byte for byte (regenerate with --regen-golden)."""
     src = DATA / "small-cruise.toml"
-    assert main(["report", str(src), "--out", str(tmp_path)]) == 0
-    md = (tmp_path / "small-cruise.md").read_text()
-    assert (tmp_path / "small-cruise" / "delay-bound-vs-eps.png").is_file()
+    md = (small_report / "small-cruise.md").read_text()
+    assert (small_report / "small-cruise" / "delay-bound-vs-eps.png").is_file()
     golden = GOLDEN / "small-cruise.md"
     if request.config.getoption("--regen-golden"):
         GOLDEN.mkdir(exist_ok=True)
@@ -111,14 +131,16 @@ def test_golden_report(tmp_path, request):
     assert (tmp_path / "again" / "small-cruise.md").read_text() == md
 
 
-def test_report_check_detects_stale_and_missing(tmp_path, capsys):
+def test_report_check_detects_stale_and_missing(tmp_path, capsys, small_report):
+    """A fresh report passes ``--check``; an edited Markdown, a figure one byte
+    longer and a missing figure each fail it (exit 1)."""
     src = str(DATA / "small-cruise.toml")
-    assert main(["report", src, "--out", str(tmp_path)]) == 0
+    _copy_report(small_report, tmp_path)               # the fresh report (`report --out`)
     assert main(["report", src, "--out", str(tmp_path), "--check"]) == 0
     md = tmp_path / "small-cruise.md"
     md.write_text(md.read_text() + "edited\n")
     assert main(["report", src, "--out", str(tmp_path), "--check"]) == 1
-    assert main(["report", src, "--out", str(tmp_path)]) == 0
+    _copy_report(small_report, tmp_path)               # fresh again
     png = tmp_path / "small-cruise" / "delay-bound-vs-eps.png"
     png.write_bytes(png.read_bytes() + b"\0")      # a figure is compared byte for byte
     assert main(["report", src, "--out", str(tmp_path), "--check"]) == 1
@@ -128,9 +150,8 @@ def test_report_check_detects_stale_and_missing(tmp_path, capsys):
     assert "missing figure" in capsys.readouterr().out
 
 
-def test_report_is_markdown_with_math_tables_and_relative_images(tmp_path):
-    assert main(["report", str(DATA / "small-cruise.toml"), "--out", str(tmp_path)]) == 0
-    md = (tmp_path / "small-cruise.md").read_text()
+def test_report_is_markdown_with_math_tables_and_relative_images(small_report):
+    md = (small_report / "small-cruise.md").read_text()
     assert "$$\n" in md and "| :---" in md or "| ---:" in md
     assert "](small-cruise/delay-bound-vs-eps.png)" in md
     for section in ("## Problem", "## Model", "## Operating point", "## Certified delay bounds",

@@ -15,6 +15,7 @@ Systems: Gaussian 2 x 2 with A + A_d Hurwitz and a finite delay margin of
 moderate size in the system's own time unit (rejection), and the
 pocket system (stable only on a window) for the interval search.
 """
+import functools
 import math
 
 import numpy as np
@@ -36,6 +37,23 @@ REL_TOL = 1e-4
 #: Bracket width twice (one per search) plus solver noise at the boundary.
 SLACK = 5 * REL_TOL
 POCKET = (np.array([[0.0, 1.0], [-2.0, 0.1]]), np.array([[0.0, 0.0], [1.0, 0.0]]))
+
+
+@functools.lru_cache(maxsize=None)
+def pocket_window(c: float):
+    """The pocket's certified window in time unit c, (c A, c A_d) with the range
+    10 / c (kept: the c = 1 window is every scale's reference)."""
+    res = certified_interval(make_criterion("bessel-legendre", c * POCKET[0], c * POCKET[1],
+                                            N=2), h_hi=10.0 / c, rel_tol=1e-3, max_solves=80)
+    return res.bounds
+
+
+@functools.lru_cache(maxsize=None)
+def scalar_synthesis(c: float):
+    """Wirtinger synthesis of x' = c x + c u(t - h) with the cap 10 / c (kept: the
+    c = 1 result is every scale's reference)."""
+    from workbench.lmi.tight_synthesis import synthesize_tight
+    return synthesize_tight(np.array([[c]]), np.array([[c]]), h_max=10.0 / c)
 
 
 def system(seed: int):
@@ -87,12 +105,8 @@ def test_similarity_and_permutation_leave_the_bound(seed):
 @pytest.mark.parametrize("c", [1e-6, 1e-3, 1e3, 1e6])
 def test_interval_search_scales_with_time(c):
     """The pocket's certified window is found in any time unit, divided by c."""
-    def window(A, Ad, scale):
-        res = certified_interval(make_criterion("bessel-legendre", A, Ad, N=2),
-                                 h_hi=10.0 / scale, rel_tol=1e-3, max_solves=80)
-        return res.bounds
-    lo, hi = window(*POCKET, 1.0)
-    lo_c, hi_c = window(c * POCKET[0], c * POCKET[1], c)
+    lo, hi = pocket_window(1.0)
+    lo_c, hi_c = pocket_window(c)
     assert abs(lo_c * c / lo - 1) <= 3e-3 and abs(hi_c * c / hi - 1) <= 3e-3
 
 
@@ -152,10 +166,7 @@ def test_synthesis_scales_with_time(c):
     """Wirtinger synthesis of x' = x + u(t - h) in another time unit: (c A, c B)
     with the cap h_max / c (the default eps grid follows the cap) gives the
     same gain K (u = K x(t - h) is dimensionless here) and h / c."""
-    from workbench.lmi.tight_synthesis import synthesize_tight
-    A, B = np.array([[1.0]]), np.array([[1.0]])
-    r1 = synthesize_tight(A, B, h_max=10.0)
-    rc = synthesize_tight(c * A, c * B, h_max=10.0 / c)
+    r1, rc = scalar_synthesis(1.0), scalar_synthesis(c)
     assert _close(r1.bracket.h_certified, c * rc.bracket.h_certified)
     assert r1.K is not None and rc.K is not None
     assert np.allclose(rc.K, r1.K, rtol=2e-3)

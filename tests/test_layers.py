@@ -95,8 +95,17 @@ def _package(module: str) -> str:
     return parts[1] if len(parts) > 1 else ""
 
 
-GRAPH = {m: {_resolve(mod, n) for mod, n, _ in _imports(m, p)} - {m}
-         for m, p in MODULES.items()}
+#: module -> the workbench modules it imports; filled before the first test of
+#: this file runs (parsing every module at import would cost each xdist worker's
+#: collection ~0.5 s, also the workers that run none of these tests)
+GRAPH: dict[str, set[str]] = {}
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _graph():
+    if not GRAPH:
+        GRAPH.update({m: {_resolve(mod, n) for mod, n, _ in _imports(m, p)} - {m}
+                      for m, p in MODULES.items()})
 
 
 def _cycles() -> list[list[str]]:

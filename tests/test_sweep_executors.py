@@ -82,7 +82,18 @@ def test_killed_worker_mid_sweep(short, reference):
     assert_identical(res, reference["numpy"])
 
 
-def test_unreachable_scheduler_is_a_cli_error(capsys):
+def test_unreachable_scheduler_is_a_cli_error(capsys, monkeypatch):
+    """A scheduler address nobody listens on: exit 2 naming --scheduler. The
+    connect is retried until its timeout (10 s in the code); the test gives it
+    0.5 s, the refusal on a closed local port is the same."""
+    import distributed
+
+    class QuickClient(distributed.Client):
+        def __init__(self, *args, timeout=None, **kwargs):
+            assert timeout is not None  # the code bounds the connect
+            super().__init__(*args, timeout="0.5s", **kwargs)
+
+    monkeypatch.setattr(distributed, "Client", QuickClient)
     code = main(["sweep", "designs/antiskid-run-dry.toml", "--samples", "2", "--seed", "1",
                  "--scheduler", "tcp://127.0.0.1:9"])
     err = capsys.readouterr().err

@@ -69,10 +69,14 @@ def test_synthesis_at_the_peak_retries_without_balancing(tmp_path):
     """With the operating point AT the peak (A11 = -0.009 1/s, A triangular),
     the balancing step of the synthesis coordinates scaled the wheel speed by
     2^12 and the synthesis returned no gain (helper rail31b, 2026-11-27); the
-    retry in the Gramian normalisation alone certifies decay >= 4 1/s."""
+    retry in the Gramian normalisation alone certifies decay >= 4 1/s. The
+    design's own synthesis only (the study's run adds margins and simulations
+    this claim does not read); its requirement rows are the quantities the
+    study reports (``requirement_quantities`` of the same synthesis)."""
     import re
 
-    from workbench.kinds import REGISTRY
+    from workbench.kinds.delay_feedback.requirements import requirement_quantities
+    from workbench.kinds.delay_feedback.run import designed_gain
     text = DESIGN.read_text()
     old = "lam_0 = { value = 0.11, "
     assert old in text
@@ -81,7 +85,9 @@ def test_synthesis_at_the_peak_retries_without_balancing(tmp_path):
     path = tmp_path / DESIGN.name
     path.write_text(text)
     design = load_design(path)
-    study = REGISTRY[design.kind]
-    q = study.quantities(study.run(design))
+    assert design.spec.synthesis.method == "requirements" and not design.spec.vertices
+    gain = designed_gain(design)
+    assert gain is not None, "no gain was certified"
+    q = requirement_quantities(gain[-1].requirements)
     assert q["requirements.decay.certified"] >= 4.0
     assert q["requirements.decay.verdict"] == "PASS"
