@@ -216,7 +216,18 @@ def delay_range_stable(windows, h_min: float, h_max: float) -> bool:
 def design_synthesis(spec, model, values, op, A, B, points=()) -> SynthesisOutcome:
     """The design's own synthesis: to its ``[requirements]`` when it has them
     (:func:`synthesise_requirements`), else the method of ``[synthesis]``
-    with the design's delay and search cap attached (for the reason)."""
+    with the design's delay and search cap attached (for the reason).
+
+    Computed once per process and run (:func:`workbench.memo.computed_once`,
+    keyed by the exact spec, which determines every other argument): the
+    study, ``simulate``, ``sweep`` and the tests share one synthesis."""
+    from ...memo import computed_once, spec_key
+    key = spec_key(spec)
+    compute = lambda: _design_synthesis(spec, model, values, op, A, B, points)  # noqa: E731
+    return compute() if key is None else computed_once("design_synthesis", key, compute)
+
+
+def _design_synthesis(spec, model, values, op, A, B, points=()) -> SynthesisOutcome:
     if spec.synthesis.method == "requirements":
         return synthesise_requirements(spec, model, values, op, A, B, points)
     return replace(synthesise(spec, A, B, points), required=spec.delay.h_max,
