@@ -333,7 +333,7 @@ def guarded_solve(problem: cp.Problem, settings: Mapping | None = None) -> tuple
     try:
         with warnings.catch_warnings():   # "inaccurate" is an outcome, not a warning
             warnings.simplefilter("ignore", UserWarning)
-            problem.solve(solver=cp.CLARABEL, **dict(settings or {}))
+            _solve_primal(problem, dict(settings or {}))
         status = str(problem.status)
     except (cp.error.SolverError, ValueError, ArithmeticError) as exc:  # an answer
         status = f"error: {exc}".splitlines()[0][:200]
@@ -342,6 +342,38 @@ def guarded_solve(problem: cp.Problem, settings: Mapping | None = None) -> tuple
             raise
         status = f"error: solver panic: {exc}".splitlines()[0][:200]
     return status, time.perf_counter() - t0
+
+
+class _PrimalOnly:
+    """Clarabel's answer without its dual vector ``z``: cvxpy then recovers
+    the primal values only (the duals of the ~10-20 PSD blocks are unpacked
+    into full matrices, the largest part of cvxpy's time after a solve, and
+    the workbench never reads them)."""
+
+    __slots__ = ("status", "solve_time", "iterations", "x", "obj_val", "z")
+
+    def __init__(self, raw):
+        self.status, self.solve_time, self.iterations = raw.status, raw.solve_time, raw.iterations
+        self.x, self.obj_val, self.z = raw.x, raw.obj_val, None
+
+
+def _solve_primal(problem: cp.Problem, settings: dict) -> None:
+    """``problem.solve(solver=cp.CLARABEL, **settings)``, primal values only.
+
+    The same steps as cvxpy's ``Problem._solve`` (``get_problem_data``, the
+    solving chain's ``solve_via_data`` with the problem's solver cache, then
+    ``unpack_results``): the same data reach Clarabel, a new Clarabel solver
+    is built for every solve as before (its data update is refused with
+    presolve or chordal decomposition on, the defaults), and the status,
+    optimal value and variable values are unpacked by the same inversion,
+    bit for bit; only the dual values are left unset (issue 36, item 4).
+    """
+    for par in problem.parameters():
+        if par.value is None:
+            raise cp.error.ParameterError(f"parameter {par.name()} has no value")
+    data, chain, inverse = problem.get_problem_data(cp.CLARABEL, solver_opts=settings)
+    raw = chain.solve_via_data(problem, data, True, False, dict(settings))
+    problem.unpack_results(_PrimalOnly(raw), chain, inverse)
 
 
 #: Probes above an inconclusive (solver-inaccurate) upper end of a bisection
