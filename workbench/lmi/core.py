@@ -61,6 +61,11 @@ DEFAULT_BOUND = 1e3
 CLARABEL_SETTINGS: dict = {}
 
 
+#: Status of a step decided without a solve, from a relaxation refuted at or
+#: below its delay (:func:`workbench.lmi.gain.canonical_gain`).
+IMPLIED = "implied"
+
+
 @dataclass(frozen=True)
 class Block:
     """One LMI block: ``matrix <= -margin I`` (``sense='nsd'``) or ``>= margin I``."""
@@ -118,7 +123,9 @@ class Bracket:
 
     @property
     def solves(self) -> int:
-        return len(self.steps)
+        """Solver calls: the steps less those decided without a solve
+        (status :data:`IMPLIED`)."""
+        return sum(1 for s in self.steps if not s.solver_status.startswith(IMPLIED))
 
     @property
     def seconds(self) -> float:
