@@ -340,7 +340,10 @@ def guarded_solve(problem: cp.Problem, settings: Mapping | None = None) -> tuple
     try:
         with warnings.catch_warnings():   # "inaccurate" is an outcome, not a warning
             warnings.simplefilter("ignore", UserWarning)
-            _solve_primal(problem, dict(settings or {}))
+            if FULL_UNPACK:
+                problem.solve(solver=cp.CLARABEL, **dict(settings or {}))
+            else:
+                _solve_primal(problem, dict(settings or {}))
         status = str(problem.status)
     except (cp.error.SolverError, ValueError, ArithmeticError) as exc:  # an answer
         status = f"error: {exc}".splitlines()[0][:200]
@@ -349,6 +352,12 @@ def guarded_solve(problem: cp.Problem, settings: Mapping | None = None) -> tuple
             raise
         status = f"error: solver panic: {exc}".splitlines()[0][:200]
     return status, time.perf_counter() - t0
+
+
+#: Solve through cvxpy's ``Problem.solve`` (dual values unpacked too) instead
+#: of :func:`_solve_primal`: the path before issue 36's cut, for
+#: ``benchmarks/synthesize_times.py`` (same status, same primal values).
+FULL_UNPACK = False
 
 
 class _PrimalOnly:

@@ -51,6 +51,10 @@ from .core import IMPLIED, Bracket, MarginLMI, Outcome, Step, bisect_delay
 DEFAULT_FRACTION = 0.99
 #: Significant digits of a canonical gain.
 DEFAULT_DIGITS = 4
+#: Decide the probes at or above ``refuted_from`` without a solve
+#: (:func:`canonical_gain`); False solves them, as before issue 36's cut
+#: (``benchmarks/synthesize_times.py``: the same bracket either way).
+IMPLIED_PROBES = True
 #: Lower end of the rounded gain's own bisection, as a fraction of the design
 #: delay (relative, so the search is the same in any time unit).
 ANALYSIS_FLOOR = 1e-4
@@ -166,7 +170,7 @@ def canonical_gain(lmi: MarginLMI, h_certified: float, fixed: Callable[[np.ndarr
     K = round_significant(lmi.gain(point.certificate) @ np.diag(1.0 / np.diag(T)), digits)
     crit = fixed(K @ T)
     decide = crit.solve_at
-    if (refuted_from is not None and math.isfinite(refuted_from)
+    if (IMPLIED_PROBES and refuted_from is not None and math.isfinite(refuted_from)
             and np.abs(K @ T).sum(axis=1).max() <= lmi.bound):
         def decide(h_, _solve=crit.solve_at, _from=float(refuted_from)):
             if h_ >= _from:
