@@ -340,10 +340,8 @@ def guarded_solve(problem: cp.Problem, settings: Mapping | None = None) -> tuple
     try:
         with warnings.catch_warnings():   # "inaccurate" is an outcome, not a warning
             warnings.simplefilter("ignore", UserWarning)
-            if FULL_UNPACK:
-                problem.solve(solver=cp.CLARABEL, **dict(settings or {}))
-            else:
-                _solve_primal(problem, dict(settings or {}))
+            problem.solve(solver=cp.CLARABEL, **({} if FULL_UNPACK else {"method": PRIMAL_ONLY}),
+                          **dict(settings or {}))
         status = str(problem.status)
     except (cp.error.SolverError, ValueError, ArithmeticError) as exc:  # an answer
         status = f"error: {exc}".splitlines()[0][:200]
@@ -354,8 +352,8 @@ def guarded_solve(problem: cp.Problem, settings: Mapping | None = None) -> tuple
     return status, time.perf_counter() - t0
 
 
-#: Solve through cvxpy's ``Problem.solve`` (dual values unpacked too) instead
-#: of :func:`_solve_primal`: the path before issue 36's cut, for
+#: Solve through cvxpy's own ``Problem._solve`` (dual values unpacked too)
+#: instead of :func:`_solve_primal`: the path before issue 36's cut, for
 #: ``benchmarks/synthesize_times.py`` (same status, same primal values).
 FULL_UNPACK = False
 
@@ -373,8 +371,9 @@ class _PrimalOnly:
         self.x, self.obj_val, self.z = raw.x, raw.obj_val, None
 
 
-def _solve_primal(problem: cp.Problem, settings: dict) -> None:
-    """``problem.solve(solver=cp.CLARABEL, **settings)``, primal values only.
+def _solve_primal(problem: cp.Problem, solver: str = cp.CLARABEL, **settings) -> None:
+    """``problem.solve(solver=cp.CLARABEL, **settings)``, primal values only
+    (registered as the cvxpy solve method :data:`PRIMAL_ONLY`).
 
     The same steps as cvxpy's ``Problem._solve`` (``get_problem_data``, the
     solving chain's ``solve_via_data`` with the problem's solver cache, then
@@ -387,9 +386,14 @@ def _solve_primal(problem: cp.Problem, settings: dict) -> None:
     for par in problem.parameters():
         if par.value is None:
             raise cp.error.ParameterError(f"parameter {par.name()} has no value")
-    data, chain, inverse = problem.get_problem_data(cp.CLARABEL, solver_opts=settings)
+    data, chain, inverse = problem.get_problem_data(solver, solver_opts=settings)
     raw = chain.solve_via_data(problem, data, True, False, dict(settings))
     problem.unpack_results(_PrimalOnly(raw), chain, inverse)
+
+
+#: Name of :func:`_solve_primal` as a cvxpy solve method (``Problem.solve(method=...)``).
+PRIMAL_ONLY = "workbench_primal_only"
+cp.Problem.register_solve(PRIMAL_ONLY, _solve_primal)
 
 
 #: Probes above an inconclusive (solver-inaccurate) upper end of a bisection
