@@ -142,11 +142,12 @@ def canonical_gain(lmi: MarginLMI, h_certified: float, fixed: Callable[[np.ndarr
         ``h_refuted``). Every point of the fixed-gain LMI is a point of
         ``lmi`` (``V = K X``) when ``|V| <= lmi.bound`` holds for it, which
         the gain guarantees when its largest absolute row sum is at most
-        ``lmi.bound`` (the entries of ``X``, positive semidefinite with trace
-        <= 1 in the solver's normalisation, are at most 1 in modulus): then
-        the fixed-gain optimum is at most ``lmi``'s, the fixed-gain LMI is
-        refuted at ``refuted_from`` and, as the bisection assumes (the
-        criterion is monotone in h), above it. Probes there are recorded as
+        ``lmi.bound`` on every point that could certify (margin t > 0: ``X``
+        is then positive definite with trace <= 1 in the solver's
+        normalisation, so its entries are at most 1 in modulus): a fixed-gain
+        point with margin >= ``lmi.margin`` would be one of ``lmi``, so the
+        fixed-gain LMI is refuted at ``refuted_from`` and, as the bisection
+        assumes (the criterion is monotone in h), above it. Probes there are recorded as
         REFUTED steps with the status :data:`~workbench.lmi.core.IMPLIED`,
         no solve; without that row-sum bound every probe is solved. For
         a ``lmi`` whose gain basis ``X`` has a positive block
