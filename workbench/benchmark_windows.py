@@ -160,8 +160,7 @@ def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: f
     search = certified_interval(lmi, h_hi=h_max, starts=starts, rel_tol=rel_tol,
                                 guess=guess or (h if 0 < h < h_max else None),
                                 max_solves=260, zero=zero,
-                                lower=comp.interval(lmi, from_zero=False),
-                                infeasible=infeasible_points(lmi, bound))
+                                lower=comp.interval(lmi, from_zero=False))
     if search.interval is not None:
         settled = tuple(settle_interval(lmi, c, h_max, win=comp.interval(lmi, from_zero=False))
                         for c in search.intervals)
@@ -178,19 +177,6 @@ def interval_fields(lmi, bound, windows, h_star: float, h_max: float, rel_tol: f
                                      (1.0 if math.isinf(iv[1]) and math.isinf(h_star)
                                       else None))
     return out
-
-
-def infeasible_points(lmi, bound) -> tuple[float, ...]:
-    """Delays (s) at which ``bound``'s own bisection found the point criterion
-    ``lmi`` infeasible (optimal with ``t* <= -margin``), for the interval
-    search (:func:`~workbench.lmi.interval.certified_interval`); none when the
-    bound was certified by another order (``certified_by``: its steps are
-    that order's)."""
-    if getattr(bound, "certified_by", None) is not None:
-        return ()
-    return tuple(s.h for s in bound.bracket.steps
-                 if s.outcome is Outcome.REFUTED and s.t_opt is not None
-                 and s.t_opt <= -lmi.margin)
 
 
 def _fresh(problem):

@@ -59,7 +59,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from .coordinates import recheck_original
-from .core import IMPLIED, Block, MarginLMI, Outcome, Step
+from .core import Block, MarginLMI, Outcome, Step
 from .delay_input import check_bisection, time_scale
 
 
@@ -218,37 +218,11 @@ class IntervalSearch:
 
     @property
     def solves(self) -> int:
-        """Solver calls: the steps less those decided without a solve
-        (status :data:`~workbench.lmi.core.IMPLIED`)."""
-        return sum(1 for s in self.steps if not s.solver_status.startswith(IMPLIED))
+        return len(self.steps)
 
     @property
     def seconds(self) -> float:
         return sum(s.seconds for s in self.steps)
-
-
-#: Decide the interval probes that contain a delay where the point criterion
-#: is infeasible without a solve (:func:`certified_interval`, ``infeasible``);
-#: False solves them, as before issue 36's cut (benchmarks: same results).
-IMPLIED_INTERVALS = True
-
-
-def _implied(decide: Callable[[float], Step], ends: Callable[[float], tuple[float, float]],
-             infeasible: Sequence[float]) -> Callable[[float], Step]:
-    """``decide`` with the probes whose interval ``ends(h) = (h_a, h_b)``
-    contains a delay of ``infeasible`` answered REFUTED without a solve."""
-    if not infeasible or not IMPLIED_INTERVALS:
-        return decide
-
-    def implied(h: float) -> Step:
-        a, b = ends(h)
-        inside = [p for p in infeasible if a <= p <= b]
-        if inside:
-            return Step(h, Outcome.REFUTED, f"{IMPLIED} (the point criterion is infeasible "
-                        f"at {inside[0]:.6g} s, inside [{a:.6g}, {b:.6g}] s)",
-                        None, {}, None, 0.0)
-        return decide(h)
-    return implied
 
 
 def _grow(decide: Callable[[float], Step], good: float, limit: float, rel_tol: float,
@@ -322,8 +296,7 @@ def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] =
                        from_zero: bool = True, guess: float | None = None,
                        rel_tol: float = 1e-5, max_solves: int = 120,
                        scan: int = SCAN_POINTS, lower: IntervalLMI | None = None,
-                       zero: MarginLMI | None = None,
-                       infeasible: Sequence[float] = ()) -> IntervalSearch:
+                       zero: MarginLMI | None = None) -> IntervalSearch:
     """Largest interval of constant delays the criterion certifies, by shared variables.
 
     Parameters
@@ -355,17 +328,6 @@ def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] =
         The interval LMIs of ``lmi`` to solve, [h_a, h_b] and [0, h_b]
         (default: built here), e.g. copies sharing a compiled problem
         (:func:`workbench.benchmark_windows.fork`).
-    infeasible : sequence of float
-        Delays (s) at which the point criterion ``lmi`` itself is infeasible:
-        a solve there was optimal with ``t* <= -margin`` (no point makes every
-        block definite, e.g. the upper refuted steps of its bisection). An
-        interval LMI certified with ``t > 0`` on [h_a, h_b] makes every block
-        definite at each delay inside (module docstring), so an interval
-        containing one of these delays is refuted: such probes are recorded
-        as REFUTED steps with the status :data:`~workbench.lmi.core.IMPLIED`,
-        no solve (the probes, hence the search, are the ones the solves would
-        give; issue 36, item 4). Not used for a delay-range criterion's own
-        point solves.
 
     Returns
     -------
@@ -386,20 +348,17 @@ def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] =
     tau = time_scale(lmi.A, lmi.Ad)
     floor = min(FLOOR_FRACTION * tau, h_hi)
     win = lower or IntervalLMI(lmi, from_zero=False)
-    infeasible = sorted(float(p) for p in infeasible)
     found: list[IntervalCertificate] = []
     if from_zero:
         # a delay-range criterion's point certificate is already one on [0, h]
-        ranged = getattr(lmi, "range_from_zero", False)
-        zero = lmi if ranged else (zero or IntervalLMI(lmi, from_zero=True))
-        decide = zero.solve_at if ranged else _implied(zero.solve_at, lambda h: (0.0, h),
-                                                       infeasible)
+        zero = lmi if getattr(lmi, "range_from_zero", False) else (
+            zero or IntervalLMI(lmi, from_zero=True))
         first = min(h_hi, guess if guess else tau)
-        hit = _find(decide, first, floor, budget, steps)
+        hit = _find(zero.solve_at, first, floor, budget, steps)
         if hit is not None:
-            hb, st = _grow(decide, hit[0], h_hi, rel_tol, budget, steps)
+            hb, st = _grow(zero.solve_at, hit[0], h_hi, rel_tol, budget, steps)
             links = [Link(0.0, hb, st or hit[1])]
-            _chain(win, links, h_hi, rel_tol, budget, steps, up=True, infeasible=infeasible)
+            _chain(win, links, h_hi, rel_tol, budget, steps, up=True)
             found.append(IntervalCertificate(0.0, links[-1].hi, tuple(links)))
     for h0 in _starts(starts, found, scan, tau, h_hi, lmi, budget, steps):
         if budget[0] <= 0 or any(iv.contains(h0) for iv in found) or not 0 < h0 <= h_hi:
@@ -408,9 +367,9 @@ def certified_interval(lmi: MarginLMI, *, h_hi: float, starts: Sequence[float] =
         if s.outcome is not Outcome.CERTIFIED:
             continue
         links = [Link(h0, h0, s)]
-        _chain(win, links, h_hi, rel_tol, budget, steps, up=True, infeasible=infeasible)
+        _chain(win, links, h_hi, rel_tol, budget, steps, up=True)
         below = max([iv.hi for iv in found if iv.hi < h0] + [LOWER_FRACTION * h0])
-        _chain(win, links, below, rel_tol, budget, steps, up=False, infeasible=infeasible)
+        _chain(win, links, below, rel_tol, budget, steps, up=False)
         links.sort(key=lambda k: k.lo)
         found.append(IntervalCertificate(links[0].lo, links[-1].hi, tuple(links)))
     found.sort(key=lambda iv: iv.lo)
@@ -439,8 +398,7 @@ MAX_LINKS = 32
 
 
 def _chain(win: IntervalLMI, links: list[Link], limit: float, rel_tol: float,
-           budget: list[int], steps: list[Step], *, up: bool,
-           infeasible: Sequence[float] = ()) -> None:
+           budget: list[int], steps: list[Step], *, up: bool) -> None:
     """Extend a certified interval by links with fresh shared variables: upwards
     from the last link's hi to ``limit`` or downwards from the first link's lo;
     stops when a link adds less than ``rel_tol`` (relative), at the limit, or
@@ -457,8 +415,6 @@ def _chain(win: IntervalLMI, links: list[Link], limit: float, rel_tol: float,
                 return win.solve_at(h)
             win.set_lower(h)
             return win.solve_at(e)
-        decide = _implied(decide, (lambda h, e=end: (e, h)) if up else (lambda h, e=end: (h, e)),
-                          infeasible)
         new, st = _grow(decide, end, limit, rel_tol, budget, steps, first=first, coarse=0.25)
         if st is None:
             return
