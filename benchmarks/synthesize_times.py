@@ -8,7 +8,7 @@ compilations excluded by a warm-up, as in a long-running session):
 * ``before issue 36``: ``WORKBENCH_SYNTH_UNSHARED=1`` (a new fixed-gain LMI,
   hence a new cvxpy compilation, for the canonical gain of every eps), every
   solve unpacked by cvxpy's ``Problem.solve`` (duals too:
-  ``workbench.lmi.core.FULL_UNPACK``) and every probe of the gain's
+  ``workbench.lmi.primal.FULL_UNPACK``) and every probe of the gain's
   bisection solved (``workbench.lmi.gain.IMPLIED_PROBES = False``);
 * ``before synth36``: the shared fixed-gain LMI, the other two as above;
 * ``after``: primal-only unpacking and the gain's probes at or above the
@@ -71,16 +71,16 @@ def _timed(split: dict) -> None:
 
 
 #: The paths timed (module docstring): (name, WORKBENCH_SYNTH_UNSHARED,
-#: ``core.FULL_UNPACK``, ``gain.IMPLIED_PROBES``).
+#: ``primal.FULL_UNPACK``, ``gain.IMPLIED_PROBES``).
 PATHS = (("before issue 36 (unshared fixed-K LMI)", "1", True, False),
          ("before synth36", "0", True, False),
          ("after", "0", False, True))
 
 
 def _set_path(unshared: str, full: bool, implied: bool) -> None:
-    from workbench.lmi import core, gain
+    from workbench.lmi import gain, primal
     os.environ["WORKBENCH_SYNTH_UNSHARED"] = unshared
-    core.FULL_UNPACK, gain.IMPLIED_PROBES = full, implied
+    primal.FULL_UNPACK, gain.IMPLIED_PROBES = full, implied
 
 
 def worker(path: str, repeat: int) -> None:
@@ -137,7 +137,7 @@ def run(path: str, repeat: int) -> dict:
 
 
 #: ``workbench verify`` of a design in a fresh process with cvxpy's full unpacking.
-VERIFY_BEFORE = ("import sys, workbench.lmi.core as c; c.FULL_UNPACK = True; "
+VERIFY_BEFORE = ("import sys, workbench.lmi.primal as p; p.FULL_UNPACK = True; "
                  "from workbench.cli import main; sys.exit(main(sys.argv[1:]))")
 VERIFY_AFTER = "import sys; from workbench.cli import main; sys.exit(main(sys.argv[1:]))"
 

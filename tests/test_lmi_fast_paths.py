@@ -1,7 +1,7 @@
 """Issue 36 item 4: the cheaper LMI paths decide exactly as the old ones.
 
 * Every LMI solve unpacks the primal values only
-  (:func:`workbench.lmi.core._solve_primal`): the same data reach Clarabel and
+  (:mod:`workbench.lmi.primal`): the same data reach Clarabel and
   the same inversion gives the values, so status, optimum and every variable
   are bit for bit those of cvxpy's ``Problem.solve``.
 * The canonical gain's bisection decides its probes at or above the

@@ -49,6 +49,7 @@ import cvxpy as cp
 import numpy as np
 
 from ..outcome import Outcome
+from . import primal
 
 #: Named definiteness margin of every LMI, relative to the largest block norm
 #: of the certificate (see the module docstring).
@@ -340,7 +341,8 @@ def guarded_solve(problem: cp.Problem, settings: Mapping | None = None) -> tuple
     try:
         with warnings.catch_warnings():   # "inaccurate" is an outcome, not a warning
             warnings.simplefilter("ignore", UserWarning)
-            problem.solve(solver=cp.CLARABEL, **({} if FULL_UNPACK else {"method": PRIMAL_ONLY}),
+            problem.solve(solver=cp.CLARABEL,
+                          **({} if primal.FULL_UNPACK else {"method": primal.PRIMAL_ONLY}),
                           **dict(settings or {}))
         status = str(problem.status)
     except (cp.error.SolverError, ValueError, ArithmeticError) as exc:  # an answer
@@ -350,50 +352,6 @@ def guarded_solve(problem: cp.Problem, settings: Mapping | None = None) -> tuple
             raise
         status = f"error: solver panic: {exc}".splitlines()[0][:200]
     return status, time.perf_counter() - t0
-
-
-#: Solve through cvxpy's own ``Problem._solve`` (dual values unpacked too)
-#: instead of :func:`_solve_primal`: the path before issue 36's cut, for
-#: ``benchmarks/synthesize_times.py`` (same status, same primal values).
-FULL_UNPACK = False
-
-
-class _PrimalOnly:
-    """Clarabel's answer without its dual vector ``z``: cvxpy then recovers
-    the primal values only (the duals of the ~10-20 PSD blocks are unpacked
-    into full matrices, the largest part of cvxpy's time after a solve, and
-    the workbench never reads them)."""
-
-    __slots__ = ("status", "solve_time", "iterations", "x", "obj_val", "z")
-
-    def __init__(self, raw):
-        self.status, self.solve_time, self.iterations = raw.status, raw.solve_time, raw.iterations
-        self.x, self.obj_val, self.z = raw.x, raw.obj_val, None
-
-
-def _solve_primal(problem: cp.Problem, solver: str = cp.CLARABEL, **settings) -> None:
-    """``problem.solve(solver=cp.CLARABEL, **settings)``, primal values only
-    (registered as the cvxpy solve method :data:`PRIMAL_ONLY`).
-
-    The same steps as cvxpy's ``Problem._solve`` (``get_problem_data``, the
-    solving chain's ``solve_via_data`` with the problem's solver cache, then
-    ``unpack_results``): the same data reach Clarabel, a new Clarabel solver
-    is built for every solve as before (its data update is refused with
-    presolve or chordal decomposition on, the defaults), and the status,
-    optimal value and variable values are unpacked by the same inversion,
-    bit for bit; only the dual values are left unset (issue 36, item 4).
-    """
-    for par in problem.parameters():
-        if par.value is None:
-            raise cp.error.ParameterError(f"parameter {par.name()} has no value")
-    data, chain, inverse = problem.get_problem_data(solver, solver_opts=settings)
-    raw = chain.solve_via_data(problem, data, True, False, dict(settings))
-    problem.unpack_results(_PrimalOnly(raw), chain, inverse)
-
-
-#: Name of :func:`_solve_primal` as a cvxpy solve method (``Problem.solve(method=...)``).
-PRIMAL_ONLY = "workbench_primal_only"
-cp.Problem.register_solve(PRIMAL_ONLY, _solve_primal)
 
 
 #: Probes above an inconclusive (solver-inaccurate) upper end of a bisection
