@@ -22,13 +22,14 @@ of the whole command ``workbench synthesize delay-bound`` in a fresh process
 (imports included) against the imports alone, and the best sweep after
 split into the cvxpy compilations, the parameter-to-data step of each solve,
 Clarabel (``solve_via_data``), cvxpy's unpacking of the solution and the
-rest (re-checks, exact margins). With ``--study`` also the CPU and wall
-seconds of ``workbench verify designs/delay-benchmarks.toml`` in a fresh
-process, before (full unpacking) and after. Nothing here asserts a time.
+rest (re-checks, exact margins). With ``--study [DESIGN ...]`` also the CPU
+and wall seconds of ``workbench verify`` of each design (default
+``designs/delay-benchmarks.toml``) in fresh processes, before synth36 (full
+unpacking, every gain probe solved) and after. Nothing here asserts a time.
 
 Usage::
 
-    python benchmarks/synthesize_times.py [designs/X.toml] [--repeat N] [--study]
+    python benchmarks/synthesize_times.py [designs/X.toml] [--repeat N] [--study [DESIGN ...]]
 """
 from __future__ import annotations
 
@@ -137,7 +138,8 @@ def run(path: str, repeat: int) -> dict:
 
 
 #: ``workbench verify`` of a design in a fresh process with cvxpy's full unpacking.
-VERIFY_BEFORE = ("import sys, workbench.lmi.primal as p; p.FULL_UNPACK = True; "
+VERIFY_BEFORE = ("import sys, workbench.lmi.primal as p, workbench.lmi.gain as g; "
+                 "p.FULL_UNPACK, g.IMPLIED_PROBES = True, False; "
                  "from workbench.cli import main; sys.exit(main(sys.argv[1:]))")
 VERIFY_AFTER = "import sys; from workbench.cli import main; sys.exit(main(sys.argv[1:]))"
 
@@ -146,8 +148,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("design", nargs="?", default="designs/antiskid-cruise-dry.toml")
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--study", action="store_true",
-                    help="also time workbench verify designs/delay-benchmarks.toml")
+    ap.add_argument("--study", nargs="*", metavar="DESIGN",
+                    help="also time workbench verify of these designs, before and after "
+                         "(default designs/delay-benchmarks.toml)")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.worker:
@@ -173,12 +176,12 @@ def main() -> None:
     new = res["after"]
     parts = " | ".join(f"{k} {v:.2f}" for k, v in new["split"].items())
     print(f"best sweep after, CPU s: {parts} (total {new['cpu']:.2f}; {new['solves']} solves)")
-    if args.study:
-        design = "designs/delay-benchmarks.toml"
-        for name, code in (("before synth36 (full unpacking)", VERIFY_BEFORE),
-                           ("after", VERIFY_AFTER)):
-            cpu, wall = command_times(["-c", code, "verify", design])
-            print(f"workbench verify {design}, {name}: {cpu:.1f} CPU s, {wall:.1f} s wall")
+    if args.study is not None:
+        for design in args.study or ["designs/delay-benchmarks.toml"]:
+            for name, code in (("before synth36", VERIFY_BEFORE), ("after", VERIFY_AFTER)):
+                cpu, wall = command_times(["-c", code, "verify", design])
+                print(f"workbench verify {design}, {name}: {cpu:.1f} CPU s, {wall:.1f} s wall",
+                      flush=True)
 
 
 if __name__ == "__main__":
