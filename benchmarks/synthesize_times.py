@@ -2,26 +2,34 @@
 
 Times :func:`workbench.synthesis.synthesize_delay_bound` for a design's eps
 sweep (default ``designs/antiskid-cruise-dry.toml``, the issue's headline
-command) in two fresh processes: one on the old path, selected by
-``WORKBENCH_SYNTH_UNSHARED=1`` (a new fixed-gain LMI, hence a new cvxpy
-compilation, for the canonical gain of every eps), and one on the current
-path (one fixed-gain LMI with the gain and eps as parameters, shared across
-the sweep). Each process runs the sweep ``--repeat`` times after one warm-up
-(imports and first compilations excluded, as in a long-running session) and
-prints the best CPU and wall seconds, the solve count, and whether the two
-paths printed the same table (they must: only the compiled problem is
-reused). Nothing here asserts a time.
+command) on three paths, interleaved in ONE process (imports and first
+compilations excluded by a warm-up, as in a long-running session):
 
-Then where the time of the command goes (issue 36: target 0.5 s): the CPU
-seconds of the whole command ``workbench synthesize delay-bound`` in a
-fresh process (imports included) against the imports alone, and the best
-sweep split into the cvxpy compilations, the parameter-to-data step of each
-solve, Clarabel (``solve_via_data``), cvxpy's unpacking of the solution
-(primal and dual values) and the rest (re-checks, exact margins).
+* ``before issue 36``: ``WORKBENCH_SYNTH_UNSHARED=1`` (a new fixed-gain LMI,
+  hence a new cvxpy compilation, for the canonical gain of every eps), every
+  solve unpacked by cvxpy's ``Problem.solve`` (duals too:
+  ``workbench.lmi.primal.FULL_UNPACK``) and every probe of the gain's
+  bisection solved (``workbench.lmi.gain.IMPLIED_PROBES = False``);
+* ``before synth36``: the shared fixed-gain LMI, the other two as above;
+* ``after``: primal-only unpacking and the gain's probes at or above the
+  synthesis's refuted delay decided without a solve.
+
+It prints the best CPU and wall seconds of each, the solver calls, and
+whether the three paths printed the same table (they must: the same data
+reach Clarabel and the bisections visit the same delays). Then where the
+time of the command goes (issue 36: target 0.5 s): the CPU and wall seconds
+of the whole command ``workbench synthesize delay-bound`` in a fresh process
+(imports included) against the imports alone, and the best sweep after
+split into the cvxpy compilations, the parameter-to-data step of each solve,
+Clarabel (``solve_via_data``), cvxpy's unpacking of the solution and the
+rest (re-checks, exact margins). With ``--study [DESIGN ...]`` also the CPU
+and wall seconds of ``workbench verify`` of each design (default
+``designs/delay-benchmarks.toml``) in fresh processes, before synth36 (full
+unpacking, every gain probe solved) and after. Nothing here asserts a time.
 
 Usage::
 
-    python benchmarks/synthesize_times.py [designs/X.toml] [--repeat N]
+    python benchmarks/synthesize_times.py [designs/X.toml] [--repeat N] [--study [DESIGN ...]]
 """
 from __future__ import annotations
 
@@ -34,10 +42,6 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-#: Environment of the old code path (module docstring).
-BEFORE_ENV = {"WORKBENCH_SYNTH_UNSHARED": "1"}
-
-
 def _cpu() -> float:
     t = os.times()
     return t.user + t.system
@@ -67,8 +71,21 @@ def _timed(split: dict) -> None:
         setattr(owner, attr, g)
 
 
+#: The paths timed (module docstring): (name, WORKBENCH_SYNTH_UNSHARED,
+#: ``primal.FULL_UNPACK``, ``gain.IMPLIED_PROBES``).
+PATHS = (("before issue 36 (unshared fixed-K LMI)", "1", True, False),
+         ("before synth36", "0", True, False),
+         ("after", "0", False, True))
+
+
+def _set_path(unshared: str, full: bool, implied: bool) -> None:
+    from workbench.lmi import gain, primal
+    os.environ["WORKBENCH_SYNTH_UNSHARED"] = unshared
+    primal.FULL_UNPACK, gain.IMPLIED_PROBES = full, implied
+
+
 def worker(path: str, repeat: int) -> None:
-    """Time the sweep in this process; one JSON line."""
+    """Time the sweep on every path of :data:`PATHS` in this process; one JSON line."""
     split: dict = {}
     _timed(split)
     from workbench.design import load_design
@@ -76,48 +93,64 @@ def worker(path: str, repeat: int) -> None:
     from workbench.synthesis import synthesize_delay_bound
     spec = load_design(path).spec
     lin = antiskid_cruise.operating_point(spec)[3]
-    c0, w0 = _cpu(), time.perf_counter()
-    rows = synthesize_delay_bound(lin.A, lin.B, spec.eps, spec.settings)
-    first = (_cpu() - c0, time.perf_counter() - w0)
-    cpu, wall, splits = [], [], []
-    for _ in range(repeat):
-        split.clear()
-        c0, w0 = _cpu(), time.perf_counter()
-        rows = synthesize_delay_bound(lin.A, lin.B, spec.eps, spec.settings)
-        cpu.append(_cpu() - c0)
-        wall.append(time.perf_counter() - w0)
-        splits.append(dict(split))
-    table = [(r.eps, r.h_certified, r.h_refuted, r.K, r.status.value) for r in rows]
-    best = splits[cpu.index(min(cpu))]
-    best["data"] = best.get("data", 0.0) - best.get("compile", 0.0)  # compile runs inside it
-    best["other"] = min(cpu) - sum(best.values())
-    print(json.dumps({"first_cpu": first[0], "first_wall": first[1], "cpu": min(cpu),
-                      "wall": min(wall), "solves": sum(r.solves for r in rows),
-                      "split": best, "table": repr(table)}), flush=True)
+    out = {name: {"cpu": [], "wall": [], "splits": []} for name, *_ in PATHS}
+    for rep in range(repeat + 1):                # the first round warms up
+        for name, *flags in PATHS:
+            _set_path(*flags)
+            split.clear()
+            c0, w0 = _cpu(), time.perf_counter()
+            rows = synthesize_delay_bound(lin.A, lin.B, spec.eps, spec.settings)
+            cpu, wall = _cpu() - c0, time.perf_counter() - w0
+            r = out[name]
+            r["table"] = repr([(r_.eps, r_.h_certified, r_.h_refuted, r_.K, r_.h_gain,
+                                r_.status.value) for r_ in rows])
+            r["solves"] = sum(r_.solves for r_ in rows)
+            if rep == 0:
+                r["first_cpu"], r["first_wall"] = cpu, wall
+                continue
+            r["cpu"].append(cpu)
+            r["wall"].append(wall)
+            r["splits"].append(dict(split))
+    for r in out.values():
+        best = r["splits"][r["cpu"].index(min(r["cpu"]))]
+        best["data"] = best.get("data", 0.0) - best.get("compile", 0.0)  # compile runs inside
+        best["other"] = min(r["cpu"]) - sum(best.values())
+        r.update(split=best, cpu=min(r["cpu"]), wall=min(r["wall"]))
+        del r["splits"]
+    print(json.dumps(out), flush=True)
 
 
-def command_cpu(args: list[str]) -> float:
-    """CPU seconds (user + system) of a fresh Python process running ``args``."""
-    before = os.times()
+def command_times(args: list[str]) -> tuple[float, float]:
+    """(CPU s as user + system, wall s) of a fresh Python process running ``args``."""
+    before, w0 = os.times(), time.perf_counter()
     subprocess.run([sys.executable] + args, cwd=ROOT, capture_output=True, check=True)
     after = os.times()
     return (after.children_user - before.children_user
-            + after.children_system - before.children_system)
+            + after.children_system - before.children_system), time.perf_counter() - w0
 
 
-def run(path: str, repeat: int, env_extra: dict) -> dict:
-    env = {**os.environ, **env_extra}
+def run(path: str, repeat: int) -> dict:
     p = subprocess.run([sys.executable, __file__, "--worker", path, "--repeat", str(repeat)],
-                       cwd=ROOT, env=env, capture_output=True, text=True)
+                       cwd=ROOT, capture_output=True, text=True)
     if p.returncode:
         sys.exit(f"worker exited {p.returncode}:\n{p.stderr[-3000:]}")
     return json.loads([line for line in p.stdout.splitlines() if line.startswith("{")][-1])
+
+
+#: ``workbench verify`` of a design in a fresh process with cvxpy's full unpacking.
+VERIFY_BEFORE = ("import sys, workbench.lmi.primal as p, workbench.lmi.gain as g; "
+                 "p.FULL_UNPACK, g.IMPLIED_PROBES = True, False; "
+                 "from workbench.cli import main; sys.exit(main(sys.argv[1:]))")
+VERIFY_AFTER = "import sys; from workbench.cli import main; sys.exit(main(sys.argv[1:]))"
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("design", nargs="?", default="designs/antiskid-cruise-dry.toml")
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--study", nargs="*", metavar="DESIGN",
+                    help="also time workbench verify of these designs, before and after "
+                         "(default designs/delay-benchmarks.toml)")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.worker:
@@ -125,21 +158,30 @@ def main() -> None:
         return
     print(f"machine: {os.cpu_count()} CPUs, {len(os.sched_getaffinity(0))} granted; "
           f"load average {os.getloadavg()[0]:.1f} at start")
-    old, new = run(args.design, args.repeat, BEFORE_ENV), run(args.design, args.repeat, {})
-    print("| path | first sweep CPU s | best sweep CPU s | best wall s | solves |")
+    res = run(args.design, args.repeat)
+    print("| path | first sweep CPU s | best sweep CPU s | best wall s | solver calls |")
     print("| --- | ---: | ---: | ---: | ---: |")
-    for name, r in (("before (WORKBENCH_SYNTH_UNSHARED=1)", old), ("after", new)):
+    for name, r in res.items():
         print(f"| {name} | {r['first_cpu']:.2f} | {r['cpu']:.2f} | {r['wall']:.2f} | "
               f"{r['solves']} |")
-    print(f"\nsame table on both paths: {old['table'] == new['table']}")
+    tables = {r["table"] for r in res.values()}
+    print(f"\nsame table on every path: {len(tables) == 1}")
     imports = ("import workbench.cli, workbench.synthesis, workbench.papers.p003.antiskid_cruise, "
                "workbench.kinds.delay_feedback.cli, workbench.margins, control, cvxpy")
-    whole = command_cpu(["-m", "workbench", "synthesize", "delay-bound", args.design])
-    bare = command_cpu(["-c", imports])
-    print(f"\nwhole command in a fresh process: {whole:.2f} CPU s, of which the imports "
-          f"{bare:.2f} (cvxpy, python-control with matplotlib, sympy for the adhesion model)")
+    whole = command_times(["-m", "workbench", "synthesize", "delay-bound", args.design])
+    bare = command_times(["-c", imports])
+    print(f"\nwhole command in a fresh process: {whole[0]:.2f} CPU s ({whole[1]:.2f} s wall), "
+          f"of which the imports {bare[0]:.2f} CPU s ({bare[1]:.2f} s wall) (cvxpy, "
+          "python-control with matplotlib, sympy for the adhesion model)")
+    new = res["after"]
     parts = " | ".join(f"{k} {v:.2f}" for k, v in new["split"].items())
     print(f"best sweep after, CPU s: {parts} (total {new['cpu']:.2f}; {new['solves']} solves)")
+    if args.study is not None:
+        for design in args.study or ["designs/delay-benchmarks.toml"]:
+            for name, code in (("before synth36", VERIFY_BEFORE), ("after", VERIFY_AFTER)):
+                cpu, wall = command_times(["-c", code, "verify", design])
+                print(f"workbench verify {design}, {name}: {cpu:.1f} CPU s, {wall:.1f} s wall",
+                      flush=True)
 
 
 if __name__ == "__main__":

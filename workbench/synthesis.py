@@ -24,7 +24,7 @@ from typing import Callable
 import numpy as np
 
 from .jsonable import json_method
-from .lmi.core import DEFAULT_MARGIN, Bracket, Outcome, bisect_delay
+from .lmi.core import DEFAULT_MARGIN, IMPLIED, Bracket, Outcome, bisect_delay
 from .lmi.diagnosis import synthesis_reason, uncontrollable_mode
 from .lmi.freeweighting003 import FreeWeighting003, FreeWeighting003FixedK
 from .lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
@@ -218,7 +218,7 @@ def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, T,
         gain = canonical_gain(
             crit, br.h_certified,
             fixed or _SharedFixedK(crit, settings.margin), T, fraction=settings.gain_fraction, digits=settings.gain_digits,
-            **settings.bisection())
+            refuted_from=br.h_refuted, **settings.bisection())
         steps.append(gain.point)
         if gain.analysis is not None:
             steps += gain.analysis.steps
@@ -236,7 +236,8 @@ def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, T,
     reason = ("" if status is Outcome.CERTIFIED else
               synthesis_reason(br, gain, margin=settings.margin, h_cap=settings.h_max))
     return SynthesisRow(float(eps), br.h_certified, br.h_refuted, K, status, exact,
-                        exact_siso, rmin, len(steps), sum(s.seconds for s in steps),
+                        exact_siso, rmin, sum(not s.solver_status.startswith(IMPLIED) for s in steps),
+                        sum(s.seconds for s in steps),
                         tuple(s.outcome.value[0] for s in br.steps), recheck, cert, gain,
                         windows, reason)
 

@@ -49,6 +49,7 @@ import cvxpy as cp
 import numpy as np
 
 from ..outcome import Outcome
+from . import primal
 
 #: Named definiteness margin of every LMI, relative to the largest block norm
 #: of the certificate (see the module docstring).
@@ -59,6 +60,11 @@ DEFAULT_BOUND = 1e3
 #: Clarabel settings on top of its defaults (none: with relative margins the
 #: defaults suffice; :attr:`MarginLMI.retry_settings` handles inaccurate answers).
 CLARABEL_SETTINGS: dict = {}
+
+
+#: Status of a step decided without a solve, from a relaxation refuted at or
+#: below its delay (:func:`workbench.lmi.gain.canonical_gain`).
+IMPLIED = "implied"
 
 
 @dataclass(frozen=True)
@@ -118,7 +124,9 @@ class Bracket:
 
     @property
     def solves(self) -> int:
-        return len(self.steps)
+        """Solver calls: the steps less those decided without a solve
+        (status :data:`IMPLIED`)."""
+        return sum(1 for s in self.steps if not s.solver_status.startswith(IMPLIED))
 
     @property
     def seconds(self) -> float:
@@ -333,7 +341,9 @@ def guarded_solve(problem: cp.Problem, settings: Mapping | None = None) -> tuple
     try:
         with warnings.catch_warnings():   # "inaccurate" is an outcome, not a warning
             warnings.simplefilter("ignore", UserWarning)
-            problem.solve(solver=cp.CLARABEL, **dict(settings or {}))
+            problem.solve(solver=cp.CLARABEL,
+                          **({} if primal.FULL_UNPACK else {"method": primal.PRIMAL_ONLY}),
+                          **dict(settings or {}))
         status = str(problem.status)
     except (cp.error.SolverError, ValueError, ArithmeticError) as exc:  # an answer
         status = f"error: {exc}".splitlines()[0][:200]

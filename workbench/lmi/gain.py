@@ -21,6 +21,15 @@ by a unique one:
 4. the rounded K is certified on its own by the same LMI with the gain fixed
    (``V = K L``), by the shared bisection: its own bracket.
 
+The fixed-gain LMI is a restriction of the synthesis LMI (its points are the
+synthesis points with ``V = K X``), so where the synthesis was refuted it is
+refuted too; :func:`canonical_gain` takes that delay (``refuted_from``) and
+decides the bisection's probes at or above it without a solve (issue 36,
+item 4: about a third of the solves of the gain's bisection). The probes are
+the same as with solves, so the bracket, the certified delay and everything
+printed from them are the same; a certified delay still needs its own solve
+and re-check.
+
 References
 ----------
 .. [BEFB94] Boyd S., El Ghaoui L., Feron E., Balakrishnan V., *Linear Matrix
@@ -29,18 +38,23 @@ References
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable
 
 import cvxpy as cp
 import numpy as np
 
-from .core import Bracket, MarginLMI, Outcome, Step, bisect_delay
+from .core import IMPLIED, Bracket, MarginLMI, Outcome, Step, bisect_delay
 
 #: Fraction of the certified delay at which the canonical point is computed.
 DEFAULT_FRACTION = 0.99
 #: Significant digits of a canonical gain.
 DEFAULT_DIGITS = 4
+#: Decide the probes at or above ``refuted_from`` without a solve
+#: (:func:`canonical_gain`); False solves them, as before issue 36's cut
+#: (``benchmarks/synthesize_times.py``: the same bracket either way).
+IMPLIED_PROBES = True
 #: Lower end of the rounded gain's own bisection, as a fraction of the design
 #: delay (relative, so the search is the same in any time unit).
 ANALYSIS_FLOOR = 1e-4
@@ -95,7 +109,8 @@ class CanonicalGain:
 def canonical_gain(lmi: MarginLMI, h_certified: float, fixed: Callable[[np.ndarray], MarginLMI],
                    T: np.ndarray, *, fraction: float = DEFAULT_FRACTION,
                    digits: int = DEFAULT_DIGITS, h_hi: float, h_lo: float | None = None,
-                   rel_tol: float = 1e-4, max_solves: int = 60) -> CanonicalGain:
+                   rel_tol: float = 1e-4, max_solves: int = 60,
+                   refuted_from: float | None = None) -> CanonicalGain:
     """The well-posed gain of a synthesis LMI (see the module docstring).
 
     Parameters
@@ -122,6 +137,22 @@ def canonical_gain(lmi: MarginLMI, h_certified: float, fixed: Callable[[np.ndarr
         the design delay (relative: no absolute default).
     rel_tol, max_solves
         Bisection settings of the fixed-gain analysis.
+    refuted_from : float, optional
+        A delay (s) at which ``lmi`` was refuted (its bisection's
+        ``h_refuted``). Every point of the fixed-gain LMI is a point of
+        ``lmi`` (``V = K X``) when ``|V| <= lmi.bound`` holds for it, which
+        the gain guarantees when its largest absolute row sum is at most
+        ``lmi.bound`` on every point that could certify (margin t > 0: ``X``
+        is then positive definite with trace <= 1 in the solver's
+        normalisation, so its entries are at most 1 in modulus): a fixed-gain
+        point with margin >= ``lmi.margin`` would be one of ``lmi``, so the
+        fixed-gain LMI is refuted at ``refuted_from`` and, as the bisection
+        assumes (the criterion is monotone in h), above it. Probes there are recorded as
+        REFUTED steps with the status :data:`~workbench.lmi.core.IMPLIED`,
+        no solve; without that row-sum bound every probe is solved. For
+        a ``lmi`` whose gain basis ``X`` has a positive block
+        ``<gain_basis>_pos`` (e.g. :class:`~workbench.lmi.freeweighting003.
+        FreeWeighting003`).
 
     Returns
     -------
@@ -139,7 +170,16 @@ def canonical_gain(lmi: MarginLMI, h_certified: float, fixed: Callable[[np.ndarr
     T = np.asarray(T, float)
     K = round_significant(lmi.gain(point.certificate) @ np.diag(1.0 / np.diag(T)), digits)
     crit = fixed(K @ T)
-    analysis = bisect_delay(crit.solve_at, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol,
+    decide = crit.solve_at
+    if (IMPLIED_PROBES and refuted_from is not None and math.isfinite(refuted_from)
+            and np.abs(K @ T).sum(axis=1).max() <= lmi.bound):
+        def decide(h_, _solve=crit.solve_at, _from=float(refuted_from)):
+            if h_ >= _from:
+                return Step(h_, Outcome.REFUTED,
+                            f"{IMPLIED} (the synthesis LMI was refuted at {_from:.6g} s)",
+                            None, {}, None, 0.0)
+            return _solve(h_)
+    analysis = bisect_delay(decide, h_lo=h_lo, h_hi=h_hi, rel_tol=rel_tol,
                             max_solves=max_solves, guess=min(max(h, h_lo), h_hi))
     return CanonicalGain(K, digits, h, point, analysis)
 
