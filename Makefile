@@ -65,7 +65,7 @@ test: install
 test-full: install
 	@t0=$$(date +%s); \
 	echo "== pytest -n $(JOBS) -m slow"; \
-	$(PY) -m pytest -n $(JOBS) -m "slow and not wheel" --durations=10 -p no:cacheprovider; slow=$$?; \
+	$(PY) -m pytest -n $(JOBS) --dist load -m "slow and not wheel" --durations=10 -p no:cacheprovider; slow=$$?; \
 	echo "== workbench check under OPENBLAS_CORETYPE=$(OTHER_KERNEL)"; \
 	OPENBLAS_CORETYPE=$(OTHER_KERNEL) $(WB) check --jobs $(JOBS) 2>/dev/null | $(NOT_OK); \
 	  other=$${PIPESTATUS[0]}; \
