@@ -120,3 +120,33 @@ def test_sweep_is_seeded(tmp_path, capsys):
                  "--figure", str(fig)]) == 0
     out = capsys.readouterr().out
     assert fig.exists() and "outcome" in out and "Wilson 95 % interval" in out
+
+
+def test_scalar_metrics_recorder_is_the_generic_one_bit_for_bit(spec, monkeypatch):
+    """MetricsRecorder's scalar path (:meth:`_scalar`, used by every case run)
+    against its generic body fed the same floats, over traction, the
+    switch to braking, the tracking window, omega = 3 rad/s and the stop."""
+    from workbench.papers.p003 import antiskid_scenario as A
+    from workbench.sim.wheel_slip import ScalarOps
+    sc = {**spec.scenario, "t_brake": 40.0, "t_end": 140.0}
+    short = dataclasses.replace(spec, scenario=sc)
+    case = next(c for c in short.cases if c.name == "compensated")
+    rs = S.run_settings(short, S.controller_settings(short, K_TABLE3, case))
+    fast = simulate_antiskid(rs, 0.01, record_dt=0.05)
+    generic_ops = type("GenericScalarOps", (ScalarOps,), {"batch": True})
+
+    def generic(self, *a):       # the generic body on floats (its batch branches)
+        self.xp = generic_ops
+        try:
+            return A.MetricsRecorder.__call__(self, *a)
+        finally:
+            self.xp = ScalarOps
+    monkeypatch.setattr(A.MetricsRecorder, "_scalar", generic)
+    slow = simulate_antiskid(rs, 0.01, record_dt=0.05)
+    mf, ms = vars(fast[1]), vars(slow[1])
+    assert math.isfinite(mf["t_stop"]) and math.isfinite(mf["t_omega3"])
+    assert math.isfinite(mf["evs_max_tracking"]) and math.isfinite(mf["t_cruise"])
+    for k in mf:
+        a, b = float(mf[k]), float(ms[k])
+        assert (math.isnan(a) and math.isnan(b)) or a == b, k
+    np.testing.assert_array_equal(fast[0].x, slow[0].x)

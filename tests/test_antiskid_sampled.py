@@ -135,3 +135,14 @@ def test_bad_sampled_table_is_exit_2(tmp_path, capsys, old, new, key):
     assert main(["verify", str(bad)]) == 2
     err = capsys.readouterr().err
     assert str(bad.name) in err and key in err and "expected" in err
+
+
+def test_a_kept_braking_run_is_the_one_the_radau_check_would_run(ctx):
+    """run_sampled hands the zoh grid's braking runs to radau_checks, which
+    then does not run them again: the kept outputs are those of its own call."""
+    from workbench.papers.p003.antiskid_sampled_kernel import run_once
+    keep = {}
+    S.rate_row(ctx, 100.0, dt_p=2e-4, predictor_step=1e-3, q=0.0, tau=0.0, keep=keep)
+    own = run_once(ctx, 100.0, 1, dt_p=2e-4, predictor_step=1e-3)[0]
+    assert set(keep) == {100.0} and math.isfinite(own["t_stop"])
+    assert {k: repr(v) for k, v in keep[100.0].items()} == {k: repr(v) for k, v in own.items()}

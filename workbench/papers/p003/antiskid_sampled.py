@@ -214,11 +214,14 @@ def rate_metrics(ctx: Context, trac: dict, brake: dict) -> dict:
 
 def rate_row(ctx: Context, rate: float, *, dt_p: float, predictor_step: float,
              q: float = 0.0, tau: float = 0.0, emulation: bool = False,
-             probe: bool = False) -> RateRow:
-    """Both scenarios at one rate."""
+             probe: bool = False, keep: dict | None = None) -> RateRow:
+    """Both scenarios at one rate (``keep``: a dict that receives the
+    braking run's kernel outputs under the rate)."""
     kw = dict(q=q, tau=tau, dt_p=dt_p, predictor_step=predictor_step, emulation=emulation)
     trac, _ = run_once(ctx, rate, 0, **kw)
     brake, _ = run_once(ctx, rate, 1, **kw)
+    if keep is not None:
+        keep[rate] = brake
     return RateRow(rate, rate_metrics(ctx, trac, brake), probe)
 
 
@@ -259,10 +262,12 @@ def _mesh_check(ctx, spec, q, tau, rows) -> tuple:
     return tuple(out), tuple(fines)
 
 
-def run_variant(ctx: Context, spec: SampledSpec, name: str, q: float, tau: float) -> Variant:
-    """The grid, the lowest passing rate, its bisection bracket and the mesh check."""
+def run_variant(ctx: Context, spec: SampledSpec, name: str, q: float, tau: float,
+                keep: dict | None = None) -> Variant:
+    """The grid, the lowest passing rate, its bisection bracket and the mesh
+    check (``keep``: as :func:`rate_row`, for the grid rates)."""
     kw = dict(dt_p=spec.plant_step, predictor_step=spec.predictor_step, q=q, tau=tau)
-    rows = tuple(rate_row(ctx, f, **kw) for f in spec.rates)
+    rows = tuple(rate_row(ctx, f, keep=keep, **kw) for f in spec.rates)
     min_rate = None
     for r in reversed(rows):
         if not r.ok:
@@ -286,9 +291,11 @@ def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:
     row, every variant, the Radau check, the traces of the figure."""
     dt_e = dt / 2
     emu = rate_row(ctx, 1.0 / dt_e, dt_p=dt_e, predictor_step=0.0, emulation=True)
-    variants = tuple(run_variant(ctx, spec, *v) for v in spec.variants())
+    brakes: dict = {}      # the zoh grid's braking runs: those the Radau check locates
+    variants = tuple(run_variant(ctx, spec, *v, keep=brakes if v[0] == "zoh" else None)
+                     for v in spec.variants())
     return SampledResult(spec, ctx.cs.lambda_opt, ctx.u_peak, emu, dt_e, variants,
-                         radau_checks(ctx, spec), traces(ctx, spec, dt_e))
+                         radau_checks(ctx, spec, brakes), traces(ctx, spec, dt_e))
 
 
 def traces(ctx: Context, spec: SampledSpec, dt_e: float) -> tuple:

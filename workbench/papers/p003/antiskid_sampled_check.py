@@ -95,13 +95,15 @@ def replay(p, rec: np.ndarray) -> tuple[float, float, int]:
     return dl, dv, pieces
 
 
-def radau_checks(ctx, spec) -> tuple:
+def radau_checks(ctx, spec, brakes: dict | None = None) -> tuple:
     """:class:`RadauCheck` of every window at every rate of
-    :data:`RADAU_RATES_HZ` in the design's grid (``zoh``, unquantised)."""
+    :data:`RADAU_RATES_HZ` in the design's grid (``zoh``, unquantised).
+    ``brakes``: rate -> kernel outputs of the ``zoh`` grid's braking run
+    (the run that locates the braking windows; run here when absent)."""
     out = []
     for rate in (f for f in RADAU_RATES_HZ if f in spec.rates):
         kw = dict(dt_p=spec.plant_step, predictor_step=spec.predictor_step)
-        brake, _ = run_once(ctx, rate, 1, **kw)
+        brake = (brakes or {}).get(rate) or run_once(ctx, rate, 1, **kw)[0]
         length = WINDOW_SAMPLES / rate
         starts = (ctx.h, brake["t_omega3"] - length / 2, brake["t_stop"] - length)
         for name, t0, scen in zip(WINDOWS, starts, (0, 1, 1)):

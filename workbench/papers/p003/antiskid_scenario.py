@@ -79,6 +79,8 @@ class MetricsRecorder:
 
     def __call__(self, t, v, lam, ph, to_cruise, to_brake, to_stop, dt_prev):
         """Update the metrics with one sample (see the class docstring)."""
+        if not self.xp.batch:
+            return self._scalar(t, v, lam, ph, to_cruise, to_brake, to_stop, dt_prev)
         s, xp, m = self.s, self.xp, self.m
         w = xp.where
         # crossing time of v = v_d, interpolated between the last two samples
@@ -138,6 +140,67 @@ class MetricsRecorder:
         e_end = e_prev + f_end * (e_on - e_prev)
         end = settled & (cross_w | cross_l)
         m.evs_max_tracking = w(end, fmax(m.evs_max_tracking, e_end), m.evs_max_tracking)
+        self._track_prev = (omega, e_on, lam)
+
+    def _scalar(self, t, v, lam, ph, to_cruise, to_brake, to_stop, dt_prev):
+        """:meth:`__call__` of a single run: the same operations on floats, in
+        the same order, each done only where its result is kept (a single
+        run's case runs call this once a step: ``tests/test_antiskid_run.py``
+        compares it with the batch form bit for bit)."""
+        s, m = self.s, self.m
+        if to_cruise:
+            frac = (v - s.v_d) / max(v - self._v_prev, 1e-12)
+            m.t_cruise = t - dt_prev * min(frac, 1.0)
+            m.v_at_cruise = v
+            m.lam_at_cruise = lam
+        self._v_prev = v
+        if ph < BRAKE_IN:
+            m.lam_max_traction = max(m.lam_max_traction, lam)
+            m.v_max = max(m.v_max, v)
+        if to_brake:
+            m.lam_at_brake = lam
+            m.v_err_at_brake = v - s.v_d
+            m.lam_err_at_brake = lam - s.lambda_d
+        if to_stop:
+            m.t_stop = t
+        if ph not in (BRAKE_IN, BRAKE):
+            return
+        if lam < 0 and math.isnan(m.t_lam_negative):
+            m.t_lam_negative = t
+        m.lam_min_brake = min(m.lam_min_brake, lam)
+        omega = wheel_speed(max(v, s.v_floor), lam, self.r_p, ScalarOps)
+        ws = s.profile.omega_switch
+        vs_on, _ = s.profile(t, v, 0.0 * v, math.inf + 0.0 * v, ScalarOps)
+        vs_star = vs_on if omega > ws else 0.0
+        vs = creep_speed(v, lam, ScalarOps)
+        e, e_on = abs(vs - vs_star), abs(vs - vs_on)
+        m.evs_last = e
+        in_window = m.t_omega3 != m.t_omega3 and m.t_past_peak != m.t_past_peak
+        cross_w = omega <= ws and m.t_omega3 != m.t_omega3
+        cross_l = lam < -s.lambda_opt and m.t_past_peak != m.t_past_peak
+        prev = self._track_prev
+        if prev is None:
+            f_w = f_l = 1.0 + 0.0 * v
+            e_prev = e_on
+        else:
+            w_prev, e_prev, l_prev = prev
+            if cross_w:
+                f_w = min(max((w_prev - ws) / max(w_prev - omega, 1e-300), 0.0), 1.0)
+            if cross_l:
+                f_l = min(max((l_prev + s.lambda_opt) / max(l_prev - lam, 1e-300), 0.0), 1.0)
+        if cross_w:
+            m.t_omega3 = t - dt_prev * (1.0 - f_w)
+        if cross_l:
+            m.t_past_peak = t - dt_prev * (1.0 - f_l)
+        if in_window and t >= s.profile.t_brake + self.evs_settle:
+            if not cross_w and not cross_l:
+                a = m.evs_max_tracking
+                m.evs_max_tracking = e if a != a else max(a, e)
+            elif cross_w or cross_l:
+                f_end = min(f_w if cross_w else 1.0, f_l if cross_l else 1.0)
+                e_end = e_prev + f_end * (e_on - e_prev)
+                a = m.evs_max_tracking
+                m.evs_max_tracking = e_end if a != a else max(a, e_end)
         self._track_prev = (omega, e_on, lam)
 
 
