@@ -57,11 +57,15 @@ def eps_matching(A, B, h_target: float, eps_lo: float, eps_hi: float, settings,
     -------
     float or None
     """
+    import numpy as np
+
     from ...lmi.core import Outcome, bisect_delay
     from ...lmi.freeweighting003 import FreeWeighting003
-    from ...synthesis import _balanced
-    At, Bt, _, _ = _balanced(A, B)
-    crit = FreeWeighting003(At, Bt, eps_lo, margin=settings.margin)
+    from ...lmi.scaling import balancing
+    A, B = np.asarray(A, float), np.asarray(B, float).reshape(np.shape(A)[0], -1)
+    T = balancing(A)                   # the balanced system of eps_for_bound, as it computes it
+    Tinv = np.diag(1.0 / np.diag(T))
+    crit = FreeWeighting003(Tinv @ A @ T, Tinv @ B, eps_lo, margin=settings.margin)
     bis = settings.bisection()
 
     def h_of(eps):
