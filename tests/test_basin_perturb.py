@@ -1,7 +1,8 @@
 """The basin figure's drawn trajectories do not depend on the last bits of
 their inputs (issue 36, item 5): the wet run's delay-free trajectory from the
 printed switch state, and sampled ones around it, with the start, lambda_d,
-the gain and every evaluation of the loop's right-hand side moved by +-3 ulp,
+the gain and every evaluation of the loop's right-hand side moved by +-3 ulp
+(and the switch state by +-3e-14, as the run's simulation moves it),
 give the same fates and the same PNG (:func:`plot_basin`, snapped by
 :func:`workbench.report.figures.figure_png`), byte for byte.
 
@@ -45,14 +46,15 @@ def _ulps(x: float, n: int) -> float:
 
 
 def _run(n: int):
-    """(PNG, fates, raw solver step times of the paper trajectory) with every
-    input moved by n ulp."""
+    """(PNG, fates, raw solver step times of the paper trajectory, drawn
+    paths) with every input moved by n ulp."""
     Kn = tuple(_ulps(k, n) for k in K)
     f, _, states, _, lam_d, lam_opt = AB._loop(VALS, V_D, Kn)
     fm = lambdify(states, f, "math")
     fn = lambda a, b: [_ulps(float(v), n) for v in fm(a, b)]
     lam_n = _ulps(lam_d, n)
-    x0 = (_ulps(PAPER[0] - V_D, n), _ulps(PAPER[1] - lam_d, n))
+    # the run's switch state moves by ~3e-14 when the plant moves by 3 ulp (its simulation)
+    x0 = (_ulps(PAPER[0] - V_D + n * 1e-14, n), _ulps(PAPER[1] - lam_d + n * 1e-14, n))
     prob = AB._cruise_problem(VALS, V_D, Kn, [x0], W)[0]
     inside = lambda p: prob.V(p) <= C_CERT
     starts = [x0] + [tuple(_ulps(v, n) for v in s) for s in SAMPLED]
@@ -63,7 +65,7 @@ def _run(n: int):
                             trajectories=tuple(trajs), lambda_opt=lam_opt, lambda_d=lam_d)
     png = figure_png(Figure("basin", "", lambda fig: plot_basin(fig, basin), (7.0, 5.0)))
     raw = AB._delay_free(fn, x0, lam_n, 3.0)
-    return png, [t.fate for t in trajs], raw.t
+    return png, [t.fate for t in trajs], raw.t, [t.path for t in trajs]
 
 
 @pytest.fixture(scope="module")
@@ -81,6 +83,14 @@ def test_perturbation_reaches_the_solver(runs):
 def test_fates_unchanged(runs):
     assert runs[0][1] == ["diverges", "diverges", "diverges", "converges", "converges"]
     assert all(runs[n][1] == runs[0][1] for n in ULPS)
+
+
+def test_drawn_paths_move_far_less_than_the_grid(runs):
+    # the figure's grid is 6e-5 in lambda; the solver's own steps move by ~1e-7 (drawn
+    # before issue 36 for a trajectory whose step fails), the dense output by ~1e-9
+    for n in (-3, 3):
+        for p, p0 in zip(runs[n][3], runs[0][3]):
+            assert p.shape == p0.shape and np.max(np.abs(p - p0)) < 1e-8
 
 
 def test_basin_figure_bytes_unchanged(runs):
