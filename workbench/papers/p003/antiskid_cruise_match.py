@@ -16,10 +16,12 @@ bisection's first solve is at ``h_target`` itself (the guess, inside
   (0 when none), is below ``h_target``.
 
 An INCONCLUSIVE solve settles nothing (island probes may look above it), and
-then the whole bisection runs as before. Each solve is stateless (a fresh
-Clarabel solve of the same parametrised problem at the same eps and delay),
-so every decision, and the returned eps, equal :func:`eps_for_bound`'s bit for
-bit; ``tests/test_antiskid_cruise_match.py`` compares the two.
+then the whole bisection runs as before. A solve at (eps, h) is the same in
+both: one parametrised problem, whose Clarabel solver cvxpy keeps and
+updates with the new data, scaled with the equilibration of its first solve
+-- which both make at (eps_lo, h_target). So every decision, and the returned
+eps, equal :func:`eps_for_bound`'s bit for bit;
+``tests/test_antiskid_cruise_match.py`` compares the two.
 
 References
 ----------
