@@ -321,6 +321,9 @@ def _delay_free(fn, x0, lam_d: float, T: float):
 #: solver's own steps; the path is the dense output on this fixed grid, because
 #: the adaptive steps themselves move with the last bits of the inputs, and a
 #: polyline with other vertices antialiases differently (issue 36 item 5).
+#: Every fate is drawn so, a trajectory whose step fails too: its accepted
+#: steps bunch up where it diverges, and their times move by ~1e-7 s under a
+#: 3-ulp change of the start (the dense output at fixed times by ~1e-9).
 PATH_DT = 0.01
 
 
@@ -338,33 +341,34 @@ def _drawn_path(sol, inside_at) -> np.ndarray:
     return path
 
 
+def _trajectory(fn, x0, lam_d: float, T: float, inside_at) -> Trajectory:
+    """One delay-free trajectory x' = fn(x) from x0 (:func:`_delay_free`) and
+    its fate: "converges" when a solver step satisfies ``inside_at`` (the
+    certified set), "diverges" when lambda leaves (-0.9, 0.9) or the step
+    fails, else "undecided" within T. The drawn path is :func:`_drawn_path`
+    (cut at the certified set for "converges") whatever the fate."""
+    sol = _delay_free(fn, x0, lam_d, T)
+    path = sol.y.T
+    if inside_at(path).any():
+        fate, drawn = "converges", _drawn_path(sol, inside_at)
+    else:
+        bad = sol.status != 0 or not np.all(np.isfinite(path))
+        fate, drawn = ("diverges" if bad else "undecided"), _drawn_path(sol, None)
+    return Trajectory(tuple(float(v) for v in x0), drawn, fate)
+
+
 def _trajectories(prob, est, pts, seed, n, T, lam_d):
-    """Delay-free trajectories from a seeded set of states around the basin
-    and from each switch state (Radau, rtol 1e-8): "converges" when a sample
-    enters {V <= c_certified}, "diverges" when lambda leaves (-0.9, 0.9) or
-    the step fails, else "undecided" within T."""
+    """Delay-free trajectories (:func:`_trajectory`, certified set {V <=
+    c_certified}) from each switch state and a seeded set of states around
+    the basin."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, 1]))
     half = np.array([max(abs(x[0]) for _, x in pts) * 2 + 1.0,
                      max(abs(x[1]) for _, x in pts) * 1.5 + 0.02]) if pts else np.array([2, 0.1])
     starts = [tuple(x) for _, x in pts]
     starts += [tuple(rng.uniform(-1, 1, 2) * half) for _ in range(n)]
     fm = lambdify(prob.states, list(prob.f), "math")
-    out = []
-    for x0 in starts:
-        sol = _delay_free(fm, x0, lam_d, T)
-        path = sol.y.T
-        inside = prob.V(path) <= est.c_certified
-        if inside.any():
-            fate = "converges"
-            drawn = _drawn_path(sol, lambda p: prob.V(p) <= est.c_certified)
-        elif sol.status != 0 or not np.all(np.isfinite(path)):
-            fate, drawn = "diverges", path
-        else:
-            fate, drawn = "undecided", _drawn_path(sol, None)
-        if fate == "diverges" and sol.status == 1:     # ended at the spin event
-            drawn = _drawn_path(sol, None)
-        out.append(Trajectory(tuple(float(v) for v in x0), drawn, fate))
-    return tuple(out)
+    inside = lambda p: prob.V(p) <= est.c_certified
+    return tuple(_trajectory(fm, x0, lam_d, T, inside) for x0 in starts)
 
 
 @dataclass(frozen=True)

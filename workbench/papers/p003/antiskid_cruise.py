@@ -287,7 +287,8 @@ class AntiskidCruise:
         import numpy as np
 
         from ...margins import delay_margin_eig
-        from ...synthesis import certify_given_gain, eps_for_bound, synthesize_delay_bound
+        from ...synthesis import certify_given_gain, synthesize_delay_bound
+        from .antiskid_cruise_match import eps_matching
         spec: CruiseSpec = design.spec
         lam_opt, lam_solved, lam_used, lin = operating_point(spec)
         rows = synthesize_delay_bound(lin.A, lin.B, spec.eps, spec.settings)
@@ -299,8 +300,7 @@ class AntiskidCruise:
                 K = np.array([p.K])
                 br = certify_given_gain(lin.A, lin.B, K, p.eps, spec.settings)
                 em = delay_margin_eig(lin.A, lin.B @ K)
-                match = eps_for_bound(lin.A, lin.B, p.h_m, eps_lo, eps_hi,
-                                      settings=spec.settings)
+                match = eps_matching(lin.A, lin.B, p.h_m, eps_lo, eps_hi, spec.settings)
                 checks.append(PublishedCheck(p, ours, br.h_certified, br.h_refuted, em, match))
         tight = _run_tight(spec, lin, rows) if spec.tight else None
         return CruiseResult(lam_opt, lam_solved, lam_used, lin, rows, tuple(checks), tight,
