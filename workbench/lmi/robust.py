@@ -68,6 +68,12 @@ def eps_grid_for(grid: Sequence[float] | None, default: Sequence[float], h_cap: 
     return out
 
 
+def _set_product(prm) -> None:
+    """``eps_ealpha = eps * ealpha`` (:class:`DescriptorSynthesis`), once both are set."""
+    if "eps_ealpha" in prm and prm["ealpha"].value is not None and prm["eps"].value is not None:
+        prm["eps_ealpha"].value = float(prm["eps"].value) * float(prm["ealpha"].value)
+
+
 class DescriptorSynthesis(MarginLMI):
     """Jensen/descriptor synthesis LMI over operating points (eps a DPP parameter).
 
@@ -114,17 +120,22 @@ class DescriptorSynthesis(MarginLMI):
         self.set_eps(eps)
 
     def parameters(self):
-        return ("eps", "ealpha")
+        # eps_ealpha = eps * ealpha, its own parameter: a product of two
+        # parameters is not DPP, and a problem that is not DPP is compiled
+        # again by cvxpy for every solve (issue 36, item 4)
+        return ("eps", "ealpha", "eps_ealpha")
 
     def set_delay(self, h: float) -> None:
         super().set_delay(h)
         self.set_parameters(ealpha=math.exp(self.alpha * h))
+        _set_product(self._params)
 
     def set_eps(self, eps: float) -> None:
         if not eps > 0:
             raise ValueError(f"eps = {eps!r}; expected a positive number")
         self.eps = float(eps)
         self.set_parameters(eps=eps)
+        _set_product(self._params)
 
     def variables(self):
         n = self.n
@@ -142,9 +153,10 @@ class DescriptorSynthesis(MarginLMI):
             A, B = A * u, B * u
             P, S, R = x[f"P{i}"], x[f"S{i}"], x[f"R{i}"]
             AY, BV = A @ Y, p["ealpha"] * (B @ V)
+            eBV = p["eps_ealpha"] * (1 / u) * (B @ V)        # eps * BV
             lmi = bmat([[AY + AY.T + S - iota * R, P - Y + eps * AY.T, BV + iota * R],
-                        [P - Y.T + eps * AY, -eps * (Y + Y.T) + h * R, eps * BV],
-                        [BV.T + iota * R, eps * BV.T, -S - iota * R]])
+                        [P - Y.T + eps * AY, -eps * (Y + Y.T) + h * R, eBV],
+                        [BV.T + iota * R, eBV.T, -S - iota * R]])
             out += [Block(f"lmi{i}", lmi, "nsd"), Block(f"P{i}_pos", P, "psd"),
                     Block(f"S{i}_pos", S, "psd"), Block(f"R{i}_pos", R, "psd")]
         return out
