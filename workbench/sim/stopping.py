@@ -161,6 +161,25 @@ def _brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params, dt, on_air):
     return dv, b_e + dt * dbe, b_a + dt * dba, cap
 
 
+def _compact_views(per_run: dict):
+    """Brake parameters, theta, kappa and the air-stage flag of the stepped runs
+    for :func:`_brake_step` (bitwise equal values as Python floats: the same
+    IEEE operations, fewer on arrays)."""
+    pe = _uniform({k: per_run[k] for k in PARAMETER_UNITS})
+    on_air = per_run["on_air"]
+    return pe, _uniform(per_run["theta"]), _uniform(per_run["kappa"]), bool(on_air.all()) or on_air
+
+
+def _spread(done: dict, act, x, v, a, stopped):
+    """Full-batch x, v, a, stopped from the stepped runs ``act`` and the final
+    values of the others (at standstill: v = a = 0)."""
+    n = len(done["x"])
+    out = [done["x"].copy(), done["v"].copy(), np.zeros(n), np.ones(n, bool)]
+    for full, val in zip(out, (x, v, a, stopped)):
+        full[act] = val
+    return tuple(out)
+
+
 def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 0.01,
              dt_ctrl: float = 0.1, dt_rec: float = 0.1, v0=0.0, x0=0.0,
              theta=0.0, kappa=1.0, c_init=0.0, t_arm: float = 0.0,
@@ -202,7 +221,6 @@ def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 
     pad = int(np.ceil(d13.max())) + 2
     hist = np.empty((steps + pad + 1, n))
     hist[:pad + 1] = c_init
-    flat = hist.reshape(-1)           # a view: rows written into hist show here
     cap = np.full(shape, np.inf)
     on_air = params["v_ho"] > 0
     b_e = np.where(v > params["v_ho"], c_init, 0.0)
@@ -212,24 +230,31 @@ def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 
     t_stop, x_stop = np.full(shape, np.nan), np.full(shape, np.nan)
     rec_t, rec = [], {k: [] for k in "xvac"}
     c = c_init.copy()
-    # equal per-run values as Python floats: the same IEEE operations, fewer array ones
-    pe, th, kap = _uniform(params), _uniform(theta), _uniform(kappa)
-    air = bool(on_air.all()) or on_air
-    plan = None
+    # Runs at standstill since an earlier step are final (x = x_stop, v = a = 0): once they
+    # are a quarter of the batch they are dropped from the stepped arrays (``act``: the
+    # runs still stepped; ``done``: the final values of all runs, read where not in ``act``).
+    # Every operation is elementwise, so each run's numbers do not depend on the others.
+    act, done = np.arange(n), None
+    per_run = dict(params, theta=theta, kappa=kappa, on_air=on_air, delay1=d13[0], delay3=d13[1])
+    pe, th, kap, air = _compact_views(per_run)
+    plan, flat = None, hist.reshape(-1)   # a view: rows written into hist show here
     for k in range(steps + 1):
         t = k * dt
+        if k % k_ctrl == 0 or k % k_rec == 0:
+            full = (x, v, a, stopped) if done is None else _spread(done, act, x, v, a, stopped)
         if k % k_ctrl == 0:
-            c = np.clip(np.asarray(policy(t, Observation(x, v, a, stopped)), float), c_min, c_max)
-            c = np.where(stopped, 0.0, c)
-        hist[k + pad] = c
+            c = np.clip(np.asarray(policy(t, Observation(*full)), float), c_min, c_max)
+            c = np.where(full[3], 0.0, c)
+        hist[k + pad] = c if done is None else c[act]
         if k % k_rec == 0:
             rec_t.append(t)
-            for key, val in zip("xvac", (x, v, a, c)):
+            for key, val in zip("xvac", (*full[:3], c)):
                 rec[key].append(val.copy())
         if k == steps or stopped.all():
             break
         if plan is None or k >= plan[0] + len(plan[1]):
-            plan = (k, *_delay_plan(d13, k, min(k + _CHUNK, steps), pad, n))
+            plan = (k, *_delay_plan(np.stack([per_run["delay1"], per_run["delay3"]]), k,
+                                    min(k + _CHUNK, steps), pad, len(act)))
         j = k - plan[0]
         ce, ca = plan[1][j] * flat[plan[2][j]] + plan[3][j] * flat[plan[4][j]]
         dv, b_e, b_a, cap = _brake_step(v, b_e, b_a, cap, ce, ca, th, kap, pe, dt, air)
@@ -237,14 +262,34 @@ def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 
         v_new = np.maximum(v + dt * a, 0.0)
         x_new = x + 0.5 * (v + v_new) * dt
         hit = ~stopped & (v_new <= 0.0) & (t + dt > t_arm)
+        final = stopped
         if hit.any():
             x_hit, t_hit = standstill(x, v, a, x_new, dt)
             x_new = np.where(hit, x_hit, x_new)
             t_stop = np.where(hit, t + t_hit, t_stop)
             x_stop = np.where(hit, x_new, x_stop)
-        stopped |= hit
+            stopped = stopped | hit
         x = np.where(stopped, x_stop, x_new)
         v = np.where(stopped, 0.0, v_new)
+        if hit.any() and 4 * np.count_nonzero(final) >= len(act) and not stopped.all():
+            if done is None:
+                done = {"x": x.copy(), "v": v.copy(), "t_stop": t_stop.copy(),
+                        "x_stop": x_stop.copy()}
+            gone, keep = act[final], ~final
+            for key, val in (("x", x), ("v", v), ("t_stop", t_stop), ("x_stop", x_stop)):
+                done[key][gone] = val[final]
+            act = act[keep]
+            x, v, a, stopped, t_stop, x_stop, b_e, b_a, cap = (
+                z[keep] for z in (x, v, a, stopped, t_stop, x_stop, b_e, b_a, cap))
+            per_run = {key: val[keep] for key, val in per_run.items()}
+            pe, th, kap, air = _compact_views(per_run)
+            rows = hist[k + 1:k + pad + 1, keep]
+            hist = np.empty((steps + pad + 1, len(act)))
+            hist[k + 1:k + pad + 1] = rows       # the rows the delay line still reads
+            plan, flat = None, hist.reshape(-1)
+    if done is not None:
+        done["t_stop"][act], done["x_stop"][act] = t_stop, x_stop
+        t_stop, x_stop = done["t_stop"], done["x_stop"]
     return Traces(np.array(rec_t), *(np.array(rec[k]) for k in "xvac"), t_stop, x_stop)
 
 
