@@ -105,7 +105,7 @@ def brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params: dict, dt: float, 
         Acceleration over the step (m/s^2, from eqs 5, 10) and the stepped
         brake states and cap.
     """
-    return _brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params, dt, on_air)
+    return _brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params, dt, on_air)[:4]
 
 
 def standstill(x, v, a, x_new, dt: float):
@@ -146,19 +146,26 @@ def _delay_plan(d, k0: int, k1: int, pad: int, n: int):
     return 1 - w, i0 * n + cols, w, np.minimum(i0 + 1, kp) * n + cols
 
 
-def _brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params, dt, on_air):
+def _brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params, dt, on_air, cap_inf=False):
     """:func:`brake_step` for :func:`simulate`: ``on_air`` may be ``True``
     (every run has an air stage) and parameters Python floats (:func:`_uniform`);
-    the same operations in the same order."""
-    fading = on_air & (v < params["v_ho"]) & np.isinf(cap)
-    cap = np.where(fading, np.maximum(b_e, 0.0), cap)
-    cap = np.where(np.isinf(cap), cap, np.maximum(cap - params["k_bra"] * dt, 0.0))
-    e_in = np.minimum(ce, cap)
-    air_in = np.maximum(ca - np.minimum(ca, cap), 0.0)
+    the same operations in the same order. ``cap_inf``: every cap is still
+    infinite; then, while no run fades, the cap steps are skipped (they leave
+    it infinite, ``min(c, inf)`` is ``c``). Returns also the new ``cap_inf``."""
+    fading = on_air & (v < params["v_ho"])
+    if cap_inf and not fading.any():
+        e_in, air_in = ce, np.maximum(ca - ca, 0.0)
+    else:
+        fading &= np.isinf(cap)
+        cap = np.where(fading, np.maximum(b_e, 0.0), cap)
+        cap = np.where(np.isinf(cap), cap, np.maximum(cap - params["k_bra"] * dt, 0.0))
+        e_in = np.minimum(ce, cap)
+        air_in = np.maximum(ca - np.minimum(ca, cap), 0.0)
+        cap_inf = False
     if on_air is not True:
         air_in = np.where(on_air, air_in, 0.0)
     dv, dbe, dba = brake_rhs(v, b_e, b_a, e_in, air_in, theta, kappa, params)
-    return dv, b_e + dt * dbe, b_a + dt * dba, cap
+    return dv, b_e + dt * dbe, b_a + dt * dba, cap, cap_inf
 
 
 def _compact_views(per_run: dict):
@@ -238,6 +245,7 @@ def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 
     per_run = dict(params, theta=theta, kappa=kappa, on_air=on_air, delay1=d13[0], delay3=d13[1])
     pe, th, kap, air = _compact_views(per_run)
     plan, flat = None, hist.reshape(-1)   # a view: rows written into hist show here
+    cap_inf, any_stopped = True, False
     for k in range(steps + 1):
         t = k * dt
         if k % k_ctrl == 0 or k % k_rec == 0:
@@ -257,21 +265,32 @@ def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 
                                     min(k + _CHUNK, steps), pad, len(act)))
         j = k - plan[0]
         ce, ca = plan[1][j] * flat[plan[2][j]] + plan[3][j] * flat[plan[4][j]]
-        dv, b_e, b_a, cap = _brake_step(v, b_e, b_a, cap, ce, ca, th, kap, pe, dt, air)
-        a = np.where(stopped, 0.0, dv)
+        dv, b_e, b_a, cap, cap_inf = _brake_step(v, b_e, b_a, cap, ce, ca, th, kap, pe, dt, air,
+                                                 cap_inf)
+        # (while no run is at standstill the masks below select nothing: skipped)
+        a = np.where(stopped, 0.0, dv) if any_stopped else dv
         v_new = np.maximum(v + dt * a, 0.0)
         x_new = x + 0.5 * (v + v_new) * dt
-        hit = ~stopped & (v_new <= 0.0) & (t + dt > t_arm)
+        hit = v_new <= 0.0
+        if any_stopped:
+            hit &= ~stopped
+        if not t + dt > t_arm:
+            hit[:] = False
         final = stopped
-        if hit.any():
+        struck = hit.any()
+        if struck:
             x_hit, t_hit = standstill(x, v, a, x_new, dt)
             x_new = np.where(hit, x_hit, x_new)
             t_stop = np.where(hit, t + t_hit, t_stop)
             x_stop = np.where(hit, x_new, x_stop)
             stopped = stopped | hit
-        x = np.where(stopped, x_stop, x_new)
-        v = np.where(stopped, 0.0, v_new)
-        if hit.any() and 4 * np.count_nonzero(final) >= len(act) and not stopped.all():
+            any_stopped = True
+        if any_stopped:
+            x = np.where(stopped, x_stop, x_new)
+            v = np.where(stopped, 0.0, v_new)
+        else:
+            x, v = x_new, v_new
+        if struck and 4 * np.count_nonzero(final) >= len(act) and not stopped.all():
             if done is None:
                 done = {"x": x.copy(), "v": v.copy(), "t_stop": t_stop.copy(),
                         "x_stop": x_stop.copy()}
@@ -287,6 +306,7 @@ def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 
             hist = np.empty((steps + pad + 1, len(act)))
             hist[k + 1:k + pad + 1] = rows       # the rows the delay line still reads
             plan, flat = None, hist.reshape(-1)
+            any_stopped = bool(stopped.any())
     if done is not None:
         done["t_stop"][act], done["x_stop"][act] = t_stop, x_stop
         t_stop, x_stop = done["t_stop"], done["x_stop"]
