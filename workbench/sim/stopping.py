@@ -142,8 +142,10 @@ def _delay_plan(d, k0: int, k1: int, pad: int, n: int):
     idx = kp - d
     i0 = np.floor(idx).astype(int)
     w = idx - i0
-    cols = np.arange(n)
-    return 1 - w, i0 * n + cols, w, np.minimum(i0 + 1, kp) * n + cols
+    lo = i0 * n + np.arange(n)
+    if d.min() >= 1.0:    # then idx <= kp - 1 (rounding is monotonic): row i0 + 1 is written
+        return 1 - w, lo, w, lo + n
+    return 1 - w, lo, w, lo + (np.minimum(i0 + 1, kp) - i0) * n
 
 
 def _brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params, dt, on_air, cap_inf=False):
