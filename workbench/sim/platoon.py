@@ -236,12 +236,18 @@ def simulate_platoon(nominal, true, law: FollowerLaw, leader_ref: Callable, *, n
     Ee, Ede, Es, Eseen = (He[k] for k in ("e", "de", "s", "e_seen"))
     fxf, fvf, faf = Hx.reshape(-1), Hv.reshape(-1), Ha.reshape(-1)
     fv_nom_f, fv_true_f = fv_nom.reshape(-1), fv_true.reshape(-1)
-    res_nom, res_true = nominal.resistance, true.resistance
+    # nominal and true resistance in one evaluation: row 0 nominal, row 1 true (elementwise)
+    both = type(nominal)(*(np.stack([np.broadcast_to(np.asarray(getattr(p, c), float), (n,))
+                                     for p in (nominal, true)]) for c in ("m", "c0", "c1", "c2")),
+                         nominal.g)
+    v2 = np.empty((2, n))
     stamped = link is not None and link.own_state != "current"
     for k in range(K):
         Hx[k], Hv[k], Ha[k] = x, v, a_prev
-        ix = np.searchsorted(edges, x, side="right") * n + cols
-        u1 = res_nom(v) + fv_nom_f[ix]
+        ix = edges.searchsorted(x, side="right") * n + cols
+        v2[:] = v
+        res = both.resistance(v2)
+        u1 = res[0] + fv_nom_f[ix]
         e = x[:-1] - x[1:] - spacing
         de = v[:-1] - v[1:]
         if link is None:
@@ -263,7 +269,7 @@ def simulate_platoon(nominal, true, law: FollowerLaw, leader_ref: Callable, *, n
             cmd = np.minimum(np.maximum(u, actuator.f_min), actuator.f_max)   # np.clip
             force = cmd + (f - cmd) * mean
             f = cmd + (f - cmd) * decay
-        acc = (force - res_true(v) - fv_true_f[ix] + w[k]) / true.m
+        acc = (force - res[1] - fv_true_f[ix] + w[k]) / true.m
         v_new = np.maximum(v + T * acc, 0.0)
         a_real = (v_new - v) / T
         Hu[k], Hf[k] = u, force
