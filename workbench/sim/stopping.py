@@ -105,7 +105,8 @@ def brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params: dict, dt: float, 
         Acceleration over the step (m/s^2, from eqs 5, 10) and the stepped
         brake states and cap.
     """
-    return _brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params, dt, on_air)[:4]
+    cap_inf = bool(np.isinf(cap).all())     # lets the cap steps be skipped (same bits)
+    return _brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params, dt, on_air, cap_inf)[:4]
 
 
 def standstill(x, v, a, x_new, dt: float):
