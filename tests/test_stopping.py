@@ -145,3 +145,30 @@ def test_within_rate_is_the_wilson_interval():
     assert hi == pytest.approx(1.959963984540054 ** 2 / (10 + 1.959963984540054 ** 2))
     k, n, p, lo, hi = within_rate([-10.0, 5.0, 31.0, -29.9], 30.0)
     assert (k, n, p) == (3, 4, 0.75) and 0.3 < lo < 0.75 < hi < 1.0
+
+
+def test_each_run_of_a_batch_equals_the_run_alone_bit_for_bit():
+    # simulate is elementwise per run: dropping stopped runs from the stepped arrays,
+    # equal parameters taken as floats, the block delay line must not change a bit
+    rng = np.random.default_rng(7)
+    n = 6
+    # T1 < T3 in every run: the delay line's row offset (from the longest delay of the
+    # batch) is then the same alone and batched; it enters the weights' last bits
+    over = {"T1": rng.uniform(0.2, 0.75, n), "K1": TABLE1["K1"] * rng.uniform(0.8, 1.2, n),
+            "v_ho": np.where(np.arange(n) % 3 == 0, 0.0, TABLE1["v_ho"])}
+    v0, theta = rng.uniform(4.0, 12.0, n), rng.uniform(-3.0, 3.0, n)
+    # basic arithmetic only: numpy's SIMD sin/exp may round a batch and a lone run differently
+    policy = lambda t, o: np.where(o.v > 4.0, 0.8, 0.5) + 0.02 * o.x / (10.0 + o.x + t)
+    kw = dict(t_end=40.0, dt=0.02, dt_ctrl=0.1, dt_rec=0.5, c_init=0.1)
+    batch = simulate(batch_params(TABLE1, n, over), policy, n=n, v0=v0, theta=theta, **kw)
+    assert np.isfinite(batch.t_stop).all() and np.ptp(batch.t_stop) > 2.0   # staggered stops
+    for i in range(n):
+        one = simulate(batch_params(TABLE1, 1, {k: x[i:i + 1] for k, x in over.items()}),
+                       policy, n=1, v0=v0[i], theta=theta[i], **kw)
+        k = len(one.t)
+        assert np.array_equal(batch.t[:k], one.t)
+        for name in ("x", "v", "a", "c"):
+            # after its stop a run's samples stay final (x = x_stop, v = a = c = 0)
+            assert np.array_equal(getattr(batch, name)[:k, i], getattr(one, name)[:, 0]), name
+        assert np.array_equal(batch.x_stop[i:i + 1], one.x_stop)
+        assert np.array_equal(batch.t_stop[i:i + 1], one.t_stop)

@@ -178,7 +178,9 @@ def _lambdified():
 
 def _pvals(p) -> list:
     """Parameter values in the order of :data:`PARAMETER_UNITS` (floats or arrays)."""
-    return [p[k] if isinstance(p, dict) else getattr(p, k) for k in PARAMETER_UNITS]
+    if isinstance(p, dict):
+        return [p[k] for k in PARAMETER_UNITS]
+    return [getattr(p, k) for k in PARAMETER_UNITS]
 
 
 def brake_rhs(v, b_e, b_a, e_in, air_in, theta, kappa, p) -> list:

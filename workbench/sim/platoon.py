@@ -228,37 +228,53 @@ def simulate_platoon(nominal, true, law: FollowerLaw, leader_ref: Callable, *, n
         mean = actuator.lag / T * (1.0 - decay)      # mean of the lag's step response gap
         f = np.zeros(n)
     u = np.zeros(n)
+    # per-step overhead cut, same arithmetic: the leader's scalars as Python floats, the
+    # history rows and the (section, train) and (step, train) lookups by flat index
+    u_lead_k, v_ref_k = u_lead.tolist(), v_ref.tolist()
+    m_gain = nominal.m * leader_gain
+    Hx, Hv, Ha, Hu, Hl, Hf = (H[k] for k in ("x", "v", "a", "u", "lumped", "force"))
+    Ee, Ede, Es, Eseen = (He[k] for k in ("e", "de", "s", "e_seen"))
+    fxf, fvf, faf = Hx.reshape(-1), Hv.reshape(-1), Ha.reshape(-1)
+    fv_nom_f, fv_true_f = fv_nom.reshape(-1), fv_true.reshape(-1)
+    # nominal and true resistance in one evaluation: row 0 nominal, row 1 true (elementwise)
+    both = type(nominal)(*(np.stack([np.broadcast_to(np.asarray(getattr(p, c), float), (n,))
+                                     for p in (nominal, true)]) for c in ("m", "c0", "c1", "c2")),
+                         nominal.g)
+    v2 = np.empty((2, n))
+    stamped = link is not None and link.own_state != "current"
     for k in range(K):
-        H["x"][k], H["v"][k], H["a"][k] = x, v, a_prev
-        sec = np.searchsorted(edges, x, side="right")
-        u1 = nominal.resistance(v) + fv_nom[sec, cols]
+        Hx[k], Hv[k], Ha[k] = x, v, a_prev
+        ix = edges.searchsorted(x, side="right") * n + cols
+        v2[:] = v
+        res = both.resistance(v2)
+        u1 = res[0] + fv_nom_f[ix]
         e = x[:-1] - x[1:] - spacing
         de = v[:-1] - v[1:]
         if link is None:
             e_seen, de_seen, a_seen = e, de, a_prev[:-1]
         else:
-            src = link.source[k]
-            xo, vo = ((x[1:], v[1:]) if link.own_state == "current"
-                      else (H["x"][src, foll], H["v"][src, foll]))
-            e_seen = H["x"][src, pred] - xo - spacing
-            de_seen = H["v"][src, pred] - vo
-            a_seen = H["a"][src, pred]
+            row = link.source[k] * n
+            ip = row + pred
+            xo, vo = (fxf[row + foll], fvf[row + foll]) if stamped else (x[1:], v[1:])
+            e_seen = fxf[ip] - xo - spacing
+            de_seen = fvf[ip] - vo
+            a_seen = faf[ip]
         u_f, s = law(e_seen, de_seen, u1[1:], a_seen)
-        u[0] = (u_lead[k] + nominal.m * leader_gain * (v_ref[k] - v[0]) + u1[0] if k < k_brake
+        u[0] = (u_lead_k[k] + m_gain * (v_ref_k[k] - float(v[0])) + float(u1[0]) if k < k_brake
                 else leader_brake[1])
         u[1:] = u_f
         if actuator is None:
             force = u
         else:
-            cmd = np.clip(u, actuator.f_min, actuator.f_max)
+            cmd = np.minimum(np.maximum(u, actuator.f_min), actuator.f_max)   # np.clip
             force = cmd + (f - cmd) * mean
             f = cmd + (f - cmd) * decay
-        acc = (force - true.resistance(v) - fv_true[sec, cols] + w[k]) / true.m
+        acc = (force - res[1] - fv_true_f[ix] + w[k]) / true.m
         v_new = np.maximum(v + T * acc, 0.0)
         a_real = (v_new - v) / T
-        H["u"][k], H["force"][k] = u, force
-        H["lumped"][k] = nominal.m * a_real - (u - u1)
-        He["e"][k], He["de"][k], He["s"][k], He["e_seen"][k] = e, de, s, e_seen
+        Hu[k], Hf[k] = u, force
+        Hl[k] = nominal.m * a_real - (u - u1)
+        Ee[k], Ede[k], Es[k], Eseen[k] = e, de, s, e_seen
         x = x + 0.5 * T * (v + v_new)
         v, a_prev = v_new, a_real
     return PlatoonRun(t_all, H["x"], H["v"], H["u"], He["e"], He["de"], He["s"],

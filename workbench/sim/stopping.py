@@ -105,13 +105,8 @@ def brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params: dict, dt: float, 
         Acceleration over the step (m/s^2, from eqs 5, 10) and the stepped
         brake states and cap.
     """
-    fading = on_air & (v < params["v_ho"]) & np.isinf(cap)
-    cap = np.where(fading, np.maximum(b_e, 0.0), cap)
-    cap = np.where(np.isinf(cap), cap, np.maximum(cap - params["k_bra"] * dt, 0.0))
-    e_in = np.minimum(ce, cap)
-    air_in = np.where(on_air, np.maximum(ca - np.minimum(ca, cap), 0.0), 0.0)
-    dv, dbe, dba = brake_rhs(v, b_e, b_a, e_in, air_in, theta, kappa, params)
-    return dv, b_e + dt * dbe, b_a + dt * dba, cap
+    cap_inf = bool(np.isinf(cap).all())     # lets the cap steps be skipped (same bits)
+    return _brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params, dt, on_air, cap_inf)[:4]
 
 
 def standstill(x, v, a, x_new, dt: float):
@@ -120,6 +115,79 @@ def standstill(x, v, a, x_new, dt: float):
     braking = a < 0
     x_hit = np.where(braking, x - v * v / (2 * np.where(braking, a, -1.0)), x_new)
     return x_hit, np.where(braking, v / np.maximum(-a, 1e-12), dt)
+
+
+#: steps per block of precomputed delay-line indices and weights
+_CHUNK = 256
+
+
+def _uniform(a):
+    """``a`` (an array, or a dict of arrays) with every array whose entries are
+    bitwise equal replaced by that entry as a Python float."""
+    if isinstance(a, dict):
+        return {k: _uniform(val) for k, val in a.items()}
+    arr = np.asarray(a)
+    if arr.ndim == 1 and arr.size and arr.dtype == np.float64:
+        bits = arr.view(np.int64)
+        if (bits == bits[0]).all():
+            return float(arr[0])
+    return a
+
+
+def _delay_plan(d, k0: int, k1: int, pad: int, n: int):
+    """Linear interpolation of the command history at steps k0 .. k1-1 for
+    delays of ``d`` steps (shape (2, n)): weights (1 - w, w) and flat indices
+    of the two history rows, each of shape (k1 - k0, 2, n); the arithmetic
+    of ``k + pad - d`` per step, done for a block at once."""
+    kp = np.arange(k0 + pad, k1 + pad)[:, None, None]
+    idx = kp - d
+    i0 = np.floor(idx).astype(int)
+    w = idx - i0
+    lo = i0 * n + np.arange(n)
+    if d.min() >= 1.0:    # then idx <= kp - 1 (rounding is monotonic): row i0 + 1 is written
+        return 1 - w, lo, w, lo + n
+    return 1 - w, lo, w, lo + (np.minimum(i0 + 1, kp) - i0) * n
+
+
+def _brake_step(v, b_e, b_a, cap, ce, ca, theta, kappa, params, dt, on_air, cap_inf=False):
+    """:func:`brake_step` for :func:`simulate`: ``on_air`` may be ``True``
+    (every run has an air stage) and parameters Python floats (:func:`_uniform`);
+    the same operations in the same order. ``cap_inf``: every cap is still
+    infinite; then, while no run fades, the cap steps are skipped (they leave
+    it infinite, ``min(c, inf)`` is ``c``). Returns also the new ``cap_inf``."""
+    fading = on_air & (v < params["v_ho"])
+    if cap_inf and not fading.any():
+        e_in, air_in = ce, np.maximum(ca - ca, 0.0)
+    else:
+        fading &= np.isinf(cap)
+        cap = np.where(fading, np.maximum(b_e, 0.0), cap)
+        cap = np.where(np.isinf(cap), cap, np.maximum(cap - params["k_bra"] * dt, 0.0))
+        e_in = np.minimum(ce, cap)
+        air_in = np.maximum(ca - np.minimum(ca, cap), 0.0)
+        cap_inf = False
+    if on_air is not True:
+        air_in = np.where(on_air, air_in, 0.0)
+    dv, dbe, dba = brake_rhs(v, b_e, b_a, e_in, air_in, theta, kappa, params)
+    return dv, b_e + dt * dbe, b_a + dt * dba, cap, cap_inf
+
+
+def _compact_views(per_run: dict):
+    """Brake parameters, theta, kappa and the air-stage flag of the stepped runs
+    for :func:`_brake_step` (bitwise equal values as Python floats: the same
+    IEEE operations, fewer on arrays)."""
+    pe = _uniform({k: per_run[k] for k in PARAMETER_UNITS})
+    on_air = per_run["on_air"]
+    return pe, _uniform(per_run["theta"]), _uniform(per_run["kappa"]), bool(on_air.all()) or on_air
+
+
+def _spread(done: dict, act, x, v, a, stopped):
+    """Full-batch x, v, a, stopped from the stepped runs ``act`` and the final
+    values of the others (at standstill: v = a = 0)."""
+    n = len(done["x"])
+    out = [done["x"].copy(), done["v"].copy(), np.zeros(n), np.ones(n, bool)]
+    for full, val in zip(out, (x, v, a, stopped)):
+        full[act] = val
+    return tuple(out)
 
 
 def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 0.01,
@@ -159,8 +227,8 @@ def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 
     steps = int(round(t_end / dt))
     k_ctrl = max(1, int(round(dt_ctrl / dt)))
     k_rec = max(1, int(round(dt_rec / dt)))
-    d1, d3 = params["T1"] / dt, params["T3"] / dt
-    pad = int(np.ceil(max(d1.max(), d3.max()))) + 2
+    d13 = np.stack([params["T1"] / dt, params["T3"] / dt])
+    pad = int(np.ceil(d13.max())) + 2
     hist = np.empty((steps + pad + 1, n))
     hist[:pad + 1] = c_init
     cap = np.full(shape, np.inf)
@@ -170,42 +238,81 @@ def simulate(params: dict, policy: Policy, *, n: int, t_end: float, dt: float = 
     a = np.zeros(shape)
     stopped = np.zeros(shape, bool)
     t_stop, x_stop = np.full(shape, np.nan), np.full(shape, np.nan)
-    cols = np.arange(n)
     rec_t, rec = [], {k: [] for k in "xvac"}
     c = c_init.copy()
-
-    def delayed(dk, k):
-        idx = k + pad - dk
-        i0 = np.floor(idx).astype(int)
-        w = idx - i0
-        return (1 - w) * hist[i0, cols] + w * hist[np.minimum(i0 + 1, k + pad), cols]
-
+    # Runs at standstill since an earlier step are final (x = x_stop, v = a = 0): once they
+    # are a quarter of the batch they are dropped from the stepped arrays (``act``: the
+    # runs still stepped; ``done``: the final values of all runs, read where not in ``act``).
+    # Every operation is elementwise, so each run's numbers do not depend on the others.
+    act, done = np.arange(n), None
+    per_run = dict(params, theta=theta, kappa=kappa, on_air=on_air, delay1=d13[0], delay3=d13[1])
+    pe, th, kap, air = _compact_views(per_run)
+    plan, flat = None, hist.reshape(-1)   # a view: rows written into hist show here
+    cap_inf, any_stopped = True, False
     for k in range(steps + 1):
         t = k * dt
+        if k % k_ctrl == 0 or k % k_rec == 0:
+            full = (x, v, a, stopped) if done is None else _spread(done, act, x, v, a, stopped)
         if k % k_ctrl == 0:
-            c = np.clip(np.asarray(policy(t, Observation(x, v, a, stopped)), float), c_min, c_max)
-            c = np.where(stopped, 0.0, c)
-        hist[k + pad] = c
+            c = np.clip(np.asarray(policy(t, Observation(*full)), float), c_min, c_max)
+            c = np.where(full[3], 0.0, c)
+        hist[k + pad] = c if done is None else c[act]
         if k % k_rec == 0:
             rec_t.append(t)
-            for key, val in zip("xvac", (x, v, a, c)):
+            for key, val in zip("xvac", (*full[:3], c)):
                 rec[key].append(val.copy())
         if k == steps or stopped.all():
             break
-        dv, b_e, b_a, cap = brake_step(v, b_e, b_a, cap, delayed(d1, k), delayed(d3, k), theta,
-                                       kappa, params, dt, on_air)
-        a = np.where(stopped, 0.0, dv)
+        if plan is None or k >= plan[0] + len(plan[1]):
+            plan = (k, *_delay_plan(np.stack([per_run["delay1"], per_run["delay3"]]), k,
+                                    min(k + _CHUNK, steps), pad, len(act)))
+        j = k - plan[0]
+        ce, ca = plan[1][j] * flat[plan[2][j]] + plan[3][j] * flat[plan[4][j]]
+        dv, b_e, b_a, cap, cap_inf = _brake_step(v, b_e, b_a, cap, ce, ca, th, kap, pe, dt, air,
+                                                 cap_inf)
+        # (while no run is at standstill the masks below select nothing: skipped)
+        a = np.where(stopped, 0.0, dv) if any_stopped else dv
         v_new = np.maximum(v + dt * a, 0.0)
         x_new = x + 0.5 * (v + v_new) * dt
-        hit = ~stopped & (v_new <= 0.0) & (t + dt > t_arm)
-        if hit.any():
+        hit = v_new <= 0.0
+        if any_stopped:
+            hit &= ~stopped
+        if not t + dt > t_arm:
+            hit[:] = False
+        final = stopped
+        struck = hit.any()
+        if struck:
             x_hit, t_hit = standstill(x, v, a, x_new, dt)
             x_new = np.where(hit, x_hit, x_new)
             t_stop = np.where(hit, t + t_hit, t_stop)
             x_stop = np.where(hit, x_new, x_stop)
-        stopped |= hit
-        x = np.where(stopped, x_stop, x_new)
-        v = np.where(stopped, 0.0, v_new)
+            stopped = stopped | hit
+            any_stopped = True
+        if any_stopped:
+            x = np.where(stopped, x_stop, x_new)
+            v = np.where(stopped, 0.0, v_new)
+        else:
+            x, v = x_new, v_new
+        if struck and 4 * np.count_nonzero(final) >= len(act) and not stopped.all():
+            if done is None:
+                done = {"x": x.copy(), "v": v.copy(), "t_stop": t_stop.copy(),
+                        "x_stop": x_stop.copy()}
+            gone, keep = act[final], ~final
+            for key, val in (("x", x), ("v", v), ("t_stop", t_stop), ("x_stop", x_stop)):
+                done[key][gone] = val[final]
+            act = act[keep]
+            x, v, a, stopped, t_stop, x_stop, b_e, b_a, cap = (
+                z[keep] for z in (x, v, a, stopped, t_stop, x_stop, b_e, b_a, cap))
+            per_run = {key: val[keep] for key, val in per_run.items()}
+            pe, th, kap, air = _compact_views(per_run)
+            rows = hist[k + 1:k + pad + 1, keep]
+            hist = np.empty((steps + pad + 1, len(act)))
+            hist[k + 1:k + pad + 1] = rows       # the rows the delay line still reads
+            plan, flat = None, hist.reshape(-1)
+            any_stopped = bool(stopped.any())
+    if done is not None:
+        done["t_stop"][act], done["x_stop"][act] = t_stop, x_stop
+        t_stop, x_stop = done["t_stop"], done["x_stop"]
     return Traces(np.array(rec_t), *(np.array(rec[k]) for k in "xvac"), t_stop, x_stop)
 
 

@@ -42,10 +42,46 @@ MC_MODES = ("ato-open", "closed")
 def axle_speeds(states: np.ndarray, v: np.ndarray, v_first: np.ndarray, spec) -> np.ndarray:
     """Speeds (m/s) read by the 4 axle sensors, shape (n, 4), from the train
     speed ``v`` and the speed ``v_first`` when braking started."""
+    return _axle_speeds(_state_masks(states), v, v_first, spec)
+
+
+def _state_masks(states: np.ndarray) -> list:
+    """Masks of the axle states read by :func:`_axle_speeds` (states are fixed per run)."""
+    return [states == "o", states == "s", states == "h", states == "z"]
+
+
+def _axle_speeds(masks: list, v: np.ndarray, v_first: np.ndarray, spec) -> np.ndarray:
     col = v[:, None]
-    return np.select([states == "o", states == "s", states == "h", states == "z"],
-                     [col, col * (1 - spec.slide), col * spec.high_ratio,
-                      np.broadcast_to(v_first[:, None], states.shape)], 0.0)
+    return np.select(masks, [col, col * (1 - spec.slide), col * spec.high_ratio,
+                             np.broadcast_to(v_first[:, None], masks[0].shape)], 0.0)
+
+
+class _ClosedPID:
+    """One :class:`~workbench.controllers.pid.PID` per closed-loop run, stepped
+    together: the arithmetic of ``PID.step`` (no output limits) elementwise,
+    a run's loop reset or stepped only where the masks say so."""
+
+    def __init__(self, gains: dict, dt: float, closed: np.ndarray):
+        ref = PID(**gains, dt=dt)     # validates; its limits are infinite (never saturates)
+        self.kp, self.ki, self.kd, self.dt = ref.kp, ref.ki, ref.kd, dt
+        self.closed = closed
+        n = len(closed)
+        self.integral, self.prev, self.has_prev = np.zeros(n), np.zeros(n), np.zeros(n, bool)
+
+    def reset(self, where: np.ndarray) -> None:
+        m = where & self.closed
+        self.integral = np.where(m, 0.0, self.integral)
+        self.has_prev &= ~m
+
+    def step(self, where: np.ndarray, e: np.ndarray, base: np.ndarray) -> np.ndarray:
+        """``base`` plus the PID output where ``where`` (closed runs only), else ``base``."""
+        m = where & self.closed
+        deriv = np.where(self.has_prev, (e - self.prev) / self.dt, 0.0)
+        u = self.kp * e + self.ki * (self.integral + e * self.dt) + self.kd * deriv
+        self.prev = np.where(m, e, self.prev)
+        self.has_prev |= m
+        self.integral = np.where(m, self.integral + e * self.dt, self.integral)
+        return np.where(m, base + u, base)
 
 
 def simulate_brake(spec, *, v0, dist, mode, bits, states, overrides: dict, theta, kappa,
@@ -74,8 +110,8 @@ def simulate_brake(spec, *, v0, dist, mode, bits, states, overrides: dict, theta
     p = batch_params({k: q.value for k, q in spec.params.items()}, n, overrides)
     fallback = np.all(np.isin(states, DETECTED), axis=1)
     closed = (mode == 2) & ~fallback
-    idx_closed = np.flatnonzero(closed)
-    pids = {j: PID(**spec.pid, dt=spec.dt_ctrl) for j in idx_closed}
+    masks = _state_masks(states)
+    pid = _ClosedPID(spec.pid, spec.dt_ctrl, closed)
     st = {"c": np.zeros(n), "a_f": np.zeros(n), "v_prev": None, "e_prev": np.zeros(n),
           "anchor": np.zeros(n), "in_pid": np.zeros(n, bool), "v_first": None}
 
@@ -87,7 +123,7 @@ def simulate_brake(spec, *, v0, dist, mode, bits, states, overrides: dict, theta
         a_req = np.where(d_go > 0, v_p**2 / (2 * np.maximum(d_go, spec.d_min)), spec.c_full)
         if st["v_first"] is None:
             st["v_first"] = o.v.copy()
-        v_m = axle_speeds(states, o.v, st["v_first"], spec).max(axis=1)
+        v_m = _axle_speeds(masks, o.v, st["v_first"], spec).max(axis=1)
         if st["v_prev"] is None:
             st["v_prev"] = v_m.copy()
         raw = (st["v_prev"] - v_m) / spec.dt_ctrl
@@ -103,14 +139,9 @@ def simulate_brake(spec, *, v0, dist, mode, bits, states, overrides: dict, theta
         small = np.abs(e) <= spec.e_switch
         enter = small & ~st["in_pid"]
         st["anchor"] = np.where(enter, corr, st["anchor"])
-        for j in idx_closed:
-            if enter[j]:
-                pids[j].reset()
+        pid.reset(enter)
         fz = corr + spec.fuzzy.increment(e, de)
-        pid_out = st["anchor"].copy()
-        for j in idx_closed:
-            if small[j]:
-                pid_out[j] += pids[j].step(float(e[j]))
+        pid_out = pid.step(small, e, st["anchor"])
         corr = np.clip(np.where(small, pid_out, fz), -spec.c_full, spec.c_full)
         st["in_pid"] = small
         st["c"] = np.where(closed, corr, 0.0)
