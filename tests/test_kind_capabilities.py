@@ -111,15 +111,18 @@ def test_switched_run_sweep_is_seeded_chunked_and_resumable(tmp_path, capsys):
     assert main(["sweep", str(p), "--samples", "120", "--seed", "3", "--resume"]) == 2
 
 
+#: A [montecarlo] table drawing the pendulum's ``a`` (the delay-feedback sweep tests).
+DRAW_A = ('\n[montecarlo]\nsamples = 5\nseed = 1\n[montecarlo.distributions]\n'
+          'a = { dist = "uniform", lo = 1.5, hi = 2.5, source = "test" }\n')
+
+
 def test_delay_feedback_sweep_draws_the_plant(tmp_path, capsys):
     """x' = -a sin(x) + u at x = 0.5 rad, a drawn: the sweep's largest errors
     are those of its draws (the same numbers for the same seed; others for
     another), and a design without [montecarlo] has no sweep."""
     from test_delay_feedback import write as write_feedback
     scen = ('\n[[scenarios]]\nname = "kick"\nx0 = { x = 0.7 }\nt_end = 2.0\ndt = 0.02\n')
-    mc = ('\n[montecarlo]\nsamples = 5\nseed = 1\n[montecarlo.distributions]\n'
-          'a = { dist = "uniform", lo = 1.5, hi = 2.5, source = "test" }\n')
-    p = write_feedback(tmp_path, extra=scen + mc)
+    p = write_feedback(tmp_path, extra=scen + DRAW_A)
     args = ["sweep", str(p), "--samples", "8", "--seed", "3", "--json"]
     assert main(args) == 0
     one = json.loads(capsys.readouterr().out)["quantities"]
@@ -143,9 +146,7 @@ def test_delay_feedback_sweep_is_chunked_and_resumable(tmp_path, capsys):
     another batch width), a deleted chunk rewritten byte for byte."""
     from test_delay_feedback import write as write_feedback
     scen = ('\n[[scenarios]]\nname = "kick"\nx0 = { x = 0.7 }\nt_end = 1.0\ndt = 0.05\n')
-    mc = ('\n[montecarlo]\nsamples = 5\nseed = 1\n[montecarlo.distributions]\n'
-          'a = { dist = "uniform", lo = 1.5, hi = 2.5, source = "test" }\n')
-    p = write_feedback(tmp_path, extra=scen + mc)
+    p = write_feedback(tmp_path, extra=scen + DRAW_A)
     args = ["sweep", str(p), "--samples", "120", "--seed", "3", "--json"]
     assert main(args) == 0
     whole = json.loads(capsys.readouterr().out)["quantities"]
