@@ -26,4 +26,4 @@ def test_first_tasks_hold_one_compiled_study_and_nothing_is_lost():
         assert sum(d.kind == "antiskid-run" for d in order[:jobs]) == 1
         assert order[0].kind == "antiskid-run"
     # two workers: the second starts a slow study that compiles nothing
-    assert _task_order(ds, 2)[1].kind in ("delay-benchmark", "antiskid-robust", "ntsm-platoon")
+    assert _task_order(ds, 2)[1].kind in ("delay-benchmark", "antiskid-robust", "platoon")

@@ -29,7 +29,7 @@ __all__ = ["TaskTime", "check_parallel", "prefetch", "report_parallel", "run_fol
            "task_times_table"]
 
 #: Kinds whose studies take longest, started first (the rest by file size).
-_SLOW_KINDS = ("antiskid-run", "delay-benchmark", "antiskid-robust", "ntsm-platoon")
+_SLOW_KINDS = ("antiskid-run", "delay-benchmark", "antiskid-robust", "platoon")
 #: Kinds whose studies compile the numba kernels on a cold disk cache.
 _COMPILED_KINDS = ("antiskid-run",)
 

@@ -93,6 +93,18 @@ def physical_ranges(spec) -> None:
                                           + base + ("" if unit == base else f" (given in {unit})"))
 
 
+def _snap(q):
+    """``q`` with its unit exponents rounded to 12 decimals (whole when within
+    1e-9): fractional powers such as (m/s)**1.4 / (m**0.4/s**1.4) leave m**0.9999..."""
+    from pint.util import UnitsContainer
+    exps = {}
+    for name, x in q._units.items():
+        x = float(round(x)) if abs(x - round(x)) < 1e-9 else round(x, 12)
+        if x:
+            exps[name] = int(x) if x == int(x) else x
+    return type(q)(q.magnitude, UnitsContainer(exps))
+
+
 class _Walker:
     def __init__(self, path: str, units: dict, shown: dict):
         self.path, self.units, self.shown = path, units, shown
@@ -131,13 +143,13 @@ class _Walker:
             for a in e.args:
                 q = self.unit(a, key)
                 out = out if q is None else out * q
-            return out
+            return _snap(out)
         if e.is_Pow:
             base, ex = e.args
             if ex.is_Number:
                 qb = self.unit(base, key)
                 return qb if qb is None or qb.dimensionless and math.isclose(
-                    qb.to("").magnitude, 1.0) else qb ** float(ex)
+                    qb.to("").magnitude, 1.0) else _snap(qb ** float(ex))
             self.dimensionless(self.unit(base, key), key, "base of a power with a "
                                "non-numeric exponent")
             self.dimensionless(self.unit(ex, key), key, "exponent")

@@ -1,15 +1,16 @@
-"""Markdown and figures of the realistic platoon of paper 001 (pure rendering of
-:class:`~workbench.papers.p001.ntsm_platoon_realism.Realism`)."""
+"""Markdown and figures of the realistic platoon (pure rendering of
+:class:`~workbench.kinds.platoon.realism.Realism`)."""
 from __future__ import annotations
 
 import numpy as np
 
 from ...features.reproducible import window
 from ...report.markdown import Figure, fmt, latex_matrix, md_table
-from .ntsm_platoon_realism import CASES, CONTROLLERS, SWEEP_FACTORS
+from .realism import CASES
 
-LABEL = {"ntsm": "NTSM (eq 13)", "pd": "PD", "pd_ff": "PD + feed-forward",
-         "linear": "NTSM's linear member"}
+__all__ = ["figures", "gap_section", "margin_body", "margin_section", "scenario_section"]
+
+WORDS = {2: "two", 3: "three", 4: "four", 5: "five", 6: "six"}
 CASE_LABEL = {"constant": "constant delay", "random": "random delay + loss"}
 ENVELOPE = r"""$$
 d_\mathrm{safe} = s_0 + v_f\,\tau_r + \max\!\Big(0,\ \frac{v_f^2}{2b} - \frac{v_p^2}{2b}\Big)
@@ -20,7 +21,11 @@ def _q(q, digits: int = 4) -> str:
     return f"{fmt(q.value, digits)} {q.unit}"
 
 
-def scenario_section(spec, rz) -> str:
+def _labels(spec) -> dict:
+    return {x.name: x.label for x in spec.laws}
+
+
+def scenario_section(spec, rz, preface: str = "") -> str:
     L, A, E = spec.link, spec.actuator, spec.emergency
     rows = [["V2V packet period", _q(L.period), L.period.source],
             ["V2V delay (constant case; floor of the random case)", _q(L.delay), L.delay.source],
@@ -42,7 +47,7 @@ def scenario_section(spec, rz) -> str:
                      for c in CASES)
     return (
         "## Realistic scenario: V2V link, actuator, emergency braking\n\n"
-        "Paper 001 has no communication, actuator or emergency. Here every follower knows its "
+        + preface + "Here every follower knows its "
         "predecessor only through a train-to-train (V2V) link: the predecessor sends its "
         "position, speed and last measured acceleration every packet period; a packet arrives "
         "after its delay (rounded up to whole steps) or is lost, and the follower holds the "
@@ -71,6 +76,7 @@ def _on_steps(t: float, T: float) -> str:
 
 
 def gap_section(spec, rz) -> str:
+    LABEL, CONTROLLERS = _labels(spec), rz.laws
     rows = []
     for law in CONTROLLERS:
         row = [LABEL[law]]
@@ -106,14 +112,18 @@ def gap_section(spec, rz) -> str:
            "**not every train is at rest at the end.** ")
         + "Smallest over the followers and over the time after the emergency brake; "
         "\"where\": time after the brake and follower of the smallest gap − d_safe. The "
-        "random case is one seeded realisation of the link, shared by the three laws.\n\n"
+        "random case is one seeded realisation of the link, shared by the "
+        f"{WORDS.get(len(CONTROLLERS), len(CONTROLLERS))} laws.\n\n"
         + md_table(head, rows, "lrrlrrlr")
         + "\n\n![emergency braking]({figdir}/emergency-gaps.png)")
 
 
-def margin_section(spec, rz) -> str:
+def margin_body(spec, rz) -> str:
+    """Where the delay enters, the exact margins, and the sweep (the general part
+    of the delay-margin section)."""
     m = rz.margin
-    g = spec.gains
+    LABEL = _labels(spec)
+    chatters = {r.law for r in spec.runs if r.chatters}
     agree, diff = m.agreement
     rows = [["Chen-Gu-Nett eigenvalues (`delay_margin_eig`)", fmt(m.eig.h, 4),
              fmt(m.eig.omega, 4), m.eig.reason],
@@ -125,24 +135,11 @@ def margin_section(spec, rz) -> str:
     for r in m.sweep:
         srows.append([LABEL[r.law], "design's V2V delay" if r.factor is None else fmt(r.factor),
                       fmt(r.h, 3), fmt(r.h / m.eig.h, 3), fmt(r.amp_first, 3),
-                      fmt(r.amp_worst, 2 if r.law == "ntsm" else 3),
+                      fmt(r.amp_worst, 2 if r.law in chatters else 3),
                       fmt(r.saturated * 100, 3)])
     lag = spec.actuator.lag.value
     state = "(e, ė, a_f)" if lag > 0 else "(e, ė)"
     return (
-        "## Delay margin of the NTSM\n\n"
-        "**Eq 13 has no linearisation at e = ė = 0.** Its powers 2 − b/a = "
-        f"{fmt(2 - g.b / g.a, 3)} and α/ξ = {fmt(g.alpha / g.xi, 3)} are below 1, so "
-        "ė^(2−b/a) and s^(α/ξ) have infinite slope at 0, and (G_w + G_d) sign(s) jumps "
-        f"by {fmt(2 * (spec.G_w + spec.G_d))} N there; only e enters s to first order "
-        "(ė^(b/a) has zero slope). The Lipschitz part linearises to "
-        f"ë = −(βaj/b) e = −{fmt(m.spring, 4)} e: a spring without damping, not asymptotically "
-        "stable, so it has no delay margin at all. The surrogate taken here is the NTSM "
-        "family's **linear member**: b = a and α = ξ (every power 1), without the switching "
-        "term, i.e. the linear sliding-mode law on s = e + ė/β with ṡ = −(j + k) s:\n\n"
-        "$$\n(u - u_1)/m = \\dot v_{i-1} + k_e e + k_d \\dot e, \\qquad k_e = \\beta(j + k) = "
-        f"{fmt(m.k_e, 4)}\\ \\mathrm{{s^{{-2}}}},\\quad k_d = \\beta + j + k = {fmt(m.k_d, 4)}"
-        "\\ \\mathrm{s^{-1}}\n$$\n\n"
         "**Where the V2V delay enters.** With the follower's own position and speed measured "
         "now (the simulated arrangement), the delay acts only on the predecessor's data: the "
         "follower's own loop has no delayed term, the platoon is a cascade of delay-free "
@@ -166,30 +163,38 @@ def margin_section(spec, rz) -> str:
         f"{fmt(m.window[1], 3)} s of the normal run (cruise):\n\n"
         + md_table(["law", "asked h / h*", "simulated h (s)", "h / h*",
                     "first follower max |e| (m)", "any follower max |e| (m)",
-                    "first follower saturated (% of steps)"], srows, "llrrrrr")
-        + "\n\nThe linear member loses stability where the exact margin says (its first "
-        f"follower's oscillation jumps between {fmt(SWEEP_FACTORS[1])} h* and "
-        f"{fmt(SWEEP_FACTORS[2])} h*; the actuator limits then "
-        "bound it). The NTSM has no threshold: its gain at ė = 0 is infinite, so with any "
-        "delay in the loop it settles into an oscillation whose size grows with the delay. "
-        "Followers further back oscillate more (their predecessor's oscillating acceleration "
-        "is fed forward). The NTSM's \"any follower\" column has 2 digits: that chattering "
-        "oscillation moves in its fourth digit when the inputs move by a few ulp.\n\n![delay sweep]({figdir}/delay-sweep.png)")
+                    "first follower saturated (% of steps)"], srows, "llrrrrr"))
+
+
+def margin_section(spec, rz) -> str:
+    """The general delay-margin section: the linear law's gains, then :func:`margin_body`."""
+    m = rz.margin
+    return (
+        "## Delay margin\n\n"
+        f"The exact margin is computed on the linear law '{_labels(spec)[m.law]}':\n\n"
+        "$$\n(u - u_1)/m = \\dot v_{i-1} + k_e e + k_d \\dot e, \\qquad k_e = "
+        f"{fmt(m.k_e, 4)}\\ \\mathrm{{s^{{-2}}}},\\quad k_d = {fmt(m.k_d, 4)}"
+        "\\ \\mathrm{s^{-1}}\n$$\n\n" + margin_body(spec, rz)
+        + "\n\n![delay sweep]({figdir}/delay-sweep.png)")
 
 
 # No tight_layout in the drawing functions: laid out before the data are snapped
 # (workbench.report.figures), the axes positions keep last-bit differences of the
 # unsnapped limits, and every line moves by a fraction of a subpixel; figure_png
 # lays out after snapping.
-def figures(rz) -> tuple[Figure, ...]:
-    return (Figure("emergency-gaps", "Gaps and the safe braking-distance envelope under the "
-                   "leader's emergency brake.", lambda fig: _plot_gaps(fig, rz), (8.0, 7.5)),
-            Figure("delay-sweep", "First follower's spacing error with the delay in the loop.",
-                   lambda fig: _plot_sweep(fig, rz), (7.0, 5.0)))
+def figures(spec, rz) -> tuple[Figure, ...]:
+    figs = (Figure("emergency-gaps", "Gaps and the safe braking-distance envelope under the "
+                   "leader's emergency brake.", lambda fig: _plot_gaps(fig, spec, rz),
+                   (8.0, 7.5)),)
+    if rz.margin is None:
+        return figs
+    return figs + (Figure("delay-sweep", "First follower's spacing error with the delay in the "
+                          "loop.", lambda fig: _plot_sweep(fig, spec, rz), (7.0, 5.0)),)
 
 
-def _plot_gaps(fig, rz):
-    axes = fig.subplots(len(CONTROLLERS), len(CASES), sharex=True, sharey=True)
+def _plot_gaps(fig, spec, rz):
+    LABEL, CONTROLLERS = _labels(spec), rz.laws
+    axes = fig.subplots(len(CONTROLLERS), len(CASES), sharex=True, sharey=True, squeeze=False)
     t0 = rz.t_emergency
     for j, case in enumerate(CASES):
         for i, law in enumerate(CONTROLLERS):
@@ -212,16 +217,17 @@ def _plot_gaps(fig, rz):
     axes[0, 0].legend(fontsize=6, ncol=2, loc="center right")
 
 
-def _plot_sweep(fig, rz):
+def _plot_sweep(fig, spec, rz):
+    LABEL = _labels(spec)
     m = rz.margin
-    laws = sorted({r.law for r in m.sweep}, key=["linear", "ntsm"].index)
+    laws = sorted({r.law for r in m.sweep}, key=lambda x: (x != m.law, spec.margin.sweep.index(x)))
     axes = fig.subplots(len(laws), 1, sharex=True)
     for ax, law in zip(np.atleast_1d(axes), laws):
         for r in (r for r in m.sweep if r.law == law):
             ax.plot(r.trace[:, 0], r.trace[:, 1] * 1000.0, lw=0.8,
                     label=f"h = {r.h:.3g} s ({r.h / m.eig.h:.2f} h*)")
         ax.set_ylabel("e, first follower (mm)")
-        ax.set_title(f"{LABEL[law]}, delay in the loop; h* = {m.eig.h:.4g} s (linear member)",
+        ax.set_title(f"{LABEL[law]}, delay in the loop; h* = {m.eig.h:.4g} s ({spec.margin.short})",
                      fontsize=9)
         ax.legend(fontsize=7, ncol=2)
     np.atleast_1d(axes)[-1].set_xlabel("time (s)")

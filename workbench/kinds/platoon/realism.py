@@ -1,11 +1,11 @@
-"""The realistic platoon of paper 001: V2V link, actuator lag and limits, the
-leader's emergency brake against the braking-distance envelope, and the exact
-delay margin of the NTSM's linear member.
+"""The realistic platoon: V2V link, actuator lag and limits, the leader's
+emergency brake against the braking-distance envelope, and the exact delay
+margin of a linear law (first written for paper 001's NTSM platoon).
 
-Runs, on the scenario of :mod:`.ntsm_platoon` (same seeded trains and external
+Runs, on the scenario of :mod:`.run` (same seeded trains and external
 force):
 
-* **emergency** — for each link case and each law of :data:`CONTROLLERS`,
+* **emergency** — for each link case and each law of ``[emergency] laws``,
   the leader's normal run until ``[emergency] time``, then its full brake
   (the actuator's brake limit) to standstill. Link cases: ``constant`` (the
   ``[v2v]`` delay, no loss) and ``random`` (the delay plus the per-packet
@@ -17,16 +17,15 @@ force):
 
   (s0 the standstill margin, tau_r the reaction time, b the brake limit of
   ``[actuator]``, v_f and v_p the follower's and predecessor's speeds).
-* **delay margin** — eq 13 has no linearisation at e = e' = 0 (powers
-  2 - b/a and alpha/xi below 1: infinite slope; sign(s): a jump); its
-  Lipschitz part linearises to e'' = -(beta a j / b) e, a spring without
-  damping. The exact margin is therefore computed on the law's linear member
-  (:func:`~workbench.controllers.ntsm.linear_member`) with the actuator lag,
-  with the delay inside the loop (the follower's own state stamped with the
-  packet's time: ``own_state = "stamped"``), by Chen-Gu-Nett and by
-  python-control's crossovers; with the own state current the delay is not
-  in any loop and the margin is infinite. A sweep simulates NTSM and linear
-  member with constant delays around h* in the stamped arrangement.
+* **delay margin** (``[delay_margin]``) — the exact margin of a law linear in
+  e and e' (``law``: (u - u1)/m = k_e e + k_d e' + c a_pred; a nonlinear law,
+  such as paper 001's eq 13, has no linearisation, so the design names a
+  linear surrogate), with the actuator lag and the delay inside the loop (the
+  follower's own state stamped with the packet's time: ``own_state =
+  "stamped"``), by Chen-Gu-Nett and by python-control's crossovers; with the
+  own state current the delay is not in any loop and the margin is infinite.
+  A sweep simulates the laws of ``sweep`` with constant delays of ``factors``
+  times h* (and the design's V2V delay) in the stamped arrangement.
 """
 from __future__ import annotations
 
@@ -35,16 +34,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...controllers.ntsm import linear_member
 from ...features.reproducible import window as window_mask
 from ...margins import Agreement, DelayMargin, compare_margins, delay_margin_eig, delay_margin_siso
 from ...sim.platoon import Actuator, Link, PlatoonRun, packet_delays, received_steps
 
+__all__ = ["CASES", "DelayMarginStudy", "EmergencyRun", "LinkStats", "Realism", "SweepRow",
+           "accel_end", "actuator", "delay_margin_model", "emergency_run", "envelope",
+           "linear_gains", "link", "realism_quantities", "realism_quantity_names",
+           "run_realism"]
+
 CASES = ("constant", "random")
-CONTROLLERS = ("ntsm", "pd", "pd_ff")
-#: Delays of the sweep, as multiples of h*.
-SWEEP_FACTORS = (0.5, 0.9, 1.1)
-SWEEP_LAWS = ("ntsm", "linear")
 
 
 @dataclass(frozen=True)
@@ -117,16 +116,12 @@ class SweepRow:
 
 @dataclass(frozen=True)
 class DelayMarginStudy:
-    """Exact delay margin of the NTSM's linear member (see the module docstring).
+    """Exact delay margin of a linear law (see the module docstring).
 
     Attributes
     ----------
-    lowest_power : float
-        min(2 - b/a, alpha/xi): below 1, eq 13 has an infinite slope at 0.
-    switching : float
-        G_w + G_d (N): the gain of sign(s), a jump at s = 0 unless 0.
-    spring : float
-        beta a j / b (1/s^2): the Lipschitz part's only linear term.
+    law : str
+        The linear law of ``[delay_margin]``.
     k_e, k_d : float
         Linear member's gains (1/s^2, 1/s).
     A, B, K : numpy.ndarray
@@ -141,9 +136,7 @@ class DelayMarginStudy:
         Where the sweep's amplitudes are measured (s).
     """
 
-    lowest_power: float
-    switching: float
-    spring: float
+    law: str
     k_e: float
     k_d: float
     A: np.ndarray
@@ -154,11 +147,7 @@ class DelayMarginStudy:
     current: DelayMargin
     sweep: tuple[SweepRow, ...]
     window: tuple[float, float]
-
-    @property
-    def linearisable(self) -> bool:
-        """Eq 13 is differentiable at e = e' = 0."""
-        return self.lowest_power >= 1.0 and self.switching == 0.0
+    factors: tuple[float, ...] = ()
 
     @property
     def agreement(self) -> tuple[Agreement, float | None]:
@@ -173,7 +162,8 @@ class Realism:
     horizon: float
     links: dict            # case -> LinkStats
     emergency: dict        # (case, law) -> EmergencyRun
-    margin: DelayMarginStudy
+    margin: DelayMarginStudy | None
+    laws: tuple[str, ...] = ()   # the laws of the emergency runs
 
 
 def actuator(spec) -> Actuator:
@@ -273,10 +263,32 @@ def _sweep_row(sc, law: str, factor, h: float, act: Actuator, window, K: int) ->
                     np.stack([run.t[w], run.e[w, 0]], axis=1))
 
 
+def linear_gains(spec) -> tuple[float, float]:
+    """(k_e (1/s^2), k_d (1/s)) of the ``[delay_margin]`` law, read off the law
+    with m = 1 (exact for a linear law); a law that is not linear in e, e' and
+    a_pred, or whose feed-forward of a_pred is not 1, is a design error."""
+    from ...errors import DesignError
+    from .laws import compile_law
+    i = next(k for k, x in enumerate(spec.laws) if x.name == spec.margin.law)
+    law = compile_law(spec.laws[i], spec.constants, {"m": 1.0, "G_w": spec.G_w, "G_d": spec.G_d},
+                      path=spec.path, index=i)
+    one, zero = np.ones(1), np.zeros(1)
+    f = lambda e, de, a: float(law(e * one, de * one, zero, a * one)[0][0])
+    k_e, k_d, c = f(1.0, 0.0, 0.0), f(0.0, 1.0, 0.0), f(0.0, 0.0, 1.0)
+    rng = np.random.default_rng(0)
+    pts = rng.uniform(-3.0, 3.0, (8, 3))
+    lin = all(math.isclose(f(*p), k_e * p[0] + k_d * p[1] + p[2], rel_tol=1e-9, abs_tol=1e-9)
+              for p in pts)
+    if not (lin and c == 1.0 and f(0.0, 0.0, 0.0) == 0.0 and k_e > 0 and k_d > 0):
+        raise DesignError(spec.path, "delay_margin.law", spec.margin.law,
+                          "a law u1 + m*(k_e*e + k_d*de) + m*a_pred with k_e, k_d > 0 (linear: "
+                          "its exact margin is computed on it)")
+    return k_e, k_d
+
+
 def delay_margin_study(sc, act: Actuator, t_acc_end: float) -> DelayMarginStudy:
     spec = sc.spec
-    g = spec.gains
-    k_e, k_d = linear_member(g)
+    k_e, k_d = linear_gains(spec)
     lag = spec.actuator.lag.value
     A, B, K = delay_margin_model(lag, k_e, k_d)
     eig, siso = delay_margin_eig(A, B @ K), delay_margin_siso(A, B, K)
@@ -285,14 +297,13 @@ def delay_margin_study(sc, act: Actuator, t_acc_end: float) -> DelayMarginStudy:
     window = (t_acc_end + 10.0, t_acc_end + 30.0)
     n_steps = int(round(window[1] / spec.T)) + 1
     steps = lambda h: round(h / spec.T) * spec.T        # whole steps, nearest
-    hs = ([(f, steps(f * eig.h)) for f in SWEEP_FACTORS]
+    hs = ([(f, steps(f * eig.h)) for f in spec.margin.factors]
           if math.isfinite(eig.h) and eig.h > 0 else [])
     hs.append((None, math.ceil(round(spec.link.delay.value / spec.T, 9)) * spec.T))
     rows = tuple(_sweep_row(sc, law, f, h, act, window, n_steps)
-                 for law in SWEEP_LAWS for f, h in hs)
-    return DelayMarginStudy(min(2.0 - g.b / g.a, g.alpha / g.xi), spec.G_w + spec.G_d,
-                            g.beta * g.a * g.j / g.b,
-                            k_e, k_d, A, B, K, eig, siso, current, rows, window)
+                 for law in spec.margin.sweep for f, h in hs)
+    return DelayMarginStudy(spec.margin.law, k_e, k_d, A, B, K, eig, siso, current, rows, window,
+                            spec.margin.factors)
 
 
 def run_realism(sc) -> Realism:
@@ -303,28 +314,35 @@ def run_realism(sc) -> Realism:
     for case in CASES:
         lk, lost = link(spec, case, K)
         links[case] = _stats(lk, spec.T, lost)
-        for law in CONTROLLERS:
+        for law in spec.emergency.laws:
             runs[case, law] = emergency_run(sc, law, lk)
+    margin = (None if spec.margin is None else
+              delay_margin_study(sc, actuator(spec), accel_end(sc.profile)))
     return Realism(spec.link.delay.value, spec.emergency.time.value, K * spec.T, links, runs,
-                   delay_margin_study(sc, actuator(spec), accel_end(sc.profile)))
+                   margin, spec.emergency.laws)
 
 
-def realism_quantity_names() -> set[str]:
+def _pairs(laws):
+    return [(a, b) for a in laws for b in laws if a != b]
+
+
+def realism_quantity_names(spec) -> set[str]:
+    laws = spec.emergency.laws
     names = set()
     for case in CASES:
         names |= {f"emergency.{case}.link.{k}" for k in ("mean_age", "max_age", "lost")}
-        names |= {f"emergency.{case}.{law}.{k}" for law in CONTROLLERS for k in
+        names |= {f"emergency.{case}.{law}.{k}" for law in laws for k in
                   ("min_gap", "t_min_gap", "min_margin", "t_min_margin", "cruise_abs_e",
                    "stopped")}
-        names |= {f"emergency.{case}.{d}.{k}" for d in ("ntsm_minus_pd_ff", "pd_ff_minus_pd")
+        names |= {f"emergency.{case}.{a}_minus_{b}.{k}" for a, b in _pairs(laws)
                   for k in ("min_gap", "min_margin")}
-    names |= {f"emergency.{who}.{k}" for who in CONTROLLERS + ("worst",)
+    names |= {f"emergency.{who}.{k}" for who in laws + ("worst",)
               for k in ("min_gap", "min_margin")}
-    names |= {f"delay_margin.{k}" for k in ("linearisable", "lowest_power", "spring", "k_e",
-                                             "k_d", "h_eig",
-                                             "h_siso", "omega", "agreement", "h_over_delay",
-                                             "current_h")}
-    names |= {f"delay_sweep.{law}.{k}" for law in SWEEP_LAWS
+    if spec.margin is None:
+        return names
+    names |= {f"delay_margin.{k}" for k in ("k_e", "k_d", "h_eig", "h_siso", "omega",
+                                             "agreement", "h_over_delay", "current_h")}
+    names |= {f"delay_sweep.{law}.{k}" for law in spec.margin.sweep
               for k in ("amp_ratio", "amp_at_delay", "saturated_at_delay")}
     return names
 
@@ -344,25 +362,27 @@ def realism_quantities(r: Realism) -> dict:
         q[f"emergency.{case}.{law}.stopped"] = "yes" if e.stopped else "no"
     for case in CASES:
         for k in ("min_gap", "min_margin"):
-            x = {law: getattr(r.emergency[case, law], k) for law in CONTROLLERS}
-            q[f"emergency.{case}.ntsm_minus_pd_ff.{k}"] = x["ntsm"] - x["pd_ff"]
-            q[f"emergency.{case}.pd_ff_minus_pd.{k}"] = x["pd_ff"] - x["pd"]
-    for who in CONTROLLERS + ("worst",):
+            x = {law: getattr(r.emergency[case, law], k) for law in r.laws}
+            for a, b in _pairs(r.laws):
+                q[f"emergency.{case}.{a}_minus_{b}.{k}"] = x[a] - x[b]
+    for who in r.laws + ("worst",):
         runs = [e for (case, law), e in r.emergency.items() if who in (law, "worst")]
         q[f"emergency.{who}.min_gap"] = min(e.min_gap for e in runs)
         q[f"emergency.{who}.min_margin"] = min(e.min_margin for e in runs)
     m = r.margin
-    q.update({"delay_margin.linearisable": "yes" if m.linearisable else "no",
-              "delay_margin.lowest_power": m.lowest_power, "delay_margin.spring": m.spring,
-              "delay_margin.k_e": m.k_e, "delay_margin.k_d": m.k_d,
+    if m is None:
+        return q
+    q.update({"delay_margin.k_e": m.k_e, "delay_margin.k_d": m.k_d,
               "delay_margin.h_eig": m.eig.h, "delay_margin.h_siso": m.siso.h,
               "delay_margin.omega": m.eig.omega,
               "delay_margin.agreement": m.agreement[0].value,
               "delay_margin.current_h": m.current.h})
     delay = r.delay
     q["delay_margin.h_over_delay"] = m.eig.h / delay if delay > 0 else math.inf
-    for law in SWEEP_LAWS:
-        lo, hi, d = _amp(m.sweep, law, 0.9), _amp(m.sweep, law, 1.1), _amp(m.sweep, law, None)
+    below = max((f for f in m.factors if f < 1.0), default=None)
+    above = min((f for f in m.factors if f > 1.0), default=None)
+    for law in dict.fromkeys(row.law for row in m.sweep):
+        lo, hi, d = _amp(m.sweep, law, below), _amp(m.sweep, law, above), _amp(m.sweep, law, None)
         q[f"delay_sweep.{law}.amp_ratio"] = (hi.amp_first / lo.amp_first
                                              if lo is not None and hi is not None else None)
         q[f"delay_sweep.{law}.amp_at_delay"] = d.amp_first
