@@ -110,10 +110,11 @@ def test_platoon_initial_error_converges_near_eq22():
 
 
 @pytest.mark.parametrize("old, new, key", [
-    ("a = 5\n", "a = 4\n", "ntsm.a"),
-    ("b = 7\n", "b = 11\n", "ntsm.b"),
+    # another exponent changes the units of eq 13's terms: the unit check names the term
+    ('a = { value = 5,', 'a = { value = 4,', "laws[0].definitions.s"),
+    ('b = { value = 7,', 'b = { value = 11,', "laws[0].definitions.s"),
     ("initial_errors = [3.0, 2.0, 1.0]", "initial_errors = [3.0, 2.0]",
-     "convergence.initial_errors"),
+     "runs[1].initial_errors"),
     ('T = { value = 0.01, unit = "s"', 'T = { value = 0.5, unit = "s"', "platoon.T.value"),
     # the realistic scenario (tests/test_platoon_realism.py)
     ('jitter = "exponential"', 'jitter = "gaussian"', "v2v.jitter"),
@@ -131,7 +132,13 @@ def test_platoon_initial_error_converges_near_eq22():
      "emergency.time"),
     ('margin = { value = 10.0, unit = "m"', 'margin = { value = "ten", unit = "m"',
      "emergency.margin.value"),
-    ("[pd_ff]  #", "[pd_ff_gains]  #", "pd_ff"),
+    ('law = "u1 + m*(kp*e + kd*de)"', 'law = "u1 + m*(kp*e + kd*de"', "laws[1].law"),
+    ('kp = { value = 0.1, unit = "1/s^2"', 'kp = { value = 0.1, unit = "1/s"', "laws[1].law"),
+    ('surface = "s"', 'surface = "u9"', "laws[0].surface"),
+    ('laws = ["ntsm", "pd", "pd_ff"]', 'laws = ["ntsm", "pid"]', "emergency.laws"),
+    ('law = "linear"', 'law = "ntsm"', "delay_margin.law"),
+    ('module = "p001.ntsm_analysis"', 'module = "os.path"', "analysis.module"),
+    ('module = "p001.ntsm_analysis"', 'module = "p001.nothing"', "analysis.module"),
 ])
 def test_bad_designs_name_the_key(tmp_path, old, new, key):
     text = DESIGN.read_text()
@@ -141,6 +148,21 @@ def test_bad_designs_name_the_key(tmp_path, old, new, key):
     with pytest.raises(DesignError) as exc:
         load_design(p)
     assert exc.value.key == key
+
+
+@pytest.mark.parametrize("name, value", [("a", 4), ("xi", 3), ("beta", -0.2)])
+def test_eq10_12_conditions_are_checked_by_the_paper_module(name, value):
+    """Gains that keep the units but break eqs 10-12 (an even a, alpha/xi > 1, a
+    negative beta): paper 001's module names the constant."""
+    import dataclasses
+
+    from workbench.papers.p001.ntsm_analysis import PLATOON_ANALYSIS
+    spec = load_design(DESIGN).spec
+    c = dict(spec.constants)
+    c[name] = dataclasses.replace(c[name], value=value)
+    with pytest.raises(DesignError) as exc:
+        PLATOON_ANALYSIS.load(None, dataclasses.replace(spec, constants=c))
+    assert exc.value.key == f"constants.{name if name != 'xi' else 'alpha'}.value"
 
 
 def test_study_claims_are_ok():

@@ -13,9 +13,9 @@ from workbench.cli import main
 from workbench.controllers.ntsm import NTSMGains, linear_member, pd_ff_force, pd_force
 from workbench.design import load_design
 from workbench.margins import delay_margin_eig, delay_margin_siso
-from workbench.papers.p001.ntsm_platoon import scenario
-from workbench.papers.p001.ntsm_platoon_realism import (delay_margin_model, emergency_run, envelope,
-                                                        link)
+from workbench.kinds.platoon.realism import (delay_margin_model, emergency_run, envelope,
+                                             linear_gains, link)
+from workbench.kinds.platoon.run import scenario
 from workbench.plants.platoon001 import TrainParams
 from workbench.sim.platoon import Actuator, Link, packet_delays, received_steps
 
@@ -132,10 +132,11 @@ def test_pd_ff_is_pd_plus_the_communicated_acceleration(spec):
     u = pd_ff_force(e, de, u1, 5e5, ap, 0.1, 0.6)
     assert np.allclose(u, u1 + 5e5 * (0.1 * e + 0.6 * de + ap))
     assert np.allclose(u - pd_force(e, de, u1, 5e5, 0.1, 0.6), 5e5 * ap)
-    law = scenario(spec).law("pd_ff")           # the study's law uses the [pd_ff] gains
+    law = scenario(spec).law("pd_ff")           # the design's law uses kp_ff, kd_ff
     got, s = law(e, de, u1, ap)
-    assert np.allclose(got, pd_ff_force(e, de, u1, spec.nominal().m, ap, spec.kp_ff,
-                                        spec.kd_ff)) and not s.any()
+    c = spec.constants
+    assert np.array_equal(got, pd_ff_force(e, de, u1, spec.nominal().m, ap, c["kp_ff"].value,
+                                           c["kd_ff"].value)) and not s.any()
 
 
 def test_linear_member_is_eq13_with_unit_powers():
@@ -149,6 +150,8 @@ def test_linear_member_is_eq13_with_unit_powers():
     k_e, k_d = linear_member(G)
     assert (k_e, k_d) == pytest.approx((1.2, 6.2))
     assert np.allclose(u, ap + k_e * e + k_d * de)
+    # the design's linear law carries exactly these gains (read off the law with m = 1)
+    assert linear_gains(load_design(DESIGN).spec) == (k_e, k_d)
 
 
 def test_delay_margin_model_against_the_closed_form():
