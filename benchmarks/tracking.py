@@ -18,7 +18,7 @@ import numpy as np
 
 from workbench.controllers.mfac import MFAC, MFACGains
 from workbench.design import load_design
-from workbench.papers.p001 import ntsm_platoon as platoon001
+from workbench.kinds.platoon import run as platoon001
 from workbench.papers.p002 import ato_tracking as tracking002
 from workbench.papers.p002.ato_tracking_spec import MFAC_KEYS
 from workbench.plants.platoon001 import TrainParams

@@ -170,7 +170,7 @@ RENDERER_CONSTANTS = {
     ("papers/p000/station_stopping_render.py", "3.2"): "section number of paper 000",
     ("papers/p000/station_stopping_render.py", "85.16"): "K1/K2 as paper 000's Table 1 prints it",
     ("features/basin_render.py", "0.6"): "a matplotlib grey level, not text",
-    ("papers/p001/ntsm_platoon_realism_render.py", "1e-9"):
+    ("kinds/platoon/realism_render.py", "1e-9"):
         "display floor of a printed relative difference",
     ("papers/p004/closed_loop_brake_fair_render.py", "0.5"):
         "the horizon before the retuning (a t_predict_sweep value)",
