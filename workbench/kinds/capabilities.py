@@ -39,6 +39,7 @@ CAPABILITIES: dict[str, dict[str, str]] = {
     "stop-accuracy": {
         "simulate": "workbench.kinds.stop_accuracy.cli:simulate_command",
         "sweep": "workbench.kinds.stop_accuracy.cli:sweep_command"},
+    "platoon": {"simulate": "workbench.kinds.platoon.cli:simulate_command"},
     "antiskid-run": {
         "simulate": "workbench.papers.p003.antiskid_run:simulate_command",
         "sweep": "workbench.papers.p003.antiskid_run:sweep_command"},
