@@ -32,7 +32,7 @@ def scenario_section(spec, rz, preface: str = "") -> str:
             ["random part per packet (random case)",
              f"{L.jitter}, scale {_q(L.jitter_scale)}", L.jitter_scale.source],
             ["packet loss (random case)", f"{fmt(L.loss * 100)} %, Bernoulli, seed {L.seed}",
-             "our choice: a poor radio channel"],
+             L.loss_source],
             ["follower's own position and speed", L.own_state,
              "measured now (\"stamped\": at the packet's time stamp)"],
             ["actuator lag (first order, every train)", _q(A.lag), A.lag.source],

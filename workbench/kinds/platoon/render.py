@@ -21,6 +21,7 @@ HOOKS = {"problem_note": "the design's choices (end of the problem section)",
          "comparison": "a section after the results",
          "reaching_text": "(intro, outro) of the reaching section",
          "realism_preface": "the first sentence of the realistic scenario",
+         "bound_note": "who assumes the lumped disturbance stays below G_w + G_d",
          "margin_section": "the delay-margin section"}
 WORDS = {2: "two", 3: "three", 4: "four", 5: "five", 6: "six"}
 
@@ -108,7 +109,8 @@ def render(design, res) -> Rendered:
         + "\n\n*Chatter* is the total variation of the commanded acceleration per second; "
         f"*sign flips* count changes of sign(s) per second in the cruise window (at most "
         f"{fmt(1 / spec.T)} Hz). *max |w+d|* is the lumped disturbance as the controller sees "
-        "it, m·v' − (u − u1), while moving: eq 6 assumes it stays below G_w + G_d"
+        "it, m·v' − (u − u1), while moving: "
+        + _hook(spec, "bound_note", res, lambda: "the design assumes it stays below G_w + G_d")
         + "".join(f"; in the run '{labels[k]}' it exceeds the bound, most at t = "
                   f"{fmt(m.lumped_peak_time, 3)} s" for k, m in res.metrics.items()
                   if m.lumped_ratio > 1.0)

@@ -44,6 +44,7 @@ class LinkSpec:
     loss: float
     own_state: str
     seed: int
+    loss_source: str = ""
 
 
 @dataclass(frozen=True)
@@ -164,8 +165,9 @@ def _read_link(root: Reader, T: float) -> LinkSpec:
     loss = r.number("loss", lo=0.0, hi=0.99, what="packet-loss probability")
     own = r.string("own_state", choices=OWN_STATE)
     seed = int(r.number("seed", integer=True, nonneg=True, what="integer seed"))
+    loss_source = r.string("loss_source", default="design choice")
     r.finish()
-    return LinkSpec(period, delay, jitter, scale, loss, own, seed)
+    return LinkSpec(period, delay, jitter, scale, loss, own, seed, loss_source)
 
 
 def _read_actuator(root: Reader) -> ActuatorSpec:

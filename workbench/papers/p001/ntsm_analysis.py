@@ -141,6 +141,9 @@ class NTSMAnalysis:
             "staying at 0, yet e follows the sliding law of eq 21 closely enough for eq 22's "
             "time to be met.")
 
+    def bound_note(self, spec, res) -> str:
+        return "eq 6 assumes it stays below G_w + G_d"
+
     def realism_preface(self, spec, res) -> str:
         return "Paper 001 has no communication, actuator or emergency. "
 
