@@ -129,3 +129,34 @@ def test_simulate_prints_a_run(tmp_path, capsys):
     assert head == "t,x1,x2,x3,v1,v2,v3,u1,u2,u3,e2,e3"
     assert [float(x) for x in first.split(",")][:4] == [0.0, 0.0, -50.0, -100.0]
     assert main(["simulate", str(SYNTHETIC), "--case", "nope"]) == 2
+
+
+def _with_headway(tmp_path, h: float, *, margin: bool) -> Path:
+    text = SYNTHETIC.read_text().replace(
+        'T = { value = 0.05, unit = "s"',
+        f'headway = {{ value = {h}, unit = "s", source = "test" }}\nT = {{ value = 0.05, unit = "s"',
+        1)
+    if not margin:
+        text = text.replace('[delay_margin]\nlaw = "pd_ff"\nshort = "PD + feed-forward"\n'
+                            'sweep = ["pd_ff"]\nfactors = [0.5, 0.9, 1.1]\n', "")
+        text = text.split("# Claims:")[0]
+    p = tmp_path / SYNTHETIC.name
+    p.write_text(text)
+    return p
+
+
+def test_time_headway_policy_keeps_gap_d_plus_h_v(tmp_path):
+    """The time-headway policy: in the settled cruise the PD + feed-forward
+    holds gap = D + h v (to the error the external force leaves), about h v =
+    16.7 m more than constant spacing would."""
+    spec = load_design(_with_headway(tmp_path, 1.0, margin=False)).spec
+    assert spec.headway == 1.0
+    sc = scenario(spec)
+    r = sc.simulate("pd_ff")
+    cruise = (r.t > 40.0) & (r.t < 80.0)
+    extra = r.gap[cruise] - spec.D.value
+    assert abs(extra.mean() - 16.6667) < 0.5
+    assert np.abs(r.e[cruise]).max() < 0.5
+    with pytest.raises(DesignError) as exc:       # the margin's loop model is constant spacing
+        load_design(_with_headway(tmp_path, 1.0, margin=True))
+    assert exc.value.key == "delay_margin"

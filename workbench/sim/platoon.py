@@ -178,7 +178,8 @@ def simulate_platoon(nominal, true, law: FollowerLaw, leader_ref: Callable, *, n
                      leader_gain: float, route: Route,
                      initial_errors: np.ndarray | None = None, link: Link | None = None,
                      actuator: Actuator | None = None,
-                     leader_brake: tuple[float, float] | None = None) -> PlatoonRun:
+                     leader_brake: tuple[float, float] | None = None,
+                     headway: float = 0.0) -> PlatoonRun:
     """Step a platoon of ``n`` trains with sampling = integration step ``T``.
 
     The leader tracks ``leader_ref(t) -> (v_ref, a_ref)`` (vectorised over the
@@ -204,6 +205,11 @@ def simulate_platoon(nominal, true, law: FollowerLaw, leader_ref: Callable, *, n
         None: the command is the force.
     leader_brake : (time, force), optional
         From ``time`` (s) on the leader commands ``force`` (N): an emergency brake.
+    headway : float
+        Spacing policy: the desired gap is ``spacing + headway * v_i`` (s; 0:
+        constant spacing), so e_i = gap - spacing - headway v_i, with v_i the
+        follower's own speed as its law sees it; ``de`` stays the relative
+        speed v_{i-1} - v_i.
     """
     K = int(round(horizon / T))
     e0 = np.zeros(n - 1) if initial_errors is None else np.asarray(initial_errors, float)
@@ -249,6 +255,8 @@ def simulate_platoon(nominal, true, law: FollowerLaw, leader_ref: Callable, *, n
         res = both.resistance(v2)
         u1 = res[0] + fv_nom_f[ix]
         e = x[:-1] - x[1:] - spacing
+        if headway:
+            e = e - headway * v[1:]
         de = v[:-1] - v[1:]
         if link is None:
             e_seen, de_seen, a_seen = e, de, a_prev[:-1]
@@ -257,6 +265,8 @@ def simulate_platoon(nominal, true, law: FollowerLaw, leader_ref: Callable, *, n
             ip = row + pred
             xo, vo = (fxf[row + foll], fvf[row + foll]) if stamped else (x[1:], v[1:])
             e_seen = fxf[ip] - xo - spacing
+            if headway:
+                e_seen = e_seen - headway * vo
             de_seen = fvf[ip] - vo
             a_seen = faf[ip]
         u_f, s = law(e_seen, de_seen, u1[1:], a_seen)

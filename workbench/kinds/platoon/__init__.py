@@ -11,7 +11,9 @@ Tables::
                    true trains and external force |w| <= G_w
     [leader]       cruise_speed, cruise_time, accel, brake, jerk, gain: the manoeuvre
                    (accelerate - cruise - brake) and the leader's speed loop
-    [platoon]      trains, spacing (m, constant spacing), T (s), horizon (s)
+    [platoon]      trains, spacing (m), T (s), horizon (s), headway (s, optional: the
+                   time-headway policy, desired gap spacing + headway v; default 0,
+                   constant spacing)
     [route]        grade_from, grade
     [constants]    name = { value, unit, source }: numbers the laws use
     [[laws]]       name, label, law = "force expression (N)", definitions = {...},
@@ -93,7 +95,8 @@ class Platoon:
         for a in ex:
             for b in ex:
                 if a != b:
-                    q[f"{a}_over_{b}.max_abs_e"] = q[f"{a}.max_abs_e"] / q[f"{b}.max_abs_e"]
+                    den = q[f"{b}.max_abs_e"]
+                    q[f"{a}_over_{b}.max_abs_e"] = q[f"{a}.max_abs_e"] / den if den else None
         if spec.reaching is not None:
             for i, c in enumerate(res.convergence):
                 for k in _REACH:

@@ -74,7 +74,9 @@ def render(design, res) -> Rendered:
     prow = [[f"`{k}`", fmt(q.value, 4), q.unit, DOC[k], q.source] for k, q in spec.plant.items()]
     sec.append(
         "## Problem\n\n"
-        f"{spec.n} trains, leader-follower, spacing D = {fmt(spec.D.value)} m, step "
+        f"{spec.n} trains, leader-follower, spacing D = {fmt(spec.D.value)} m"
+        + (f" plus a time headway of {fmt(spec.headway)} s (desired gap D + h v_i; e_i = gap − "
+           f"D − h v_i)" if spec.headway else "") + ", step "
         f"T = {fmt(spec.T)} s (zero-order hold, the same step integrates the trains), "
         f"{fmt(spec.horizon)} s. The leader accelerates ({fmt(spec.accel)} m/s², jerk "
         f"{fmt(spec.jerk)} m/s³), cruises at {fmt(res.profile.v_cruise * 3.6, 3)} km/h for "

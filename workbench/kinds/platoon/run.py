@@ -113,8 +113,11 @@ class Scenario:
 
     def common(self) -> dict:
         spec = self.spec
-        return dict(n=spec.n, spacing=spec.D.value, T=spec.T, horizon=spec.horizon, w=self.w,
-                    leader_gain=spec.leader_gain, route=spec.route)
+        out = dict(n=spec.n, spacing=spec.D.value, T=spec.T, horizon=spec.horizon, w=self.w,
+                   leader_gain=spec.leader_gain, route=spec.route)
+        if spec.headway:
+            out["headway"] = spec.headway
+        return out
 
     def simulate(self, law: str, initial_errors=None, *, horizon: float | None = None,
                  **realism) -> PlatoonRun:

@@ -4,7 +4,7 @@ beyond the profile, no sympy until the laws are unit-checked).
 Tables: ``[plant]`` (the train model, :data:`TRAIN_MODELS`), ``[uncertainty]``
 (seeded parameter spread and external force; bounds G_w, G_d), ``[leader]``
 (accelerate - cruise - brake), ``[platoon]`` (trains, spacing, step,
-horizon), ``[route]`` (gradients), ``[constants]`` and ``[[laws]]``
+horizon; optional ``headway``: the time-headway spacing policy), ``[route]`` (gradients), ``[constants]`` and ``[[laws]]``
 (:mod:`.laws`), ``[[runs]]``, ``[reaching]``, ``[figures]``, and the
 realistic scenario: ``[v2v]`` (the train-to-train link), ``[actuator]``
 (first-order lag, traction and brake limits), ``[emergency]`` (the leader's
@@ -137,6 +137,7 @@ class PlatoonSpec:
     margin: MarginSpec | None
     analysis: object = None     # a paper's named module (``[analysis]``)
     analysis_spec: object = None
+    headway: float = 0.0        # s: desired gap D + headway v (0: constant spacing)
 
     def nominal(self) -> TrainParams:
         p = {k: q.value for k, q in self.plant.items()}
@@ -350,6 +351,8 @@ def load_spec(root: Reader) -> PlatoonSpec:
     D = pt.quantity("spacing", "m", positive=True)
     T = pt.quantity("T", "s", positive=True, hi=0.1).value
     horizon = pt.quantity("horizon", "s", positive=True, hi=3600.0).value
+    hw = pt.quantity("headway", "s", nonneg=True, hi=10.0, default=None)
+    headway = 0.0 if hw is None else hw.value
     pt.finish()
     ro = root.table("route")
     g_from, grade = _read_gradients(ro)
@@ -367,10 +370,15 @@ def load_spec(root: Reader) -> PlatoonSpec:
     t_brake = profile.run_time - phase_time(vc.value, brk, jerk)   # service braking starts
     em = _read_emergency(root, t_brake, T, laws)
     margin = _read_margin(root, laws)
+    if margin is not None and headway > 0:
+        raise root.fail("delay_margin", {"law": margin.law}, "no [delay_margin] with a time "
+                        "headway (platoon.headway > 0): its loop model is that of constant "
+                        "spacing")
     analysis = _read_analysis(root)
     spec = PlatoonSpec(root.path, plant, ms, ds, G_w, G_d, hold, seed, vc, ct, acc, brk, jerk,
                        lg, n, D, T, horizon, Route(1e9, g_from, grade), constants, laws, runs,
-                       reaching, figures, captions, link, act, em, margin, analysis)
+                       reaching, figures, captions, link, act, em, margin, analysis,
+                       headway=headway)
     if margin is not None:
         from .realism import linear_gains
         linear_gains(spec)              # a DesignError when the law is not linear
