@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 from ...plants.platoon001 import PARAMETER_UNITS, TrainParams
 from ...profiles import phase_time, spec_for_cruise
-from ...reader import Quantity, Reader
+from ...reader import Quantity, Reader, read_gradients
 from ...sim.platoon import JITTER, OWN_STATE
 from ...sim.tracking import Route
 from .laws import SIGNALS, Law, read_constants, read_laws
@@ -313,17 +313,6 @@ def _read_figures(root: Reader, runs) -> tuple[tuple[str, ...], dict]:
     return tuple(val), captions
 
 
-def _read_gradients(r: Reader) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    g_from = r.numbers("grade_from", default=(0.0,), what="positions (m)")
-    grade = r.numbers("grade", default=(0.0,), what="gradients (-)")
-    if len(g_from) != len(grade) or g_from[0] != 0.0 or list(g_from) != sorted(g_from):
-        raise r.fail("grade_from", list(g_from), "increasing positions starting at 0, one per "
-                     "entry of grade")
-    if any(abs(x) > 0.05 for x in grade):
-        raise r.fail("grade", list(grade), "gradients within +/-0.05 (50 permille)")
-    return g_from, grade
-
-
 def load_spec(root: Reader) -> PlatoonSpec:
     """Read and validate every table of a ``platoon`` design."""
     pl = root.table("plant")
@@ -355,7 +344,7 @@ def load_spec(root: Reader) -> PlatoonSpec:
     headway = 0.0 if hw is None else hw.value
     pt.finish()
     ro = root.table("route")
-    g_from, grade = _read_gradients(ro)
+    g_from, grade = read_gradients(ro)
     ro.finish()
     constants = read_constants(root, set(SIGNALS) | {"force", "time", "e_r", "e_end"})
     laws = read_laws(root, constants)

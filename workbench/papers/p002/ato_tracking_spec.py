@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from ...errors import DesignError, ModelError
 from ...plants.train002 import MODELS, PARAMETER_UNITS, FirstOrderTrain002, Train002
 from ...profiles import ProfileSpec, build_profile
-from ...reader import Quantity, Reader
+from ...reader import Quantity, Reader, read_gradients
 from ...sim.tracking import Objectives, Route
 
 OBJECTIVES = Objectives.NAMES
@@ -89,18 +89,6 @@ class TrackingSpec:
     def profile_spec(self, sec: Section) -> ProfileSpec:
         return ProfileSpec(sec.route.distance, sec.v_limit, self.profile["accel"],
                            self.profile["brake"], self.profile["jerk"], sec.run_time)
-
-
-def read_gradients(r: Reader) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """``grade_from`` (m, increasing from 0) and ``grade`` (-, |i| <= 0.05) of a table."""
-    g_from = r.numbers("grade_from", default=(0.0,), what="positions (m)")
-    grade = r.numbers("grade", default=(0.0,), what="gradients (-)")
-    if len(g_from) != len(grade) or g_from[0] != 0.0 or list(g_from) != sorted(g_from):
-        raise r.fail("grade_from", list(g_from), "increasing positions starting at 0, one per "
-                     "entry of grade")
-    if any(abs(x) > 0.05 for x in grade):
-        raise r.fail("grade", list(grade), "gradients within +/-0.05 (50 permille)")
-    return g_from, grade
 
 
 def _section(r: Reader, *, with_source: bool) -> Section:
