@@ -29,25 +29,13 @@ Tables::
 
 Laws are stateless: an expression of what the follower sees now, parsed
 with :mod:`workbench.expr` (never evaluated as Python) and unit-checked.
-Claimable quantities: ``<run>.<metric>`` (max_abs_e, cruise_abs_e, ...),
-``<a>_over_<b>.max_abs_e`` of two runs from exact spacing, ``convergence.*``
-(with ``[reaching]``), ``emergency.*``, ``delay_margin.*``, ``delay_sweep.*``,
-``leader.v_cruise``, and the ``[analysis]`` module's.
+Claimable quantities: :mod:`.quantities` (declared once, with units).
 """
 from __future__ import annotations
 
 from ...reader import Reader
 
-__all__ = ["METRICS", "STUDY", "Platoon"]
-
-#: Per-run metrics a claim may name (``<run>.<metric>``).
-METRICS = ("max_abs_e", "cruise_abs_e", "cruise_abs_de", "chatter", "sign_rate",
-           "lumped_ratio", "string_ratio", "max_speed")
-_REACH = ("t_reach", "e_reach", "slide_eq22", "slide_band", "slide_measured")
-
-
-def _ratio_runs(spec) -> list[str]:
-    return [r.name for r in spec.runs if r.initial_errors is None]
+__all__ = ["STUDY", "Platoon"]
 
 
 class Platoon:
@@ -61,57 +49,24 @@ class Platoon:
         return load_spec(root)
 
     def quantity_names(self, spec) -> set[str]:
-        from .realism import realism_quantity_names
-        names = {f"{r.name}.{k}" for r in spec.runs for k in METRICS} | {"leader.v_cruise"}
-        ex = _ratio_runs(spec)
-        names |= {f"{a}_over_{b}.max_abs_e" for a in ex for b in ex if a != b}
-        if spec.reaching is not None:
-            names |= {"convergence.max_reaching_time", "convergence.max_rel_error_band",
-                      "convergence.max_ratio_eq22"}
-            for i in range(2, spec.n + 1):
-                names |= {f"convergence.train{i}.{k}" for k in _REACH}
-        if spec.analysis is not None:
-            names |= spec.analysis.quantity_names(spec)
-        return names | realism_quantity_names(spec)
+        from ...features.quantities import names
+        from .quantities import TABLE
+        return names(TABLE, spec)
+
+    def quantity_units(self, spec) -> dict[str, str]:
+        """name -> unit of every claimable quantity (:mod:`.quantities`)."""
+        from ...features.quantities import units
+        from .quantities import TABLE
+        return units(TABLE, spec)
 
     def run(self, design):
         from .run import run
         return run(design.spec)
 
     def quantities(self, res) -> dict:
-        from .realism import realism_quantities
-        spec = res.spec
-        q = {"leader.v_cruise": res.profile.v_cruise}
-        for name, m in res.metrics.items():
-            q[f"{name}.max_abs_e"] = max(m.max_abs_e)
-            q[f"{name}.cruise_abs_e"] = max(m.cruise_abs_e)
-            q[f"{name}.cruise_abs_de"] = max(m.cruise_abs_de)
-            q[f"{name}.chatter"] = max(m.chatter)
-            q[f"{name}.sign_rate"] = max(m.sign_rate)
-            q[f"{name}.lumped_ratio"] = m.lumped_ratio
-            q[f"{name}.string_ratio"] = m.string_ratio
-            q[f"{name}.max_speed"] = max(m.max_speed)
-        ex = _ratio_runs(spec)
-        for a in ex:
-            for b in ex:
-                if a != b:
-                    den = q[f"{b}.max_abs_e"]
-                    q[f"{a}_over_{b}.max_abs_e"] = q[f"{a}.max_abs_e"] / den if den else None
-        if spec.reaching is not None:
-            for i, c in enumerate(res.convergence):
-                for k in _REACH:
-                    q[f"convergence.train{i + 2}.{k}"] = getattr(c, k)
-            done = [c for c in res.convergence if c.slide_measured is not None]
-            ok = len(done) == len(res.convergence) and bool(done)
-            q["convergence.max_reaching_time"] = max(c.t_reach for c in done) if ok else None
-            q["convergence.max_rel_error_band"] = max(
-                abs(c.slide_measured / c.slide_band - 1.0) for c in done) if ok else None
-            q["convergence.max_ratio_eq22"] = max(
-                c.slide_measured / c.slide_eq22 for c in done) if ok else None
-        q.update(realism_quantities(res.realism))
-        if spec.analysis is not None:
-            q.update(spec.analysis.quantities(spec, res))
-        return q
+        from ...features.quantities import values
+        from .quantities import TABLE
+        return values(TABLE, res.spec, res)
 
 
 STUDY = Platoon()

@@ -40,8 +40,7 @@ from ...sim.platoon import Actuator, Link, PlatoonRun, packet_delays, received_s
 
 __all__ = ["CASES", "DelayMarginStudy", "EmergencyRun", "LinkStats", "Realism", "SweepRow",
            "accel_end", "actuator", "delay_margin_model", "emergency_run", "envelope",
-           "linear_gains", "link", "realism_quantities", "realism_quantity_names",
-           "run_realism"]
+           "linear_gains", "link", "run_realism"]
 
 CASES = ("constant", "random")
 
@@ -320,71 +319,3 @@ def run_realism(sc) -> Realism:
               delay_margin_study(sc, actuator(spec), accel_end(sc.profile)))
     return Realism(spec.link.delay.value, spec.emergency.time.value, K * spec.T, links, runs,
                    margin, spec.emergency.laws)
-
-
-def _pairs(laws):
-    return [(a, b) for a in laws for b in laws if a != b]
-
-
-def realism_quantity_names(spec) -> set[str]:
-    laws = spec.emergency.laws
-    names = set()
-    for case in CASES:
-        names |= {f"emergency.{case}.link.{k}" for k in ("mean_age", "max_age", "lost")}
-        names |= {f"emergency.{case}.{law}.{k}" for law in laws for k in
-                  ("min_gap", "t_min_gap", "min_margin", "t_min_margin", "cruise_abs_e",
-                   "stopped")}
-        names |= {f"emergency.{case}.{a}_minus_{b}.{k}" for a, b in _pairs(laws)
-                  for k in ("min_gap", "min_margin")}
-    names |= {f"emergency.{who}.{k}" for who in laws + ("worst",)
-              for k in ("min_gap", "min_margin")}
-    if spec.margin is None:
-        return names
-    names |= {f"delay_margin.{k}" for k in ("k_e", "k_d", "h_eig", "h_siso", "omega",
-                                             "agreement", "h_over_delay", "current_h")}
-    names |= {f"delay_sweep.{law}.{k}" for law in spec.margin.sweep
-              for k in ("amp_ratio", "amp_at_delay", "saturated_at_delay")}
-    return names
-
-
-def _amp(rows, law: str, factor) -> SweepRow | None:
-    return next((r for r in rows if r.law == law and r.factor == factor), None)
-
-
-def realism_quantities(r: Realism) -> dict:
-    q = {}
-    for case, st in r.links.items():
-        q.update({f"emergency.{case}.link.{k}": getattr(st, k)
-                  for k in ("mean_age", "max_age", "lost")})
-    for (case, law), e in r.emergency.items():
-        for k in ("min_gap", "t_min_gap", "min_margin", "t_min_margin", "cruise_abs_e"):
-            q[f"emergency.{case}.{law}.{k}"] = getattr(e, k)
-        q[f"emergency.{case}.{law}.stopped"] = "yes" if e.stopped else "no"
-    for case in CASES:
-        for k in ("min_gap", "min_margin"):
-            x = {law: getattr(r.emergency[case, law], k) for law in r.laws}
-            for a, b in _pairs(r.laws):
-                q[f"emergency.{case}.{a}_minus_{b}.{k}"] = x[a] - x[b]
-    for who in r.laws + ("worst",):
-        runs = [e for (case, law), e in r.emergency.items() if who in (law, "worst")]
-        q[f"emergency.{who}.min_gap"] = min(e.min_gap for e in runs)
-        q[f"emergency.{who}.min_margin"] = min(e.min_margin for e in runs)
-    m = r.margin
-    if m is None:
-        return q
-    q.update({"delay_margin.k_e": m.k_e, "delay_margin.k_d": m.k_d,
-              "delay_margin.h_eig": m.eig.h, "delay_margin.h_siso": m.siso.h,
-              "delay_margin.omega": m.eig.omega,
-              "delay_margin.agreement": m.agreement[0].value,
-              "delay_margin.current_h": m.current.h})
-    delay = r.delay
-    q["delay_margin.h_over_delay"] = m.eig.h / delay if delay > 0 else math.inf
-    below = max((f for f in m.factors if f < 1.0), default=None)
-    above = min((f for f in m.factors if f > 1.0), default=None)
-    for law in dict.fromkeys(row.law for row in m.sweep):
-        lo, hi, d = _amp(m.sweep, law, below), _amp(m.sweep, law, above), _amp(m.sweep, law, None)
-        q[f"delay_sweep.{law}.amp_ratio"] = (hi.amp_first / lo.amp_first
-                                             if lo is not None and hi is not None else None)
-        q[f"delay_sweep.{law}.amp_at_delay"] = d.amp_first
-        q[f"delay_sweep.{law}.saturated_at_delay"] = d.saturated
-    return q

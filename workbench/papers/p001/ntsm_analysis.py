@@ -73,6 +73,10 @@ class NTSMAnalysis:
     def quantity_names(self, spec) -> set[str]:
         return {"delay_margin.linearisable", "delay_margin.lowest_power", "delay_margin.spring"}
 
+    def quantity_units(self, spec) -> dict[str, str]:
+        return {"delay_margin.linearisable": "", "delay_margin.lowest_power": "1",
+                "delay_margin.spring": "1/s^2"}
+
     def run(self, spec, res):
         return None
 
