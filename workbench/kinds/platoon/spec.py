@@ -135,9 +135,14 @@ class PlatoonSpec:
     actuator: ActuatorSpec
     emergency: EmergencySpec
     margin: MarginSpec | None
-    analysis: object = None     # a paper's named module (``[analysis]``)
+    analysis_module: str | None = None   # ``[analysis] module`` (a name: specs stay keyable)
     analysis_spec: object = None
     headway: float = 0.0        # s: desired gap D + headway v (0: constant spacing)
+
+    @property
+    def analysis(self):
+        """The ``[analysis]`` module's ``PLATOON_ANALYSIS`` object, or None."""
+        return None if self.analysis_module is None else _analysis(self.analysis_module)
 
     def nominal(self) -> TrainParams:
         p = {k: q.value for k, q in self.plant.items()}
@@ -279,7 +284,6 @@ def _read_analysis(root: Reader):
     """``[analysis] module = "pNNN.name"``: a paper's module (under
     ``workbench.papers``) with a ``PLATOON_ANALYSIS`` object, for what a
     design cannot express (its docstring says why)."""
-    import importlib
     import re
     if not root.has("analysis"):
         return None
@@ -289,11 +293,16 @@ def _read_analysis(root: Reader):
     if not re.fullmatch(r"p\d{3}\.[a-z][a-z0-9_]*", name):
         raise r.fail("module", name, 'a paper module "pNNN.name" under workbench.papers')
     try:
-        obj = importlib.import_module(f"workbench.papers.{name}").PLATOON_ANALYSIS
+        _analysis(name)
     except (ImportError, AttributeError):
         raise r.fail("module", name, "a module of workbench.papers with PLATOON_ANALYSIS") \
             from None
-    return obj
+    return name
+
+
+def _analysis(name: str):
+    import importlib
+    return importlib.import_module(f"workbench.papers.{name}").PLATOON_ANALYSIS
 
 
 #: ``[figures]`` captions (drawn in each figure's title) and their defaults.
@@ -373,5 +382,5 @@ def load_spec(root: Reader) -> PlatoonSpec:
         linear_gains(spec)              # a DesignError when the law is not linear
     if analysis is not None:
         from dataclasses import replace
-        spec = replace(spec, analysis_spec=analysis.load(root, spec))
+        spec = replace(spec, analysis_spec=spec.analysis.load(root, spec))
     return spec
