@@ -36,9 +36,10 @@ class Convergence:
     e_reach : float or None
         e(t_reach) (m).
     slide_eq22 : float or None
-        Eq 22: t_f - t_e to e = 0 (s).
+        ``[reaching] sliding_time`` from e(t_reach) to e = 0 (s) (the name is
+        paper 001's eq 22, kept for its claims' quantity names).
     slide_band : float or None
-        The same law integrated to the converge band (s).
+        The same to the converge band (s).
     slide_measured : float or None
         Measured time from t_reach until |e| stays within the band (s).
     """
