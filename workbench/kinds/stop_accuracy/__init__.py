@@ -25,7 +25,12 @@ Tables::
                    its output limited to ±c_max unless ``limited = false``),
                    or smarc = { c = "constant", ... } (the named module ``smarc``: the whole
                    law), compensation = { predictor = true, terminal = true,
-                   gain_correction = true } (optional, with [compensation]; :mod:`.modules`)
+                   gain_correction = true } (optional, with [compensation]; :mod:`.modules`),
+                   deceleration_loop = { e_switch = "constant", ..., axles = 4 } (optional:
+                   the named module closes a loop on the deceleration measured from the
+                   axle speeds, the law being its target; :mod:`.decel_loop`),
+                   levels = 7 (optional: a command channel of that many levels above 0,
+                   the command rounded to the nearest multiple of c_max / levels)
     [reference]    model = "ato-trapezoid", v_max, a_acc, a_dec (optional: the target a
                    tracking law follows; laws see x_d, v_d, a_d; runs start where it starts
                    braking, [target] has no speeds_kmh and distance is the section length)
@@ -35,7 +40,8 @@ Tables::
                    "gradient" } (permille) | { effect = "force_error" } | { effect = "mass_ratio" }
                    (the factors, in this order: a Monte Carlo draw's stream is its position)
     [[faults]]     name, parameters = { brake parameter = value }, speed_ratio (the speed
-                   the law sees / the true speed), disturbance = { factor = value }
+                   the law sees / the true speed), disturbance = { factor = value },
+                   axles = "fffo" (the axle sensors' states, with a deceleration_loop)
     [grid]         factor = [values, ...]  (every combination, in the order written: the
                    corners of an error grid, as paper 004 section 1.3)
     [montecarlo]   samples, seed, distributions = { factor = { dist = ... } }
@@ -53,9 +59,10 @@ an integrator is the one named module a design may reference (``pid``: its
 gains are constants of the design, unit-checked as ``kp*error``,
 ``ki*error*t`` and ``kd*error/t`` in m/s^2; the PID output is limited to
 ±c_max with conditional integration, or unlimited). Paper 000's SMARC, the
-Smith predictor and the predictive terminal law are the other named modules
-(:mod:`.modules`, which says why each is not an expression). Paper 004's
-fuzzy/PID command generator on four axle sensors stays in its paper's module.
+Smith predictor and the predictive terminal law are named modules too
+(:mod:`.modules`, which says why each is not an expression), and so is paper
+004's fuzzy/PID command generator on the axle sensors (``deceleration_loop``,
+:mod:`.decel_loop`).
 """
 from __future__ import annotations
 
@@ -85,6 +92,8 @@ class Controller:
     terminal: bool = False                           # ... terminal = true
     gain_correction: bool = True                     # ... gain_correction = false: none
     pid_limited: bool = True                         # pid = { limited = false }: no limit
+    loop: object = None                              # decel_loop.LoopGains
+    levels: int = 0                                  # command channel levels (0: analogue)
 
 
 @dataclass(frozen=True)
@@ -93,6 +102,7 @@ class Fault:
     parameters: dict
     speed_ratio: float = 1.0
     disturbance: dict | None = None
+    axles: str | None = None       # axle-sensor states (module deceleration_loop)
 
 
 @dataclass(frozen=True)
@@ -189,6 +199,15 @@ def _controllers(root: Reader, names: set, constants) -> tuple[Controller, ...]:
             raise t.fail("compensation", t.raw("compensation"), "a [compensation] table "
                          "(d_terminal, gain_tau, gain_bounds) for the predictor's model")
         pid = None
+        loop = None
+        if t.has("deceleration_loop"):
+            from .decel_loop import read_loop
+            if law is None or t.has("pid"):
+                raise t.fail("deceleration_loop", t.raw("deceleration_loop"), "a law (the "
+                             "target deceleration) and no pid (the loop has its own)")
+            loop = read_loop(t, constants)
+        levels = int(t.number("levels", default=0, integer=True, lo=1, hi=1024,
+                              what="count of command levels above 0"))
         if t.has("pid"):
             pt = t.table("pid")
             err = pt.raw("error")
@@ -200,7 +219,8 @@ def _controllers(root: Reader, names: set, constants) -> tuple[Controller, ...]:
             pt.finish()
             pid = (err, *gains)
         t.finish()
-        out.append(Controller(name, law, tuple(defs), pid, smarc, *flags, limited))
+        out.append(Controller(name, law, tuple(defs), pid, smarc, *flags, limited, loop,
+                              levels))
     return tuple(out)
 
 
@@ -229,7 +249,7 @@ def _factors(root: Reader, params: dict) -> tuple[Factor, ...]:
     return tuple(out)
 
 
-def _faults(root: Reader, params: dict, factors) -> tuple[Fault, ...]:
+def _faults(root: Reader, params: dict, factors, controllers=()) -> tuple[Fault, ...]:
     out, seen = [], set()
     for t in root.tables("faults", default=[]):
         name = _name(t, "name", seen)
@@ -250,8 +270,10 @@ def _faults(root: Reader, params: dict, factors) -> tuple[Fault, ...]:
             dist[k] = dt.number(k, lo=-1e3, hi=1e3, positive=positive)
         dt.finish()
         ratio = t.number("speed_ratio", default=1.0, lo=0.0, hi=2.0)
+        from .decel_loop import read_axles
+        axles = read_axles(t, controllers)
         t.finish()
-        out.append(Fault(name, over, ratio, dist))
+        out.append(Fault(name, over, ratio, dist, axles))
     return tuple(out)
 
 
@@ -348,7 +370,7 @@ class StopAccuracy:
         controllers = _controllers(root, set(law_names) | set(constants), constants)
         compensation = read_compensation(root)
         factors = _factors(root, params)
-        faults = _faults(root, params, factors)
+        faults = _faults(root, params, factors, controllers)
         mc = None
         if root.has("montecarlo"):
             if not factors:

@@ -107,10 +107,10 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
     return tr.x_stop - D, traces
 
 
-def simulate_cases(spec, laws, dt, cases, draws=None):
+def simulate_cases(spec, laws, dt, cases, draws=None, dt_rec=None):
     """Simulate ``cases`` [(speed km/h, controller index, fault or None, D m)],
     each repeated over the Monte Carlo ``draws`` (factor -> array) when given,
-    in one batch (every operation is elementwise over runs: a run's result
+    recorded every ``dt_rec`` (default dt_ctrl), in one batch (every operation is elementwise over runs: a run's result
     does not depend on the others in its batch).
 
     Returns
@@ -142,17 +142,26 @@ def simulate_cases(spec, laws, dt, cases, draws=None):
     v0, x0 = rep(lambda c: c[0] / 3.6), 0.0
     if spec.reference is not None:    # start where the target starts braking
         x0, v0 = (rep(lambda c, k=k: spec.reference.start(c[3])[k]) for k in (0, 1))
+    axles = None
+    if any(c[2] is not None and c[2].axles for c in cases):
+        k = len(next(c[2].axles for c in cases if c[2] is not None and c[2].axles))
+        axles = np.repeat([list(c[2].axles if c[2] is not None and c[2].axles else "o" * k)
+                           for c in cases], N, axis=0)
     tr, _ = simulate_runs(spec, laws, dt, p, ctl, D, x0=x0, v0=v0, ratio=ratio, theta=theta,
-                          kappa=kappa)
+                          kappa=kappa, axles=axles, dt_rec=dt_rec)
     return tr, D
 
 
-def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa):
+def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa, axles=None,
+                  constants=None, dt_rec=None):
     """Simulate a batch of runs, each its own: brake parameters ``p``
     (:func:`workbench.sim.stopping.batch_params`), controller index ``ctl``,
     stopping point ``D`` (m), start ``x0`` (m), ``v0`` (m/s), speed-sensor
     ``ratio``, gradient ``theta`` and load-weighing gain ``kappa`` (arrays
-    over the runs, or scalars).
+    over the runs, or scalars); ``axles`` (shape (n, axles), states of
+    :data:`.decel_loop.AXLE_STATES`; default all healthy) for the module
+    ``deceleration_loop``, ``constants`` (name -> array over the runs) in place
+    of the design's values, ``dt_rec`` the recording period (default dt_ctrl).
 
     Returns
     -------
@@ -174,8 +183,17 @@ def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa):
             law, err, (kp, ki, kd) = law
             lim = spec.c_max if spec.controllers[i].pid_limited else np.inf
             pid = (err, BatchPID(kp, ki, kd, idx.size, dt=spec.dt_ctrl, u_min=-lim, u_max=lim))
-        groups.append((law, idx, pid, spec.controllers[i].name))
+        loop, c = None, spec.controllers[i]
+        if c.loop is not None:             # the named module ``deceleration_loop``
+            from .decel_loop import DecelerationLoop
+            st = (np.full((idx.size, c.loop.axles), "o") if axles is None else
+                  np.asarray(axles)[idx])
+            loop = DecelerationLoop(c.loop.values(spec.constants), st, spec.dt_ctrl,
+                                    spec.c_max)
+        groups.append((law, idx, pid, c.name, loop, c.levels))
     const = {k: np.full(n, q.value) for k, q in spec.constants.items()}
+    for k, x in (constants or {}).items():
+        const[k] = np.broadcast_to(np.asarray(x, float), (n,))
     names = _law_names(spec) + tuple(const)
     longest = max(float(p["T1"].max()), float(p["T3"].max()))
     if not longest <= spec.t_end:       # the delay line would outgrow the run (memory)
@@ -189,7 +207,7 @@ def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa):
                 "D": D, "v0": v0, "t": np.full(n, t)} | ref | const
         c = np.zeros(n)
         with np.errstate(all="ignore"):    # a law's nan (e.g. sqrt(-1)) is a run without a stop
-            for law, idx, pid, name in groups:
+            for law, idx, pid, name, loop, _ in groups:
                 if idx.size and law is None:
                     c[idx] = track.smarc_command(name, idx, vals["x"], vals["v"], ref)
                 elif idx.size:
@@ -197,10 +215,16 @@ def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa):
                     c[idx] = np.broadcast_to(law(*args), idx.shape)
                     if pid is not None:
                         c[idx] += pid[1].step(np.broadcast_to(pid[0](*args), idx.shape))
-        return track.finish(np.clip(c, spec.c_min, spec.c_max), o)
+                    if loop is not None:   # the law is the loop's target deceleration
+                        c[idx] = loop.command(c[idx], vals["v"][idx])
+        c = np.clip(c, spec.c_min, spec.c_max)
+        for _, idx, _, _, _, levels in groups:
+            if levels and idx.size:        # a channel of ``levels`` steps of c_max / levels
+                c[idx] = np.round(c[idx] / spec.c_max * levels) / levels * spec.c_max
+        return track.finish(c, o)
 
     tr = simulate(p, policy, n=n, t_end=spec.t_end, dt=dt, dt_ctrl=spec.dt_ctrl,
-                  dt_rec=spec.dt_ctrl, x0=x0, v0=v0, theta=theta, kappa=kappa,
+                  dt_rec=spec.dt_ctrl if dt_rec is None else dt_rec, x0=x0, v0=v0, theta=theta, kappa=kappa,
                   c_min=spec.c_min, c_max=spec.c_max)
     return tr, track
 
