@@ -206,8 +206,9 @@ def _controllers(root: Reader, names: set, constants) -> tuple[Controller, ...]:
                 raise t.fail("deceleration_loop", t.raw("deceleration_loop"), "a law (the "
                              "target deceleration) and no pid (the loop has its own)")
             loop = read_loop(t, constants)
-        levels = int(t.number("levels", default=0, integer=True, lo=1, hi=1024,
-                              what="count of command levels above 0"))
+        levels = t.number("levels", default=None, integer=True, lo=1, hi=1024,
+                          what="count of command levels above 0")
+        levels = 0 if levels is None else int(levels)
         if t.has("pid"):
             pt = t.table("pid")
             err = pt.raw("error")

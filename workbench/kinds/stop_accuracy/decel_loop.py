@@ -6,7 +6,8 @@ The controller's law gives the *target* deceleration ``a_req`` (m/s^2; in
 paper 004 the ATO's a_req = v_p^2 / (2 d_p)). The module, every control
 period and per run:
 
-1. reads the axle speeds (each axle in a state: ``o`` healthy, ``s`` sliding,
+1. reads the axle speeds of the measured speed v (the true speed times a
+   fault's ``speed_ratio``; each axle in a state: ``o`` healthy, ``s`` sliding,
    reads ``slide_ratio`` x v, ``f`` failed, reads 0, ``h`` reads
    ``high_ratio`` x v, ``z`` stuck at its reading when braking started) and
    takes the train speed as their maximum (004 section 2.7);
@@ -72,8 +73,8 @@ class LoopGains:
         """One line for the report."""
         return ("deceleration loop (module `deceleration_loop`: the law is the target "
                 f"deceleration; measured from the max of {self.axles} axle speeds; fuzzy "
-                "increments above e_switch, PID below: " + ", ".join(
-                    f"{k} = {v}" for k, v in self.names.items()) + ")")
+                "increments above e_switch, PID below; constants " + ", ".join(
+                    k if k == v else f"{k} = {v}" for k, v in self.names.items()) + ")")
 
 
 def read_loop(t, constants) -> LoopGains:
@@ -81,7 +82,8 @@ def read_loop(t, constants) -> LoopGains:
     :data:`LOOP_UNITS` names a constant of that unit, ``axles`` is a count."""
     from .modules import named_constants
     lt = t.table("deceleration_loop")
-    axles = int(lt.number("axles", default=4, integer=True, lo=1, hi=16, what="axle count"))
+    axles = lt.number("axles", default=None, integer=True, lo=1, hi=16, what="axle count")
+    axles = 4 if axles is None else int(axles)
     names = named_constants(lt, constants, LOOP_UNITS)
     lt.finish()
     v = LoopGains(names, axles).values(constants)

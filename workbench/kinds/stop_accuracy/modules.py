@@ -2,7 +2,9 @@
 stopping controller that are not expressions (issue 35, item 2).
 
 A law of the kind is an expression of the measured state (parsed, never
-evaluated, unit-checked). Four things are not, and are named here:
+evaluated, unit-checked). Five things are not, and are named here (the
+fifth, paper 004's command generator ``deceleration_loop``, in
+:mod:`.decel_loop`):
 
 ``pid``          (``[[controllers]] pid = {...}``, :mod:`.run`): an integrator
                  is internal state that an expression of the present cannot hold.

@@ -59,12 +59,20 @@ def _problem(spec) -> str:
                                             else ""), f.what] for f in spec.factors]
         out += "\n\n" + md_table(["factor", "acts on", "what"], rows, "lll")
     if spec.faults:
+        axles = any(f.axles for f in spec.faults)
         rows = [[f"`{f.name}`", ", ".join(f"{k} = {fmt(v)}" for k, v in f.parameters.items())
                  or "—", fmt(f.speed_ratio), ", ".join(
                      f"{k} = {fmt(v)}" for k, v in (f.disturbance or {}).items()) or "—"]
-                for f in spec.faults]
+                + ([f.axles or "—"] if axles else []) for f in spec.faults]
         out += "\n\n" + md_table(["fault", "brake parameters", "speed read / true",
-                                  "disturbance"], rows, "llrl")
+                                  "disturbance"] + (["axles"] if axles else []), rows,
+                                 "llrl" + ("l" if axles else ""))
+        if axles:
+            out += ("\n\nAxle states (module `deceleration_loop`): o healthy, s sliding "
+                    "(reads slide_ratio × v), f failed (reads 0), h reads high_ratio × v, "
+                    "z stuck at its reading when braking started; the train speed is the "
+                    "maximum; where every axle is s or f the loop is off (the law alone). "
+                    "A controller without the module does not read the axles.")
     return out
 
 
@@ -79,6 +87,11 @@ def _law_text(c) -> str:
                                f" + PID(`{c.pid[0]}`; kp = {c.pid[1]}, ki = {c.pid[2]}, "
                                f"kd = {c.pid[3]}" + ("" if c.pid_limited else ", no limit")
                                + ")")
+    if c.loop is not None:
+        text += " as the target of the " + c.loop.text()
+    if c.levels:
+        text += (f"; command channel of {c.levels} levels above 0 (rounded to multiples of "
+                 f"c_max / {c.levels})")
     mods = [m for m, on in (("predictor", c.predictor), ("terminal", c.terminal)) if on]
     if mods:
         text += " with modules " + " and ".join(f"`{m}`" for m in mods) + (
