@@ -44,6 +44,9 @@ Tables::
                    axles = "fffo" (the axle sensors' states, with a deceleration_loop)
     [grid]         factor = [values, ...]  (every combination, in the order written: the
                    corners of an error grid, as paper 004 section 1.3)
+    [[sections]]   name, length = { value, unit = "m", source }, with [repeats] count, seed, ranges = { factor
+                   = [lo, hi] } (with [reference]: every controller's repeats on every
+                   section, paper 000 Tables 3-4; :mod:`.sections`)
     [montecarlo]   samples, seed, distributions = { factor = { dist = ... } }
                    (:mod:`workbench.features.montecarlo`)
     [convergence]  (no keys: every nominal and fault stop error at dt, dt/2, dt/4,
@@ -127,6 +130,7 @@ class StopAccuracySpec:
     reference: object = None       # modules.Reference ([reference])
     compensation: object = None    # modules.Compensation ([compensation])
     c_min: float = 0.0             # m/s^2: -traction_max (the law may call for traction)
+    sections: object = None        # sections.Repeats ([[sections]], [repeats])
 
     def base(self) -> dict:
         return {k: q.value for k, q in self.params.items()}
@@ -372,6 +376,8 @@ class StopAccuracy:
         compensation = read_compensation(root)
         factors = _factors(root, params)
         faults = _faults(root, params, factors, controllers)
+        from .sections import read_sections
+        sections = read_sections(root, factors, reference, controllers)
         mc = None
         if root.has("montecarlo"):
             if not factors:
@@ -405,7 +411,7 @@ class StopAccuracy:
                                 None if cmd is None else cmd.value, constants, controllers,
                                 factors, faults, dt, dt_ctrl, t_end, mc, convergence, grid,
                                 reference, compensation,
-                                0.0 if traction is None else -traction.value)
+                                0.0 if traction is None else -traction.value, sections)
 
     def quantity_names(self, spec: StopAccuracySpec) -> set[str]:
         from ...features.quantities import names

@@ -14,10 +14,23 @@ Per speed ``v<s>`` (km/h, e.g. ``v50``) and controller ``c``::
                                           (Wilson 95 %), p95_abs_m, mean_m, overshoot_share
     v<s>.<c>.convergence.estimate_m       with [convergence]: Richardson error estimate of
                                           the nominal stop error at dt/4 (m)
+
+With ``[[sections]]`` and ``[repeats]``, per section ``k`` (1, 2, ...) and
+repeating controller ``c`` (cm, cm^2, m/s^3)::
+
+    sections[<k>].<c>.mean_abs_cm         mean |stop error| over the repeats
+    sections[<k>].<c>.mean_cm             signed mean
+    sections[<k>].<c>.var_cm2             variance (ddof 1)
+    sections[<k>].<c>.max_abs_cm          largest |stop error|
+    sections[<k>].<c>.jerk_mean           mean |da/dt| while moving
+    sections.<c>.mean_abs_cm              mean over the sections of mean_abs_cm
+    sections.<c>.worst_mean_abs_cm        largest section mean_abs_cm
 """
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 from ...features.montecarlo import MC_QUANTITIES
 from ...features.quantities import Declared
@@ -70,6 +83,28 @@ def _estimate(r, s, speed, c):
     return None if chk is None or chk.estimate is None else _finite(chk.estimate)
 
 
+def _sec_cases(spec):
+    rp = spec.sections
+    if rp is None:
+        return []
+    return [{"c": c.name} for c in spec.controllers if not rp.controllers
+            or c.name in rp.controllers]
+
+
+def _sec_cells(spec):
+    n = 0 if spec.sections is None else len(spec.sections.sections)
+    return [x | {"k": i + 1, "i": i} for i in range(n) for x in _sec_cases(spec)]
+
+
+def _over_sections(r, c, f):
+    return f([r.sections[i, c].mean_abs for i in range(len(r.spec.sections.sections))])
+
+
+_SECTION_STATS = (("mean_abs_cm", "cm", "mean_abs"), ("mean_cm", "cm", "mean"),
+                  ("var_cm2", "cm^2", "var"), ("max_abs_cm", "cm", "max_abs"),
+                  ("jerk_mean", "m/s^3", "jerk_mean"))
+
+
 TABLE = (
     Declared("{s}.distance_m", "m", lambda r, s, speed: r.distance[speed], over=_speeds),
     Declared("{s}.{c}.nominal_m", "m", lambda r, s, speed, c: _finite(r.nominal[speed, c]),
@@ -85,4 +120,11 @@ TABLE = (
     Declared("{s}.{c}.grid.failing_corners", "1", lambda r, s, speed, c: float(sum(
         not abs(x) <= r.spec.tolerance for x in r.grid[speed, c])), over=_grid),
     Declared("{s}.{c}.convergence.estimate_m", "m", _estimate, over=_conv),
+    *(Declared("sections[{k}].{c}." + name, unit,
+               lambda r, k, i, c, a=attr: getattr(r.sections[i, c], a), over=_sec_cells)
+      for name, unit, attr in _SECTION_STATS),
+    Declared("sections.{c}.mean_abs_cm", "cm",
+             lambda r, c: _over_sections(r, c, lambda x: float(np.mean(x))), over=_sec_cases),
+    Declared("sections.{c}.worst_mean_abs_cm", "cm",
+             lambda r, c: _over_sections(r, c, max), over=_sec_cases),
 )

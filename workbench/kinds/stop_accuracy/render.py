@@ -25,11 +25,14 @@ def render(design, res) -> Rendered:
         sections.append(_grid(spec, res))
     if spec.montecarlo is not None:
         sections.append(_montecarlo(spec, res))
+    if spec.sections is not None:
+        sections.append(_sections(spec, res))
     if spec.convergence:
         sections.append(_convergence(spec, res))
     anchors = ((r"v[0-9.]+\.[A-Za-z0-9_]+\.mc\.", "Monte Carlo"),
                (r"v[0-9.]+\.[A-Za-z0-9_]+\.grid\.", "Error grid"),
                (r"v[0-9.]+\.[A-Za-z0-9_]+\.convergence\.", "Convergence"),
+               (r"sections[.\[]", "Sections"),
                (r"v[0-9.]+\.", "Stops"))
     return Rendered(tuple(sections), (), anchors)
 
@@ -169,6 +172,34 @@ def _montecarlo(spec, res) -> str:
             + md_table(["speed (km/h)", "controller", f"within ±{fmt(spec.tolerance)} m",
                         "Wilson 95 %", "p95 |error| (m)", "mean (m)", "overshoot share"],
                        rows, "rlrrrrr"))
+
+
+def design_quantities(spec, res) -> dict:
+    from ...features.quantities import values
+    from .quantities import TABLE
+    return values(TABLE, spec, res)
+
+
+def _sections(spec, res) -> str:
+    rp = spec.sections
+    ctl = [c.name for c in spec.controllers if not rp.controllers or c.name in rp.controllers]
+    rows = []
+    for i, sec in enumerate(rp.sections):
+        cells = [res.sections[i, c] for c in ctl]
+        rows.append([str(i + 1), sec.name, fmt(sec.length, 6)] + [
+            f"{fmt(x.mean_abs, 3)} / {fmt(x.mean, 3)} / {fmt(x.var, 3)}" for x in cells])
+    q = design_quantities(spec, res)
+    rows.append(["all", "mean over the sections", "—"] + [
+        f"**{fmt(q[f'sections.{c}.mean_abs_cm'], 3)}**" for c in ctl])
+    rng = ", ".join(f"`{k}` [{fmt(lo)}, {fmt(hi)}]" for k, lo, hi in rp.ranges)
+    return ("## Sections\n\n"
+            f"Every controller stops {rp.count} times at the end of each section (`[[sections]]`, "
+            f"`[repeats]`, seed {rp.seed}, one stream per section), starting where the target "
+            f"starts braking, on plants drawn uniformly: {rng}. Stop error (cm, + = overshoot) "
+            "over the repeats: mean |error| / signed mean / variance (cm²) "
+            "(`workbench/kinds/stop_accuracy/sections.py`).\n\n"
+            + md_table(["#", "section", "length (m)"] + [f"`{c}`" for c in ctl], rows,
+                       "rlr" + "r" * len(ctl)))
 
 
 def _convergence(spec, res) -> str:

@@ -30,8 +30,8 @@ import numpy as np
 from ...jsonable import json_method
 from .pipeline import LAW_NAMES, apply_factors, group_statistics, open_loop_distance
 
-__all__ = ["StopAccuracyResult", "compile_laws", "montecarlo_draws", "run", "simulate_cases",
-           "simulate_runs", "stopping_points", "speed_key"]
+__all__ = ["StopAccuracyResult", "compile_laws", "montecarlo_draws", "run", "run_sections",
+           "simulate_cases", "simulate_runs", "stopping_points", "speed_key"]
 
 
 def speed_key(s: float) -> str:
@@ -51,6 +51,7 @@ class StopAccuracyResult:
     refinement: tuple = ()                          # RefinementRow of claims on errors
     traces: dict = field(default_factory=dict, repr=False)  # (speed, ctl) -> (x - D, v)
     grid: dict = field(default_factory=dict)        # (speed, controller) -> errors per corner
+    sections: dict = field(default_factory=dict)    # (section index, controller) -> CellStats
 
     JSON_FIELDS = {"distance": lambda r: {speed_key(s): d for s, d in r.distance.items()},
                    "nominal": lambda r: {f"{speed_key(s)}.{c}": e
@@ -258,6 +259,36 @@ def montecarlo_draws(spec, mc) -> dict:
     return {k: v for k, v in d.items() if k in mc.distributions}
 
 
+def run_sections(spec, laws, dt: float) -> dict:
+    """{(section index, controller): CellStats}: every controller's repeats on
+    every section, in one batch (:func:`simulate_runs`; [[sections]], [repeats],
+    :mod:`.sections`)."""
+    from ...sim.stopping import batch_params
+    from .sections import batch_rates, cell_stats, draw_sections
+    rp = spec.sections
+    ns, R = len(rp.sections), rp.count
+    d = draw_sections(rp.seed, rp.ranges, ns, R)
+    idx = [j for j, c in enumerate(spec.controllers) if not rp.controllers
+           or c.name in rp.controllers]
+    nc = len(idx)
+    ci = np.repeat(idx, ns * R)
+    si = np.tile(np.repeat(np.arange(ns), R), nc)
+    ri = np.tile(np.arange(R), nc * ns)
+    n = ci.size
+    D = np.array([rp.sections[i].length for i in si])
+    base = spec.base()
+    over, theta, kappa = apply_factors(base, spec.factors, {k: v[si, ri] for k, v in d.items()},
+                                       n)
+    starts = [spec.reference.start(s.length) for s in rp.sections]
+    x0 = np.array([starts[i][0] for i in si])
+    v0 = np.array([starts[i][1] for i in si])
+    tr, _ = simulate_runs(spec, laws, dt, batch_params(base, n, over), ci, D, x0=x0, v0=v0,
+                          ratio=np.ones(n), theta=theta, kappa=kappa)
+    err_cm, rates = (tr.x_stop - D) * 100.0, batch_rates(tr, spec.dt_ctrl)
+    return {(s, c.name): cell_stats(err_cm, tr, (ci == j) & (si == s), rates)
+            for s in range(ns) for j, c in enumerate(spec.controllers) if j in idx}
+
+
 def run(spec, claims=()) -> StopAccuracyResult:
     """Compute a design (see the module docstring)."""
     laws = compile_laws(spec)
@@ -285,6 +316,9 @@ def run(spec, claims=()) -> StopAccuracyResult:
         N = len(corners)
         grid = {(s, spec.controllers[i].name): tuple(float(e) for e in err[j * N:(j + 1) * N])
                 for j, (s, i, _, _) in enumerate(cases)}
+    sections = {}
+    if spec.sections is not None:
+        sections = run_sections(spec, laws, spec.dt)
     levels, checks, rows = {}, {}, ()
     if spec.convergence:
         from ...refinement import refinement_row
@@ -296,4 +330,5 @@ def run(spec, claims=()) -> StopAccuracyResult:
         rows = tuple(refinement_row(c, levels[c.quantity], "dt", levels[c.quantity][0])
                      for c in claims if c.quantity in levels
                      and math.isfinite(levels[c.quantity][0]))
-    return StopAccuracyResult(spec, D, nominal, faults, mc, levels, checks, rows, traces, grid)
+    return StopAccuracyResult(spec, D, nominal, faults, mc, levels, checks, rows, traces, grid,
+                              sections)

@@ -6,12 +6,14 @@ section and controller).
 
 Tables::
 
-    [[sections]]   name, length = { value, unit = "m" }, source
+    [[sections]]   name, length = { value, unit = "m", source }
     [repeats]      count, seed, ranges = { factor = [lo, hi] } (factors of
                    [disturbances]; drawn in the order written, one stream per
-                   section: numpy SeedSequence(seed).spawn(sections))
+                   section: numpy SeedSequence(seed).spawn(sections)),
+                   controllers = ["name", ...] (optional: those that repeat; all)
 
-Each repeat starts where the target of its section starts braking. Statistics
+Each repeat starts where the target of its section starts braking
+(:func:`.run.run_sections` runs them). Statistics
 per (section, controller), :class:`CellStats`: mean, variance (ddof 1) and
 largest |error| in cm, the jerk |da/dt| and command rate |dc/dt| while moving
 (m/s^3, recorded every control period), the mean time to standstill (s).
@@ -26,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CellStats", "Repeats", "Section", "batch_rates", "cell_stats", "draw_sections", "read_sections",
-           "run_sections"]
+__all__ = ["CellStats", "Repeats", "Section", "batch_rates", "cell_stats", "draw_sections",
+           "read_sections"]
 
 
 @dataclass(frozen=True)
@@ -45,6 +47,7 @@ class Repeats:
     count: int
     seed: int
     ranges: tuple            # ((factor, lo, hi), ...) in draw order
+    controllers: tuple = ()  # names of the controllers that repeat (all: ())
 
 
 @dataclass(frozen=True)
@@ -62,7 +65,7 @@ class CellStats:
     errors: tuple[float, ...]
 
 
-def read_sections(root, factors, reference) -> Repeats | None:
+def read_sections(root, factors, reference, controllers=()) -> Repeats | None:
     """``[[sections]]`` with ``[repeats]`` (both or neither; a [reference] needed)."""
     if not root.has("sections") and not root.has("repeats"):
         return None
@@ -72,14 +75,20 @@ def read_sections(root, factors, reference) -> Repeats | None:
                         "is a stop-to-stop run of the target)")
     out = []
     for t in root.tables("sections"):
-        out.append(Section(t.string("name"), t.quantity("length", "m", positive=True,
-                                                         hi=1e5).value, t.string("source")))
+        q = t.quantity("length", "m", positive=True, hi=1e5)
+        out.append(Section(t.string("name"), q.value, q.source))
         t.finish()
     if not out or len(out) > 100:
         raise root.fail("sections", len(out), "1 to 100 sections")
     rp = root.table("repeats")
     count = int(rp.number("count", integer=True, lo=2, hi=10000, what="repeats per section"))
     seed = int(rp.number("seed", integer=True, lo=0, what="seed"))
+    names = [c.name for c in controllers]
+    which = tuple(rp.raw("controllers", names))
+    if (not isinstance(rp.raw("controllers", names), list) or not which
+            or any(c not in names for c in which) or len(set(which)) < len(which)):
+        raise rp.fail("controllers", rp.raw("controllers"), "names of [[controllers]] ("
+                      + ", ".join(names) + "), each once")
     rt, ranges = rp.table("ranges"), []
     known = {f.name: f for f in factors}
     for k in list(rt.data):
@@ -96,7 +105,8 @@ def read_sections(root, factors, reference) -> Repeats | None:
         raise root.fail("repeats.ranges", {}, "at least one factor")
     if len(out) * count > 20000:
         raise root.fail("repeats.count", count, "at most 20000 repeats in all (sections x count)")
-    return Repeats(tuple(out), count, seed, tuple(ranges))
+    return Repeats(tuple(out), count, seed, tuple(ranges),
+                   () if len(which) == len(names) else which)
 
 
 def draw_sections(seed: int, ranges, n_sections: int, count: int) -> dict:
@@ -129,30 +139,3 @@ def cell_stats(err_cm, tr, m, rates) -> CellStats:
                      float(np.mean(tr.t_stop[m])),
                      float(np.nanmean(np.where(moving[:, m], crate[:, m], np.nan))),
                      tuple(float(x) for x in e))
-
-
-def run_sections(spec, laws, dt: float) -> dict:
-    """{(section index, controller): CellStats}: every controller's repeats on
-    every section, in one batch (:func:`.run.simulate_runs`)."""
-    from ...sim.stopping import batch_params
-    from .pipeline import apply_factors
-    from .run import simulate_runs
-    rp, nc = spec.sections, len(spec.controllers)
-    ns, R = len(rp.sections), rp.count
-    d = draw_sections(rp.seed, rp.ranges, ns, R)
-    ci = np.repeat(np.arange(nc), ns * R)
-    si = np.tile(np.repeat(np.arange(ns), R), nc)
-    ri = np.tile(np.arange(R), nc * ns)
-    n = ci.size
-    D = np.array([rp.sections[i].length for i in si])
-    base = spec.base()
-    over, theta, kappa = apply_factors(base, spec.factors, {k: v[si, ri] for k, v in d.items()},
-                                       n)
-    starts = [spec.reference.start(s.length) for s in rp.sections]
-    x0 = np.array([starts[i][0] for i in si])
-    v0 = np.array([starts[i][1] for i in si])
-    tr, _ = simulate_runs(spec, laws, dt, batch_params(base, n, over), ci, D, x0=x0, v0=v0,
-                          ratio=np.ones(n), theta=theta, kappa=kappa)
-    err_cm, rates = (tr.x_stop - D) * 100.0, batch_rates(tr, spec.dt_ctrl)
-    return {(s, c.name): cell_stats(err_cm, tr, (ci == j) & (si == s), rates)
-            for s in range(ns) for j, c in enumerate(spec.controllers)}
