@@ -15,11 +15,11 @@ import numpy as np
 
 from ...features.montecarlo import StopStatistics, draw, stop_statistics
 from ...kinds.stop_accuracy.pipeline import apply_factors
-from ...kinds.stop_accuracy.sections import batch_rates, cell_stats, draw_sections
+from ...kinds.stop_accuracy.sections import Section, batch_rates, cell_stats, draw_sections
 from ...sim.stopping import TargetCurve, batch_params
 from ...tuning.pid import Damping, damping, speed_loop
 from .station_stopping_spec import (ABLATION, CONTROLLERS, DAMPING, FACTORS, MC_CONTROLLERS,
-                                    MC_FACTORS, NOMINAL, UNCERTAIN, VARIANTS, Section, StopSpec)
+                                    MC_FACTORS, NOMINAL, UNCERTAIN, VARIANTS, StopSpec)
 
 #: Speed errors below this (m/s; 0.18 km/h, below a speedometer's resolution) do not
 #: count as a sign change (oscillation count).
