@@ -122,6 +122,7 @@ BAD = [
     ('lag        = [0.8, 1.2]', 'lag        = [0.0, 1.2]', "above 0"),
     ('controllers = ["pid", "smc", "smarc"]', 'controllers = ["pid", "pid"]', "each once"),
     ('count = 10', 'count = 1', "repeats per section"),
+    ('count = 10', 'count = 2000', "at most 20000 runs"),
     ('length = { value = 1544.0, unit = "m"', 'length = { value = 1544.0, unit = "km"', '"m"'),
     ('[repeats]\n', '[repeat]\n', "repeats.count"),
 ]

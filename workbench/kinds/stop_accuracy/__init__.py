@@ -405,6 +405,13 @@ class StopAccuracy:
         if mc is not None and mc.samples * len(speeds) * len(controllers) * t_end / dt > MAX_WORK:
             raise root.fail("montecarlo.samples", mc.samples, f"at most {MAX_WORK:g} runs x "
                             "steps (a Monte Carlo of hours is a study, not a check)")
+        if sections is not None:
+            runs = len(sections.sections) * sections.count * len(
+                sections.controllers or controllers)
+            if runs > MAX_RUNS or runs * t_end / dt > MAX_WORK:
+                raise root.fail("repeats.count", sections.count, f"at most {MAX_RUNS} runs and "
+                                f"{MAX_WORK:g} runs x steps (sections x count x controllers = "
+                                f"{runs})")
         _check_units(root.path, constants, controllers, law_names)
         return StopAccuracySpec(root.path, params, tuple(speeds), tol, c_max,
                                 None if dist is None else dist.value,
