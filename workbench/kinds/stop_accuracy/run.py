@@ -11,6 +11,8 @@ refinement.
   Wilson 95 % interval, 95th percentile of |error|, mean, overshoot share);
 * ``[grid]``: every corner of the error grid per (speed, controller), in one
   batch (itertools.product of the factors' values, in the order written);
+* ``[[sections]]`` with ``[repeats]``: every repeating controller's stops on
+  every section, in one batch (:func:`run_sections`, :mod:`.sections`);
 * ``[convergence]``: the nominal and fault batch again at dt/2 and dt/4, every
   stop error through :func:`workbench.sim.convergence.refinement_check`, and
   every claim on one through :func:`workbench.refinement.refinement_row`
@@ -111,8 +113,9 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
 def simulate_cases(spec, laws, dt, cases, draws=None, dt_rec=None):
     """Simulate ``cases`` [(speed km/h, controller index, fault or None, D m)],
     each repeated over the Monte Carlo ``draws`` (factor -> array) when given,
-    recorded every ``dt_rec`` (default dt_ctrl), in one batch (every operation is elementwise over runs: a run's result
-    does not depend on the others in its batch).
+    recorded every ``dt_rec`` (default dt_ctrl), in one batch (every operation
+    is elementwise over runs: a run's result does not depend on the others in
+    its batch).
 
     Returns
     -------
@@ -225,8 +228,8 @@ def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa, axl
         return track.finish(c, o)
 
     tr = simulate(p, policy, n=n, t_end=spec.t_end, dt=dt, dt_ctrl=spec.dt_ctrl,
-                  dt_rec=spec.dt_ctrl if dt_rec is None else dt_rec, x0=x0, v0=v0, theta=theta, kappa=kappa,
-                  c_min=spec.c_min, c_max=spec.c_max)
+                  dt_rec=spec.dt_ctrl if dt_rec is None else dt_rec, x0=x0, v0=v0, theta=theta,
+                  kappa=kappa, c_min=spec.c_min, c_max=spec.c_max)
     return tr, track
 
 
