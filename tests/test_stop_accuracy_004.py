@@ -49,6 +49,11 @@ def test_closed_loop_reproduces_closed_loop_brake_bit_for_bit(both):
         ref = [e for _, e in grid.select(mode="closed", channel=channel, fault="healthy",
                                          electric=True)]
         assert res.grid[50.0, name] == tuple(ref)                   # corner by corner
+    from workbench.kinds.stop_accuracy.quantities import feasible
+    sel = [k for k, r in enumerate(grid.runs) if r.mode == "closed" and r.channel == "analogue"
+           and r.fault == "healthy" and r.electric]
+    assert feasible(res, 50.0) == [grid.feasible[k] for k in sel]    # [grid] feasible_with
+    assert 0 < sum(feasible(res, 50.0)) < len(sel)
     ref = mc[50.0, "closed"]
     np.testing.assert_array_equal(res.mc[50.0, "closed"].errors, ref.errors)   # draw by draw
     nominal = dict(speed_kmh=50.0, mode="closed", channel="analogue", force_error=0.0,
@@ -89,6 +94,7 @@ BAD = [
     ('slide      = { value = 0.2,', 'slide      = { value = 1.5,', "slide_ratio"),
     ('levels = 7', 'levels = 2.5', "levels"),
     ('levels = 7', 'levels = 0', "levels"),
+    ('feasible_with = "full_service"', 'feasible_with = "full"', "feasible_with"),
     ('axles = 4 }\n\n[[controllers]]', 'axles = 4 }\npid = { error = "d_go", kp = "kp", '
      'ki = "kp", kd = "kp" }\n\n[[controllers]]', "no pid"),
 ]

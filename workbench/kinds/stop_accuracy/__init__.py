@@ -43,7 +43,9 @@ Tables::
                    the law sees / the true speed), disturbance = { factor = value },
                    axles = "fffo" (the axle sensors' states, with a deceleration_loop)
     [grid]         factor = [values, ...]  (every combination, in the order written: the
-                   corners of an error grid, as paper 004 section 1.3)
+                   corners of an error grid, as paper 004 section 1.3), feasible_with =
+                   "controller" (optional: a corner is feasible where that controller, e.g.
+                   full service held, stops at least the tolerance short of D)
     [[sections]]   name, length = { value, unit = "m", source }, with [repeats] count, seed, ranges = { factor
                    = [lo, hi] } (with [reference]: every controller's repeats on every
                    section, paper 000 Tables 3-4; :mod:`.sections`)
@@ -131,6 +133,7 @@ class StopAccuracySpec:
     compensation: object = None    # modules.Compensation ([compensation])
     c_min: float = 0.0             # m/s^2: -traction_max (the law may call for traction)
     sections: object = None        # sections.Repeats ([[sections]], [repeats])
+    grid_feasible: str | None = None   # [grid] feasible_with: the controller that decides
 
     def base(self) -> dict:
         return {k: q.value for k, q in self.params.items()}
@@ -282,11 +285,15 @@ def _faults(root: Reader, params: dict, factors, controllers=()) -> tuple[Fault,
     return tuple(out)
 
 
-def _grid(root: Reader, factors) -> tuple:
+def _grid(root: Reader, factors, controllers=()) -> tuple:
+    """((factor, values), ...) of ``[grid]`` and its ``feasible_with`` (or None)."""
     if not root.has("grid"):
-        return ()
+        return (), None
     t, out, corners = root.table("grid"), [], 1
+    feasible = t.string("feasible_with", default=None, choices=[c.name for c in controllers])
     for k in list(t.data):
+        if k == "feasible_with":
+            continue
         if k not in {f.name for f in factors}:
             raise t.fail(k, t.data[k], "a factor of [disturbances]")
         positive = next(f.positive for f in factors if f.name == k)
@@ -299,7 +306,7 @@ def _grid(root: Reader, factors) -> tuple:
     t.finish()
     if not out or corners > 10000:
         raise root.fail("grid", {k: list(v) for k, v in out}, "1 to 10000 corners")
-    return tuple(out)
+    return tuple(out), feasible
 
 
 def _check_units(path: str, constants: dict, controllers, law_names=LAW_NAMES) -> None:
@@ -388,7 +395,7 @@ class StopAccuracy:
             if work > MAX_RUNS:
                 raise root.fail("montecarlo.samples", mc.samples, f"at most {MAX_RUNS} runs in "
                                 f"all (samples x speeds x controllers = {work})")
-        grid = _grid(root, factors)
+        grid, feasible = _grid(root, factors, controllers)
         convergence = root.has("convergence")
         if convergence:
             root.table("convergence").finish()
@@ -418,7 +425,8 @@ class StopAccuracy:
                                 None if cmd is None else cmd.value, constants, controllers,
                                 factors, faults, dt, dt_ctrl, t_end, mc, convergence, grid,
                                 reference, compensation,
-                                0.0 if traction is None else -traction.value, sections)
+                                0.0 if traction is None else -traction.value, sections,
+                                feasible)
 
     def quantity_names(self, spec: StopAccuracySpec) -> set[str]:
         from ...features.quantities import names

@@ -10,6 +10,9 @@ Per speed ``v<s>`` (km/h, e.g. ``v50``) and controller ``c``::
     v<s>.<c>.grid.max_abs_m               with [grid]: largest |error| over the corners (m)
     v<s>.<c>.grid.failing_corners         ... corners outside the tolerance (a run without
                                           a stop counts)
+    v<s>.<c>.grid.feasible_max_abs_m      with [grid] feasible_with: largest |error| over the
+                                          feasible corners (m)
+    v<s>.<c>.grid.failing_feasible_corners ... feasible corners outside the tolerance
     v<s>.<c>.mc.<stat>                    with [montecarlo]: p_within, within_lo, within_hi
                                           (Wilson 95 %), p95_abs_m, mean_m, overshoot_share
     v<s>.<c>.convergence.estimate_m       with [convergence]: Richardson error estimate of
@@ -36,7 +39,7 @@ from ...features.montecarlo import MC_QUANTITIES
 from ...features.quantities import Declared
 from .run import speed_key
 
-__all__ = ["TABLE"]
+__all__ = ["TABLE", "feasible"]
 
 _MC_UNITS = {"p_within": "1", "within_lo": "1", "within_hi": "1", "p95_abs_m": "m",
              "mean_m": "m", "overshoot_share": "1"}
@@ -68,6 +71,24 @@ def _grid(spec):
 def _grid_max(r, s, speed, c):
     e = [abs(x) for x in r.grid[speed, c]]
     return max(e) if all(math.isfinite(x) for x in e) else None
+
+
+def _feasible_grid(spec):
+    return _cases(spec) if spec.grid and spec.grid_feasible else []
+
+
+def feasible(r, speed) -> list:
+    """Per corner of the grid: ``feasible_with`` stops at least the tolerance short."""
+    return [e <= -r.spec.tolerance for e in r.grid[speed, r.spec.grid_feasible]]
+
+
+def _feasible_errors(r, speed, c):
+    return [x for x, ok in zip(r.grid[speed, c], feasible(r, speed)) if ok]
+
+
+def _feasible_max(r, s, speed, c):
+    e = [abs(x) for x in _feasible_errors(r, speed, c)]
+    return max(e) if e and all(math.isfinite(x) for x in e) else None
 
 
 def _conv(spec):
@@ -119,6 +140,10 @@ TABLE = (
     Declared("{s}.{c}.grid.max_abs_m", "m", _grid_max, over=_grid),
     Declared("{s}.{c}.grid.failing_corners", "1", lambda r, s, speed, c: float(sum(
         not abs(x) <= r.spec.tolerance for x in r.grid[speed, c])), over=_grid),
+    Declared("{s}.{c}.grid.feasible_max_abs_m", "m", _feasible_max, over=_feasible_grid),
+    Declared("{s}.{c}.grid.failing_feasible_corners", "1", lambda r, s, speed, c: float(sum(
+        not abs(x) <= r.spec.tolerance for x in _feasible_errors(r, speed, c))),
+        over=_feasible_grid),
     Declared("{s}.{c}.convergence.estimate_m", "m", _estimate, over=_conv),
     *(Declared("sections[{k}].{c}." + name, unit,
                lambda r, k, i, c, a=attr: getattr(r.sections[i, c], a), over=_sec_cells)

@@ -141,18 +141,27 @@ def _grid(spec, res) -> str:
     n = 1
     for _, v in spec.grid:
         n *= len(v)
-    rows = []
+    from .quantities import feasible
+    rows, fw = [], spec.grid_feasible
     for s in spec.speeds_kmh:
+        ok = feasible(res, s) if fw else None
         for c in spec.controllers:
             e = res.grid[s, c.name]
             worst = max(abs(x) for x in e) if all(x == x for x in e) else None
             rows.append([fmt(s), f"`{c.name}`", "no stop" if worst is None else f"{worst:.3f}",
-                         f"{sum(not abs(x) <= spec.tolerance for x in e)} of {n}"])
+                         f"{sum(not abs(x) <= spec.tolerance for x in e)} of {n}"] + (
+                [f"{sum(f and not abs(x) <= spec.tolerance for x, f in zip(e, ok))} of "
+                 f"{sum(ok)}"] if fw else []))
     axes = " × ".join(f"{k} {list(v)}" for k, v in spec.grid)
+    note = (f" A corner is *feasible* where `{fw}` stops at least {fmt(spec.tolerance)} m short "
+            "of D (`[grid] feasible_with`): elsewhere no controller of this brake can stop at "
+            "D." if fw else "")
     return ("## Error grid\n\n"
-            f"Every corner of {axes} ({n} corners) per speed and controller.\n\n"
+            f"Every corner of {axes} ({n} corners) per speed and controller.{note}\n\n"
             + md_table(["speed (km/h)", "controller", "max |error| (m)",
-                        f"outside ±{fmt(spec.tolerance)} m"], rows, "rlrr"))
+                        f"outside ±{fmt(spec.tolerance)} m"] + (
+                            ["feasible outside"] if fw else []), rows, "rlrr" + ("r" if fw
+                                                                              else "")))
 
 
 def _montecarlo(spec, res) -> str:
