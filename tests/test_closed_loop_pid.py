@@ -1,15 +1,15 @@
-"""Paper 004: the closed-loop runs' PIDs stepped as one batch equal one PID per run."""
+"""Paper 004: the deceleration loops' PIDs stepped as one batch (MaskedBatchPID) equal one PID per run."""
 import numpy as np
 
 from workbench.controllers.pid import PID
-from workbench.papers.p004.closed_loop_brake_run import _ClosedPID
+from workbench.controllers.pid import MaskedBatchPID
 
 
 def test_batched_pids_equal_one_pid_per_run_bit_for_bit():
     rng = np.random.default_rng(3)
     n, gains, dt = 9, {"kp": 0.7, "ki": 0.35, "kd": 0.05}, 0.1
     closed = rng.uniform(size=n) > 0.3
-    batch = _ClosedPID(gains, dt, closed)
+    batch = MaskedBatchPID(gains, dt, closed)
     pids = [PID(**gains, dt=dt) for _ in range(n)]
     in_pid = np.zeros(n, bool)
     for _ in range(60):

@@ -154,6 +154,8 @@ BAD = [
     ('[convergence]', '[grid]\ngradient = [1.0, 1.0]\n\n[convergence]', "distinct"),
     ('[convergence]', '[grid]\nmass_ratio = [0.0, 1.0]\n\n[convergence]', "above 0"),
     ('effect = "mass_ratio"', 'effect = "force_error"', None),            # fine alone
+    ('[convergence]', '[[sections]]\nname = "a"\nlength = { value = 100.0, unit = "m", '
+     'source = "x" }\n\n[convergence]', "with a [reference]"),         # sections: a tracking law
 ]
 
 

@@ -42,7 +42,8 @@ def test_line5_configuration_is_stopping_line5():
     N = 3
     # one batch: draw 0 at the nominal factors (x * 1.0 == x: the nominal plant), then N draws
     drawn = montecarlo_draws(spec, dataclasses.replace(spec.montecarlo, samples=N))
-    draws = {f.name: np.concatenate([[f.nominal], drawn[f.name]]) for f in spec.factors}
+    draws = {f.name: np.concatenate([[f.nominal], drawn[f.name]]) for f in spec.factors
+             if f.name in drawn}
     (speed,) = spec.speeds_kmh
     cases = [(speed, i, None, spec.distance) for i in range(len(spec.controllers))]
     tr, D = simulate_cases(spec, compile_laws(spec), spec.dt, cases, draws)
@@ -65,8 +66,36 @@ def test_line5_configuration_is_stopping_line5():
         mc = err[(rs["kind"] == "mc") & (rs["variant"] == v)]
         assert got[1:].tolist() == mc.tolist(), c
     assert mine[names.index("smarc"), 0] > 0.1 > abs(mine[names.index("smarc_comp"), 0])
-    res = run(dataclasses.replace(spec, montecarlo=None, controllers=spec.controllers[3:4]))
+    res = run(dataclasses.replace(spec, montecarlo=None, controllers=spec.controllers[3:4],
+                                  sections=None))
     assert res.nominal[speed, "smarc"] == mine[names.index("smarc"), 0]
+
+
+def test_line5_sections_are_stopping_line5_repeats():
+    """The kind's [[sections]] and [repeats] give stopping-line5's per-section
+    repeats (Tables 3-4) repeat by repeat, to the last bit (2 sections x 2
+    repeats; the whole 7 x 10 table: reports/stop-accuracy-000-line5.md
+    prints stopping-line5's 99.3, 149 and 28.7 cm). The error statistics are
+    the same arithmetic on the same errors (equal); the jerk is averaged over
+    each batch's records, whose length depends on the batch (to 1e-12)."""
+    from workbench.kinds.stop_accuracy.run import run_sections
+    from workbench.kinds.stop_accuracy.run import compile_laws
+    from workbench.papers.p000.station_stopping_run import run_station_stops
+    spec = load_design(LINE5).spec
+    rp = dataclasses.replace(spec.sections, sections=spec.sections.sections[:2], count=2)
+    spec = dataclasses.replace(spec, sections=rp)
+    mine = run_sections(spec, compile_laws(spec), spec.dt)
+    l5 = load_design(ROOT / "designs" / "stopping-line5.toml").spec
+    l5 = dataclasses.replace(l5, sections=l5.sections[:2], repeats=2)
+    ref = run_station_stops(l5, extras=False).stats
+    assert rp.controllers == ("pid", "smc", "smarc") and len(mine) == 2 * 3
+    for (i, c), got in mine.items():
+        want = ref[c, i]
+        assert got.errors == want.errors, (i, c)
+        assert (got.mean_abs, got.mean, got.var, got.max_abs) == (
+            want.mean_abs, want.mean, want.var, want.max_abs)
+        assert got.jerk_mean == pytest.approx(want.jerk_mean, rel=1e-12)
+        assert got.run_time == want.run_time
 
 
 def _bad(tmp_path, old: str, new: str) -> Path:
@@ -88,6 +117,14 @@ BAD = [
     ('gain_bounds = [0.5, 1.5]', 'gain_bounds = [1.2, 1.5]', "lo <= 1 <= hi"),
     ('compensation = { predictor = true, terminal = true }',
      'compensation = { predictor = "yes", terminal = true }', "predictor"),
+    ('air_gain   = [0.9, 1.1]', 'wind = [0.9, 1.1]', "a factor of [disturbances]"),
+    ('delay      = [0.8, 1.2]', 'delay      = [1.2, 0.8]', "lo <= hi"),
+    ('lag        = [0.8, 1.2]', 'lag        = [0.0, 1.2]', "above 0"),
+    ('controllers = ["pid", "smc", "smarc"]', 'controllers = ["pid", "pid"]', "each once"),
+    ('count = 10', 'count = 1', "repeats per section"),
+    ('count = 10', 'count = 2000', "at most 20000 runs"),
+    ('length = { value = 1544.0, unit = "m"', 'length = { value = 1544.0, unit = "km"', '"m"'),
+    ('[repeats]\n', '[repeat]\n', "repeats.count"),
 ]
 
 

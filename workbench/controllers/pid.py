@@ -99,3 +99,43 @@ class BatchPID:
         saturating = ((u_free > self.u_max) & (error > 0)) | ((u_free < self.u_min) & (error < 0))
         self.integral = np.where(saturating, self.integral, self.integral + error * self.dt)
         return u
+
+
+class MaskedBatchPID:
+    """:class:`PID` (no output limits) for a batch of loops that are restarted
+    and stepped only where masks say so: the arithmetic of ``PID.step``,
+    elementwise (paper 004's deceleration PID, which runs only while the error
+    is small and restarts at each switch from the fuzzy controller, section 2.5).
+
+    Parameters
+    ----------
+    gains : dict
+        ``kp``, ``ki``, ``kd`` (validated by :class:`PID`).
+    dt : float
+        Sampling period (s).
+    active : ndarray of bool
+        Loops that run at all (the others are never stepped).
+    """
+
+    def __init__(self, gains: dict, dt: float, active: np.ndarray):
+        ref = PID(**gains, dt=dt)     # validates; its limits are infinite (never saturates)
+        self.kp, self.ki, self.kd, self.dt = ref.kp, ref.ki, ref.kd, dt
+        self.active = active
+        n = len(active)
+        self.integral, self.prev, self.has_prev = np.zeros(n), np.zeros(n), np.zeros(n, bool)
+
+    def reset(self, where: np.ndarray) -> None:
+        """Restart the loops ``where`` (as :meth:`PID.reset`)."""
+        m = where & self.active
+        self.integral = np.where(m, 0.0, self.integral)
+        self.has_prev &= ~m
+
+    def step(self, where: np.ndarray, e: np.ndarray, base: np.ndarray) -> np.ndarray:
+        """``base`` plus the PID output where ``where`` (active loops only), else ``base``."""
+        m = where & self.active
+        deriv = np.where(self.has_prev, (e - self.prev) / self.dt, 0.0)
+        u = self.kp * e + self.ki * (self.integral + e * self.dt) + self.kd * deriv
+        self.prev = np.where(m, e, self.prev)
+        self.has_prev |= m
+        self.integral = np.where(m, self.integral + e * self.dt, self.integral)
+        return np.where(m, base + u, base)

@@ -25,7 +25,12 @@ Tables::
                    its output limited to ±c_max unless ``limited = false``),
                    or smarc = { c = "constant", ... } (the named module ``smarc``: the whole
                    law), compensation = { predictor = true, terminal = true,
-                   gain_correction = true } (optional, with [compensation]; :mod:`.modules`)
+                   gain_correction = true } (optional, with [compensation]; :mod:`.modules`),
+                   deceleration_loop = { e_switch = "constant", ..., axles = 4 } (optional:
+                   the named module closes a loop on the deceleration measured from the
+                   axle speeds, the law being its target; :mod:`.decel_loop`),
+                   levels = 7 (optional: a command channel of that many levels above 0,
+                   the command rounded to the nearest multiple of c_max / levels)
     [reference]    model = "ato-trapezoid", v_max, a_acc, a_dec (optional: the target a
                    tracking law follows; laws see x_d, v_d, a_d; runs start where it starts
                    braking, [target] has no speeds_kmh and distance is the section length)
@@ -35,9 +40,15 @@ Tables::
                    "gradient" } (permille) | { effect = "force_error" } | { effect = "mass_ratio" }
                    (the factors, in this order: a Monte Carlo draw's stream is its position)
     [[faults]]     name, parameters = { brake parameter = value }, speed_ratio (the speed
-                   the law sees / the true speed), disturbance = { factor = value }
+                   the law sees / the true speed), disturbance = { factor = value },
+                   axles = "fffo" (the axle sensors' states, with a deceleration_loop)
     [grid]         factor = [values, ...]  (every combination, in the order written: the
-                   corners of an error grid, as paper 004 section 1.3)
+                   corners of an error grid, as paper 004 section 1.3), feasible_with =
+                   "controller" (optional: a corner is feasible where that controller, e.g.
+                   full service held, stops at least the tolerance short of D)
+    [[sections]]   name, length = { value, unit = "m", source }, with [repeats] count, seed, ranges = { factor
+                   = [lo, hi] } (with [reference]: every controller's repeats on every
+                   section, paper 000 Tables 3-4; :mod:`.sections`)
     [montecarlo]   samples, seed, distributions = { factor = { dist = ... } }
                    (:mod:`workbench.features.montecarlo`)
     [convergence]  (no keys: every nominal and fault stop error at dt, dt/2, dt/4,
@@ -53,9 +64,10 @@ an integrator is the one named module a design may reference (``pid``: its
 gains are constants of the design, unit-checked as ``kp*error``,
 ``ki*error*t`` and ``kd*error/t`` in m/s^2; the PID output is limited to
 ±c_max with conditional integration, or unlimited). Paper 000's SMARC, the
-Smith predictor and the predictive terminal law are the other named modules
-(:mod:`.modules`, which says why each is not an expression). Paper 004's
-fuzzy/PID command generator on four axle sensors stays in its paper's module.
+Smith predictor and the predictive terminal law are named modules too
+(:mod:`.modules`, which says why each is not an expression), and so is paper
+004's fuzzy/PID command generator on the axle sensors (``deceleration_loop``,
+:mod:`.decel_loop`).
 """
 from __future__ import annotations
 
@@ -85,6 +97,8 @@ class Controller:
     terminal: bool = False                           # ... terminal = true
     gain_correction: bool = True                     # ... gain_correction = false: none
     pid_limited: bool = True                         # pid = { limited = false }: no limit
+    loop: object = None                              # decel_loop.LoopGains
+    levels: int = 0                                  # command channel levels (0: analogue)
 
 
 @dataclass(frozen=True)
@@ -93,6 +107,7 @@ class Fault:
     parameters: dict
     speed_ratio: float = 1.0
     disturbance: dict | None = None
+    axles: str | None = None       # axle-sensor states (module deceleration_loop)
 
 
 @dataclass(frozen=True)
@@ -117,6 +132,8 @@ class StopAccuracySpec:
     reference: object = None       # modules.Reference ([reference])
     compensation: object = None    # modules.Compensation ([compensation])
     c_min: float = 0.0             # m/s^2: -traction_max (the law may call for traction)
+    sections: object = None        # sections.Repeats ([[sections]], [repeats])
+    grid_feasible: str | None = None   # [grid] feasible_with: the controller that decides
 
     def base(self) -> dict:
         return {k: q.value for k, q in self.params.items()}
@@ -189,6 +206,16 @@ def _controllers(root: Reader, names: set, constants) -> tuple[Controller, ...]:
             raise t.fail("compensation", t.raw("compensation"), "a [compensation] table "
                          "(d_terminal, gain_tau, gain_bounds) for the predictor's model")
         pid = None
+        loop = None
+        if t.has("deceleration_loop"):
+            from .decel_loop import read_loop
+            if law is None or t.has("pid"):
+                raise t.fail("deceleration_loop", t.raw("deceleration_loop"), "a law (the "
+                             "target deceleration) and no pid (the loop has its own)")
+            loop = read_loop(t, constants)
+        levels = t.number("levels", default=None, integer=True, lo=1, hi=1024,
+                          what="count of command levels above 0")
+        levels = 0 if levels is None else int(levels)
         if t.has("pid"):
             pt = t.table("pid")
             err = pt.raw("error")
@@ -200,7 +227,8 @@ def _controllers(root: Reader, names: set, constants) -> tuple[Controller, ...]:
             pt.finish()
             pid = (err, *gains)
         t.finish()
-        out.append(Controller(name, law, tuple(defs), pid, smarc, *flags, limited))
+        out.append(Controller(name, law, tuple(defs), pid, smarc, *flags, limited, loop,
+                              levels))
     return tuple(out)
 
 
@@ -229,7 +257,7 @@ def _factors(root: Reader, params: dict) -> tuple[Factor, ...]:
     return tuple(out)
 
 
-def _faults(root: Reader, params: dict, factors) -> tuple[Fault, ...]:
+def _faults(root: Reader, params: dict, factors, controllers=()) -> tuple[Fault, ...]:
     out, seen = [], set()
     for t in root.tables("faults", default=[]):
         name = _name(t, "name", seen)
@@ -250,16 +278,22 @@ def _faults(root: Reader, params: dict, factors) -> tuple[Fault, ...]:
             dist[k] = dt.number(k, lo=-1e3, hi=1e3, positive=positive)
         dt.finish()
         ratio = t.number("speed_ratio", default=1.0, lo=0.0, hi=2.0)
+        from .decel_loop import read_axles
+        axles = read_axles(t, controllers)
         t.finish()
-        out.append(Fault(name, over, ratio, dist))
+        out.append(Fault(name, over, ratio, dist, axles))
     return tuple(out)
 
 
-def _grid(root: Reader, factors) -> tuple:
+def _grid(root: Reader, factors, controllers=()) -> tuple:
+    """((factor, values), ...) of ``[grid]`` and its ``feasible_with`` (or None)."""
     if not root.has("grid"):
-        return ()
+        return (), None
     t, out, corners = root.table("grid"), [], 1
+    feasible = t.string("feasible_with", default=None, choices=[c.name for c in controllers])
     for k in list(t.data):
+        if k == "feasible_with":
+            continue
         if k not in {f.name for f in factors}:
             raise t.fail(k, t.data[k], "a factor of [disturbances]")
         positive = next(f.positive for f in factors if f.name == k)
@@ -272,7 +306,7 @@ def _grid(root: Reader, factors) -> tuple:
     t.finish()
     if not out or corners > 10000:
         raise root.fail("grid", {k: list(v) for k, v in out}, "1 to 10000 corners")
-    return tuple(out)
+    return tuple(out), feasible
 
 
 def _check_units(path: str, constants: dict, controllers, law_names=LAW_NAMES) -> None:
@@ -348,7 +382,9 @@ class StopAccuracy:
         controllers = _controllers(root, set(law_names) | set(constants), constants)
         compensation = read_compensation(root)
         factors = _factors(root, params)
-        faults = _faults(root, params, factors)
+        faults = _faults(root, params, factors, controllers)
+        from .sections import read_sections
+        sections = read_sections(root, factors, reference, controllers)
         mc = None
         if root.has("montecarlo"):
             if not factors:
@@ -359,7 +395,7 @@ class StopAccuracy:
             if work > MAX_RUNS:
                 raise root.fail("montecarlo.samples", mc.samples, f"at most {MAX_RUNS} runs in "
                                 f"all (samples x speeds x controllers = {work})")
-        grid = _grid(root, factors)
+        grid, feasible = _grid(root, factors, controllers)
         convergence = root.has("convergence")
         if convergence:
             root.table("convergence").finish()
@@ -376,13 +412,21 @@ class StopAccuracy:
         if mc is not None and mc.samples * len(speeds) * len(controllers) * t_end / dt > MAX_WORK:
             raise root.fail("montecarlo.samples", mc.samples, f"at most {MAX_WORK:g} runs x "
                             "steps (a Monte Carlo of hours is a study, not a check)")
+        if sections is not None:
+            runs = len(sections.sections) * sections.count * len(
+                sections.controllers or controllers)
+            if runs > MAX_RUNS or runs * t_end / dt > MAX_WORK:
+                raise root.fail("repeats.count", sections.count, f"at most {MAX_RUNS} runs and "
+                                f"{MAX_WORK:g} runs x steps (sections x count x controllers = "
+                                f"{runs})")
         _check_units(root.path, constants, controllers, law_names)
         return StopAccuracySpec(root.path, params, tuple(speeds), tol, c_max,
                                 None if dist is None else dist.value,
                                 None if cmd is None else cmd.value, constants, controllers,
                                 factors, faults, dt, dt_ctrl, t_end, mc, convergence, grid,
                                 reference, compensation,
-                                0.0 if traction is None else -traction.value)
+                                0.0 if traction is None else -traction.value, sections,
+                                feasible)
 
     def quantity_names(self, spec: StopAccuracySpec) -> set[str]:
         from ...features.quantities import names

@@ -2,7 +2,9 @@
 stopping controller that are not expressions (issue 35, item 2).
 
 A law of the kind is an expression of the measured state (parsed, never
-evaluated, unit-checked). Four things are not, and are named here:
+evaluated, unit-checked). Five things are not, and are named here (the
+fifth, paper 004's command generator ``deceleration_loop``, in
+:mod:`.decel_loop`):
 
 ``pid``          (``[[controllers]] pid = {...}``, :mod:`.run`): an integrator
                  is internal state that an expression of the present cannot hold.
@@ -45,8 +47,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Compensation", "Reference", "SmarcGains", "Tracking", "read_compensation",
-           "read_reference", "read_smarc", "REFERENCE_NAMES", "SMARC_UNITS"]
+__all__ = ["Compensation", "Reference", "SmarcGains", "Tracking", "named_constants",
+           "read_compensation", "read_reference", "read_smarc", "REFERENCE_NAMES", "SMARC_UNITS"]
 
 #: Law names a [reference] adds: name -> unit.
 REFERENCE_NAMES = {"x_d": "m", "v_d": "m/s", "a_d": "m/s^2"}
@@ -133,18 +135,28 @@ def read_compensation(root):
     return out
 
 
+def named_constants(st, constants, units: dict) -> dict:
+    """key -> constant name of a module's table ``st``: every key of ``units``
+    names a constant of ``[constants]`` in that unit (pint, scale included)."""
+    from ..delay_feedback.units import parse_unit
+    if not constants:
+        raise st.fail(next(iter(units)), st.raw(next(iter(units)), None),
+                      "a constant of [constants] (none)")
+    names = {k: st.string(k, choices=sorted(constants)) for k in units}
+    for k, name in names.items():
+        q = constants[name]
+        a, b = parse_unit(q.unit, "", "").to_base_units(), parse_unit(units[k], "", "")
+        if not (a.dimensionality == b.dimensionality and a.magnitude == b.to_base_units().magnitude):
+            raise st.fail(k, name, f"a constant in {units[k]} (it is in {q.unit})")
+    return names
+
+
 def read_smarc(t, constants) -> SmarcGains:
     """A controller's ``smarc = { c = "const", ... }``: every gain of
     :data:`SMARC_UNITS` names a constant of that unit."""
-    from ..delay_feedback.units import parse_unit
     st = t.table("smarc")
-    names = {k: st.string(k, choices=sorted(constants)) for k in SMARC_UNITS}
+    names = named_constants(st, constants, SMARC_UNITS)
     st.finish()
-    for k, name in names.items():
-        q = constants[name]
-        a, b = parse_unit(q.unit, "", "").to_base_units(), parse_unit(SMARC_UNITS[k], "", "")
-        if not (a.dimensionality == b.dimensionality and a.magnitude == b.to_base_units().magnitude):
-            raise st.fail(k, name, f"a constant in {SMARC_UNITS[k]} (it is in {q.unit})")
     v = SmarcGains(names).values(constants)
     if not (v["c"] > 0 and v["k_s"] > 0 and v["eta"] >= 0 and v["phi"] >= 0 and v["lam"] > 0
             and 0 < v["theta_min"] < 1.0 < v["theta_max"]):

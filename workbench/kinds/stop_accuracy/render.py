@@ -25,11 +25,14 @@ def render(design, res) -> Rendered:
         sections.append(_grid(spec, res))
     if spec.montecarlo is not None:
         sections.append(_montecarlo(spec, res))
+    if spec.sections is not None:
+        sections.append(_sections(spec, res))
     if spec.convergence:
         sections.append(_convergence(spec, res))
     anchors = ((r"v[0-9.]+\.[A-Za-z0-9_]+\.mc\.", "Monte Carlo"),
                (r"v[0-9.]+\.[A-Za-z0-9_]+\.grid\.", "Error grid"),
                (r"v[0-9.]+\.[A-Za-z0-9_]+\.convergence\.", "Convergence"),
+               (r"sections[.\[]", "Sections"),
                (r"v[0-9.]+\.", "Stops"))
     return Rendered(tuple(sections), (), anchors)
 
@@ -59,12 +62,20 @@ def _problem(spec) -> str:
                                             else ""), f.what] for f in spec.factors]
         out += "\n\n" + md_table(["factor", "acts on", "what"], rows, "lll")
     if spec.faults:
+        axles = any(f.axles for f in spec.faults)
         rows = [[f"`{f.name}`", ", ".join(f"{k} = {fmt(v)}" for k, v in f.parameters.items())
                  or "—", fmt(f.speed_ratio), ", ".join(
                      f"{k} = {fmt(v)}" for k, v in (f.disturbance or {}).items()) or "—"]
-                for f in spec.faults]
+                + ([f.axles or "—"] if axles else []) for f in spec.faults]
         out += "\n\n" + md_table(["fault", "brake parameters", "speed read / true",
-                                  "disturbance"], rows, "llrl")
+                                  "disturbance"] + (["axles"] if axles else []), rows,
+                                 "llrl" + ("l" if axles else ""))
+        if axles:
+            out += ("\n\nAxle states (module `deceleration_loop`): o healthy, s sliding "
+                    "(reads slide_ratio × v), f failed (reads 0), h reads high_ratio × v, "
+                    "z stuck at its reading when braking started; the train speed is the "
+                    "maximum; where every axle is s or f the loop is off (the law alone). "
+                    "A controller without the module does not read the axles.")
     return out
 
 
@@ -79,6 +90,11 @@ def _law_text(c) -> str:
                                f" + PID(`{c.pid[0]}`; kp = {c.pid[1]}, ki = {c.pid[2]}, "
                                f"kd = {c.pid[3]}" + ("" if c.pid_limited else ", no limit")
                                + ")")
+    if c.loop is not None:
+        text += " as the target of the " + c.loop.text()
+    if c.levels:
+        text += (f"; command channel of {c.levels} levels above 0 (rounded to multiples of "
+                 f"c_max / {c.levels})")
     mods = [m for m, on in (("predictor", c.predictor), ("terminal", c.terminal)) if on]
     if mods:
         text += " with modules " + " and ".join(f"`{m}`" for m in mods) + (
@@ -125,18 +141,27 @@ def _grid(spec, res) -> str:
     n = 1
     for _, v in spec.grid:
         n *= len(v)
-    rows = []
+    from .quantities import feasible
+    rows, fw = [], spec.grid_feasible
     for s in spec.speeds_kmh:
+        ok = feasible(res, s) if fw else None
         for c in spec.controllers:
             e = res.grid[s, c.name]
             worst = max(abs(x) for x in e) if all(x == x for x in e) else None
             rows.append([fmt(s), f"`{c.name}`", "no stop" if worst is None else f"{worst:.3f}",
-                         f"{sum(not abs(x) <= spec.tolerance for x in e)} of {n}"])
+                         f"{sum(not abs(x) <= spec.tolerance for x in e)} of {n}"] + (
+                [f"{sum(f and not abs(x) <= spec.tolerance for x, f in zip(e, ok))} of "
+                 f"{sum(ok)}"] if fw else []))
     axes = " × ".join(f"{k} {list(v)}" for k, v in spec.grid)
+    note = (f" A corner is *feasible* where `{fw}` stops at least {fmt(spec.tolerance)} m short "
+            "of D (`[grid] feasible_with`): elsewhere no controller of this brake can stop at "
+            "D." if fw else "")
     return ("## Error grid\n\n"
-            f"Every corner of {axes} ({n} corners) per speed and controller.\n\n"
+            f"Every corner of {axes} ({n} corners) per speed and controller.{note}\n\n"
             + md_table(["speed (km/h)", "controller", "max |error| (m)",
-                        f"outside ±{fmt(spec.tolerance)} m"], rows, "rlrr"))
+                        f"outside ±{fmt(spec.tolerance)} m"] + (
+                            ["feasible outside"] if fw else []), rows, "rlrr" + ("r" if fw
+                                                                              else "")))
 
 
 def _montecarlo(spec, res) -> str:
@@ -156,6 +181,34 @@ def _montecarlo(spec, res) -> str:
             + md_table(["speed (km/h)", "controller", f"within ±{fmt(spec.tolerance)} m",
                         "Wilson 95 %", "p95 |error| (m)", "mean (m)", "overshoot share"],
                        rows, "rlrrrrr"))
+
+
+def design_quantities(spec, res) -> dict:
+    from ...features.quantities import values
+    from .quantities import TABLE
+    return values(TABLE, spec, res)
+
+
+def _sections(spec, res) -> str:
+    rp = spec.sections
+    ctl = [c.name for c in spec.controllers if not rp.controllers or c.name in rp.controllers]
+    rows = []
+    for i, sec in enumerate(rp.sections):
+        cells = [res.sections[i, c] for c in ctl]
+        rows.append([str(i + 1), sec.name, fmt(sec.length, 6)] + [
+            f"{fmt(x.mean_abs, 3)} / {fmt(x.mean, 3)} / {fmt(x.var, 3)}" for x in cells])
+    q = design_quantities(spec, res)
+    rows.append(["all", "mean over the sections", "—"] + [
+        f"**{fmt(q[f'sections.{c}.mean_abs_cm'], 3)}**" for c in ctl])
+    rng = ", ".join(f"`{k}` [{fmt(lo)}, {fmt(hi)}]" for k, lo, hi in rp.ranges)
+    return ("## Sections\n\n"
+            f"Every controller stops {rp.count} times at the end of each section (`[[sections]]`, "
+            f"`[repeats]`, seed {rp.seed}, one stream per section), starting where the target "
+            f"starts braking, on plants drawn uniformly: {rng}. Stop error (cm, + = overshoot) "
+            "over the repeats: mean |error| / signed mean / variance (cm²) "
+            "(`workbench/kinds/stop_accuracy/sections.py`).\n\n"
+            + md_table(["#", "section", "length (m)"] + [f"`{c}`" for c in ctl], rows,
+                       "rlr" + "r" * len(ctl)))
 
 
 def _convergence(spec, res) -> str:

@@ -11,6 +11,8 @@ refinement.
   Wilson 95 % interval, 95th percentile of |error|, mean, overshoot share);
 * ``[grid]``: every corner of the error grid per (speed, controller), in one
   batch (itertools.product of the factors' values, in the order written);
+* ``[[sections]]`` with ``[repeats]``: every repeating controller's stops on
+  every section, in one batch (:func:`run_sections`, :mod:`.sections`);
 * ``[convergence]``: the nominal and fault batch again at dt/2 and dt/4, every
   stop error through :func:`workbench.sim.convergence.refinement_check`, and
   every claim on one through :func:`workbench.refinement.refinement_row`
@@ -30,8 +32,8 @@ import numpy as np
 from ...jsonable import json_method
 from .pipeline import LAW_NAMES, apply_factors, group_statistics, open_loop_distance
 
-__all__ = ["StopAccuracyResult", "compile_laws", "montecarlo_draws", "run", "simulate_cases",
-           "simulate_runs", "stopping_points", "speed_key"]
+__all__ = ["StopAccuracyResult", "compile_laws", "montecarlo_draws", "run", "run_sections",
+           "simulate_cases", "simulate_runs", "stopping_points", "speed_key"]
 
 
 def speed_key(s: float) -> str:
@@ -51,6 +53,7 @@ class StopAccuracyResult:
     refinement: tuple = ()                          # RefinementRow of claims on errors
     traces: dict = field(default_factory=dict, repr=False)  # (speed, ctl) -> (x - D, v)
     grid: dict = field(default_factory=dict)        # (speed, controller) -> errors per corner
+    sections: dict = field(default_factory=dict)    # (section index, controller) -> CellStats
 
     JSON_FIELDS = {"distance": lambda r: {speed_key(s): d for s, d in r.distance.items()},
                    "nominal": lambda r: {f"{speed_key(s)}.{c}": e
@@ -107,11 +110,12 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
     return tr.x_stop - D, traces
 
 
-def simulate_cases(spec, laws, dt, cases, draws=None):
+def simulate_cases(spec, laws, dt, cases, draws=None, dt_rec=None):
     """Simulate ``cases`` [(speed km/h, controller index, fault or None, D m)],
     each repeated over the Monte Carlo ``draws`` (factor -> array) when given,
-    in one batch (every operation is elementwise over runs: a run's result
-    does not depend on the others in its batch).
+    recorded every ``dt_rec`` (default dt_ctrl), in one batch (every operation
+    is elementwise over runs: a run's result does not depend on the others in
+    its batch).
 
     Returns
     -------
@@ -142,17 +146,26 @@ def simulate_cases(spec, laws, dt, cases, draws=None):
     v0, x0 = rep(lambda c: c[0] / 3.6), 0.0
     if spec.reference is not None:    # start where the target starts braking
         x0, v0 = (rep(lambda c, k=k: spec.reference.start(c[3])[k]) for k in (0, 1))
+    axles = None
+    if any(c[2] is not None and c[2].axles for c in cases):
+        k = len(next(c[2].axles for c in cases if c[2] is not None and c[2].axles))
+        axles = np.repeat([list(c[2].axles if c[2] is not None and c[2].axles else "o" * k)
+                           for c in cases], N, axis=0)
     tr, _ = simulate_runs(spec, laws, dt, p, ctl, D, x0=x0, v0=v0, ratio=ratio, theta=theta,
-                          kappa=kappa)
+                          kappa=kappa, axles=axles, dt_rec=dt_rec)
     return tr, D
 
 
-def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa):
+def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa, axles=None,
+                  constants=None, dt_rec=None):
     """Simulate a batch of runs, each its own: brake parameters ``p``
     (:func:`workbench.sim.stopping.batch_params`), controller index ``ctl``,
     stopping point ``D`` (m), start ``x0`` (m), ``v0`` (m/s), speed-sensor
     ``ratio``, gradient ``theta`` and load-weighing gain ``kappa`` (arrays
-    over the runs, or scalars).
+    over the runs, or scalars); ``axles`` (shape (n, axles), states of
+    :data:`.decel_loop.AXLE_STATES`; default all healthy) for the module
+    ``deceleration_loop``, ``constants`` (name -> array over the runs) in place
+    of the design's values, ``dt_rec`` the recording period (default dt_ctrl).
 
     Returns
     -------
@@ -174,8 +187,17 @@ def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa):
             law, err, (kp, ki, kd) = law
             lim = spec.c_max if spec.controllers[i].pid_limited else np.inf
             pid = (err, BatchPID(kp, ki, kd, idx.size, dt=spec.dt_ctrl, u_min=-lim, u_max=lim))
-        groups.append((law, idx, pid, spec.controllers[i].name))
+        loop, c = None, spec.controllers[i]
+        if c.loop is not None:             # the named module ``deceleration_loop``
+            from .decel_loop import DecelerationLoop
+            st = (np.full((idx.size, c.loop.axles), "o") if axles is None else
+                  np.asarray(axles)[idx])
+            loop = DecelerationLoop(c.loop.values(spec.constants), st, spec.dt_ctrl,
+                                    spec.c_max)
+        groups.append((law, idx, pid, c.name, loop, c.levels))
     const = {k: np.full(n, q.value) for k, q in spec.constants.items()}
+    for k, x in (constants or {}).items():
+        const[k] = np.broadcast_to(np.asarray(x, float), (n,))
     names = _law_names(spec) + tuple(const)
     longest = max(float(p["T1"].max()), float(p["T3"].max()))
     if not longest <= spec.t_end:       # the delay line would outgrow the run (memory)
@@ -189,7 +211,7 @@ def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa):
                 "D": D, "v0": v0, "t": np.full(n, t)} | ref | const
         c = np.zeros(n)
         with np.errstate(all="ignore"):    # a law's nan (e.g. sqrt(-1)) is a run without a stop
-            for law, idx, pid, name in groups:
+            for law, idx, pid, name, loop, _ in groups:
                 if idx.size and law is None:
                     c[idx] = track.smarc_command(name, idx, vals["x"], vals["v"], ref)
                 elif idx.size:
@@ -197,11 +219,17 @@ def simulate_runs(spec, laws, dt, p, ctl, D, *, x0, v0, ratio, theta, kappa):
                     c[idx] = np.broadcast_to(law(*args), idx.shape)
                     if pid is not None:
                         c[idx] += pid[1].step(np.broadcast_to(pid[0](*args), idx.shape))
-        return track.finish(np.clip(c, spec.c_min, spec.c_max), o)
+                    if loop is not None:   # the law is the loop's target deceleration
+                        c[idx] = loop.command(c[idx], vals["v"][idx])
+        c = np.clip(c, spec.c_min, spec.c_max)
+        for _, idx, _, _, _, levels in groups:
+            if levels and idx.size:        # a channel of ``levels`` steps of c_max / levels
+                c[idx] = np.round(c[idx] / spec.c_max * levels) / levels * spec.c_max
+        return track.finish(c, o)
 
     tr = simulate(p, policy, n=n, t_end=spec.t_end, dt=dt, dt_ctrl=spec.dt_ctrl,
-                  dt_rec=spec.dt_ctrl, x0=x0, v0=v0, theta=theta, kappa=kappa,
-                  c_min=spec.c_min, c_max=spec.c_max)
+                  dt_rec=spec.dt_ctrl if dt_rec is None else dt_rec, x0=x0, v0=v0, theta=theta,
+                  kappa=kappa, c_min=spec.c_min, c_max=spec.c_max)
     return tr, track
 
 
@@ -234,6 +262,36 @@ def montecarlo_draws(spec, mc) -> dict:
     return {k: v for k, v in d.items() if k in mc.distributions}
 
 
+def run_sections(spec, laws, dt: float) -> dict:
+    """{(section index, controller): CellStats}: every controller's repeats on
+    every section, in one batch (:func:`simulate_runs`; [[sections]], [repeats],
+    :mod:`.sections`)."""
+    from ...sim.stopping import batch_params
+    from .sections import batch_rates, cell_stats, draw_sections
+    rp = spec.sections
+    ns, R = len(rp.sections), rp.count
+    d = draw_sections(rp.seed, rp.ranges, ns, R)
+    idx = [j for j, c in enumerate(spec.controllers) if not rp.controllers
+           or c.name in rp.controllers]
+    nc = len(idx)
+    ci = np.repeat(idx, ns * R)
+    si = np.tile(np.repeat(np.arange(ns), R), nc)
+    ri = np.tile(np.arange(R), nc * ns)
+    n = ci.size
+    D = np.array([rp.sections[i].length for i in si])
+    base = spec.base()
+    over, theta, kappa = apply_factors(base, spec.factors, {k: v[si, ri] for k, v in d.items()},
+                                       n)
+    starts = [spec.reference.start(s.length) for s in rp.sections]
+    x0 = np.array([starts[i][0] for i in si])
+    v0 = np.array([starts[i][1] for i in si])
+    tr, _ = simulate_runs(spec, laws, dt, batch_params(base, n, over), ci, D, x0=x0, v0=v0,
+                          ratio=np.ones(n), theta=theta, kappa=kappa)
+    err_cm, rates = (tr.x_stop - D) * 100.0, batch_rates(tr, spec.dt_ctrl)
+    return {(s, c.name): cell_stats(err_cm, tr, (ci == j) & (si == s), rates)
+            for s in range(ns) for j, c in enumerate(spec.controllers) if j in idx}
+
+
 def run(spec, claims=()) -> StopAccuracyResult:
     """Compute a design (see the module docstring)."""
     laws = compile_laws(spec)
@@ -261,6 +319,9 @@ def run(spec, claims=()) -> StopAccuracyResult:
         N = len(corners)
         grid = {(s, spec.controllers[i].name): tuple(float(e) for e in err[j * N:(j + 1) * N])
                 for j, (s, i, _, _) in enumerate(cases)}
+    sections = {}
+    if spec.sections is not None:
+        sections = run_sections(spec, laws, spec.dt)
     levels, checks, rows = {}, {}, ()
     if spec.convergence:
         from ...refinement import refinement_row
@@ -272,4 +333,5 @@ def run(spec, claims=()) -> StopAccuracyResult:
         rows = tuple(refinement_row(c, levels[c.quantity], "dt", levels[c.quantity][0])
                      for c in claims if c.quantity in levels
                      and math.isfinite(levels[c.quantity][0]))
-    return StopAccuracyResult(spec, D, nominal, faults, mc, levels, checks, rows, traces, grid)
+    return StopAccuracyResult(spec, D, nominal, faults, mc, levels, checks, rows, traces, grid,
+                              sections)

@@ -15,29 +15,15 @@ import numpy as np
 
 from ...features.montecarlo import StopStatistics, draw, stop_statistics
 from ...kinds.stop_accuracy.pipeline import apply_factors
+from ...kinds.stop_accuracy.sections import Section, batch_rates, cell_stats, draw_sections
 from ...sim.stopping import TargetCurve, batch_params
 from ...tuning.pid import Damping, damping, speed_loop
 from .station_stopping_spec import (ABLATION, CONTROLLERS, DAMPING, FACTORS, MC_CONTROLLERS,
-                                    MC_FACTORS, NOMINAL, UNCERTAIN, VARIANTS, Section, StopSpec)
+                                    MC_FACTORS, NOMINAL, UNCERTAIN, VARIANTS, StopSpec)
 
 #: Speed errors below this (m/s; 0.18 km/h, below a speedometer's resolution) do not
 #: count as a sign change (oscillation count).
 SIGN_DEADBAND = 0.05
-
-
-@dataclass(frozen=True)
-class CellStats:
-    """Stop statistics of one controller on one section (cm, cm^2, m/s^3, s)."""
-
-    mean_abs: float
-    mean: float
-    var: float
-    max_abs: float
-    jerk_mean: float
-    jerk_max: float
-    run_time: float
-    command_rate: float     # mean |dc/dt| of the brake command while moving (m/s^3)
-    errors: tuple[float, ...]
 
 
 @dataclass(frozen=True)
@@ -84,14 +70,10 @@ class StopResult:
 
 
 def draw_plants(spec: StopSpec, n_sections: int) -> dict:
-    """Uncertain factors per (section, repeat), seeded per section."""
-    seqs = np.random.SeedSequence(spec.seed).spawn(n_sections)
-    out = {k: np.empty((n_sections, spec.repeats)) for k in UNCERTAIN}
-    for i, sq in enumerate(seqs):
-        rng = np.random.default_rng(sq)
-        for k in UNCERTAIN:
-            out[k][i] = rng.uniform(*spec.ranges[k], spec.repeats)
-    return out
+    """Uncertain factors per (section, repeat), seeded per section (the kind's
+    :func:`~workbench.kinds.stop_accuracy.sections.draw_sections`)."""
+    return draw_sections(spec.seed, [(k, *spec.ranges[k]) for k in UNCERTAIN], n_sections,
+                         spec.repeats)
 
 
 def _runset(variants, kind, section, repeat, length, factors) -> dict:
@@ -266,24 +248,14 @@ def _collect(spec: StopSpec, blocks) -> StopResult:
 
 
 def _repeat_stats(spec, rs, tr, tc, tb, err, stats, example, planned) -> None:
-    err_cm = err * 100.0
-    jerk = np.abs(np.diff(tr.a, axis=0)) / spec.dt_ctrl
-    crate = np.abs(np.diff(tr.c, axis=0)) / spec.dt_ctrl
-    moving = tr.t[1:, None] <= tr.t_stop[None, :]
+    err_cm, rates = err * 100.0, batch_rates(tr, spec.dt_ctrl)
     rep = rs["kind"] == "rep"
     t_plan = tc.t_final - tb
     for s in np.unique(rs["section"][rep]):
         planned[int(s)] = float(t_plan[rep & (rs["section"] == s)][0])
         for name in CONTROLLERS:
             m = rep & (rs["variant"] == name) & (rs["section"] == s)
-            e = err_cm[m]
-            jm = np.where(moving[:, m], jerk[:, m], np.nan)
-            stats[name, int(s)] = CellStats(
-                float(np.mean(np.abs(e))), float(np.mean(e)), float(np.var(e, ddof=1)),
-                float(np.max(np.abs(e))), float(np.nanmean(jm)), float(np.nanmax(jm)),
-                float(np.mean(tr.t_stop[m])),
-                float(np.nanmean(np.where(moving[:, m], crate[:, m], np.nan))),
-                tuple(float(x) for x in e))
+            stats[name, int(s)] = cell_stats(err_cm, tr, m, rates)
             if int(s) == 0:
                 j = int(np.flatnonzero(m)[0])
                 one = TargetCurve.build(rs["length"][j:j + 1], v_max=spec.v_max.value,
@@ -293,5 +265,5 @@ def _repeat_stats(spec, rs, tr, tc, tb, err, stats, example, planned) -> None:
                                  xd - rs["length"][j], vd)
 
 
-__all__ = ["CellStats", "NominalRun", "StopResult", "draw_plants", "loop_dead_time",
+__all__ = ["NominalRun", "StopResult", "draw_plants", "loop_dead_time",
            "run_station_stops", "simulate_runs"]

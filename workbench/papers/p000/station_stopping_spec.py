@@ -39,6 +39,7 @@ from ...controllers.smc import SlidingGains
 from ...features.montecarlo import MonteCarloSpec, load_montecarlo
 from ...kinds.stop_accuracy.modules import Compensation   # [compensation]: the kind's modules
 from ...kinds.stop_accuracy.pipeline import Factor, read_brake_plant
+from ...kinds.stop_accuracy.sections import Section   # [[sections]]: the kind's
 from ...reader import Quantity, Reader
 
 #: Paper 000's three controllers, then SMARC with the discontinuous sgn of eq 22
@@ -135,13 +136,6 @@ ABLATION_LAWS = {
 #: PID variants whose linearised loop is analysed: with the dead time T1 (+ half a
 #: control period), or, behind the Smith predictor, half a control period only.
 DAMPING = ("pid", "pid-damped", "pid-comp")
-
-
-@dataclass(frozen=True)
-class Section:
-    name: str
-    length: float
-    source: str
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,7 @@ from ...features.montecarlo import MC_QUANTITIES, MonteCarloSpec, load_montecarl
 from ...kinds.stop_accuracy.pipeline import open_loop_distance, read_brake_plant
 from ...reader import Quantity, Reader
 from ...tuning.pid import Damping, damping, deceleration_loop
-from .closed_loop_brake_run import (CHANNELS, FAULTS, FULL, MC_FACTORS, MC_MODES, MODES,
+from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, FAULTS, FULL, MC_FACTORS, MC_MODES,
                                     run_horizon_sweep, run_montecarlo, simulate_brake)
 
 __all__ = ["STUDY", "Result004", "Run", "Spec004", "compute_worked", "decel_damping", "run_grid",
@@ -226,8 +226,7 @@ def stopping_point(spec: Spec004, v0: float) -> float:
                               dt=spec.dt, dt_ctrl=spec.dt_ctrl)
 
 
-def run_grid(spec: Spec004, *, debug: dict | None = None,
-             montecarlo: bool = True) -> Result004:
+def run_grid(spec: Spec004, *, montecarlo: bool = True) -> Result004:
     """The error grid, the sensor faults, the electric-brake loss; with
     ``montecarlo`` also the Monte Carlo and the horizon sweep."""
     runs = _cases(spec)
@@ -238,12 +237,11 @@ def run_grid(spec: Spec004, *, debug: dict | None = None,
     dist = arr(lambda r: D[r.speed_kmh])
     tr = simulate_brake(
         spec, v0=arr(lambda r: r.speed_kmh / 3.6), dist=dist,
-        mode=np.array([(*MODES, FULL).index(r.mode) for r in runs]),
-        bits=np.array([r.channel == "3bit" for r in runs]),
+        controller=np.array([list(CONTROLLERS).index((r.mode, r.channel)) for r in runs]),
         states=np.array([list(FAULTS[r.fault]) for r in runs]),
         overrides={"K1": base["K1"] * arr(lambda r: r.friction),
                    "v_ho": np.where(arr(lambda r: r.electric) > 0, base["v_ho"], 1e3)},
-        theta=arr(lambda r: r.gradient), kappa=1 + arr(lambda r: r.force_error), debug=debug)
+        theta=arr(lambda r: r.gradient), kappa=1 + arr(lambda r: r.force_error))
     err = tr.x_stop - dist
     full = {(r.speed_kmh, r.force_error, r.gradient, r.friction): e
             for r, e in zip(runs, err) if r.mode == FULL}
