@@ -46,7 +46,6 @@ from ...outcome import Outcome
 from ...plants.adhesion import NumericAdhesion, adhesion_model
 from ...plants.lambdify_cache import lambdify
 from ...roa import BasinEstimate, BasinProblem, estimate_basin, modal_P
-from ...roa.basin import falsified_top
 from ...roa.falsify import StagedFalsification
 from ...roa.check import BasinCheck, PointCheck, largest_level_in_box
 from ...roa.problem import quadratic_enclosure
@@ -300,10 +299,15 @@ def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
     for q in W_GRID:
         try:
             prob, c = _cruise_problem(vals, v_d, K, xs, q)
-            fal, c_top = falsified_top(prob, c, seed=seed)
-            if best is not None and not os.environ.get(EAGER_ENV) \
-                    and _score_bound(prob, c_top, xs) <= best[0]:
-                continue        # coarse pass: this P cannot be chosen (_score_bound)
+            stage = StagedFalsification(prob, c, seed=seed)
+            coarse = best is not None and not os.environ.get(EAGER_ENV)
+            # coarse pass: this P cannot be chosen (_score_bound, which grows
+            # with the level: c_top <= min(c, c_upper) before the optimiser)
+            if coarse and _score_bound(prob, min(c, stage.c_upper), xs) <= best[0]:
+                continue
+            fal = stage.finish()
+            if coarse and _score_bound(prob, min(c, fal.c_refuted), xs) <= best[0]:
+                continue
             est = estimate_basin(prob, c, seed=seed, falsified=fal)
         except ModelError:
             continue
