@@ -72,8 +72,9 @@ class ScalarSample:
             ev.t_diverged, ev.phase_diverged, ev.diverged_how = t, ph, 2.0
             self.phase = ph = DIVERGED
             u = fv = fl = 0.0
-        self.fv.push(fv, self._ticks)
-        self.fl.push(fl, self._ticks)
+        if s.compensate and s.predictor != "rollout":   # only eq (2) literal reads them
+            self.fv.push(fv, self._ticks)
+            self.fl.push(fl, self._ticks)
         self.uline.push(u, self._ticks)
         if self.recorder is not None:
             self.recorder(t, v_true, lam_true, ph, to_cruise, to_brake, to_stop, self._dt_prev)
