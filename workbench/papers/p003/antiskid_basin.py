@@ -123,8 +123,10 @@ def _loop_symbolic(values: tuple, v_d: float):
     return f, J, H, states, (k1, k2), lin, lam_d, plant.lambda_opt()
 
 
+@lru_cache(maxsize=8)
 def _loop(values: tuple, v_d: float, K: tuple):
-    """(f, derivatives, states, A_cl, lambda_d, lambda_opt) at the gain K."""
+    """(f, derivatives, states, A_cl, lambda_d, lambda_opt) at the gain K
+    (once per gain: the weights of the grid and the fate share it)."""
     f, J, H, states, ks, lin, lam_d, lam_opt = _loop_symbolic(values, v_d)
     rep = {ks[0]: sp.Float(float(K[0])), ks[1]: sp.Float(float(K[1]))}
     put = lambda e: e.xreplace(rep)
