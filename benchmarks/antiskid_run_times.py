@@ -11,7 +11,8 @@ parts timed by wrapping their functions (CPU seconds of this process):
   case at dt/4, ``AntiskidRun._cases``);
 * ``linear``, ``sampled``, ``basin``: the linear checks, the ``[sampled]``
   section (``sampled: Radau`` is its scipy check, included in ``sampled``),
-  the basin (cruise basin, k2 sweep, brake switch: ``run_basin``);
+  the basin (cruise basin, k2 sweep, brake switch: ``run_basin``; ``basin:
+  cruise`` and ``basin: k2 sweep`` are its first two, included in ``basin``);
 * ``montecarlo``: the sweep and its step-halving check, in the study's
   process pool (the CPU of the child processes);
 * ``refine``: the three-level refinement of the findings;
@@ -45,8 +46,10 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-PARTS = ("compile", "cases", "linear", "sampled", "sampled: Radau", "basin", "montecarlo",
-         "refine", "rest")
+PARTS = ("compile", "cases", "linear", "sampled", "sampled: Radau", "basin", "basin: cruise",
+         "basin: k2 sweep", "montecarlo", "refine", "rest")
+#: parts inside another part (shown, not added to the total)
+SUBPARTS = ("sampled: Radau", "basin: cruise", "basin: k2 sweep")
 
 
 def _cpu() -> float:
@@ -93,11 +96,13 @@ def worker(path: str) -> None:
     wrap(SA, "run_sampled", "sampled")
     wrap(SA, "radau_checks", "sampled: Radau")
     wrap(BR, "run_basin", "basin")
+    wrap(BR, "cruise_basin", "basin: cruise")
+    wrap(BR, "safe_k2_range", "basin: k2 sweep")
     evaluate_design(design)
     t = os.times()
     spent["montecarlo"] = t.children_user + t.children_system
     total = _cpu() - c_start + spent["montecarlo"]
-    spent["rest"] = total - sum(spent[p] for p in PARTS if p not in ("rest", "sampled: Radau"))
+    spent["rest"] = total - sum(spent[p] for p in PARTS if p != "rest" and p not in SUBPARTS)
     spent["total"] = total
     spent["wall"] = time.perf_counter() - w_start
     print(json.dumps(spent))

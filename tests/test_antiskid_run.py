@@ -150,3 +150,49 @@ def test_scalar_metrics_recorder_is_the_generic_one_bit_for_bit(spec, monkeypatc
         a, b = float(mf[k]), float(ms[k])
         assert (math.isnan(a) and math.isnan(b)) or a == b, k
     np.testing.assert_array_equal(fast[0].x, slow[0].x)
+
+
+@pytest.mark.parametrize("case_name", ["paper", "compensated", "uncompensated", "recursive"])
+def test_scalar_controller_and_plant_step_are_the_generic_ones_bit_for_bit(
+        spec, case_name, monkeypatch):
+    """The single-run paths of the controller (its sample, observer and
+    predictor rollout: :mod:`workbench.controllers.antiskid003_scalar`) and of
+    the plant step (``wheel_slip._scalar_plant_step``), which every case run
+    takes, against the generic bodies fed the same floats: every metric and
+    the recorded trajectory equal bit for bit, over traction, the cruise
+    switch (``paper``: it diverges there), braking and the stop, on the fixed
+    step and on the refined mesh (``uncompensated``) (issue 36, item 4)."""
+    from workbench.controllers.antiskid003 import Antiskid003 as C
+    from workbench.sim import wheel_slip as W
+    sc = {**spec.scenario, "t_brake": 40.0, "t_end": 140.0}
+    short = dataclasses.replace(spec, scenario=sc)
+    case = next(c for c in short.cases if c.name == case_name)
+    rs = S.run_settings(short, S.controller_settings(short, K_TABLE3, case))
+    mesh = S.case_mesh(short, case)
+    fast = simulate_antiskid(rs, 0.01, record_dt=0.05, mesh=mesh)
+    used = dict.fromkeys(("call", "observe", "rollout", "plant"), 0)
+
+    def counted(key, fn):
+        def run(*a):
+            used[key] += 1
+            return fn(*a)
+        return run
+    monkeypatch.setattr(C, "_call_scalar", counted("call", C._call_generic))
+    monkeypatch.setattr(C, "_observe_scalar", counted("observe", C._observe_generic))
+    monkeypatch.setattr(C, "_rollout_scalar", counted("rollout", C._rollout_generic))
+    monkeypatch.setattr(W, "_scalar_plant_step", counted("plant", lambda v, lam, u, dt, p, fns, vf, depth: W.stiff_step_flagged(
+        v, lam, u, dt, lambda vv, ll: W.plant_forms(W.ScalarOps.maximum(vv, vf), ll, p, fns,
+                                                     W.ScalarOps), W.ScalarOps, True, depth)))
+    slow = simulate_antiskid(rs, 0.01, record_dt=0.05, mesh=mesh)
+    assert used["call"] > 1000 and used["plant"] >= used["call"] - 1
+    assert used["rollout"] > 0 or not case.compensate or case.predictor != "rollout"
+    mf, ms = vars(fast[1]), vars(slow[1])
+    for k in mf:
+        a, b = float(mf[k]), float(ms[k])
+        assert (math.isnan(a) and math.isnan(b)) or a == b, k
+    for f in ("t", "x", "u", "u_applied", "phase"):
+        np.testing.assert_array_equal(getattr(fast[0], f), getattr(slow[0], f), err_msg=f)
+    if case_name == "compensated":
+        assert math.isfinite(mf["t_stop"]) and math.isfinite(mf["t_handover_done"])
+    if case_name == "paper":
+        assert math.isfinite(mf["t_diverged"])

@@ -54,6 +54,45 @@ def test_deferred_answers_are_the_full_estimate(deferred, switch):
     assert deferred.enters(inside) is bool(est.c_certified > 0)
 
 
+def test_first_stage_settles_the_refuted_switch(switch, monkeypatch):
+    """The printed switch is REFUTED on the falsifier's samples alone: its
+    optimiser (SLSQP) and the cover never run, and the answers equal the full
+    ones (issue 36, item 4)."""
+    from workbench.roa import falsify as F
+    monkeypatch.delenv(AB.EAGER_ENV, raising=False)
+    ran = []
+    monkeypatch.setattr(F, "minimize", lambda *a, **k: ran.append(1) or pytest.fail("SLSQP"))
+    d = AB._Deferred(VALS, 70.0, K, switch, 100.0, 0)
+    path = np.array([switch, (switch[0] * 2, switch[1] * 1.5)])
+    assert d.outcome(switch) is Outcome.REFUTED and d.enters(path) is False
+    assert d._stage._done is None and d._est is None and not ran
+    monkeypatch.undo()
+    fal = d.fal                                          # the optimiser now runs
+    assert fal.c_refuted <= d._stage.c_upper < np.inf
+    assert fal == falsified_top(d.prob, d._c, seed=0)[0]
+
+
+def test_staged_falsification_is_falsify():
+    """Both stages give falsify's result bit for bit, and the first stage's
+    bound holds, on the textbook problems of tests/test_roa.py and a problem
+    without any hit."""
+    import sympy as sp
+    from workbench.roa import BasinProblem
+    from workbench.roa.falsify import StagedFalsification, falsify
+    x, y = sp.symbols("x y", real=True)
+    probs = [BasinProblem([-x + x**3, -y], (x, y), (0.0, 0.0), np.eye(2)),
+             BasinProblem([-y, x - (1 - x**2) * y], (x, y), (0.0, 0.0), np.eye(2)),
+             BasinProblem([-x, -y], (x, y), (0.0, 0.0), np.eye(2))]
+    for prob, c in zip(probs, (4.0, 9.0, 1.0)):
+        for seed in (0, 3):
+            st = StagedFalsification(prob, c, seed=seed)
+            upper = st.c_upper
+            full = falsify(prob, c, seed=seed)
+            assert st.finish() == full and st.finish() is st.finish()
+            assert full.c_refuted <= upper and st.c_upper == full.c_refuted
+    assert falsify(probs[2], 1.0).c_refuted == np.inf
+
+
 def test_falsified_top_is_the_estimates_falsifier(deferred):
     fal, c_top = falsified_top(deferred.prob, deferred._c, seed=0)
     assert fal == deferred.fal and c_top == min(deferred._c, fal.c_refuted)

@@ -60,9 +60,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..sim.history import DelayLine, TimedDelayLine
-from ..sim.wheel_slip import (MAX_DLAMBDA, MAX_HALVINGS, PARAM_ORDER, ArrayOps, ScalarOps,
+from ..sim.wheel_slip import (PARAM_ORDER, ArrayOps, ScalarOps,
                               exp_euler, model_functions, phi1, plant_forms, plant_step,
                               stiff_step, wheel_speed)
+from .antiskid003_scalar import ScalarSample, _scalar_stiff_step
 from .antiskid003_settings import (ACCEL, BRAKE, BRAKE_IN, CRUISE, DIVERGED, DIVERGED_HOW,  # noqa: F401
                                    HANDOVER, PHASE_NAMES, STOPPED, ControllerSettings,
                                    CreepSpeedProfile)
@@ -81,7 +82,7 @@ class PhaseEvents:
     diverged_how: object = math.nan   # index into DIVERGED_HOW
 
 
-class Antiskid003:
+class Antiskid003(ScalarSample):
     """Controller (75) with the predictor of Lemma 1, as a sampled callable
     ``(t, x, inputs) -> (u, phase)`` for :func:`simulate_closed_loop`.
 
@@ -215,8 +216,16 @@ class Antiskid003:
         a refined mesh, in pieces of the current step with the exact average
         input over each)."""
         line = self.uline
+        pieces = line.pieces() if self._base is None else line.pieces(self._ticks)
+        if not self.xp.batch:
+            return self._rollout_scalar(v, lam, ph, pieces)
+        return self._rollout_generic(v, lam, ph, pieces)
+
+    def _rollout_generic(self, v, lam, ph, pieces):
+        """:meth:`_rollout` for a batch (arrays) or a single run (floats), one
+        :meth:`_model_step` per piece."""
         masks = self._model_masks(ph) if self.xp.batch else None
-        for u, d in (line.pieces() if self._base is None else line.pieces(self._ticks)):
+        for u, d in pieces:
             v, lam = self._model_step(v, lam, u, d, ph, masks)
         return v, lam
 
@@ -244,6 +253,12 @@ class Antiskid003:
         ``ControllerSettings.observer_tau``): the model says the step from
         the previous sample under the input the controller believes applied,
         u(t - h_model), moves lambda by dt phi1(dt J) (f_model + delta)."""
+        if not self.xp.batch:
+            return self._observe_scalar(v, lam, ph)
+        self._observe_generic(v, lam, ph)
+
+    def _observe_generic(self, v, lam, ph):
+        """:meth:`_observe` for a batch (arrays) or a single run (floats)."""
         s, xp, dt = self.s, self.xp, self._dt_prev
         braking = ph >= BRAKE_IN
         if xp.batch and braking.all() or not xp.batch and braking:
@@ -293,6 +308,12 @@ class Antiskid003:
 
     # -- one sample -----------------------------------------------------------------
     def __call__(self, t, x, inputs):
+        if not self.xp.batch:
+            return self._call_scalar(t, x)
+        return self._call_generic(t, x)
+
+    def _call_generic(self, t, x):
+        """One sample, for a batch (arrays) or a single run (floats)."""
         s, xp = self.s, self.xp
         v_true, lam_true = x
         v, lam = x if self.measure is None else self.measure(v_true, lam_true)
@@ -381,17 +402,3 @@ class Antiskid003:
                 u, fv, fl = xp.where(sel, uc, u), xp.where(sel, fvc, fv), xp.where(sel, flc, fl)
         return u, fv, fl
 
-
-def _scalar_stiff_step(v, lam, u, dt, fn, v_floor, p, depth):
-    """:func:`~workbench.sim.wheel_slip.stiff_step` of a single run with the
-    model ``fn`` (speed floored at ``v_floor``): the same operations in the
-    same order (bit for bit), written out for floats (the predictor's
-    rollout calls it every piece of every sample)."""
-    f1, f20, f2u, j0, ju = fn(max(v, v_floor), lam, *p)
-    z = (j0 + ju * u) * dt
-    nv = v + dt * f1
-    nl = lam + dt * (math.expm1(z) / z if abs(z) > 1e-8 else 1.0 + 0.5 * z) * (f20 + f2u * u)
-    if depth < MAX_HALVINGS and not abs(nl - lam) <= MAX_DLAMBDA:
-        hv, hl = _scalar_stiff_step(v, lam, u, dt / 2, fn, v_floor, p, depth + 1)
-        return _scalar_stiff_step(hv, hl, u, dt / 2, fn, v_floor, p, depth + 1)
-    return nv, nl

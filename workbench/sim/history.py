@@ -76,18 +76,18 @@ class DelayLine:
     def push(self, value, ticks=None) -> None:
         """Append the sample s_n of the current step (``ticks`` is for the
         interface of :class:`TimedDelayLine`; the step here is fixed)."""
-        n = self._n
+        n, buf, L = self._n, self._buf, self._L
         if self.N > 0:
-            self._sum = self._sum + value - self._get(n - self.N)
-        self._buf[n % self._L] = value
+            self._sum = self._sum + value - buf[(n - self.N) % L]
+        buf[n % L] = value
         self._n = n + 1
 
     def delayed(self):
         """Average of s(t - h) over the step that starts at the last pushed
         sample's time (call after :meth:`push`)."""
-        n = self._n - 1
-        a = self._get(n - self.N)
-        return a if self.f == 0.0 else (1.0 - self.f) * a + self.f * self._get(n - self.N - 1)
+        k, buf, L = self._n - 1 - self.N, self._buf, self._L
+        a = buf[k % L]
+        return a if self.f == 0.0 else (1.0 - self.f) * a + self.f * buf[(k - 1) % L]
 
     def window_integral(self):
         """Integral of s over [t_n - h, t_n), t_n the time of the *next*
@@ -99,9 +99,10 @@ class DelayLine:
     def pieces(self) -> list:
         """The window [t_n - h, t_n) (t_n as in :meth:`window_integral`) as
         (value, duration in s) pieces, oldest first."""
-        n, dt = self._n, self.dt
-        out = [(self._get(n - self.N - 1), self.f * dt)] if self.f > 0 else []
-        return out + [(self._get(k), dt) for k in range(n - self.N, n)]
+        n, dt, buf, L = self._n, self.dt, self._buf, self._L
+        out = [(buf[(n - self.N - 1) % L], self.f * dt)] if self.f > 0 else []
+        out += [(buf[k % L], dt) for k in range(n - self.N, n)]
+        return out
 
 
 class TimedDelayLine:

@@ -181,9 +181,29 @@ def plant_step(x, u, p, dt, fns, xp, v_floor=1e-3, mask=True, with_flag=False):
     """One step of the adhesion plant (module docstring), the form (eq 12 or
     15) chosen by the sign of lambda; ``with_flag``: also return the
     ``unresolved`` flag of :func:`_stiff_step`."""
+    if not xp.batch:
+        out = _scalar_plant_step(x[0], x[1], u, dt, p, fns, v_floor, 0)
+        return out if with_flag else out[:2]
     out = stiff_step_flagged(x[0], x[1], u, dt,
                       lambda v, lam: plant_forms(xp.maximum(v, v_floor), lam, p, fns, xp), xp, mask, 0)
     return out if with_flag else out[:2]
+
+
+def _scalar_plant_step(v, lam, u, dt, p, fns, v_floor, depth):
+    """:func:`plant_step` of a single run (floats, ``with_flag``): the
+    operations of :func:`stiff_step_flagged` with :func:`plant_forms` and
+    :func:`exp_euler`, in the same order (bit for bit), written out (every
+    case run calls it once a step)."""
+    f1, f20, f2u, j0, ju = fns["traction" if lam >= 0 else "braking"](max(v, v_floor), lam, *p)
+    z = (j0 + ju * u) * dt
+    nv = v + dt * f1
+    nl = lam + dt * (math.expm1(z) / z if abs(z) > 1e-8 else 1.0 + 0.5 * z) * (f20 + f2u * u)
+    big = not abs(nl - lam) <= MAX_DLAMBDA
+    if depth < MAX_HALVINGS and big:
+        hv, hl, bad1 = _scalar_plant_step(v, lam, u, dt / 2, p, fns, v_floor, depth + 1)
+        nv, nl, bad2 = _scalar_plant_step(hv, hl, u, dt / 2, p, fns, v_floor, depth + 1)
+        return nv, nl, bad1 or bad2
+    return nv, nl, big
 
 
 @lru_cache(maxsize=1)

@@ -46,7 +46,7 @@ from ...outcome import Outcome
 from ...plants.adhesion import NumericAdhesion, adhesion_model
 from ...plants.lambdify_cache import lambdify
 from ...roa import BasinEstimate, BasinProblem, estimate_basin, modal_P
-from ...roa.basin import falsified_top
+from ...roa.falsify import StagedFalsification
 from ...roa.check import BasinCheck, PointCheck, largest_level_in_box
 from ...roa.problem import quadratic_enclosure
 from ...symbolic.linearise import linearise_cruise
@@ -123,8 +123,10 @@ def _loop_symbolic(values: tuple, v_d: float):
     return f, J, H, states, (k1, k2), lin, lam_d, plant.lambda_opt()
 
 
+@lru_cache(maxsize=8)
 def _loop(values: tuple, v_d: float, K: tuple):
-    """(f, derivatives, states, A_cl, lambda_d, lambda_opt) at the gain K."""
+    """(f, derivatives, states, A_cl, lambda_d, lambda_opt) at the gain K
+    (once per gain: the weights of the grid and the fate share it)."""
     f, J, H, states, ks, lin, lam_d, lam_opt = _loop_symbolic(values, v_d)
     rep = {ks[0]: sp.Float(float(K[0])), ks[1]: sp.Float(float(K[1]))}
     put = lambda e: e.xreplace(rep)
@@ -167,20 +169,37 @@ EAGER_ENV = "WORKBENCH_BASIN_EAGER"
 
 
 class _Deferred:
-    """The estimate of :func:`estimate_cruise` in two stages (issue 36, item 4):
-    the falsifier now, the certificate (Taylor ball and box cover, most of
-    the cost) only when asked for. Before the cover, ``c_certified <= c_top``
-    is known (:func:`workbench.roa.basin.falsified_top`)."""
+    """The estimate of :func:`estimate_cruise` in three stages (issue 36, item 4):
+    the falsifier's samples and rays now, its optimiser only when a question
+    needs the refuted level itself, the certificate (Taylor ball and box
+    cover) only when asked for. After the first stage ``c_refuted <= c_upper``
+    is known (:class:`~workbench.roa.falsify.StagedFalsification`), after
+    the second ``c_certified <= c_top`` (:func:`workbench.roa.basin.falsified_top`)."""
 
     def __init__(self, values, v_d, K, x, w, seed):
         self.prob, self._c = _cruise_problem(values, v_d, K, [x], w)
         self._seed = seed
-        self.fal, self.c_top = falsified_top(self.prob, self._c, seed=seed)
+        self._stage = StagedFalsification(self.prob, self._c, seed=seed)
         self._est = None
         if os.environ.get(EAGER_ENV) or not self.prob.M_eig_bounds()[0] > 0:
             # the cover's one ModelError (bounding_box_z): raised here, where
             # estimate_cruise raised it, so the caller's handling is unchanged
             self.est
+
+    @property
+    def fal(self):
+        """The falsifier's result: exactly ``falsified_top(prob, c, seed)[0]``."""
+        return self._stage.finish()
+
+    @property
+    def c_top(self) -> float:
+        """``min(c_search, c_refuted)``: an upper bound of c_certified."""
+        return min(self._c, self.fal.c_refuted)
+
+    @property
+    def _top_upper(self) -> float:
+        """An upper bound of :attr:`c_top` known before the optimiser runs."""
+        return min(self._c, self._stage.c_upper)
 
     @property
     def est(self) -> BasinEstimate:
@@ -194,22 +213,28 @@ class _Deferred:
         """``est.point_verdict(x).outcome``, without the cover when the
         falsifier settles it: with lo <= V(x) <= hi, lo >= c_refuted and
         hi > c_top >= c_certified, point_verdict's first test (hi <=
-        c_certified) fails and its second (lo >= c_refuted) holds: REFUTED."""
+        c_certified) fails and its second (lo >= c_refuted) holds: REFUTED.
+        The falsifier's first stage settles it already when lo >= c_upper
+        and hi > min(c_search, c_upper) (c_refuted <= c_upper)."""
         iv = quadratic_enclosure(self.prob.P, self.prob.x_eq, np.asarray(x, float)[None, :],
                                  np.asarray(x, float)[None, :])
         lo, hi = float(iv.lo[0]), float(iv.hi[0])
+        if lo >= self._stage.c_upper and hi > self._top_upper:
+            return Outcome.REFUTED
         if lo >= self.fal.c_refuted and hi > self.c_top:
             return Outcome.REFUTED
         return self.est.point_verdict(x).outcome
 
     def enters(self, path) -> bool:
         """``est.c_certified > 0 and any(V(path) <= est.c_certified)``, without
-        the cover when V > c_top >= c_certified along the whole path (a NaN
-        state is not above c_top: the cover then decides)."""
-        if np.all(self.prob.V(path) > self.c_top):
+        the cover when V > c_top >= c_certified along the whole path, and
+        without the falsifier's optimiser when V > min(c_search, c_upper) >=
+        c_top (a NaN state is not above either: the cover then decides)."""
+        V = self.prob.V(path)
+        if np.all(V > self._top_upper) or np.all(V > self.c_top):
             return False
         est = self.est
-        return bool(est.c_certified > 0 and np.any(self.prob.V(path) <= est.c_certified))
+        return bool(est.c_certified > 0 and np.any(V <= est.c_certified))
 
 
 def _score(est: BasinEstimate, points) -> tuple:
@@ -276,10 +301,15 @@ def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
     for q in W_GRID:
         try:
             prob, c = _cruise_problem(vals, v_d, K, xs, q)
-            fal, c_top = falsified_top(prob, c, seed=seed)
-            if best is not None and not os.environ.get(EAGER_ENV) \
-                    and _score_bound(prob, c_top, xs) <= best[0]:
-                continue        # coarse pass: this P cannot be chosen (_score_bound)
+            stage = StagedFalsification(prob, c, seed=seed)
+            coarse = best is not None and not os.environ.get(EAGER_ENV)
+            # coarse pass: this P cannot be chosen (_score_bound, which grows
+            # with the level: c_top <= min(c, c_upper) before the optimiser)
+            if coarse and _score_bound(prob, min(c, stage.c_upper), xs) <= best[0]:
+                continue
+            fal = stage.finish()
+            if coarse and _score_bound(prob, min(c, fal.c_refuted), xs) <= best[0]:
+                continue
             est = estimate_basin(prob, c, seed=seed, falsified=fal)
         except ModelError:
             continue
