@@ -19,8 +19,8 @@ import numpy as np
 from workbench.controllers.mfac import MFAC, MFACGains
 from workbench.design import load_design
 from workbench.papers.p001 import ntsm_platoon as platoon001
-from workbench.papers.p002 import ato_tracking as tracking002
-from workbench.papers.p002.ato_tracking_spec import MFAC_KEYS
+from workbench.kinds import tracking as tracking002
+from workbench.kinds.tracking.spec import MFAC_KEYS
 from workbench.plants.platoon001 import TrainParams
 from workbench.profiles import build_profile
 from workbench.sim.tracking import simulate_tracking

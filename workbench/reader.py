@@ -184,3 +184,16 @@ def display_path(path: str | Path) -> str:
         return str(p.resolve().relative_to(Path.cwd().resolve()))
     except ValueError:
         return str(p)
+
+
+def read_gradients(r: Reader) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """``grade_from`` (m, increasing from 0) and ``grade`` (-, |i| <= 0.05) of a
+    table (a route's gradient sections: papers 001 and 002)."""
+    g_from = r.numbers("grade_from", default=(0.0,), what="positions (m)")
+    grade = r.numbers("grade", default=(0.0,), what="gradients (-)")
+    if len(g_from) != len(grade) or g_from[0] != 0.0 or list(g_from) != sorted(g_from):
+        raise r.fail("grade_from", list(g_from), "increasing positions starting at 0, one per "
+                     "entry of grade")
+    if any(abs(x) > 0.05 for x in grade):
+        raise r.fail("grade", list(grade), "gradients within +/-0.05 (50 permille)")
+    return g_from, grade

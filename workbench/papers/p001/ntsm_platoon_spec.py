@@ -17,10 +17,9 @@ from dataclasses import dataclass
 from ...controllers.ntsm import NTSMGains
 from ...plants.platoon001 import PARAMETER_UNITS, TrainParams
 from ...profiles import phase_time, spec_for_cruise
-from ...reader import Quantity, Reader
+from ...reader import Quantity, Reader, read_gradients
 from ...sim.platoon import JITTER, OWN_STATE
 from ...sim.tracking import Route
-from ..p002.ato_tracking_spec import read_gradients
 
 
 @dataclass(frozen=True)

@@ -4,8 +4,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...report.markdown import fmt
-from .ato_tracking_run import ReadingResult, TrackingResult
-from .ato_tracking_spec import OBJECTIVES
+from .run import ReadingResult, TrackingResult
+from .spec import OBJECTIVES
 
 AXIS = {"stop_error": "stop error (m)", "punctuality": "punctuality |T_t − T_o| (s)",
         "comfort": "RMS jerk (m/s³)", "energy": "traction energy (J/kg)"}

@@ -46,7 +46,7 @@ from ...profiles import Profile, build_profile
 from ...report.markdown import fmt
 from ...sim.tracking import Objectives, TrackingRun, objectives, simulate_tracking
 from ...tuning.pareto import choose, dominated_share, grid_edges, pareto_mask, weighted_cost
-from .ato_tracking_spec import MFAC_KEYS, OBJECTIVES, PID_KEYS, Reading, Section, TrackingSpec
+from .spec import MFAC_KEYS, OBJECTIVES, PID_KEYS, Reading, Section, TrackingSpec
 
 WINNER_DIGITS = 3   # significant digits at which two values count as a tie
 SENSITIVITY_KEYS = ("eta", "mu", "rho", "lam")

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from ...errors import DesignError, ModelError
 from ...plants.train002 import MODELS, PARAMETER_UNITS, FirstOrderTrain002, Train002
 from ...profiles import ProfileSpec, build_profile
-from ...reader import Quantity, Reader
+from ...reader import Quantity, Reader, read_gradients
 from ...sim.tracking import Objectives, Route
 
 OBJECTIVES = Objectives.NAMES
@@ -85,22 +85,11 @@ class TrackingSpec:
     weights: tuple[float, ...]
     stop_tolerance: Quantity
     peak_jerk: Quantity | None = None   # comfort constraint of the tuning ([tuning]); None: none
+    analysis_module: str | None = None  # ``[analysis] module`` (a name: specs stay keyable)
 
     def profile_spec(self, sec: Section) -> ProfileSpec:
         return ProfileSpec(sec.route.distance, sec.v_limit, self.profile["accel"],
                            self.profile["brake"], self.profile["jerk"], sec.run_time)
-
-
-def read_gradients(r: Reader) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """``grade_from`` (m, increasing from 0) and ``grade`` (-, |i| <= 0.05) of a table."""
-    g_from = r.numbers("grade_from", default=(0.0,), what="positions (m)")
-    grade = r.numbers("grade", default=(0.0,), what="gradients (-)")
-    if len(g_from) != len(grade) or g_from[0] != 0.0 or list(g_from) != sorted(g_from):
-        raise r.fail("grade_from", list(g_from), "increasing positions starting at 0, one per "
-                     "entry of grade")
-    if any(abs(x) > 0.05 for x in grade):
-        raise r.fail("grade", list(grade), "gradients within +/-0.05 (50 permille)")
-    return g_from, grade
 
 
 def _section(r: Reader, *, with_source: bool) -> Section:
@@ -200,7 +189,7 @@ def load_spec(root: Reader) -> TrackingSpec:
     tol = req.quantity("stop_tolerance", "m", positive=True, hi=1e4)   # declared range (issue 32)
     req.finish()
     spec = TrackingSpec(main, line, prof, train, u_lim, Ts, dt, readings, scales, weights,
-                        tol, peak_jerk)
+                        tol, peak_jerk, _read_analysis(root))
     for i, sec in enumerate((main, *line)):
         try:
             build_profile(spec.profile_spec(sec), dt=Ts)
@@ -209,6 +198,26 @@ def load_spec(root: Reader) -> TrackingSpec:
             raise DesignError(root.path, key, sec.run_time, f"a feasible run time ({exc})") \
                 from None
     return spec
+
+
+def _read_analysis(root: Reader) -> str | None:
+    """``[analysis] module = "pNNN.name"``: a paper's module (under
+    ``workbench.papers``) with a ``render(design, res)`` for the report."""
+    import importlib
+    import re
+    if not root.has("analysis"):
+        return None
+    r = root.table("analysis")
+    name = r.string("module")
+    r.finish()
+    if not re.fullmatch(r"p\d{3}\.[a-z][a-z0-9_]*", name):
+        raise r.fail("module", name, 'a paper module "pNNN.name" under workbench.papers')
+    try:
+        importlib.import_module(f"workbench.papers.{name}").render
+    except (ImportError, AttributeError):
+        raise r.fail("module", name, "a module of workbench.papers with a render function") \
+            from None
+    return name
 
 
 def quantity_names(spec: TrackingSpec) -> set[str]:
