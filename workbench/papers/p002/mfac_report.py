@@ -17,7 +17,7 @@ from ...plants.train002 import latex_equations
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...tuning.pareto import TIE_REL, dominated_share
 from ...kinds.tracking import figures as F
-from ...kinds.tracking.run import most_sensitive
+from ...kinds.tracking.mfac import most_sensitive
 from ...kinds.tracking.spec import OBJECTIVE_UNITS, OBJECTIVES
 
 LABEL = {"stop_error": "stop error (m)", "punctuality": "punctuality (s)",
