@@ -119,3 +119,20 @@ def test_kind_runs_equal_the_old_code_bit_for_bit():
     for f in ("v", "s", "a", "u"):
         np.testing.assert_array_equal(getattr(alone.pid, f)[:, :K], getattr(old_p, f)[:, :K])
     assert alone.pid.stop_time == old_p.stop_time
+
+
+def test_simulate_prints_the_chosen_point_and_writes_its_trajectory(synth, tmp_path, capsys):
+    from workbench.kinds import capabilities
+    design, res = synth
+    out = tmp_path / "run.csv"
+    assert capabilities.run(design, "simulate", case=None, as_json=True, csv=str(out),
+                            dt=None, plot=None) == 0
+    import json
+    got = json.loads(capsys.readouterr().out)
+    r = res.readings[0]
+    assert got["gains"] == {"PID": r.pid.chosen_params()}
+    assert got["metrics"]["pid.stop_error"] == r.main.value("PID", "stop_error")
+    lines = out.read_text().splitlines()
+    assert lines[0] == "t,target,v_pid,s_pid,a_pid,u_pid"
+    v = np.array([float(x.split(",")[2]) for x in lines[1:]])
+    np.testing.assert_array_equal(v, r.main.pid.v[0])      # repr floats read back bit for bit
