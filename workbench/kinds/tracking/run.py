@@ -269,7 +269,8 @@ def _tune(spec, reading, sec, prof, kind: str) -> tuple[Tuning, TrackingRun, MFA
     except ValueError:
         raise ModelError(f"reading {reading.name!r}: no reproducible run of the "
                          f"{kind.upper()} grid ({len(P)} parameter sets) stops on {sec.name}; "
-                         f"widen the grid in plant_readings.{kind}") from None
+                         "widen the grid in "
+                         + ".".join(x for x in (reading.table, kind) if x)) from None
     front = np.zeros(len(P), bool)
     front[repro] = pareto_mask(obj[repro])
     tuning = Tuning(keys, P, obj, front, weighted_cost(obj, scales, spec.weights),

@@ -67,6 +67,8 @@ class Reading:
         Reset threshold of the MFAC's estimate (in the command's and the PPD's units).
     pid_grid : dict[str, tuple[float, ...]] or None
         kp, ki, kd values (None: no PID on this reading).
+    table : str
+        Design-file table that holds the controllers' grids (``""``: the top level).
     """
 
     name: str
@@ -77,6 +79,7 @@ class Reading:
     mfac_grid: dict | None
     epsilon: float | None
     pid_grid: dict | None
+    table: str = "plant_readings"   # where its controller tables are ("": top level)
 
     @property
     def controllers(self) -> tuple[str, ...]:
@@ -180,7 +183,7 @@ def _nominal(root: Reader, base: dict, u_lim) -> Reading:
     and the top-level controller tables."""
     train = Train002(**{k: q.value for k, q in base.items()}, u_min=u_lim[0], u_max=u_lim[1])
     mgrid, eps, pgrid = _controllers(root)
-    return Reading("nominal", "delay-lag-002", "[train]", train, {}, mgrid, eps, pgrid)
+    return Reading("nominal", "delay-lag-002", "[train]", train, {}, mgrid, eps, pgrid, "")
 
 
 def load_spec(root: Reader) -> TrackingSpec:
