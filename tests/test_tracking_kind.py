@@ -67,7 +67,7 @@ def test_bad_tables_name_file_key_value(tmp_path, old, new, key):
 
 
 def test_bad_value_exits_2_with_one_line(tmp_path):
-    p = _bad(tmp_path, "ki = [0.1, 0.3, 1.0]", 'ki = [0.1, "x"]')
+    p = _bad(tmp_path, "ki = [0.1, 0.3, 0.6]", 'ki = [0.1, "x"]')
     out = subprocess.run([sys.executable, "-m", "workbench", "verify", str(p)],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 2
