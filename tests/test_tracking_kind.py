@@ -136,3 +136,16 @@ def test_simulate_prints_the_chosen_point_and_writes_its_trajectory(synth, tmp_p
     assert lines[0] == "t,target,v_pid,s_pid,a_pid,u_pid"
     v = np.array([float(x.split(",")[2]) for x in lines[1:]])
     np.testing.assert_array_equal(v, r.main.pid.v[0])      # repr floats read back bit for bit
+
+
+def test_general_report_without_an_analysis_module(synth):
+    from workbench.kinds import renderer
+    design, res = synth
+    assert design.spec.analysis_module is None
+    out = renderer("tracking")(design, res)
+    heads = [s.splitlines()[0] for s in out.sections]
+    assert heads == ["## Problem", "## Tuning per reading and controller",
+                     "## Chosen points on the main pair", "## Line"]
+    assert {f.name for f in out.figures} == {"pareto-nominal", "tracking", "jerk", "line"}
+    assert "MFAC" not in "".join(out.sections)
+    assert "| `nominal` | PID | 27 | 0 |" in out.sections[1]
