@@ -187,7 +187,7 @@ def _nominal(root: Reader, base: dict, u_lim) -> Reading:
 
 
 def load_spec(root: Reader) -> TrackingSpec:
-    """The validated spec of an ``ato-tracking`` design (see the module docstring)."""
+    """The validated spec of a ``tracking`` design (see the module docstring)."""
     main = _section(root.table("route"), with_source=False)
     line = tuple(_section(r, with_source=True) for r in root.tables("line", default=[]))
     pr = root.table("profile")
