@@ -2,7 +2,7 @@
 
 Prints, in the same process:
 
-1. the wall time of the whole ``ato-tracking`` study (two plant readings,
+1. the wall time of the whole paper-002 ``tracking`` study (two plant readings,
    tuning grids and Pareto fronts, synthetic line) — target under 60 s — and, as a baseline, the
    same N MFAC grid runs stepped one at a time instead of as one batch;
 2. the wall time of one 4-train, 300 s platoon run at T = 0.01 s under the
@@ -19,8 +19,8 @@ import numpy as np
 from workbench.controllers.mfac import MFAC, MFACGains
 from workbench.design import load_design
 from workbench.kinds.platoon import run as platoon001
-from workbench.papers.p002 import ato_tracking as tracking002
-from workbench.papers.p002.ato_tracking_spec import MFAC_KEYS
+from workbench.kinds import tracking as tracking002
+from workbench.kinds.tracking.spec import MFAC_KEYS
 from workbench.plants.platoon001 import TrainParams
 from workbench.profiles import build_profile
 from workbench.sim.tracking import simulate_tracking
@@ -56,7 +56,7 @@ def bench_line() -> None:
     one_by_one = time.perf_counter() - t0
     diff = max(np.nanmax(np.abs(s.v[0] - batch.v[i, :s.v.shape[1]]))
                for i, s in enumerate(single))
-    print("paper 002 ato-tracking study (2 plant readings, Macun-Nanhu + 6 synthetic sections)")
+    print("paper 002 tracking study (2 plant readings, Macun-Nanhu + 6 synthetic sections)")
     print(f"  whole study (tuning grids, fronts, line):      {whole:7.2f} s   (target < 60 s)")
     print(f"  {N_GRID} MFAC runs as one batch:                {batched:7.2f} s")
     print(f"  the same {N_GRID} runs one at a time (baseline):  {one_by_one:7.2f} s   "

@@ -30,7 +30,7 @@ from contextlib import contextmanager
 
 from workbench import memo
 from workbench.design import load_design
-from workbench.papers.p002 import ato_tracking_run as R
+from workbench.kinds.tracking import run as R
 from workbench.sim import tracking
 from workbench.sim.tracking import Objectives
 from workbench.verify import evaluate_design

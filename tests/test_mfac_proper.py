@@ -220,7 +220,7 @@ def small_reading():
 
 @pytest.mark.slow
 def test_study_is_deterministic(small_reading):
-    from workbench.papers.p002.ato_tracking_run import run_study, study_quantities
+    from workbench.kinds.tracking.run import run_study, study_quantities
     a, b = run_study(small_reading), run_study(small_reading)
     ra, rb = a.readings[0], b.readings[0]
     for x, y in ((ra.mfac.objectives, rb.mfac.objectives), (ra.pid.objectives, rb.pid.objectives),
@@ -232,7 +232,7 @@ def test_study_is_deterministic(small_reading):
 
 def test_a_grid_where_nothing_stops_is_a_model_error(small_reading):
     from workbench.errors import ModelError
-    from workbench.papers.p002.ato_tracking_run import run_study
+    from workbench.kinds.tracking.run import run_study
     r = small_reading.readings[0]
     # a command pinned at a demanded speed of 2 cm/s: the train creeps and never stands still
     creep = dataclasses.replace(r.train, u_min=0.02, u_max=0.02)

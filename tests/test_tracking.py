@@ -169,7 +169,7 @@ def evaluation():
 
 @pytest.mark.slow     # the design is run at dt, dt/2 and dt/4 (refinement of the findings)
 def test_study_runs_and_claims_are_ok(evaluation):
-    from workbench.papers.p002.ato_tracking_run import study_quantities
+    from workbench.kinds.tracking.run import study_quantities
     assert evaluation.ok
     res = evaluation.result
     q = study_quantities(res)
@@ -197,7 +197,7 @@ def test_study_runs_and_claims_are_ok(evaluation):
 
 
 def test_most_sensitive_ignores_parameters_without_a_reproducible_neighbour():
-    from workbench.papers.p002.ato_tracking_run import most_sensitive
+    from workbench.kinds.tracking.run import most_sensitive
     assert most_sensitive({"eta": 0.01, "rho": math.nan, "lam": 0.09}) == "lam"
     assert most_sensitive({"eta": 0.2, "rho": math.nan, "lam": 0.09}) == "eta"
 

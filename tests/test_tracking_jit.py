@@ -8,7 +8,7 @@ import pytest
 
 from workbench.design import load_design
 from workbench.features.reproducible import NUDGE, nudged
-from workbench.papers.p002 import ato_tracking_run as R
+from workbench.kinds.tracking import run as R
 from workbench.profiles import build_profile
 from workbench.sim.tracking import simulate_tracking
 

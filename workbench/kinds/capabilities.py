@@ -47,6 +47,7 @@ CAPABILITIES: dict[str, dict[str, str]] = {
         "synthesize delay-bound": "workbench.papers.p003.antiskid_cruise_cli:synthesize_command"},
     "brake-fit": {"fit": "workbench.papers.p000.brake_fit:fit_command"},
     "delay-benchmark": {"benchmark delay": "workbench.benchmark:benchmark_delay"},
+    "tracking": {"simulate": "workbench.kinds.tracking.cli:simulate_command"},
 }
 
 #: verb -> what a design needs for it (the error's words).

@@ -1,7 +1,7 @@
 """Pareto fronts of minimised objectives and a stated rule to pick one point.
 
 Used by the multi-objective tuning of paper 002's controllers
-(:mod:`workbench.papers.p002.ato_tracking_run`): every candidate is a row of
+(:mod:`workbench.kinds.tracking.run`): every candidate is a row of
 objective values, all minimised; a row with a non-finite entry (a run that
 did not stop) is never on a front and never chosen.
 """

@@ -1,11 +1,12 @@
-"""Figures of the ``ato-tracking`` study (pure functions of its results)."""
+"""Figures of a ``tracking`` design (pure functions of its results; a
+controller the reading does not have is left out)."""
 from __future__ import annotations
 
 import numpy as np
 
 from ...report.markdown import fmt
-from .ato_tracking_run import ReadingResult, TrackingResult
-from .ato_tracking_spec import OBJECTIVES
+from .run import ReadingResult, TrackingResult
+from .spec import OBJECTIVES
 
 AXIS = {"stop_error": "stop error (m)", "punctuality": "punctuality |T_t − T_o| (s)",
         "comfort": "RMS jerk (m/s³)", "energy": "traction energy (J/kg)"}
@@ -35,7 +36,7 @@ def plot_pareto(fig, r: ReadingResult) -> None:
     axes = fig.subplots(1, len(PROJECTIONS))
     for ax, (x, y) in zip(axes, PROJECTIONS):
         ix, iy = OBJECTIVES.index(x), OBJECTIVES.index(y)
-        for name, tun in (("MFAC", r.mfac), ("PID", r.pid)):
+        for name, tun in r.tunings:
             c = COLOURS[name]
             P = tun.objectives[:, [ix, iy]]
             ok = np.all(np.isfinite(P), axis=1) & tun.reproducible
@@ -64,6 +65,8 @@ def plot_tracking(fig, res: TrackingResult) -> None:
     for j, r in enumerate(res.readings):
         m = r.main
         for run, name in ((m.mfac, "MFAC"), (m.pid, "PID")):
+            if run is None:
+                continue
             axes[0, j].plot(run.t, (run.v[0] - run.target[0]) * 3.6, lw=0.8,
                             color=COLOURS[name], label=name)
             axes[1, j].plot(run.t, run.a[0], lw=0.6, color=COLOURS[name], label=name)
@@ -92,6 +95,8 @@ def plot_jerk(fig, res: TrackingResult, limit: float | None) -> None:
     axes = fig.subplots(1, len(res.readings), sharey=True, squeeze=False)[0]
     for ax, r in zip(axes, res.readings):
         for run, name in ((r.main.mfac, "MFAC"), (r.main.pid, "PID")):
+            if run is None:
+                continue
             t, j = jerk_1s(run)
             ax.plot(t, j, lw=0.7, color=COLOURS[name], label=name)
         if limit is not None:
@@ -134,6 +139,8 @@ def plot_line(fig, res: TrackingResult) -> None:
         names = [c.section.name.replace(" (synthetic)", "*") for c in comps]
         x = np.arange(len(comps))
         for ctrl, off in (("MFAC", -0.2), ("PID", 0.2)):
+            if ctrl not in dict(r.tunings):
+                continue
             vals = [c.value(ctrl, "stop_error") for c in comps]
             ax.bar(x + off, [v if np.isfinite(v) else np.nan for v in vals], 0.4, label=ctrl,
                    color=COLOURS[ctrl])

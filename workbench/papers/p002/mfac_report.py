@@ -1,5 +1,13 @@
-"""Markdown and figures of the ``ato-tracking`` study (pure rendering)."""
+"""Report of paper 002's design (kind ``tracking``, ``[analysis] module =
+"p002.mfac_report"``) in the paper's words; pure rendering.
+
+Why it is not general: it words paper 002's questions (MFAC against PID per
+reading of its lost Table 1, eq 9's reset, the CFDL data model, lambda the
+most sensitive parameter) and typesets its equations.
+"""
 from __future__ import annotations
+
+__all__ = ["render"]
 
 import numpy as np
 
@@ -8,9 +16,9 @@ from ...features.reproducible import NUDGE, RTOL, count_text
 from ...plants.train002 import latex_equations
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...tuning.pareto import TIE_REL, dominated_share
-from . import ato_tracking_figures as F
-from .ato_tracking_run import most_sensitive
-from .ato_tracking_spec import OBJECTIVE_UNITS, OBJECTIVES
+from ...kinds.tracking import figures as F
+from ...kinds.tracking.mfac import most_sensitive
+from ...kinds.tracking.spec import OBJECTIVE_UNITS, OBJECTIVES
 
 LABEL = {"stop_error": "stop error (m)", "punctuality": "punctuality (s)",
          "comfort": "RMS jerk (m/s³)", "energy": "energy (J/kg)",

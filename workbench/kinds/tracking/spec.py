@@ -1,15 +1,18 @@
-"""Design tables of the ``ato-tracking`` study (paper 002) and the names of its quantities.
+"""Design tables of a ``tracking`` design and the names of its quantities.
 
-Design tables read here: ``[route]`` (the main station pair), ``[profile]``
-(limits of the target curve), ``[train]`` (the 002 train: Davis resistance,
-gravity, and the integrating reading's eq 1-2 chain, units checked),
-``[simulation]`` (sample, step), ``[tuning]`` (the four objectives' scales
-and weights of the rule that picks one point of each Pareto front),
-``[[plant_readings]]`` (the readings of the lost Table 1: model, parameters
-of a non-integrating reading, and per reading the MFAC and PID grids, whose
-units follow the command's), ``[requirements]`` and ``[[line]]`` (further
-station pairs). The computation is in :mod:`.ato_tracking_run`, the study
-object in :mod:`.ato_tracking`.
+Tables read here: ``[route]`` (the main station pair), ``[profile]`` (limits
+of the target curve), ``[train]`` (a ``delay-lag-002`` train of
+:mod:`workbench.plants.train002`: static map, delay, lag, Davis resistance,
+gravity and command limits, units checked), ``[simulation]`` (control cycle,
+plant step), ``[tuning]`` (the four objectives' scales and weights of the
+rule that picks one point of each Pareto front, and the peak-jerk comfort
+constraint), ``[[plant_readings]]`` (optional: several plant models, each with
+its controllers' grids, whose units follow the command's) or else the
+controllers' grids at the top level (``[pid]``, ``[mfac]``; one reading named
+``nominal``, the ``[train]``), ``[requirements]`` (stop tolerance),
+``[[line]]`` (further station pairs) and ``[analysis]`` (a paper's report
+module). The computation is in :mod:`.run`, the study object in
+:mod:`workbench.kinds.tracking`.
 """
 from __future__ import annotations
 
@@ -20,6 +23,9 @@ from ...plants.train002 import MODELS, PARAMETER_UNITS, FirstOrderTrain002, Trai
 from ...profiles import ProfileSpec, build_profile
 from ...reader import Quantity, Reader, read_gradients
 from ...sim.tracking import Objectives, Route
+
+__all__ = ["MFAC_KEYS", "OBJECTIVES", "OBJECTIVE_UNITS", "PID_KEYS", "Reading", "Section",
+           "TrackingSpec", "load_spec", "quantity_names"]
 
 OBJECTIVES = Objectives.NAMES
 OBJECTIVE_UNITS = {"stop_error": "m", "punctuality": "s", "comfort": "m/s^3", "energy": "J/kg"}
@@ -49,16 +55,20 @@ class Reading:
     ----------
     name, model, source : str
         Name used in claims, plant model (one of ``MODELS``), where it comes from.
+        Without ``[[plant_readings]]`` the one reading is ``nominal``, the ``[train]``.
     train : Train002
         The plant (a :class:`FirstOrderTrain002` for ``"first-order-002"``).
     params : dict[str, Quantity]
         The reading's own parameters as written (empty when they are ``[train]``'s).
-    mfac_grid : dict[str, tuple[float, ...]]
-        eta, mu, rho, lam, phi1 values; every combination is simulated.
-    epsilon : float
-        Reset threshold of eq 9 (in the command's and the PPD's units).
-    pid_grid : dict[str, tuple[float, ...]]
-        kp, ki, kd values.
+    mfac_grid : dict[str, tuple[float, ...]] or None
+        eta, mu, rho, lam, phi1 values; every combination is simulated
+        (None: no MFAC on this reading).
+    epsilon : float or None
+        Reset threshold of the MFAC's estimate (in the command's and the PPD's units).
+    pid_grid : dict[str, tuple[float, ...]] or None
+        kp, ki, kd values (None: no PID on this reading).
+    table : str
+        Design-file table that holds the controllers' grids (``""``: the top level).
     """
 
     name: str
@@ -66,9 +76,16 @@ class Reading:
     source: str
     train: Train002
     params: dict
-    mfac_grid: dict
-    epsilon: float
-    pid_grid: dict
+    mfac_grid: dict | None
+    epsilon: float | None
+    pid_grid: dict | None
+    table: str = "plant_readings"   # where its controller tables are ("": top level)
+
+    @property
+    def controllers(self) -> tuple[str, ...]:
+        """The controllers tuned on this reading, of ``("mfac", "pid")``."""
+        return tuple(c for c, g in (("mfac", self.mfac_grid), ("pid", self.pid_grid))
+                     if g is not None)
 
 
 @dataclass(frozen=True)
@@ -85,6 +102,7 @@ class TrackingSpec:
     weights: tuple[float, ...]
     stop_tolerance: Quantity
     peak_jerk: Quantity | None = None   # comfort constraint of the tuning ([tuning]); None: none
+    analysis_module: str | None = None  # ``[analysis] module`` (a name: specs stay keyable)
 
     def profile_spec(self, sec: Section) -> ProfileSpec:
         return ProfileSpec(sec.route.distance, sec.v_limit, self.profile["accel"],
@@ -136,19 +154,40 @@ def _reading(r: Reader, base: dict, u_lim, dt: float) -> Reading:
                          "a_min < 0 and u_min < u_max")
         train = FirstOrderTrain002(**p, **davis)
     _multiple_of(r.path, r.key("delay") if params else "train.delay", train.delay, dt)
-    mf = r.table("mfac")
-    mgrid = _grid(mf, MFAC_KEYS, positive=True)
-    eps = mf.number("epsilon", positive=True)
-    mf.finish()
-    pi = r.table("pid")
-    pgrid = _grid(pi, PID_KEYS, positive=False)
-    pi.finish()
+    mgrid, eps, pgrid = _controllers(r)
     r.finish()
     return Reading(name, model, source, train, params, mgrid, eps, pgrid)
 
 
+def _controllers(r: Reader):
+    """(MFAC grid, epsilon, PID grid) of the ``mfac`` and ``pid`` tables of
+    ``r`` (each optional, at least one)."""
+    if not (r.has("mfac") or r.has("pid")):
+        raise r.fail("pid", None, "a controller grid: a pid table (kp, ki, kd) and/or an "
+                     "mfac table (eta, mu, rho, lam, phi1, epsilon)")
+    mgrid = eps = pgrid = None
+    if r.has("mfac"):
+        mf = r.table("mfac")
+        mgrid = _grid(mf, MFAC_KEYS, positive=True)
+        eps = mf.number("epsilon", positive=True)
+        mf.finish()
+    if r.has("pid"):
+        pi = r.table("pid")
+        pgrid = _grid(pi, PID_KEYS, positive=False)
+        pi.finish()
+    return mgrid, eps, pgrid
+
+
+def _nominal(root: Reader, base: dict, u_lim) -> Reading:
+    """The one reading of a design without ``[[plant_readings]]``: the ``[train]``
+    and the top-level controller tables."""
+    train = Train002(**{k: q.value for k, q in base.items()}, u_min=u_lim[0], u_max=u_lim[1])
+    mgrid, eps, pgrid = _controllers(root)
+    return Reading("nominal", "delay-lag-002", "[train]", train, {}, mgrid, eps, pgrid, "")
+
+
 def load_spec(root: Reader) -> TrackingSpec:
-    """The validated spec of an ``ato-tracking`` design (see the module docstring)."""
+    """The validated spec of a ``tracking`` design (see the module docstring)."""
     main = _section(root.table("route"), with_source=False)
     line = tuple(_section(r, with_source=True) for r in root.tables("line", default=[]))
     pr = root.table("profile")
@@ -169,7 +208,11 @@ def load_spec(root: Reader) -> TrackingSpec:
     dt = sim.quantity("dt", "s", positive=True, hi=0.1).value
     sim.finish()
     _multiple_of(root.path, "simulation.Ts", Ts, dt)
-    readings = tuple(_reading(r, train, u_lim, dt) for r in root.tables("plant_readings"))
+    if root.has("plant_readings"):
+        readings = tuple(_reading(r, train, u_lim, dt) for r in root.tables("plant_readings"))
+    else:
+        _multiple_of(root.path, "train.delay", train["delay"].value, dt)
+        readings = (_nominal(root, train, u_lim),)
     names = [r.name for r in readings]
     if not readings or len(set(names)) != len(names):
         raise DesignError(root.path, "plant_readings", names, "one or more readings with "
@@ -188,7 +231,7 @@ def load_spec(root: Reader) -> TrackingSpec:
     tol = req.quantity("stop_tolerance", "m", positive=True, hi=1e4)   # declared range (issue 32)
     req.finish()
     spec = TrackingSpec(main, line, prof, train, u_lim, Ts, dt, readings, scales, weights,
-                        tol, peak_jerk)
+                        tol, peak_jerk, _read_analysis(root))
     for i, sec in enumerate((main, *line)):
         try:
             build_profile(spec.profile_spec(sec), dt=Ts)
@@ -199,24 +242,53 @@ def load_spec(root: Reader) -> TrackingSpec:
     return spec
 
 
+def _read_analysis(root: Reader) -> str | None:
+    """``[analysis] module = "pNNN.name"``: a paper's module (under
+    ``workbench.papers``) with a ``render(design, res)`` for the report."""
+    import importlib
+    import re
+    if not root.has("analysis"):
+        return None
+    r = root.table("analysis")
+    name = r.string("module")
+    r.finish()
+    if not re.fullmatch(r"p\d{3}\.[a-z][a-z0-9_]*", name):
+        raise r.fail("module", name, 'a paper module "pNNN.name" under workbench.papers')
+    try:
+        importlib.import_module(f"workbench.papers.{name}").render
+    except (ImportError, AttributeError):
+        raise r.fail("module", name, "a module of workbench.papers with a render function") \
+            from None
+    return name
+
+
 def quantity_names(spec: TrackingSpec) -> set[str]:
-    """Every quantity a claim may name."""
+    """Every quantity a claim may name: per reading and controller the chosen
+    point's objectives, its front and line; the comparison when a reading has
+    both controllers; the CFDL diagnostics when it has an MFAC."""
     names = {"profile.v_cruise", "profile.end_error", "line.sections"}
     for r in spec.readings:
         p = f"reading[{r.name}]"
-        for c in ("mfac", "pid"):
+        ctrls = r.controllers
+        for c in ctrls:
             names |= {f"{p}.{c}.{i}" for i in (*OBJECTIVES, "rms_speed_error", "cost")}
             names |= {f"{p}.{c}.front_size", f"{p}.line.{c}.within_tolerance",
                       f"{p}.line.{c}.max_stop_error"}
-        names |= {f"{p}.{k}" for k in (
-            "verdict", "mfac_wins", "design_points_interior", "front.pid_dominated", "front.mfac_dominated",
-            "mfac.reset_rate", "mfac.reset_rate.small_du", "mfac.reset_rate.sign_change",
-            "mfac.reset_rate.small_phi", "mfac.reset_rate.at_limit", "mfac.saturated",
-            "grid.reset_rate_min", "grid.reset_rate_median", "ppd.phi_min", "ppd.phi_max",
-            "ppd.data_sign_agreement", "ppd.data_median", "ppd.data_p95",
-            "ppd.median_to_dc_gain", "plant.dc_gain", "plant.time_constant",
-            "frozen.spectral_radius", "sensitivity.most_sensitive")}
-        names |= {f"{p}.best.{c}.{i}" for c in ("mfac", "pid") for i in OBJECTIVES}
-        names |= {f"{p}.{c}.{k}" for c in ("mfac", "pid") for k in ("peak_jerk", "grid_edge")}
-        names |= {f"{p}.sensitivity.{k}" for k in ("eta", "mu", "rho", "lam")}
+
+            names |= {f"{p}.best.{c}.{i}" for i in OBJECTIVES}
+            names |= {f"{p}.{c}.{k}" for k in ("peak_jerk", "grid_edge")}
+        names.add(f"{p}.design_points_interior")
+        names |= {f"{p}.{k}" for k in ("plant.dc_gain", "plant.time_constant")}
+        if len(ctrls) == 2:
+            names |= {f"{p}.{k}" for k in (
+                "verdict", "mfac_wins", "front.pid_dominated", "front.mfac_dominated")}
+        if "mfac" in ctrls:
+            names |= {f"{p}.{k}" for k in (
+                "mfac.reset_rate", "mfac.reset_rate.small_du", "mfac.reset_rate.sign_change",
+                "mfac.reset_rate.small_phi", "mfac.reset_rate.at_limit", "mfac.saturated",
+                "grid.reset_rate_min", "grid.reset_rate_median", "ppd.phi_min", "ppd.phi_max",
+                "ppd.data_sign_agreement", "ppd.data_median", "ppd.data_p95",
+                "ppd.median_to_dc_gain", "frozen.spectral_radius",
+                "sensitivity.most_sensitive")}
+            names |= {f"{p}.sensitivity.{k}" for k in ("eta", "mu", "rho", "lam")}
     return names
