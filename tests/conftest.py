@@ -38,3 +38,42 @@ def pytest_runtest_logstart(nodeid, location):
     _TIMELINE["seen"].add(path)
     sys.stderr.write(f"\n[{time.monotonic() - _TIMELINE['t0']:7.1f} s] {path}\n")
     sys.stderr.flush()
+
+
+# The order in which pytest-xdist hands out the test files (issue 36): with
+# `--dist loadscope --no-loadscope-reorder` (pyproject addopts) a worker takes
+# the next file in collection order when it runs out of work. Longest files
+# first (tests/file_costs.txt, measured): the last file handed out is then a
+# short one, and no worker idles for long at the end while the other finishes
+# a long module. Tests keep their order inside a file (module fixtures).
+# Only on xdist workers: a plain `pytest` run keeps the file order.
+COSTS = ROOT / "tests" / "file_costs.txt"
+
+
+def file_costs(path: Path = COSTS) -> dict[str, float]:
+    """{test file (as in a node id): seconds} from ``tests/file_costs.txt``."""
+    costs = {}
+    for line in path.read_text(encoding="utf-8").splitlines():
+        if line.strip() and not line.startswith("#"):
+            seconds, name = line.split()
+            costs[name] = float(seconds)
+    return costs
+
+
+def longest_files_first(nodeids: list[str], costs: dict[str, float]) -> list[int]:
+    """The positions of ``nodeids`` reordered: files by decreasing cost (an
+    unlisted file: cost 0), ties in their first-seen order, each file's tests
+    in their own order."""
+    first: dict[str, int] = {}
+    files = [n.split("::")[0] for n in nodeids]
+    for i, f in enumerate(files):
+        first.setdefault(f, i)
+    return sorted(range(len(nodeids)), key=lambda i: (-costs.get(files[i], 0.0),
+                                                      first[files[i]], i))
+
+
+def pytest_collection_modifyitems(session, config, items):
+    if not hasattr(config, "workerinput"):
+        return
+    order = longest_files_first([it.nodeid for it in items], file_costs())
+    items[:] = [items[i] for i in order]

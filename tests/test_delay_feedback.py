@@ -108,14 +108,29 @@ def test_vertices_name_parameters(tmp_path, monkeypatch, capsys):
     assert "vertices[0].b" in line and "a parameter" in line
 
 
-def test_template_runs_as_written(tmp_path, monkeypatch, capsys):
+@pytest.fixture(scope="module")
+def template(tmp_path_factory):
+    """(exit code, project folder, design file) of ``workbench new delay-feedback
+    my-plant`` in a fresh folder. The tests that run this one file share its
+    synthesis (computed once per process: ``design_synthesis`` is keyed by the
+    spec, file path included)."""
+    root = tmp_path_factory.mktemp("template")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.chdir(root)
+        code = main(["new", "delay-feedback", "my-plant"])
+    return code, root, root / "designs" / "my-plant.toml"
+
+
+def test_template_runs_as_written(template, monkeypatch, capsys):
     """``workbench new delay-feedback NAME`` writes a design that verifies, and
     simulate / synthesize accept it; a second ``new`` never overwrites."""
-    monkeypatch.chdir(tmp_path)
-    assert main(["new", "delay-feedback", "my-plant"]) == 0
-    path = tmp_path / "designs" / "my-plant.toml"
+    code, root, path = template
+    assert code == 0
     assert path.is_file()
+    monkeypatch.chdir(root)
+    written = path.read_bytes()
     assert main(["new", "delay-feedback", "my-plant"]) == 2
+    assert path.read_bytes() == written
     assert main(["new", "delay-feedback", "Bad_Name"]) == 2
     assert main(["new", "pid", "x"]) == 2
     capsys.readouterr()
@@ -126,6 +141,28 @@ def test_template_runs_as_written(tmp_path, monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "final_error.x1" in out
     assert main(["simulate", str(path), "--case", "nope"]) == 2
+
+
+def test_simulate_writes_the_trajectory_csv(template, tmp_path, monkeypatch, capsys):
+    """``simulate --csv --plot --json`` of a delay-feedback design (the one
+    ``workbench new`` writes: its gain is synthesised in about a quarter of the
+    time of a shipped design's requirements synthesis; the CSV and the figure
+    are written by the same code for every delay-feedback design). Moved here
+    from tests/test_hardening.py: it shares the template's synthesis."""
+    out = tmp_path / "run.csv"
+    png = tmp_path / "run.png"
+    code, root, path = template
+    assert code == 0
+    monkeypatch.chdir(root)
+    code = main(["simulate", str(path), "--csv", str(out), "--plot", str(png), "--json"])
+    assert code == 0, capsys.readouterr().err
+    lines = out.read_text().splitlines()
+    head = lines[0].split(",")
+    assert head[0] == "t" and len(lines) > 100
+    data = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
+    assert data.shape[1] == len(head) and np.all(np.diff(data[:, 0]) > 0)
+    assert np.all(np.isfinite(data))
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_expression_functions_reach_the_model(tmp_path, monkeypatch):

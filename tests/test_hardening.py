@@ -232,27 +232,6 @@ def test_trim_false_linearises_off_equilibrium(tmp_path):
     assert nominal_point(d.spec)[2].residual > 1e-3      # reported, not hidden
 
 
-def test_simulate_writes_the_trajectory_csv(tmp_path, monkeypatch, capsys):
-    """``simulate --csv --plot --json`` of a delay-feedback design (the one
-    ``workbench new`` writes: its gain is synthesised in about a quarter of the
-    time of a shipped design's requirements synthesis; the CSV and the figure
-    are written by the same code for every delay-feedback design)."""
-    out = tmp_path / "run.csv"
-    png = tmp_path / "run.png"
-    monkeypatch.chdir(tmp_path)
-    assert main(["new", "delay-feedback", "csv-plant"]) == 0
-    code = main(["simulate", str(tmp_path / "designs" / "csv-plant.toml"),
-                 "--csv", str(out), "--plot", str(png), "--json"])
-    assert code == 0, capsys.readouterr().err
-    lines = out.read_text().splitlines()
-    head = lines[0].split(",")
-    assert head[0] == "t" and len(lines) > 100
-    data = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
-    assert data.shape[1] == len(head) and np.all(np.diff(data[:, 0]) > 0)
-    assert np.all(np.isfinite(data))
-    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-
-
 def test_new_writes_into_the_project_roots_designs(tmp_path, monkeypatch, capsys):
     assert main(["init", str(tmp_path / "p")]) == 0
     (tmp_path / "p" / "proofs" / "deep").mkdir()
