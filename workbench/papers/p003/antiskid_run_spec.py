@@ -300,29 +300,29 @@ def _range(t: Reader, key: str, **kw) -> tuple[float, float]:
 
 #: gain_for's answers in this process, keyed by what they depend on (the
 #: sweep, the halving check and the cases of a design all ask for the same K).
-_GAINS: dict = {}
-
-
 def gain_for(spec: RunSpec) -> tuple[tuple, str, float | None]:
     """(K, how it was obtained, h_certified or None): from the certified
     synthesis of problem (60) at the design's eps on the nominal cruise
-    linearisation, or the design's table gain (each synthesis once per
-    process: the answer depends on the nominal plant, v_d and eps only)."""
+    linearisation, or the design's table gain. The answer depends on the
+    nominal plant, v_d and eps only: each synthesis runs once per process and
+    run folder (:func:`workbench.memo.computed_once`; the test session of
+    ``make test`` reads what ``workbench check`` computed)."""
     if spec.gain == "table":
         return tuple(spec.K_table), spec.K_source, None
-    from ...memo import spec_key
+    from ...memo import computed_once, spec_key
     key = spec_key((spec.params, spec.scenario["v_d"], spec.eps))
-    if key is None or key not in _GAINS:
-        from ...synthesis import synthesize_delay_bound
-        _, _, lin = nominal_cruise(spec)
-        row = synthesize_delay_bound(lin.A, lin.B, (spec.eps,))[0]
-        if row.K is None:
-            raise ModelError(f"synthesis at eps = {spec.eps} certified no gain")
-        out = (row.K, f"synthesis, problem (60) at eps = {spec.eps:g}", row.h_certified)
-        if key is None:
-            return out
-        _GAINS[key] = out
-    return _GAINS[key]
+    if key is None:
+        return _synthesized_gain(spec)
+    return computed_once("antiskid-run-gain", key, lambda: _synthesized_gain(spec))
+
+
+def _synthesized_gain(spec: RunSpec) -> tuple[tuple, str, float | None]:
+    from ...synthesis import synthesize_delay_bound
+    _, _, lin = nominal_cruise(spec)
+    row = synthesize_delay_bound(lin.A, lin.B, (spec.eps,))[0]
+    if row.K is None:
+        raise ModelError(f"synthesis at eps = {spec.eps} certified no gain")
+    return row.K, f"synthesis, problem (60) at eps = {spec.eps:g}", row.h_certified
 
 
 def load_run_spec(root: Reader) -> RunSpec:
