@@ -11,8 +11,13 @@ compilations excluded by a warm-up, as in a long-running session):
   ``workbench.lmi.primal.FULL_UNPACK``) and every probe of the gain's
   bisection solved (``workbench.lmi.gain.IMPLIED_PROBES = False``);
 * ``before synth36``: the shared fixed-gain LMI, the other two as above;
-* ``after``: primal-only unpacking and the gain's probes at or above the
-  synthesis's refuted delay decided without a solve.
+* ``before synth36b``: primal-only unpacking and the gain's probes at or
+  above the synthesis's refuted delay decided without a solve, every solve
+  through cvxpy's ``get_problem_data`` and ``unpack_results``
+  (``workbench.lmi.primal.LEAN = False``);
+* ``after``: the same with repeat solves on the lean path (the compiled
+  parameter map applied directly, the values taken from Clarabel's ``x``:
+  :mod:`workbench.lmi.primal`).
 
 It prints the best CPU and wall seconds of each, the solver calls, and
 whether the three paths printed the same table (they must: the same data
@@ -72,16 +77,17 @@ def _timed(split: dict) -> None:
 
 
 #: The paths timed (module docstring): (name, WORKBENCH_SYNTH_UNSHARED,
-#: ``primal.FULL_UNPACK``, ``gain.IMPLIED_PROBES``).
-PATHS = (("before issue 36 (unshared fixed-K LMI)", "1", True, False),
-         ("before synth36", "0", True, False),
-         ("after", "0", False, True))
+#: ``primal.FULL_UNPACK``, ``gain.IMPLIED_PROBES``, ``primal.LEAN``).
+PATHS = (("before issue 36 (unshared fixed-K LMI)", "1", True, False, False),
+         ("before synth36", "0", True, False, False),
+         ("before synth36b", "0", False, True, False),
+         ("after", "0", False, True, True))
 
 
-def _set_path(unshared: str, full: bool, implied: bool) -> None:
+def _set_path(unshared: str, full: bool, implied: bool, lean: bool) -> None:
     from workbench.lmi import gain, primal
     os.environ["WORKBENCH_SYNTH_UNSHARED"] = unshared
-    primal.FULL_UNPACK, gain.IMPLIED_PROBES = full, implied
+    primal.FULL_UNPACK, gain.IMPLIED_PROBES, primal.LEAN = full, implied, lean
 
 
 def worker(path: str, repeat: int) -> None:
@@ -137,11 +143,15 @@ def run(path: str, repeat: int) -> dict:
     return json.loads([line for line in p.stdout.splitlines() if line.startswith("{")][-1])
 
 
-#: ``workbench verify`` of a design in a fresh process with cvxpy's full unpacking.
-VERIFY_BEFORE = ("import sys, workbench.lmi.primal as p, workbench.lmi.gain as g; "
-                 "p.FULL_UNPACK, g.IMPLIED_PROBES = True, False; "
-                 "from workbench.cli import main; sys.exit(main(sys.argv[1:]))")
-VERIFY_AFTER = "import sys; from workbench.cli import main; sys.exit(main(sys.argv[1:]))"
+#: ``workbench verify`` of a design in a fresh process: (name, code) before
+#: synth36 (cvxpy's full unpacking, every gain probe solved), before synth36b
+#: (no lean repeat solves) and after.
+VERIFY = (("before synth36", "import sys, workbench.lmi.primal as p, workbench.lmi.gain as g; "
+           "p.FULL_UNPACK, g.IMPLIED_PROBES, p.LEAN = True, False, False; "
+           "from workbench.cli import main; sys.exit(main(sys.argv[1:]))"),
+          ("before synth36b", "import sys, workbench.lmi.primal as p; p.LEAN = False; "
+           "from workbench.cli import main; sys.exit(main(sys.argv[1:]))"),
+          ("after", "import sys; from workbench.cli import main; sys.exit(main(sys.argv[1:]))"))
 
 
 def main() -> None:
@@ -151,6 +161,8 @@ def main() -> None:
     ap.add_argument("--study", nargs="*", metavar="DESIGN",
                     help="also time workbench verify of these designs, before and after "
                          "(default designs/delay-benchmarks.toml)")
+    ap.add_argument("--skip-oldest", action="store_true",
+                    help="with --study: leave out the path before synth36")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.worker:
@@ -178,7 +190,7 @@ def main() -> None:
     print(f"best sweep after, CPU s: {parts} (total {new['cpu']:.2f}; {new['solves']} solves)")
     if args.study is not None:
         for design in args.study or ["designs/delay-benchmarks.toml"]:
-            for name, code in (("before synth36", VERIFY_BEFORE), ("after", VERIFY_AFTER)):
+            for name, code in VERIFY[1:] if args.skip_oldest else VERIFY:
                 cpu, wall = command_times(["-c", code, "verify", design])
                 print(f"workbench verify {design}, {name}: {cpu:.1f} CPU s, {wall:.1f} s wall",
                       flush=True)
