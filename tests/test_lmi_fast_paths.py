@@ -140,3 +140,25 @@ def test_lean_data_map_that_differs_from_cvxpys_is_not_used():
     tampered = dict(data, A=data["A"].copy())
     tampered["A"].data[0] = np.nextafter(tampered["A"].data[0], np.inf)
     assert not primal._Lean(p, tampered, chain, inverse).data_ok
+
+
+def test_lean_value_map_that_combines_entries_is_not_used(monkeypatch):
+    lmi = FreeWeighting003(A2, B2, 0.3)
+    lmi.set_delay(0.1)
+    p = lmi._problem
+    data, chain, inverse = p.get_problem_data(cp.CLARABEL, solver_opts={})
+    assert primal._Lean(p, data, chain, inverse).values_ok
+    first, L = chain.reductions[0], lmi._vars["L"]
+    invert = first.invert
+
+    def mixed(solution, inv):
+        # L[0, 0] = a + (b - floor(b)) with b = L[1, 1]: on the positions marker
+        # (integers) a copy of a, on the random marker not: only the second marker
+        # can reject this map
+        sol = invert(solution, inv)
+        x = np.array(sol.primal_vars[L.id], dtype=float)
+        x[0, 0] = x[0, 0] + (x[1, 1] - np.floor(x[1, 1]))
+        sol.primal_vars[L.id] = x
+        return sol
+    monkeypatch.setattr(first, "invert", mixed)
+    assert not primal._Lean(p, data, chain, inverse).values_ok

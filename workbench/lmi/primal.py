@@ -15,8 +15,9 @@ product cvxpy computes), placed into the same sparse structure cvxpy builds,
 and the variables' values are the entries of Clarabel's ``x`` that cvxpy's
 inversion copies into them. Both maps are taken from cvxpy's own path at the
 problem's first solve and kept only when they reproduce it exactly: the data
-array for array, the inversion on a marker vector (each value an entry of
-``x``). Clarabel, its settings, its solver cache and the status map are
+array for array, the inversion on two marker vectors (the positions, and
+seeded random reals: each value must be one entry of ``x``, not a
+combination). Clarabel, its settings, its solver cache and the status map are
 cvxpy's; only cvxpy's per-solve bookkeeping (about a millisecond a solve)
 is skipped, so the lean path is bit for bit cvxpy's answer too.
 """
@@ -41,6 +42,8 @@ FULL_UNPACK = False
 #: False: cvxpy's ``get_problem_data`` and ``unpack_results`` every time
 #: (``benchmarks/synthesize_times.py``; the same bits either way).
 LEAN = True
+#: Seed of the random marker that checks the lean value map (:class:`_Lean`).
+MARKER_SEED = 36
 
 
 class _PrimalOnly:
@@ -130,17 +133,28 @@ class _Lean:
     def _value_map(self, problem, chain, inverse) -> None:
         var_id = self.solver_inverse[chain.solver.VAR_ID]
         n = int(self.prog.x.size)
-        # the solver step's own inversion gives {var_id: x}; invert the rest
-        sol = Solution(cps.OPTIMAL, 0.0, {var_id: np.arange(1.0, n + 1.0)}, {}, {})
-        for r, inv in reversed(list(zip(chain.reductions[:-1], self.inverse))):
-            sol = r.invert(sol, inv)
+        # two markers: the positions 1..n, and seeded random reals (an entry that
+        # cvxpy combines from several entries of x, e.g. an average, matches
+        # one random marker only by a measure-zero accident)
+        noise = np.random.default_rng(MARKER_SEED).standard_normal(n)
+        values = []
+        for marker in (np.arange(1.0, n + 1.0), noise):
+            # the solver step's own inversion gives {var_id: x}; invert the rest
+            sol = Solution(cps.OPTIMAL, 0.0, {var_id: marker}, {}, {})
+            for r, inv in reversed(list(zip(chain.reductions[:-1], self.inverse))):
+                sol = r.invert(sol, inv)
+            values.append(sol.primal_vars)
         self.take = {}
         for v in problem.variables():
-            val = np.asarray(sol.primal_vars[v.id], dtype=float)
-            idx = val.ravel(order="F")
-            if not (np.all(idx == np.round(idx)) and np.all((idx >= 1) & (idx <= n))):
+            val = np.asarray(values[0][v.id], dtype=float)
+            pos = val.ravel(order="F")
+            if not (np.all(pos == np.round(pos)) and np.all((pos >= 1) & (pos <= n))):
                 return
-            self.take[v.id] = (v, idx.astype(np.intp) - 1, val.shape)
+            idx = pos.astype(np.intp) - 1
+            if not np.array_equal(np.asarray(values[1][v.id], dtype=float).ravel(order="F"),
+                                  noise[idx]):
+                return
+            self.take[v.id] = (v, idx, val.shape)
         self.var_id = var_id
         self.values_ok = True
 
