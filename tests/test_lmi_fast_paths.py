@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from workbench.lmi import core, gain, primal
-from workbench.lmi.analysis import BesselLegendreLMI
+from workbench.lmi.analysis import BesselLegendreLMI, DelayIndependentLMI
 from workbench.lmi.core import IMPLIED, Outcome
 from workbench.lmi.freeweighting003 import FreeWeighting003, FreeWeighting003FixedK
 from workbench.lmi.interval import IntervalLMI
@@ -113,7 +113,8 @@ def _vary(lmi, i):
     lambda: FreeWeighting003FixedK(A2, B2, 0.3, K=[[-1.0, -2.0]], shared=True),
     lambda: BesselLegendreLMI(AW, ADW, N=2),
     lambda: IntervalLMI(BesselLegendreLMI(AW, ADW, N=2), from_zero=False),
-], ids=["free-weighting-003", "fixed-gain", "bessel-legendre", "interval"])
+    lambda: DelayIndependentLMI(AW, ADW),
+], ids=["free-weighting-003", "fixed-gain", "bessel-legendre", "interval", "no-parameter"])
 def test_lean_repeat_solves_are_cvxpys_bit_for_bit(make, monkeypatch):
     old, lmi = make(), make()
     # certified, refuted and near-boundary delays

@@ -121,7 +121,8 @@ class _Lean:
 
     def data(self, pvec) -> dict:
         """The solver's data at parameter vector ``pvec`` (cvxpy's layout)."""
-        flat = self.mat @ pvec
+        # (no parameter: cvxpy flattens the constant map itself)
+        flat = self.mat.toarray().flatten() if pvec is None else self.mat @ pvec
         A = sp.csc_array((-flat[:self.nnz_A], self.A_indices, self.A_indptr),
                          shape=(self.m, self.n))
         b = np.zeros(self.m)
