@@ -11,8 +11,13 @@ compilations excluded by a warm-up, as in a long-running session):
   ``workbench.lmi.primal.FULL_UNPACK``) and every probe of the gain's
   bisection solved (``workbench.lmi.gain.IMPLIED_PROBES = False``);
 * ``before synth36``: the shared fixed-gain LMI, the other two as above;
-* ``after``: primal-only unpacking and the gain's probes at or above the
-  synthesis's refuted delay decided without a solve.
+* ``before synth36b``: primal-only unpacking and the gain's probes at or
+  above the synthesis's refuted delay decided without a solve, every solve
+  through cvxpy's ``get_problem_data`` and ``unpack_results``
+  (``workbench.lmi.primal.LEAN = False``);
+* ``after``: the same with repeat solves on the lean path (the compiled
+  parameter map applied directly, the values taken from Clarabel's ``x``:
+  :mod:`workbench.lmi.primal`).
 
 It prints the best CPU and wall seconds of each, the solver calls, and
 whether the three paths printed the same table (they must: the same data
@@ -25,11 +30,17 @@ Clarabel (``solve_via_data``), cvxpy's unpacking of the solution and the
 rest (re-checks, exact margins). With ``--study [DESIGN ...]`` also the CPU
 and wall seconds of ``workbench verify`` of each design (default
 ``designs/delay-benchmarks.toml``) in fresh processes, before synth36 (full
-unpacking, every gain probe solved) and after. Nothing here asserts a time.
+unpacking, every gain probe solved) and after. With ``--examples NAME,...``
+the delay benchmark's examples (``designs/delay-benchmarks.toml``) are run
+in ONE process, cvxpy's per-solve path (``primal.LEAN = False``) and the lean
+repeat solve alternated for ``--repeat`` rounds: at a high machine load two
+fresh processes do not resolve a 15 % difference, the alternation does.
+Nothing here asserts a time.
 
 Usage::
 
     python benchmarks/synthesize_times.py [designs/X.toml] [--repeat N] [--study [DESIGN ...]]
+        [--examples classic-2x2,scalar-a1-b2]
 """
 from __future__ import annotations
 
@@ -72,16 +83,17 @@ def _timed(split: dict) -> None:
 
 
 #: The paths timed (module docstring): (name, WORKBENCH_SYNTH_UNSHARED,
-#: ``primal.FULL_UNPACK``, ``gain.IMPLIED_PROBES``).
-PATHS = (("before issue 36 (unshared fixed-K LMI)", "1", True, False),
-         ("before synth36", "0", True, False),
-         ("after", "0", False, True))
+#: ``primal.FULL_UNPACK``, ``gain.IMPLIED_PROBES``, ``primal.LEAN``).
+PATHS = (("before issue 36 (unshared fixed-K LMI)", "1", True, False, False),
+         ("before synth36", "0", True, False, False),
+         ("before synth36b", "0", False, True, False),
+         ("after", "0", False, True, True))
 
 
-def _set_path(unshared: str, full: bool, implied: bool) -> None:
+def _set_path(unshared: str, full: bool, implied: bool, lean: bool) -> None:
     from workbench.lmi import gain, primal
     os.environ["WORKBENCH_SYNTH_UNSHARED"] = unshared
-    primal.FULL_UNPACK, gain.IMPLIED_PROBES = full, implied
+    primal.FULL_UNPACK, gain.IMPLIED_PROBES, primal.LEAN = full, implied, lean
 
 
 def worker(path: str, repeat: int) -> None:
@@ -120,6 +132,27 @@ def worker(path: str, repeat: int) -> None:
     print(json.dumps(out), flush=True)
 
 
+def examples_worker(names: str, repeat: int) -> None:
+    """CPU s of ``run_example`` per example, full and lean path alternated; one JSON line."""
+    from workbench import benchmark as bm
+    from workbench.design import load_design
+    from workbench.lmi import primal
+    design = load_design("designs/delay-benchmarks.toml")
+    out = {}
+    for name in names.split(","):
+        ex = next((e for e in design.spec.examples if e.name == name), None)
+        if ex is None:
+            sys.exit(f"--examples: {name!r} is not an example of designs/delay-benchmarks.toml")
+        out[name] = {"full": [], "lean": []}
+        for _ in range(repeat):
+            for path, lean in (("full", False), ("lean", True)):
+                primal.LEAN = lean
+                c0 = _cpu()
+                bm.run_example(ex, design.spec.settings)
+                out[name][path].append(round(_cpu() - c0, 2))
+    print(json.dumps(out), flush=True)
+
+
 def command_times(args: list[str]) -> tuple[float, float]:
     """(CPU s as user + system, wall s) of a fresh Python process running ``args``."""
     before, w0 = os.times(), time.perf_counter()
@@ -137,11 +170,15 @@ def run(path: str, repeat: int) -> dict:
     return json.loads([line for line in p.stdout.splitlines() if line.startswith("{")][-1])
 
 
-#: ``workbench verify`` of a design in a fresh process with cvxpy's full unpacking.
-VERIFY_BEFORE = ("import sys, workbench.lmi.primal as p, workbench.lmi.gain as g; "
-                 "p.FULL_UNPACK, g.IMPLIED_PROBES = True, False; "
-                 "from workbench.cli import main; sys.exit(main(sys.argv[1:]))")
-VERIFY_AFTER = "import sys; from workbench.cli import main; sys.exit(main(sys.argv[1:]))"
+#: ``workbench verify`` of a design in a fresh process: (name, code) before
+#: synth36 (cvxpy's full unpacking, every gain probe solved), before synth36b
+#: (no lean repeat solves) and after.
+VERIFY = (("before synth36", "import sys, workbench.lmi.primal as p, workbench.lmi.gain as g; "
+           "p.FULL_UNPACK, g.IMPLIED_PROBES, p.LEAN = True, False, False; "
+           "from workbench.cli import main; sys.exit(main(sys.argv[1:]))"),
+          ("before synth36b", "import sys, workbench.lmi.primal as p; p.LEAN = False; "
+           "from workbench.cli import main; sys.exit(main(sys.argv[1:]))"),
+          ("after", "import sys; from workbench.cli import main; sys.exit(main(sys.argv[1:]))"))
 
 
 def main() -> None:
@@ -151,10 +188,18 @@ def main() -> None:
     ap.add_argument("--study", nargs="*", metavar="DESIGN",
                     help="also time workbench verify of these designs, before and after "
                          "(default designs/delay-benchmarks.toml)")
+    ap.add_argument("--skip-oldest", action="store_true",
+                    help="with --study: leave out the path before synth36")
+    ap.add_argument("--examples", metavar="NAME,...",
+                    help="delay-benchmark examples to time in one process, full and lean "
+                         "path alternated")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.worker:
-        worker(args.design, args.repeat)
+        if args.examples:
+            examples_worker(args.examples, args.repeat)
+        else:
+            worker(args.design, args.repeat)
         return
     print(f"machine: {os.cpu_count()} CPUs, {len(os.sched_getaffinity(0))} granted; "
           f"load average {os.getloadavg()[0]:.1f} at start")
@@ -176,9 +221,21 @@ def main() -> None:
     new = res["after"]
     parts = " | ".join(f"{k} {v:.2f}" for k, v in new["split"].items())
     print(f"best sweep after, CPU s: {parts} (total {new['cpu']:.2f}; {new['solves']} solves)")
+    if args.examples:
+        p = subprocess.run([sys.executable, __file__, "--worker", "--examples", args.examples,
+                            "--repeat", str(args.repeat)], cwd=ROOT, capture_output=True,
+                           text=True)
+        if p.returncode:
+            sys.exit(f"worker exited {p.returncode}:\n{p.stderr[-3000:]}")
+        res = json.loads([line for line in p.stdout.splitlines() if line.startswith("{")][-1])
+        print("\n| example | cvxpy per-solve path, CPU s per round | lean, CPU s per round |")
+        print("| --- | ---: | ---: |")
+        for name, r in res.items():
+            print(f"| {name} | {', '.join(map(str, r['full']))} | "
+                  f"{', '.join(map(str, r['lean']))} |")
     if args.study is not None:
         for design in args.study or ["designs/delay-benchmarks.toml"]:
-            for name, code in (("before synth36", VERIFY_BEFORE), ("after", VERIFY_AFTER)):
+            for name, code in VERIFY[1:] if args.skip_oldest else VERIFY:
                 cpu, wall = command_times(["-c", code, "verify", design])
                 print(f"workbench verify {design}, {name}: {cpu:.1f} CPU s, {wall:.1f} s wall",
                       flush=True)

@@ -7,6 +7,11 @@
 * The canonical gain's bisection decides its probes at or above the
   synthesis's refuted delay without a solve: the same probes, the same bracket
   and gain, fewer solver calls.
+* Repeat solves of a compiled problem take the lean path
+  (:class:`workbench.lmi.primal._Lean`): the same data arrays and the same
+  values as cvxpy's ``get_problem_data`` and ``unpack_results``, bit for bit,
+  whatever parameter changed (delay, eps, a shared gain, an interval's lower
+  end); a map that does not reproduce cvxpy's is not used.
 """
 from __future__ import annotations
 
@@ -14,10 +19,11 @@ import cvxpy as cp
 import numpy as np
 import pytest
 
-from workbench.lmi import core, gain
-from workbench.lmi.analysis import BesselLegendreLMI
+from workbench.lmi import core, gain, primal
+from workbench.lmi.analysis import BesselLegendreLMI, DelayIndependentLMI
 from workbench.lmi.core import IMPLIED, Outcome
-from workbench.lmi.freeweighting003 import FreeWeighting003
+from workbench.lmi.freeweighting003 import FreeWeighting003, FreeWeighting003FixedK
+from workbench.lmi.interval import IntervalLMI
 from workbench.synthesis import synthesize_delay_bound
 
 A2 = np.array([[0.0, 1.0], [-2.0, -0.5]])
@@ -87,3 +93,73 @@ def test_no_implied_probe_without_a_bounded_gain():
         below = [s for s in g.analysis.steps if s.h < 1e-3]
         assert not any(s.solver_status.startswith(IMPLIED) for s in below)
         assert g.analysis.solves == len(below) + (0 if bounded else len(above))
+
+
+AW, ADW = np.array([[-2.0, 0.0], [0.0, -0.9]]), np.array([[-1.0, 0.0], [-1.0, -1.0]])
+
+
+def _vary(lmi, i):
+    """Change every parameter of ``lmi`` besides the delay for solve ``i``."""
+    if isinstance(lmi, FreeWeighting003FixedK):
+        lmi.set_gain([[-1.0 - 0.25 * i, -2.0 + 0.125 * i]])
+    if isinstance(lmi, FreeWeighting003):
+        lmi.set_eps(0.3 + 0.01 * i)
+    if isinstance(lmi, IntervalLMI):
+        lmi.set_lower(0.05 * (i + 1))
+
+
+@pytest.mark.parametrize("make", [
+    lambda: FreeWeighting003(A2, B2, 0.3),
+    lambda: FreeWeighting003FixedK(A2, B2, 0.3, K=[[-1.0, -2.0]], shared=True),
+    lambda: BesselLegendreLMI(AW, ADW, N=2),
+    lambda: IntervalLMI(BesselLegendreLMI(AW, ADW, N=2), from_zero=False),
+    lambda: DelayIndependentLMI(AW, ADW),
+], ids=["free-weighting-003", "fixed-gain", "bessel-legendre", "interval", "no-parameter"])
+def test_lean_repeat_solves_are_cvxpys_bit_for_bit(make, monkeypatch):
+    old, lmi = make(), make()
+    # certified, refuted and near-boundary delays
+    for i, h in enumerate((0.05, 0.6, 3.0, 1.0, 6.2, 6.3, 0.01)):
+        for twin, lean in ((old, False), (lmi, True)):
+            monkeypatch.setattr(primal, "LEAN", lean)
+            _vary(twin, i)
+            twin.set_delay(h)
+            core.guarded_solve(twin._problem)
+        full, fast = _values(old), _values(lmi)
+        assert fast[2] == full[2] and fast[1] == full[1]
+        assert all(np.array_equal(fast[0][k], full[0][k]) for k in full[0])
+    maps = lmi._problem._workbench_lean           # ... and the lean maps were used
+    assert maps.data_ok and maps.values_ok
+    assert not hasattr(old._problem, "_workbench_lean")
+
+
+def test_lean_data_map_that_differs_from_cvxpys_is_not_used():
+    lmi = FreeWeighting003(A2, B2, 0.3)
+    lmi.set_delay(0.1)
+    p = lmi._problem
+    data, chain, inverse = p.get_problem_data(cp.CLARABEL, solver_opts={})
+    assert primal._Lean(p, data, chain, inverse).data_ok
+    tampered = dict(data, A=data["A"].copy())
+    tampered["A"].data[0] = np.nextafter(tampered["A"].data[0], np.inf)
+    assert not primal._Lean(p, tampered, chain, inverse).data_ok
+
+
+def test_lean_value_map_that_combines_entries_is_not_used(monkeypatch):
+    lmi = FreeWeighting003(A2, B2, 0.3)
+    lmi.set_delay(0.1)
+    p = lmi._problem
+    data, chain, inverse = p.get_problem_data(cp.CLARABEL, solver_opts={})
+    assert primal._Lean(p, data, chain, inverse).values_ok
+    first, L = chain.reductions[0], lmi._vars["L"]
+    invert = first.invert
+
+    def mixed(solution, inv):
+        # L[0, 0] = a + (b - floor(b)) with b = L[1, 1]: on the positions marker
+        # (integers) a copy of a, on the random marker not: only the second marker
+        # can reject this map
+        sol = invert(solution, inv)
+        x = np.array(sol.primal_vars[L.id], dtype=float)
+        x[0, 0] = x[0, 0] + (x[1, 1] - np.floor(x[1, 1]))
+        sol.primal_vars[L.id] = x
+        return sol
+    monkeypatch.setattr(first, "invert", mixed)
+    assert not primal._Lean(p, data, chain, inverse).values_ok
