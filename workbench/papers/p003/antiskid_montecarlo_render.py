@@ -15,6 +15,27 @@ _DRAW_LABELS = (("mass", "mass factor"), ("adhesion", "adhesion s"), ("h", "h (s
                 ("v0", "v(0) (m/s)"))
 
 
+def refined_runs_text(n: int, big: int | None) -> str:
+    """What the three-level refinement of the Monte Carlo findings covers
+    when only the first ``n`` of ``big`` runs are run at dt/2 and dt/4
+    (:func:`workbench.papers.p003.antiskid_refine.mc_share_levels`; empty
+    when every run is)."""
+    if big is None or n >= big:
+        return ""
+    return (f"\n\n**Refinement of the Monte Carlo findings.** A finding on the share of an "
+            f"outcome is checked at the sweep's dt (all {big} runs), dt / 2 (the first {n}: "
+            f"this check) and dt / 4 (the first {n} once more; see the refinement of the "
+            f"findings). The other {big - n} runs are not run at dt / 2 and dt / 4 but bounded: "
+            f"if k of the first {n} have the outcome there, between k and k + {big - n} of the "
+            f"{big} runs have it, whatever the others do. A level decides a finding when its "
+            f"verdict is the same at every count of that range; the finding has converged "
+            f"when dt, dt / 2 and dt / 4 decide it the same way, and is INCONCLUSIVE otherwise "
+            f"(the refinement table shows each level's count and verdict). A claim that no "
+            f"run has the outcome is decided by one refined run that has it at every level; a "
+            f"bound on the rate (a Wilson interval's end) may need more of the {big} runs than "
+            f"the {n} refined, and is then INCONCLUSIVE.")
+
+
 def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
     """Markdown (no heading) of a :class:`HalvingCheck`: what was done, a
     row per metric (runs finite at both steps, runs that agree, largest
@@ -48,6 +69,8 @@ def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
         ["outcome", "runs at dt", "runs at dt / 2", f"agree (of {n})"],
         [[f"`{o}`", sum(hc.coarse[o]), sum(hc.fine[o]), sum(hc.agree[o])]
          for o in HALVING_OUTCOMES], "lrrr")
+    tail = refined_runs_text(n, None if spec is None or spec.montecarlo is None else
+                             spec.montecarlo.samples)
     labels = tuple(("delay_period", "h(t) period (s)") if d == "h" and "delay_period" in hc.draws
                    else (d, lab) for d, lab in _DRAW_LABELS)    # the h draw unused then
     bad = [[i] + [fmt(hc.draws[d][i], 4) for d, _ in labels]
@@ -55,10 +78,10 @@ def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
            for i in range(n) for key in hc.agree if not hc.agree[key][i]]
     text += "\n\nRuns that disagree:"
     if not bad:
-        return text + " none."
+        return text + " none." + tail
     return text + "\n\n" + md_table(["run"] + [lab for _, lab in labels]
                                     + ["metric or outcome", "at dt", "at dt / 2"],
-                                    bad, "rrrrrlrr")
+                                    bad, "rrrrrlrr") + tail
 
 
 def draw_histograms(fig, res: SweepResult) -> None:
