@@ -34,10 +34,11 @@ def _claim(cid, quantity, compare, value, tol=0.0, expect="pass"):
 
 
 def test_three_level_check_of_a_rate_metric():
-    ok = S.three_level_check("zoh_q_tau", 100.0, "evs_max_tracking", EVS_100)
+    tol = S.MESH_ATOL["evs_max_tracking"]
+    ok = S.three_level_check("zoh_q_tau", 100.0, "evs_max_tracking", EVS_100, tol)
     assert ok.converged and ok.estimate < 1e-5 and ok.tolerance == S.MESH_ATOL[
         "evs_max_tracking"] and ok.reason() == ""
-    bad = S.three_level_check("zoh_q_tau", 200.0, "evs_max_tracking", EVS_200)
+    bad = S.three_level_check("zoh_q_tau", 200.0, "evs_max_tracking", EVS_200, tol)
     # every difference is below the two-level screen's 2e-4; the guarded
     # estimate (sign change: the larger difference at order 0.5) is not
     assert max(abs(a - b) for a, b in zip(EVS_200, EVS_200[1:])) < 2e-4
@@ -74,11 +75,12 @@ def test_a_non_converged_mesh_metric_makes_the_mesh_claim_inconclusive():
     and the section's three-level table says which metric and why."""
     from workbench.papers.p003.antiskid_sampled_render import three_level_text
     claim = _claim("mesh", "sampled.zoh.mesh_converged", "==", "yes")
-    good = (S.three_level_check("zoh", 100.0, "evs_max_tracking", EVS_100),)
+    tol = S.MESH_ATOL["evs_max_tracking"]
+    good = (S.three_level_check("zoh", 100.0, "evs_max_tracking", EVS_100, tol),)
     q = S.sampled_quantities(_result(good))
     assert q["sampled.zoh.mesh_converged"] == "yes"
     assert check_claim(claim, q["sampled.zoh.mesh_converged"]).verdict is Verdict.PASS
-    bad = good + (S.three_level_check("zoh", 200.0, "evs_max_tracking", EVS_200),)
+    bad = good + (S.three_level_check("zoh", 200.0, "evs_max_tracking", EVS_200, tol),)
     res = _result(bad)
     q = S.sampled_quantities(res)
     assert q["sampled.zoh.mesh_converged"] is None

@@ -286,5 +286,6 @@ def _own_row(r: ClaimResult, lv: Levels | None, field: str) -> RefinementRow:
         return RefinementRow(r.claim.id, r.claim.quantity, (), None, INCONCLUSIVE, None,
                              f"not converged: no three-level check ({why})",
                              lv.label if lv else "")
-    return _row(r.claim, lv.values, field, r.got, lv.label, guarded=True, decides=lv.decides)
+    return _row(r.claim, lv.values, field, r.got, lv.label, guarded=True,
+                decides=lv.decides)
 

@@ -57,10 +57,10 @@ import numpy as np
 
 from ...jsonable import json_method
 from ...reader import Quantity
-from ...refinement import guarded_check
-from ...sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
 from .antiskid_sampled_check import RADAU_QUANTITIES, radau_checks, radau_quantities
 from .antiskid_sampled_kernel import OUT, Context, run_once
+from .antiskid_sampled_levels import (BRAKING_METRICS, TRACTION_METRICS, ThreeLevel,  # noqa: F401
+                                      scenarios_of, three_level_check)
 
 #: Grid rates up to this (Hz) are run again at plant_step / 2.
 MESH_CHECK_MAX_HZ = 1000.0
@@ -75,10 +75,6 @@ RATE_METRICS = ("lam_max_over_opt", "time_above", "t_cruise", "u_max_over_peak",
 TRACE_RATES_HZ, TRACE_SECONDS = (100.0, 1000.0), 4.0
 #: Metrics compared between the highest grid rate and the emulation.
 GAP_METRICS = ("lam_max_over_opt", "t_cruise", "braking_duration", "stop_distance")
-#: Rate metrics of the traction run and of the braking run (the others need both).
-TRACTION_METRICS = ("lam_max_over_opt", "time_above", "t_cruise", "traction_ok")
-BRAKING_METRICS = ("braking_duration", "stop_distance", "lam_min_brake", "evs_max_tracking",
-                   "omega3_after_brake", "braking_ok")
 #: Rate quantities that are a difference to the emulation -> the rate metric they move with
 #: (the emulation does not depend on plant_step).
 TO_EMULATION = {"stop_time_minus_emulation": "braking_duration",
@@ -208,41 +204,6 @@ class Variant:
 
 
 @dataclass(frozen=True)
-class ThreeLevel:
-    """A claimed rate metric at plant_step, plant_step / 2, plant_step / 4.
-
-    ``values``: (q1, q2, q4); ``tolerance``: the bound of the Richardson
-    estimate (:data:`MESH_ATOL`, 0 for a metric without one; None for an
-    outcome, which converges when the three levels agree); ``outcome``: a
-    :mod:`workbench.sim.convergence` outcome; ``estimate``: the Richardson
-    estimate of the error of q4 (None for an outcome); ``note``: why an
-    estimate was guarded (empty otherwise)."""
-
-    variant: str
-    rate: float
-    metric: str
-    values: tuple
-    tolerance: float | None
-    outcome: str
-    estimate: float | None = None
-    note: str = ""
-
-    @property
-    def converged(self) -> bool:
-        return self.outcome == CONVERGED
-
-    def reason(self) -> str:
-        """``not converged: ...`` (empty when converged)."""
-        if self.converged:
-            return ""
-        shown = " / ".join(str(x) if isinstance(x, str) else f"{x:.6g}" for x in self.values)
-        est = "" if self.estimate is None else (f", estimate {self.estimate:.2g} > tolerance "
-                                                f"{self.tolerance:.2g}")
-        return (f"not converged: {self.variant} {self.rate:g} Hz {self.metric} is {shown} at "
-                f"plant_step, /2, /4{est}" + (f" ({self.note})" if self.note else ""))
-
-
-@dataclass(frozen=True)
 class Trace:
     """lambda / lambda_opt - 1 on the plant's mesh from the start of traction."""
 
@@ -317,11 +278,6 @@ def rate_row(ctx: Context, rate: float, *, dt_p: float, predictor_step: float,
     return RateRow(rate, rate_metrics(ctx, trac, brake), probe)
 
 
-def scenarios_of(metric: str) -> tuple:
-    """The scenarios (0 traction, 1 braking) a rate metric is computed from."""
-    return (0,) if metric in TRACTION_METRICS else (1,) if metric in BRAKING_METRICS else (0, 1)
-
-
 def partial_row(ctx: Context, rate: float, scenarios: tuple, *, dt_p: float,
                 predictor_step: float, q: float = 0.0, tau: float = 0.0) -> RateRow:
     """The metrics of ``scenarios`` (0 traction, 1 braking) at one rate:
@@ -335,27 +291,6 @@ def partial_row(ctx: Context, rate: float, scenarios: tuple, *, dt_p: float,
             + (("u_max_over_peak", "ok") if len(set(scenarios)) == 2 else ()))
     m = rate_metrics(ctx, trac, brake)
     return RateRow(rate, {k: m[k] for k in keep})
-
-
-def three_level_check(variant: str, rate: float, metric: str, values: tuple) -> ThreeLevel:
-    """The three-level check of one rate metric (``values`` at plant_step,
-    /2, /4): an outcome converges when the three agree; a number when every
-    level is NaN (not reached), or by
-    :func:`workbench.refinement.guarded_check` with the tolerance of the
-    section (:data:`MESH_ATOL`; 0, rounding only, for a metric without one);
-    NaN at some levels only is INCONCLUSIVE."""
-    if any(isinstance(x, str) for x in values):
-        same = len(set(values)) == 1
-        return ThreeLevel(variant, rate, metric, values, None,
-                          CONVERGED if same else NOT_CONVERGED)
-    tol = MESH_ATOL.get(metric, 0.0)
-    nans = sum(math.isnan(x) for x in values)
-    if nans:
-        return ThreeLevel(variant, rate, metric, values, tol,
-                          CONVERGED if nans == 3 else INCONCLUSIVE, None,
-                          "" if nans == 3 else "reached at some levels only")
-    r = guarded_check(*values, tolerance=tol)
-    return ThreeLevel(variant, rate, metric, values, tol, r.outcome, r.estimate, r.note)
 
 
 def _three_level(ctx, spec: SampledSpec, name, q, tau, rows, fines) -> tuple:
@@ -372,8 +307,8 @@ def _three_level(ctx, spec: SampledSpec, name, q, tau, rows, fines) -> tuple:
                     for rate, sc in sorted(need.items()))
     by = lambda rr, f: next(r for r in rr if r.rate == f)     # noqa: E731
     checks = tuple(three_level_check(name, rate, metric, tuple(
-        by(rr, rate).metrics[metric] for rr in (rows, fines, quarter)))
-        for v, rate, metric in spec.three_level if v == name)
+        by(rr, rate).metrics[metric] for rr in (rows, fines, quarter)),
+        MESH_ATOL.get(metric, 0.0)) for v, rate, metric in spec.three_level if v == name)
     return checks, quarter
 
 
