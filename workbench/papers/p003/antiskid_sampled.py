@@ -43,8 +43,9 @@ to :data:`MESH_CHECK_MAX_HZ` again at ``plant_step`` / 2
 design compares (``sampled.<variant>.rate[<f>].<metric>``, f up to
 :data:`MESH_CHECK_MAX_HZ`) at three levels, plant_step, /2 (the screen's
 run) and /4 (only the scenario the metric needs), with a Richardson
-estimate of its error (:func:`three_level_rows`, issue 33 item 4); and the
-plant's mesh against scipy's Radau (:mod:`.antiskid_sampled_check`).
+estimate of its error (:func:`.antiskid_sampled_levels.three_level_check`,
+issue 33 item 4); and the plant's mesh against scipy's Radau
+(:mod:`.antiskid_sampled_check`).
 """
 from __future__ import annotations
 
