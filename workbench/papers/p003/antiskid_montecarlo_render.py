@@ -22,7 +22,7 @@ def refined_runs_text(n: int, big: int | None) -> str:
     when every run is)."""
     if big is None or n >= big:
         return ""
-    return (f"\n\n**Refinement of the Monte Carlo findings.** A finding on the share of an "
+    return (f" **Refinement of the Monte Carlo findings.** A finding on the share of an "
             f"outcome is checked at the sweep's dt (all {big} runs), dt / 2 (the first {n}: "
             f"this check) and dt / 4 (the first {n} once more; see the refinement of the "
             f"findings). The other {big - n} runs are not run at dt / 2 and dt / 4 but bounded: "
@@ -55,7 +55,9 @@ def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
             f"(else 0); two missing values agree, a missing and a finite one do not; "
             f"`lam_max_over_opt` is not compared for a run that diverged in traction at "
             f"either step. An outcome agrees when it is the same at both steps. "
-            f"**{k} of {n} runs agree in every metric and outcome.**\n\n")
+            f"**{k} of {n} runs agree in every metric and outcome.**")
+    text += refined_runs_text(n, None if spec is None or spec.montecarlo is None else
+                              spec.montecarlo.samples) + "\n\n"
     rows = []
     for m in HALVING_METRICS:
         a, b = np.asarray(hc.coarse[m], float), np.asarray(hc.fine[m], float)
@@ -69,8 +71,6 @@ def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
         ["outcome", "runs at dt", "runs at dt / 2", f"agree (of {n})"],
         [[f"`{o}`", sum(hc.coarse[o]), sum(hc.fine[o]), sum(hc.agree[o])]
          for o in HALVING_OUTCOMES], "lrrr")
-    tail = refined_runs_text(n, None if spec is None or spec.montecarlo is None else
-                             spec.montecarlo.samples)
     labels = tuple(("delay_period", "h(t) period (s)") if d == "h" and "delay_period" in hc.draws
                    else (d, lab) for d, lab in _DRAW_LABELS)    # the h draw unused then
     bad = [[i] + [fmt(hc.draws[d][i], 4) for d, _ in labels]
@@ -78,10 +78,10 @@ def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
            for i in range(n) for key in hc.agree if not hc.agree[key][i]]
     text += "\n\nRuns that disagree:"
     if not bad:
-        return text + " none." + tail
+        return text + " none."
     return text + "\n\n" + md_table(["run"] + [lab for _, lab in labels]
                                     + ["metric or outcome", "at dt", "at dt / 2"],
-                                    bad, "rrrrrlrr") + tail
+                                    bad, "rrrrrlrr")
 
 
 def draw_histograms(fig, res: SweepResult) -> None:
