@@ -124,7 +124,7 @@ def test_a_partial_row_is_the_rate_row_of_its_scenarios():
     from workbench.papers.p003.antiskid_run_spec import sampled_context
     design = load_design(DRY)
     ctx = sampled_context(design.spec, design.spec.K_table)
-    kw = dict(dt_p=4e-4, predictor_step=1e-3, q=8.0, tau=0.002)
+    kw = dict(dt_p=1e-3, predictor_step=1e-3, q=8.0, tau=0.002)
     full = S.rate_row(ctx, 100.0, **kw).metrics
     brake = S.partial_row(ctx, 100.0, (1,), **kw).metrics
     assert set(brake) == set(S.BRAKING_METRICS) | {"braking_diverged"}
