@@ -45,7 +45,10 @@ class Levels:
     the refined parameter (e.g. ``"dt"``, ``"plant_step"``) and ``step``
     its designed value (the levels are it, its half, its quarter; ``unit``
     its unit); ``reason``: set (and ``values`` empty) when the metric has
-    no three-level check, which makes the finding INCONCLUSIVE.
+    no three-level check, which makes the finding INCONCLUSIVE;
+    ``decides``: for word values, the part of each level that must agree
+    (e.g. the claim's verdict at that level, where ``values`` also show the
+    counts behind it; empty: the values themselves).
     """
 
     values: tuple
@@ -53,6 +56,7 @@ class Levels:
     step: float | None = None
     unit: str = "s"
     reason: str = ""
+    decides: tuple = ()
 
     @property
     def label(self) -> str:
@@ -184,7 +188,7 @@ def screen(values: dict, tolerances: dict) -> tuple[str | None, tuple[str, ...]]
 
 
 def _row(c: Claim, values: tuple, field: str, got, parameter: str = "",
-         guarded: bool = False) -> RefinementRow:
+         guarded: bool = False, decides: tuple = ()) -> RefinementRow:
     tol = claim_tolerance(c, got)
     levels = f"{field}, {field}/2, {field}/4"
     if parameter:
@@ -192,14 +196,14 @@ def _row(c: Claim, values: tuple, field: str, got, parameter: str = "",
         levels = f"{name}, {name}/2, {name}/4"
     instead = (f"`{c.converged_instead}`" if c.converged_instead else
                "a quantity that converges (the claim's `converged_instead`)")
-    row = _check(c, values, levels, tol, instead, guarded)
+    row = _check(c, values, levels, tol, instead, guarded, decides)
     return dataclasses.replace(row, parameter=parameter) if parameter else row
 
 
 def _check(c: Claim, values: tuple, levels: str, tol, instead: str,
-           guarded: bool = False) -> RefinementRow:
+           guarded: bool = False, decides: tuple = ()) -> RefinementRow:
     if tol is None or not all(isinstance(x, (int, float)) for x in values):
-        same = len({str(x) for x in values}) == 1
+        same = len({str(x) for x in (decides or values)}) == 1
         return RefinementRow(c.id, c.quantity, values, None, CONVERGED if same else NOT_CONVERGED,
                              None, "" if same else f"not converged: {c.quantity} is "
                              f"{' / '.join(str(x) for x in values)} at {levels}; "
@@ -282,5 +286,6 @@ def _own_row(r: ClaimResult, lv: Levels | None, field: str) -> RefinementRow:
         return RefinementRow(r.claim.id, r.claim.quantity, (), None, INCONCLUSIVE, None,
                              f"not converged: no three-level check ({why})",
                              lv.label if lv else "")
-    return _row(r.claim, lv.values, field, r.got, lv.label, guarded=True)
+    return _row(r.claim, lv.values, field, r.got, lv.label, guarded=True,
+                decides=lv.decides)
 

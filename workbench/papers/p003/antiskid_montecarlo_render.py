@@ -15,6 +15,27 @@ _DRAW_LABELS = (("mass", "mass factor"), ("adhesion", "adhesion s"), ("h", "h (s
                 ("v0", "v(0) (m/s)"))
 
 
+def refined_runs_text(n: int, big: int | None) -> str:
+    """What the three-level refinement of the Monte Carlo findings covers
+    when only the first ``n`` of ``big`` runs are run at dt/2 and dt/4
+    (:func:`workbench.papers.p003.antiskid_refine.mc_share_levels`; empty
+    when every run is)."""
+    if big is None or n >= big:
+        return ""
+    return (f" **Refinement of the Monte Carlo findings.** A finding on the share of an "
+            f"outcome is checked at the sweep's dt (all {big} runs), dt / 2 (the first {n}: "
+            f"this check) and dt / 4 (the first {n} once more; see the refinement of the "
+            f"findings). The other {big - n} runs are not run at dt / 2 and dt / 4 but bounded: "
+            f"if k of the first {n} have the outcome there, between k and k + {big - n} of the "
+            f"{big} runs have it, whatever the others do. A level decides a finding when its "
+            f"verdict is the same at every count of that range; the finding has converged "
+            f"when dt, dt / 2 and dt / 4 decide it the same way, and is INCONCLUSIVE otherwise "
+            f"(the refinement table shows each level's count and verdict). A claim that no "
+            f"run has the outcome is decided by one refined run that has it at every level; a "
+            f"bound on the rate (a Wilson interval's end) may need more of the {big} runs than "
+            f"the {n} refined, and is then INCONCLUSIVE.")
+
+
 def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
     """Markdown (no heading) of a :class:`HalvingCheck`: what was done, a
     row per metric (runs finite at both steps, runs that agree, largest
@@ -34,7 +55,9 @@ def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
             f"(else 0); two missing values agree, a missing and a finite one do not; "
             f"`lam_max_over_opt` is not compared for a run that diverged in traction at "
             f"either step. An outcome agrees when it is the same at both steps. "
-            f"**{k} of {n} runs agree in every metric and outcome.**\n\n")
+            f"**{k} of {n} runs agree in every metric and outcome.**")
+    text += refined_runs_text(n, None if spec is None or spec.montecarlo is None else
+                              spec.montecarlo.samples) + "\n\n"
     rows = []
     for m in HALVING_METRICS:
         a, b = np.asarray(hc.coarse[m], float), np.asarray(hc.fine[m], float)

@@ -13,13 +13,20 @@ level of what enters a finding, and only that:
 * ``switch.cruise[<case>].in_basin`` / ``switch.brake[<case>].in_basin``:
   the basin verdict of the switch state of the run at each of the three
   levels;
-* ``sampled.<variant>.rate[<f>].*``: the rate once more at plant_step/4;
-  the levels are plant_step (reported), plant_step/2 and plant_step/4;
-* ``montecarlo.*``: the first ``halving_samples`` runs of the sweep once
-  more at the sweep's dt/4 (compiled kernel when the sweep uses it); a
-  share claim is refined on the outcome behind it, per run: the row shows
-  how many of those runs have it at dt, dt/2, dt/4 (our choice: the whole
-  sample at dt/4 would cost four sweeps);
+* ``sampled.<variant>.rate[<f>].*``: the levels are plant_step (reported),
+  plant_step/2 and plant_step/4; at a rate up to 1 kHz the study has run
+  them already (its three-level check of every claimed rate metric,
+  :func:`~workbench.papers.p003.antiskid_sampled.run_variant`), above it
+  the rate is run here at /2 and /4;
+* ``montecarlo.*``: a share claim is refined on the outcome behind it,
+  per run: all N runs of the sweep at its dt, the first n
+  (``halving_samples``) again at dt/2 (the halving check) and at dt/4 (run
+  here, compiled kernel when the sweep uses it). At dt/2 and dt/4 the
+  other N - n runs are bounded, not run: the count lies in [k_n, k_n + N -
+  n] whatever they do, and a level decides the claim only when its verdict
+  is the same over that whole range (:func:`mc_share_levels`; our choice:
+  all 64 runs at dt/2 and dt/4 cost about 6 and 18 CPU s, against 1.2 and
+  2.7 s for the first 16);
 * ``basin.*`` of the k2 sweep: no step (a certificate at the printed switch
   state (v_d, lambda_opt)), the same value at every level.
 
@@ -38,7 +45,8 @@ import numpy as np
 from ...refinement import Levels, screen
 from ...report.markdown import fmt
 
-__all__ = ["last_refine_seconds", "quarter_cases", "refine_levels", "three_level_metrics"]
+__all__ = ["last_refine_seconds", "mc_share_levels", "quarter_cases", "refine_levels",
+           "three_level_metrics"]
 
 _CASE = re.compile(r"^cases\[([^\]]+)\]\.")
 _SWITCH = re.compile(r"^switch\.(cruise|brake)\[([^\]]+)\]\.in_basin$")
@@ -89,7 +97,7 @@ def refine_levels(design, result, findings, *, quantities, record_dt: float) -> 
         elif m_rate:
             lv = _rate_levels(spec, result, cache, m_rate.group(1), float(m_rate.group(2)), qn)
         elif qn in MC_OUTCOMES or qn == "montecarlo.halving.fraction_agree":
-            lv = _mc_levels(design, result, cache, qn)
+            lv = _mc_levels(design, result, cache, qn, r.claim)
         elif qn.startswith("basin."):
             v = fmt(r.got, 6)
             lv = Levels((v, v, v), "none (a certificate at the printed switch state, no step)")
@@ -174,21 +182,29 @@ def _switch_levels(spec, result, cache, which: str, name: str, got) -> Levels:
 def _rate_levels(spec, result, cache, variant: str, rate: float, qn: str) -> Levels:
     """A sampled rate's metric at plant_step (reported), /2 and /4."""
     from .antiskid_run_spec import sampled_context
-    from .antiskid_sampled import rate_row, sampled_quantities
+    from .antiskid_sampled import TO_EMULATION, rate_row, sampled_quantities
     sp = spec.sampled
     res = result.sampled
     v = res.variant(variant)
     if rate not in sp.rates:
         return Levels((), reason=f"rate {rate:g} Hz is not a grid rate")
-    ctx = cache.get("ctx") or cache.setdefault("ctx", sampled_context(spec, result.K))
     half = next((r for r in v.mesh_rows if r.rate == rate), None)   # the mesh check's
+    metric = qn.rsplit(".", 1)[1]
+    quarter = next((r for r in v.quarter_rows if r.rate == rate
+                    and TO_EMULATION.get(metric, metric) in r.metrics), None)
+    if quarter is not None:   # the study's three-level check ran the scenario at plant_step/4
+        quarter = dataclasses.replace(quarter, metrics={**v.row(rate).metrics,
+                                                        **quarter.metrics})
     rows = []
-    for k in (1, 2):
-        key = ("rate", variant, rate, k)
+    for k, have in ((1, half), (2, quarter)):
+        key = ("rate", variant, rate, k, None if have is None else metric)
         if key not in cache:
-            cache[key] = half if k == 1 and half is not None else rate_row(
-                ctx, rate, dt_p=sp.plant_step / 2 ** k, predictor_step=sp.predictor_step,
-                q=v.q, tau=v.tau)
+            if have is None:
+                ctx = cache.get("ctx") or cache.setdefault(
+                    "ctx", sampled_context(spec, result.K))
+                have = rate_row(ctx, rate, dt_p=sp.plant_step / 2 ** k,
+                                predictor_step=sp.predictor_step, q=v.q, tau=v.tau)
+            cache[key] = have
         rows.append(cache[key])
     vals = [sampled_quantities(res).get(qn)]
     for row in rows:
@@ -199,22 +215,68 @@ def _rate_levels(spec, result, cache, variant: str, rate: float, qn: str) -> Lev
     return Levels(tuple(vals), "plant_step", sp.plant_step)
 
 
-def _mc_levels(design, result, cache, qn: str) -> Levels:
-    """A Monte Carlo share on the first runs at the sweep's dt, dt/2, dt/4."""
+def _mc_levels(design, result, cache, qn: str, claim) -> Levels:
+    """A Monte Carlo share finding at the sweep's dt, dt/2, dt/4 (the
+    runs the halving check refines, :func:`mc_share_levels`)."""
     hc = result.halving
     if hc is None:
         return Levels((), reason="the design has no step check of its Monte Carlo runs")
-    if "mc" not in cache:
-        cache["mc"] = _mc_quarter(design, result, hc.n)
-    quarter = cache["mc"]
     if qn == "montecarlo.halving.fraction_agree":
         return Levels((), reason="a comparison of two steps, not a metric of the runs; the "
                       "outcomes behind the Monte Carlo findings are refined three levels in "
                       "the rows of the share findings (first runs at dt, dt/2, dt/4)")
+    if "mc" not in cache:
+        cache["mc"] = _mc_quarter(design, result, hc.n)
     key = MC_OUTCOMES[qn]
-    vals = tuple(f"{sum(bool(x) for x in lv[key])} of {hc.n} {key.replace('_', ' ')}"
-                 for lv in (hc.coarse, hc.fine, quarter))
-    return Levels(vals, f"montecarlo.dt (first {hc.n} runs)", hc.dt)
+    whole = result.montecarlo.violations[key]
+    return mc_share_levels(claim, key, whole, hc.fine[key], cache["mc"][key], hc.dt)
+
+
+def _share(qn: str, k: int, n: int) -> float:
+    """The value of Monte Carlo quantity ``qn`` when k of n runs have its outcome."""
+    from ...features.montecarlo import wilson_interval
+    if qn.startswith("montecarlo.fraction."):
+        return k / n
+    _, _, _, lo, hi = wilson_interval(k, n)
+    return lo if qn.endswith(".lo") else hi
+
+
+def mc_share_levels(claim, key: str, whole, half, quarter, dt: float) -> Levels:
+    """A share finding (``claim``, on ``montecarlo.fraction.<key>`` or
+    ``montecarlo.wilson.<key>.lo`` / ``.hi``) at the sweep's dt, dt/2 and
+    dt/4, when all N runs ran at dt (``whole``: N bools) and only the first
+    n again at dt/2 and dt/4 (``half``, ``quarter``: n bools each).
+
+    At dt the count k is known. At dt/2 and dt/4 the n refined runs give
+    k_n, and the other N - n runs, not run there, may have the outcome or
+    not: the count lies in [k_n, k_n + N - n], a bound that holds whatever
+    they do. The claim is checked at every count of that range: a level
+    *decides* the claim when the verdict is the same over the whole range
+    (``holds`` / ``fails``), else it is ``undecided``. The finding has
+    converged when the three levels decide it the same way (the values
+    show the counts, :attr:`Levels.decides` the verdicts); n = N refines
+    every run and the range is the count itself.
+    """
+    from ...claims import Verdict, check_claim
+    big, n = len(whole), len(half)
+    word = key.replace("_", " ")
+
+    def verdict(lo: int, hi: int) -> str:
+        got = {check_claim(claim, _share(claim.quantity, k, big)).verdict
+               for k in range(lo, hi + 1)}
+        if len(got) != 1:
+            return "undecided"
+        return {Verdict.PASS: "holds", Verdict.FAIL: "fails"}.get(got.pop(), "undecided")
+
+    k = sum(bool(x) for x in whole)
+    vals, dec = [f"{k} of {big} {word}: {verdict(k, k)}"], [verdict(k, k)]
+    for level in (half, quarter):
+        kn = sum(bool(x) for x in level)
+        v = verdict(kn, kn + big - n)
+        vals.append(f"{kn} of the first {n}, so {kn}-{kn + big - n} of {big} {word}: {v}"
+                    if n < big else f"{kn} of {big} {word}: {v}")
+        dec.append(v)
+    return Levels(tuple(vals), "montecarlo.dt", dt, decides=tuple(dec))
 
 
 def _mc_quarter(design, result, n: int) -> dict:

@@ -39,12 +39,19 @@ The lowest passing rate is the lowest grid rate from which every higher grid
 rate passes; between it and the grid rate below, ``bisect`` steps on log f_c
 give a bracket (assuming one crossing in between). Checks: every grid rate up
 to :data:`MESH_CHECK_MAX_HZ` again at ``plant_step`` / 2
-(:data:`MESH_ATOL`), and the plant's mesh against scipy's Radau
+(:data:`MESH_ATOL`, a two-level screen); every rate metric a claim of the
+design compares (``sampled.<variant>.rate[<f>].<metric>``, f up to
+:data:`MESH_CHECK_MAX_HZ`) at three levels, plant_step, /2 (the screen's
+run) and /4 (only the scenario the metric needs), with a Richardson
+estimate of its error (:func:`.antiskid_sampled_levels.three_level_check`,
+issue 33 item 4); and the plant's mesh against scipy's Radau
 (:mod:`.antiskid_sampled_check`).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -52,7 +59,9 @@ import numpy as np
 from ...jsonable import json_method
 from ...reader import Quantity
 from .antiskid_sampled_check import RADAU_QUANTITIES, radau_checks, radau_quantities
-from .antiskid_sampled_kernel import Context, run_once
+from .antiskid_sampled_kernel import OUT, Context, run_once
+from .antiskid_sampled_levels import (BRAKING_METRICS, TRACTION_METRICS, ThreeLevel,  # noqa: F401
+                                      scenarios_of, three_level_check)
 
 #: Grid rates up to this (Hz) are run again at plant_step / 2.
 MESH_CHECK_MAX_HZ = 1000.0
@@ -67,6 +76,11 @@ RATE_METRICS = ("lam_max_over_opt", "time_above", "t_cruise", "u_max_over_peak",
 TRACE_RATES_HZ, TRACE_SECONDS = (100.0, 1000.0), 4.0
 #: Metrics compared between the highest grid rate and the emulation.
 GAP_METRICS = ("lam_max_over_opt", "t_cruise", "braking_duration", "stop_distance")
+#: Rate quantities that are a difference to the emulation -> the rate metric they move with
+#: (the emulation does not depend on plant_step).
+TO_EMULATION = {"stop_time_minus_emulation": "braking_duration",
+                "stop_distance_minus_emulation": "stop_distance"}
+_RATE_QUANTITY = re.compile(r"^sampled\.([a-z_]+)\.rate\[([^\]]+)\]\.([a-z0-9_]+)$")
 
 
 @dataclass(frozen=True)
@@ -81,6 +95,9 @@ class SampledSpec:
     bisect: int
     quantisation: Quantity | None
     measurement_delay: Quantity | None
+    #: ((variant, rate, metric), ...): the rate metrics the design's claims
+    #: compare, checked at three levels of plant_step (:func:`claimed_rate_metrics`).
+    three_level: tuple = ()
 
     def variants(self) -> tuple:
         """((name, q in N m, tau in s), ...): ``zoh``, and ``zoh_q_tau`` when
@@ -109,7 +126,30 @@ def load_sampled(root, case_names) -> SampledSpec | None:
         t.quantity("quantisation", "N m", positive=True, default=None),
         t.quantity("measurement_delay", "s", nonneg=True, hi=0.5, default=None))
     t.finish()
-    return out
+    return dataclasses.replace(out, three_level=claimed_rate_metrics(
+        out, root.data.get("claims", [])))
+
+
+def claimed_rate_metrics(spec: SampledSpec, claims) -> tuple:
+    """((variant, rate, metric), ...), sorted: the rate metrics that the
+    ``[[claims]]`` tables ``claims`` (raw TOML tables; a malformed one is
+    skipped here and reported by the claims' own validation) compare, at a
+    grid rate up to :data:`MESH_CHECK_MAX_HZ` (a difference to the emulation
+    counts as its rate metric, :data:`TO_EMULATION`)."""
+    names = {n for n, _, _ in spec.variants()}
+    out = set()
+    for c in claims if isinstance(claims, list) else ():
+        m = _RATE_QUANTITY.match(str(c.get("quantity", ""))) if isinstance(c, dict) else None
+        if m is None or m[1] not in names:
+            continue
+        try:
+            rate = float(m[2])
+        except ValueError:
+            continue
+        metric = TO_EMULATION.get(m[3], m[3])
+        if rate in spec.rates and rate <= MESH_CHECK_MAX_HZ and metric in RATE_METRICS:
+            out.add((m[1], rate, metric))
+    return tuple(sorted(out))
 
 
 @dataclass(frozen=True)
@@ -136,8 +176,11 @@ class Variant:
     (None: the highest fails); ``bracket``: (highest failing, lowest passing)
     rate known after bisection (None on a side with no rate);
     ``mesh``: (rate, agree, {metric: |difference|}) of the mesh check;
-    ``mesh_rows``: its RateRows at plant_step / 2 (reused by the three-level
-    refinement of the findings, :mod:`workbench.papers.p003.antiskid_refine`)."""
+    ``mesh_rows``: its RateRows at plant_step / 2; ``three_level``: the
+    :class:`ThreeLevel` check of every claimed rate metric of the variant;
+    ``quarter_rows``: its RateRows at plant_step / 4 (the metrics of the
+    scenarios run only). Both row sets are reused by the three-level
+    refinement of the findings (:mod:`workbench.papers.p003.antiskid_refine`)."""
 
     name: str
     q: float
@@ -148,9 +191,17 @@ class Variant:
     bracket: tuple
     mesh: tuple
     mesh_rows: tuple = field(default=(), compare=False)
+    three_level: tuple = ()
+    quarter_rows: tuple = field(default=(), compare=False)
 
     def row(self, rate: float) -> RateRow:
         return next(r for r in self.rows if r.rate == rate)
+
+    @property
+    def mesh_converged(self) -> bool:
+        """The two-level screen agrees at every rate and every claimed rate
+        metric converged over three levels."""
+        return all(a for _, a, _ in self.mesh) and all(t.converged for t in self.three_level)
 
 
 @dataclass(frozen=True)
@@ -189,7 +240,10 @@ class SampledResult:
 def _variant_json(v) -> dict:
     rows = lambda rr: [{"rate_hz": r.rate, **r.metrics} for r in rr]
     return {"q": v.q, "tau": v.tau, "rows": rows(v.rows), "probes": rows(v.probes),
-            "min_rate": v.min_rate, "bracket": v.bracket}
+            "min_rate": v.min_rate, "bracket": v.bracket,
+            "three_level": [{"rate_hz": t.rate, "metric": t.metric, "values": t.values,
+                             "outcome": t.outcome, "estimate": t.estimate,
+                             "tolerance": t.tolerance} for t in v.three_level]}
 
 
 def rate_metrics(ctx: Context, trac: dict, brake: dict) -> dict:
@@ -223,6 +277,40 @@ def rate_row(ctx: Context, rate: float, *, dt_p: float, predictor_step: float,
     if keep is not None:
         keep[rate] = brake
     return RateRow(rate, rate_metrics(ctx, trac, brake), probe)
+
+
+def partial_row(ctx: Context, rate: float, scenarios: tuple, *, dt_p: float,
+                predictor_step: float, q: float = 0.0, tau: float = 0.0) -> RateRow:
+    """The metrics of ``scenarios`` (0 traction, 1 braking) at one rate:
+    the runs :func:`rate_row` makes (the same calls, the same numbers), only
+    those a metric needs."""
+    kw = dict(q=q, tau=tau, dt_p=dt_p, predictor_step=predictor_step, emulation=False)
+    nan = dict.fromkeys(OUT, math.nan)
+    trac, brake = (run_once(ctx, rate, s, **kw)[0] if s in scenarios else nan for s in (0, 1))
+    keep = ((TRACTION_METRICS + ("traction_diverged",) if 0 in scenarios else ())
+            + (BRAKING_METRICS + ("braking_diverged",) if 1 in scenarios else ())
+            + (("u_max_over_peak", "ok") if len(set(scenarios)) == 2 else ()))
+    m = rate_metrics(ctx, trac, brake)
+    return RateRow(rate, {k: m[k] for k in keep})
+
+
+def _three_level(ctx, spec: SampledSpec, name, q, tau, rows, fines) -> tuple:
+    """The claimed rate metrics of variant ``name`` at three levels: the
+    grid's run (plant_step), the mesh check's (plant_step / 2) and one more
+    at plant_step / 4 of the scenarios they need; returns (ThreeLevel rows,
+    RateRows at plant_step / 4)."""
+    need: dict = {}
+    for v, rate, metric in spec.three_level:
+        if v == name:
+            need.setdefault(rate, set()).update(scenarios_of(metric))
+    quarter = tuple(partial_row(ctx, rate, tuple(sorted(sc)), dt_p=spec.plant_step / 4,
+                                predictor_step=spec.predictor_step, q=q, tau=tau)
+                    for rate, sc in sorted(need.items()))
+    by = lambda rr, f: next(r for r in rr if r.rate == f)     # noqa: E731
+    checks = tuple(three_level_check(name, rate, metric, tuple(
+        by(rr, rate).metrics[metric] for rr in (rows, fines, quarter)),
+        MESH_ATOL.get(metric, 0.0)) for v, rate, metric in spec.three_level if v == name)
+    return checks, quarter
 
 
 def _bisect(ctx, spec: SampledSpec, q, tau, lo: float, hi: float) -> tuple:
@@ -280,8 +368,10 @@ def run_variant(ctx: Context, spec: SampledSpec, name: str, q: float, tau: float
         bracket = (lo, hi)
     elif min_rate is None:
         bracket = (spec.rates[-1], None)
-    return Variant(name, q, tau, rows, probes, min_rate, bracket,
-                   *_mesh_check(ctx, spec, q, tau, rows))
+    mesh, fines = _mesh_check(ctx, spec, q, tau, rows)
+    checks, quarter = _three_level(ctx, spec, name, q, tau, rows, fines)
+    return Variant(name, q, tau, rows, probes, min_rate, bracket, mesh, fines,
+                   checks, quarter)
 
 
 def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:
@@ -341,7 +431,7 @@ def sampled_quantities(res: SampledResult) -> dict:
         b = f"sampled.{v.name}"
         q[f"{b}.min_rate"] = v.min_rate
         q[f"{b}.bracket_low"], q[f"{b}.bracket_high"] = v.bracket
-        q[f"{b}.mesh_converged"] = "yes" if all(a for _, a, _ in v.mesh) else "no"
+        q[f"{b}.mesh_converged"] = "yes" if v.mesh_converged else None
         top = v.rows[-1].metrics
         for m in GAP_METRICS:
             q[f"{b}.gap_to_emulation.{m}"] = _q(abs(top[m] - res.emulation.metrics[m]))

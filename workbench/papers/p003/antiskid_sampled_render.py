@@ -164,6 +164,47 @@ def bound(x: float) -> str:
     return "< " + fmt(10.0 ** (math.floor(math.log10(x)) + 1))
 
 
+def _level(x) -> str:
+    if isinstance(x, str):
+        return x
+    return fmt(None if math.isnan(x) else x, printed_digits(x, 5))
+
+
+def three_level_text(res) -> str:
+    """*Mesh, three levels*: the claimed rate metrics at plant_step, /2, /4
+    (:class:`~workbench.papers.p003.antiskid_sampled.ThreeLevel`)."""
+    sp = res.spec
+    rows = []
+    for v in res.variants:
+        for t in v.three_level:
+            est = "—" if t.estimate is None else bound(t.estimate)
+            out = "converged" if t.converged else f"**{t.reason()}**"
+            rows.append([variant_label(v), fmt(t.rate), f"`{t.metric}`",
+                         *(_level(x) for x in t.values), est,
+                         "equal" if t.tolerance is None else fmt(t.tolerance), out])
+    ps = fmt(1e3 * sp.plant_step)
+    text = (
+        f"*Mesh, three levels*: every rate metric a claim of the design compares, at a grid "
+        f"rate up to {fmt(MESH_CHECK_MAX_HZ)} Hz, at plant_step = {ps} ms (the grid's run), "
+        "plant_step/2 (the screen's run) and plant_step/4 (run for this check, only the "
+        "scenario the metric needs: traction or braking). Richardson estimate of the error "
+        "of the plant_step/4 value from the observed order p = log2(|q1 − q2| / |q2 − q4|), "
+        "p clipped to [0.5, 4]; levels whose differences change sign are estimated from the "
+        "larger difference at order 0.5. A metric has converged when its estimate is within "
+        "the screen's tolerance (0, rounding only, for a metric without one), an outcome "
+        "when it is the same at the three levels; a variant's mesh claim holds when both "
+        "checks do, and is INCONCLUSIVE (not converged) otherwise. Estimates are printed as "
+        "the next power of ten above them. Not covered by either mesh check: the metrics "
+        "claims compare above 1 kHz (the gaps to the emulation at the top rate), the lowest "
+        "passing rate and the bisection brackets (outcomes at 2 and 5 kHz and at the "
+        "bisection rates).")
+    if not rows:
+        return text + " No claim compares a rate metric at such a rate."
+    return text + "\n\n" + md_table(
+        ["variant", "f_c (Hz)", "metric", "plant_step", "/2", "/4", "estimate", "tolerance",
+         "outcome"], rows, "lrlrrrrrl")
+
+
 def _checks_text(res) -> str:
     sp = res.spec
     mesh = []
@@ -176,12 +217,13 @@ def _checks_text(res) -> str:
               bound(c.max_dlam / res.lambda_opt), bound(c.max_dv_rel)] for c in res.radau]
     tol = ", ".join(f"{k} {fmt(t)}" for k, t in MESH_ATOL.items())
     return (
-        "**Checks of the plant's integration.** *Mesh*: every grid rate up to "
+        "**Checks of the plant's integration.** *Mesh, two levels*: every grid rate up to "
         f"{fmt(MESH_CHECK_MAX_HZ)} Hz again with sub-steps of at most "
         f"{fmt(1e3 * sp.plant_step / 2)} ms; largest differences of the metrics (tolerances: "
         f"{tol}; the outcomes must agree):\n\n"
         + md_table(["variant", "f_c (Hz)", "agree"] + list(MESH_ATOL), mesh, "lrl" + "r" *
                    len(MESH_ATOL))
+        + "\n\n" + three_level_text(res)
         + "\n\n*Radau*: the torque the wheel received in a window of "
         f"{WINDOW_SAMPLES} samples (ZOH variant) replayed into scipy's "
         f"`solve_ivp(method=\"Radau\")` (rtol {fmt(RTOL)}), restarted from its own state at "
