@@ -81,8 +81,10 @@ def design_inputs(data: dict, folder: Path) -> set[float]:
     """Numbers a design gives as input (rule 4)."""
     out = _numbers(data, set())
     for s in _strings(data):
+        if not s or "/" in s or len(s) > 100:     # a sentence, not a folder's name
+            continue
         sub = folder / s
-        if s and "/" not in s and sub.is_dir():
+        if sub.is_dir():
             for f in sorted(sub.glob("*.toml")):
                 _numbers(tomllib.loads(f.read_text(encoding="utf-8")), out)
     return out

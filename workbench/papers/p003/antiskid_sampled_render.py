@@ -8,6 +8,7 @@ import numpy as np
 
 from ...printed_grid import printed_digits
 from ...report.markdown import Figure, fmt, md_table
+from ...sim.convergence import P_MAX, P_MIN
 from .antiskid_sampled import MESH_ATOL, MESH_CHECK_MAX_HZ, TRACE_SECONDS
 from .antiskid_sampled_check import RTOL, WINDOW_SAMPLES
 from .antiskid_sampled_kernel import BRAKING_LEAD, EVS_SETTLE, TRACTION_TAIL
@@ -189,8 +190,8 @@ def three_level_text(res) -> str:
         "plant_step/2 (the screen's run) and plant_step/4 (run for this check, only the "
         "scenario the metric needs: traction or braking). Richardson estimate of the error "
         "of the plant_step/4 value from the observed order p = log2(|q1 − q2| / |q2 − q4|), "
-        "p clipped to [0.5, 4]; levels whose differences change sign are estimated from the "
-        "larger difference at order 0.5. A metric has converged when its estimate is within "
+        f"p clipped to [{fmt(P_MIN)}, {fmt(P_MAX)}]; levels whose differences change sign are "
+        f"estimated from the larger difference at order {fmt(P_MIN)}. A metric has converged when its estimate is within "
         "the screen's tolerance (0, rounding only, for a metric without one), an outcome "
         "when it is the same at the three levels; a variant's mesh claim holds when both "
         "checks do, and is INCONCLUSIVE (not converged) otherwise. Estimates are printed as "
