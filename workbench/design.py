@@ -102,9 +102,6 @@ def load_design(path: str | Path) -> Design:
     DesignError
         On any problem, naming file, key, value and what was expected.
     """
-    from . import kinds
-    from .claims import parse_claims, parse_register
-
     shown = display_path(path)
     p = Path(path)
     if not p.is_file():
@@ -113,6 +110,29 @@ def load_design(path: str | Path) -> Design:
     data = load_toml(p, shown)
     raw = p.read_bytes()
     ulps = os.environ.get(PERTURB_ENV, "").strip()
+    key = (shown, str(p.resolve()), hashlib.sha256(raw).hexdigest(), ulps)
+    if key in _LOADED:
+        return _LOADED[key]
+    design = _validated(p, shown, data, raw, ulps)
+    from . import kinds
+    if not getattr(kinds.REGISTRY[design.kind], "reads_other_files", False):
+        _LOADED[key] = design
+    return design
+
+
+#: (shown path, absolute path, SHA-256 of the bytes, perturbation) -> Design:
+#: a design is validated once per process (``workbench check`` loads every
+#: design in its parent, again for its verify and report phases, and its
+#: forked workers inherit what the parent loaded). Only valid designs are
+#: kept, and only of kinds whose spec is read from the design file alone (a
+#: study with ``reads_other_files``, such as ``delay-benchmark``'s example
+#: folder, is read again every time).
+_LOADED: dict = {}
+
+
+def _validated(p: Path, shown: str, data: dict, raw: bytes, ulps: str) -> Design:
+    from . import kinds
+    from .claims import parse_claims, parse_register
     if ulps:
         if not ulps.lstrip("+-").isdigit() or len(ulps) > 6:
             raise DesignError("<environment>", PERTURB_ENV, ulps[:40], "an integer number of ulps")

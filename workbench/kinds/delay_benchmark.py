@@ -63,6 +63,9 @@ def _row_key(r) -> str:
 
 class DelayBenchmark:
     kind = "delay-benchmark"
+    #: its spec reads the example folder too (:func:`workbench.design.load_design`
+    #: validates such a design again on every load)
+    reads_other_files = True
 
     def load(self, root: Reader) -> BenchmarkSpec:
         settings = load_settings(root.table("benchmark"))
