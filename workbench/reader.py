@@ -197,3 +197,25 @@ def read_gradients(r: Reader) -> tuple[tuple[float, ...], tuple[float, ...]]:
     if any(abs(x) > 0.05 for x in grade):
         raise r.fail("grade", list(grade), "gradients within +/-0.05 (50 permille)")
     return g_from, grade
+
+
+def read_paper_module(root: "Reader", load, what: str) -> str | None:
+    """``[analysis] module = "pNNN.name"`` of a kind that hands what a design
+    cannot express to a paper's module under ``workbench.papers``: the name,
+    or None without the table. ``load(name)`` imports it and reads what the
+    kind needs (ImportError or AttributeError: a design error saying the
+    module should be ``what``)."""
+    import re
+    if not root.has("analysis"):
+        return None
+    r = root.table("analysis")
+    name = r.string("module")
+    r.finish()
+    if not re.fullmatch(r"p\d{3}\.[a-z][a-z0-9_]*", name):
+        raise r.fail("module", name, 'a paper module "pNNN.name" under workbench.papers')
+    try:
+        load(name)
+    except (ImportError, AttributeError):
+        raise r.fail("module", name, what) from None
+    return name
+

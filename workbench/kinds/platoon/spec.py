@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 from ...plants.platoon001 import PARAMETER_UNITS, TrainParams
 from ...profiles import phase_time, spec_for_cruise
-from ...reader import Quantity, Reader, read_gradients
+from ...reader import Quantity, Reader, read_gradients, read_paper_module
 from ...sim.platoon import JITTER, OWN_STATE
 from ...sim.tracking import Route
 from .laws import SIGNALS, Law, read_constants, read_laws
@@ -284,20 +284,8 @@ def _read_analysis(root: Reader):
     """``[analysis] module = "pNNN.name"``: a paper's module (under
     ``workbench.papers``) with a ``PLATOON_ANALYSIS`` object, for what a
     design cannot express (its docstring says why)."""
-    import re
-    if not root.has("analysis"):
-        return None
-    r = root.table("analysis")
-    name = r.string("module")
-    r.finish()
-    if not re.fullmatch(r"p\d{3}\.[a-z][a-z0-9_]*", name):
-        raise r.fail("module", name, 'a paper module "pNNN.name" under workbench.papers')
-    try:
-        _analysis(name)
-    except (ImportError, AttributeError):
-        raise r.fail("module", name, "a module of workbench.papers with PLATOON_ANALYSIS") \
-            from None
-    return name
+    return read_paper_module(root, _analysis,
+                             "a module of workbench.papers with PLATOON_ANALYSIS")
 
 
 def _analysis(name: str):

@@ -11,7 +11,7 @@ from ...report.markdown import Figure, Rendered, fmt, md_table
 from . import figures as F
 from .spec import OBJECTIVE_UNITS, OBJECTIVES
 
-__all__ = ["render"]
+__all__ = ["render", "tuning_figures"]
 
 H_TUNE = "Tuning per reading and controller"
 H_MAIN = "Chosen points on the main pair"
@@ -115,15 +115,7 @@ def render(design, res) -> Rendered:
     """The general report of a ``tracking`` design (see the module docstring)."""
     spec = design.spec
     sections = [_problem(spec), _tuning(spec, res), _main(res), _line(res)]
-    figs = [Figure(f"pareto-{r.reading.name}",
-                   f"Pareto fronts (two projections), reading {r.reading.name}.",
-                   lambda fig, r=r: F.plot_pareto(fig, r), (8.0, 3.8)) for r in res.readings]
-    figs += [Figure("tracking", "Speed error and acceleration at the chosen points.",
-                    lambda fig: F.plot_tracking(fig, res), (8.0, 5.0)),
-             Figure("jerk", "Jerk (1 s windows) of the chosen points against the comfort "
-                    "limit.", lambda fig: F.plot_jerk(
-                        fig, res, None if spec.peak_jerk is None else spec.peak_jerk.value),
-                    (8.0, 3.2))]
+    figs = tuning_figures(spec, res)
     if res.readings[0].line:
         figs.append(Figure("line", "Stop error per pair.",
                            lambda fig: F.plot_line(fig, res), (8.0, 4.0)))
@@ -131,3 +123,17 @@ def render(design, res) -> Rendered:
                (r"reading\[[^\]]+\]\.(best|[a-z]+\.(grid_edge|front_size|peak_jerk))", H_TUNE),
                (r"reading\[[^\]]+\]\.", H_MAIN), (r"profile\.", H_MAIN))
     return Rendered(tuple(s for s in sections if s), tuple(figs), anchors)
+
+
+def tuning_figures(spec, res) -> list:
+    """The figures every tracking report has: each reading's Pareto fronts,
+    the tracking and the jerk of the chosen points against the comfort limit."""
+    figs = [Figure(f"pareto-{r.reading.name}",
+                   f"Pareto fronts (two projections), reading {r.reading.name}.",
+                   lambda fig, r=r: F.plot_pareto(fig, r), (8.0, 3.8)) for r in res.readings]
+    return figs + [Figure("tracking", "Speed error and acceleration at the chosen points.",
+                          lambda fig: F.plot_tracking(fig, res), (8.0, 5.0)),
+                   Figure("jerk", "Jerk (1 s windows) of the chosen points against the comfort "
+                          "limit.", lambda fig: F.plot_jerk(
+                              fig, res, None if spec.peak_jerk is None else spec.peak_jerk.value),
+                          (8.0, 3.2))]

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from ...errors import DesignError, ModelError
 from ...plants.train002 import MODELS, PARAMETER_UNITS, FirstOrderTrain002, Train002
 from ...profiles import ProfileSpec, build_profile
-from ...reader import Quantity, Reader, read_gradients
+from ...reader import Quantity, Reader, read_gradients, read_paper_module
 from ...sim.tracking import Objectives, Route
 
 __all__ = ["MFAC_KEYS", "OBJECTIVES", "OBJECTIVE_UNITS", "PID_KEYS", "Reading", "Section",
@@ -246,20 +246,9 @@ def _read_analysis(root: Reader) -> str | None:
     """``[analysis] module = "pNNN.name"``: a paper's module (under
     ``workbench.papers``) with a ``render(design, res)`` for the report."""
     import importlib
-    import re
-    if not root.has("analysis"):
-        return None
-    r = root.table("analysis")
-    name = r.string("module")
-    r.finish()
-    if not re.fullmatch(r"p\d{3}\.[a-z][a-z0-9_]*", name):
-        raise r.fail("module", name, 'a paper module "pNNN.name" under workbench.papers')
-    try:
-        importlib.import_module(f"workbench.papers.{name}").render
-    except (ImportError, AttributeError):
-        raise r.fail("module", name, "a module of workbench.papers with a render function") \
-            from None
-    return name
+    return read_paper_module(
+        root, lambda name: importlib.import_module(f"workbench.papers.{name}").render,
+        "a module of workbench.papers with a render function")
 
 
 def quantity_names(spec: TrackingSpec) -> set[str]:

@@ -18,6 +18,7 @@ from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...tuning.pareto import TIE_REL, dominated_share
 from ...kinds.tracking import figures as F
 from ...kinds.tracking.mfac import most_sensitive
+from ...kinds.tracking.render_general import tuning_figures
 from ...kinds.tracking.spec import OBJECTIVE_UNITS, OBJECTIVES
 
 LABEL = {"stop_error": "stop error (m)", "punctuality": "punctuality (s)",
@@ -419,15 +420,7 @@ def render(design, res) -> Rendered:
     sections = [_problem(spec, res), _model(spec), _profile(spec, res), _why(spec, res),
                 _tuning(spec, res), _compare(res), _ppd(res), _line(spec, res),
                 _sensitivity(res), _closing(res)]
-    figs = [Figure(f"pareto-{r.reading.name}",
-                   f"Pareto fronts (two projections), reading {r.reading.name}.",
-                   lambda fig, r=r: F.plot_pareto(fig, r), (8.0, 3.8)) for r in res.readings]
-    figs += [Figure("tracking", "Speed error and acceleration at the chosen points.",
-                    lambda fig: F.plot_tracking(fig, res), (8.0, 5.0)),
-             Figure("jerk", "Jerk (1 s windows) of the chosen points against the comfort "
-                    "limit.", lambda fig: F.plot_jerk(
-                        fig, res, None if spec.peak_jerk is None else spec.peak_jerk.value),
-                    (8.0, 3.2)),
+    figs = tuning_figures(spec, res) + [
              Figure("ppd", "PPD estimate and realised PPD of the chosen MFAC runs.",
                     lambda fig: F.plot_ppd(fig, res), (8.0, 3.8))]
     if res.readings[0].line:
