@@ -31,7 +31,7 @@ design reader imports it); numpy, sympy and the solvers load when it runs.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from ..reader import Reader
 
@@ -104,16 +104,6 @@ def check_domain(settings: BasinSettings, path: str, names, x_op, scenarios) -> 
                                        for k, v in s.x0.items()) for s in scenarios):
         raise DesignError(path, "basin.domain", "<missing>", "a box { state = [lo, hi], ... } "
                           "(no scenario starts away from the operating point)")
-
-
-@dataclass(frozen=True)
-class Trajectory:
-    """A delay-free trajectory: start, path (N, n), fate ("converges": enters
-    {V <= c_certified}; "leaves the domain"; "undecided" within the horizon)."""
-
-    x0: tuple
-    path: object = field(repr=False)
-    fate: str
 
 
 @dataclass(frozen=True)
@@ -205,6 +195,7 @@ def run_basin(settings: BasinSettings, spec, model, values: dict, op, K) -> Dela
     import numpy as np
     import sympy as sp
 
+    from .basin_trajectory import decays
     names = spec.plant.state_names
     n = len(names)
     lo = np.array([settings.domain.get(k, (-math.inf, math.inf))[0] for k in names])
@@ -249,26 +240,22 @@ def run_basin(settings: BasinSettings, spec, model, values: dict, op, K) -> Dela
         X0 = x_eq + np.sqrt(BOUNDARY * c_cert) * dirs @ np.linalg.inv(L.T).T
         inside = tuple(_trajectory(fn, x0, V, c_cert, escape, horizon, full=True)
                        for x0 in X0)
-        ok = all(_decays(tr.path, V) for tr in inside)
+        ok = all(decays(tr.path, V) for tr in inside)
     return DelayFeedbackBasin(chk, outcome.name, plane, (tuple(box[0]), tuple(box[1])), sampled,
                               inside, ok, horizon, dict(settings.domain), tuple(names))
 
 
-def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False) -> Trajectory:
-    """The delay-free loop from x0 over [0, T] (Radau, rtol 1e-8). Ends when it
+def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False):
+    """The delay-free loop from x0 over [0, T] (Radau, rtol RADAU_RTOL)
+    (:func:`~workbench.features.basin_trajectory.trajectory`). Ends when it
     leaves ``box`` (fate "leaves the domain": the domain, or far away), or,
     unless ``full``, when V falls below 1e-3 c_certified; "converges" when it
     entered {V <= c_certified}; "undecided" when the integrator stops on an
-    inf/NaN Jacobian (a vector field not finite near x0)."""
+    inf/NaN Jacobian (a vector field not finite near x0, e.g. a scenario at a
+    wheel speed of 1e-9 rad/s)."""
     import numpy as np
-    from scipy.integrate import solve_ivp
+    from .basin_trajectory import trajectory
     lo, hi = (np.asarray(b, float) for b in box)
-
-    def rhs(t, x):
-        try:
-            return list(fn(*x))
-        except (OverflowError, ValueError, ZeroDivisionError):
-            return [math.nan] * len(x)
 
     def out(t, x):
         return float(np.min(np.concatenate([x - lo, hi - x])))
@@ -278,30 +265,9 @@ def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False) -> Trajectory:
         return float(V(np.asarray(x)[None, :])[0] - 1e-3 * c_cert)
     near.terminal = True
     events = [out] if full or not c_cert > 0 else [out, near]
-    with np.errstate(all="ignore"):
-        try:
-            sol = solve_ivp(rhs, (0.0, T), np.asarray(x0, float), method="Radau",
-                            rtol=RADAU_RTOL, atol=1e-10, events=events)
-        except (ValueError, np.linalg.LinAlgError):
-            # the vector field is not finite near x0 (e.g. a scenario at a wheel speed
-            # of 1e-9 rad/s): Radau's Jacobian has inf/NaN; the fate stays open
-            return Trajectory(tuple(float(v) for v in x0), np.asarray([x0], float), "undecided")
-    path = sol.y.T
-    if c_cert > 0 and np.any(V(path) <= c_cert):
-        fate = "converges"
-    elif len(sol.t_events[0]) or sol.status != 0 or not np.all(np.isfinite(path)):
-        fate = "leaves the domain"
-    else:
-        fate = "undecided"
-    return Trajectory(tuple(float(v) for v in x0), path, fate)
-
-
-def _decays(path, V) -> bool:
-    """V never rose along the path (1e-6 relative) and ends below 1 % of its start."""
-    import numpy as np
-    v = V(path)
-    return bool(np.all(np.isfinite(v)) and np.all(np.diff(v) <= 1e-6 * v[0])
-                and v[-1] <= 0.01 * v[0])
+    inside = ((lambda p: V(p) <= c_cert) if c_cert > 0
+              else (lambda p: np.zeros(len(p), bool)))
+    return trajectory(fn, x0, T, inside, events=events, rtol=RADAU_RTOL)
 
 
 def basin_quantity_names(spec) -> set:

@@ -46,6 +46,7 @@ from functools import lru_cache
 import numpy as np
 import sympy as sp
 
+from ...features.basin_trajectory import escaped, integrate
 from ...outcome import Outcome
 from ...plants.adhesion import NumericAdhesion, adhesion_model
 from ...plants.lambdify_cache import lambdify
@@ -228,7 +229,6 @@ def brake_switch(values: dict, label: str, point, *, profile, k_de: float,
 def time_varying_fate(values: dict, x0, profile, k_de: float) -> tuple[str, float | None]:
     """Fate of the time-varying delay-free loop from x0 = (v, lambda) at t_brake
     (class :class:`BrakeSwitch`, ``fate``), and when it diverged."""
-    from scipy.integrate import solve_ivp
     (y1, y2, y3), (z1, z2, z3), vs_, lam = _forms(tuple(sorted(values.items())))
     fns = [lambdify((vs_, lam), e, "math") for e in (y1, y2, y3, z1, z2, z3)]
     Y1, Y2, Y3, Z1, Z2, Z3 = fns
@@ -240,24 +240,18 @@ def time_varying_fate(values: dict, x0, profile, k_de: float) -> tuple[str, floa
         return ((-k_de * (v * la - vs) + z1v + dvs) / v - (1 + la) / v * z1v
                 - Z2(v, la)) / Z3(v, la), float(vs)
 
-    def rhs(t, x):
-        v, la = x
-        try:
-            u, _ = law(t, v, la)
-            if la >= 0:
-                return [Y1(v, la), Y2(v, la) + Y3(v, la) * u]
-            return [Z1(v, la), Z2(v, la) + Z3(v, la) * u]
-        except (OverflowError, ValueError, ZeroDivisionError):
-            return [math.nan, math.nan]
+    def rhs(t, v, la):
+        u, _ = law(t, v, la)
+        if la >= 0:
+            return [Y1(v, la), Y2(v, la) + Y3(v, la) * u]
+        return [Z1(v, la), Z2(v, la) + Z3(v, la) * u]
 
     def spin(t, x):
         return LAM_LIMIT - abs(x[1])
     spin.terminal = True
     t0 = profile.t_brake
-    with np.errstate(all="ignore"):
-        sol = solve_ivp(rhs, (t0, t0 + T_FATE), np.array(x0, float), method="Radau",
-                        rtol=FATE_RTOL, atol=1e-10, events=spin, max_step=0.05)
-    if len(sol.t_events[0]) or sol.status != 0 or not np.all(np.isfinite(sol.y)):
+    sol = integrate(rhs, x0, T_FATE, events=[spin], rtol=FATE_RTOL, max_step=0.05, t0=t0)
+    if escaped(sol):
         return "diverges", float(sol.t[-1] - t0)
     v, la = sol.y[:, -1]
     _, vs = law(sol.t[-1], v, la)
