@@ -118,3 +118,17 @@ def test_figure_of_the_toy_basin():
     sampled = ax.get_lines()[-3]          # from (1.2, 0) to |x| = 3, clipped at x = 2
     assert sampled.get_label() == "sampled: leaves the domain"
     assert np.max(sampled.get_xdata()) == 2.0
+
+
+def test_scalar_verdicts_of_toy_loops():
+    """One-state loops: no equilibrium ahead (REFUTED, |x'| >= 1 proven), and the
+    stable equilibrium x* = 1 of x' = x - x^3 reached from either side."""
+    from workbench.features.basin_scalar import scalar_verdict
+    none = scalar_verdict(1 + Z**2, Z, 0.0, -1.0, 2.0)
+    assert (none.outcome, none.why, none.direction, none.star) == (
+        Outcome.REFUTED, "no equilibrium", 1.0, None)
+    assert 0.5 < none.rate <= 1.0
+    for x_s in (0.05, 0.5, 1.6):
+        sv = scalar_verdict(Z - Z**3, Z, x_s, -2.0, 2.0)
+        assert sv.outcome is Outcome.CERTIFIED and sv.star == pytest.approx(1.0)
+        assert sv.direction == (1.0 if x_s < 1 else -1.0) and sv.level[1] > 0
