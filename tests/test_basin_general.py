@@ -132,3 +132,15 @@ def test_scalar_verdicts_of_toy_loops():
         sv = scalar_verdict(Z - Z**3, Z, x_s, -2.0, 2.0)
         assert sv.outcome is Outcome.CERTIFIED and sv.star == pytest.approx(1.0)
         assert sv.direction == (1.0 if x_s < 1 else -1.0) and sv.level[1] > 0
+
+
+def test_point_quantities_of_a_toy_check():
+    from workbench.features.basin import level_quantities, point_quantities, point_quantity_names
+    chk = check_basin([-Z + Z**3], (Z,), (0.0,), A_cl=[[-1.0]],
+                      points=[("in", (0.5,)), ("out", (1.5,))], domain=((-2.0,), (2.0,)))
+    q = point_quantities(chk, "toy[{label}]", fate=["converges", "diverges"])
+    assert list(q) == ["toy[in].in_basin", "toy[in].fate", "toy[out].in_basin", "toy[out].fate"]
+    assert (q["toy[in].in_basin"], q["toy[out].in_basin"]) == ("CERTIFIED", "REFUTED")
+    assert set(q) == point_quantity_names(["in", "out"], "toy[{label}]", ("in_basin", "fate"))
+    lv = level_quantities(chk.estimate)
+    assert 0 < lv["basin.c_certified"] <= lv["basin.c_refuted"] <= 0.5 * 1.0 + 1e-9

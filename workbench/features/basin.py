@@ -52,9 +52,12 @@ class BasinSettings:
     seed: int
 
 
-def load_basin_settings(root, plant, n_scenarios: int) -> BasinSettings | None:
-    """Read ``[basin]`` (or a bare ``basin = true | false``) from a design
-    (a :class:`workbench.reader.Reader`); None when absent or disabled."""
+def basin_table(root):
+    """(reader of the design's ``[basin]`` table, enabled, seed), or None when
+    the design has none; a bare ``basin = true | false`` is an empty table
+    (``root``: a :class:`workbench.reader.Reader`). Any design's basin table
+    has ``enabled = true | false`` (default true) and ``seed`` (falsifier and
+    sampled starts, default 0); the caller reads the rest and calls ``finish``."""
     if not root.has("basin"):
         return None
     raw = root.raw("basin")
@@ -65,6 +68,16 @@ def load_basin_settings(root, plant, n_scenarios: int) -> BasinSettings | None:
         enabled = b.boolean("enabled", default=True)
     else:
         raise root.fail("basin", raw, "true, false or a [basin] table")
+    return b, enabled, int(b.number("seed", integer=True, default=0, nonneg=True, what="integer"))
+
+
+def load_basin_settings(root, plant, n_scenarios: int) -> BasinSettings | None:
+    """Read ``[basin]`` (or a bare ``basin = true | false``) from a design
+    (a :class:`workbench.reader.Reader`); None when absent or disabled."""
+    table = basin_table(root)
+    if table is None:
+        return None
+    b, enabled, seed = table
     states = plant.state_names
     dom = b.table("domain", default=None)
     domain = {}
@@ -81,7 +94,6 @@ def load_basin_settings(root, plant, n_scenarios: int) -> BasinSettings | None:
     if (not isinstance(plane, list) or len(plane) != want or len(set(map(str, plane))) != want
             or not all(isinstance(p, str) and p in states for p in plane)):
         raise b.fail("plane", plane, f"{want} different states of: " + ", ".join(states))
-    seed = b.number("seed", integer=True, default=0, nonneg=True, what="integer")
     b.finish()
     if not enabled:
         return None
@@ -270,26 +282,53 @@ def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False):
     return trajectory(fn, x0, T, inside, events=events, rtol=RADAU_RTOL)
 
 
+#: Claimable quantities of any basin estimate (:func:`level_quantities`).
+LEVEL_QUANTITIES = frozenset({"basin.c_certified", "basin.c_refuted"})
+
+
+def level_quantities(est) -> dict:
+    """The certified and refuted levels of a basin estimate."""
+    return {"basin.c_certified": est.c_certified, "basin.c_refuted": est.c_refuted}
+
+
+def point_quantity_names(labels, key: str, suffixes=("in_basin",)) -> set:
+    """``{key}.{suffix}`` for each label (``key`` formats ``{label}``)."""
+    return {f"{key.format(label=lab)}.{x}" for lab in labels for x in suffixes}
+
+
+def point_quantities(check, key: str, **more) -> dict:
+    """``{key}.in_basin`` (the verdict) of each judged point of a
+    :class:`workbench.roa.check.BasinCheck`, then ``{key}.{name}`` for each
+    keyword ``name`` = a sequence with one value per point."""
+    q = {}
+    for k, p in enumerate(check.points):
+        at = key.format(label=p.label)
+        q[f"{at}.in_basin"] = p.verdict.outcome.name
+        q.update({f"{at}.{name}": vals[k] for name, vals in more.items()})
+    return q
+
+
+#: Key of a delay-feedback scenario's quantities.
+_SCENARIO = "basin.scenario[{label}]"
+
+
 def basin_quantity_names(spec) -> set:
     """Claimable quantities of the basin check (see :func:`basin_quantities`)."""
-    names = {"basin.c_certified", "basin.c_refuted", "basin.c_search", "basin.outcome",
-             "basin.certified", "basin.inside_converge"}
-    for s in spec.scenarios:
-        names |= {f"basin.scenario[{s.name}].in_basin", f"basin.scenario[{s.name}].level"}
-    return names
+    return (set(LEVEL_QUANTITIES)
+            | {"basin.c_search", "basin.outcome", "basin.certified", "basin.inside_converge"}
+            | point_quantity_names([s.name for s in spec.scenarios], _SCENARIO,
+                                   ("in_basin", "level")))
 
 
 def basin_quantities(res: DelayFeedbackBasin) -> dict:
     """Values of :func:`basin_quantity_names` (a design without a certified
     gain has no basin: its basin claims are not determined)."""
     est = res.check.estimate
-    q = {}
-    q.update({"basin.c_certified": est.c_certified, "basin.c_refuted": est.c_refuted,
-              "basin.c_search": est.c_search, "basin.outcome": res.outcome,
+    q = level_quantities(est)
+    q.update({"basin.c_search": est.c_search, "basin.outcome": res.outcome,
               "basin.certified": "yes" if est.c_certified > 0 else "no",
               "basin.inside_converge": None if res.inside_ok is None
               else ("yes" if res.inside_ok else "no")})
-    for p in res.check.points:
-        q[f"basin.scenario[{p.label}].in_basin"] = p.verdict.outcome.name
-        q[f"basin.scenario[{p.label}].level"] = est.level_bounds(p.x)[1]
+    q.update(point_quantities(res.check, _SCENARIO,
+                              level=[est.level_bounds(p.x)[1] for p in res.check.points]))
     return q
