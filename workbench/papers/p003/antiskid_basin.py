@@ -55,7 +55,7 @@ from ...outcome import Outcome
 from ...plants.adhesion import NumericAdhesion, adhesion_model
 from ...plants.lambdify_cache import lambdify
 from ...roa import BasinProblem, estimate_basin, modal_P
-from ...roa.check import BasinCheck, PointCheck, largest_level_in_box
+from ...roa.check import BasinCheck, PointCheck, search_level
 from ...symbolic.linearise import linearise_cruise
 
 #: Weights w of the fast (creep-ratio) mode against the slow (speed) mode
@@ -145,11 +145,7 @@ def _cruise_problem(values, v_d, K, points, w, c_search=None):
     P = modal_P(A_cl, [1.0, w])
     prob = BasinProblem(f, states, (0.0, 0.0), P, P_source="optimised",
                         names=("v - v_d (m/s)", "lambda - lambda_d"), derivatives=derivs)
-    cap = largest_level_in_box(P, np.zeros(2), *_domain(v_d, lam_d))
-    lv = [float(prob.V(np.asarray(x)[None, :])[0]) for x in points]
-    if c_search is None:
-        c_search = 4.0 * max(lv) if lv and max(lv) > 0 else cap
-    return prob, min(c_search, cap)
+    return prob, search_level(prob, points, _domain(v_d, lam_d), c_search)
 
 
 def estimate_cruise(values, v_d, K, points, w, *, seed=0, c_search=None):
