@@ -13,6 +13,9 @@ grid value and the next one is then bisected
 The rule is *sufficient*: a state outside every certified level set may
 still converge (the "fate" column says what the delay-free trajectory does).
 
+Only the gain parameterisation (k2 of law (61), k1 kept, Table 3's rows) is
+paper 003's; the sweep is :func:`workbench.features.basin_sweep.gain_edge`.
+
 References
 ----------
 .. [003] Cai L., Yue Y., Huang D., "Antiskid control of high-speed trains

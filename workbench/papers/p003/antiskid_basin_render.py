@@ -1,6 +1,10 @@
 """Markdown and figure of the cruise-basin check (pure rendering of
 :class:`~workbench.papers.p003.antiskid_basin.CruiseBasin` and
-:class:`~workbench.papers.p003.antiskid_basin_k2.K2Sweep`)."""
+:class:`~workbench.papers.p003.antiskid_basin_k2.K2Sweep`).
+
+Paper 003's wording (laws (61), (69), eqs (75)-(76), the k2 rule) and the
+cruise figure's look stay here; the figure itself is the general
+:func:`workbench.features.basin_plot.plot_basin`."""
 from __future__ import annotations
 
 import math

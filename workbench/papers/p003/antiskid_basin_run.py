@@ -19,6 +19,10 @@ switch state (v_d, lambda_opt). The cruise -> braking switch is judged at
 each case's state at t_brake against the braking law (69) frozen at that
 instant (:mod:`.antiskid_basin_brake`). The basin uses the controller's nominal
 model (a design's plant mass factor is not in it; the report says so).
+
+What stays here is paper 003's: the table's gain rows, where the switches are
+in a case's metrics and the claim names; the table opener and the level and
+point quantities are the general ones of :mod:`workbench.features.basin`.
 """
 from __future__ import annotations
 
