@@ -7,6 +7,7 @@ import pytest
 from workbench.outcome import Outcome
 from workbench.plants.adhesion import NumericAdhesion
 from workbench.roa.basin import falsified_top
+from workbench.features import basin_select as SEL
 from workbench.papers.p003 import antiskid_basin as AB
 
 # as tests/test_roa_antiskid.py: 003 Tables 1-2 (dry rail), the certified gain at eps = 0.35
@@ -138,11 +139,11 @@ def test_score_bound_bounds_the_score(deferred, switch):
     cannot beat the best score: it must bound the score the cover gives."""
     est = deferred.est
     for pts in ([switch], [switch, (0.0, 0.0), (-1.0, 0.001)], []):
-        assert AB._score(est, pts) <= AB._score_bound(deferred.prob, deferred.c_top, pts)
+        assert SEL.score(est, pts) <= SEL.score_bound(deferred.prob, deferred.c_top, pts)
     # c_certified = c_top: the bound is the score itself (it is not loose)
     from dataclasses import replace
     top = replace(est, c_certified=deferred.c_top)
-    assert AB._score(top, [switch]) == AB._score_bound(deferred.prob, deferred.c_top, [switch])
+    assert SEL.score(top, [switch]) == SEL.score_bound(deferred.prob, deferred.c_top, [switch])
 
 
 @pytest.mark.slow
@@ -153,8 +154,8 @@ def test_cruise_basin_coarse_pass_equals_every_cover(monkeypatch):
     lam_opt = NumericAdhesion.from_dict(DRY).lambda_opt()
     pts = [("printed", (70.0, lam_opt)), ("near", (69.5, AB.cruise_lambda_d(VALS, 70.0) + 0.002))]
     calls = []
-    orig = AB.estimate_basin
-    monkeypatch.setattr(AB, "estimate_basin", lambda *a, **k: calls.append(1) or orig(*a, **k))
+    orig = SEL.estimate_basin
+    monkeypatch.setattr(SEL, "estimate_basin", lambda *a, **k: calls.append(1) or orig(*a, **k))
     monkeypatch.delenv(AB.EAGER_ENV, raising=False)
     fast = AB.cruise_basin(DRY, 70.0, K, pts, n_traj=2)
     n_fast = len(calls)

@@ -59,7 +59,8 @@ def _run(n: int):
     inside = lambda p: prob.V(p) <= C_CERT
     starts = [x0] + [tuple(_ulps(v, n) for v in s) for s in SAMPLED]
     trajs = [AB._trajectory(fn, s, lam_n, 3.0, inside) for s in starts]
-    est = SimpleNamespace(P=prob.P, c_certified=C_CERT, c_refuted=math.inf, counterexample=None)
+    est = SimpleNamespace(P=prob.P, x_eq=prob.x_eq, c_certified=C_CERT, c_refuted=math.inf,
+                          counterexample=None)
     point = SimpleNamespace(label="paper", x=x0, verdict=SimpleNamespace(outcome=Outcome.REFUTED))
     basin = SimpleNamespace(check=SimpleNamespace(estimate=est, points=(point,)),
                             trajectories=tuple(trajs), lambda_opt=lam_opt, lambda_d=lam_d)

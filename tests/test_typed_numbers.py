@@ -162,7 +162,6 @@ def _key(path: Path) -> str:
 
 #: (module, number) typed in a renderer's prose on purpose, and why.
 RENDERER_CONSTANTS = {
-    ("papers/p003/antiskid_basin_render.py", "0.6"): "a matplotlib grey level, not text",
     ("papers/p003/antiskid_cruise_render.py", "1e-12"): "display floor of a printed residual",
     ("kinds/delay_feedback/render.py", "1e-12"): "display floor of a printed residual",
     ("kinds/delay_benchmark_render.py", "1e-12"): "display floor of a printed relative difference",
@@ -171,7 +170,6 @@ RENDERER_CONSTANTS = {
         "the deceleration paper 004 printed (its rounding is the finding)",
     ("papers/p000/station_stopping_render.py", "3.2"): "section number of paper 000",
     ("papers/p000/station_stopping_render.py", "85.16"): "K1/K2 as paper 000's Table 1 prints it",
-    ("features/basin_render.py", "0.6"): "a matplotlib grey level, not text",
     ("kinds/platoon/realism_render.py", "1e-9"):
         "display floor of a printed relative difference",
     ("papers/p004/closed_loop_brake_fair_render.py", "0.5"):

@@ -31,7 +31,7 @@ design reader imports it); numpy, sympy and the solvers load when it runs.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from ..reader import Reader
 
@@ -52,9 +52,12 @@ class BasinSettings:
     seed: int
 
 
-def load_basin_settings(root, plant, n_scenarios: int) -> BasinSettings | None:
-    """Read ``[basin]`` (or a bare ``basin = true | false``) from a design
-    (a :class:`workbench.reader.Reader`); None when absent or disabled."""
+def basin_table(root):
+    """(reader of the design's ``[basin]`` table, enabled, seed), or None when
+    the design has none; a bare ``basin = true | false`` is an empty table
+    (``root``: a :class:`workbench.reader.Reader`). Any design's basin table
+    has ``enabled = true | false`` (default true) and ``seed`` (falsifier and
+    sampled starts, default 0); the caller reads the rest and calls ``finish``."""
     if not root.has("basin"):
         return None
     raw = root.raw("basin")
@@ -65,6 +68,16 @@ def load_basin_settings(root, plant, n_scenarios: int) -> BasinSettings | None:
         enabled = b.boolean("enabled", default=True)
     else:
         raise root.fail("basin", raw, "true, false or a [basin] table")
+    return b, enabled, int(b.number("seed", integer=True, default=0, nonneg=True, what="integer"))
+
+
+def load_basin_settings(root, plant, n_scenarios: int) -> BasinSettings | None:
+    """Read ``[basin]`` (or a bare ``basin = true | false``) from a design
+    (a :class:`workbench.reader.Reader`); None when absent or disabled."""
+    table = basin_table(root)
+    if table is None:
+        return None
+    b, enabled, seed = table
     states = plant.state_names
     dom = b.table("domain", default=None)
     domain = {}
@@ -81,7 +94,6 @@ def load_basin_settings(root, plant, n_scenarios: int) -> BasinSettings | None:
     if (not isinstance(plane, list) or len(plane) != want or len(set(map(str, plane))) != want
             or not all(isinstance(p, str) and p in states for p in plane)):
         raise b.fail("plane", plane, f"{want} different states of: " + ", ".join(states))
-    seed = b.number("seed", integer=True, default=0, nonneg=True, what="integer")
     b.finish()
     if not enabled:
         return None
@@ -104,16 +116,6 @@ def check_domain(settings: BasinSettings, path: str, names, x_op, scenarios) -> 
                                        for k, v in s.x0.items()) for s in scenarios):
         raise DesignError(path, "basin.domain", "<missing>", "a box { state = [lo, hi], ... } "
                           "(no scenario starts away from the operating point)")
-
-
-@dataclass(frozen=True)
-class Trajectory:
-    """A delay-free trajectory: start, path (N, n), fate ("converges": enters
-    {V <= c_certified}; "leaves the domain"; "undecided" within the horizon)."""
-
-    x0: tuple
-    path: object = field(repr=False)
-    fate: str
 
 
 @dataclass(frozen=True)
@@ -205,6 +207,7 @@ def run_basin(settings: BasinSettings, spec, model, values: dict, op, K) -> Dela
     import numpy as np
     import sympy as sp
 
+    from .basin_trajectory import decays
     names = spec.plant.state_names
     n = len(names)
     lo = np.array([settings.domain.get(k, (-math.inf, math.inf))[0] for k in names])
@@ -249,26 +252,22 @@ def run_basin(settings: BasinSettings, spec, model, values: dict, op, K) -> Dela
         X0 = x_eq + np.sqrt(BOUNDARY * c_cert) * dirs @ np.linalg.inv(L.T).T
         inside = tuple(_trajectory(fn, x0, V, c_cert, escape, horizon, full=True)
                        for x0 in X0)
-        ok = all(_decays(tr.path, V) for tr in inside)
+        ok = all(decays(tr.path, V) for tr in inside)
     return DelayFeedbackBasin(chk, outcome.name, plane, (tuple(box[0]), tuple(box[1])), sampled,
                               inside, ok, horizon, dict(settings.domain), tuple(names))
 
 
-def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False) -> Trajectory:
-    """The delay-free loop from x0 over [0, T] (Radau, rtol 1e-8). Ends when it
+def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False):
+    """The delay-free loop from x0 over [0, T] (Radau, rtol RADAU_RTOL)
+    (:func:`~workbench.features.basin_trajectory.trajectory`). Ends when it
     leaves ``box`` (fate "leaves the domain": the domain, or far away), or,
     unless ``full``, when V falls below 1e-3 c_certified; "converges" when it
     entered {V <= c_certified}; "undecided" when the integrator stops on an
-    inf/NaN Jacobian (a vector field not finite near x0)."""
+    inf/NaN Jacobian (a vector field not finite near x0, e.g. a scenario at a
+    wheel speed of 1e-9 rad/s)."""
     import numpy as np
-    from scipy.integrate import solve_ivp
+    from .basin_trajectory import trajectory
     lo, hi = (np.asarray(b, float) for b in box)
-
-    def rhs(t, x):
-        try:
-            return list(fn(*x))
-        except (OverflowError, ValueError, ZeroDivisionError):
-            return [math.nan] * len(x)
 
     def out(t, x):
         return float(np.min(np.concatenate([x - lo, hi - x])))
@@ -278,52 +277,58 @@ def _trajectory(fn, x0, V, c_cert, box, T, *, full: bool = False) -> Trajectory:
         return float(V(np.asarray(x)[None, :])[0] - 1e-3 * c_cert)
     near.terminal = True
     events = [out] if full or not c_cert > 0 else [out, near]
-    with np.errstate(all="ignore"):
-        try:
-            sol = solve_ivp(rhs, (0.0, T), np.asarray(x0, float), method="Radau",
-                            rtol=RADAU_RTOL, atol=1e-10, events=events)
-        except (ValueError, np.linalg.LinAlgError):
-            # the vector field is not finite near x0 (e.g. a scenario at a wheel speed
-            # of 1e-9 rad/s): Radau's Jacobian has inf/NaN; the fate stays open
-            return Trajectory(tuple(float(v) for v in x0), np.asarray([x0], float), "undecided")
-    path = sol.y.T
-    if c_cert > 0 and np.any(V(path) <= c_cert):
-        fate = "converges"
-    elif len(sol.t_events[0]) or sol.status != 0 or not np.all(np.isfinite(path)):
-        fate = "leaves the domain"
-    else:
-        fate = "undecided"
-    return Trajectory(tuple(float(v) for v in x0), path, fate)
+    inside = ((lambda p: V(p) <= c_cert) if c_cert > 0
+              else (lambda p: np.zeros(len(p), bool)))
+    return trajectory(fn, x0, T, inside, events=events, rtol=RADAU_RTOL)
 
 
-def _decays(path, V) -> bool:
-    """V never rose along the path (1e-6 relative) and ends below 1 % of its start."""
-    import numpy as np
-    v = V(path)
-    return bool(np.all(np.isfinite(v)) and np.all(np.diff(v) <= 1e-6 * v[0])
-                and v[-1] <= 0.01 * v[0])
+#: Claimable quantities of any basin estimate (:func:`level_quantities`).
+LEVEL_QUANTITIES = frozenset({"basin.c_certified", "basin.c_refuted"})
+
+
+def level_quantities(est) -> dict:
+    """The certified and refuted levels of a basin estimate."""
+    return {"basin.c_certified": est.c_certified, "basin.c_refuted": est.c_refuted}
+
+
+def point_quantity_names(labels, key: str, suffixes=("in_basin",)) -> set:
+    """``{key}.{suffix}`` for each label (``key`` formats ``{label}``)."""
+    return {f"{key.format(label=lab)}.{x}" for lab in labels for x in suffixes}
+
+
+def point_quantities(check, key: str, **more) -> dict:
+    """``{key}.in_basin`` (the verdict) of each judged point of a
+    :class:`workbench.roa.check.BasinCheck`, then ``{key}.{name}`` for each
+    keyword ``name`` = a sequence with one value per point."""
+    q = {}
+    for k, p in enumerate(check.points):
+        at = key.format(label=p.label)
+        q[f"{at}.in_basin"] = p.verdict.outcome.name
+        q.update({f"{at}.{name}": vals[k] for name, vals in more.items()})
+    return q
+
+
+#: Key of a delay-feedback scenario's quantities.
+_SCENARIO = "basin.scenario[{label}]"
 
 
 def basin_quantity_names(spec) -> set:
     """Claimable quantities of the basin check (see :func:`basin_quantities`)."""
-    names = {"basin.c_certified", "basin.c_refuted", "basin.c_search", "basin.outcome",
-             "basin.certified", "basin.inside_converge"}
-    for s in spec.scenarios:
-        names |= {f"basin.scenario[{s.name}].in_basin", f"basin.scenario[{s.name}].level"}
-    return names
+    return (set(LEVEL_QUANTITIES)
+            | {"basin.c_search", "basin.outcome", "basin.certified", "basin.inside_converge"}
+            | point_quantity_names([s.name for s in spec.scenarios], _SCENARIO,
+                                   ("in_basin", "level")))
 
 
 def basin_quantities(res: DelayFeedbackBasin) -> dict:
     """Values of :func:`basin_quantity_names` (a design without a certified
     gain has no basin: its basin claims are not determined)."""
     est = res.check.estimate
-    q = {}
-    q.update({"basin.c_certified": est.c_certified, "basin.c_refuted": est.c_refuted,
-              "basin.c_search": est.c_search, "basin.outcome": res.outcome,
+    q = level_quantities(est)
+    q.update({"basin.c_search": est.c_search, "basin.outcome": res.outcome,
               "basin.certified": "yes" if est.c_certified > 0 else "no",
               "basin.inside_converge": None if res.inside_ok is None
               else ("yes" if res.inside_ok else "no")})
-    for p in res.check.points:
-        q[f"basin.scenario[{p.label}].in_basin"] = p.verdict.outcome.name
-        q[f"basin.scenario[{p.label}].level"] = est.level_bounds(p.x)[1]
+    q.update(point_quantities(res.check, _SCENARIO,
+                              level=[est.level_bounds(p.x)[1] for p in res.check.points]))
     return q

@@ -7,9 +7,10 @@ import numpy as np
 from ..report.markdown import Figure, fmt
 from ..roa.render import fmt_level, render_basin_markdown
 from .basin import BOUNDARY, N_INSIDE, RADAU_RTOL
+from .basin_plot import FATE_COLOR, BasinPlotStyle
+from .basin_plot import plot_basin as draw_basin
 
-_FATE_COLOR = {"converges": "tab:green", "leaves the domain": "tab:red", "undecided": "0.6"}
-_MARK = {"CERTIFIED": "o", "REFUTED": "X", "INCONCLUSIVE": "s"}
+_STYLE = BasinPlotStyle(point_label="scenario {label}: {outcome}")
 _OUTCOME = {
     "CERTIFIED": "**CERTIFIED**: V' < 0 is proven on the whole of {0 < V <= c_search}",
     "REFUTED": "**REFUTED**: a point of {V <= c_search} has V' >= 0 (c_refuted <= c_search); "
@@ -87,26 +88,17 @@ def render_basin_section(spec, res, basin) -> tuple[str, tuple]:
     return text, (fig,)
 
 
-def _ellipse(P: np.ndarray, c: float, plane) -> np.ndarray:
-    """Points of {e' P_pp e = c} in the plane's coordinates (slice through x*)."""
-    Pp = P[np.ix_(plane, plane)]
-    T = np.linalg.inv(np.linalg.cholesky(Pp).T)
-    th = np.linspace(0, 2 * np.pi, 400)
-    return np.sqrt(c) * T @ np.vstack([np.cos(th), np.sin(th)])
-
-
 def plot_basin(fig, basin, names) -> None:
     """Level sets, counterexample, sampled trajectories and scenario states
-    (``names``: axis labels, one per state)."""
+    (``names``: axis labels, one per state; :func:`.basin_plot.plot_basin`)."""
     est = basin.check.estimate
     ax = fig.add_subplot(111)
     P, x_eq = np.array(est.P), np.array(est.x_eq)
     lo, hi = np.array(basin.box[0]), np.array(basin.box[1])
-    n_pts = len(basin.check.points)
     if len(names) == 1:
         for tr in basin.sampled:
             t = np.linspace(0, 1, len(tr.path))
-            ax.plot(t, tr.path[:, 0], color=_FATE_COLOR[tr.fate], lw=0.8)
+            ax.plot(t, tr.path[:, 0], color=FATE_COLOR[tr.fate], lw=0.8)
         r = np.sqrt(est.c_certified / P[0, 0])
         ax.axhspan(x_eq[0] - r, x_eq[0] + r, color="tab:green", alpha=0.15,
                    label="certified level set")
@@ -115,28 +107,11 @@ def plot_basin(fig, basin, names) -> None:
         ax.legend(fontsize=7)
         return
     i, j = basin.plane
-    for c, style, lab in ((est.c_certified, "-", "certified level c_certified"),
-                          (est.c_refuted, "--", "refuted level c_refuted")):
-        if 0 < c < np.inf:
-            e = _ellipse(P, c, [i, j])
-            ax.plot(x_eq[i] + e[0], x_eq[j] + e[1], "k" + style, lw=1.2, label=lab)
-    if est.counterexample is not None:
-        cx = est.counterexample
-        ax.plot(cx[i], cx[j], "k*", ms=9, label="counterexample (V' >= 0)")
-    seen = set()
-    for tr in basin.sampled[n_pts:]:
-        lab = None if tr.fate in seen else f"sampled: {tr.fate}"
-        seen.add(tr.fate)
-        ax.plot(tr.path[:, i], tr.path[:, j], color=_FATE_COLOR[tr.fate], lw=0.8, alpha=0.85,
-                label=lab)
-    for p, tr in zip(basin.check.points, basin.sampled):
-        ax.plot(tr.path[:, i], tr.path[:, j], color=_FATE_COLOR[tr.fate], lw=1.6)
-        ax.plot(p.x[i], p.x[j], _MARK[p.verdict.outcome.name], color="tab:blue", ms=8,
-                mec="k", label=f"scenario {p.label}: {p.verdict.outcome.name}")
+    draw_basin(ax, est, basin.check.points, basin.sampled, (i, j), _STYLE)
     ax.plot(x_eq[i], x_eq[j], "k+", ms=10, label="operating point x*")
     pad_i, pad_j = 0.05 * (hi[i] - lo[i]), 0.05 * (hi[j] - lo[j])
     ax.set_xlim(lo[i] - pad_i, hi[i] + pad_i)
     ax.set_ylim(lo[j] - pad_j, hi[j] + pad_j)
     ax.set_xlabel(names[i])
     ax.set_ylabel(names[j])
-    ax.legend(fontsize=6, loc="best", framealpha=0.9)
+    ax.legend(fontsize=6, loc=_STYLE.legend_loc, framealpha=0.9)

@@ -67,6 +67,29 @@ def largest_level_in_box(P: np.ndarray, x_eq: np.ndarray, lo: Sequence[float],
     return float(np.min(d * d / np.diag(np.linalg.inv(P))) * (1 - 1e-6))
 
 
+def search_level(prob: BasinProblem, points, domain: tuple | None = None,
+                 c_search: float | None = None) -> float:
+    """The level a basin search examines: ``c_search`` if given, else 4 x the
+    largest level V of ``points`` (states), capped by the largest ellipsoid
+    whose bounding box fits in ``domain`` = (lo, hi) (that level alone when no
+    point lies away from x*).
+
+    Raises
+    ------
+    ModelError
+        When neither gives a positive level.
+    """
+    levels = [float(prob.V(np.asarray(x, float)[None, :])[0]) for x in points]
+    if c_search is None:
+        c_search = 4.0 * max(levels) if levels and max(levels) > 0 else None
+    if domain is not None:
+        cap = largest_level_in_box(prob.P, prob.x_eq, *domain)
+        c_search = cap if c_search is None else min(c_search, cap)
+    if c_search is None or not c_search > 0:
+        raise ModelError("check_basin needs c_search, a domain box or points away from x*")
+    return c_search
+
+
 def check_basin(f: Sequence[sp.Expr], states: Sequence[sp.Symbol], x_eq: Sequence[float], *,
                 A_cl=None, P=None, Q=None, weights=None, points: Sequence[tuple[str, Sequence[float]]] = (),
                 c_search: float | None = None, domain: tuple | None = None,
@@ -120,14 +143,7 @@ def check_basin(f: Sequence[sp.Expr], states: Sequence[sp.Symbol], x_eq: Sequenc
     else:
         raise ModelError("check_basin needs A_cl (for a Lyapunov equation) or P")
     prob = BasinProblem(f, states, x_eq, Pm, P_source=src, names=names)
-    levels = [float(prob.V(np.asarray(x, float)[None, :])[0]) for _, x in points]
-    if c_search is None:
-        c_search = 4.0 * max(levels) if levels and max(levels) > 0 else None
-    if domain is not None:
-        cap = largest_level_in_box(prob.P, prob.x_eq, *domain)
-        c_search = cap if c_search is None else min(c_search, cap)
-    if c_search is None or not c_search > 0:
-        raise ModelError("check_basin needs c_search, a domain box or points away from x*")
+    c_search = search_level(prob, [x for _, x in points], domain, c_search)
     est: BasinEstimate = estimate_basin(prob, c_search, seed=seed, min_width=min_width)
     checks = tuple(PointCheck(label, tuple(float(v) for v in x), est.point_verdict(x))
                    for label, x in points)

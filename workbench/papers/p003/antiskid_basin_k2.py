@@ -6,11 +6,15 @@ For each k2 of a grid (k1 kept), :func:`~workbench.papers.p003.antiskid_basin.sw
 decides whether the switch state is CERTIFIED (inside {V <= c_certified}
 for some P = modal_P(A + B K, [1, w]) of the grid) or not, and simulates
 the delay-free trajectory from it; the edge between the largest certified
-grid value and the next one is then bisected. Gains given for comparison
+grid value and the next one is then bisected
+(:func:`workbench.features.basin_sweep.gain_edge`). Gains given for comparison
 (e.g. the rows of 003's Table 3) are judged the same way, with their own k1.
 
 The rule is *sufficient*: a state outside every certified level set may
 still converge (the "fate" column says what the delay-free trajectory does).
+
+Only the gain parameterisation (k2 of law (61), k1 kept, Table 3's rows) is
+paper 003's; the sweep is :func:`workbench.features.basin_sweep.gain_edge`.
 
 References
 ----------
@@ -23,6 +27,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 
+from ...features.basin_sweep import gain_edge
 from ...memo import shared
 from ...outcome import Outcome
 from .antiskid_basin import SwitchVerdict, switch_in_basin
@@ -80,23 +85,11 @@ def _sweep(values: tuple, v_d: float, k1: float, point: tuple, grid: tuple, comp
     vals = dict(values)
     judge = lambda k1_, k2_, src: K2Row(k1_, k2_, switch_in_basin(vals, v_d, (k1_, k2_), point,
                                                                    seed=seed), src)
-    rows = [judge(k1, k2, "grid") for k2 in sorted(grid)]
-    edge = None
-    ok = [_ok(r) for r in rows]
-    for i in range(len(rows) - 1):
-        if ok[i] and not ok[i + 1]:
-            lo, hi = rows[i].k2, rows[i + 1].k2
-            for _ in range(bisect):
-                mid = 0.5 * (lo + hi)
-                r = judge(k1, mid, "edge")
-                rows.append(r)
-                lo, hi = (mid, hi) if _ok(r) else (lo, mid)
-            edge = (lo, hi)
-            break
-    rows.sort(key=lambda r: r.k2)
-    below = edge is not None and all(_ok(r) for r in rows if r.k2 <= edge[0])
+    sw = gain_edge(lambda k2, src: judge(k1, k2, src), grid, ok=_ok, gain=lambda r: r.k2,
+                   bisect=bisect)
     compared = tuple(judge(float(g[0]), float(g[1]), label) for label, g in compare)
-    return K2Sweep(tuple(point), k1, tuple(rows), compared, edge, min(grid), below)
+    return K2Sweep(tuple(point), k1, sw.rows, compared, sw.edge, min(grid),
+                   sw.certified_below_edge)
 
 
 def safe_k2_range(values: dict, v_d: float, k1: float, point, *, grid, compare=(),

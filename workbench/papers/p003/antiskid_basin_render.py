@@ -1,18 +1,19 @@
 """Markdown and figure of the cruise-basin check (pure rendering of
 :class:`~workbench.papers.p003.antiskid_basin.CruiseBasin` and
-:class:`~workbench.papers.p003.antiskid_basin_k2.K2Sweep`)."""
+:class:`~workbench.papers.p003.antiskid_basin_k2.K2Sweep`).
+
+Paper 003's wording (laws (61), (69), eqs (75)-(76), the k2 rule) and the
+cruise figure's look stay here; the figure itself is the general
+:func:`workbench.features.basin_plot.plot_basin`."""
 from __future__ import annotations
 
 import math
 
-import numpy as np
-
+from ...features.basin_plot import BasinPlotStyle
+from ...features.basin_plot import plot_basin as draw_basin
 from ...report.markdown import fmt, md_table
 from ...roa.render import fmt_level, render_basin_markdown
 from .antiskid_basin import LAM_DIVERGED
-
-_FATE_COLOR = {"converges": "tab:green", "diverges": "tab:red", "undecided": "0.6"}
-_SWITCH_MARK = {"CERTIFIED": "o", "REFUTED": "X", "INCONCLUSIVE": "s"}
 
 
 def render_basin_result(res, *, rail: str) -> str:
@@ -155,37 +156,21 @@ def _k2_text(sweep, compare_source) -> str:
             "delay-free loop as well.\n")
 
 
+#: The cruise figure's look: paths clipped to lambda - lambda_d in [-0.3, 0.5].
+_STYLE = BasinPlotStyle(sampled_lw=0.7, sampled_alpha=0.8, point_lw=1.8, point_ms=9, cx_ms=8,
+                        point_label="switch `{label}`: {outcome}", clip=(None, (-0.3, 0.5)),
+                        legend_loc="upper left")
+
+
 def plot_basin(fig, basin) -> None:
     """(v - v_d, lambda - lambda_d) plane: certified and refuted level sets,
-    the counterexample, sampled delay-free trajectories, switch states."""
-    est = basin.check.estimate
+    the counterexample, sampled delay-free trajectories, switch states
+    (:func:`workbench.features.basin_plot.plot_basin`), lambda = lambda_opt."""
     ax = fig.add_subplot(111)
-    P = np.array(est.P)
-    T = np.linalg.inv(np.linalg.cholesky(P).T)
-    th = np.linspace(0, 2 * np.pi, 400)
-    circ = np.vstack([np.cos(th), np.sin(th)])
-    for c, style, lab in ((est.c_certified, "-", "certified level c_certified"),
-                          (est.c_refuted, "--", "refuted level c_refuted")):
-        if 0 < c < np.inf:
-            e = np.sqrt(c) * T @ circ
-            ax.plot(e[0], e[1], "k" + style, lw=1.2, label=lab)
-    if est.counterexample is not None:
-        ax.plot(*est.counterexample, "k*", ms=8, label="counterexample (V' >= 0)")
-    seen = set()
-    for tr in basin.trajectories[len(basin.check.points):]:
-        p = tr.path
-        lab = None if tr.fate in seen else f"sampled: {tr.fate}"
-        seen.add(tr.fate)
-        ax.plot(p[:, 0], np.clip(p[:, 1], -0.3, 0.5), color=_FATE_COLOR[tr.fate], lw=0.7,
-                alpha=0.8, label=lab)
-    for pt, tr in zip(basin.check.points, basin.trajectories):
-        p = tr.path
-        ax.plot(p[:, 0], np.clip(p[:, 1], -0.3, 0.5), color=_FATE_COLOR[tr.fate], lw=1.8)
-        ax.plot(*pt.x, _SWITCH_MARK[pt.verdict.outcome.name], color="tab:blue", ms=9,
-                mec="k", label=f"switch `{pt.label}`: {pt.verdict.outcome.name}")
+    draw_basin(ax, basin.check.estimate, basin.check.points, basin.trajectories, (0, 1), _STYLE)
     ax.axhline(basin.lambda_opt - basin.lambda_d, color="tab:purple", ls=":", lw=0.8,
                label="lambda = lambda_opt")
     ax.set_xlabel("v - v_d (m/s)")
     ax.set_ylabel("lambda - lambda_d")
     ax.set_ylim(-0.15, 0.3)
-    ax.legend(fontsize=6, loc="upper left", framealpha=0.9)
+    ax.legend(fontsize=6, loc=_STYLE.legend_loc, framealpha=0.9)

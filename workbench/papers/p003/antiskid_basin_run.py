@@ -19,12 +19,18 @@ switch state (v_d, lambda_opt). The cruise -> braking switch is judged at
 each case's state at t_brake against the braking law (69) frozen at that
 instant (:mod:`.antiskid_basin_brake`). The basin uses the controller's nominal
 model (a design's plant mass factor is not in it; the report says so).
+
+What stays here is paper 003's: the table's gain rows, where the switches are
+in a case's metrics and the claim names; the table opener and the level and
+point quantities are the general ones of :mod:`workbench.features.basin`.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 
+from ...features.basin import (LEVEL_QUANTITIES, basin_table, level_quantities,
+                                point_quantities, point_quantity_names)
 from .antiskid_basin import CruiseBasin, cruise_basin
 from .antiskid_basin_k2 import K2Sweep, safe_k2_range
 
@@ -54,10 +60,10 @@ class BasinResult:
 def load_basin_settings(root) -> BasinSettings | None:
     """Read ``[basin]`` from a design (a :class:`workbench.reader.Reader`);
     None when the table is absent or ``enabled = false``."""
-    if not root.has("basin"):
+    table = basin_table(root)
+    if table is None:
         return None
-    b = root.table("basin")
-    enabled = b.boolean("enabled", default=True)
+    b, enabled, seed = table
     grid = b.numbers("k2_grid", min_len=2, what="cruise gains k2")
     gains = b.raw("compare_gains", default=[])
     if not isinstance(gains, list):
@@ -76,11 +82,14 @@ def load_basin_settings(root) -> BasinSettings | None:
         raise b.fail("compare_labels", labels, f"{len(rows)} non-empty strings, one per gain")
     source = b.string("compare_source", default="—")
     bisect = b.number("bisect", integer=True, default=4, lo=0, hi=12, what="integer")
-    seed = b.number("seed", integer=True, default=0, nonneg=True, what="integer")
     b.finish()
     if not enabled:
         return None
     return BasinSettings(tuple(sorted(grid)), tuple(zip(labels, rows)), source, bisect, seed)
+
+
+#: Key of a case's acceleration -> cruise switch quantities.
+_CRUISE = "switch.cruise[{label}]"
 
 
 def switch_points(cases) -> list:
@@ -144,17 +153,14 @@ def run_basin(settings: BasinSettings, values: dict, v_d: float, K, lambda_opt: 
 def basin_quantities(basin, sweep, labels=(), brake=()) -> dict:
     """Claim quantities of the basin check (``labels``: every case; a case
     whose cruise law never started, or that never braked, gets None)."""
-    est = basin.check.estimate
-    q = {"basin.c_certified": est.c_certified, "basin.c_refuted": est.c_refuted}
+    q = level_quantities(basin.check.estimate)
     for lab in labels:
         q[f"switch.cruise[{lab}].in_basin"] = q[f"switch.cruise[{lab}].fate"] = None
         q[f"switch.brake[{lab}].in_basin"] = q[f"switch.brake[{lab}].fate"] = None
     for b in brake:
         q[f"switch.brake[{b.label}].in_basin"] = b.outcome.name
         q[f"switch.brake[{b.label}].fate"] = b.fate
-    for p, tr in zip(basin.check.points, basin.trajectories):
-        q[f"switch.cruise[{p.label}].in_basin"] = p.verdict.outcome.name
-        q[f"switch.cruise[{p.label}].fate"] = tr.fate
+    q.update(point_quantities(basin.check, _CRUISE, fate=[tr.fate for tr in basin.trajectories]))
     if sweep is not None:
         q["basin.k2_safe_max"] = None if sweep.edge is None else sweep.edge[0]
         q["basin.k2_unsafe_min"] = None if sweep.edge is None else sweep.edge[1]
@@ -164,10 +170,8 @@ def basin_quantities(basin, sweep, labels=(), brake=()) -> dict:
 
 
 def basin_quantity_names(labels, with_sweep: bool) -> set:
-    names = {"basin.c_certified", "basin.c_refuted"}
-    for lab in labels:
-        names |= {f"switch.cruise[{lab}].in_basin", f"switch.cruise[{lab}].fate",
-                  f"switch.brake[{lab}].in_basin", f"switch.brake[{lab}].fate"}
+    names = (set(LEVEL_QUANTITIES) | point_quantity_names(labels, _CRUISE, ("in_basin", "fate"))
+             | point_quantity_names(labels, "switch.brake[{label}]", ("in_basin", "fate")))
     if with_sweep:
         names |= {"basin.k2_safe_max", "basin.k2_unsafe_min", "basin.compared_certified"}
     return names
