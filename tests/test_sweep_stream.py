@@ -91,7 +91,7 @@ def test_cli_resume_needs_out(capsys):
 def test_default_chunk_is_bounded():
     """A large sweep is cut into chunks of at most MAX_CHUNK runs (streaming,
     resume and progress at a fine grain); a small one into DEFAULT_CHUNKS."""
-    from workbench.papers.p003.antiskid_montecarlo import DEFAULT_CHUNKS, MAX_CHUNK, default_chunk
+    from workbench.features.montecarlo_chunks import DEFAULT_CHUNKS, MAX_CHUNK, default_chunk
     assert default_chunk(1) == 1
     assert default_chunk(64) == 64 // DEFAULT_CHUNKS
     assert default_chunk(10**6) == MAX_CHUNK

@@ -141,14 +141,18 @@ def load_montecarlo(root: Reader, factors: dict[str, bool], *,
 def draw(spec: MonteCarloSpec, order: tuple[str, ...], nominal: dict) -> dict:
     """Draws of every factor of ``order`` (arrays of ``spec.samples``);
     factors without a distribution take their ``nominal`` value."""
-    out = {}
-    for k, name in enumerate(order):
-        if name in spec.distributions:
-            u = np.random.default_rng([spec.seed, k]).random(spec.samples)
-            out[name] = spec.distributions[name].ppf(u)
-        else:
-            out[name] = np.full(spec.samples, float(nominal[name]))
-    return out
+    drawn = drawn_factors(spec, order)
+    return {name: drawn[name] if name in drawn else np.full(spec.samples, float(nominal[name]))
+            for name in order}
+
+
+def drawn_factors(spec: MonteCarloSpec, order: tuple[str, ...]) -> dict:
+    """The draws of the factors of ``order`` with a distribution only (in
+    the order of ``spec.distributions``), each the same as in :func:`draw`:
+    the inverse CDF of ``default_rng([seed, k]).random(samples)``, k the
+    factor's index in ``order``."""
+    return {name: d.ppf(np.random.default_rng([spec.seed, order.index(name)]).random(
+        spec.samples)) for name, d in spec.distributions.items() if name in order}
 
 
 def within_rate(errors, tol: float, z: float = Z95):

@@ -222,14 +222,14 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool = False,
     With ``out`` the runs are computed in chunks and written to
     ``out/<scenario>-chunk-NNNN.csv`` (one row per run: its drawn parameters
     and its metrics), ``resume`` skipping the chunks already there
-    (:mod:`workbench.kinds.sweep_out`); the summary is read back from the
+    (:mod:`workbench.features.montecarlo_chunks`); the summary is read back from the
     files. A chunk's runs equal the one-batch sweep's up to the last bits of
     the gain's matrix product (the only operation not elementwise over runs)."""
     from pathlib import Path
     from types import SimpleNamespace
 
     from ..capabilities import sweep_draws
-    from ..sweep_out import check_resume
+    from ...features.montecarlo_chunks import check_resume
     from .montecarlo import montecarlo_values, run_montecarlo
     from .run import designed_gain, predict, reference
     spec = replace(design.spec, montecarlo=sweep_draws(design, samples, seed, 2000))
@@ -252,13 +252,12 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool = False,
 
 def _chunked_montecarlo(design, spec, model, values, op, K, folder, resume):
     """The Monte Carlo of :func:`sweep_command` through the chunk files."""
-    from ...features.montecarlo import draw
-    from ..sweep_out import Group, run_chunks
+    from ...features.montecarlo import drawn_factors
+    from ...features.montecarlo_chunks import Group, run_chunks
     from .montecarlo import MonteCarloScenario, drawn_scenarios, montecarlo_batch
     from .run import predict, reference
     mc = spec.montecarlo
-    drawn = draw(mc, tuple(spec.plant.parameters), values)
-    draws = {k: drawn[k] for k in mc.distributions}
+    draws = drawn_factors(mc, tuple(spec.plant.parameters))
     batch = montecarlo_batch(spec, model, values, op, K, reference, predict)
     scen = {sc.name: sc for sc in drawn_scenarios(spec)}
     got = run_chunks(folder, {"design": design.name, "scenarios": list(scen),

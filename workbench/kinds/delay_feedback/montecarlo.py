@@ -26,6 +26,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...features.montecarlo_stats import finite_span
+
 __all__ = ["MonteCarloScenario", "drawn_scenarios", "load_montecarlo_table",
            "montecarlo_batch", "montecarlo_names", "montecarlo_values", "run_montecarlo",
            "montecarlo_section"]
@@ -79,8 +81,7 @@ def montecarlo_values(r) -> dict:
         out[f"montecarlo.{mc.name}.diverged"] = int(mc.metrics["diverged"].sum())
         for k, v in mc.metrics.items():
             if k != "diverged":
-                ok = ~np.isnan(v)
-                out[f"montecarlo.{mc.name}.max.{k}"] = float(np.max(v[ok])) if ok.any() else None
+                out[f"montecarlo.{mc.name}.max.{k}"] = finite_span(v)[1]
     return out
 
 
@@ -106,7 +107,7 @@ def montecarlo_batch(spec, model, values, op, K, reference, predict):
     runs; a parameter left out is nominal), the model compiled once.
     Every operation but the gain's matrix product is elementwise over the
     runs (``sweep --out`` cuts a sweep into such batches,
-    :mod:`workbench.kinds.sweep_out`)."""
+    :mod:`workbench.features.montecarlo_chunks`)."""
     import sympy as sp
     names = tuple(spec.plant.parameters)
     fn = sp.lambdify(model.x + model.u + tuple(model.p[k] for k in names), list(model.f),
@@ -184,13 +185,11 @@ def montecarlo_section(spec, r) -> str:
     rows = []
     for m in r.montecarlo or ():
         for k, v in m.metrics.items():
-            ok = ~np.isnan(v)
             if k == "diverged":
                 rows.append([f"`{m.name}`", "diverged (runs)", f"{int(v.sum())} of {m.samples}",
                              ""])
             else:
-                rows.append([f"`{m.name}`", f"`{k}`", fmt(np.min(v[ok]), 4) if ok.any() else "—",
-                             fmt(np.max(v[ok]), 4) if ok.any() else "—"])
+                rows.append([f"`{m.name}`", f"`{k}`", *(fmt(x, 4) for x in finite_span(v))])
     skipped = [s.name for s in spec.scenarios if s.parameters]
     return ("## Monte Carlo\n\nEvery scenario again with the plant's parameters drawn "
             f"({mc.samples} runs, seed {mc.seed}; `workbench/features/montecarlo.py`); the gain, "

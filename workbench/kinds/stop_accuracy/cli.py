@@ -20,7 +20,7 @@ within the tolerance (Wilson 95 %), the 95th percentile of |error|, the mean
 error and the overshoot share. With ``--out DIR`` the runs are computed in
 chunks and written to ``DIR/<case>-chunk-NNNN.csv`` (one row per run: its
 draws and its stop error, m), ``--resume`` skipping the chunks already there
-(:mod:`workbench.kinds.sweep_out`).
+(:mod:`workbench.features.montecarlo_chunks`).
 """
 from __future__ import annotations
 
@@ -122,7 +122,7 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool, case: str |
     error)."""
     from ...errors import DesignError
     from ..capabilities import sweep_draws
-    from ..sweep_out import Group, check_resume, run_chunks
+    from ...features.montecarlo_chunks import Group, check_resume, run_chunks
     from . import MAX_WORK
     from .run import compile_laws, montecarlo_draws, simulate_cases, stopping_points
     spec = design.spec

@@ -12,7 +12,7 @@
 ``--out DIR`` the runs are computed in chunks and written to
 ``DIR/<scenario>-chunk-NNNN.csv`` (one row per run: its draws, its metrics,
 why it ended), ``--resume`` skipping the chunks already there
-(:mod:`workbench.kinds.sweep_out`, the machinery of every kind's sweep).
+(:mod:`workbench.features.montecarlo_chunks`, the machinery of every kind's sweep).
 """
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..sweep_out import CHUNK
+from ...features.montecarlo_chunks import CHUNK
 
 __all__ = ["CHUNK", "simulate_command", "sweep_command", "trajectory_csv"]
 
@@ -99,9 +99,9 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool, case: str |
     (Wilson 95 %) and the range of every metric; exit 0 (failing runs are
     reported, not an error)."""
     from ...errors import DesignError
-    from ...features.montecarlo import draw
+    from ...features.montecarlo import drawn_factors
     from ..capabilities import sweep_draws
-    from ..sweep_out import check_resume
+    from ...features.montecarlo_chunks import check_resume
     from . import MAX_WORK
     from .study import MonteCarloRun
     spec = design.spec
@@ -111,10 +111,9 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool, case: str |
     if samples * sc.t_end / sc.dt > MAX_WORK:
         raise DesignError("<cli>", "--samples", samples, f"at most {MAX_WORK:g} samples x "
                           "steps")
-    drawn = draw(mc, tuple(spec.plant.parameters), spec.plant.values(sc.parameters))
-    draws = {k: drawn[k] for k in mc.distributions}
+    draws = drawn_factors(mc, tuple(spec.plant.parameters))
     if out:
-        from ..sweep_out import Group, run_chunks
+        from ...features.montecarlo_chunks import Group, run_chunks
         got = run_chunks(Path(out), {"design": design.name, "scenario": sc.name,
                                      "samples": samples, "seed": seed},
                          [Group(sc.name, draws)], lambda g, d: _run(spec, sc, d), resume)
@@ -127,21 +126,19 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool, case: str |
 
 
 def _run(spec, sc, draws):
-    from .simulate import Compiled, simulate
-    b = simulate(spec, Compiled(spec), sc, sc.dt, plant_params=draws)
-    return b.metrics, list(b.reasons)
+    from .simulate import Compiled
+    from .study import drawn_runs
+    return drawn_runs(spec, Compiled(spec), sc, draws)
 
 
 def _print_summary(design, sc, res, as_json: bool) -> None:
+    from ...features.montecarlo_stats import finite_span
     from ...report.markdown import fmt, md_table
     from .quantities import scenario_metrics
     from .study import _rate
     rates = [_rate(c, res) for c in design.spec.claims if c.scenario == sc.name]
     units = scenario_metrics(design.spec, sc.name)
-    span = {}
-    for k, v in res.metrics.items():
-        ok = ~np.isnan(v)
-        span[k] = (float(np.min(v[ok])), float(np.max(v[ok]))) if ok.any() else (None, None)
+    span = {k: finite_span(v) for k, v in res.metrics.items()}
     if as_json:
         print(json.dumps({"design": design.name, "case": sc.name, "samples": res.samples,
                           "seed": res.seed, "diverged": int(np.nansum(res.metrics["diverged"])),

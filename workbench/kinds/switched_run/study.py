@@ -128,12 +128,18 @@ def run(spec) -> SwitchedRunResult:
 
 
 def _montecarlo(spec, comp, sc) -> MonteCarloRun:
-    from ...features.montecarlo import draw
+    from ...features.montecarlo import drawn_factors
     mc = spec.montecarlo
-    drawn = draw(mc, tuple(spec.plant.parameters), spec.plant.values(sc.parameters))
-    draws = {k: drawn[k] for k in mc.distributions}
-    batch = simulate(spec, comp, sc, sc.dt, plant_params=draws)
-    return MonteCarloRun(mc.samples, mc.seed, draws, batch.metrics, batch.reasons)
+    draws = drawn_factors(mc, tuple(spec.plant.parameters))
+    metrics, reasons = drawn_runs(spec, comp, sc, draws)
+    return MonteCarloRun(mc.samples, mc.seed, draws, metrics, tuple(reasons))
+
+
+def drawn_runs(spec, comp, sc, draws) -> tuple[dict, list]:
+    """(metrics, reasons) of one batch of runs of scenario ``sc`` at its step,
+    the plant's parameters ``draws`` (name -> array over the runs)."""
+    b = simulate(spec, comp, sc, sc.dt, plant_params=draws)
+    return b.metrics, list(b.reasons)
 
 
 def _rate(target, mc: MonteCarloRun) -> ClaimRate:

@@ -23,12 +23,14 @@ the rendering is :mod:`workbench.papers.p003.antiskid_montecarlo_render`.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass
 from functools import lru_cache
+from typing import ClassVar
 
 import numpy as np
 
+from ...features.montecarlo_chunks import chunk_ranges, default_chunk
+from ...features.montecarlo_stats import OK, RunsResult, quantity_names
 from ...sim.batch import PendingBatch, available_cpus, uniform_draws
 from .antiskid_run_spec import SweepSpec
 
@@ -43,9 +45,6 @@ from .antiskid_run_spec import SweepSpec
 #: paper's "about 350 s") is converged.
 SUMMARY_METRICS = ("lam_max_over_opt", "t_cruise", "omega3_after_brake")
 
-#: Statistics of each summary metric (over its finite values).
-STATISTICS = ("n_finite", "min", "median", "p95", "max")
-
 #: Checks counted per run: key -> what a violation means.
 VIOLATIONS = {"above_lambda_opt": "creep ratio above the sample's lambda_opt in traction",
               "diverged": "diverged (|lambda| >= 0.9, torque out of range, or step not resolved)",
@@ -53,66 +52,16 @@ VIOLATIONS = {"above_lambda_opt": "creep ratio above the sample's lambda_opt in 
 
 #: Outcomes reported as rates with their Wilson 95 % interval: the checks of
 #: :data:`VIOLATIONS` and "ok" (none of them).
-OUTCOMES = (*VIOLATIONS, "ok")
-
-#: Default number of chunks a sweep is cut into (independent of the workers)...
-DEFAULT_CHUNKS = 4
-#: ... unless a chunk would hold more runs than this: a large sweep streams,
-#: resumes and reports progress in chunks of at most MAX_CHUNK runs (about a
-#: minute of one core with the compiled kernel), and a worker's memory does
-#: not grow with the sweep.
-MAX_CHUNK = 500
-
-
-def default_chunk(samples: int) -> int:
-    """Runs per chunk when the caller gives none: samples / DEFAULT_CHUNKS,
-    at most MAX_CHUNK, at least 1 (the results do not depend on it)."""
-    return max(1, min(math.ceil(samples / DEFAULT_CHUNKS), MAX_CHUNK))
+OUTCOMES = (*VIOLATIONS, OK)
 
 
 @dataclass(frozen=True)
-class SweepResult:
-    samples: dict           # name -> list of floats
-    metrics: dict           # name -> list of floats
-    violations: dict        # key of VIOLATIONS -> list of bool
-    seconds: float
-    workers: int
+class SweepResult(RunsResult):
+    """The runs of a sweep (:class:`~workbench.features.montecarlo_stats.RunsResult`)
+    with the paper's summary metrics and outcomes."""
 
-    @property
-    def n(self) -> int:
-        return len(self.metrics["t_cruise"])
-
-    def summary_rows(self) -> list[list]:
-        """[metric, n finite, min, median, 95th percentile, max] per summary
-        metric (None where no run has a finite value)."""
-        rows = []
-        for k in SUMMARY_METRICS:
-            x = np.asarray(self.metrics[k], float)
-            ok = x[np.isfinite(x)]
-            if ok.size == 0:
-                rows.append([k, 0, None, None, None, None])
-                continue
-            rows.append([k, int(ok.size), float(ok.min()), float(np.median(ok)),
-                         float(np.percentile(ok, 95)), float(ok.max())])
-        return rows
-
-    def statistics(self) -> dict:
-        """``{"<metric>.<statistic>": value}`` from :meth:`summary_rows`,
-        ``{"fraction.<violation>": value}`` (fraction of all runs) and
-        ``{"wilson.<outcome>.lo" | ".hi": bound}`` (:meth:`outcome_rates`)."""
-        out = {f"{r[0]}.{s}": x for r in self.summary_rows() for s, x in zip(STATISTICS, r[1:])}
-        out.update({f"fraction.{k}": sum(v) / self.n for k, v in self.violations.items()})
-        for o, _, _, _, lo, hi in self.outcome_rates():
-            out[f"wilson.{o}.lo"], out[f"wilson.{o}.hi"] = lo, hi
-        return out
-
-    def outcome_rates(self) -> list[tuple]:
-        """(outcome, k, n, k / n, lo, hi) per :data:`OUTCOMES`: runs with the
-        outcome and the Wilson 95 % score interval of its rate."""
-        from ...features.montecarlo import wilson_interval
-        flags = {k: np.asarray(v, bool) for k, v in self.violations.items()}
-        flags["ok"] = ~np.logical_or.reduce(list(flags.values()))
-        return [(o, *wilson_interval(int(flags[o].sum()), self.n)) for o in OUTCOMES]
+    SUMMARY: ClassVar[tuple] = SUMMARY_METRICS
+    OUTCOMES: ClassVar[tuple] = OUTCOMES
 
 
 def montecarlo_quantity_names() -> set[str]:
@@ -120,16 +69,12 @@ def montecarlo_quantity_names() -> set[str]:
     ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
     ``montecarlo.fraction.<violation>`` and ``montecarlo.wilson.<outcome>.lo``
     / ``.hi`` (the Wilson 95 % interval of an outcome's rate)."""
-    return ({"montecarlo.samples"}
-            | {f"montecarlo.{m}.{s}" for m in SUMMARY_METRICS for s in STATISTICS}
-            | {f"montecarlo.fraction.{k}" for k in VIOLATIONS}
-            | {f"montecarlo.wilson.{o}.{b}" for o in OUTCOMES for b in ("lo", "hi")})
+    return quantity_names("montecarlo", SUMMARY_METRICS, VIOLATIONS, OUTCOMES)
 
 
 def montecarlo_quantities(res: SweepResult) -> dict:
     """The values of :func:`montecarlo_quantity_names` (None: no finite value)."""
-    return {"montecarlo.samples": res.n,
-            **{f"montecarlo.{k}": v for k, v in res.statistics().items()}}
+    return res.quantities("montecarlo")
 
 
 def draw_samples(n: int, seed: int, spec: SweepSpec, start: int = 0) -> dict:
@@ -318,8 +263,8 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
     chunk = chunk or default_chunk(samples)
     kernel = kernel or default_kernel()
     pool = workers > 1 if pool is None else pool
-    payloads = [chunk_payload(inp, i0, min(i0 + chunk, samples), inp["dt"], kernel)
-                for i0 in range(0, samples, chunk)]
+    payloads = [chunk_payload(inp, i0, i1, inp["dt"], kernel)
+                for i0, i1 in chunk_ranges(samples, chunk)]
     if kernel == "compiled" and pool and len(payloads) > 1 and scheduler is None:
         from .antiskid_kernel import compile_kernel
         compile_kernel()     # once, here: the forked workers inherit it
@@ -348,7 +293,8 @@ def sweep(design, samples: int, seed: int, *, workers: int | None = None,
     workers : int, optional
         Process count (default: CPU count); 1 runs in-process.
     chunk : int, optional
-        Samples per batch (default: :func:`default_chunk`).
+        Samples per batch (default:
+        :func:`~workbench.features.montecarlo_chunks.default_chunk`).
         The results depend on it, not on ``workers``.
     progress : bool
         Progress bar on stderr.

@@ -1,10 +1,13 @@
-"""Rendering of the Monte Carlo sweep and its step-halving check (pure)."""
+"""Rendering of the Monte Carlo sweep and its step-halving check (pure): the
+paper's words, units and figures; the tables, rates and histograms are
+:mod:`workbench.features.montecarlo_render`."""
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
+from ...features.montecarlo_render import draw_histograms as general_histograms
+from ...features.montecarlo_render import draw_rates  # noqa: F401  (the report's figure)
+from ...features.montecarlo_render import summary_tables as general_tables
 from ...report.markdown import fmt, md_table
 from .antiskid_halving import HALVING_METRICS, HALVING_OUTCOMES, HalvingCheck
 from .antiskid_montecarlo import SUMMARY_METRICS, VIOLATIONS, SweepResult
@@ -85,33 +88,10 @@ def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
 
 
 def draw_histograms(fig, res: SweepResult) -> None:
-    """Histograms of the summary metrics (pure)."""
-    axes = fig.subplots(1, len(SUMMARY_METRICS))
-    for ax, k in zip(axes, SUMMARY_METRICS):
-        x = np.asarray(res.metrics[k], float)
-        x = x[np.isfinite(x)]
-        if x.size:
-            ax.hist(x, bins=int(np.clip(2 * np.sqrt(x.size), 5, 30)), color="tab:blue")
-        if k == "lam_max_over_opt":
-            ax.axvline(1.0, color="k", ls="--", lw=0.8, label="lambda_opt")
-            ax.legend(fontsize=7)
-        ax.set_title(f"{k} (n = {x.size})", fontsize=8)
-        ax.set_xlabel(k + {"lam_max_over_opt": " (-)"}.get(k, " (s)"))
-
-
-def draw_rates(fig, res: SweepResult) -> None:
-    """Each outcome's rate (percent of the runs) with its Wilson 95 %
-    interval (pure)."""
-    ax = fig.subplots()
-    rows = res.outcome_rates()
-    y = np.arange(len(rows))[::-1]
-    p = np.array([100 * r[3] for r in rows])
-    lo, hi = np.array([100 * r[4] for r in rows]), np.array([100 * r[5] for r in rows])
-    ax.errorbar(p, y, xerr=[p - lo, hi - p], fmt="o", color="tab:blue", capsize=4)
-    ax.set_yticks(y, [r[0] for r in rows], fontsize=8)
-    ax.set_xlim(-2, 102)
-    ax.set_xlabel(f"runs with the outcome (%) of {res.n}, Wilson 95 % interval")
-    ax.grid(alpha=0.3)
+    """Histograms of the summary metrics, lambda_opt marked (pure)."""
+    general_histograms(fig, res, {k: "-" if k == "lam_max_over_opt" else "s"
+                                  for k in SUMMARY_METRICS},
+                       {"lam_max_over_opt": (1.0, "lambda_opt")})
 
 
 def draw_outcomes(fig, res: SweepResult) -> None:
@@ -150,19 +130,4 @@ def draw_outcomes(fig, res: SweepResult) -> None:
 def summary_tables(res: SweepResult, sig: int) -> str:
     """Markdown: the summary statistics and the violation fractions (``sig``
     significant digits), as printed by ``workbench sweep`` and in reports."""
-    stats = md_table(["metric", "n finite", "min", "median", "95 %", "max"],
-                     [[f"`{r[0]}`", r[1]] + [fmt(x, sig) for x in r[2:]]
-                      for r in res.summary_rows()], "lrrrrr")
-    label = {**VIOLATIONS, "ok": "ok: none of the above"}
-    viol = md_table(["outcome", "runs", "fraction", "rate [Wilson 95 % interval]"],
-                    [[label[o], k, fmt(p, 3), rate_text(k, n, lo, hi)]
-                     for o, k, n, p, lo, hi in res.outcome_rates()], "lrrr")
-    return stats + "\n\n" + viol
-
-
-def rate_text(k: int, n: int, lo: float, hi: float) -> str:
-    """"k / n = p % [lo, hi] %" (one decimal; the interval's ends rounded
-    outwards, so the printed interval contains the computed one)."""
-    down = math.floor(1000 * lo) / 10
-    up = math.ceil(1000 * hi) / 10
-    return f"{k} / {n} = {100 * k / n:.1f} % [{down:.1f}, {up:.1f}] %"
+    return general_tables(res, sig, {**VIOLATIONS, "ok": "ok: none of the above"})

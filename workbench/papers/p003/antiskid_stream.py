@@ -11,9 +11,11 @@ another sweep (other design data, seed, size, chunking or step path) is
 refused.
 
 Why ``.npz`` per chunk and not one Parquet file: each chunk is one atomic
-file (written to a temporary name, then renamed), so a crash never leaves a
-half-written result and resuming needs no index; numpy reads it without a
-new dependency (pyarrow is a ~40 MB wheel); a chunk of 250 runs is ~50 kB.
+file, numpy reads it without a new dependency (pyarrow is a ~40 MB wheel); a
+chunk of 250 runs is ~50 kB. The folder, its manifest, resuming and the
+executors are the general :mod:`workbench.features.montecarlo_chunks`; this
+module keeps what is paper 003's: what a chunk file holds and how the sweep's
+metrics and outcomes are made from it.
 
 File ``chunk-<i0>-<i1>.npz`` (runs i0 <= i < i1): ``index``, ``draw.<name>``
 (the samples), ``raw.<field>`` (the :class:`RunMetrics` of each run) and
@@ -30,11 +32,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ...features.montecarlo_chunks import (MANIFEST, Chunk, chunk_ranges, default_chunk,
+                                           read_npz, start_chunks, write_npz)
 from ...sim.batch import PendingBatch, available_cpus
-from .antiskid_montecarlo import (SweepResult, chunk_payload, chunk_worker, default_chunk,
-                                  lambda_opt_of, per_run, sweep_inputs)
-
-MANIFEST = "sweep.json"
+from .antiskid_montecarlo import (SweepResult, chunk_payload, chunk_worker, lambda_opt_of,
+                                  per_run, sweep_inputs)
 
 #: Raw metrics :func:`load_sweep` reads (what :func:`per_run` needs).
 READ = ("lam_max_traction", "t_cruise", "t_omega3", "t_diverged", "phase_diverged", "t_stop")
@@ -70,11 +72,6 @@ def _manifest(design, samples: int, seed: int, chunk: int, kernel: str, K) -> di
             "inputs_sha256": digest.hexdigest()}
 
 
-def _write(path: Path, arrays: dict) -> Path:
-    from ...report.files import atomic_write
-    return atomic_write(path, lambda fh: np.savez(fh, **arrays))
-
-
 def start_streaming(design, samples: int, seed: int, out, *, resume: bool = False,
                     workers: int | None = None, chunk: int | None = None,
                     kernel: str | None = None, scheduler: str | None = None,
@@ -96,34 +93,20 @@ def start_streaming(design, samples: int, seed: int, out, *, resume: bool = Fals
     chunk = chunk or default_chunk(samples)
     kernel = kernel or default_kernel()
     K = tuple(gain_for(design.spec)[0] if K is None else K)
-    man = _manifest(design, samples, seed, chunk, kernel, K)
-    mpath = out / MANIFEST
-    if mpath.exists() or (out.is_dir() and any(out.glob("chunk-*.npz"))):
-        if not resume:
-            raise FileExistsError(f"{out} already holds a sweep; resume it or choose a new folder")
-        old = json.loads(mpath.read_text()) if mpath.exists() else None
-        if old != man:
-            raise FileExistsError(f"{out} holds another sweep ({old}); expected {man}")
-    out.mkdir(parents=True, exist_ok=True)
-    from ...report.files import atomic_write
-    atomic_write(mpath, json.dumps(man, indent=1) + "\n")
-    ranges = [(i0, min(i0 + chunk, samples)) for i0 in range(0, samples, chunk)]
-    todo = [r for r in ranges if not chunk_file(out, *r).exists()]
-    payloads = [{"design": design, "K": K, "seed": seed, "i0": i0, "i1": i1, "kernel": kernel}
-                for i0, i1 in todo]
-    if kernel == "compiled" and len(payloads) > 1 and scheduler is None and workers > 1:
+    chunks = [Chunk(chunk_file(out, i0, i1), {"design": design, "K": K, "seed": seed,
+                                             "i0": i0, "i1": i1, "kernel": kernel}, i1 - i0)
+              for i0, i1 in chunk_ranges(samples, chunk)]
+    if kernel == "compiled" and scheduler is None and workers > 1 and \
+            sum(not c.path.exists() for c in chunks) > 1:
         compile_kernel()     # once, here: the forked workers inherit it
-
-    def sink(i: int, arrays: dict) -> Path:
-        return _write(chunk_file(out, *todo[i]), arrays)
 
     def collect(paths: list, seconds: float, n_workers: int) -> SweepResult:
         res = load_sweep(out)
         return SweepResult(res.samples, res.metrics, res.violations, seconds, n_workers)
 
-    return PendingBatch(range_worker, payloads, collect, workers, workers > 1,
-                        sizes=[i1 - i0 for i0, i1 in todo], unit="run", scheduler=scheduler,
-                        sink=sink)
+    return start_chunks(out, _manifest(design, samples, seed, chunk, kernel, K), chunks,
+                        range_worker, write_npz, collect, resume=resume, workers=workers,
+                        pool=workers > 1, scheduler=scheduler)
 
 
 def load_sweep(out) -> SweepResult:
@@ -132,19 +115,14 @@ def load_sweep(out) -> SweepResult:
     out = Path(out)
     man = json.loads((out / MANIFEST).read_text())
     n, chunk = man["samples"], man["chunk"]
-    ranges = [(i0, min(i0 + chunk, n)) for i0 in range(0, n, chunk)]
+    ranges = chunk_ranges(n, chunk)
     missing = [r for r in ranges if not chunk_file(out, *r).exists()]
     if missing:
         raise FileNotFoundError(f"{out}: {len(missing)} of {len(ranges)} chunks not written "
                                 f"(first: runs {missing[0][0]}-{missing[0][1] - 1}); resume the sweep")
-    cols: dict = {}
-    for r in ranges:
-        with np.load(chunk_file(out, *r)) as z:
-            keys = ["lambda_opt"] + [k for k in z.files if k.startswith("draw.")] + [
-                f"raw.{k}" for k in READ]
-            for k in keys:
-                cols.setdefault(k, []).append(z[k])
-    col = {k: np.concatenate(v) for k, v in cols.items()}
+    keep = {"lambda_opt", *(f"raw.{k}" for k in READ)}
+    col = read_npz([chunk_file(out, *r) for r in ranges],
+                   lambda k: k in keep or k.startswith("draw."))
     raw = {k: col[f"raw.{k}"] for k in READ}
     metrics, viol = per_run(raw, col["lambda_opt"], float(man["t_brake"]))
     draws = {k[5:]: v.tolist() for k, v in col.items() if k.startswith("draw.")}
