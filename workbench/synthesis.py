@@ -208,6 +208,103 @@ class _SharedFixedK:
         return self.lmi
 
 
+#: Run each eps's tie-break (canonical gain) and exact margins in one forked
+#: worker process while the next eps is bisected (:class:`_GainStage`); False,
+#: or the environment variable ``WORKBENCH_SYNTH_SERIAL=1``, runs everything in
+#: this process, one eps after the other (``benchmarks/synthesize_delay_bound.py``).
+PIPELINE = True
+
+
+class _GainStage:
+    """The second half of each eps's row (:func:`_row`: canonical gain, its own
+    bisection, exact margins) in ONE forked worker, overlapped with the
+    bisection of the next eps in this process (issue 36, item 4).
+
+    The bisection of eps i + 1 depends only on the bracket of eps i (its
+    guess), never on a gain, so the split changes no probe. The worker is a
+    fork of this process taken before any solve: the same compiled code, the
+    same parameters set by :func:`_row`'s own calls (eps by ``set_eps``, the
+    delay by every solve), the same Clarabel with no warm start and no state
+    kept between solves, so every solve sees the same data and gives the same
+    bits; the rows come back pickled (exact for floats and arrays) in the
+    order submitted. A row the worker could not return (it died, or raised)
+    is computed here instead, as without the stage.
+    """
+
+    def __init__(self, work: Callable, warm: bool):
+        import multiprocessing as mp
+        ctx = mp.get_context("fork")
+        self.conn, child = ctx.Pipe()
+        self.work, self.pending = work, []
+        self.proc = ctx.Process(target=self._serve, args=(child, work, warm), daemon=True)
+        self.proc.start()
+        child.close()
+
+    @classmethod
+    def start(cls, work: Callable, n_items: int, warm: bool = False) -> "_GainStage | None":
+        """A stage, or None (serial) for a single eps, with :data:`PIPELINE`
+        off, without ``fork`` or a second CPU, or inside a daemonic worker
+        (which may not have children)."""
+        import multiprocessing as mp
+        if (n_items < 2 or not PIPELINE or os.environ.get("WORKBENCH_SYNTH_SERIAL") == "1"
+                or "fork" not in mp.get_all_start_methods() or (os.cpu_count() or 1) < 2
+                or mp.current_process().daemon):
+            return None
+        try:
+            return cls(work, warm)
+        except OSError:                  # no process to spare: serial
+            return None
+
+    @staticmethod
+    def _serve(conn, work: Callable, warm: bool) -> None:
+        if warm:       # delay_margin_siso's lazy import, while the first eps is bisected
+            try:
+                import control  # noqa: F401
+            except ImportError:
+                pass
+        while True:
+            item = conn.recv()
+            if item is None:
+                break
+            try:
+                out = (True, work(*item))
+            except BaseException as exc:   # noqa: BLE001 - re-raised by the serial retry
+                out = (False, repr(exc))
+            conn.send(out)
+        conn.close()
+
+    def submit(self, *item) -> None:
+        """Queue ``work(*item)`` in the worker."""
+        self.pending.append(item)
+        try:
+            self.conn.send(item)
+        except OSError:
+            pass                         # collected serially in :meth:`results`
+
+    def results(self, work: Callable) -> tuple:
+        """The results of every submitted item, in order (``work`` here for any
+        the worker did not return); the worker is stopped."""
+        out, alive = [], True
+        for item in self.pending:
+            ok = False
+            if alive:
+                try:
+                    ok, res = self.conn.recv()
+                except (EOFError, OSError):
+                    alive = False
+            out.append(res if ok else work(*item))
+        try:
+            self.conn.send(None)
+        except OSError:
+            pass
+        self.conn.close()
+        self.proc.join(timeout=5)
+        if self.proc.is_alive():
+            self.proc.kill()
+            self.proc.join()
+        return tuple(out)
+
+
 def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, T,
          settings: SynthesisSettings, fixed: Callable | None = None) -> SynthesisRow:
     K = exact = exact_siso = rmin = gain = None
@@ -268,14 +365,23 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
                                   None, 0, 0.0, (), reason=diag.reason) for e in eps_values)
     At, Bt, T, _ = _balanced(A, B)
     crit = FreeWeighting003(At, Bt, eps_values[0], margin=settings.margin)
-    rows, guess, fixed = [], None, _SharedFixedK(crit, settings.margin)
+    fixed = _SharedFixedK(crit, settings.margin)
+
+    def row(eps, br):                   # the tie-break and exact margins of one eps
+        crit.set_eps(eps)
+        return _row(eps, br, crit, A, B, T, settings, fixed)
+    stage = _GainStage.start(row, len(eps_values), warm=B.shape[1] == 1)
+    rows, guess = [], None
     for eps in eps_values:
         crit.set_eps(eps)
         br = bisect_delay(crit.solve_at, guess=guess, **settings.bisection())
         if br.h_certified > 0:
             guess = br.h_certified
-        rows.append(_row(eps, br, crit, A, B, T, settings, fixed))
-    return tuple(rows)
+        if stage is None:
+            rows.append(row(eps, br))
+        else:
+            stage.submit(eps, br)
+    return tuple(rows) if stage is None else stage.results(row)
 
 
 def certify_given_gain(A, B, K, eps: float, settings: SynthesisSettings = SynthesisSettings()
