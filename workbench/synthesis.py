@@ -28,6 +28,7 @@ from .lmi.core import DEFAULT_MARGIN, IMPLIED, Bracket, Outcome, bisect_delay
 from .lmi.diagnosis import synthesis_reason, uncontrollable_mode
 from .lmi.freeweighting003 import FreeWeighting003, FreeWeighting003FixedK
 from .lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
+from .lmi.primal import precompile
 from .lmi.scaling import balancing
 from .margins import DelayMargin, delay_margin_eig, delay_margin_siso, stability_windows
 
@@ -228,23 +229,27 @@ class _GainStage:
     kept between solves, so every solve sees the same data and gives the same
     bits; the rows come back pickled (exact for floats and arrays) in the
     order submitted. A row the worker could not return (it died, or raised)
-    is computed here instead, as without the stage.
+    is computed here instead, as without the stage. Before the first row the
+    worker compiles its two problems (the minimum-norm one and the shared
+    fixed-gain LMI; a DPP compilation does not depend on the parameter
+    values) and imports python-control, while the first eps is bisected here.
     """
 
-    def __init__(self, work: Callable, warm: bool):
+    def __init__(self, work: Callable, warm: Callable | None):
         import multiprocessing as mp
         ctx = mp.get_context("fork")
         self.conn, child = ctx.Pipe()
-        self.work, self.pending = work, []
+        self.pending = []
         self.proc = ctx.Process(target=self._serve, args=(child, work, warm), daemon=True)
         self.proc.start()
         child.close()
 
     @classmethod
-    def start(cls, work: Callable, n_items: int, warm: bool = False) -> "_GainStage | None":
-        """A stage, or None (serial) for a single eps, with :data:`PIPELINE`
-        off, without ``fork`` or a second CPU, or inside a daemonic worker
-        (which may not have children)."""
+    def start(cls, work: Callable, n_items: int, warm: Callable | None = None
+              ) -> "_GainStage | None":
+        """A stage whose worker first calls ``warm()``, or None (serial) for a
+        single eps, with :data:`PIPELINE` off, without ``fork`` or a second
+        CPU, or inside a daemonic worker (which may not have children)."""
         import multiprocessing as mp
         if (n_items < 2 or not PIPELINE or os.environ.get("WORKBENCH_SYNTH_SERIAL") == "1"
                 or "fork" not in mp.get_all_start_methods() or (os.cpu_count() or 1) < 2
@@ -256,11 +261,11 @@ class _GainStage:
             return None
 
     @staticmethod
-    def _serve(conn, work: Callable, warm: bool) -> None:
-        if warm:       # delay_margin_siso's lazy import, while the first eps is bisected
+    def _serve(conn, work: Callable, warm: Callable | None) -> None:
+        if warm is not None:
             try:
-                import control  # noqa: F401
-            except ImportError:
+                warm()
+            except Exception:   # noqa: BLE001 - only a head start: the items decide
                 pass
         while True:
             item = conn.recv()
@@ -303,6 +308,14 @@ class _GainStage:
             self.proc.kill()
             self.proc.join()
         return tuple(out)
+
+
+def _import_siso() -> None:
+    """The lazy import of :func:`~workbench.margins.delay_margin_siso` (python-control)."""
+    try:
+        import control  # noqa: F401
+    except ImportError:
+        pass
 
 
 def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, T,
@@ -370,7 +383,17 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
     def row(eps, br):                   # the tie-break and exact margins of one eps
         crit.set_eps(eps)
         return _row(eps, br, crit, A, B, T, settings, fixed)
-    stage = _GainStage.start(row, len(eps_values), warm=B.shape[1] == 1)
+
+    def warm():      # in the worker, while the first eps is bisected here
+        crit.set_delay(settings.h_max)
+        precompile(crit.canonical_problem())
+        if not fixed.unshared:
+            lmi = fixed(np.zeros((B.shape[1], A.shape[0])))
+            lmi.set_delay(settings.h_max)
+            precompile(lmi._problem)
+        if B.shape[1] == 1:
+            _import_siso()
+    stage = _GainStage.start(row, len(eps_values), warm=warm)
     rows, guess = [], None
     for eps in eps_values:
         crit.set_eps(eps)
