@@ -230,9 +230,9 @@ class _GainStage:
     bits; the rows come back pickled (exact for floats and arrays) in the
     order submitted. A row the worker could not return (it died, or raised)
     is computed here instead, as without the stage. Before the first row the
-    worker compiles its two problems (the minimum-norm one and the shared
-    fixed-gain LMI; a DPP compilation does not depend on the parameter
-    values) and imports python-control, while the first eps is bisected here.
+    worker compiles the shared fixed-gain LMI (a DPP compilation does not
+    depend on the parameter values) and imports python-control, while the
+    first eps is bisected here.
     """
 
     def __init__(self, work: Callable, warm: Callable | None):
@@ -385,8 +385,6 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
         return _row(eps, br, crit, A, B, T, settings, fixed)
 
     def warm():      # in the worker, while the first eps is bisected here
-        crit.set_delay(settings.h_max)
-        precompile(crit.canonical_problem())
         if not fixed.unshared:
             lmi = fixed(np.zeros((B.shape[1], A.shape[0])))
             lmi.set_delay(settings.h_max)

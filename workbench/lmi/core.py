@@ -286,15 +286,6 @@ class MarginLMI:
             return Step(h, Outcome.REFUTED, status, t_opt, {}, None, seconds)
         return self._checked(h, status, t_opt, seconds)
 
-    def canonical_problem(self) -> cp.Problem:
-        """The minimum-norm problem of :meth:`canonical_point` (built at its first use)."""
-        if self._canonical is None:
-            cons = [sym << -eye if blk.sense == "nsd" else sym >> eye
-                    for blk, sym, eye in self._symmetric_blocks()]
-            size = cp.norm(cp.hstack([cp.vec(v, order="F") for v in self._vars.values()]), 2)
-            self._canonical = cp.Problem(cp.Minimize(size), cons)
-        return self._canonical
-
     def canonical_point(self, h: float) -> Step:
         """The minimum-norm certificate at delay ``h``: a unique point.
 
@@ -318,7 +309,12 @@ class MarginLMI:
             infeasible at ``h``, or a failed re-check); ``t_opt`` is the
             point's smallest relative margin.
         """
-        status, seconds = self._run(self.canonical_problem(), h, CLARABEL_SETTINGS)
+        if self._canonical is None:
+            cons = [sym << -eye if blk.sense == "nsd" else sym >> eye
+                    for blk, sym, eye in self._symmetric_blocks()]
+            size = cp.norm(cp.hstack([cp.vec(v, order="F") for v in self._vars.values()]), 2)
+            self._canonical = cp.Problem(cp.Minimize(size), cons)
+        status, seconds = self._run(self._canonical, h, CLARABEL_SETTINGS)
         retries = (self.retry_settings if self.canonical_retry_settings is None
                    else self.canonical_retry_settings)
         for extra in retries:
