@@ -290,14 +290,21 @@ class _GainStage:
         """The results of every submitted item, in order (``work`` here for any
         the worker did not return); the worker is stopped."""
         out, alive = [], True
-        for item in self.pending:
-            ok = False
-            if alive:
-                try:
-                    ok, res = self.conn.recv()
-                except (EOFError, OSError):
-                    alive = False
-            out.append(res if ok else work(*item))
+        try:
+            for item in self.pending:
+                ok = False
+                if alive:
+                    try:
+                        ok, res = self.conn.recv()
+                    except (EOFError, OSError):
+                        alive = False
+                out.append(res if ok else work(*item))
+        finally:
+            self.close()
+        return tuple(out)
+
+    def close(self) -> None:
+        """Stop the worker (after its current item)."""
         try:
             self.conn.send(None)
         except OSError:
@@ -307,7 +314,6 @@ class _GainStage:
         if self.proc.is_alive():
             self.proc.kill()
             self.proc.join()
-        return tuple(out)
 
 
 def _import_siso() -> None:
@@ -393,15 +399,20 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
             _import_siso()
     stage = _GainStage.start(row, len(eps_values), warm=warm)
     rows, guess = [], None
-    for eps in eps_values:
-        crit.set_eps(eps)
-        br = bisect_delay(crit.solve_at, guess=guess, **settings.bisection())
-        if br.h_certified > 0:
-            guess = br.h_certified
-        if stage is None:
-            rows.append(row(eps, br))
-        else:
-            stage.submit(eps, br)
+    try:
+        for eps in eps_values:
+            crit.set_eps(eps)
+            br = bisect_delay(crit.solve_at, guess=guess, **settings.bisection())
+            if br.h_certified > 0:
+                guess = br.h_certified
+            if stage is None:
+                rows.append(row(eps, br))
+            else:
+                stage.submit(eps, br)
+    except BaseException:
+        if stage is not None:
+            stage.close()
+        raise
     return tuple(rows) if stage is None else stage.results(row)
 
 
