@@ -237,12 +237,27 @@ class _GainStage:
 
     def __init__(self, work: Callable, warm: Callable | None):
         import multiprocessing as mp
+        import threading
         ctx = mp.get_context("fork")
-        self.conn, child = ctx.Pipe()
-        self.pending = []
-        self.proc = ctx.Process(target=self._serve, args=(child, work, warm), daemon=True)
+        items_in, self.items = ctx.Pipe(duplex=False)      # (reader, writer)
+        self.answers, answers_out = ctx.Pipe(duplex=False)
+        self.pending, self.got = [], []
+        self.proc = ctx.Process(target=self._serve, args=(items_in, answers_out, work, warm),
+                                daemon=True)
         self.proc.start()
-        child.close()
+        items_in.close()
+        answers_out.close()
+        # a thread here takes every answer as it comes, so the worker never waits
+        # on a full pipe while this process waits on the other (no deadlock)
+        self.reader = threading.Thread(target=self._read, daemon=True)
+        self.reader.start()
+
+    def _read(self) -> None:
+        while True:
+            try:
+                self.got.append(self.answers.recv())
+            except (EOFError, OSError):            # the worker is done (or died)
+                return
 
     @classmethod
     def start(cls, work: Callable, n_items: int, warm: Callable | None = None
@@ -263,55 +278,55 @@ class _GainStage:
             return None
 
     @staticmethod
-    def _serve(conn, work: Callable, warm: Callable | None) -> None:
+    def _serve(items, answers, work: Callable, warm: Callable | None) -> None:
         if warm is not None:
             try:
                 warm()
             except Exception:   # noqa: BLE001 - only a head start: the items decide
                 pass
         while True:
-            item = conn.recv()
+            try:
+                item = items.recv()
+            except EOFError:
+                break
             if item is None:
                 break
             try:
                 out = (True, work(*item))
             except BaseException as exc:   # noqa: BLE001 - re-raised by the serial retry
                 out = (False, repr(exc))
-            conn.send(out)
-        conn.close()
+            answers.send(out)
+        answers.close()
 
     def submit(self, *item) -> None:
         """Queue ``work(*item)`` in the worker."""
         self.pending.append(item)
         try:
-            self.conn.send(item)
+            self.items.send(item)
         except OSError:
-            pass                         # collected serially in :meth:`results`
+            pass                         # computed here in :meth:`results`
 
     def results(self, work: Callable) -> tuple:
         """The results of every submitted item, in order (``work`` here for any
         the worker did not return); the worker is stopped."""
-        out, alive = [], True
-        try:
-            for item in self.pending:
-                ok = False
-                if alive:
-                    try:
-                        ok, res = self.conn.recv()
-                    except (EOFError, OSError):
-                        alive = False
-                out.append(res if ok else work(*item))
-        finally:
-            self.close()
+        self.close()
+        out = []
+        for i, item in enumerate(self.pending):
+            ok, res = self.got[i] if i < len(self.got) else (False, None)
+            out.append(res if ok else work(*item))
         return tuple(out)
 
-    def close(self) -> None:
-        """Stop the worker (after its current item)."""
+    def close(self, finish: bool = True) -> None:
+        """Stop the worker: after the items sent (``finish``), or now."""
+        if not finish:
+            self.proc.kill()
         try:
-            self.conn.send(None)
+            self.items.send(None)
         except OSError:
             pass
-        self.conn.close()
+        self.items.close()
+        self.reader.join()
+        self.answers.close()
         self.proc.join(timeout=5)
         if self.proc.is_alive():
             self.proc.kill()
@@ -413,7 +428,7 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
                 stage.submit(eps, br)
     except BaseException:
         if stage is not None:
-            stage.close()
+            stage.close(finish=False)
         raise
     return tuple(rows) if stage is None else stage.results(row)
 
