@@ -264,13 +264,15 @@ class _GainStage:
               ) -> "_GainStage | None":
         """A stage whose worker first calls ``warm()``, or None (serial) for a
         single eps, with :data:`PIPELINE` off, without ``fork`` or a second
-        CPU, or inside a worker of a process pool (``workbench check --jobs``:
+        CPU, inside a worker of a process pool (``workbench check --jobs``:
         its processes already use the CPUs, and the stage costs some CPU of its
-        own: the fork and the pages the worker copies)."""
+        own: the fork and the pages the worker copies), or in a process with
+        other threads (a notebook kernel, a GUI: forking it is not safe)."""
         import multiprocessing as mp
+        import threading
         if (n_items < 2 or not PIPELINE or os.environ.get("WORKBENCH_SYNTH_SERIAL") == "1"
                 or "fork" not in mp.get_all_start_methods() or (os.cpu_count() or 1) < 2
-                or mp.parent_process() is not None):
+                or mp.parent_process() is not None or threading.active_count() > 1):
             return None
         try:
             return cls(work, warm)
