@@ -13,7 +13,10 @@ warm-up sweep, as in a long-running session), the design's eps sweep
   eps in one forked worker while this process bisects the next eps.
 
 For each it prints the best wall seconds, the CPU seconds of this process
-and of the worker (``os.times`` of the joined child), and whether the rows
+and of the worker (``os.times`` of the joined child), the critical path
+on an idle machine estimated from CPU seconds (the pipelined sweep's
+own, plus the last eps's second half, which the worker computes after the
+last bisection; a loaded machine stretches wall time), and whether the rows
 are the same (every printed and ``--json`` field but ``seconds``, plus the
 re-check margins and certificate of each canonical gain, bit for bit). The
 solves are counted per eps: the delay bisection, the minimum-norm point
@@ -115,11 +118,22 @@ def worker(path: str, repeat: int) -> None:
     _clarabel_timed(split)
     for name in MARGINS:
         wrap(synthesis, name, split, "exact margins")
+    row_cpu: list = []               # CPU s of each row's second half, in this process
+    f_row = synthesis._row
+
+    def timed_row(*a, **k):
+        c0 = time.process_time()
+        try:
+            return f_row(*a, **k)
+        finally:
+            row_cpu.append(time.process_time() - c0)
+    synthesis._row = timed_row
     out = {name: {"cpu": [], "child": [], "wall": [], "splits": []} for name, _ in PATHS}
     for rep in range(repeat + 1):                # the first round warms up
         for name, pipelined in PATHS:
             synthesis.PIPELINE = pipelined
             split.clear()
+            row_cpu.clear()
             c0, k0, w0 = _cpu(), _children_cpu(), time.perf_counter()
             rows = synthesis.synthesize_delay_bound(lin.A, lin.B, spec.eps, spec.settings)
             cpu, child, wall = _cpu() - c0, _children_cpu() - k0, time.perf_counter() - w0
@@ -131,6 +145,7 @@ def worker(path: str, repeat: int) -> None:
             r["child"].append(child)
             r["wall"].append(wall)
             r["splits"].append(dict(split))
+            r.setdefault("last_row", []).append(row_cpu[-1] if row_cpu else 0.0)
     for r in out.values():
         i = r["wall"].index(min(r["wall"]))
         best = r["splits"][i]
@@ -140,7 +155,7 @@ def worker(path: str, repeat: int) -> None:
             "clarabel iterations", 0.0)
         best["other"] = r["cpu"][i] - sum(best.values())
         r.update(split=best, cpu=r["cpu"][i], child=r["child"][i], wall=r["wall"][i],
-                 rounds=len(r["wall"]))
+                 rounds=len(r["wall"]), last_row=r["last_row"][i])
         del r["splits"]
     out["stage"] = stage_cost(repeat)
     print(json.dumps(out), flush=True)
@@ -206,6 +221,11 @@ def main() -> None:
               f"{r['cpu'] + r['child']:.3f} |")
     print(f"\nworker start (fork) + one trivial item + shutdown, best: {stage['wall'] * 1e3:.1f} ms "
           f"wall, {stage['cpu'] * 1e3:.1f} ms CPU in this process")
+    ser, pip = res["serial"], res["pipelined"]
+    print(f"\ncritical path on an idle 2-core machine (estimate, CPU s): serial {ser['cpu']:.3f}; "
+          f"pipelined {pip['cpu'] + ser['last_row']:.3f} = this process {pip['cpu']:.3f} + the "
+          f"last row's second half {ser['last_row']:.3f} (timed on the serial path), which the "
+          "worker computes after the last bisection")
     print(f"\nsame rows on both paths (bit for bit, but seconds): "
           f"{res['serial']['table'] == res['pipelined']['table']}")
     print("solves: " + ", ".join(f"{k} {v}" for k, v in res["serial"]["solves"].items()))
