@@ -235,6 +235,9 @@ class _GainStage:
     first eps is bisected here.
     """
 
+    #: Stages started in this process.
+    started = 0
+
     def __init__(self, work: Callable, warm: Callable | None):
         import multiprocessing as mp
         import threading
@@ -244,7 +247,13 @@ class _GainStage:
         self.pending, self.got = [], []
         self.proc = ctx.Process(target=self._serve, args=(items_in, answers_out, work, warm),
                                 daemon=True)
-        self.proc.start()
+        import gc
+        gc.freeze()        # the worker's collector then leaves this process's objects
+        try:               # (and the pages they are on) alone: fewer pages copied
+            self.proc.start()
+        finally:
+            gc.unfreeze()
+        _GainStage.started += 1
         items_in.close()
         answers_out.close()
         # a thread here takes every answer as it comes, so the worker never waits
@@ -416,6 +425,8 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
             precompile(lmi._problem)
         if B.shape[1] == 1:
             _import_siso()
+    if B.shape[1] == 1 and _GainStage.started:
+        _import_siso()   # a later sweep in this process: once here, not in every worker
     stage = _GainStage.start(row, len(eps_values), warm=warm)
     rows, guess = [], None
     try:
