@@ -231,8 +231,9 @@ class _GainStage:
     order submitted. A row the worker could not return (it died, or raised)
     is computed here instead, as without the stage. Before the first row the
     worker compiles the shared fixed-gain LMI (a DPP compilation does not
-    depend on the parameter values) and imports python-control, while the
-    first eps is bisected here.
+    depend on the parameter values) and imports python-control (unless this
+    process has: it does from its second sweep on), while the first eps is
+    bisected here.
     """
 
     #: Stages started in this process.
