@@ -165,12 +165,12 @@ def stage_cost(repeat: int) -> dict:
     """Best wall and CPU s (this process, by ``time.process_time``) of starting
     the worker (fork), one trivial item through it and its shutdown."""
     from workbench import synthesis
-    from workbench.synthesis import _GainStage
+    from workbench.forked_stage import ForkedStage
     walls, cpus = [], []
     for _ in range(max(repeat, 3)):
         c0, w0 = time.process_time(), time.perf_counter()
         synthesis.PIPELINE = True
-        stage = _GainStage.start(lambda x: x, 2)
+        stage = ForkedStage.start(lambda x: x, 2)
         stage.submit(1)
         stage.results(lambda x: x)
         cpus.append(time.process_time() - c0)

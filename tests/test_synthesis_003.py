@@ -137,14 +137,14 @@ def test_pipelined_sweep_is_the_serial_one_bit_for_bit(rows, lin, monkeypatch):
 def test_gain_stage_rows_it_could_not_return_are_computed_here():
     import os
 
-    from workbench.synthesis import _GainStage
+    from workbench.forked_stage import ForkedStage
     parent = os.getpid()
 
     def work(x):
         if x == 2 and os.getpid() != parent:
             os._exit(3)                      # the worker dies on the second item
         return x * x
-    stage = _GainStage.start(work, 3)
+    stage = ForkedStage.start(work, 3)
     if stage is None:
         pytest.skip("no fork or a single CPU: the sweep runs serially")
     for x in (1, 2, 3):
@@ -153,7 +153,7 @@ def test_gain_stage_rows_it_could_not_return_are_computed_here():
 
     def fails(x):
         raise ValueError(f"bad item {x}")
-    stage = _GainStage.start(fails, 2)
+    stage = ForkedStage.start(fails, 2)
     stage.submit(1)
     with pytest.raises(ValueError, match="bad item 1"):   # raised here, as serially
         stage.results(fails)

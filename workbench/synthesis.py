@@ -23,6 +23,7 @@ from typing import Callable
 
 import numpy as np
 
+from .forked_stage import ForkedStage
 from .jsonable import json_method
 from .lmi.core import DEFAULT_MARGIN, IMPLIED, Bracket, Outcome, bisect_delay
 from .lmi.diagnosis import synthesis_reason, uncontrollable_mode
@@ -210,139 +211,19 @@ class _SharedFixedK:
 
 
 #: Run each eps's tie-break (canonical gain) and exact margins in one forked
-#: worker process while the next eps is bisected (:class:`_GainStage`); False,
-#: or the environment variable ``WORKBENCH_SYNTH_SERIAL=1``, runs everything in
-#: this process, one eps after the other (``benchmarks/synthesize_delay_bound.py``).
+#: worker process while the next eps is bisected here
+#: (:class:`~workbench.forked_stage.ForkedStage`; issue 36, item 4). The
+#: bisection of eps i + 1 depends only on the bracket of eps i (its guess),
+#: never on a gain, so no probe moves; the worker is a fork taken before any
+#: solve, its parameters are set by :func:`_row`'s own calls (eps by
+#: ``set_eps``, the delay by every solve) and Clarabel keeps no state between
+#: solves, so every solve sees the same data and gives the same bits. Before
+#: the first row the worker compiles the shared fixed-gain LMI (a DPP
+#: compilation does not depend on the parameter values) and imports
+#: python-control (unless this process has: it does from its second sweep on).
+#: False, or the environment variable ``WORKBENCH_SYNTH_SERIAL=1``, runs
+#: everything here, one eps after the other (``benchmarks/synthesize_delay_bound.py``).
 PIPELINE = True
-
-
-class _GainStage:
-    """The second half of each eps's row (:func:`_row`: canonical gain, its own
-    bisection, exact margins) in ONE forked worker, overlapped with the
-    bisection of the next eps in this process (issue 36, item 4).
-
-    The bisection of eps i + 1 depends only on the bracket of eps i (its
-    guess), never on a gain, so the split changes no probe. The worker is a
-    fork of this process taken before any solve: the same compiled code, the
-    same parameters set by :func:`_row`'s own calls (eps by ``set_eps``, the
-    delay by every solve), the same Clarabel with no warm start and no state
-    kept between solves, so every solve sees the same data and gives the same
-    bits; the rows come back pickled (exact for floats and arrays) in the
-    order submitted. A row the worker could not return (it died, or raised)
-    is computed here instead, as without the stage. Before the first row the
-    worker compiles the shared fixed-gain LMI (a DPP compilation does not
-    depend on the parameter values) and imports python-control (unless this
-    process has: it does from its second sweep on), while the first eps is
-    bisected here.
-    """
-
-    #: Stages started in this process.
-    started = 0
-
-    def __init__(self, work: Callable, warm: Callable | None):
-        import multiprocessing as mp
-        import threading
-        ctx = mp.get_context("fork")
-        items_in, self.items = ctx.Pipe(duplex=False)      # (reader, writer)
-        self.answers, answers_out = ctx.Pipe(duplex=False)
-        self.pending, self.got = [], []
-        self.proc = ctx.Process(target=self._serve, args=(items_in, answers_out, work, warm),
-                                daemon=True)
-        import gc
-        gc.freeze()        # the worker's collector then leaves this process's objects
-        try:               # (and the pages they are on) alone: fewer pages copied
-            self.proc.start()
-        finally:
-            gc.unfreeze()
-        _GainStage.started += 1
-        items_in.close()
-        answers_out.close()
-        # a thread here takes every answer as it comes, so the worker never waits
-        # on a full pipe while this process waits on the other (no deadlock)
-        self.reader = threading.Thread(target=self._read, daemon=True)
-        self.reader.start()
-
-    def _read(self) -> None:
-        while True:
-            try:
-                self.got.append(self.answers.recv())
-            except (EOFError, OSError):            # the worker is done (or died)
-                return
-
-    @classmethod
-    def start(cls, work: Callable, n_items: int, warm: Callable | None = None
-              ) -> "_GainStage | None":
-        """A stage whose worker first calls ``warm()``, or None (serial) for a
-        single eps, with :data:`PIPELINE` off, without ``fork`` or a second
-        CPU, inside a worker of a process pool (``workbench check --jobs``:
-        its processes already use the CPUs, and the stage costs some CPU of its
-        own: the fork and the pages the worker copies), or in a process with
-        other threads (a notebook kernel, a GUI: forking it is not safe)."""
-        import multiprocessing as mp
-        import threading
-        if (n_items < 2 or not PIPELINE or os.environ.get("WORKBENCH_SYNTH_SERIAL") == "1"
-                or "fork" not in mp.get_all_start_methods() or (os.cpu_count() or 1) < 2
-                or mp.parent_process() is not None or threading.active_count() > 1):
-            return None
-        try:
-            return cls(work, warm)
-        except OSError:                  # no process to spare: serial
-            return None
-
-    @staticmethod
-    def _serve(items, answers, work: Callable, warm: Callable | None) -> None:
-        if warm is not None:
-            try:
-                warm()
-            except Exception:   # noqa: BLE001 - only a head start: the items decide
-                pass
-        while True:
-            try:
-                item = items.recv()
-            except EOFError:
-                break
-            if item is None:
-                break
-            try:
-                out = (True, work(*item))
-            except BaseException as exc:   # noqa: BLE001 - re-raised by the serial retry
-                out = (False, repr(exc))
-            answers.send(out)
-        answers.close()
-
-    def submit(self, *item) -> None:
-        """Queue ``work(*item)`` in the worker."""
-        self.pending.append(item)
-        try:
-            self.items.send(item)
-        except OSError:
-            pass                         # computed here in :meth:`results`
-
-    def results(self, work: Callable) -> tuple:
-        """The results of every submitted item, in order (``work`` here for any
-        the worker did not return); the worker is stopped."""
-        self.close()
-        out = []
-        for i, item in enumerate(self.pending):
-            ok, res = self.got[i] if i < len(self.got) else (False, None)
-            out.append(res if ok else work(*item))
-        return tuple(out)
-
-    def close(self, finish: bool = True) -> None:
-        """Stop the worker: after the items sent (``finish``), or now."""
-        if not finish:
-            self.proc.kill()
-        try:
-            self.items.send(None)
-        except OSError:
-            pass
-        self.items.close()
-        self.reader.join()
-        self.answers.close()
-        self.proc.join(timeout=5)
-        if self.proc.is_alive():
-            self.proc.kill()
-            self.proc.join()
 
 
 def _import_siso() -> None:
@@ -426,9 +307,10 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
             precompile(lmi._problem)
         if B.shape[1] == 1:
             _import_siso()
-    if B.shape[1] == 1 and _GainStage.started:
+    if B.shape[1] == 1 and ForkedStage.started:
         _import_siso()   # a later sweep in this process: once here, not in every worker
-    stage = _GainStage.start(row, len(eps_values), warm=warm)
+    stage = (ForkedStage.start(row, len(eps_values), warm=warm)
+             if PIPELINE and os.environ.get("WORKBENCH_SYNTH_SERIAL") != "1" else None)
     rows, guess = [], None
     try:
         for eps in eps_values:
