@@ -45,6 +45,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from synthesize_times import wrap as timed_call
+
 ROOT = Path(__file__).resolve().parents[1]
 PARTS = ("compile", "cases", "linear", "sampled", "sampled: Radau", "basin", "basin: cruise",
          "basin: k2 sweep", "montecarlo", "refine", "rest")
@@ -63,15 +65,7 @@ def worker(path: str) -> None:
     spent: dict = dict.fromkeys(PARTS, 0.0)
 
     def wrap(obj, name, part):
-        f = getattr(obj, name)
-
-        def timed(*a, **k):
-            c0 = _cpu()
-            try:
-                return f(*a, **k)
-            finally:
-                spent[part] += _cpu() - c0
-        setattr(obj, name, timed)
+        timed_call(obj, name, spent, part)
 
     from workbench.design import load_design
     from workbench.papers.p003 import antiskid_basin_run as BR

@@ -66,20 +66,24 @@ SPLIT = (("cvxpy.reductions.chain", "Chain", "apply", "compile"),
          ("cvxpy.problems.problem", "Problem", "unpack_results", "unpack"))
 
 
+def wrap(owner, attr: str, split: dict, label: str) -> None:
+    """Replace ``owner.attr`` by a function adding its CPU seconds to ``split[label]``."""
+    f = getattr(owner, attr)
+
+    def g(*a, **k):
+        c0 = _cpu()
+        try:
+            return f(*a, **k)
+        finally:
+            split[label] = split.get(label, 0.0) + _cpu() - c0
+    setattr(owner, attr, g)
+
+
 def _timed(split: dict) -> None:
     """Wrap the functions of :data:`SPLIT` to add their CPU seconds to ``split``."""
     import importlib
     for mod, cls, attr, label in SPLIT:
-        owner = getattr(importlib.import_module(mod), cls)
-        f = getattr(owner, attr)
-
-        def g(*a, _f=f, _label=label, **k):
-            c0 = _cpu()
-            try:
-                return _f(*a, **k)
-            finally:
-                split[_label] = split.get(_label, 0.0) + _cpu() - c0
-        setattr(owner, attr, g)
+        wrap(getattr(importlib.import_module(mod), cls), attr, split, label)
 
 
 #: The paths timed (module docstring): (name, WORKBENCH_SYNTH_UNSHARED,

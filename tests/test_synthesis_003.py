@@ -116,3 +116,44 @@ def test_unstable_gain_is_refuted_not_certified(lin):
                             SynthesisSettings(max_solves=12))
     assert delay_margin_eig(lin.A, lin.B @ np.array([[0.0, 40.0]])).h == 0.0
     assert br.h_certified == 0.0 and br.outcome is not Outcome.CERTIFIED
+
+
+def _bits(r):
+    """Every field of a row but its seconds, certificate arrays as bytes."""
+    cert = {k: v.tobytes() for k, v in r.certificate.items()}
+    return ({k: v for k, v in r.to_json().items() if k != "seconds"}, r.statuses,
+            r.recheck, cert, r.gain.point.h, [s.h for s in r.gain.analysis.steps])
+
+
+def test_pipelined_sweep_is_the_serial_one_bit_for_bit(rows, lin, monkeypatch):
+    # the fixture ran with the tie-breaks in a forked worker (where fork exists);
+    # one process, one eps after the other, gives the same bits
+    from workbench import synthesis
+    monkeypatch.setattr(synthesis, "PIPELINE", False)
+    serial = synthesize_delay_bound(lin.A, lin.B, (0.35, 0.30, 0.25, 0.20, 0.10))
+    assert [_bits(r) for r in serial] == [_bits(rows[r.eps]) for r in serial]
+
+
+def test_gain_stage_rows_it_could_not_return_are_computed_here():
+    import os
+
+    from workbench.forked_stage import ForkedStage
+    parent = os.getpid()
+
+    def work(x):
+        if x == 2 and os.getpid() != parent:
+            os._exit(3)                      # the worker dies on the second item
+        return x * x
+    stage = ForkedStage.start(work, 3)
+    if stage is None:
+        pytest.skip("no fork or a single CPU: the sweep runs serially")
+    for x in (1, 2, 3):
+        stage.submit(x)
+    assert stage.results(work) == (1, 4, 9)
+
+    def fails(x):
+        raise ValueError(f"bad item {x}")
+    stage = ForkedStage.start(fails, 2)
+    stage.submit(1)
+    with pytest.raises(ValueError, match="bad item 1"):   # raised here, as serially
+        stage.results(fails)

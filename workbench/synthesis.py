@@ -23,11 +23,13 @@ from typing import Callable
 
 import numpy as np
 
+from .forked_stage import ForkedStage
 from .jsonable import json_method
 from .lmi.core import DEFAULT_MARGIN, IMPLIED, Bracket, Outcome, bisect_delay
 from .lmi.diagnosis import synthesis_reason, uncontrollable_mode
 from .lmi.freeweighting003 import FreeWeighting003, FreeWeighting003FixedK
 from .lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION, CanonicalGain, canonical_gain
+from .lmi.primal import precompile
 from .lmi.scaling import balancing
 from .margins import DelayMargin, delay_margin_eig, delay_margin_siso, stability_windows
 
@@ -208,6 +210,30 @@ class _SharedFixedK:
         return self.lmi
 
 
+#: Run each eps's tie-break (canonical gain) and exact margins in one forked
+#: worker process while the next eps is bisected here
+#: (:class:`~workbench.forked_stage.ForkedStage`; issue 36, item 4). The
+#: bisection of eps i + 1 depends only on the bracket of eps i (its guess),
+#: never on a gain, so no probe moves; the worker is a fork taken before any
+#: solve, its parameters are set by :func:`_row`'s own calls (eps by
+#: ``set_eps``, the delay by every solve) and Clarabel keeps no state between
+#: solves, so every solve sees the same data and gives the same bits. Before
+#: the first row the worker compiles the shared fixed-gain LMI (a DPP
+#: compilation does not depend on the parameter values) and imports
+#: python-control (unless this process has: it does from its second sweep on).
+#: False, or the environment variable ``WORKBENCH_SYNTH_SERIAL=1``, runs
+#: everything here, one eps after the other (``benchmarks/synthesize_delay_bound.py``).
+PIPELINE = True
+
+
+def _import_siso() -> None:
+    """The lazy import of :func:`~workbench.margins.delay_margin_siso` (python-control)."""
+    try:
+        import control  # noqa: F401
+    except ImportError:
+        pass
+
+
 def _row(eps, br: Bracket, crit: FreeWeighting003, A, B, T,
          settings: SynthesisSettings, fixed: Callable | None = None) -> SynthesisRow:
     K = exact = exact_siso = rmin = gain = None
@@ -268,14 +294,39 @@ def synthesize_delay_bound(A, B, eps_values, settings: SynthesisSettings = Synth
                                   None, 0, 0.0, (), reason=diag.reason) for e in eps_values)
     At, Bt, T, _ = _balanced(A, B)
     crit = FreeWeighting003(At, Bt, eps_values[0], margin=settings.margin)
-    rows, guess, fixed = [], None, _SharedFixedK(crit, settings.margin)
-    for eps in eps_values:
+    fixed = _SharedFixedK(crit, settings.margin)
+
+    def row(eps, br):                   # the tie-break and exact margins of one eps
         crit.set_eps(eps)
-        br = bisect_delay(crit.solve_at, guess=guess, **settings.bisection())
-        if br.h_certified > 0:
-            guess = br.h_certified
-        rows.append(_row(eps, br, crit, A, B, T, settings, fixed))
-    return tuple(rows)
+        return _row(eps, br, crit, A, B, T, settings, fixed)
+
+    def warm():      # in the worker, while the first eps is bisected here
+        if not fixed.unshared:
+            lmi = fixed(np.zeros((B.shape[1], A.shape[0])))
+            lmi.set_delay(settings.h_max)
+            precompile(lmi._problem)
+        if B.shape[1] == 1:
+            _import_siso()
+    if B.shape[1] == 1 and ForkedStage.started:
+        _import_siso()   # a later sweep in this process: once here, not in every worker
+    stage = (ForkedStage.start(row, len(eps_values), warm=warm)
+             if PIPELINE and os.environ.get("WORKBENCH_SYNTH_SERIAL") != "1" else None)
+    rows, guess = [], None
+    try:
+        for eps in eps_values:
+            crit.set_eps(eps)
+            br = bisect_delay(crit.solve_at, guess=guess, **settings.bisection())
+            if br.h_certified > 0:
+                guess = br.h_certified
+            if stage is None:
+                rows.append(row(eps, br))
+            else:
+                stage.submit(eps, br)
+    except BaseException:
+        if stage is not None:
+            stage.close(finish=False)
+        raise
+    return tuple(rows) if stage is None else stage.results(row)
 
 
 def certify_given_gain(A, B, K, eps: float, settings: SynthesisSettings = SynthesisSettings()

@@ -211,6 +211,15 @@ def _solve_primal(problem: cp.Problem, solver: str = cp.CLARABEL, **settings) ->
         problem.unpack_results(_PrimalOnly(raw), chain, inverse)
 
 
+def precompile(problem: cp.Problem) -> None:
+    """Compile ``problem`` for Clarabel ahead of its first solve (e.g. in a
+    worker process while another process solves): cvxpy keeps the compiled
+    chain in the problem's cache under the key every solve here uses, so the
+    first solve only applies the parameters. The parameters need values; a
+    DPP compilation does not depend on them."""
+    problem.get_problem_data(cp.CLARABEL)
+
+
 #: Name of :func:`_solve_primal` as a cvxpy solve method (``Problem.solve(method=...)``).
 PRIMAL_ONLY = "workbench_primal_only"
 cp.Problem.register_solve(PRIMAL_ONLY, _solve_primal)
