@@ -18,8 +18,12 @@ def _mm(x) -> str:
 
 
 def render(design, res) -> Rendered:
-    """The report sections of a ``stop-accuracy`` design."""
+    """The report sections of a ``stop-accuracy`` design (with ``[analysis]``:
+    the paper module's, in its wording)."""
     spec = design.spec
+    if spec.analysis is not None:
+        from . import paper_analysis
+        return paper_analysis(spec.analysis).render(design, res)
     sections = [_problem(spec), _stops(spec, res)]
     if spec.grid:
         sections.append(_grid(spec, res))
