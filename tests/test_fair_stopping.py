@@ -37,8 +37,9 @@ D004 = "designs/closed-loop-brake-004.toml"
     (D000, "zeta_min = { value = 0.7", "zeta_min = { value = 1.5", "constants.zeta_min"),
     (D000, 'tolerance = { value = 0.3, unit = "m"', 'tolerance = { value = 0.3, unit = "cm"',
      "target.tolerance.unit"),
-    (D004, "high_ratio = 1.1", "high_ratio = 0.9", "control.high_ratio"),
-    (D004, "t_predict_sweep = [0.0,", "t_predict_sweep = [-1.0,", "control.t_predict_sweep"),
+    (D004, "high       = { value = 1.1", "high       = { value = 0.9",
+     "deceleration_loop.high_ratio"),
+    (D004, "t_predict_sweep = [0.0,", "t_predict_sweep = [-1.0,", "retuning.t_predict_sweep"),
     (D004, 'force_error = { dist = "normal", mean = 0.0, sd = 0.05, lo = -0.15, hi = 0.15',
      'force_error = { dist = "normal", mean = 0.0, sd = 0.05, lo = 0.15, hi = 0.15',
      "montecarlo.distributions.force_error.lo"),
@@ -170,8 +171,8 @@ def test_predictor_loop_dead_time(spec000):
 # -- 004: retuned nominal corner, sensor faults, Monte Carlo determinism ----------------------
 @pytest.fixture(scope="module")
 def res004():
-    from workbench.papers.p004.closed_loop_brake import run_grid
-    spec = load_design(D004).spec
+    from workbench.papers.p004.closed_loop_brake import run_grid, view
+    spec = view(load_design(D004).spec)
     nominal = replace(spec, force_error=(0.0,), gradient=(0.0,), friction=(1.0,))
     return spec, run_grid(nominal, montecarlo=False)
 
@@ -200,8 +201,9 @@ def test_004_sensor_reading_high_wins_max_of_4_and_stuck_one_defeats_it(res004):
 
 
 def test_004_montecarlo_is_seeded():
+    from workbench.papers.p004.closed_loop_brake import view
     from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
-    spec = load_design(D004).spec
+    spec = view(load_design(D004).spec)
     spec = replace(spec, speeds_kmh=(50.0,), montecarlo=MonteCarloSpec(
         6, spec.montecarlo.seed, spec.montecarlo.distributions))
     a, b = run_montecarlo(spec, {50.0: 152.74}), run_montecarlo(spec, {50.0: 152.74})

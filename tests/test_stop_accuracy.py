@@ -50,12 +50,12 @@ def test_ato_open_reproduces_closed_loop_brake():
     ATO open-loop stop errors draw by draw, bit for bit (10 draws, 50 km/h;
     all 200 draws at both speeds are equal too, 166/200 and 164/200 within
     0.3 m, as reports/closed-loop-brake-004.md prints)."""
-    from workbench.papers.p004.closed_loop_brake import stopping_point
+    from workbench.papers.p004.closed_loop_brake import stopping_point, view
     from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
     d = load_design(ATO)
     spec = _small(d.spec, samples=10, speeds=(50.0,))
     res = run(spec)
-    p4 = load_design(ROOT / "designs" / "closed-loop-brake-004.toml").spec
+    p4 = view(load_design(ROOT / "designs" / "closed-loop-brake-004.toml").spec)
     p4 = dataclasses.replace(p4, speeds_kmh=(50.0,),
                              montecarlo=dataclasses.replace(p4.montecarlo, samples=10))
     D = stopping_point(p4, 50 / 3.6)

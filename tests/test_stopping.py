@@ -129,7 +129,7 @@ def test_smarc_beats_smc_on_every_section(small_spec):
     (DESIGN, 'T1    = { value = 0.9,     unit = "s"', 'T1    = { value = 0.9,     unit = "ms"',
      "plant.T1.unit"),
     ("designs/closed-loop-brake-004.toml", "force_error = [-0.15, 0.0, 0.15]",
-     "force_error = [-0.15, 0.0, 1.5]", "scenario.force_error"),
+     "force_error = [-0.15, 0.0, 1.5]", "grid.force_error"),
     ("designs/brake-fit-000.toml", "step_levels = [0.0, 0.6, 0.8, 0.7]",
      "step_levels = [0.0, 0.6, 0.8]", r"logs\[0\].step_levels"),
 ])

@@ -308,6 +308,9 @@ def _grid(root: Reader, factors, controllers=()) -> tuple:
         if not vals or len(set(vals)) < len(vals) or positive and min(vals) <= 0:
             raise t.fail(k, list(vals), "distinct values" + (" above 0 (a ratio)" if positive
                                                              else ""))
+        effect = next(f.effect for f in factors if f.name == k)
+        if effect == "force_error" and not all(abs(x) < 0.9 for x in vals):
+            raise t.fail(k, list(vals), "force errors in (-0.9, 0.9) (kappa = 1 + error)")
         out.append((k, tuple(vals)))
         corners *= len(vals)
     t.finish()
@@ -369,8 +372,7 @@ class StopAccuracy:
     refine_field, refine_unit = "dt", "s"
 
     def refines(self, spec: StopAccuracySpec) -> bool:
-        """Whether the findings of ``spec`` are refined by running it again at
-        dt/2 and dt/4 (with [analysis]; the general report has [convergence])."""
+        """Whether ``spec``'s findings are run again at dt/2, dt/4 ([analysis])."""
         return spec.analysis is not None
 
     def load(self, root: Reader) -> StopAccuracySpec:

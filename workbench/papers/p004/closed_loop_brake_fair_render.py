@@ -1,4 +1,4 @@
-"""Markdown and figures of the ``closed-loop-brake`` study's retuning, sensor
+"""Markdown and figures of paper 004's retuning, sensor
 faults and Monte Carlo (pure rendering of a
 :class:`~workbench.papers.p004.closed_loop_brake.Result004`)."""
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...report.markdown import Figure, fmt, md_table
-from .closed_loop_brake_run import FAULTS, MC_FACTORS, MC_MODES
+from .closed_loop_brake_run import FAULTS, MC_MODES
 
 MODE_LABEL = {"ato-open": "ATO open loop", "closed": "closed loop (analogue)"}
 
@@ -60,7 +60,8 @@ def fault_text(spec) -> str:
 
 def mc_section(spec, res) -> str:
     mc = spec.montecarlo
-    drows = [[f"`{k}`", MC_FACTORS[k].what, d.describe(), MC_FACTORS[k].unit, d.source]
+    factor = {f.name: f for f in spec.kind.factors}
+    drows = [[f"`{k}`", factor[k].what, d.describe(), factor[k].unit, d.source]
              for k, d in mc.distributions.items()]
     rows = []
     for (s, m), st in res.mc.items():
