@@ -145,16 +145,27 @@ def test_modules_need_their_tables(tmp_path, capsys):
     assert "a [reference] for SMARC to track" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("old,new,word", [
-    ('module = "p000.station_stopping"', 'module = "p000.no_such_module"', "ANALYSIS"),
-    ('module = "p000.station_stopping"', 'module = "os.path"', "pNNN.name"),
-    ('name = "smarc_terminal"', 'name = "smarc_term"', "missing: smarc_terminal"),
-    ('zeta_min = { value = 0.7,', 'zeta_min = { value = 0.0,', "(0, 1]"),
-    ('[[published]]\nsection = 1\n', '[[published]]\nsection = 9\n', "published[0].section"),
+@pytest.mark.parametrize("name,old,new,word", [
+    ("stopping-line5", 'module = "p000.station_stopping"', 'module = "p000.no_such_module"',
+     "ANALYSIS"),
+    ("stopping-line5", 'module = "p000.station_stopping"', 'module = "os.path"', "pNNN.name"),
+    ("stopping-line5", 'name = "smarc_terminal"', 'name = "smarc_term"',
+     "missing: smarc_terminal"),
+    ("stopping-line5", 'zeta_min = { value = 0.7,', 'zeta_min = { value = 0.0,', "(0, 1]"),
+    ("stopping-line5", '[[published]]\nsection = 1\n', '[[published]]\nsection = 9\n',
+     "published[0].section"),
+    ("closed-loop-brake-004", 'name = "open"\n', 'name = "held"\n',
+     "the controllers open, ato_open"),
+    ("closed-loop-brake-004", '[retuning]\n', '[retune]\n', "retuning"),
+    ("closed-loop-brake-004", 'gradient_permille = 15.0 #', 'gradient_permille = -15.0 #',
+     "worked.gradient_permille"),
+    ("closed-loop-brake-004", 'friction = [0.8, 1.0, 1.2]', 'friction = [0.8, 1.0, 0.0]',
+     "grid.friction"),
 ])
-def test_bad_analysis_input_exit_2(tmp_path, capsys, old, new, word):
-    """The kind's [analysis] module and what paper 000's module checks: one line, exit 2."""
-    src = ROOT / "designs" / "stopping-line5.toml"
+def test_bad_analysis_input_exit_2(tmp_path, capsys, name, old, new, word):
+    """The kind's [analysis] module and what the paper modules (p000, p004) check
+    of their designs: one line, exit 2."""
+    src = ROOT / "designs" / f"{name}.toml"
     text = src.read_text(encoding="utf-8")
     assert old in text, old
     p = tmp_path / src.name

@@ -6,10 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...kinds.stop_accuracy.render import distribution_table, mc_cells, plot_ecdf, tolerance_lines
 from ...report.markdown import Figure, fmt, md_table
 from .station_stopping_run import loop_dead_time
 from .station_stopping_spec import (ABLATION_LAWS, COMPENSATED, DAMPING, MC_CONTROLLERS,
-                                    UNCOMPENSATED, factor, gains, label)
+                                    UNCOMPENSATED, gains, label)
 
 GROUP = {**{c: "as in paper 000" for c in UNCOMPENSATED},
          **{c: "with known-delay compensation" for c in MC_CONTROLLERS if c not in UNCOMPENSATED}}
@@ -117,21 +118,14 @@ def _nominal_part(res) -> str:
 
 def _mc_part(spec, res, tol: float) -> str:
     mc = spec.montecarlo
-    drows = [[f"`{k}`", factor(spec, k).what, d.describe(), factor(spec, k).unit, d.source]
-             for k, d in mc.distributions.items()]
-    rows = []
-    for c in MC_CONTROLLERS:
-        s = res.mc[c]
-        rows.append([label(c), GROUP[c], f"{s.k} / {s.n}", fmt(s.p, 3),
-                     f"[{fmt(s.lo, 3)}, {fmt(s.hi, 3)}]", _cm(s.p95), _cm(s.mean),
-                     fmt(100 * s.overshoot, 3)])
+    rows = [[label(c), GROUP[c]] + mc_cells(res.mc[c], _cm) for c in MC_CONTROLLERS]
     return (
         f"### Monte Carlo: P(|e| ≤ {fmt(tol)} m) over continuous distributions\n\n"
         f"{mc.samples} draws (seed {mc.seed}; `workbench/studies/stopping_mc.py`: inverse CDF "
         "of seeded uniforms, one stream per factor), the same draws for every controller "
         "(common random numbers), on section 1's braking phase (every section reaches v_max "
         "before braking, so their braking phases are the same):\n\n"
-        + md_table(["factor", "meaning", "distribution", "unit", "source"], drows, "lllll")
+        + distribution_table(spec)
         + "\n\n" + md_table(["controller", "group", f"stops within {fmt(tol)} m",
                              f"P(|e| ≤ {fmt(tol)} m)", "Wilson 95 % interval",
                              "95th percentile of |e| (cm)", "mean e (cm)", "overshoots (%)"],
@@ -192,11 +186,8 @@ def _plot_mc(fig, res):
                              sharey=axes[0] if axes else None)
         axes.append(ax)
         for k, c in enumerate(ctls):
-            e = np.sort(100 * np.asarray(res.mc[c].errors))
-            ax.step(e, np.arange(1, len(e) + 1) / len(e), where="post", color=f"C{k}",
-                    label=label(c))
-        for x in (-tol, tol):
-            ax.axvline(x, color="k", ls="--", lw=0.8)
+            plot_ecdf(ax, 100 * np.asarray(res.mc[c].errors), color=f"C{k}", label=label(c))
+        tolerance_lines(ax, tol)
         ax.set_xscale("symlog", linthresh=1.0)
         ax.set_xlabel("stop error (cm, + overshoot)")
         ax.set_title(title, fontsize=9)

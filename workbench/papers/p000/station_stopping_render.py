@@ -7,6 +7,7 @@ import numpy as np
 import sympy as sp
 
 from ...features.montecarlo import within_rate
+from ...kinds.stop_accuracy.render import plot_ecdf
 from ...plants.brake000 import brake_model
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .station_stopping_fair_render import fair_section, figures
@@ -160,9 +161,7 @@ def _within_section(res) -> str:
 def _plot_cdf(fig, res):
     ax = fig.add_subplot(111)
     for k, c in enumerate(CONTROLLERS):
-        e = np.sort(np.abs(_errors(res, c)))
-        ax.step(e, np.arange(1, len(e) + 1) / len(e), where="post", color=f"C{k}",
-                label=label(c))
+        plot_ecdf(ax, np.abs(_errors(res, c)), color=f"C{k}", label=label(c))
     ax.axvline(100 * STOP_WINDOW_M, color="k", ls="--", lw=0.8, label=f"{fmt(STOP_WINDOW_M)} m")
     ax.set_xscale("symlog", linthresh=1.0)
     ax.set_xlim(left=0.0)              # an |error| axis has no negative ticks
