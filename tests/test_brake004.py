@@ -6,14 +6,14 @@ import pytest
 
 from workbench.controllers.fuzzy import FuzzyIncrement, memberships
 from workbench.design import load_design
-from workbench.papers.p004.closed_loop_brake import compute_worked, run_grid
+from workbench.papers.p004.closed_loop_brake import compute_worked, run_grid, view
 
 DESIGN = "designs/closed-loop-brake-004.toml"
 
 
 @pytest.fixture(scope="module")
 def spec():
-    return load_design(DESIGN).spec
+    return view(load_design(DESIGN).spec)
 
 
 def test_worked_numbers_match_print_at_printed_digits(spec):

@@ -229,3 +229,16 @@ def test_pytest_plugin_inactive_without_option_and_ini_selects(pytester):
     assert "tests/test_own.py::test_own" in text                        # the team's tests
     assert "designs/example-cruise.toml::certified-delay" in text       # plus the claims
     assert "proofs/braking_distance.py::stop-distance-formula" in text
+
+
+def test_changed_since_follows_the_analysis_module():
+    """A design whose [analysis] table names a paper module (imported by name)
+    is checked again when that module, or one it imports, changed."""
+    from workbench.changes import PACKAGE_DIR, design_changed
+    d = Path("designs").resolve()
+    design = d / "stopping-line5.toml"
+    p000 = PACKAGE_DIR / "papers" / "p000"
+    for f in ("station_stopping.py", "station_stopping_run.py", "station_stopping_render.py"):
+        assert design_changed(design, "stop-accuracy", d, {p000 / f}), f
+    assert not design_changed(d / "stop-accuracy-synthetic.toml", "stop-accuracy", d,
+                              {p000 / "station_stopping.py"})

@@ -13,7 +13,7 @@ from workbench.design import load_design
 from workbench.features.montecarlo import (Distribution, MonteCarloSpec, draw, percentile,
                                            stop_statistics, within_rate)
 from workbench.papers.p000.station_stopping_run import loop_dead_time, run_station_stops
-from workbench.papers.p000.station_stopping_spec import MC_FACTORS, NOMINAL
+from workbench.papers.p000.station_stopping_spec import gains
 from workbench.sim.stopping import batch_params, simulate
 from workbench.tuning.pid import damping, speed_loop, tune_pid
 
@@ -31,13 +31,15 @@ D004 = "designs/closed-loop-brake-004.toml"
     (D000, "samples = 200", "samples = 1", "montecarlo.samples"),
     (D000, "[montecarlo.distributions]\n", "[montecarlo.distributions]\nwind = { dist = \"uniform\", lo = 0.0, hi = 1.0, source = \"x\" }\n",
      "montecarlo.distributions.wind"),
-    (D000, "d_terminal = 40.0", "d_terminal = -40.0", "compensation.d_terminal"),
+    (D000, "d_terminal = { value = 40.0", "d_terminal = { value = -40.0",
+     "compensation.d_terminal"),
     (D000, "gain_bounds = [0.5, 1.5]", "gain_bounds = [1.2, 1.5]", "compensation.gain_bounds"),
-    (D000, "\nzeta_min = 0.7", "\nzeta_min = 1.5", "controllers.pid_damped.zeta_min"),
+    (D000, "zeta_min = { value = 0.7", "zeta_min = { value = 1.5", "constants.zeta_min"),
     (D000, 'tolerance = { value = 0.3, unit = "m"', 'tolerance = { value = 0.3, unit = "cm"',
      "target.tolerance.unit"),
-    (D004, "high_ratio = 1.1", "high_ratio = 0.9", "control.high_ratio"),
-    (D004, "t_predict_sweep = [0.0,", "t_predict_sweep = [-1.0,", "control.t_predict_sweep"),
+    (D004, "high       = { value = 1.1", "high       = { value = 0.9",
+     "deceleration_loop.high_ratio"),
+    (D004, "t_predict_sweep = [0.0,", "t_predict_sweep = [-1.0,", "retuning.t_predict_sweep"),
     (D004, 'force_error = { dist = "normal", mean = 0.0, sd = 0.05, lo = -0.15, hi = 0.15',
      'force_error = { dist = "normal", mean = 0.0, sd = 0.05, lo = 0.15, hi = 0.15',
      "montecarlo.distributions.force_error.lo"),
@@ -55,8 +57,10 @@ def test_bad_new_key_is_one_line_exit_2(tmp_path, capsys, design, old, new, key)
 
 # -- Monte Carlo draws and statistics -------------------------------------------------------
 def test_draws_are_seeded_and_per_factor():
-    mc = load_design(D000).spec.montecarlo
-    order = tuple(MC_FACTORS)
+    spec = load_design(D000).spec
+    mc = spec.montecarlo
+    order = tuple(f.name for f in spec.factors)
+    NOMINAL = {f.name: f.nominal for f in spec.factors}
     a, b = draw(mc, order, NOMINAL), draw(mc, order, NOMINAL)
     assert all(np.array_equal(a[k], b[k]) for k in order)            # same seed, same draws
     other = draw(replace(mc, seed=mc.seed + 1), order, NOMINAL)
@@ -95,14 +99,13 @@ def test_damped_pid_meets_the_criterion_and_paper_gains_do_not(spec000):
     p = {k: q.value for k, q in spec000.params.items()}
     h = p["T1"] + spec000.dt_ctrl / 2
     loop = lambda g: damping(*speed_loop(**g, P1=p["P1"], T2=p["T2"]), h)
-    assert loop(spec000.pid_damped).zeta >= spec000.zeta_min
-    ringing = loop(spec000.pid)
+    assert loop(gains(spec000, "pid-damped")).zeta >= spec000.paper.zeta_min
+    ringing = loop(gains(spec000, "pid"))
     assert ringing.zeta < 0.1 and 7.0 < ringing.period < 10.0      # the 8-9 s ringing
 
 
-@pytest.mark.parametrize("table, variant", [("pid_damped", "pid-damped"),
-                                            ("pid_compensated", "pid-comp")])
-def test_tuner_reproduces_the_design_gains(spec000, table, variant):
+@pytest.mark.parametrize("variant", ["pid-damped", "pid-comp"])
+def test_tuner_reproduces_the_design_gains(spec000, variant):
     """tune_pid as the design file states it (default grid, kd = 0), on the loop
     each PID runs in (with the dead time, or behind the predictor), gives the
     design's gains to their 2 printed digits, and the rounded gains still meet
@@ -110,11 +113,10 @@ def test_tuner_reproduces_the_design_gains(spec000, table, variant):
     p = {k: q.value for k, q in spec000.params.items()}
     loop = lambda a, b: speed_loop(a, b, 0.0, P1=p["P1"], T2=p["T2"])
     h = loop_dead_time(spec000, variant)
-    kp, ki, _ = tune_pid(loop, h, zeta_min=spec000.zeta_min)
-    gains = spec000.gains(table)
-    assert (float(f"{kp:.2g}"), float(f"{ki:.2g}"), gains["kd"]) == \
-        (gains["kp"], gains["ki"], 0.0)
-    assert damping(*loop(gains["kp"], gains["ki"]), h).zeta >= spec000.zeta_min
+    kp, ki, _ = tune_pid(loop, h, zeta_min=spec000.paper.zeta_min)
+    g = gains(spec000, variant)
+    assert (float(f"{kp:.2g}"), float(f"{ki:.2g}"), g["kd"]) == (g["kp"], g["ki"], 0.0)
+    assert damping(*loop(g["kp"], g["ki"]), h).zeta >= spec000.paper.zeta_min
 
 
 # -- the controller's brake model ------------------------------------------------------------
@@ -133,8 +135,8 @@ def test_model_predicts_the_held_command_stop(spec000):
 # -- compensation: nominal row, bias, determinism ---------------------------------------------
 @pytest.fixture(scope="module")
 def small(spec000):
-    spec = replace(spec000, repeats=2, sections=spec000.sections[:1],
-                   montecarlo=replace(spec000.montecarlo, samples=24))
+    rp = replace(spec000.sections, count=2, sections=spec000.sections.sections[:1])
+    spec = replace(spec000, sections=rp, montecarlo=replace(spec000.montecarlo, samples=24))
     return spec, run_station_stops(spec)
 
 
@@ -169,8 +171,8 @@ def test_predictor_loop_dead_time(spec000):
 # -- 004: retuned nominal corner, sensor faults, Monte Carlo determinism ----------------------
 @pytest.fixture(scope="module")
 def res004():
-    from workbench.papers.p004.closed_loop_brake import run_grid
-    spec = load_design(D004).spec
+    from workbench.papers.p004.closed_loop_brake import run_grid, view
+    spec = view(load_design(D004).spec)
     nominal = replace(spec, force_error=(0.0,), gradient=(0.0,), friction=(1.0,))
     return spec, run_grid(nominal, montecarlo=False)
 
@@ -199,8 +201,9 @@ def test_004_sensor_reading_high_wins_max_of_4_and_stuck_one_defeats_it(res004):
 
 
 def test_004_montecarlo_is_seeded():
+    from workbench.papers.p004.closed_loop_brake import view
     from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
-    spec = load_design(D004).spec
+    spec = view(load_design(D004).spec)
     spec = replace(spec, speeds_kmh=(50.0,), montecarlo=MonteCarloSpec(
         6, spec.montecarlo.seed, spec.montecarlo.distributions))
     a, b = run_montecarlo(spec, {50.0: 152.74}), run_montecarlo(spec, {50.0: 152.74})

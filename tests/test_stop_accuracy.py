@@ -50,12 +50,12 @@ def test_ato_open_reproduces_closed_loop_brake():
     ATO open-loop stop errors draw by draw, bit for bit (10 draws, 50 km/h;
     all 200 draws at both speeds are equal too, 166/200 and 164/200 within
     0.3 m, as reports/closed-loop-brake-004.md prints)."""
-    from workbench.papers.p004.closed_loop_brake import stopping_point
+    from workbench.papers.p004.closed_loop_brake import stopping_point, view
     from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
     d = load_design(ATO)
     spec = _small(d.spec, samples=10, speeds=(50.0,))
     res = run(spec)
-    p4 = load_design(ROOT / "designs" / "closed-loop-brake-004.toml").spec
+    p4 = view(load_design(ROOT / "designs" / "closed-loop-brake-004.toml").spec)
     p4 = dataclasses.replace(p4, speeds_kmh=(50.0,),
                              montecarlo=dataclasses.replace(p4.montecarlo, samples=10))
     D = stopping_point(p4, 50 / 3.6)
@@ -180,3 +180,31 @@ def test_distance_or_command_exactly_one(tmp_path, capsys):
     p = _design(tmp_path, SYNTH.read_text(), 'c_max =',
                 'command = { value = 0.7, unit = "m/s^2", source = "x" }\nc_max =')
     assert main(["verify", str(p)]) == 2 and "exactly one" in capsys.readouterr().err
+
+
+def test_monte_carlo_report_pieces_on_a_non_paper_design():
+    """The Monte Carlo table pieces papers 000 and 004 share
+    (kinds/stop_accuracy/render.py) on the synthetic design: every distribution
+    with its factor's meaning and unit; the statistics cells; the ECDF steps."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from workbench.features.montecarlo import stop_statistics
+    from workbench.kinds.stop_accuracy.render import (distribution_table, mc_cells, plot_ecdf,
+                                                      tolerance_lines)
+    spec = load_design(SYNTH).spec
+    table = distribution_table(spec).splitlines()
+    factor = {f.name: f for f in spec.factors}
+    assert len(table) == 2 + len(spec.montecarlo.distributions)
+    for k, line in zip(spec.montecarlo.distributions, table[2:]):
+        assert f"`{k}`" in line and factor[k].what in line and factor[k].unit in line
+    st = stop_statistics([0.1, -0.2, 0.5, 0.25], 0.3)
+    assert mc_cells(st, lambda x: f"{x:.2f}")[:2] == ["3 / 4", "0.75"]
+    assert mc_cells(st, lambda x: f"{x:.2f}")[4:] == ["0.16", "75"]
+    fig, ax = plt.subplots()
+    plot_ecdf(ax, [0.5, -0.2, 0.1], color="C0")
+    tolerance_lines(ax, 0.3)
+    x, y = ax.lines[0].get_data()
+    assert list(x) == [-0.2, 0.1, 0.5] and y[-1] == 1.0 and len(ax.lines) == 3
+    plt.close(fig)

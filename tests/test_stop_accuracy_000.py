@@ -1,7 +1,8 @@
 """Paper 000's station stops as a ``stop-accuracy`` configuration (issue 35,
 item 2): designs/stop-accuracy-000-line5.toml, with the named modules
 ``smarc``, ``predictor`` and ``terminal`` (workbench/kinds/stop_accuracy/modules.py),
-gives the stop errors of designs/stopping-line5.toml's study bit for bit, and
+gives the stop errors of designs/stopping-line5.toml (the same kind with paper 000's
+``[analysis]`` module) bit for bit, and
 its new tables reject bad input in one line (exit 2)."""
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ from workbench.kinds.stop_accuracy.run import run
 
 ROOT = Path(__file__).resolve().parent.parent
 LINE5 = ROOT / "designs" / "stop-accuracy-000-line5.toml"
-#: stopping-line5's variant -> the configuration's controller.
+#: stopping-line5's paper name -> the configuration's controller (the same in both files).
 SHARED = {"pid": "pid", "pid-damped": "pid_damped", "smc": "smc", "smarc": "smarc",
           "pid-comp": "pid_comp", "smc-comp": "smc_comp", "smarc-comp": "smarc_comp",
           "smarc-comp-nogain": "smarc_comp_nogain"}
@@ -25,46 +26,38 @@ SHARED = {"pid": "pid", "pid-damped": "pid_damped", "smc": "smc", "smarc": "smar
 
 def test_line5_configuration_is_stopping_line5():
     """Every controller of stopping-line5's nominal row and Monte Carlo, on
-    the nominal plant and on 3 draws of its [montecarlo], stops where the
-    paper study's stops, to the last bit (all 200 draws are equal too:
+    the nominal plant and on 3 draws of its [montecarlo], stops where
+    stopping-line5's (a stop-accuracy design with paper 000's [analysis]
+    module) stops, to the last bit (all 200 draws are equal too:
     reports/stop-accuracy-000-line5.md prints stopping-line5's rates). The
     PID with feed-forward and the SMC of eq 22 are expressions here, SMARC
-    and the compensation named modules. The study runs its laws through the
-    kind too (``station_stopping_run.kind_spec``), so this checks that the
-    design file (constants, factor order, modules, start, clip range)
-    configures what the study runs."""
-    from workbench.papers.p000.station_stopping_run import _runset, _concat, simulate_runs
-    from workbench.features.montecarlo import draw
-    from workbench.papers.p000.station_stopping_spec import MC_FACTORS, NOMINAL
+    and the compensation named modules; stopping-line5 adds SMARC with sgn
+    and the nominal ablation. Checks that the two files (constants, factor
+    order, modules, start, clip range) configure the same stops."""
     from workbench.kinds.stop_accuracy.run import (compile_laws, montecarlo_draws,
                                                    simulate_cases)
+    from workbench.papers.p000.station_stopping_spec import VARIANTS
+
+    def stops(spec, names, N=3):
+        # one batch: draw 0 at the nominal factors (x * 1.0 == x: the nominal plant), then N
+        drawn = montecarlo_draws(spec, dataclasses.replace(spec.montecarlo, samples=N))
+        draws = {f.name: np.concatenate([[f.nominal], drawn[f.name]]) for f in spec.factors
+                 if f.name in drawn}
+        (speed,) = spec.speeds_kmh
+        ctl = [c.name for c in spec.controllers]
+        cases = [(speed, ctl.index(c), None, spec.distance) for c in names]
+        tr, D = simulate_cases(spec, compile_laws(spec), spec.dt, cases, draws)
+        return (tr.x_stop - D).reshape(len(cases), N + 1)
+
     spec = load_design(LINE5).spec
-    N = 3
-    # one batch: draw 0 at the nominal factors (x * 1.0 == x: the nominal plant), then N draws
-    drawn = montecarlo_draws(spec, dataclasses.replace(spec.montecarlo, samples=N))
-    draws = {f.name: np.concatenate([[f.nominal], drawn[f.name]]) for f in spec.factors
-             if f.name in drawn}
-    (speed,) = spec.speeds_kmh
-    cases = [(speed, i, None, spec.distance) for i in range(len(spec.controllers))]
-    tr, D = simulate_cases(spec, compile_laws(spec), spec.dt, cases, draws)
-    mine = (tr.x_stop - D).reshape(len(cases), N + 1)
-    names = [c.name for c in spec.controllers]
     l5 = load_design(ROOT / "designs" / "stopping-line5.toml").spec
-    l5 = dataclasses.replace(l5, montecarlo=dataclasses.replace(l5.montecarlo, samples=N))
-    L = l5.sections[0].length
-    d = draw(l5.montecarlo, tuple(MC_FACTORS), NOMINAL)
-    nom = list(SHARED)
-    rs = _concat(_runset(nom, "nom", [0] * len(nom), [0] * len(nom), [L] * len(nom), {}),
-                 *(_runset([v] * N, "mc", [0] * N, np.arange(N), [L] * N, d) for v in nom))
-    tr = simulate_runs(l5, rs)[0]
-    err = tr.x_stop - rs["length"]
-    assert f"v{speed:g}" == "v79.9992" and spec.distance == L and list(SHARED.values()) == names
-    for v, c in SHARED.items():
-        got = mine[names.index(c)]
-        nominal = err[(rs["kind"] == "nom") & (rs["variant"] == v)]
-        assert got[0] == nominal[0], c
-        mc = err[(rs["kind"] == "mc") & (rs["variant"] == v)]
-        assert got[1:].tolist() == mc.tolist(), c
+    assert l5.analysis == "p000.station_stopping" and spec.analysis is None
+    assert [VARIANTS[k][0] for k in SHARED] == list(SHARED.values())
+    mine, theirs = stops(spec, list(SHARED.values())), stops(l5, list(SHARED.values()))
+    (speed,) = spec.speeds_kmh
+    assert f"v{speed:g}" == "v79.9992" and spec.distance == l5.distance == 1544.0
+    assert mine.tolist() == theirs.tolist()
+    names = list(SHARED.values())
     assert mine[names.index("smarc"), 0] > 0.1 > abs(mine[names.index("smarc_comp"), 0])
     res = run(dataclasses.replace(spec, montecarlo=None, controllers=spec.controllers[3:4],
                                   sections=None))
@@ -72,23 +65,23 @@ def test_line5_configuration_is_stopping_line5():
 
 
 def test_line5_sections_are_stopping_line5_repeats():
-    """The kind's [[sections]] and [repeats] give stopping-line5's per-section
-    repeats (Tables 3-4) repeat by repeat, to the last bit (2 sections x 2
-    repeats; the whole 7 x 10 table: reports/stop-accuracy-000-line5.md
-    prints stopping-line5's 99.3, 149 and 28.7 cm). The error statistics are
-    the same arithmetic on the same errors (equal); the jerk is averaged over
-    each batch's records, whose length depends on the batch (to 1e-12)."""
-    from workbench.kinds.stop_accuracy.run import run_sections
-    from workbench.kinds.stop_accuracy.run import compile_laws
+    """The per-section repeats (Tables 3-4) of the two files agree repeat by
+    repeat, to the last bit (2 sections x 2 repeats; the whole 7 x 10 table:
+    reports/stop-accuracy-000-line5.md prints stopping-line5's 99.3, 149 and
+    28.7 cm), and stopping-line5's paper rows are the kind's statistics."""
+    from workbench.kinds.stop_accuracy.run import compile_laws, run_sections
     from workbench.papers.p000.station_stopping_run import run_station_stops
-    spec = load_design(LINE5).spec
-    rp = dataclasses.replace(spec.sections, sections=spec.sections.sections[:2], count=2)
-    spec = dataclasses.replace(spec, sections=rp)
+
+    def small(spec):
+        rp = dataclasses.replace(spec.sections, sections=spec.sections.sections[:2], count=2)
+        return dataclasses.replace(spec, sections=rp)
+
+    spec = small(load_design(LINE5).spec)
     mine = run_sections(spec, compile_laws(spec), spec.dt)
-    l5 = load_design(ROOT / "designs" / "stopping-line5.toml").spec
-    l5 = dataclasses.replace(l5, sections=l5.sections[:2], repeats=2)
-    ref = run_station_stops(l5, extras=False).stats
-    assert rp.controllers == ("pid", "smc", "smarc") and len(mine) == 2 * 3
+    l5 = small(load_design(ROOT / "designs" / "stopping-line5.toml").spec)
+    l5 = dataclasses.replace(l5, montecarlo=dataclasses.replace(l5.montecarlo, samples=2))
+    ref = run_station_stops(l5).stats
+    assert spec.sections.controllers == ("pid", "smc", "smarc") and len(mine) == 2 * 3
     for (i, c), got in mine.items():
         want = ref[c, i]
         assert got.errors == want.errors, (i, c)
@@ -150,3 +143,33 @@ def test_modules_need_their_tables(tmp_path, capsys):
         "[disturbances]"), encoding="utf-8")
     assert main(["verify", str(p)]) == 2
     assert "a [reference] for SMARC to track" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name,old,new,word", [
+    ("stopping-line5", 'module = "p000.station_stopping"', 'module = "p000.no_such_module"',
+     "ANALYSIS"),
+    ("stopping-line5", 'module = "p000.station_stopping"', 'module = "os.path"', "pNNN.name"),
+    ("stopping-line5", 'name = "smarc_terminal"', 'name = "smarc_term"',
+     "missing: smarc_terminal"),
+    ("stopping-line5", 'zeta_min = { value = 0.7,', 'zeta_min = { value = 0.0,', "(0, 1]"),
+    ("stopping-line5", '[[published]]\nsection = 1\n', '[[published]]\nsection = 9\n',
+     "published[0].section"),
+    ("closed-loop-brake-004", 'name = "open"\n', 'name = "held"\n',
+     "the controllers open, ato_open"),
+    ("closed-loop-brake-004", '[retuning]\n', '[retune]\n', "retuning"),
+    ("closed-loop-brake-004", 'gradient_permille = 15.0 #', 'gradient_permille = -15.0 #',
+     "worked.gradient_permille"),
+    ("closed-loop-brake-004", 'friction = [0.8, 1.0, 1.2]', 'friction = [0.8, 1.0, 0.0]',
+     "grid.friction"),
+])
+def test_bad_analysis_input_exit_2(tmp_path, capsys, name, old, new, word):
+    """The kind's [analysis] module and what the paper modules (p000, p004) check
+    of their designs: one line, exit 2."""
+    src = ROOT / "designs" / f"{name}.toml"
+    text = src.read_text(encoding="utf-8")
+    assert old in text, old
+    p = tmp_path / src.name
+    p.write_text(text.replace(old, new, 1), encoding="utf-8")
+    assert main(["verify", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert word in err and "Traceback" not in err and len(err.strip().splitlines()) == 1

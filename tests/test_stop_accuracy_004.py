@@ -1,7 +1,9 @@
 """Paper 004's closed loop as a ``stop-accuracy`` configuration
 (designs/stop-accuracy-004-closed.toml, the named module ``deceleration_loop``):
-its stop errors equal the ``closed-loop-brake`` study's draw by draw, corner by
-corner and fault by fault, bit for bit; bad module input exits 2 in one line."""
+its stop errors equal those of designs/closed-loop-brake-004.toml (the same kind
+with paper 004's ``[analysis]`` module and its own run lists) draw by draw,
+corner by corner and fault by fault, bit for bit; bad module input exits 2 in
+one line."""
 from __future__ import annotations
 
 import dataclasses
@@ -29,13 +31,13 @@ CORNERS = {"force_error": (0.0, 0.15), "gradient": (-30.0, 0.0), "friction": (1.
 def both():
     """The kind's run and the study's, on 4 Monte Carlo draws and a 2 x 2 x 2
     grid from 50 km/h."""
-    from workbench.papers.p004.closed_loop_brake import run_grid, stopping_point
+    from workbench.papers.p004.closed_loop_brake import run_grid, stopping_point, view
     from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
     spec = load_design(CLOSED).spec
     spec = dataclasses.replace(spec, speeds_kmh=(50.0,), convergence=False,
                                montecarlo=dataclasses.replace(spec.montecarlo, samples=4),
                                grid=tuple((k, CORNERS[k]) for k, _ in spec.grid))
-    p4 = load_design(P004).spec
+    p4 = view(load_design(P004).spec)
     p4 = dataclasses.replace(p4, speeds_kmh=(50.0,), **CORNERS,
                              montecarlo=dataclasses.replace(p4.montecarlo, samples=4))
     D = stopping_point(p4, 50 / 3.6)
@@ -118,3 +120,4 @@ def test_axles_need_a_loop(tmp_path, capsys):
                               'parameters = { v_ho = 1000.0 }\naxles = "oooo"', 1))
     assert main(["verify", str(p)]) == 2
     assert "no controller has a deceleration_loop" in capsys.readouterr().err
+

@@ -10,7 +10,8 @@ that git does not ignore. A design is checked again when any of these changed:
 * ``workbench.toml``, ``pyproject.toml`` or ``constraints.txt`` (the project
   or its pinned versions) — every design and proof then;
 * a file of the ``workbench`` package that its study runs: the study module
-  of its ``kind`` and every ``workbench`` module it imports, transitively,
+  of its ``kind`` (and of the paper module its ``[analysis]`` table names)
+  and every ``workbench`` module it imports, transitively,
   plus those of the claim machinery (``verify``, ``claims``, ``design``).
   Imports are read statically from the source (:mod:`ast`, every ``import``
   statement anywhere in a module, so a lazy import counts too); a package's
@@ -164,7 +165,19 @@ def design_changed(path: Path, kind: str, designs_dir: Path, changed: set[Path])
     data = designs_dir.resolve()
     if any(data in c.parents and c.parent != data for c in changed):
         return True
-    return bool(study_files(kind) & changed)
+    return bool((study_files(kind) | _analysis_files(path)) & changed)
+
+
+def _analysis_files(path: Path) -> frozenset[Path]:
+    """Files of the paper module a design names in ``[analysis] module =
+    "pNNN.name"`` (imported by name, so not in its kind's imports)."""
+    import tomllib
+    try:
+        name = tomllib.loads(path.read_text(encoding="utf-8"))["analysis"]["module"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return frozenset()
+    f = _module_file(f"workbench.papers.{name}") if isinstance(name, str) else None
+    return frozenset() if f is None else _closure(f, _package_of(f, f"workbench.papers.{name}"))
 
 
 def proof_changed(path: Path, changed: set[Path]) -> bool:

@@ -29,7 +29,8 @@ def evaluate_design(design: Design) -> Evaluation:
     """Run the design's study (once per process for an equal spec,
     :func:`workbench.memo.run_study`) and check each of its claims.
 
-    A study with a ``refine_field`` (the spec's numerical step) has every
+    A study with a ``refine_field`` (the spec's numerical step; for the
+    designs its ``refines(spec)`` accepts, when it has one) has every
     finding's metric checked at the step, its half and its quarter (:func:`workbench.refinement.refine_findings`, issue 33 item 4):
     a finding whose metric has not converged within the claim's tolerance
     is INCONCLUSIVE ("not converged: ...")."""
@@ -39,7 +40,7 @@ def evaluate_design(design: Design) -> Evaluation:
     checked = [replace(check_claim(fill_claim(c, q, fmt), q.get(c.quantity)),
                        peak=noise_peak(c.quantity, q)) for c in design.claims]
     table = None
-    if hasattr(study, "refine_field"):
+    if hasattr(study, "refine_field") and getattr(study, "refines", lambda spec: True)(design.spec):
         table = _refined(design, study, q, checked, result)
         by_id = {row.claim_id: row for row in table.rows}
         checked = [_unconverged(r, by_id[r.claim.id]) if r.claim.id in by_id

@@ -54,6 +54,11 @@ Tables::
     [convergence]  (no keys: every nominal and fault stop error at dt, dt/2, dt/4,
                    :func:`workbench.sim.convergence.refinement_check`)
     [sim]          dt, dt_ctrl, t_end (s)
+    [analysis]     module = "pNNN.name" (optional: a paper's module under
+                   ``workbench.papers`` with an ``ANALYSIS`` object that reads the paper's
+                   own tables, runs the design through this kind's simulation and names
+                   the claims' quantities and the report; its findings are refined at
+                   dt/2 and dt/4, :mod:`workbench.refinement`)
 
 A law sees ``x`` (m since braking began), ``v`` (the measured speed, m/s),
 ``decel`` (the measured deceleration, m/s^2, >= 0), ``d_go = D - x`` (m),
@@ -134,6 +139,8 @@ class StopAccuracySpec:
     c_min: float = 0.0             # m/s^2: -traction_max (the law may call for traction)
     sections: object = None        # sections.Repeats ([[sections]], [repeats])
     grid_feasible: str | None = None   # [grid] feasible_with: the controller that decides
+    analysis: str | None = None    # [analysis] module (a name: specs stay keyable)
+    paper: object = None           # what that module read of the paper's own tables
 
     def base(self) -> dict:
         return {k: q.value for k, q in self.params.items()}
@@ -301,6 +308,9 @@ def _grid(root: Reader, factors, controllers=()) -> tuple:
         if not vals or len(set(vals)) < len(vals) or positive and min(vals) <= 0:
             raise t.fail(k, list(vals), "distinct values" + (" above 0 (a ratio)" if positive
                                                              else ""))
+        effect = next(f.effect for f in factors if f.name == k)
+        if effect == "force_error" and not all(abs(x) < 0.9 for x in vals):
+            raise t.fail(k, list(vals), "force errors in (-0.9, 0.9) (kappa = 1 + error)")
         out.append((k, tuple(vals)))
         corners *= len(vals)
     t.finish()
@@ -347,13 +357,37 @@ def _check_units(path: str, constants: dict, controllers, law_names=LAW_NAMES) -
         check_expression_units(plant, items)
 
 
+def paper_analysis(name: str):
+    """The ``ANALYSIS`` object of the paper module ``name`` ("pNNN.name")."""
+    import importlib
+    return importlib.import_module(f"workbench.papers.{name}").ANALYSIS
+
+
 class StopAccuracy:
     """The ``stop-accuracy`` study (see the module docstring)."""
 
     kind = "stop-accuracy"
     uses_solver = False
+    #: numerical step of a design with [analysis], refined (dt/2, dt/4) for its findings
+    refine_field, refine_unit = "dt", "s"
+
+    def refines(self, spec: StopAccuracySpec) -> bool:
+        """Whether ``spec``'s findings are run again at dt/2, dt/4 ([analysis])."""
+        return spec.analysis is not None
 
     def load(self, root: Reader) -> StopAccuracySpec:
+        from dataclasses import replace
+
+        from ...reader import read_paper_module
+        analysis = read_paper_module(root, paper_analysis, "a module of workbench.papers with "
+                                     "an ANALYSIS object")
+        spec = self._load(root)
+        if analysis is None:
+            return spec
+        spec = replace(spec, analysis=analysis)
+        return replace(spec, paper=paper_analysis(analysis).load(root, spec))
+
+    def _load(self, root: Reader) -> StopAccuracySpec:
         from .modules import REFERENCE_NAMES, read_compensation, read_reference
         params = read_brake_plant(root)
         reference = read_reference(root)
@@ -431,25 +465,35 @@ class StopAccuracy:
     def quantity_names(self, spec: StopAccuracySpec) -> set[str]:
         from ...features.quantities import names
         from .quantities import TABLE
+        if spec.analysis is not None:
+            return paper_analysis(spec.analysis).quantity_names(spec)
         return names(TABLE, spec)
 
     def quantity_units(self, spec: StopAccuracySpec) -> dict[str, str]:
         from ...features.quantities import units
         from .quantities import TABLE
+        if spec.analysis is not None:
+            return {}
         return units(TABLE, spec)
 
     def run(self, design):
         from .run import run
+        if design.spec.analysis is not None:
+            return paper_analysis(design.spec.analysis).run(design.spec)
         return run(design.spec, design.claims)
 
     def quantities(self, res) -> dict:
         from ...features.quantities import values
         from .quantities import TABLE
+        if res.spec.analysis is not None:
+            return paper_analysis(res.spec.analysis).quantities(res)
         return values(TABLE, res.spec, res)
 
     def unconverged(self, res) -> dict[str, str]:
         """claim id -> reason, for the claims on a stop error that did not
         converge over dt, dt/2, dt/4 (``[convergence]``)."""
+        if res.spec.analysis is not None:   # refined by running again (refine_field)
+            return {}
         return {r.claim_id: r.reason for r in res.refinement if not r.converged}
 
 

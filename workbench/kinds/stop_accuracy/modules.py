@@ -80,8 +80,7 @@ class Reference:
 @dataclass(frozen=True)
 class Compensation:
     """``[compensation]``: the known-delay compensation of the modules
-    ``predictor`` and ``terminal`` (paper 000's ``station-stopping`` reads
-    its own table into this too).
+    ``predictor`` and ``terminal``.
 
     Attributes
     ----------

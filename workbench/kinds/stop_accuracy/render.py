@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from ...report.markdown import Rendered, fmt, md_table
 
-__all__ = ["render"]
+__all__ = ["distribution_table", "mc_cells", "plot_ecdf", "render", "tolerance_lines"]
 
 
 def _mm(x) -> str:
@@ -18,8 +18,12 @@ def _mm(x) -> str:
 
 
 def render(design, res) -> Rendered:
-    """The report sections of a ``stop-accuracy`` design."""
+    """The report sections of a ``stop-accuracy`` design (with ``[analysis]``:
+    the paper module's, in its wording)."""
     spec = design.spec
+    if spec.analysis is not None:
+        from . import paper_analysis
+        return paper_analysis(spec.analysis).render(design, res)
     sections = [_problem(spec), _stops(spec, res)]
     if spec.grid:
         sections.append(_grid(spec, res))
@@ -229,3 +233,34 @@ def _convergence(spec, res) -> str:
             for r in res.refinement], "lll")
     return out
 
+
+
+# -- pieces of the Monte Carlo tables and figures a paper's [analysis] report shares ------------
+def distribution_table(spec) -> str:
+    """The ``[montecarlo]`` distributions of ``spec`` with each factor's meaning
+    and unit (``[disturbances]``)."""
+    factor = {f.name: f for f in spec.factors}
+    rows = [[f"`{k}`", factor[k].what, d.describe(), factor[k].unit, d.source]
+            for k, d in spec.montecarlo.distributions.items()]
+    return md_table(["factor", "meaning", "distribution", "unit", "source"], rows, "lllll")
+
+
+def mc_cells(st, error) -> list:
+    """Stops within the tolerance, their share, its Wilson 95 % interval, the
+    95th percentile of |error|, the mean error (both as ``error(m)`` writes
+    them) and the overshoot share (%) of a :class:`StopStatistics` ``st``."""
+    return [f"{st.k} / {st.n}", fmt(st.p, 3), f"[{fmt(st.lo, 3)}, {fmt(st.hi, 3)}]",
+            error(st.p95), error(st.mean), fmt(100 * st.overshoot, 3)]
+
+
+def plot_ecdf(ax, errors, **kw) -> None:
+    """The empirical distribution of ``errors`` on ``ax`` (a step per error)."""
+    import numpy as np
+    e = np.sort(np.asarray(errors, float))
+    ax.step(e, np.arange(1, len(e) + 1) / len(e), where="post", **kw)
+
+
+def tolerance_lines(ax, tol: float) -> None:
+    """Dashed vertical lines at -tol and +tol on ``ax``."""
+    for x in (-tol, tol):
+        ax.axvline(x, color="k", ls="--", lw=0.8)

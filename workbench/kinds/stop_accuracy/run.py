@@ -33,7 +33,8 @@ from ...jsonable import json_method
 from .pipeline import LAW_NAMES, apply_factors, group_statistics, open_loop_distance
 
 __all__ = ["StopAccuracyResult", "compile_laws", "montecarlo_draws", "run", "run_sections",
-           "simulate_cases", "simulate_runs", "stopping_points", "speed_key"]
+           "section_runs", "section_statistics", "simulate_cases", "simulate_runs",
+           "stopping_points", "speed_key"]
 
 
 def speed_key(s: float) -> str:
@@ -262,12 +263,20 @@ def montecarlo_draws(spec, mc) -> dict:
     return {k: v for k, v in d.items() if k in mc.distributions}
 
 
-def run_sections(spec, laws, dt: float) -> dict:
-    """{(section index, controller): CellStats}: every controller's repeats on
-    every section, in one batch (:func:`simulate_runs`; [[sections]], [repeats],
-    :mod:`.sections`)."""
+def section_runs(spec, laws, dt: float):
+    """Every repeating controller's repeats on every section, in one batch
+    (:func:`simulate_runs`; [[sections]], [repeats], :mod:`.sections`).
+
+    Returns
+    -------
+    tr : workbench.sim.stopping.Traces
+    track : .modules.Tracking
+        The modules' state at the end (each SMARC's estimates).
+    runs : dict
+        ``controller``, ``section``, ``repeat`` (indices) and ``D`` (m) of every run.
+    """
     from ...sim.stopping import batch_params
-    from .sections import batch_rates, cell_stats, draw_sections
+    from .sections import draw_sections
     rp = spec.sections
     ns, R = len(rp.sections), rp.count
     d = draw_sections(rp.seed, rp.ranges, ns, R)
@@ -285,11 +294,26 @@ def run_sections(spec, laws, dt: float) -> dict:
     starts = [spec.reference.start(s.length) for s in rp.sections]
     x0 = np.array([starts[i][0] for i in si])
     v0 = np.array([starts[i][1] for i in si])
-    tr, _ = simulate_runs(spec, laws, dt, batch_params(base, n, over), ci, D, x0=x0, v0=v0,
-                          ratio=np.ones(n), theta=theta, kappa=kappa)
-    err_cm, rates = (tr.x_stop - D) * 100.0, batch_rates(tr, spec.dt_ctrl)
+    tr, track = simulate_runs(spec, laws, dt, batch_params(base, n, over), ci, D, x0=x0, v0=v0,
+                              ratio=np.ones(n), theta=theta, kappa=kappa)
+    return tr, track, {"controller": ci, "section": si, "repeat": ri, "D": D}
+
+
+def section_statistics(spec, tr, runs) -> dict:
+    """{(section index, controller): CellStats} of :func:`section_runs`."""
+    from .sections import batch_rates, cell_stats
+    ci, si = runs["controller"], runs["section"]
+    err_cm, rates = (tr.x_stop - runs["D"]) * 100.0, batch_rates(tr, spec.dt_ctrl)
     return {(s, c.name): cell_stats(err_cm, tr, (ci == j) & (si == s), rates)
-            for s in range(ns) for j, c in enumerate(spec.controllers) if j in idx}
+            for s in range(len(spec.sections.sections)) for j, c in enumerate(spec.controllers)
+            if j in set(ci.tolist())}
+
+
+def run_sections(spec, laws, dt: float) -> dict:
+    """{(section index, controller): CellStats}: every controller's repeats on
+    every section, in one batch (:func:`section_runs`)."""
+    tr, _, runs = section_runs(spec, laws, dt)
+    return section_statistics(spec, tr, runs)
 
 
 def run(spec, claims=()) -> StopAccuracyResult:

@@ -1,36 +1,32 @@
-"""Study ``station-stopping``: PID, SMC and SMARC station stops of paper 000,
-as in the paper and with known-delay compensation.
+"""Paper 000's station stops (PID, SMC, SMARC; designs/stopping-line5.toml):
+the ``[analysis]`` module of a ``stop-accuracy`` design.
 
-The design tables and controller variants are in
-:mod:`~workbench.papers.p000.station_stopping_spec`, the simulation in
-:mod:`~workbench.papers.p000.station_stopping_run`; this module is the study object
-(quantities for the claims).
+The design is a configuration of the general kind
+(:mod:`workbench.kinds.stop_accuracy`: the laws are its expressions and named
+modules, the runs its simulation, :mod:`.station_stopping_run`). What stays
+here is paper 000's: the names of the quantities its claims use (the paper's
+rows: ``smarc.mean_abs_cm``, ``pid-damped.damping_zeta``, ...), the damping
+analysis of the PID gains, the printed Tables 3-4 and the report's wording
+(:mod:`.station_stopping_render`).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ...features.montecarlo import MC_QUANTITIES
-from ...reader import Reader
-from .station_stopping_run import StopResult, run_station_stops
 from .station_stopping_spec import (COMPENSATED, CONTROLLERS, DAMPING, MC_CONTROLLERS,
-                                    PAPER_CONTROLLERS, UNCOMPENSATED, VARIANTS, StopSpec,
-                                    load_stop_spec)
+                                    PAPER_CONTROLLERS, UNCOMPENSATED, VARIANTS, load)
 
-__all__ = ["STUDY", "StationStopping"]
-
+__all__ = ["ANALYSIS", "StationStopping"]
 
 
 class StationStopping:
-    kind = "station-stopping"
-    uses_solver = False    # no convex solver runs: the report says so
-    #: numerical step refined (dt/2, dt/4) for the findings (workbench.refinement)
-    refine_field, refine_unit = "dt", "s"
+    """The analysis of ``[analysis] module = "p000.station_stopping"``."""
 
-    def load(self, root: Reader) -> StopSpec:
-        return load_stop_spec(root)
+    def load(self, root, spec):
+        return load(root, spec)
 
-    def quantity_names(self, spec: StopSpec) -> set[str]:
+    def quantity_names(self, spec) -> set[str]:
         names = {"order", "best", "mc.compensation_margin", "mc.compensated_max_abs_mean_m",
                  "mc.uncompensated_min_overshoot_share", "mc.compensated_spread",
                  "nominal.compensated_max_abs_m"}
@@ -38,7 +34,7 @@ class StationStopping:
             names |= {f"{c}.mean_abs_cm", f"{c}.worst_section_mean_abs_cm",
                       f"{c}.worst_section_var_cm2",
                       f"{c}.best_section_mean_abs_cm", f"{c}.jerk_mean"}
-            for i in range(len(spec.sections)):
+            for i in range(len(spec.sections.sections)):
                 names |= {f"{c}.sections[{i + 1}].mean_abs_cm", f"{c}.sections[{i + 1}].var_cm2"}
         for c in MC_CONTROLLERS:
             names |= {f"{c}.nominal_m"} | {f"{c}.mc.{k}" for k in MC_QUANTITIES}
@@ -47,10 +43,11 @@ class StationStopping:
         names |= {f"{c}.nominal_m" for c in VARIANTS if "+" in c}
         return names
 
-    def run(self, design) -> StopResult:
-        return run_station_stops(design.spec)
+    def run(self, spec):
+        from .station_stopping_run import run_station_stops
+        return run_station_stops(spec)
 
-    def quantities(self, res: StopResult) -> dict:
+    def quantities(self, res) -> dict:
         q = {}
         ns = len(res.sections)
         for c in CONTROLLERS:
@@ -82,5 +79,9 @@ class StationStopping:
         q["nominal.compensated_max_abs_m"] = max(abs(res.nominal[c].error) for c in COMPENSATED)
         return q
 
+    def render(self, design, res):
+        from .station_stopping_render import render
+        return render(design, res)
 
-STUDY = StationStopping()
+
+ANALYSIS = StationStopping()

@@ -1,4 +1,4 @@
-"""Markdown and figures of the ``station-stopping`` study's fair baselines:
+"""Markdown and figures of paper 000's fair baselines (designs/stopping-line5.toml):
 known-delay compensation, the damped PID, the nominal row and the Monte
 Carlo (pure rendering of a
 :class:`~workbench.papers.p000.station_stopping_run.StopResult`)."""
@@ -6,10 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...kinds.stop_accuracy.render import distribution_table, mc_cells, plot_ecdf, tolerance_lines
 from ...report.markdown import Figure, fmt, md_table
 from .station_stopping_run import loop_dead_time
 from .station_stopping_spec import (ABLATION_LAWS, COMPENSATED, DAMPING, MC_CONTROLLERS,
-                                    MC_FACTORS, UNCOMPENSATED, VARIANTS)
+                                    UNCOMPENSATED, gains, label)
 
 GROUP = {**{c: "as in paper 000" for c in UNCOMPENSATED},
          **{c: "with known-delay compensation" for c in MC_CONTROLLERS if c not in UNCOMPENSATED}}
@@ -63,14 +64,14 @@ def fair_section(spec, res) -> str:
 def _pid_part(spec, res) -> str:
     rows = []
     for c in DAMPING:
-        g, d = spec.gains(VARIANTS[c].gains), res.damping[c]
-        rows.append([VARIANTS[c].label, fmt(g["kp"]), fmt(g["ki"]), fmt(g["kd"]),
+        g, d = gains(spec, c), res.damping[c]
+        rows.append([label(c), fmt(g["kp"]), fmt(g["ki"]), fmt(g["kd"]),
                      fmt(loop_dead_time(spec, c), 3), fmt(d.zeta, 2), fmt(d.period, 3),
                      fmt(-d.alpha, 2), res.nominal[c].sign_changes])
     return (
         "### PID tuning: no oscillation\n\n"
         f"Criterion: every dominant root of the linearised speed loop (roots with Re s ≥ 2α, α "
-        f"the spectral abscissa) has damping ratio ζ = −Re s / |s| ≥ {fmt(spec.zeta_min)}. "
+        f"the spectral abscissa) has damping ratio ζ = −Re s / |s| ≥ {fmt(spec.paper.zeta_min)}. "
         "The loop is the speed error through the electric stage (dead time T1 plus half a "
         "control period for the sample-and-hold, lag T2, gain P1) closed by the PID with the "
         "target deceleration as feed-forward; its roots are the exact ones of the delay "
@@ -96,7 +97,7 @@ def _pid_part(spec, res) -> str:
 
 
 def _nominal_part(res) -> str:
-    rows = [[VARIANTS[c].label, GROUP[c], _cm(res.nominal[c].error)] for c in MC_CONTROLLERS]
+    rows = [[label(c), GROUP[c], _cm(res.nominal[c].error)] for c in MC_CONTROLLERS]
     arows = []
     for law, (base, pred, term, both) in ABLATION_LAWS.items():
         arows.append([law] + [_cm(res.nominal[c].error) for c in (base, pred, term, both)])
@@ -117,21 +118,14 @@ def _nominal_part(res) -> str:
 
 def _mc_part(spec, res, tol: float) -> str:
     mc = spec.montecarlo
-    drows = [[f"`{k}`", MC_FACTORS[k].what, d.describe(), MC_FACTORS[k].unit, d.source]
-             for k, d in mc.distributions.items()]
-    rows = []
-    for c in MC_CONTROLLERS:
-        s = res.mc[c]
-        rows.append([VARIANTS[c].label, GROUP[c], f"{s.k} / {s.n}", fmt(s.p, 3),
-                     f"[{fmt(s.lo, 3)}, {fmt(s.hi, 3)}]", _cm(s.p95), _cm(s.mean),
-                     fmt(100 * s.overshoot, 3)])
+    rows = [[label(c), GROUP[c]] + mc_cells(res.mc[c], _cm) for c in MC_CONTROLLERS]
     return (
         f"### Monte Carlo: P(|e| ≤ {fmt(tol)} m) over continuous distributions\n\n"
         f"{mc.samples} draws (seed {mc.seed}; `workbench/studies/stopping_mc.py`: inverse CDF "
         "of seeded uniforms, one stream per factor), the same draws for every controller "
         "(common random numbers), on section 1's braking phase (every section reaches v_max "
         "before braking, so their braking phases are the same):\n\n"
-        + md_table(["factor", "meaning", "distribution", "unit", "source"], drows, "lllll")
+        + distribution_table(spec)
         + "\n\n" + md_table(["controller", "group", f"stops within {fmt(tol)} m",
                              f"P(|e| ≤ {fmt(tol)} m)", "Wilson 95 % interval",
                              "95th percentile of |e| (cm)", "mean e (cm)", "overshoots (%)"],
@@ -155,7 +149,7 @@ def _plot_pid(fig, res):
     for k, c in enumerate(DAMPING):
         n = res.nominal[c]
         moving = np.concatenate(([True], n.v[1:] > 0))
-        ax.plot(n.t[moving], 100 * (n.v - n.v_d)[moving], color=f"C{k}", label=VARIANTS[c].label)
+        ax.plot(n.t[moving], 100 * (n.v - n.v_d)[moving], color=f"C{k}", label=label(c))
     ax.axhline(0, color="k", lw=0.6)
     ax.set_xlabel("time from braking start (s)")
     ax.set_ylabel("speed error v − v_d (cm/s)")
@@ -192,11 +186,8 @@ def _plot_mc(fig, res):
                              sharey=axes[0] if axes else None)
         axes.append(ax)
         for k, c in enumerate(ctls):
-            e = np.sort(100 * np.asarray(res.mc[c].errors))
-            ax.step(e, np.arange(1, len(e) + 1) / len(e), where="post", color=f"C{k}",
-                    label=VARIANTS[c].label)
-        for x in (-tol, tol):
-            ax.axvline(x, color="k", ls="--", lw=0.8)
+            plot_ecdf(ax, 100 * np.asarray(res.mc[c].errors), color=f"C{k}", label=label(c))
+        tolerance_lines(ax, tol)
         ax.set_xscale("symlog", linthresh=1.0)
         ax.set_xlabel("stop error (cm, + overshoot)")
         ax.set_title(title, fontsize=9)

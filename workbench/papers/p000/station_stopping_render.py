@@ -1,16 +1,17 @@
-"""Markdown and figures of the ``station-stopping`` study (pure rendering)."""
+"""Markdown and figures of paper 000's station stops (designs/stopping-line5.toml,
+``[analysis] module = "p000.station_stopping"``): pure rendering of a
+:class:`~workbench.papers.p000.station_stopping_run.StopResult`, in the paper's wording."""
 from __future__ import annotations
 
 import numpy as np
 import sympy as sp
 
 from ...features.montecarlo import within_rate
+from ...kinds.stop_accuracy.render import plot_ecdf
 from ...plants.brake000 import brake_model
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .station_stopping_fair_render import fair_section, figures
-from .station_stopping_spec import CONTROLLERS, UNCERTAIN
-
-LABEL = {"pid": "PID", "smc": "SMC", "smarc": "SMARC", "smarc-sgn": "SMARC (sgn)"}
+from .station_stopping_spec import CONTROLLERS, factor, gains, label, smarc_gains
 
 
 #: Stop window of the accuracy table and figure (m): the usual platform-screen-door tolerance.
@@ -40,17 +41,17 @@ def model_section() -> str:
 def render(design, res) -> Rendered:
     spec = design.spec
     prow = [[f"`{k}`", fmt(q.value, 5), q.unit, q.source] for k, q in spec.params.items()]
-    urow = [[f"`{k}`", UNCERTAIN[k][0], f"[{fmt(lo)}, {fmt(hi)}]", UNCERTAIN[k][1]]
-            for k, (lo, hi) in spec.ranges.items()]
+    urow = [[f"`{k}`", factor(spec, k).what, f"[{fmt(lo)}, {fmt(hi)}]", factor(spec, k).unit]
+            for k, lo, hi in spec.sections.ranges]
     srow = [[i + 1, s.name, fmt(s.length, 5), fmt(t, 4), s.source]
             for i, (s, t) in enumerate(zip(res.sections, res.planned_time))]
-    g = spec.sliding
+    g, pid, ref, rp = smarc_gains(spec), gains(spec, "pid"), spec.reference, spec.sections
     sections = [
         "## Problem\n\nStation stops of paper 000 (section 3.2) on the seven Beijing Line 5 "
         "sections of Table 3, **synthetic**: the ATO logs are not public. Each run starts "
-        f"where the target curve (v_max {fmt(spec.v_max.value, 4)} m/s, braking at "
-        f"{fmt(spec.a_dec.value, 3)} m/s²) begins to brake and tracks it to the stopping point. "
-        f"{spec.repeats} repeats per section (seed {spec.seed}); the three controllers meet the "
+        f"where the target curve (v_max {fmt(ref.v_max, 4)} m/s, braking at "
+        f"{fmt(ref.a_dec, 3)} m/s²) begins to brake and tracks it to the stopping point. "
+        f"{rp.count} repeats per section (seed {rp.seed}); the three controllers meet the "
         "same uncertain plants.\n\n"
         + md_table(["parameter", "value", "unit", "source"], prow, "lrll")
         + "\n\nUncertainty (uniform, per repeat):\n\n"
@@ -60,11 +61,11 @@ def render(design, res) -> Rendered:
         + "\n\nEvery section reaches v_max before braking, so the public data (lengths) do not "
         "distinguish the sections' braking phases: they differ here only by their random "
         "draws. Controllers: PID on the speed error with the target deceleration as "
-        f"feed-forward (kp {fmt(spec.pid['kp'])}, ki {fmt(spec.pid['ki'])}, kd "
-        f"{fmt(spec.pid['kd'])}); SMC = eq 22 with the fixed estimate theta = 1; SMARC = eq 22 "
-        f"with eqs 26-27 (c {fmt(g.c)} 1/s, k_s {fmt(g.k_s)} 1/s, eta {fmt(g.eta)} m/s², "
-        f"boundary layer phi {fmt(g.phi)} m/s, lambda {fmt(spec.smarc['lam'])}, theta in "
-        f"[{fmt(spec.smarc['theta_min'])}, {fmt(spec.smarc['theta_max'])}]); SMARC (sgn) = "
+        f"feed-forward (kp {fmt(pid['kp'])}, ki {fmt(pid['ki'])}, kd "
+        f"{fmt(pid['kd'])}); SMC = eq 22 with the fixed estimate theta = 1; SMARC = eq 22 "
+        f"with eqs 26-27 (c {fmt(g['c'])} 1/s, k_s {fmt(g['k_s'])} 1/s, eta {fmt(g['eta'])} m/s², "
+        f"boundary layer phi {fmt(g['phi'])} m/s, lambda {fmt(g['lam'])}, theta in "
+        f"[{fmt(g['theta_min'])}, {fmt(g['theta_max'])}]); SMARC (sgn) = "
         "the same with the discontinuous sgn(z) of eq 22 as printed (phi = 0); sampled every "
         f"{fmt(spec.dt_ctrl)} s, plant stepped at {fmt(spec.dt)} s.",
         model_section(),
@@ -78,14 +79,14 @@ def render(design, res) -> Rendered:
             row += [fmt(s.mean_abs, 3), fmt(s.mean, 3), fmt(s.var, 3)]
         rows.append(row)
     rows.append(["all"] + sum(([f"**{fmt(res.overall(c), 3)}**", "", ""] for c in CONTROLLERS), []))
-    head = ["#"] + [f"{LABEL[c]} {h}" for c in CONTROLLERS for h in ("mean abs", "mean", "var")]
+    head = ["#"] + [f"{label(c)} {h}" for c in CONTROLLERS for h in ("mean abs", "mean", "var")]
     qrow = []
     for c in CONTROLLERS:
         js = [res.stats[c, i].jerk_mean for i in range(ns)]
         jm = [res.stats[c, i].jerk_max for i in range(ns)]
         rt = [res.stats[c, i].run_time for i in range(ns)]
         cr = [res.stats[c, i].command_rate for i in range(ns)]
-        qrow.append([LABEL[c], fmt(np.mean(js), 3), fmt(np.max(jm), 3), fmt(np.mean(cr), 3),
+        qrow.append([label(c), fmt(np.mean(js), 3), fmt(np.max(jm), 3), fmt(np.mean(cr), 3),
                      fmt(np.mean(rt), 4), fmt(np.mean(res.planned_time), 4)])
     sections.append(
         "## Stop accuracy (cf. Tables 3-4)\n\nStop error = stop position − stopping point "
@@ -96,11 +97,11 @@ def render(design, res) -> Rendered:
                     "mean |dc/dt| of the command (m/s³)", "mean run time (s)", "planned (s)"],
                    qrow, "lrrrrr")
         + f"\n\nThe command rate measures chattering of the brake command. With the robust "
-        f"gain eta = {fmt(g.eta)} m/s² the switching term of eq 22 is small beside k_s z, so "
+        f"gain eta = {fmt(g['eta'])} m/s² the switching term of eq 22 is small beside k_s z, so "
         "the boundary layer changes little here (compare the two SMARC rows); the brake's "
         "delays and lags filter the rest before it reaches the jerk."
         + "\n\nShare of stops beyond the stopping point (overshoots): " + ", ".join(
-            f"{LABEL[c]} {fmt(_overshoot_share(res, c, ns), 3)} %" for c in CONTROLLERS)
+            f"{label(c)} {fmt(_overshoot_share(res, c, ns), 3)} %" for c in CONTROLLERS)
         + ": the errors are mostly a systematic overshoot, set by the air stage's delay and lag "
         "after the hand-over, not scatter."
         + f"\n\nFinal SMARC mass estimates theta_hat span [{fmt(res.theta_hat_final[0], 3)}, "
@@ -109,9 +110,9 @@ def render(design, res) -> Rendered:
         "![stop errors]({figdir}/stop-errors.png)\n\n![curves]({figdir}/stop-curves.png)"
         + "\n\n" + _within_section(res))
     sections.append(fair_section(spec, res))
-    if spec.published:
+    if spec.paper.published:
         prow = []
-        for k, smarc, smc, pid, m4, v4, src in spec.published:
+        for k, smarc, smc, pid, m4, v4, src in spec.paper.published:
             ours = [res.stats[c, k - 1].mean_abs for c in ("smarc", "smc", "pid")]
             st = res.stats["smarc", k - 1]
             prow.append([k, fmt(smarc, 3), fmt(ours[0], 3), fmt(smc, 3), fmt(ours[1], 3),
@@ -125,7 +126,7 @@ def render(design, res) -> Rendered:
             + md_table(["#", "SMARC printed", "SMARC ours", "SMC printed", "SMC ours",
                         "PID printed", "PID ours", "SMARC mean printed", "ours",
                         "SMARC var printed", "ours", "source"], prow, "rrrrrrrrrrrl")
-            + _consistency(spec.published))
+            + _consistency(spec.paper.published))
     figs = (Figure("stop-errors", "Stop-error distribution per controller and section.",
                    lambda fig, res=res: _plot_errors(fig, res), size=(7.0, 4.0)),
             Figure("stop-curves", "Speed against distance to the stopping point, section 1.",
@@ -145,7 +146,7 @@ def _within_section(res) -> str:
     rows = []
     for c in CONTROLLERS:
         k, n, p, lo, hi = within_rate(_errors(res, c), 100 * STOP_WINDOW_M)
-        rows.append([LABEL[c], f"{k} / {n}", fmt(p, 3), f"[{fmt(lo, 3)}, {fmt(hi, 3)}]",
+        rows.append([label(c), f"{k} / {n}", fmt(p, 3), f"[{fmt(lo, 3)}, {fmt(hi, 3)}]",
                      fmt(float(np.percentile(np.abs(_errors(res, c)), 95)), 3)])
     w = fmt(STOP_WINDOW_M)
     return (f"**Stops within ±{w} m** (the usual platform-screen-door tolerance), over all "
@@ -160,9 +161,7 @@ def _within_section(res) -> str:
 def _plot_cdf(fig, res):
     ax = fig.add_subplot(111)
     for k, c in enumerate(CONTROLLERS):
-        e = np.sort(np.abs(_errors(res, c)))
-        ax.step(e, np.arange(1, len(e) + 1) / len(e), where="post", color=f"C{k}",
-                label=LABEL[c])
+        plot_ecdf(ax, np.abs(_errors(res, c)), color=f"C{k}", label=label(c))
     ax.axvline(100 * STOP_WINDOW_M, color="k", ls="--", lw=0.8, label=f"{fmt(STOP_WINDOW_M)} m")
     ax.set_xscale("symlog", linthresh=1.0)
     ax.set_xlim(left=0.0)              # an |error| axis has no negative ticks
@@ -199,7 +198,7 @@ def _plot_errors(fig, res):
         for patch in b["boxes"]:
             patch.set_facecolor(f"C{k}")
             patch.set_alpha(0.6)
-        ax.plot([], [], "s", color=f"C{k}", label=LABEL[c])
+        ax.plot([], [], "s", color=f"C{k}", label=label(c))
     ax.axhline(0, color="k", lw=0.6)
     ax.set_xticks(np.arange(ns) + 1)
     ax.set_xticklabels([str(i + 1) for i in range(ns)])
@@ -214,8 +213,8 @@ def _plot_curves(fig, res):
     for k, c in enumerate(CONTROLLERS):
         t, dx, v, _, vd = res.example[c]
         keep = np.concatenate(([True], v[1:] > 0)) if len(v) > 1 else np.ones(len(v), bool)
-        ax1.plot(dx[keep], v[keep] * 3.6, color=f"C{k}", label=LABEL[c])
-        ax2.plot(t[keep], (v[keep] - vd[keep]) * 100, color=f"C{k}", label=LABEL[c])
+        ax1.plot(dx[keep], v[keep] * 3.6, color=f"C{k}", label=label(c))
+        ax2.plot(t[keep], (v[keep] - vd[keep]) * 100, color=f"C{k}", label=label(c))
     t, _, _, xd, vd = res.example["pid"]
     ax1.plot(xd, vd * 3.6, "k--", lw=0.8, label="target")
     ax1.set_xlabel("position − stopping point (m)")

@@ -1,2 +1,3 @@
-"""Paper 004: the closed-loop brake with its ATO stopping (kind ``closed-loop-brake``).
+"""Paper 004: the closed-loop brake with its ATO stopping (the ``[analysis]``
+module of the ``stop-accuracy`` design closed-loop-brake-004).
 """

@@ -1,10 +1,18 @@
-"""Study ``closed-loop-brake``: paper 004's deceleration feedback against the
-open-loop brake, over an error grid, on the paper-000 brake plant.
+"""Paper 004's deceleration feedback against the open-loop brake, over an
+error grid, on the paper-000 brake plant (designs/closed-loop-brake-004.toml):
+the ``[analysis]`` module of a ``stop-accuracy`` design.
 
-Worked numbers of section 1.3 (stopping distances, gradient shares) are
-computed from sympy expressions written here once. The simulations brake a
-train from each initial speed to a stopping point D (the nominal open-loop
-stopping distance of the single command ``a_target``) in three modes:
+The design is a configuration of the general kind
+(:mod:`workbench.kinds.stop_accuracy`): the modes are its controllers (the
+ATO law an expression, the command generator its named module
+``deceleration_loop``), the grid its ``[grid]``, the Monte Carlo its
+``[montecarlo]``, every run its simulation (:mod:`.closed_loop_brake_run`).
+What stays here is paper 004's: the worked numbers of section 1.3 (sympy
+expressions written here once, ``[worked]``), the runs of its report and
+their names (``open``, ``ato-open``, ``closed``; channels ``analogue`` and
+``3bit``; the axle-sensor cases of section 2.7 and the electric-brake loss at
+the nominal corner; the ATO-horizon sweep of ``[retuning]``), the quantities
+its claims name and the report's wording. The modes:
 
 ``open``
     one brake command a_target, held (the "large open loop" of section 1);
@@ -15,134 +23,26 @@ stopping distance of the single command ``a_target``) in three modes:
     the ATO's a_req is the *target deceleration* of the command generator,
     which measures the deceleration from the axle speeds (train speed = max
     of 4 axles) and closes the loop: incremental fuzzy control when
-    |error| > e_switch, PID (shared :class:`~workbench.controllers.pid.PID`)
-    otherwise (section 2.5); all four axles failed or sliding -> fallback
-    to ``ato-open``.
-
-Each mode runs over force error x gradient x friction scatter, with an
-analogue (PWM / network) or a 3-bit (levels 0-7) command channel, plus
-sensor-fault and electric-brake-loss cases at the nominal corner.
+    |error| > e_switch, PID otherwise (section 2.5); all four axles failed
+    or sliding -> fallback to ``ato-open``.
 """
 from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
-import sympy as sp
 
-from ...controllers.fuzzy import FuzzyIncrement
-from ...features.montecarlo import MC_QUANTITIES, MonteCarloSpec, load_montecarlo
-from ...kinds.stop_accuracy.pipeline import open_loop_distance, read_brake_plant
-from ...reader import Quantity, Reader
+from ...features.montecarlo import MC_QUANTITIES
+from ...kinds.stop_accuracy.pipeline import open_loop_distance
+from ...reader import Reader
 from ...tuning.pid import Damping, damping, deceleration_loop
-from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, FAULTS, FULL, MC_FACTORS, MC_MODES,
+from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, FAULTS, FULL, MC_MODES,
                                     run_horizon_sweep, run_montecarlo, simulate_brake)
+from .closed_loop_brake_spec import Paper004, Spec004, compute_worked, load, view
 
-__all__ = ["STUDY", "Result004", "Run", "Spec004", "compute_worked", "decel_damping", "run_grid",
-           "worked_formulas"]
-
-
-@lru_cache(maxsize=1)
-def worked_formulas():
-    """Sympy expressions of paper 004 section 1.3: (symbols, distance, degraded
-    deceleration, gradient share)."""
-    v, a, err, i, g, a_brake = sp.symbols("v a epsilon i g a_b", real=True)
-    distance = v**2 / (2 * a)                                 # constant-deceleration stop
-    grade = g * sp.sin(sp.atan(i / 1000))                     # along-track gravity, i in permille
-    degraded = a * (1 - err) - grade                          # force error + down-grade
-    share = grade / a_brake
-    return (v, a, err, i, g, a_brake), distance, degraded, share
-
-
-@dataclass(frozen=True)
-class Worked:
-    v_kmh: float
-    v_printed: Quantity
-    a_full: Quantity
-    force_error: float
-    gradient_permille: float
-    shares: tuple  # (gradient permille, fraction of full brake)
-    g: float
-
-
-@dataclass(frozen=True)
-class Spec004:
-    params: dict
-    worked: Worked
-    speeds_kmh: tuple
-    a_target: float
-    c_full: float
-    force_error: tuple
-    gradient: tuple
-    friction: tuple
-    tolerance: float
-    fuzzy: FuzzyIncrement
-    e_switch: float
-    pid: dict
-    tau_filter: float
-    slide: float
-    d_min: float
-    t_predict: float
-    dt: float
-    dt_ctrl: float
-    high_ratio: float = 1.1                   # a sensor reading high reads this x the speed
-    montecarlo: MonteCarloSpec | None = None
-    t_predict_sweep: tuple = ()               # ATO horizons (s) of the retuning sweep
-
-
-def _load(root: Reader) -> Spec004:
-    params = read_brake_plant(root)
-    w = root.table("worked")
-    shares = []
-    for s in w.tables("shares"):
-        shares.append((s.number("gradient_permille", positive=True),
-                       s.number("brake_fraction", positive=True, hi=1.0)))
-        s.finish()
-    worked = Worked(w.number("v_kmh", positive=True), w.quantity("v_printed", "m/s", positive=True),
-                    w.quantity("a_full", "m/s^2", positive=True),
-                    w.number("force_error", lo=0.0, hi=0.9),
-                    w.number("gradient_permille", lo=0.0, hi=100.0), tuple(shares),
-                    params["g"].value)
-    w.finish()
-    sc = root.table("scenario")
-    speeds = sc.numbers("speeds_kmh", positive=True)
-    a_t = sc.number("a_target", positive=True, hi=2.0)
-    c_full = sc.number("c_full", positive=True, hi=2.0)
-    fe = sc.numbers("force_error")
-    gr = sc.numbers("gradient")
-    fr = sc.numbers("friction", positive=True)
-    if any(abs(x) >= 0.9 for x in fe):
-        raise sc.fail("force_error", list(fe), "fractions in (-0.9, 0.9)")
-    tol = sc.number("tolerance", positive=True)
-    sc.finish()
-    ct = root.table("control")
-    fz = ct.table("fuzzy")
-    fuzzy = FuzzyIncrement(fz.number("e_scale", positive=True), fz.number("de_scale", positive=True),
-                           fz.number("du_scale", positive=True))
-    fz.finish()
-    p = ct.table("pid")
-    pid = {k: p.number(k, nonneg=True) for k in ("kp", "ki", "kd")}
-    p.finish()
-    spec = Spec004(params, worked, speeds, a_t, c_full, fe, gr, fr, tol, fuzzy,
-                   e_switch=ct.number("e_switch", positive=True), pid=pid,
-                   tau_filter=ct.number("tau_filter", nonneg=True),
-                   slide=ct.number("slide_ratio", positive=True, hi=1.0),
-                   d_min=ct.number("d_min", positive=True),
-                   t_predict=ct.number("t_predict", nonneg=True, hi=5.0), dt=0.0, dt_ctrl=0.0,
-                   high_ratio=ct.number("high_ratio", lo=1.0, hi=2.0,
-                                        what="ratio >= 1 (a sensor reading high)"),
-                   t_predict_sweep=ct.numbers("t_predict_sweep", what="horizons (s)"))
-    if not all(0 <= x <= 5.0 for x in spec.t_predict_sweep):
-        raise ct.fail("t_predict_sweep", list(spec.t_predict_sweep), "horizons in [0, 5] s")
-    ct.finish()
-    mc = load_montecarlo(root, {k: f.positive for k, f in MC_FACTORS.items()})
-    sim = root.table("sim")
-    spec = Spec004(**{**spec.__dict__, "dt": sim.number("dt", positive=True, hi=0.05),
-                      "dt_ctrl": sim.number("dt_ctrl", positive=True, hi=1.0), "montecarlo": mc})
-    sim.finish()
-    return spec
+__all__ = ["ANALYSIS", "Result004", "Run", "Spec004", "compute_worked", "decel_damping",
+           "run_grid", "stopping_point", "view"]
 
 
 @dataclass(frozen=True)
@@ -171,6 +71,7 @@ class Result004:
     mc: dict | None = None  # (speed km/h, mode) -> StopStatistics of the Monte Carlo
     damping: Damping | None = None   # of the linearised deceleration PID loop
     sweep: tuple = ()       # (ATO horizon s, speed km/h, nominal closed-loop stop error m)
+    spec: object = None     # the design's StopAccuracySpec
 
     def failing(self, **kw) -> list[tuple[Run, float]]:
         """Runs (with errors) outside the tolerance among those selected."""
@@ -183,24 +84,6 @@ class Result004:
     def max_abs(self, **kw) -> float:
         errs = [abs(e) for _, e in self.select(**kw)]
         return float(max(errs)) if errs and all(np.isfinite(errs)) else float("nan")
-
-
-def compute_worked(w: Worked) -> dict:
-    (v, a, err, i, g, a_b), distance, degraded, share = worked_formulas()
-    v_exact = w.v_kmh / 3.6
-    a2 = float(degraded.subs({a: w.a_full.value, err: w.force_error, i: w.gradient_permille,
-                              g: w.g}))
-    d = lambda vv, aa: float(distance.subs({v: vv, a: aa}))
-    out = {"d1": d(w.v_printed.value, w.a_full.value), "d1_exact_speed": d(v_exact, w.a_full.value),
-           "a2": a2, "a2_printed": round(a2, 3)}
-    out["d2"] = d(w.v_printed.value, a2)
-    out["delta"] = out["d2"] - out["d1"]
-    out["delta_exact_speed"] = d(v_exact, a2) - out["d1_exact_speed"]
-    out["delta_rounded_inputs"] = d(w.v_printed.value, out["a2_printed"]) - out["d1"]
-    for gp, frac in w.shares:
-        out[f"share[{gp:g}permille,{frac:g}]"] = 100 * float(
-            share.subs({g: w.g, i: gp, a_b: frac * w.a_full.value}))
-    return out
 
 
 def _cases(spec: Spec004) -> list[Run]:
@@ -256,7 +139,7 @@ def run_grid(spec: Spec004, *, montecarlo: bool = True) -> Result004:
                      tuple(float(err[k]) for k in keep), spec.tolerance,
                      tuple(feasible[k] for k in keep), curves,
                      run_montecarlo(spec, D) if montecarlo else None, decel_damping(spec),
-                     run_horizon_sweep(spec, D) if montecarlo else ())
+                     run_horizon_sweep(spec, D) if montecarlo else (), spec.kind)
 
 
 def decel_damping(spec: Spec004) -> Damping:
@@ -273,15 +156,13 @@ def _key(x: float) -> str:
 
 
 class ClosedLoopBrake:
-    kind = "closed-loop-brake"
-    #: numerical step refined (dt/2, dt/4) for the findings (workbench.refinement)
-    refine_field, refine_unit = "dt", "s"
-    uses_solver = False    # no convex solver runs: the report says so
+    """The analysis of ``[analysis] module = "p004.closed_loop_brake"``."""
 
-    def load(self, root: Reader) -> Spec004:
-        return _load(root)
+    def load(self, root: Reader, spec) -> Paper004:
+        return load(root, spec)
 
-    def quantity_names(self, spec: Spec004) -> set[str]:
+    def quantity_names(self, spec) -> set[str]:
+        spec = view(spec)
         names = {f"worked.{k}" for k in compute_worked(spec.worked)}
         for s in spec.speeds_kmh:
             b = f"v{_key(s)}"
@@ -301,8 +182,8 @@ class ClosedLoopBrake:
             names.add(f"{b}.mc.closed_minus_ato-open_p")
         return names | {"pid.damping_zeta"}
 
-    def run(self, design) -> Result004:
-        return run_grid(design.spec)
+    def run(self, spec) -> Result004:
+        return run_grid(view(spec))
 
     def quantities(self, res: Result004) -> dict:
         q = {f"worked.{k}": v for k, v in res.worked.items()}
@@ -348,4 +229,9 @@ class ClosedLoopBrake:
         return q
 
 
-STUDY = ClosedLoopBrake()
+    def render(self, design, res):
+        from .closed_loop_brake_render import render
+        return render(design, res)
+
+
+ANALYSIS = ClosedLoopBrake()

@@ -1,12 +1,13 @@
-"""Markdown and figures of the ``closed-loop-brake`` study's retuning, sensor
+"""Markdown and figures of paper 004's retuning, sensor
 faults and Monte Carlo (pure rendering of a
 :class:`~workbench.papers.p004.closed_loop_brake.Result004`)."""
 from __future__ import annotations
 
 import numpy as np
 
+from ...kinds.stop_accuracy.render import distribution_table, mc_cells, plot_ecdf, tolerance_lines
 from ...report.markdown import Figure, fmt, md_table
-from .closed_loop_brake_run import FAULTS, MC_FACTORS, MC_MODES
+from .closed_loop_brake_run import FAULTS, MC_MODES
 
 MODE_LABEL = {"ato-open": "ATO open loop", "closed": "closed loop (analogue)"}
 
@@ -60,20 +61,15 @@ def fault_text(spec) -> str:
 
 def mc_section(spec, res) -> str:
     mc = spec.montecarlo
-    drows = [[f"`{k}`", MC_FACTORS[k].what, d.describe(), MC_FACTORS[k].unit, d.source]
-             for k, d in mc.distributions.items()]
-    rows = []
-    for (s, m), st in res.mc.items():
-        rows.append([fmt(s), MODE_LABEL[m], f"{st.k} / {st.n}", fmt(st.p, 3),
-                     f"[{fmt(st.lo, 3)}, {fmt(st.hi, 3)}]", fmt(st.p95, 3), fmt(st.mean, 3),
-                     fmt(100 * st.overshoot, 3)])
+    rows = [[fmt(s), MODE_LABEL[m]] + mc_cells(st, lambda x: fmt(x, 3))
+            for (s, m), st in res.mc.items()]
     tol = fmt(res.tolerance)
     return (
         f"## Monte Carlo: P(|e| ≤ {tol} m) over continuous distributions\n\n"
         f"{mc.samples} draws (seed {mc.seed}; `workbench/studies/stopping_mc.py`), the same "
         "draws for both modes and both speeds, analogue channel, healthy sensors; the stopping "
         "point D is the nominal one of each speed.\n\n"
-        + md_table(["factor", "meaning", "distribution", "unit", "source"], drows, "lllll")
+        + distribution_table(spec.kind)
         + "\n\n" + md_table(["km/h", "mode", f"stops within {tol} m", f"P(|e| ≤ {tol} m)",
                              "Wilson 95 % interval", "95th percentile of |e| (m)",
                              "mean e (m)", "overshoots (%)"], rows, "rlrrrrrr")
@@ -130,11 +126,8 @@ def _plot_mc(fig, res):
         ax = fig.add_subplot(1, len(speeds), i + 1, sharex=first, sharey=first)
         first = first or ax
         for k, m in enumerate(MC_MODES):
-            e = np.sort(np.asarray(res.mc[s, m].errors))
-            ax.step(e, np.arange(1, len(e) + 1) / len(e), where="post", color=f"C{k}",
-                    label=MODE_LABEL[m])
-        for x in (-res.tolerance, res.tolerance):
-            ax.axvline(x, color="k", ls="--", lw=0.8)
+            plot_ecdf(ax, res.mc[s, m].errors, color=f"C{k}", label=MODE_LABEL[m])
+        tolerance_lines(ax, res.tolerance)
         ax.set_xlabel("stop error (m, + overshoot)")
         if i == 0:
             ax.set_ylabel("fraction of stops ≤ error")

@@ -1,11 +1,13 @@
-"""Markdown and figures of the ``closed-loop-brake`` study (pure rendering)."""
+"""Markdown and figures of paper 004's closed-loop brake
+(designs/closed-loop-brake-004.toml, ``[analysis] module =
+"p004.closed_loop_brake"``): pure rendering, in the paper's wording."""
 from __future__ import annotations
 
 import numpy as np
 import sympy as sp
 
 from ...report.markdown import Figure, Rendered, fmt, md_table
-from .closed_loop_brake import worked_formulas
+from .closed_loop_brake_spec import view, worked_formulas
 from .closed_loop_brake_fair_render import fault_text, figures, mc_section, retune_section
 from .closed_loop_brake_run import CHANNELS, FAULTS, MODES
 
@@ -34,7 +36,7 @@ def _worked_section(res, spec) -> str:
 
 
 def render(design, res) -> Rendered:
-    spec = design.spec
+    spec = view(design.spec)
     prow = [[f"`{k}`", fmt(q.value, 5), q.unit, q.source] for k, q in spec.params.items()]
     sections = [
         "## Problem\n\nPaper 004 argues qualitatively that closing the loop on the measured "

@@ -1,22 +1,19 @@
-"""Simulation of the ``closed-loop-brake`` study (paper 004) through the
-``stop-accuracy`` kind: its modes are controllers of a kind spec
-(:func:`kind_spec`; designs/stop-accuracy-004-closed.toml and
-designs/stop-accuracy-004-ato.toml write the same laws), its command generator
-is the kind's named module ``deceleration_loop``
-(:mod:`workbench.kinds.stop_accuracy.decel_loop`), and every batch runs in
-:func:`workbench.kinds.stop_accuracy.run.simulate_runs`.
+"""Simulation of paper 004's runs (designs/closed-loop-brake-004.toml)
+through the ``stop-accuracy`` kind: its modes are the design's controllers
+(in the order of :data:`CONTROLLERS`), its command generator the kind's named
+module ``deceleration_loop`` (:mod:`workbench.kinds.stop_accuracy.decel_loop`),
+and every batch runs in :func:`workbench.kinds.stop_accuracy.run.simulate_runs`.
 
-What stays here, and why: the study's run lists (the error grid with its
+What stays here, and why: the report's run lists (the error grid with its
 full-service feasibility runs, the sensor faults and the electric-brake loss
 at the nominal corner, the Monte Carlo of two modes, the ATO-horizon sweep)
-and the names its report and claims use (``ato-open``, ``3bit``, "1 sliding");
-the kind's design file expresses the same runs with its own names.
+and the names its report and claims use (``ato-open``, ``3bit``, "1 sliding").
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ...kinds.stop_accuracy.pipeline import Factor, group_statistics
+from ...kinds.stop_accuracy.pipeline import group_statistics
 
 MODES = ("open", "ato-open", "closed")
 #: not a control mode: full service from t = 0, to test each corner's feasibility
@@ -28,55 +25,12 @@ CHANNELS = ("analogue", "3bit")
 FAULTS = {"healthy": "oooo", "1 sliding": "sooo", "3 failed": "fffo",
           "2 sliding + 1 failed": "ssfo", "all 4 failed": "ffff", "all 4 sliding": "ssss",
           "1 reading high": "hooo", "1 stuck": "zooo"}
-#: Monte Carlo factors in draw order (a factor's stream is its position), and how each
-#: acts on the plant (the stop-accuracy pipeline, :mod:`workbench.kinds.stop_accuracy.pipeline`)
-MC_FACTORS = {f.name: f for f in (
-    Factor("delay", "scale", ("T1", "T3"), "factor on the transmission delays T1, T3"),
-    Factor("force_error", "force_error", (),
-           "brake-force error (load weighing, force computation): kappa - 1"),
-    Factor("friction", "scale", ("K1",), "factor on K1 (air-brake friction)"),
-    Factor("gradient", "gradient", (), "station gradient (‰, + uphill)", "permille"))}
 #: modes of the Monte Carlo
 MC_MODES = ("ato-open", "closed")
-#: (mode, channel) -> controller of :func:`kind_spec` (index = position)
+#: (mode, channel) -> the design's controller (index = its position in the design)
 CONTROLLERS = {("open", "analogue"): "open", ("ato-open", "analogue"): "ato_open",
                ("closed", "analogue"): "closed", ("closed", "3bit"): "closed_3bit",
                (FULL, "analogue"): "full_service"}
-#: The ATO's target deceleration, re-commanded every cycle at the state predicted
-#: t_p ahead (the laws of designs/stop-accuracy-004-ato.toml).
-ATO_LAW = ((("v_p", "max(v - decel*t_p, 0)"), ("d_p", "d_go - 0.5*(v + v_p)*t_p")),
-           "where(d_p > 0, v_p**2/(2*max(d_p, d_min)), c_full)")
-
-
-def kind_spec(spec, t_end: float):
-    """``spec`` (a Spec004) as a ``stop-accuracy`` spec: the controllers of
-    :data:`CONTROLLERS` in order, horizon ``t_end`` (s)."""
-    from ...kinds.stop_accuracy import Controller, StopAccuracySpec
-    from ...kinds.stop_accuracy.decel_loop import LOOP_UNITS, LoopGains
-    from ...reader import Quantity
-    loop = {"e_switch": spec.e_switch, "tau_filter": spec.tau_filter,
-            "e_scale": spec.fuzzy.e_scale, "de_scale": spec.fuzzy.de_scale,
-            "du_scale": spec.fuzzy.du_scale, **spec.pid, "slide_ratio": spec.slide,
-            "high_ratio": spec.high_ratio}
-    const = {k: Quantity(v, u, "") for k, v, u in (
-        ("a_target", spec.a_target, "m/s^2"), ("t_p", spec.t_predict, "s"),
-        ("d_min", spec.d_min, "m"), ("c_full", spec.c_full, "m/s^2"))}
-    const |= {k: Quantity(v, LOOP_UNITS[k], "") for k, v in loop.items()}
-    gains = LoopGains({k: k for k in LOOP_UNITS}, 4)
-    defs, ato = ATO_LAW
-    ctls = (Controller("open", "a_target"), Controller("ato_open", ato, defs),
-            Controller("closed", ato, defs, loop=gains),
-            Controller("closed_3bit", ato, defs, loop=gains, levels=7),
-            Controller("full_service", "c_full"))
-    return StopAccuracySpec("<closed-loop-brake>", spec.params, spec.speeds_kmh, spec.tolerance,
-                            spec.c_full, None, spec.a_target, const, ctls,
-                            tuple(MC_FACTORS.values()), (), spec.dt, spec.dt_ctrl, t_end)
-
-
-def _t_end(spec, v0) -> float:
-    return float(2 * (np.asarray(v0) / spec.a_target).max() + 60)
-
-
 def simulate_brake(spec, *, v0, dist, controller, states, overrides: dict, theta, kappa,
                    t_predict=None):
     """Brake ``n`` runs to their stopping points ``dist`` (m) through the
@@ -85,6 +39,7 @@ def simulate_brake(spec, *, v0, dist, controller, states, overrides: dict, theta
     Parameters
     ----------
     spec : Spec004
+        The paper's view of the design (its ``kind``: the spec that runs).
     v0, dist : ndarray
         Initial speed (m/s) and stopping point (m) per run.
     controller : ndarray of int
@@ -105,7 +60,7 @@ def simulate_brake(spec, *, v0, dist, controller, states, overrides: dict, theta
     """
     from ...kinds.stop_accuracy.run import compile_laws, simulate_runs
     from ...sim.stopping import batch_params
-    ks = kind_spec(spec, _t_end(spec, v0))
+    ks = spec.kind
     p = batch_params(ks.base(), len(v0), overrides)
     tr, _ = simulate_runs(ks, compile_laws(ks), spec.dt, p, np.asarray(controller),
                           np.asarray(dist, float), x0=0.0, v0=v0, ratio=1.0, theta=theta,
@@ -122,7 +77,7 @@ def run_montecarlo(spec, distance: dict) -> dict:
     {(speed, mode): StopStatistics}."""
     from ...kinds.stop_accuracy.run import compile_laws, montecarlo_draws, simulate_cases
     mc = spec.montecarlo
-    ks = kind_spec(spec, _t_end(spec, [s / 3.6 for s in spec.speeds_kmh]))
+    ks = spec.kind
     names = list(CONTROLLERS.values())
     cases = [(s, m) for s in spec.speeds_kmh for m in MC_MODES]
     tr, D = simulate_cases(ks, compile_laws(ks), spec.dt, [
@@ -145,5 +100,5 @@ def run_horizon_sweep(spec, distance: dict) -> tuple:
     return tuple((tp, s, float(x - distance[s])) for (tp, s), x in zip(cases, tr.x_stop))
 
 
-__all__ = ["ATO_LAW", "CHANNELS", "CONTROLLERS", "FAULTS", "FULL", "MC_FACTORS", "MC_MODES",
-           "MODES", "kind_spec", "run_horizon_sweep", "run_montecarlo", "simulate_brake"]
+__all__ = ["CHANNELS", "CONTROLLERS", "FAULTS", "FULL", "MC_MODES", "MODES",
+           "run_horizon_sweep", "run_montecarlo", "simulate_brake"]
