@@ -95,27 +95,51 @@ def replay(p, rec: np.ndarray) -> tuple[float, float, int]:
     return dl, dv, pieces
 
 
-def radau_checks(ctx, spec, brakes: dict | None = None) -> tuple:
+def _window(rec: np.ndarray, t0: float, t1: float) -> np.ndarray:
+    """The rows of a mesh record with t0 <= t <= t1 (the kernel's own test):
+    what a run recording only that window records."""
+    return rec[(rec[:, 0] >= t0) & (rec[:, 0] <= t1)]
+
+
+def radau_checks(ctx, spec, runs=None, traction: dict | None = None) -> tuple:
     """:class:`RadauCheck` of every window at every rate of
     :data:`RADAU_RATES_HZ` in the design's grid (``zoh``, unquantised).
-    ``brakes``: rate -> kernel outputs of the ``zoh`` grid's braking run
-    (the run that locates the braking windows; run here when absent)."""
+
+    ``runs``: the section's :class:`workbench.features.rate_sweep.Runs` (the
+    grid's braking run locates the braking windows; made here when absent);
+    ``traction``: rate -> mesh record of the first seconds of the ``zoh``
+    traction run from t = 0 (the figure's traces), which holds the traction
+    window. Both braking windows come from one recorded run; the kernel's
+    mesh before the end of a record does not depend on where the run or the
+    record ends, so the windows are those of separate runs (issue 36)."""
     out = []
     for rate in (f for f in RADAU_RATES_HZ if f in spec.rates):
         kw = dict(dt_p=spec.plant_step, predictor_step=spec.predictor_step)
-        brake = (brakes or {}).get(rate) or run_once(ctx, rate, 1, **kw)[0]
+        brake = (runs(rate, 1, 0.0, 0.0, spec.plant_step) if runs is not None
+                 else run_once(ctx, rate, 1, **kw)[0])
         length = WINDOW_SAMPLES / rate
+        # the traction window starts and ends on sample times (h, h + 40 samples):
+        # whether those mesh points are recorded depended on the last bit of h, so
+        # every window starts and ends half a mesh step earlier (issue 36 item 5)
+        half = 0.5 * min(spec.plant_step, 1.0 / rate)
         starts = (ctx.h, brake["t_omega3"] - length / 2, brake["t_stop"] - length)
-        for name, t0, scen in zip(WINDOWS, starts, (0, 1, 1)):
-            if math.isnan(t0):
+        wins = [(name, t0 - half, t0 + length - half, scen)
+                for name, t0, scen in zip(WINDOWS, starts, (0, 1, 1)) if not math.isnan(t0)]
+        recs = {}
+        for scen in (0, 1):
+            mine = [(a, b) for _, a, b, s in wins if s == scen]
+            if not mine:
                 continue
-            cap = int(length / spec.plant_step * 1.5) + 4 * int(length * rate) + 16
-            # the traction window starts and ends on sample times (h, h + 40 samples):
-            # whether those mesh points are recorded depended on the last bit of h, so
-            # every window starts and ends half a mesh step earlier (issue 36 item 5)
-            half = 0.5 * min(spec.plant_step, 1.0 / rate)
-            _, (rec, _) = run_once(ctx, rate, scen, record=(t0 - half, t0 + length - half, cap),
-                                   **kw)
+            a, b = min(a for a, _ in mine), max(b for _, b in mine)
+            have = (traction or {}).get(rate) if scen == 0 else None
+            # the stretch holding b ends by b + 1 / rate: before the record's run ended
+            if have is not None and len(have) and have[0, 0] <= a and b + 2 / rate <= have[-1, 0]:
+                recs[scen] = have
+                continue
+            cap = int((b - a) / spec.plant_step * 1.5) + 4 * int((b - a) * rate) + 16
+            recs[scen] = run_once(ctx, rate, scen, record=(a, b, cap), **kw)[1][0]
+        for name, a, b, scen in wins:
+            rec = _window(recs[scen], a, b)
             if len(rec) < 2:
                 continue
             dl, dv, pieces = replay(ctx.plant, rec)
