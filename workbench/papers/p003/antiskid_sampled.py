@@ -35,16 +35,15 @@ The *emulation* row is the case's controller as the other sections run it
 (every step of dt/2, the stiff hold with its mismatch estimate, the plant
 stepped with the control step), in the same two scenarios.
 
-The lowest passing rate is the lowest grid rate from which every higher grid
-rate passes; between it and the grid rate below, ``bisect`` steps on log f_c
-give a bracket (assuming one crossing in between). Checks: every grid rate up
-to :data:`MESH_CHECK_MAX_HZ` again at ``plant_step`` / 2
-(:data:`MESH_ATOL`, a two-level screen); every rate metric a claim of the
-design compares (``sampled.<variant>.rate[<f>].<metric>``, f up to
-:data:`MESH_CHECK_MAX_HZ`) at three levels, plant_step, /2 (the screen's
-run) and /4 (only the scenario the metric needs), with a Richardson
-estimate of its error (:func:`.antiskid_sampled_levels.three_level_check`,
-issue 33 item 4); and the plant's mesh against scipy's Radau
+The sweep itself is general (:mod:`workbench.features.rate_sweep`: the
+grid, the lowest passing rate and its bisection bracket, the mesh check of
+every grid rate up to :data:`MESH_CHECK_MAX_HZ` at ``plant_step`` / 2 within
+:data:`MESH_ATOL`, the three levels plant_step, /2, /4 of every rate metric a
+claim compares, every run made once). What stays here is paper 003's: the
+``[sampled]`` table, the kernel as the sweep's ``run`` callback
+(:func:`runs_of`), the metrics of a rate and their tolerances
+(:func:`rate_metrics`, :func:`declaration`), the emulation row, the traces of
+the figure, the quantity names, and the plant's mesh against scipy's Radau
 (:mod:`.antiskid_sampled_check`).
 """
 from __future__ import annotations
