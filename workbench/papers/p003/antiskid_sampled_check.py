@@ -4,11 +4,10 @@ Radau (issue 20).
 The sampled loop (:mod:`.antiskid_sampled_kernel`) integrates the plant by
 exponential-Euler sub-steps of at most ``plant_step``. Here the torque the
 wheel received in a window of a run (piecewise constant: the held,
-delayed commands) is replayed open loop into
-:func:`scipy.integrate.solve_ivp` (``method="Radau"``, an implicit,
-stiffly accurate Runge-Kutta method of order 5, tight tolerances), restarted
-at each change of the torque from its own previous end point, and both
-trajectories are compared at every mesh point of the window. The right-hand
+delayed commands) is replayed open loop into scipy's Radau and both
+trajectories are compared at every mesh point of the window (the general
+replay: :mod:`workbench.features.mesh_replay`). What stays here is paper
+003's: the windows, the tolerances and the right-hand side. The right-hand
 side is the lambdified sympy model of :mod:`workbench.sim.wheel_slip` (the
 traction form for lambda >= 0, the braking form otherwise; speed floored as
 the plant step floors it), not a retyped one.
@@ -27,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...features.mesh_replay import replay as mesh_replay
 from ...sim.wheel_slip import model_functions
 from .antiskid_sampled_kernel import run_once
 
@@ -74,24 +74,8 @@ def _rhs(p, u):
 def replay(p, rec: np.ndarray) -> tuple[float, float, int]:
     """(max |d lambda|, max |d v| / v, pieces) of the mesh record ``rec``
     (rows t, v, lambda, torque over the sub-step ending at t) against Radau
-    from its first row."""
-    from scipy.integrate import solve_ivp
-    x = rec[0, 1:3].copy()
-    dl = dv = 0.0
-    i, n, pieces = 1, len(rec), 0
-    while i < n:
-        j = i
-        while j + 1 < n and rec[j + 1, 3] == rec[i, 3]:
-            j += 1
-        ts = rec[i:j + 1, 0]
-        sol = solve_ivp(_rhs(p, rec[i, 3]), (rec[i - 1, 0], ts[-1]), x, method="Radau",
-                        t_eval=ts, rtol=RTOL, atol=ATOL)
-        if not sol.success:
-            return math.nan, math.nan, pieces
-        dl = max(dl, float(np.max(np.abs(sol.y[1] - rec[i:j + 1, 2]))))
-        dv = max(dv, float(np.max(np.abs(sol.y[0] - rec[i:j + 1, 1]) / rec[i:j + 1, 1])))
-        x = sol.y[:, -1]
-        i, pieces = j + 1, pieces + 1
+    from its first row (:func:`workbench.features.mesh_replay.replay`)."""
+    (_, dl), (dv, _), pieces = mesh_replay(lambda u: _rhs(p, u), rec, RTOL, ATOL)
     return dl, dv, pieces
 
 
