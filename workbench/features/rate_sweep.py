@@ -199,6 +199,16 @@ class Variant:
         metric converged over three levels."""
         return all(a for _, a, _ in self.mesh) and all(t.converged for t in self.three_level)
 
+    def json(self) -> dict:
+        """The variant as JSON-able values (the mesh check's rows not included)."""
+        rows = lambda rr: [{"rate_hz": r.rate, **r.metrics} for r in rr]    # noqa: E731
+        return {"q": self.q, "tau": self.tau, "rows": rows(self.rows),
+                "probes": rows(self.probes), "min_rate": self.min_rate,
+                "bracket": self.bracket,
+                "three_level": [{"rate_hz": t.rate, "metric": t.metric, "values": t.values,
+                                 "outcome": t.outcome, "estimate": t.estimate,
+                                 "tolerance": t.tolerance} for t in self.three_level]}
+
 
 def rate_row(runs: Runs, decl: RateMetrics, rate: float, q: float, tau: float, step: float,
              probe: bool = False) -> RateRow:

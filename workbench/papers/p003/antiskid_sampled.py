@@ -173,18 +173,9 @@ class SampledResult:
 
     #: The JSON of the result (:func:`workbench.jsonable.to_json`).
     JSON_FIELDS = {"emulation": "emulation.metrics",
-                   "variants": lambda r: {v.name: _variant_json(v) for v in r.variants},
+                   "variants": lambda r: {v.name: v.json() for v in r.variants},
                    "radau": "radau"}
     to_json = json_method
-
-
-def _variant_json(v) -> dict:
-    rows = lambda rr: [{"rate_hz": r.rate, **r.metrics} for r in rr]
-    return {"q": v.q, "tau": v.tau, "rows": rows(v.rows), "probes": rows(v.probes),
-            "min_rate": v.min_rate, "bracket": v.bracket,
-            "three_level": [{"rate_hz": t.rate, "metric": t.metric, "values": t.values,
-                             "outcome": t.outcome, "estimate": t.estimate,
-                             "tolerance": t.tolerance} for t in v.three_level]}
 
 
 def rate_metrics(ctx: Context, trac: dict, brake: dict) -> dict:
