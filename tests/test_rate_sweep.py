@@ -144,3 +144,9 @@ def test_mesh_replay_agrees_with_an_exact_record_and_sees_a_tampered_one():
     bad = rec.copy()
     bad[70:, 1] += 1e-4
     assert replay(lambda v: lambda s, y: -y + v, bad, 1e-10, 1e-12)[0][0] >= 0.9e-4
+
+
+def test_variants_of_a_sweep():
+    assert RS.variants(0.0, 0.0) == (("zoh", 0.0, 0.0),)
+    assert RS.variants(8.0, 0.0) == (("zoh", 0.0, 0.0), ("zoh_q_tau", 8.0, 0.0))
+    assert RS.variants(0.0, 0.002)[1] == ("zoh_q_tau", 0.0, 0.002)

@@ -44,7 +44,14 @@ from ..refinement import guarded_check
 from ..sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
 
 __all__ = ["RateMetrics", "Runs", "RateRow", "Variant", "ThreeLevel", "three_level_check",
-           "rate_row", "partial_row", "sweep_variant", "claimed_rate_metrics"]
+           "rate_row", "partial_row", "sweep_variant", "claimed_rate_metrics", "variants"]
+
+
+def variants(q: float, tau: float) -> tuple:
+    """((name, q, tau), ...): ``zoh`` (exact, current samples, unquantised),
+    and ``zoh_q_tau`` (commands quantised to ``q``, measurements ``tau``
+    old) when either is not 0."""
+    return (("zoh", 0.0, 0.0),) + ((("zoh_q_tau", q, tau),) if q or tau else ())
 
 
 @dataclass(frozen=True)

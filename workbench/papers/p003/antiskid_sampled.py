@@ -109,7 +109,7 @@ class SampledSpec:
         the design gives a quantisation or a measurement delay."""
         q = 0.0 if self.quantisation is None else self.quantisation.value
         tau = 0.0 if self.measurement_delay is None else self.measurement_delay.value
-        return (("zoh", 0.0, 0.0),) + ((("zoh_q_tau", q, tau),) if q or tau else ())
+        return RS.variants(q, tau)
 
 
 def load_sampled(root, case_names) -> SampledSpec | None:
