@@ -150,3 +150,19 @@ def test_variants_of_a_sweep():
     assert RS.variants(0.0, 0.0) == (("zoh", 0.0, 0.0),)
     assert RS.variants(8.0, 0.0) == (("zoh", 0.0, 0.0), ("zoh_q_tau", 8.0, 0.0))
     assert RS.variants(0.0, 0.002)[1] == ("zoh_q_tau", 0.0, 0.002)
+
+
+def test_quantities_of_a_toy_variant():
+    runs, _ = _counted()
+    v = RS.sweep_variant(runs, DECL, RATES, 1e-3, "p", 0.0, 0.0, bisect=0)
+    ref = {"x_end": 0.0}
+    q = RS.quantities("toy", v, ("x_end", "ok"), "reference", ref, ("x_end",),
+                      {"x_end_minus_reference": "x_end"})
+    names = RS.quantity_names("toy", "p", RATES, ("x_end", "ok"), "reference", ("x_end",),
+                              {"x_end_minus_reference": "x_end"})
+    assert set(q) == names
+    assert q["toy.p.min_rate"] == 20.0 and q["toy.p.bracket_low"] == 10.0
+    assert q["toy.p.rate[100].ok"] == "yes" and q["toy.p.mesh_converged"] is None
+    assert q["toy.p.gap_to_reference.x_end"] == v.row(100.0).metrics["x_end"]
+    assert q["toy.p.rate[20].x_end_minus_reference"] == q["toy.p.rate[20].x_end"]
+    assert RS.quantity_value(math.nan) is None and RS.quantity_value("no") == "no"

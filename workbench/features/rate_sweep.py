@@ -44,7 +44,8 @@ from ..refinement import guarded_check
 from ..sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
 
 __all__ = ["RateMetrics", "Runs", "RateRow", "Variant", "ThreeLevel", "three_level_check",
-           "rate_row", "partial_row", "sweep_variant", "claimed_rate_metrics", "variants"]
+           "rate_row", "partial_row", "sweep_variant", "claimed_rate_metrics", "variants",
+           "quantity_names", "quantities", "quantity_value"]
 
 
 def variants(q: float, tau: float) -> tuple:
@@ -333,3 +334,39 @@ def claimed_rate_metrics(prefix: str, variants, rates: tuple, names: tuple, max_
         if rate in rates and rate <= max_rate and metric in names:
             out.add((m[1], rate, metric))
     return tuple(sorted(out))
+
+
+def quantity_value(x):
+    """A quantity value: None for NaN."""
+    return None if isinstance(x, float) and math.isnan(x) else x
+
+
+def quantity_names(prefix: str, name: str, rates: tuple, metrics: tuple,
+                   reference: str = "", gaps: tuple = (), differences=()) -> set[str]:
+    """The quantities of variant ``name`` (:func:`quantities`)."""
+    b = f"{prefix}.{name}"
+    return ({f"{b}.{k}" for k in ("min_rate", "bracket_low", "bracket_high", "mesh_converged")}
+            | {f"{b}.gap_to_{reference}.{m}" for m in gaps}
+            | {f"{b}.rate[{f:g}].{m}" for f in rates for m in tuple(metrics) + tuple(differences)})
+
+
+def quantities(prefix: str, v: Variant, metrics: tuple, reference: str = "",
+               ref: dict | None = None, gaps: tuple = (), differences=None) -> dict:
+    """The quantities of a variant: ``<prefix>.<name>.min_rate``,
+    ``.bracket_low``, ``.bracket_high``, ``.mesh_converged`` ("yes" or None),
+    ``.gap_to_<reference>.<m>`` (|top grid rate - ``ref``| of each metric of
+    ``gaps``), and per grid rate ``.rate[<f>].<m>`` of ``metrics`` and of
+    ``differences`` (name -> metric: the metric minus ``ref``'s); None for
+    NaN."""
+    b = f"{prefix}.{v.name}"
+    q = {f"{b}.min_rate": v.min_rate}
+    q[f"{b}.bracket_low"], q[f"{b}.bracket_high"] = v.bracket
+    q[f"{b}.mesh_converged"] = "yes" if v.mesh_converged else None
+    top = v.rows[-1].metrics
+    for m in gaps:
+        q[f"{b}.gap_to_{reference}.{m}"] = quantity_value(abs(top[m] - ref[m]))
+    for r in v.rows:
+        q.update({f"{b}.rate[{r.rate:g}].{m}": quantity_value(r.metrics[m]) for m in metrics})
+        for d, m in (differences or {}).items():
+            q[f"{b}.rate[{r.rate:g}].{d}"] = quantity_value(r.metrics[m] - ref[m])
+    return q

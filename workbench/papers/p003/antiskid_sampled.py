@@ -276,43 +276,21 @@ def trace_records(ctx: Context, spec: SampledSpec, dt_e: float) -> list:
     return out
 
 
-def _q(x):
-    """A quantity value: None for NaN."""
-    return None if isinstance(x, float) and math.isnan(x) else x
-
-
 def sampled_quantity_names(spec: SampledSpec) -> set[str]:
     """The ``sampled.*`` quantities a design with ``[sampled]`` has."""
     names = {f"sampled.emulation.{m}" for m in RATE_METRICS} | set(RADAU_QUANTITIES)
     for name, _, _ in spec.variants():
-        b = f"sampled.{name}"
-        names |= {f"{b}.min_rate", f"{b}.bracket_low", f"{b}.bracket_high",
-                  f"{b}.mesh_converged"}
-        names |= {f"{b}.gap_to_emulation.{m}" for m in GAP_METRICS}
-        names |= {f"{b}.rate[{f:g}].{m}" for f in spec.rates
-                  for m in RATE_METRICS + ("stop_time_minus_emulation",
-                                           "stop_distance_minus_emulation")}
+        names |= RS.quantity_names("sampled", name, spec.rates, RATE_METRICS, "emulation",
+                                   GAP_METRICS, TO_EMULATION)
     return names
 
 
 def sampled_quantities(res: SampledResult) -> dict:
     """Values of :func:`sampled_quantity_names`."""
-    q = {f"sampled.emulation.{m}": _q(res.emulation.metrics[m]) for m in RATE_METRICS}
+    emu = res.emulation.metrics
+    q = {f"sampled.emulation.{m}": RS.quantity_value(emu[m]) for m in RATE_METRICS}
     q.update(radau_quantities(res.radau, res.lambda_opt))
     for v in res.variants:
-        b = f"sampled.{v.name}"
-        q[f"{b}.min_rate"] = v.min_rate
-        q[f"{b}.bracket_low"], q[f"{b}.bracket_high"] = v.bracket
-        q[f"{b}.mesh_converged"] = "yes" if v.mesh_converged else None
-        top = v.rows[-1].metrics
-        for m in GAP_METRICS:
-            q[f"{b}.gap_to_emulation.{m}"] = _q(abs(top[m] - res.emulation.metrics[m]))
-        emu_stop = res.emulation.metrics["braking_duration"]
-        emu_dist = res.emulation.metrics["stop_distance"]
-        for r in v.rows:
-            q.update({f"{b}.rate[{r.rate:g}].{m}": _q(r.metrics[m]) for m in RATE_METRICS})
-            q[f"{b}.rate[{r.rate:g}].stop_time_minus_emulation"] = _q(
-                r.metrics["braking_duration"] - emu_stop)
-            q[f"{b}.rate[{r.rate:g}].stop_distance_minus_emulation"] = _q(
-                r.metrics["stop_distance"] - emu_dist)
+        q.update(RS.quantities("sampled", v, RATE_METRICS, "emulation", emu, GAP_METRICS,
+                               TO_EMULATION))
     return q
