@@ -137,12 +137,21 @@ def test_bad_sampled_table_is_exit_2(tmp_path, capsys, old, new, key):
     assert str(bad.name) in err and key in err and "expected" in err
 
 
-def test_a_kept_braking_run_is_the_one_the_radau_check_would_run(ctx):
-    """run_sampled hands the zoh grid's braking runs to radau_checks, which
-    then does not run them again: the kept outputs are those of its own call."""
+def test_a_memoised_run_and_a_cut_record_are_those_of_separate_runs(ctx):
+    """run_sampled memoises its runs: the braking run that locates the Radau
+    check's windows is the grid's, the outputs of its own call; a window cut
+    from a longer record (the figure's trace, or one run over both braking
+    windows) holds the rows of a run recording that window alone."""
+    from workbench.papers.p003.antiskid_sampled_check import _window
     from workbench.papers.p003.antiskid_sampled_kernel import run_once
-    keep = {}
-    S.rate_row(ctx, 100.0, dt_p=2e-4, predictor_step=1e-3, q=0.0, tau=0.0, keep=keep)
+    runs = S.runs_of(ctx, 1e-3)
+    kept = runs(100.0, 1, 0.0, 0.0, 2e-4)
+    assert runs(100.0, 1, 0.0, 0.0, 2e-4) is kept and runs.made == 1
     own = run_once(ctx, 100.0, 1, dt_p=2e-4, predictor_step=1e-3)[0]
-    assert set(keep) == {100.0} and math.isfinite(own["t_stop"])
-    assert {k: repr(v) for k, v in keep[100.0].items()} == {k: repr(v) for k, v in own.items()}
+    assert math.isfinite(own["t_stop"])
+    assert {k: repr(v) for k, v in kept.items()} == {k: repr(v) for k, v in own.items()}
+    kw = dict(dt_p=2e-4, predictor_step=1e-3)
+    long = run_once(ctx, 100.0, 0, record=(0.0, 0.5, 20000), t_cap=0.5, **kw)[1][0]
+    t0, t1 = ctx.h - 1e-4, ctx.h + 0.05 - 1e-4
+    alone = run_once(ctx, 100.0, 0, record=(t0, t1, 2000), **kw)[1][0]
+    assert len(alone) > 100 and np.array_equal(_window(long, t0, t1), alone)

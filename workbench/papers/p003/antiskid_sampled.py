@@ -35,33 +35,32 @@ The *emulation* row is the case's controller as the other sections run it
 (every step of dt/2, the stiff hold with its mismatch estimate, the plant
 stepped with the control step), in the same two scenarios.
 
-The lowest passing rate is the lowest grid rate from which every higher grid
-rate passes; between it and the grid rate below, ``bisect`` steps on log f_c
-give a bracket (assuming one crossing in between). Checks: every grid rate up
-to :data:`MESH_CHECK_MAX_HZ` again at ``plant_step`` / 2
-(:data:`MESH_ATOL`, a two-level screen); every rate metric a claim of the
-design compares (``sampled.<variant>.rate[<f>].<metric>``, f up to
-:data:`MESH_CHECK_MAX_HZ`) at three levels, plant_step, /2 (the screen's
-run) and /4 (only the scenario the metric needs), with a Richardson
-estimate of its error (:func:`.antiskid_sampled_levels.three_level_check`,
-issue 33 item 4); and the plant's mesh against scipy's Radau
+The sweep itself is general (:mod:`workbench.features.rate_sweep`: the
+grid, the lowest passing rate and its bisection bracket, the mesh check of
+every grid rate up to :data:`MESH_CHECK_MAX_HZ` at ``plant_step`` / 2 within
+:data:`MESH_ATOL`, the three levels plant_step, /2, /4 of every rate metric a
+claim compares, every run made once). What stays here is paper 003's: the
+``[sampled]`` table, the kernel as the sweep's ``run`` callback
+(:func:`runs_of`), the metrics of a rate and their tolerances
+(:func:`rate_metrics`, :func:`declaration`), the emulation row, the traces of
+the figure, the quantity names, and the plant's mesh against scipy's Radau
 (:mod:`.antiskid_sampled_check`).
 """
 from __future__ import annotations
 
 import dataclasses
 import math
-import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
+from ...features import rate_sweep as RS
+from ...features.rate_sweep import (RateMetrics, RateRow, Runs, ThreeLevel,  # noqa: F401
+                                       Variant, three_level_check)
 from ...jsonable import json_method
 from ...reader import Quantity
 from .antiskid_sampled_check import RADAU_QUANTITIES, radau_checks, radau_quantities
 from .antiskid_sampled_kernel import OUT, Context, run_once
-from .antiskid_sampled_levels import (BRAKING_METRICS, TRACTION_METRICS, ThreeLevel,  # noqa: F401
-                                      scenarios_of, three_level_check)
 
 #: Grid rates up to this (Hz) are run again at plant_step / 2.
 MESH_CHECK_MAX_HZ = 1000.0
@@ -72,6 +71,13 @@ MESH_ATOL = {"lam_max_over_opt": 2e-5, "t_cruise": 0.005, "braking_duration": 0.
 RATE_METRICS = ("lam_max_over_opt", "time_above", "t_cruise", "u_max_over_peak",
                 "braking_duration", "stop_distance", "lam_min_brake", "evs_max_tracking",
                 "omega3_after_brake", "traction_ok", "braking_ok", "ok")
+#: Rate metrics of the traction run and of the braking run (the others need both).
+TRACTION_METRICS = ("lam_max_over_opt", "time_above", "t_cruise", "traction_ok")
+BRAKING_METRICS = ("braking_duration", "stop_distance", "lam_min_brake", "evs_max_tracking",
+                   "omega3_after_brake", "braking_ok")
+#: Metric -> the scenarios (0 traction, 1 braking) it is computed from (absent: both).
+NEEDS = {**dict.fromkeys(TRACTION_METRICS + ("traction_diverged",), (0,)),
+         **dict.fromkeys(BRAKING_METRICS + ("braking_diverged",), (1,))}
 #: Rates (Hz, those of the grid) and seconds of the traction traces of the figure.
 TRACE_RATES_HZ, TRACE_SECONDS = (100.0, 1000.0), 4.0
 #: Metrics compared between the highest grid rate and the emulation.
@@ -80,7 +86,6 @@ GAP_METRICS = ("lam_max_over_opt", "t_cruise", "braking_duration", "stop_distanc
 #: (the emulation does not depend on plant_step).
 TO_EMULATION = {"stop_time_minus_emulation": "braking_duration",
                 "stop_distance_minus_emulation": "stop_distance"}
-_RATE_QUANTITY = re.compile(r"^sampled\.([a-z_]+)\.rate\[([^\]]+)\]\.([a-z0-9_]+)$")
 
 
 @dataclass(frozen=True)
@@ -104,7 +109,7 @@ class SampledSpec:
         the design gives a quantisation or a measurement delay."""
         q = 0.0 if self.quantisation is None else self.quantisation.value
         tau = 0.0 if self.measurement_delay is None else self.measurement_delay.value
-        return (("zoh", 0.0, 0.0),) + ((("zoh_q_tau", q, tau),) if q or tau else ())
+        return RS.variants(q, tau)
 
 
 def load_sampled(root, case_names) -> SampledSpec | None:
@@ -131,77 +136,13 @@ def load_sampled(root, case_names) -> SampledSpec | None:
 
 
 def claimed_rate_metrics(spec: SampledSpec, claims) -> tuple:
-    """((variant, rate, metric), ...), sorted: the rate metrics that the
-    ``[[claims]]`` tables ``claims`` (raw TOML tables; a malformed one is
-    skipped here and reported by the claims' own validation) compare, at a
-    grid rate up to :data:`MESH_CHECK_MAX_HZ` (a difference to the emulation
-    counts as its rate metric, :data:`TO_EMULATION`)."""
-    names = {n for n, _, _ in spec.variants()}
-    out = set()
-    for c in claims if isinstance(claims, list) else ():
-        m = _RATE_QUANTITY.match(str(c.get("quantity", ""))) if isinstance(c, dict) else None
-        if m is None or m[1] not in names:
-            continue
-        try:
-            rate = float(m[2])
-        except ValueError:
-            continue
-        metric = TO_EMULATION.get(m[3], m[3])
-        if rate in spec.rates and rate <= MESH_CHECK_MAX_HZ and metric in RATE_METRICS:
-            out.add((m[1], rate, metric))
-    return tuple(sorted(out))
-
-
-@dataclass(frozen=True)
-class RateRow:
-    """Both scenarios at one rate (``rate`` NaN: the emulation row).
-
-    ``metrics``: :data:`RATE_METRICS` plus ``traction_diverged`` and
-    ``braking_diverged`` (the time each run was declared diverged, NaN: not)."""
-
-    rate: float
-    metrics: dict
-    probe: bool = False       # a bisection rate, not on the grid
-
-    @property
-    def ok(self) -> bool:
-        return self.metrics["ok"] == "yes"
-
-
-@dataclass(frozen=True)
-class Variant:
-    """One sampled controller over the grid.
-
-    ``min_rate``: lowest grid rate from which every higher grid rate passes
-    (None: the highest fails); ``bracket``: (highest failing, lowest passing)
-    rate known after bisection (None on a side with no rate);
-    ``mesh``: (rate, agree, {metric: |difference|}) of the mesh check;
-    ``mesh_rows``: its RateRows at plant_step / 2; ``three_level``: the
-    :class:`ThreeLevel` check of every claimed rate metric of the variant;
-    ``quarter_rows``: its RateRows at plant_step / 4 (the metrics of the
-    scenarios run only). Both row sets are reused by the three-level
-    refinement of the findings (:mod:`workbench.papers.p003.antiskid_refine`)."""
-
-    name: str
-    q: float
-    tau: float
-    rows: tuple
-    probes: tuple
-    min_rate: float | None
-    bracket: tuple
-    mesh: tuple
-    mesh_rows: tuple = field(default=(), compare=False)
-    three_level: tuple = ()
-    quarter_rows: tuple = field(default=(), compare=False)
-
-    def row(self, rate: float) -> RateRow:
-        return next(r for r in self.rows if r.rate == rate)
-
-    @property
-    def mesh_converged(self) -> bool:
-        """The two-level screen agrees at every rate and every claimed rate
-        metric converged over three levels."""
-        return all(a for _, a, _ in self.mesh) and all(t.converged for t in self.three_level)
+    """((variant, rate, metric), ...), sorted: the rate metrics the
+    ``[[claims]]`` tables ``claims`` compare at a grid rate up to
+    :data:`MESH_CHECK_MAX_HZ` (a difference to the emulation counts as its
+    rate metric, :data:`TO_EMULATION`;
+    :func:`workbench.features.rate_sweep.claimed_rate_metrics`)."""
+    return RS.claimed_rate_metrics("sampled", [n for n, _, _ in spec.variants()], spec.rates,
+                                   RATE_METRICS, MESH_CHECK_MAX_HZ, claims, TO_EMULATION)
 
 
 @dataclass(frozen=True)
@@ -232,18 +173,9 @@ class SampledResult:
 
     #: The JSON of the result (:func:`workbench.jsonable.to_json`).
     JSON_FIELDS = {"emulation": "emulation.metrics",
-                   "variants": lambda r: {v.name: _variant_json(v) for v in r.variants},
+                   "variants": lambda r: {v.name: v.json() for v in r.variants},
                    "radau": "radau"}
     to_json = json_method
-
-
-def _variant_json(v) -> dict:
-    rows = lambda rr: [{"rate_hz": r.rate, **r.metrics} for r in rr]
-    return {"q": v.q, "tau": v.tau, "rows": rows(v.rows), "probes": rows(v.probes),
-            "min_rate": v.min_rate, "bracket": v.bracket,
-            "three_level": [{"rate_hz": t.rate, "metric": t.metric, "values": t.values,
-                             "outcome": t.outcome, "estimate": t.estimate,
-                             "tolerance": t.tolerance} for t in v.three_level]}
 
 
 def rate_metrics(ctx: Context, trac: dict, brake: dict) -> dict:
@@ -266,131 +198,71 @@ def rate_metrics(ctx: Context, trac: dict, brake: dict) -> dict:
             "traction_diverged": trac["t_diverged"], "braking_diverged": brake["t_diverged"]}
 
 
+def declaration(ctx: Context) -> RateMetrics:
+    """The metric declarations of the sampled section: :data:`RATE_METRICS`
+    of a rate from its traction (0) and braking (1) runs (:func:`rate_metrics`;
+    a scenario not run counts as NaN outputs)."""
+    nan = dict.fromkeys(OUT, math.nan)
+    return RateMetrics(RATE_METRICS, (0, 1),
+                       lambda got: rate_metrics(ctx, got[0] or nan, got[1] or nan), NEEDS,
+                       MESH_ATOL, MESH_CHECK_MAX_HZ)
+
+
+def runs_of(ctx: Context, predictor_step: float, emulation: bool = False) -> Runs:
+    """The memo of the kernel's runs (:func:`.antiskid_sampled_kernel.run_once`,
+    its outputs) of the sampled controller (``emulation``: of the case's own
+    controller, every step)."""
+    return Runs(lambda rate, s, q, tau, step: run_once(
+        ctx, rate, s, q=q, tau=tau, dt_p=step, predictor_step=predictor_step,
+        emulation=emulation)[0])
+
+
 def rate_row(ctx: Context, rate: float, *, dt_p: float, predictor_step: float,
-             q: float = 0.0, tau: float = 0.0, emulation: bool = False,
-             probe: bool = False, keep: dict | None = None) -> RateRow:
-    """Both scenarios at one rate (``keep``: a dict that receives the
-    braking run's kernel outputs under the rate)."""
-    kw = dict(q=q, tau=tau, dt_p=dt_p, predictor_step=predictor_step, emulation=emulation)
-    trac, _ = run_once(ctx, rate, 0, **kw)
-    brake, _ = run_once(ctx, rate, 1, **kw)
-    if keep is not None:
-        keep[rate] = brake
-    return RateRow(rate, rate_metrics(ctx, trac, brake), probe)
+             q: float = 0.0, tau: float = 0.0, emulation: bool = False) -> RateRow:
+    """Both scenarios at one rate, run now (the study's runs: :func:`run_sampled`)."""
+    return RS.rate_row(runs_of(ctx, predictor_step, emulation), declaration(ctx), rate, q,
+                       tau, dt_p)
 
 
 def partial_row(ctx: Context, rate: float, scenarios: tuple, *, dt_p: float,
                 predictor_step: float, q: float = 0.0, tau: float = 0.0) -> RateRow:
-    """The metrics of ``scenarios`` (0 traction, 1 braking) at one rate:
-    the runs :func:`rate_row` makes (the same calls, the same numbers), only
-    those a metric needs."""
-    kw = dict(q=q, tau=tau, dt_p=dt_p, predictor_step=predictor_step, emulation=False)
-    nan = dict.fromkeys(OUT, math.nan)
-    trac, brake = (run_once(ctx, rate, s, **kw)[0] if s in scenarios else nan for s in (0, 1))
-    keep = ((TRACTION_METRICS + ("traction_diverged",) if 0 in scenarios else ())
-            + (BRAKING_METRICS + ("braking_diverged",) if 1 in scenarios else ())
-            + (("u_max_over_peak", "ok") if len(set(scenarios)) == 2 else ()))
-    m = rate_metrics(ctx, trac, brake)
-    return RateRow(rate, {k: m[k] for k in keep})
+    """The metrics of ``scenarios`` (0 traction, 1 braking) at one rate
+    (:func:`workbench.features.rate_sweep.partial_row`)."""
+    return RS.partial_row(runs_of(ctx, predictor_step), declaration(ctx), rate, scenarios,
+                          q, tau, dt_p)
 
 
-def _three_level(ctx, spec: SampledSpec, name, q, tau, rows, fines) -> tuple:
-    """The claimed rate metrics of variant ``name`` at three levels: the
-    grid's run (plant_step), the mesh check's (plant_step / 2) and one more
-    at plant_step / 4 of the scenarios they need; returns (ThreeLevel rows,
-    RateRows at plant_step / 4)."""
-    need: dict = {}
-    for v, rate, metric in spec.three_level:
-        if v == name:
-            need.setdefault(rate, set()).update(scenarios_of(metric))
-    quarter = tuple(partial_row(ctx, rate, tuple(sorted(sc)), dt_p=spec.plant_step / 4,
-                                predictor_step=spec.predictor_step, q=q, tau=tau)
-                    for rate, sc in sorted(need.items()))
-    by = lambda rr, f: next(r for r in rr if r.rate == f)     # noqa: E731
-    checks = tuple(three_level_check(name, rate, metric, tuple(
-        by(rr, rate).metrics[metric] for rr in (rows, fines, quarter)),
-        MESH_ATOL.get(metric, 0.0)) for v, rate, metric in spec.three_level if v == name)
-    return checks, quarter
-
-
-def _bisect(ctx, spec: SampledSpec, q, tau, lo: float, hi: float) -> tuple:
-    """Rates probed between a failing ``lo`` and a passing ``hi`` (Hz),
-    geometric midpoints rounded to whole Hz; returns (probes, lo, hi)."""
-    probes = []
-    for _ in range(spec.bisect):
-        mid = float(round(math.sqrt(lo * hi)))
-        if not lo < mid < hi:
-            break
-        row = rate_row(ctx, mid, dt_p=spec.plant_step, predictor_step=spec.predictor_step,
-                       q=q, tau=tau, probe=True)
-        probes.append(row)
-        lo, hi = (lo, mid) if row.ok else (mid, hi)
-    return tuple(probes), lo, hi
-
-
-def _mesh_check(ctx, spec, q, tau, rows) -> tuple:
-    """Grid rates up to MESH_CHECK_MAX_HZ again at plant_step / 2:
-    ((rate, agree, {metric: |difference|}), ...) and the RateRows at
-    plant_step / 2."""
-    out, fines = [], []
-    for row in rows:
-        if row.rate > MESH_CHECK_MAX_HZ:
-            continue
-        fine = rate_row(ctx, row.rate, dt_p=spec.plant_step / 2,
-                        predictor_step=spec.predictor_step, q=q, tau=tau)
-        fines.append(fine)
-        diffs, agree = {}, fine.metrics["ok"] == row.metrics["ok"]
-        for k, tol in MESH_ATOL.items():
-            a, b = row.metrics[k], fine.metrics[k]
-            same_nan = math.isnan(a) and math.isnan(b)
-            d = 0.0 if same_nan else abs(a - b)
-            diffs[k] = d
-            agree = agree and (same_nan or d <= tol)
-        out.append((row.rate, agree, diffs))
-    return tuple(out), tuple(fines)
-
-
-def run_variant(ctx: Context, spec: SampledSpec, name: str, q: float, tau: float,
-                keep: dict | None = None) -> Variant:
-    """The grid, the lowest passing rate, its bisection bracket and the mesh
-    check (``keep``: as :func:`rate_row`, for the grid rates)."""
-    kw = dict(dt_p=spec.plant_step, predictor_step=spec.predictor_step, q=q, tau=tau)
-    rows = tuple(rate_row(ctx, f, keep=keep, **kw) for f in spec.rates)
-    min_rate = None
-    for r in reversed(rows):
-        if not r.ok:
-            break
-        min_rate = r.rate
-    probes, bracket = (), (None, min_rate)
-    if min_rate is not None and min_rate > spec.rates[0]:
-        below = spec.rates[spec.rates.index(min_rate) - 1]
-        probes, lo, hi = _bisect(ctx, spec, q, tau, below, min_rate)
-        bracket = (lo, hi)
-    elif min_rate is None:
-        bracket = (spec.rates[-1], None)
-    mesh, fines = _mesh_check(ctx, spec, q, tau, rows)
-    checks, quarter = _three_level(ctx, spec, name, q, tau, rows, fines)
-    return Variant(name, q, tau, rows, probes, min_rate, bracket, mesh, fines,
-                   checks, quarter)
+def scenarios_of(metric: str) -> tuple:
+    """The scenarios (0 traction, 1 braking) a rate metric is computed from."""
+    return NEEDS.get(metric, (0, 1))
 
 
 def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:
     """The sampled section of an ``antiskid-run`` design with ``[sampled]``
     (``ctx``: :func:`workbench.papers.p003.antiskid_run_spec.sampled_context`;
     ``dt``: the design's step, the emulation runs at dt/2): the emulation
-    row, every variant, the Radau check, the traces of the figure."""
+    row, every variant (:func:`workbench.features.rate_sweep.sweep_variant`),
+    the traces of the figure, the Radau check (on the grid's runs and the
+    traces' records)."""
     dt_e = dt / 2
-    emu = rate_row(ctx, 1.0 / dt_e, dt_p=dt_e, predictor_step=0.0, emulation=True)
-    brakes: dict = {}      # the zoh grid's braking runs: those the Radau check locates
-    variants = tuple(run_variant(ctx, spec, *v, keep=brakes if v[0] == "zoh" else None)
-                     for v in spec.variants())
+    decl = declaration(ctx)
+    emu = RS.rate_row(runs_of(ctx, 0.0, emulation=True), decl, 1.0 / dt_e, 0.0, 0.0, dt_e)
+    runs = runs_of(ctx, spec.predictor_step)
+    variants = tuple(RS.sweep_variant(runs, decl, spec.rates, spec.plant_step, name, q, tau,
+                                      bisect=spec.bisect, claimed=spec.three_level)
+                     for name, q, tau in spec.variants())
+    recs = trace_records(ctx, spec, dt_e)
+    shown = tuple(Trace(name, f, rec[:, 0].copy(), rec[:, 2] / ctx.cs.lambda_opt - 1.0)
+                  for name, f, rec in recs)
+    zoh = {f: rec for name, f, rec in recs if name == "zoh"}
     return SampledResult(spec, ctx.cs.lambda_opt, ctx.u_peak, emu, dt_e, variants,
-                         radau_checks(ctx, spec, brakes), traces(ctx, spec, dt_e))
+                         radau_checks(ctx, spec, runs, zoh), shown)
 
 
-def traces(ctx: Context, spec: SampledSpec, dt_e: float) -> tuple:
-    """The first :data:`TRACE_SECONDS` of traction of each variant at
-    :data:`TRACE_RATES_HZ` (grid rates only) and of the emulation."""
+def trace_records(ctx: Context, spec: SampledSpec, dt_e: float) -> list:
+    """[(variant, rate, mesh record), ...]: the first :data:`TRACE_SECONDS`
+    of traction of each variant at :data:`TRACE_RATES_HZ` (grid rates only)
+    and of the emulation."""
     runs = [(name, f, dict(q=q, tau=tau, dt_p=spec.plant_step,
                            predictor_step=spec.predictor_step))
             for name, q, tau in spec.variants() for f in TRACE_RATES_HZ if f in spec.rates]
@@ -400,47 +272,25 @@ def traces(ctx: Context, spec: SampledSpec, dt_e: float) -> tuple:
         cap = int(TRACE_SECONDS / min(kw["dt_p"], 1.0 / f)) * 3 + 16
         _, (rec, _) = run_once(ctx, f, 0, record=(0.0, TRACE_SECONDS, cap),
                                t_cap=TRACE_SECONDS, **kw)
-        out.append(Trace(name, f, rec[:, 0].copy(), rec[:, 2] / ctx.cs.lambda_opt - 1.0))
-    return tuple(out)
-
-
-def _q(x):
-    """A quantity value: None for NaN."""
-    return None if isinstance(x, float) and math.isnan(x) else x
+        out.append((name, f, rec))
+    return out
 
 
 def sampled_quantity_names(spec: SampledSpec) -> set[str]:
     """The ``sampled.*`` quantities a design with ``[sampled]`` has."""
     names = {f"sampled.emulation.{m}" for m in RATE_METRICS} | set(RADAU_QUANTITIES)
     for name, _, _ in spec.variants():
-        b = f"sampled.{name}"
-        names |= {f"{b}.min_rate", f"{b}.bracket_low", f"{b}.bracket_high",
-                  f"{b}.mesh_converged"}
-        names |= {f"{b}.gap_to_emulation.{m}" for m in GAP_METRICS}
-        names |= {f"{b}.rate[{f:g}].{m}" for f in spec.rates
-                  for m in RATE_METRICS + ("stop_time_minus_emulation",
-                                           "stop_distance_minus_emulation")}
+        names |= RS.quantity_names("sampled", name, spec.rates, RATE_METRICS, "emulation",
+                                   GAP_METRICS, TO_EMULATION)
     return names
 
 
 def sampled_quantities(res: SampledResult) -> dict:
     """Values of :func:`sampled_quantity_names`."""
-    q = {f"sampled.emulation.{m}": _q(res.emulation.metrics[m]) for m in RATE_METRICS}
+    emu = res.emulation.metrics
+    q = {f"sampled.emulation.{m}": RS.quantity_value(emu[m]) for m in RATE_METRICS}
     q.update(radau_quantities(res.radau, res.lambda_opt))
     for v in res.variants:
-        b = f"sampled.{v.name}"
-        q[f"{b}.min_rate"] = v.min_rate
-        q[f"{b}.bracket_low"], q[f"{b}.bracket_high"] = v.bracket
-        q[f"{b}.mesh_converged"] = "yes" if v.mesh_converged else None
-        top = v.rows[-1].metrics
-        for m in GAP_METRICS:
-            q[f"{b}.gap_to_emulation.{m}"] = _q(abs(top[m] - res.emulation.metrics[m]))
-        emu_stop = res.emulation.metrics["braking_duration"]
-        emu_dist = res.emulation.metrics["stop_distance"]
-        for r in v.rows:
-            q.update({f"{b}.rate[{r.rate:g}].{m}": _q(r.metrics[m]) for m in RATE_METRICS})
-            q[f"{b}.rate[{r.rate:g}].stop_time_minus_emulation"] = _q(
-                r.metrics["braking_duration"] - emu_stop)
-            q[f"{b}.rate[{r.rate:g}].stop_distance_minus_emulation"] = _q(
-                r.metrics["stop_distance"] - emu_dist)
+        q.update(RS.quantities("sampled", v, RATE_METRICS, "emulation", emu, GAP_METRICS,
+                               TO_EMULATION))
     return q

@@ -4,11 +4,10 @@ Radau (issue 20).
 The sampled loop (:mod:`.antiskid_sampled_kernel`) integrates the plant by
 exponential-Euler sub-steps of at most ``plant_step``. Here the torque the
 wheel received in a window of a run (piecewise constant: the held,
-delayed commands) is replayed open loop into
-:func:`scipy.integrate.solve_ivp` (``method="Radau"``, an implicit,
-stiffly accurate Runge-Kutta method of order 5, tight tolerances), restarted
-at each change of the torque from its own previous end point, and both
-trajectories are compared at every mesh point of the window. The right-hand
+delayed commands) is replayed open loop into scipy's Radau and both
+trajectories are compared at every mesh point of the window (the general
+replay: :mod:`workbench.features.mesh_replay`). What stays here is paper
+003's: the windows, the tolerances and the right-hand side. The right-hand
 side is the lambdified sympy model of :mod:`workbench.sim.wheel_slip` (the
 traction form for lambda >= 0, the braking form otherwise; speed floored as
 the plant step floors it), not a retyped one.
@@ -27,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...features.mesh_replay import replay as mesh_replay
 from ...sim.wheel_slip import model_functions
 from .antiskid_sampled_kernel import run_once
 
@@ -74,48 +74,56 @@ def _rhs(p, u):
 def replay(p, rec: np.ndarray) -> tuple[float, float, int]:
     """(max |d lambda|, max |d v| / v, pieces) of the mesh record ``rec``
     (rows t, v, lambda, torque over the sub-step ending at t) against Radau
-    from its first row."""
-    from scipy.integrate import solve_ivp
-    x = rec[0, 1:3].copy()
-    dl = dv = 0.0
-    i, n, pieces = 1, len(rec), 0
-    while i < n:
-        j = i
-        while j + 1 < n and rec[j + 1, 3] == rec[i, 3]:
-            j += 1
-        ts = rec[i:j + 1, 0]
-        sol = solve_ivp(_rhs(p, rec[i, 3]), (rec[i - 1, 0], ts[-1]), x, method="Radau",
-                        t_eval=ts, rtol=RTOL, atol=ATOL)
-        if not sol.success:
-            return math.nan, math.nan, pieces
-        dl = max(dl, float(np.max(np.abs(sol.y[1] - rec[i:j + 1, 2]))))
-        dv = max(dv, float(np.max(np.abs(sol.y[0] - rec[i:j + 1, 1]) / rec[i:j + 1, 1])))
-        x = sol.y[:, -1]
-        i, pieces = j + 1, pieces + 1
+    from its first row (:func:`workbench.features.mesh_replay.replay`)."""
+    (_, dl), (dv, _), pieces = mesh_replay(lambda u: _rhs(p, u), rec, RTOL, ATOL)
     return dl, dv, pieces
 
 
-def radau_checks(ctx, spec, brakes: dict | None = None) -> tuple:
+def _window(rec: np.ndarray, t0: float, t1: float) -> np.ndarray:
+    """The rows of a mesh record with t0 <= t <= t1 (the kernel's own test):
+    what a run recording only that window records."""
+    return rec[(rec[:, 0] >= t0) & (rec[:, 0] <= t1)]
+
+
+def radau_checks(ctx, spec, runs=None, traction: dict | None = None) -> tuple:
     """:class:`RadauCheck` of every window at every rate of
     :data:`RADAU_RATES_HZ` in the design's grid (``zoh``, unquantised).
-    ``brakes``: rate -> kernel outputs of the ``zoh`` grid's braking run
-    (the run that locates the braking windows; run here when absent)."""
+
+    ``runs``: the section's :class:`workbench.features.rate_sweep.Runs` (the
+    grid's braking run locates the braking windows; made here when absent);
+    ``traction``: rate -> mesh record of the first seconds of the ``zoh``
+    traction run from t = 0 (the figure's traces), which holds the traction
+    window. Both braking windows come from one recorded run; the kernel's
+    mesh before the end of a record does not depend on where the run or the
+    record ends, so the windows are those of separate runs (issue 36)."""
     out = []
     for rate in (f for f in RADAU_RATES_HZ if f in spec.rates):
         kw = dict(dt_p=spec.plant_step, predictor_step=spec.predictor_step)
-        brake = (brakes or {}).get(rate) or run_once(ctx, rate, 1, **kw)[0]
+        brake = (runs(rate, 1, 0.0, 0.0, spec.plant_step) if runs is not None
+                 else run_once(ctx, rate, 1, **kw)[0])
         length = WINDOW_SAMPLES / rate
+        # the traction window starts and ends on sample times (h, h + 40 samples):
+        # whether those mesh points are recorded depended on the last bit of h, so
+        # every window starts and ends half a mesh step earlier (issue 36 item 5)
+        half = 0.5 * min(spec.plant_step, 1.0 / rate)
         starts = (ctx.h, brake["t_omega3"] - length / 2, brake["t_stop"] - length)
-        for name, t0, scen in zip(WINDOWS, starts, (0, 1, 1)):
-            if math.isnan(t0):
+        wins = [(name, t0 - half, t0 + length - half, scen)
+                for name, t0, scen in zip(WINDOWS, starts, (0, 1, 1)) if not math.isnan(t0)]
+        recs = {}
+        for scen in (0, 1):
+            mine = [(a, b) for _, a, b, s in wins if s == scen]
+            if not mine:
                 continue
-            cap = int(length / spec.plant_step * 1.5) + 4 * int(length * rate) + 16
-            # the traction window starts and ends on sample times (h, h + 40 samples):
-            # whether those mesh points are recorded depended on the last bit of h, so
-            # every window starts and ends half a mesh step earlier (issue 36 item 5)
-            half = 0.5 * min(spec.plant_step, 1.0 / rate)
-            _, (rec, _) = run_once(ctx, rate, scen, record=(t0 - half, t0 + length - half, cap),
-                                   **kw)
+            a, b = min(a for a, _ in mine), max(b for _, b in mine)
+            have = (traction or {}).get(rate) if scen == 0 else None
+            # the stretch holding b ends by b + 1 / rate: before the record's run ended
+            if have is not None and len(have) and have[0, 0] <= a and b + 2 / rate <= have[-1, 0]:
+                recs[scen] = have
+                continue
+            cap = int((b - a) / spec.plant_step * 1.5) + 4 * int((b - a) * rate) + 16
+            recs[scen] = run_once(ctx, rate, scen, record=(a, b, cap), **kw)[1][0]
+        for name, a, b, scen in wins:
+            rec = _window(recs[scen], a, b)
             if len(rec) < 2:
                 continue
             dl, dv, pieces = replay(ctx.plant, rec)

@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
+from ...features import rate_sweep_render as RR
+from ...features.rate_sweep_render import bound
 from ...printed_grid import printed_digits
 from ...report.markdown import Figure, fmt, md_table
-from ...sim.convergence import P_MAX, P_MIN
 from .antiskid_sampled import MESH_ATOL, MESH_CHECK_MAX_HZ, TRACE_SECONDS
 from .antiskid_sampled_check import RTOL, WINDOW_SAMPLES
 from .antiskid_sampled_kernel import BRAKING_LEAD, EVS_SETTLE, TRACTION_TAIL
@@ -98,12 +97,8 @@ def sampled_section(res, rail: str) -> str:
     head = ["f_c (Hz)", "max λ/λ_opt", f"time λ > λ_opt (1 + {fmt(sp.creep_margin)}) (s)",
             "time to v_d (s)", "traction", "t_brake → stop (s)", "stop distance (m)",
             "min λ, braking", "max e_vs (m/s)", "max |u| / T_adh", "braking"]
-    tables = []
-    for v in res.variants:
-        rows = [_row(f"{EMULATION}, dt/2 = {fmt(res.emulation_dt)} s", res.emulation.metrics)]
-        for r in sorted(v.rows + v.probes, key=lambda r: r.rate):
-            rows.append(_row(fmt(r.rate) + (" (bisection)" if r.probe else ""), r.metrics))
-        tables.append(f"**{variant_label(v)}**\n\n" + md_table(head, rows, "l" + "r" * 10))
+    tables = RR.rate_tables(res.variants, variant_label, head, _row, _row(
+        f"{EMULATION}, dt/2 = {fmt(res.emulation_dt)} s", res.emulation.metrics))
     return (
         f"## {HEADING}\n\n"
         "The other sections run the laws as an *emulation*: the law is evaluated at every "
@@ -154,65 +149,18 @@ TRACE_CAPTION = (
     "falls; dotted: the requirement.")
 
 
-def bound(x: float) -> str:
-    """A small non-negative difference as the next power of ten above it
-    ("< 1e-6"; "0" for none): its leading digit moves with the CPU's
-    floating-point contractions, its size does not."""
-    if x == 0:
-        return "0"
-    if not x > 0:
-        return fmt(x)
-    return "< " + fmt(10.0 ** (math.floor(math.log10(x)) + 1))
-
-
-def _level(x) -> str:
-    if isinstance(x, str):
-        return x
-    return fmt(None if math.isnan(x) else x, printed_digits(x, 5))
-
-
 def three_level_text(res) -> str:
-    """*Mesh, three levels*: the claimed rate metrics at plant_step, /2, /4
-    (:class:`~workbench.papers.p003.antiskid_sampled.ThreeLevel`)."""
-    sp = res.spec
-    rows = []
-    for v in res.variants:
-        for t in v.three_level:
-            est = "—" if t.estimate is None else bound(t.estimate)
-            out = "converged" if t.converged else f"**{t.reason()}**"
-            rows.append([variant_label(v), fmt(t.rate), f"`{t.metric}`",
-                         *(_level(x) for x in t.values), est,
-                         "equal" if t.tolerance is None else fmt(t.tolerance), out])
-    ps = fmt(1e3 * sp.plant_step)
-    text = (
-        f"*Mesh, three levels*: every rate metric a claim of the design compares, at a grid "
-        f"rate up to {fmt(MESH_CHECK_MAX_HZ)} Hz, at plant_step = {ps} ms (the grid's run), "
-        "plant_step/2 (the screen's run) and plant_step/4 (run for this check, only the "
-        "scenario the metric needs: traction or braking). Richardson estimate of the error "
-        "of the plant_step/4 value from the observed order p = log2(|q1 − q2| / |q2 − q4|), "
-        f"p clipped to [{fmt(P_MIN)}, {fmt(P_MAX)}]; levels whose differences change sign are "
-        f"estimated from the larger difference at order {fmt(P_MIN)}. A metric has converged when its estimate is within "
-        "the screen's tolerance (0, rounding only, for a metric without one), an outcome "
-        "when it is the same at the three levels; a variant's mesh claim holds when both "
-        "checks do, and is INCONCLUSIVE (not converged) otherwise. Estimates are printed as "
-        "the next power of ten above them. Not covered by either mesh check: the metrics "
-        "claims compare above 1 kHz (the gaps to the emulation at the top rate), the lowest "
-        "passing rate and the bisection brackets (outcomes at 2 and 5 kHz and at the "
-        "bisection rates).")
-    if not rows:
-        return text + " No claim compares a rate metric at such a rate."
-    return text + "\n\n" + md_table(
-        ["variant", "f_c (Hz)", "metric", "plant_step", "/2", "/4", "estimate", "tolerance",
-         "outcome"], rows, "lrlrrrrrl")
+    """*Mesh, three levels* (:func:`workbench.features.rate_sweep_render.three_level_text`)."""
+    return RR.three_level_text(
+        res.variants, variant_label, max_rate=MESH_CHECK_MAX_HZ, step=res.spec.plant_step,
+        scenarios="traction or braking", not_covered=(
+            "the metrics claims compare above 1 kHz (the gaps to the emulation at the top "
+            "rate), the lowest passing rate and the bisection brackets (outcomes at 2 and 5 "
+            "kHz and at the bisection rates)"))
 
 
 def _checks_text(res) -> str:
     sp = res.spec
-    mesh = []
-    for v in res.variants:
-        for rate, agree, diffs in v.mesh:
-            mesh.append([variant_label(v), fmt(rate), "yes" if agree else "**no**"]
-                        + [bound(diffs[k]) for k in MESH_ATOL])
     radau = [[fmt(c.rate), c.window, f"{fmt(c.t0, 5)}–{fmt(c.t1, 5)}",
               f"{fmt(c.v_lo, 2)}–{fmt(c.v_hi, 2)}", str(c.pieces),
               bound(c.max_dlam / res.lambda_opt), bound(c.max_dv_rel)] for c in res.radau]
@@ -222,8 +170,7 @@ def _checks_text(res) -> str:
         f"{fmt(MESH_CHECK_MAX_HZ)} Hz again with sub-steps of at most "
         f"{fmt(1e3 * sp.plant_step / 2)} ms; largest differences of the metrics (tolerances: "
         f"{tol}; the outcomes must agree):\n\n"
-        + md_table(["variant", "f_c (Hz)", "agree"] + list(MESH_ATOL), mesh, "lrl" + "r" *
-                   len(MESH_ATOL))
+        + RR.mesh_table(res.variants, variant_label, MESH_ATOL)
         + "\n\n" + three_level_text(res)
         + "\n\n*Radau*: the torque the wheel received in a window of "
         f"{WINDOW_SAMPLES} samples (ZOH variant) replayed into scipy's "
@@ -251,12 +198,6 @@ def trace_figure(res) -> Figure:
                   lambda fig, res=res: plot_traces(fig, res), (7.0, 4.0))
 
 
-def _series(v, key):
-    rows = sorted(v.rows + v.probes, key=lambda r: r.rate)
-    return (np.array([r.rate for r in rows]), np.array([r.metrics[key] for r in rows]),
-            rows)
-
-
 def plot_sampled(fig, res):
     axes = fig.subplots(2, 2, sharex=True).ravel()
     keys = (("lam_max_over_opt", "max λ / λ_opt − 1, traction (symlog)", "traction"),
@@ -265,19 +206,10 @@ def plot_sampled(fig, res):
             ("stop_distance", "stop distance (m)", "braking"))
     shift = {"lam_max_over_opt": 1.0}          # the top left panel shows the excess over 1
     for ax, (key, label, which) in zip(axes, keys):
-        d = shift.get(key, 0.0)
-        for v in res.variants:
-            f, y, rows = _series(v, key)
-            c = _COLORS.get(v.name, "tab:green")
-            ax.plot(f, y - d, "o-", color=c, ms=3, label=variant_label(v))
-            bad = [r.rate for r in rows if not math.isnan(r.metrics[f"{which}_diverged"])]
-            if bad:     # a diverged run: a cross at the top of the panel
-                ax.plot(bad, [0.97] * len(bad), "x", color=c, ms=7,
-                        transform=ax.get_xaxis_transform())
-        e = res.emulation.metrics[key]
-        if not math.isnan(e):
-            ax.axhline(e - d, color="k", ls="--", lw=0.8, label=EMULATION)
-        ax.set_xscale("log")
+        RR.plot_rate_metric(ax, res.variants, key, f"{which}_diverged",
+                            lambda v: _COLORS.get(v.name, "tab:green"), variant_label,
+                            shift=shift.get(key, 0.0), reference=res.emulation.metrics[key],
+                            reference_label=EMULATION)
         ax.set_ylabel(label)
     m = res.spec.creep_margin
     axes[0].axhline(0.0, color="grey", lw=0.8, label="λ_opt")

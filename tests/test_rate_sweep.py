@@ -1,0 +1,168 @@
+"""The general rate sweep (:mod:`workbench.features.rate_sweep`) on a system
+of no paper: an unstable first-order plant x' = a x + u + d under a sampled
+proportional law u = -k x(t_k), quantised and held (ZOH), the plant stepped
+by explicit Euler on sub-steps of at most ``step``.
+
+With exact ZOH the loop contracts per sample by |e^{aT} - k (e^{aT} - 1) / a|;
+for a = 10, k = 30 it is stable for T < ln 2 / 10, rates above
+10 / ln 2 = 14.43 Hz."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from workbench.features import rate_sweep as RS
+from workbench.sim.convergence import CONVERGED
+
+A, K, T_END = 10.0, 30.0, 1.0
+BOUNDARY_HZ = A / math.log(2.0)
+
+
+def toy_run(rate, scenario, q, tau, step):
+    """Scenario 0: from x = 1, no disturbance; 1: from 0, d = 1. Outputs:
+    |x| at the end and its largest value."""
+    assert tau == 0.0
+    x, d = (1.0, 0.0) if scenario == 0 else (0.0, 1.0)
+    t, peak, k_next, u = 0.0, abs(x), 0, 0.0
+    T = 1.0 / rate
+    while t < T_END - 1e-12:
+        if t >= k_next * T - 1e-12:           # a sample: the law, quantised, held
+            u = -K * x
+            u = q * round(u / q) if q else u
+            k_next += 1
+        t_next = min(k_next * T, T_END)
+        n = max(1, math.ceil((t_next - t) / step - 1e-9))
+        h = (t_next - t) / n
+        for _ in range(n):
+            x += h * (A * x + u + d)
+            peak = max(peak, abs(x))
+        t = t_next
+    return {"x_end": abs(x), "peak": peak}
+
+
+def combine(got):
+    nan = {"x_end": math.nan, "peak": math.nan}
+    s0, s1 = got[0] or nan, got[1] or nan
+    ok0, ok1 = s0["x_end"] < 1.0, s1["peak"] < 10.0
+    return {"x_end": s0["x_end"], "peak": s1["peak"], "decays": "yes" if ok0 else "no",
+            "bounded": "yes" if ok1 else "no", "ok": "yes" if ok0 and ok1 else "no"}
+
+
+DECL = RS.RateMetrics(("x_end", "peak", "decays", "bounded", "ok"), (0, 1), combine,
+                      {"x_end": (0,), "decays": (0,), "peak": (1,), "bounded": (1,)},
+                      {"x_end": 1e-2}, mesh_max_rate=50.0)
+RATES = (5.0, 10.0, 20.0, 50.0, 100.0)
+
+
+def _counted():
+    calls = []
+
+    def run(*key):
+        calls.append(key)
+        return toy_run(*key)
+    return RS.Runs(run), calls
+
+
+def test_the_sweep_brackets_the_stability_boundary_of_a_toy_loop():
+    runs, calls = _counted()
+    claimed = RS.claimed_rate_metrics(
+        "toy", ["p"], RATES, DECL.names, DECL.mesh_max_rate,
+        [{"quantity": "toy.p.rate[20].x_end"}, {"quantity": "toy.p.rate[100].x_end"},
+         {"quantity": "toy.p.rate[50].decays"}, {"quantity": "toy.q.rate[20].x_end"}])
+    assert claimed == (("p", 20.0, "x_end"), ("p", 50.0, "decays"))   # 100 Hz: above the max
+    v = RS.sweep_variant(runs, DECL, RATES, 1e-4, "p", 0.0, 0.0, bisect=4, claimed=claimed)
+    assert [r.ok for r in v.rows] == [False, False, True, True, True]
+    assert v.min_rate == 20.0
+    lo, hi = v.bracket
+    assert lo < BOUNDARY_HZ < hi and hi - lo <= 1.0 and lo >= 10.0
+    assert all(r.probe for r in v.probes) and 1 <= len(v.probes) <= 4
+    # the mesh check: grid rates up to 50 Hz at step / 2, Euler's error within 1e-2
+    assert [m[0] for m in v.mesh] == [5.0, 10.0, 20.0, 50.0]
+    assert all(a for r, a, _ in v.mesh if r >= 20.0)
+    # three levels: x_end at 20 Hz converges at order ~1; the 50 Hz outcome agrees
+    by = {(t.rate, t.metric): t for t in v.three_level}
+    t = by[(20.0, "x_end")]
+    assert t.outcome == CONVERGED and t.tolerance == 1e-2 and t.values[0] == v.row(20.0).metrics[
+        "x_end"]
+    assert by[(50.0, "decays")].values == ("yes",) * 3 and by[(50.0, "decays")].converged
+    # the growing runs below the boundary move by more than the tolerance: not converged
+    assert [r for r, a, _ in v.mesh if not a] == [5.0, 10.0] and not v.mesh_converged
+    # step / 4: only the scenario the claimed metric needs, and only its metrics
+    quarter = {r.rate: r for r in v.quarter_rows}
+    assert set(quarter[20.0].metrics) == {"x_end", "decays"}
+    assert sum(1 for c in calls if c[4] == 1e-4 / 4) == 2         # 20 Hz and 50 Hz, scenario 0
+    assert len(calls) == len(set(calls)) == runs.made
+
+
+def test_runs_shared_between_sweeps_are_made_once():
+    runs, calls = _counted()
+    a = RS.sweep_variant(runs, DECL, RATES, 1e-4, "p", 0.0, 0.0, bisect=2)
+    n = len(calls)
+    b = RS.sweep_variant(runs, DECL, RATES, 1e-4, "p", 0.0, 0.0, bisect=2)
+    assert a == b and len(calls) == n
+    # a quantised variant is a different run, and coarse quantisation loses the loop
+    coarse = RS.sweep_variant(runs, DECL, RATES, 1e-4, "q", 40.0, 0.0, bisect=0)
+    assert len(calls) > n and coarse.row(100.0).metrics["x_end"] != a.row(100.0).metrics[
+        "x_end"]
+    # a partial row has the numbers of the full row, bit for bit
+    full = RS.rate_row(runs, DECL, 20.0, 0.0, 0.0, 1e-4).metrics
+    part = RS.partial_row(runs, DECL, 20.0, (1,), 0.0, 0.0, 1e-4).metrics
+    assert set(part) == {"peak", "bounded"} and all(part[k] == full[k] for k in part)
+
+
+def test_a_grid_failing_at_the_top_has_no_lowest_rate():
+    runs, _ = _counted()
+    v = RS.sweep_variant(runs, DECL, (2.0, 5.0, 10.0), 1e-3, "p", 0.0, 0.0)
+    assert v.min_rate is None and v.bracket == (10.0, None) and v.probes == ()
+
+
+@pytest.mark.parametrize("values, outcome", [
+    ((1.0, 0.5, 0.25), "NOT_CONVERGED"), ((1.0, 1.0 + 1e-9, 1.0 + 1.5e-9), CONVERGED),
+    (("yes", "no", "no"), "NOT_CONVERGED"), ((math.nan, 1.0, 1.0), "INCONCLUSIVE")])
+def test_three_level_check_outcomes(values, outcome):
+    t = RS.three_level_check("p", 20.0, "x_end", values, 1e-3)
+    assert t.outcome == outcome
+    assert (t.reason() == "") == (outcome == CONVERGED)
+    assert np.isfinite(t.rate)
+
+
+def test_mesh_replay_agrees_with_an_exact_record_and_sees_a_tampered_one():
+    """x' = -x + u under a held input, recorded at the exact solution on a
+    mesh: Radau agrees within its tolerance; a state moved by hand is seen."""
+    from workbench.features.mesh_replay import replay
+    t = np.linspace(0.0, 1.0, 101)
+    u = np.where(t <= 0.5, 1.0, -1.0)      # the input over the sub-step ending at t
+    x = np.empty_like(t)
+    x[0] = 2.0
+    for i in range(1, len(t)):
+        x[i] = u[i] + (x[i - 1] - u[i]) * math.exp(-(t[i] - t[i - 1]))
+    rec = np.column_stack([t, x, u])
+    d_abs, d_rel, pieces = replay(lambda v: lambda s, y: -y + v, rec, 1e-10, 1e-12)
+    assert pieces == 2 and d_abs[0] <= 1e-8 and d_rel[0] <= 1e-7
+    bad = rec.copy()
+    bad[70:, 1] += 1e-4
+    assert replay(lambda v: lambda s, y: -y + v, bad, 1e-10, 1e-12)[0][0] >= 0.9e-4
+
+
+def test_variants_of_a_sweep():
+    assert RS.variants(0.0, 0.0) == (("zoh", 0.0, 0.0),)
+    assert RS.variants(8.0, 0.0) == (("zoh", 0.0, 0.0), ("zoh_q_tau", 8.0, 0.0))
+    assert RS.variants(0.0, 0.002)[1] == ("zoh_q_tau", 0.0, 0.002)
+
+
+def test_quantities_of_a_toy_variant():
+    runs, _ = _counted()
+    v = RS.sweep_variant(runs, DECL, RATES, 1e-3, "p", 0.0, 0.0, bisect=0)
+    ref = {"x_end": 0.0}
+    q = RS.quantities("toy", v, ("x_end", "ok"), "reference", ref, ("x_end",),
+                      {"x_end_minus_reference": "x_end"})
+    names = RS.quantity_names("toy", "p", RATES, ("x_end", "ok"), "reference", ("x_end",),
+                              {"x_end_minus_reference": "x_end"})
+    assert set(q) == names
+    assert q["toy.p.min_rate"] == 20.0 and q["toy.p.bracket_low"] == 10.0
+    assert q["toy.p.rate[100].ok"] == "yes" and q["toy.p.mesh_converged"] is None
+    assert q["toy.p.gap_to_reference.x_end"] == v.row(100.0).metrics["x_end"]
+    assert q["toy.p.rate[20].x_end_minus_reference"] == q["toy.p.rate[20].x_end"]
+    assert RS.quantity_value(math.nan) is None and RS.quantity_value("no") == "no"

@@ -1,0 +1,62 @@
+"""An independent check of a sampled loop's plant mesh: the input the plant
+received in a window (piecewise constant: held commands) replayed open loop
+into :func:`scipy.integrate.solve_ivp` (``method="Radau"``, an implicit,
+stiffly accurate Runge-Kutta method of order 5), restarted at each change
+of the input from its own previous end point, and compared with the mesh at
+every mesh point (issue 20, made general in issue 35).
+
+A record is an array with rows (t, x_1, ..., x_n, u): the state at the end
+of a sub-step and the input held over the sub-step ending at t; its first
+row is the initial state. Test on a system of no paper:
+``tests/test_rate_sweep.py``.
+"""
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+__all__ = ["replay"]
+
+
+def replay(rhs: Callable, rec: np.ndarray, rtol: float, atol) -> tuple:
+    """Replay the mesh record ``rec`` against Radau from its first row.
+
+    Parameters
+    ----------
+    rhs : callable
+        ``rhs(u)`` -> ``f(t, x)``, the right-hand side under the constant
+        input u.
+    rec : ndarray
+        Rows (t, x_1, ..., x_n, u).
+    rtol, atol
+        The tolerances of :func:`scipy.integrate.solve_ivp`.
+
+    Returns
+    -------
+    (abs, rel, pieces)
+        Per state, the largest |x_mesh - x_Radau| and |x_mesh - x_Radau| /
+        x_mesh (tuples; NaN when Radau fails), and the input pieces replayed.
+    """
+    from scipy.integrate import solve_ivp
+    n_x = rec.shape[1] - 2
+    x = rec[0, 1:1 + n_x].copy()
+    d_abs, d_rel = [0.0] * n_x, [0.0] * n_x
+    i, n, pieces = 1, len(rec), 0
+    while i < n:
+        j = i
+        while j + 1 < n and rec[j + 1, -1] == rec[i, -1]:
+            j += 1
+        ts = rec[i:j + 1, 0]
+        sol = solve_ivp(rhs(rec[i, -1]), (rec[i - 1, 0], ts[-1]), x, method="Radau",
+                        t_eval=ts, rtol=rtol, atol=atol)
+        if not sol.success:
+            return (np.nan,) * n_x, (np.nan,) * n_x, pieces
+        for k in range(n_x):
+            diff = np.abs(sol.y[k] - rec[i:j + 1, 1 + k])
+            d_abs[k] = max(d_abs[k], float(np.max(diff)))
+            with np.errstate(divide="ignore", invalid="ignore"):    # a state through 0
+                d_rel[k] = max(d_rel[k], float(np.max(diff / rec[i:j + 1, 1 + k])))
+        x = sol.y[:, -1]
+        i, pieces = j + 1, pieces + 1
+    return tuple(d_abs), tuple(d_rel), pieces

@@ -1,0 +1,372 @@
+"""A controller sampled at a grid of rates f_c: which rates meet the
+requirements, the smallest one, and whether the plant's mesh is fine enough
+(issue 20, made general in issue 35).
+
+The model is a callback ``run(rate, scenario, q, tau, step) -> outputs``:
+one scenario of the sampled loop at f_c = ``rate`` (Hz), its commands rounded
+to multiples of ``q``, its measurements ``tau`` s old, the plant integrated
+on a mesh of sub-steps of at most ``step``, returning a dict of outputs. The
+metric declarations (:class:`RateMetrics`) say which scenarios a rate runs,
+how the metrics of a rate follow from their outputs, which scenarios each
+metric needs and the tolerances of the mesh check. The metrics of a rate
+always include ``ok``, "yes" when the rate meets every requirement.
+
+Every run goes through a :class:`Runs` memo keyed on (rate, scenario, q, tau,
+step), so a run that the table, the bisection, the mesh check, the three
+levels or a caller share is made once (issue 36).
+
+For one variant (q, tau) (:func:`sweep_variant`):
+
+* the grid: every rate, every scenario, at ``step``;
+* the lowest passing rate: the lowest grid rate from which every higher
+  grid rate passes; between it and the grid rate below, ``bisect`` steps on
+  log f_c (geometric midpoints rounded to whole Hz, assuming one crossing)
+  give a bracket;
+* the mesh check (a two-level screen): every grid rate up to
+  ``mesh_max_rate`` again at ``step`` / 2, each metric of ``mesh_atol``
+  within its tolerance and the verdict the same;
+* the three-level check (issue 33 item 4): every claimed
+  ``(variant, rate, metric)`` at ``step`` (the grid's run), ``step`` / 2 (the
+  screen's run) and ``step`` / 4 (only the scenarios the metric needs), with
+  a Richardson estimate of its error (:func:`three_level_check`).
+
+Test on a system of no paper: ``tests/test_rate_sweep.py`` (a first-order
+loop with a sampled proportional law).
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from typing import Callable, Mapping
+
+from ..refinement import guarded_check
+from ..sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
+
+__all__ = ["RateMetrics", "Runs", "RateRow", "Variant", "ThreeLevel", "three_level_check",
+           "rate_row", "partial_row", "sweep_variant", "claimed_rate_metrics", "variants",
+           "quantity_names", "quantities", "quantity_value"]
+
+
+def variants(q: float, tau: float) -> tuple:
+    """((name, q, tau), ...): ``zoh`` (exact, current samples, unquantised),
+    and ``zoh_q_tau`` (commands quantised to ``q``, measurements ``tau``
+    old) when either is not 0."""
+    return (("zoh", 0.0, 0.0),) + ((("zoh_q_tau", q, tau),) if q or tau else ())
+
+
+@dataclass(frozen=True)
+class RateMetrics:
+    """The metric declarations of a rate sweep.
+
+    ``names``: the metrics of a rate (quantities ``<prefix>.<variant>.rate[<f>].<name>``);
+    ``scenarios``: the scenarios a rate runs; ``combine``: {scenario: outputs
+    or None (not run)} -> the metrics of a rate (``names``, ``ok`` and any
+    others the rendering needs); ``needs``: metric -> the scenarios it is
+    computed from (absent: every scenario); ``mesh_atol``: metric -> largest
+    difference between ``step`` and ``step`` / 2 (the mesh check);
+    ``mesh_max_rate``: the mesh and three-level checks cover grid rates up
+    to this (Hz)."""
+
+    names: tuple
+    scenarios: tuple
+    combine: Callable[[dict], dict]
+    needs: Mapping[str, tuple] = field(default_factory=dict)
+    mesh_atol: Mapping[str, float] = field(default_factory=dict)
+    mesh_max_rate: float = math.inf
+
+    def scenarios_of(self, metric: str) -> tuple:
+        """The scenarios ``metric`` is computed from."""
+        return tuple(self.needs.get(metric, self.scenarios))
+
+
+class Runs:
+    """``run(rate, scenario, q, tau, step)`` made once per distinct call.
+
+    Parameters
+    ----------
+    run : callable
+        The model (module docstring); its outputs are shared between the
+        callers, which must not change them.
+    """
+
+    def __init__(self, run: Callable):
+        self._run, self._done = run, {}
+
+    def __call__(self, rate: float, scenario, q: float, tau: float, step: float):
+        key = (rate, scenario, q, tau, step)
+        if key not in self._done:
+            self._done[key] = self._run(rate, scenario, q, tau, step)
+        return self._done[key]
+
+    @property
+    def made(self) -> int:
+        """Runs made (distinct calls)."""
+        return len(self._done)
+
+
+@dataclass(frozen=True)
+class RateRow:
+    """The metrics of one rate (``probe``: a bisection rate, not on the grid)."""
+
+    rate: float
+    metrics: dict
+    probe: bool = False
+
+    @property
+    def ok(self) -> bool:
+        return self.metrics["ok"] == "yes"
+
+
+@dataclass(frozen=True)
+class ThreeLevel:
+    """A claimed rate metric at plant_step, plant_step / 2, plant_step / 4.
+
+    ``values``: (q1, q2, q4); ``tolerance``: the bound of the Richardson
+    estimate (the mesh check's tolerance of the metric, 0 for a metric
+    without one; None for an outcome, which converges when the three levels
+    agree); ``outcome``: a :mod:`workbench.sim.convergence` outcome;
+    ``estimate``: the Richardson estimate of the error of q4 (None for an
+    outcome); ``note``: why an estimate was guarded (empty otherwise)."""
+
+    variant: str
+    rate: float
+    metric: str
+    values: tuple
+    tolerance: float | None
+    outcome: str
+    estimate: float | None = None
+    note: str = ""
+
+    @property
+    def converged(self) -> bool:
+        return self.outcome == CONVERGED
+
+    def reason(self) -> str:
+        """``not converged: ...`` (empty when converged)."""
+        if self.converged:
+            return ""
+        shown = " / ".join(str(x) if isinstance(x, str) else f"{x:.6g}" for x in self.values)
+        est = "" if self.estimate is None else (f", estimate {self.estimate:.2g} > tolerance "
+                                                f"{self.tolerance:.2g}")
+        return (f"not converged: {self.variant} {self.rate:g} Hz {self.metric} is {shown} at "
+                f"plant_step, /2, /4{est}" + (f" ({self.note})" if self.note else ""))
+
+
+def three_level_check(variant: str, rate: float, metric: str, values: tuple,
+                      tolerance: float = 0.0) -> ThreeLevel:
+    """The three-level check of one rate metric (``values`` at plant_step,
+    /2, /4): an outcome converges when the three agree; a number when every
+    level is NaN (not reached), or by
+    :func:`workbench.refinement.guarded_check` within ``tolerance`` (the
+    mesh check's; 0, rounding only, for a metric without one); NaN at some
+    levels only is INCONCLUSIVE."""
+    if any(isinstance(x, str) for x in values):
+        same = len(set(values)) == 1
+        return ThreeLevel(variant, rate, metric, values, None,
+                          CONVERGED if same else NOT_CONVERGED)
+    nans = sum(math.isnan(x) for x in values)
+    if nans:
+        return ThreeLevel(variant, rate, metric, values, tolerance,
+                          CONVERGED if nans == 3 else INCONCLUSIVE, None,
+                          "" if nans == 3 else "reached at some levels only")
+    r = guarded_check(*values, tolerance=tolerance)
+    return ThreeLevel(variant, rate, metric, values, tolerance, r.outcome, r.estimate, r.note)
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One sampled controller (q, tau) over the grid.
+
+    ``min_rate``: lowest grid rate from which every higher grid rate passes
+    (None: the highest fails); ``bracket``: (highest failing, lowest passing)
+    rate known after bisection (None on a side with no rate); ``mesh``:
+    (rate, agree, {metric: |difference|}) of the mesh check; ``mesh_rows``:
+    its RateRows at step / 2; ``three_level``: the :class:`ThreeLevel` check
+    of every claimed rate metric of the variant; ``quarter_rows``: its
+    RateRows at step / 4 (the metrics of the scenarios run only)."""
+
+    name: str
+    q: float
+    tau: float
+    rows: tuple
+    probes: tuple
+    min_rate: float | None
+    bracket: tuple
+    mesh: tuple
+    mesh_rows: tuple = field(default=(), compare=False)
+    three_level: tuple = ()
+    quarter_rows: tuple = field(default=(), compare=False)
+
+    def row(self, rate: float) -> RateRow:
+        return next(r for r in self.rows if r.rate == rate)
+
+    @property
+    def mesh_converged(self) -> bool:
+        """The two-level screen agrees at every rate and every claimed rate
+        metric converged over three levels."""
+        return all(a for _, a, _ in self.mesh) and all(t.converged for t in self.three_level)
+
+    def json(self) -> dict:
+        """The variant as JSON-able values (the mesh check's rows not included)."""
+        rows = lambda rr: [{"rate_hz": r.rate, **r.metrics} for r in rr]    # noqa: E731
+        return {"q": self.q, "tau": self.tau, "rows": rows(self.rows),
+                "probes": rows(self.probes), "min_rate": self.min_rate,
+                "bracket": self.bracket,
+                "three_level": [{"rate_hz": t.rate, "metric": t.metric, "values": t.values,
+                                 "outcome": t.outcome, "estimate": t.estimate,
+                                 "tolerance": t.tolerance} for t in self.three_level]}
+
+
+def rate_row(runs: Runs, decl: RateMetrics, rate: float, q: float, tau: float, step: float,
+             probe: bool = False) -> RateRow:
+    """Every scenario of ``decl`` at one rate."""
+    return RateRow(rate, decl.combine({s: runs(rate, s, q, tau, step)
+                                       for s in decl.scenarios}), probe)
+
+
+def partial_row(runs: Runs, decl: RateMetrics, rate: float, scenarios: tuple, q: float,
+                tau: float, step: float) -> RateRow:
+    """The metrics of ``scenarios`` at one rate: those computed from them
+    alone, from the runs :func:`rate_row` makes (the same calls, the same
+    numbers)."""
+    got = {s: runs(rate, s, q, tau, step) if s in scenarios else None for s in decl.scenarios}
+    m = decl.combine(got)
+    return RateRow(rate, {k: v for k, v in m.items()
+                          if set(decl.scenarios_of(k)) <= set(scenarios)})
+
+
+def _bisect(runs, decl, q, tau, step, lo: float, hi: float, steps: int) -> tuple:
+    """Rates probed between a failing ``lo`` and a passing ``hi`` (Hz),
+    geometric midpoints rounded to whole Hz; returns (probes, lo, hi)."""
+    probes = []
+    for _ in range(steps):
+        mid = float(round(math.sqrt(lo * hi)))
+        if not lo < mid < hi:
+            break
+        row = rate_row(runs, decl, mid, q, tau, step, probe=True)
+        probes.append(row)
+        lo, hi = (lo, mid) if row.ok else (mid, hi)
+    return tuple(probes), lo, hi
+
+
+def _mesh_check(runs, decl, q, tau, step, rows) -> tuple:
+    """Grid rates up to ``mesh_max_rate`` again at step / 2: ((rate, agree,
+    {metric: |difference|}), ...) and the RateRows at step / 2."""
+    out, fines = [], []
+    for row in rows:
+        if row.rate > decl.mesh_max_rate:
+            continue
+        fine = rate_row(runs, decl, row.rate, q, tau, step / 2)
+        fines.append(fine)
+        diffs, agree = {}, fine.metrics["ok"] == row.metrics["ok"]
+        for k, tol in decl.mesh_atol.items():
+            a, b = row.metrics[k], fine.metrics[k]
+            same_nan = math.isnan(a) and math.isnan(b)
+            d = 0.0 if same_nan else abs(a - b)
+            diffs[k] = d
+            agree = agree and (same_nan or d <= tol)
+        out.append((row.rate, agree, diffs))
+    return tuple(out), tuple(fines)
+
+
+def _three_level(runs, decl, name, q, tau, step, claimed, rows, fines) -> tuple:
+    """The claimed rate metrics of variant ``name`` at step (``rows``),
+    step / 2 (``fines``) and step / 4 (run here, the scenarios they need);
+    returns (ThreeLevel rows, RateRows at step / 4)."""
+    need: dict = {}
+    for v, rate, metric in claimed:
+        if v == name:
+            need.setdefault(rate, set()).update(decl.scenarios_of(metric))
+    quarter = tuple(partial_row(runs, decl, rate, tuple(sorted(sc)), q, tau, step / 4)
+                    for rate, sc in sorted(need.items()))
+    by = lambda rr, f: next(r for r in rr if r.rate == f)     # noqa: E731
+    checks = tuple(three_level_check(name, rate, metric, tuple(
+        by(rr, rate).metrics[metric] for rr in (rows, fines, quarter)),
+        decl.mesh_atol.get(metric, 0.0)) for v, rate, metric in claimed if v == name)
+    return checks, quarter
+
+
+def sweep_variant(runs: Runs, decl: RateMetrics, rates: tuple, step: float, name: str,
+                  q: float, tau: float, *, bisect: int = 4, claimed: tuple = ()) -> Variant:
+    """The grid ``rates`` (Hz, increasing), the lowest passing rate, its
+    bisection bracket (``bisect`` steps), the mesh check and the three-level
+    check of the ``claimed`` ((variant, rate, metric), ...) rate metrics of
+    variant ``name`` (module docstring)."""
+    rows = tuple(rate_row(runs, decl, f, q, tau, step) for f in rates)
+    min_rate = None
+    for r in reversed(rows):
+        if not r.ok:
+            break
+        min_rate = r.rate
+    probes, bracket = (), (None, min_rate)
+    if min_rate is not None and min_rate > rates[0]:
+        below = rates[rates.index(min_rate) - 1]
+        probes, lo, hi = _bisect(runs, decl, q, tau, step, below, min_rate, bisect)
+        bracket = (lo, hi)
+    elif min_rate is None:
+        bracket = (rates[-1], None)
+    mesh, fines = _mesh_check(runs, decl, q, tau, step, rows)
+    checks, quarter = _three_level(runs, decl, name, q, tau, step, claimed, rows, fines)
+    return Variant(name, q, tau, rows, probes, min_rate, bracket, mesh, fines, checks, quarter)
+
+
+def claimed_rate_metrics(prefix: str, variants, rates: tuple, names: tuple, max_rate: float,
+                         claims, alias: Mapping[str, str] | None = None) -> tuple:
+    """((variant, rate, metric), ...), sorted: the rate metrics that the
+    ``[[claims]]`` tables ``claims`` (raw TOML tables; a malformed one is
+    skipped here and reported by the claims' own validation) compare as
+    ``<prefix>.<variant>.rate[<f>].<metric>`` (``variants``: their names;
+    ``metric`` in ``names``), at a grid rate up to ``max_rate``; ``alias``: quantity -> the rate metric it moves
+    with (a difference to a reference, say)."""
+    pattern = re.compile(r"^" + re.escape(prefix) + r"\.([a-z_]+)\.rate\[([^\]]+)\]\.([a-z0-9_]+)$")
+    known, alias = set(variants), alias or {}
+    out = set()
+    for c in claims if isinstance(claims, list) else ():
+        m = pattern.match(str(c.get("quantity", ""))) if isinstance(c, dict) else None
+        if m is None or m[1] not in known:
+            continue
+        try:
+            rate = float(m[2])
+        except ValueError:
+            continue
+        metric = alias.get(m[3], m[3])
+        if rate in rates and rate <= max_rate and metric in names:
+            out.add((m[1], rate, metric))
+    return tuple(sorted(out))
+
+
+def quantity_value(x):
+    """A quantity value: None for NaN."""
+    return None if isinstance(x, float) and math.isnan(x) else x
+
+
+def quantity_names(prefix: str, name: str, rates: tuple, metrics: tuple,
+                   reference: str = "", gaps: tuple = (), differences=()) -> set[str]:
+    """The quantities of variant ``name`` (:func:`quantities`)."""
+    b = f"{prefix}.{name}"
+    return ({f"{b}.{k}" for k in ("min_rate", "bracket_low", "bracket_high", "mesh_converged")}
+            | {f"{b}.gap_to_{reference}.{m}" for m in gaps}
+            | {f"{b}.rate[{f:g}].{m}" for f in rates for m in tuple(metrics) + tuple(differences)})
+
+
+def quantities(prefix: str, v: Variant, metrics: tuple, reference: str = "",
+               ref: dict | None = None, gaps: tuple = (), differences=None) -> dict:
+    """The quantities of a variant: ``<prefix>.<name>.min_rate``,
+    ``.bracket_low``, ``.bracket_high``, ``.mesh_converged`` ("yes" or None),
+    ``.gap_to_<reference>.<m>`` (|top grid rate - ``ref``| of each metric of
+    ``gaps``), and per grid rate ``.rate[<f>].<m>`` of ``metrics`` and of
+    ``differences`` (name -> metric: the metric minus ``ref``'s); None for
+    NaN."""
+    b = f"{prefix}.{v.name}"
+    q = {f"{b}.min_rate": v.min_rate}
+    q[f"{b}.bracket_low"], q[f"{b}.bracket_high"] = v.bracket
+    q[f"{b}.mesh_converged"] = "yes" if v.mesh_converged else None
+    top = v.rows[-1].metrics
+    for m in gaps:
+        q[f"{b}.gap_to_{reference}.{m}"] = quantity_value(abs(top[m] - ref[m]))
+    for r in v.rows:
+        q.update({f"{b}.rate[{r.rate:g}].{m}": quantity_value(r.metrics[m]) for m in metrics})
+        for d, m in (differences or {}).items():
+            q[f"{b}.rate[{r.rate:g}].{d}"] = quantity_value(r.metrics[m] - ref[m])
+    return q

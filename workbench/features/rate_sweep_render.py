@@ -1,0 +1,117 @@
+"""Tables, text and figure panels of a rate sweep
+(:mod:`workbench.features.rate_sweep`; pure rendering). The caller gives the
+words of its system: a variant's label, the cells of a rate's row, the
+metrics drawn."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..printed_grid import printed_digits
+from ..report.markdown import fmt, md_table
+from ..sim.convergence import P_MAX, P_MIN
+
+__all__ = ["bound", "rate_tables", "mesh_table", "three_level_text", "plot_rate_metric"]
+
+
+def bound(x: float) -> str:
+    """A small non-negative difference as the next power of ten above it
+    ("< 1e-6"; "0" for none): its leading digit moves with the CPU's
+    floating-point contractions, its size does not."""
+    if x == 0:
+        return "0"
+    if not x > 0:
+        return fmt(x)
+    return "< " + fmt(10.0 ** (math.floor(math.log10(x)) + 1))
+
+
+def _level(x) -> str:
+    if isinstance(x, str):
+        return x
+    return fmt(None if math.isnan(x) else x, printed_digits(x, 5))
+
+
+def _rows(v) -> list:
+    """The grid's rows and the bisection's of a variant, by rate."""
+    return sorted(v.rows + v.probes, key=lambda r: r.rate)
+
+
+def rate_tables(variants, label, head: list, cells, first: list | None = None) -> list[str]:
+    """One Markdown table per variant: ``**label(v)**`` and a row per rate
+    of the grid and of the bisection (``cells(rate label, metrics)``: the
+    row), after ``first`` (a row, say a reference's) when given."""
+    out = []
+    for v in variants:
+        rows = [] if first is None else [first]
+        rows += [cells(fmt(r.rate) + (" (bisection)" if r.probe else ""), r.metrics)
+                 for r in _rows(v)]
+        out.append(f"**{label(v)}**\n\n" + md_table(head, rows, "l" + "r" * (len(head) - 1)))
+    return out
+
+
+def mesh_table(variants, label, atol: dict) -> str:
+    """The mesh check (two levels): per variant and rate, whether step and
+    step / 2 agree and the largest difference of each metric of ``atol``."""
+    rows = [[label(v), fmt(rate), "yes" if agree else "**no**"] + [bound(d[k]) for k in atol]
+            for v in variants for rate, agree, d in v.mesh]
+    return md_table(["variant", "f_c (Hz)", "agree"] + list(atol), rows,
+                    "lrl" + "r" * len(atol))
+
+
+def three_level_text(variants, label, *, max_rate: float, step: float, scenarios: str,
+                     not_covered: str) -> str:
+    """*Mesh, three levels*: the claimed rate metrics at plant_step, /2, /4
+    (:class:`~workbench.features.rate_sweep.ThreeLevel`); ``step``: the
+    plant step (s); ``scenarios``: what "the scenario the metric needs" can
+    be, in words; ``not_covered``: what claims compare that neither mesh
+    check covers."""
+    rows = []
+    for v in variants:
+        for t in v.three_level:
+            est = "—" if t.estimate is None else bound(t.estimate)
+            out = "converged" if t.converged else f"**{t.reason()}**"
+            rows.append([label(v), fmt(t.rate), f"`{t.metric}`",
+                         *(_level(x) for x in t.values), est,
+                         "equal" if t.tolerance is None else fmt(t.tolerance), out])
+    text = (
+        f"*Mesh, three levels*: every rate metric a claim of the design compares, at a grid "
+        f"rate up to {fmt(max_rate)} Hz, at plant_step = {fmt(1e3 * step)} ms (the grid's "
+        "run), plant_step/2 (the screen's run) and plant_step/4 (run for this check, only the "
+        f"scenario the metric needs: {scenarios}). Richardson estimate of the error "
+        "of the plant_step/4 value from the observed order p = log2(|q1 − q2| / |q2 − q4|), "
+        f"p clipped to [{fmt(P_MIN)}, {fmt(P_MAX)}]; levels whose differences change sign are "
+        f"estimated from the larger difference at order {fmt(P_MIN)}. A metric has converged "
+        "when its estimate is within "
+        "the screen's tolerance (0, rounding only, for a metric without one), an outcome "
+        "when it is the same at the three levels; a variant's mesh claim holds when both "
+        "checks do, and is INCONCLUSIVE (not converged) otherwise. Estimates are printed as "
+        "the next power of ten above them. Not covered by either mesh check: " + not_covered
+        + ".")
+    if not rows:
+        return text + " No claim compares a rate metric at such a rate."
+    return text + "\n\n" + md_table(
+        ["variant", "f_c (Hz)", "metric", "plant_step", "/2", "/4", "estimate", "tolerance",
+         "outcome"], rows, "lrlrrrrrl")
+
+
+def plot_rate_metric(ax, variants, key: str, failed: str, color, label, *,
+                     shift: float = 0.0, reference: float | None = None,
+                     reference_label: str = "") -> None:
+    """One panel: metric ``key`` (minus ``shift``) against the rate (log
+    axis), a line per variant (grid and bisection); a cross at the top of
+    the panel where the metric ``failed`` (a time, NaN: no failure) is set;
+    ``reference``: a dashed black line (not drawn when NaN or None)."""
+    for v in variants:
+        rows = _rows(v)
+        f = np.array([r.rate for r in rows])
+        y = np.array([r.metrics[key] for r in rows])
+        c = color(v)
+        ax.plot(f, y - shift, "o-", color=c, ms=3, label=label(v))
+        bad = [r.rate for r in rows if not math.isnan(r.metrics[failed])]
+        if bad:
+            ax.plot(bad, [0.97] * len(bad), "x", color=c, ms=7,
+                    transform=ax.get_xaxis_transform())
+    if reference is not None and not math.isnan(reference):
+        ax.axhline(reference - shift, color="k", ls="--", lw=0.8, label=reference_label)
+    ax.set_xscale("log")
