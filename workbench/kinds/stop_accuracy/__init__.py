@@ -52,7 +52,7 @@ Tables::
     [montecarlo]   samples, seed, distributions = { factor = { dist = ... } }
                    (:mod:`workbench.features.montecarlo`)
     [convergence]  (no keys: every nominal and fault stop error at dt, dt/2, dt/4,
-                   :func:`workbench.sim.convergence.refinement_check`)
+                   :mod:`workbench.features.convergence`)
     [sim]          dt, dt_ctrl, t_end (s)
 
 A law sees ``x`` (m since braking began), ``v`` (the measured speed, m/s),

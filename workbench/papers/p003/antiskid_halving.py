@@ -5,6 +5,10 @@ draws) as one batch at the design's dt and as one batch at dt / 2, and
 compares their metrics and outcomes per run with the design's convergence
 tolerances (:class:`HalvingCheck`; rendered by
 :func:`workbench.papers.p003.antiskid_montecarlo_render.halving_section`).
+The comparison is the general dt-halving one
+(:func:`workbench.features.convergence.compare_steps`); this module keeps
+what is paper 003's: which metrics and outcomes of its kernel's runs are
+compared, the traction-divergence rule, and the kernel batches.
 """
 from __future__ import annotations
 
@@ -92,31 +96,25 @@ def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict) -> tuple[di
     Returns
     -------
     (coarse, fine, agree) : dict, dict, dict
-        Values (tuples per run) and agree flags. A metric agrees by
-        :func:`workbench.papers.p003.antiskid_run.agree` (both NaN agree, one
-        NaN disagrees); an outcome when it is equal. ``lam_max_over_opt``
-        is set NaN at both steps (not compared) for a run that diverged in
-        a traction phase (``phase_diverged`` < BRAKE_IN) at either step:
-        its maximum there is where the divergence test fired, as for the
-        nominal cases (:func:`~workbench.papers.p003.antiskid_run.case_metrics`).
+        Values (tuples per run) and agree flags, by the general comparison
+        :func:`workbench.features.convergence.compare_steps` (a metric by
+        :func:`~workbench.features.convergence.agree`: both NaN agree, one
+        NaN disagrees; an outcome when it is equal). Paper-specific:
+        ``lam_max_over_opt`` is set NaN at both steps (not compared) for a
+        run that diverged in a traction phase (``phase_diverged`` <
+        BRAKE_IN) at either step: its maximum there is where the divergence
+        test fired, as for the nominal cases
+        (:func:`~workbench.papers.p003.antiskid_run.case_metrics`).
     """
     from ...controllers.antiskid003_settings import BRAKE_IN
-    from .antiskid_run_spec import agree as agree_values
+    from ...features.convergence import compare_steps as compare
 
     traction = (np.asarray(coarse["phase_diverged"], float) < BRAKE_IN) | (
         np.asarray(fine["phase_diverged"], float) < BRAKE_IN)
-    out = []
-    for vals in (coarse, fine):
-        d = {k: tuple(float(x) for x in vals[k]) for k in HALVING_METRICS}
-        d["lam_max_over_opt"] = tuple(math.nan if t else x
-                                      for x, t in zip(d["lam_max_over_opt"], traction))
-        d.update({k: tuple(bool(x) for x in vals[k]) for k in HALVING_OUTCOMES})
-        out.append(d)
-    c, f = out
-    agree = {k: tuple(agree_values(a, b, rtol, atol.get(k, 0.0)) for a, b in zip(c[k], f[k]))
-             for k in HALVING_METRICS}
-    agree.update({k: tuple(a == b for a, b in zip(c[k], f[k])) for k in HALVING_OUTCOMES})
-    return c, f, agree
+    masked = [{**vals, "lam_max_over_opt": tuple(
+        math.nan if t else float(x) for x, t in zip(vals["lam_max_over_opt"], traction))}
+        for vals in (coarse, fine)]
+    return compare(*masked, rtol, atol, HALVING_METRICS, HALVING_OUTCOMES)
 
 
 def _step_values(metrics: dict, viol: dict) -> dict:

@@ -32,6 +32,12 @@ level of what enters a finding, and only that:
 
 A finding whose metric is not among these is INCONCLUSIVE
 (:func:`workbench.refinement.refine_findings`).
+
+Why this stays in the paper: it defines which of paper 003's quantities
+are refined at which step and runs its kernels to get them; the checks
+themselves (three levels against the claim's tolerance, the share bound
+over partly refined runs) are :mod:`workbench.features.convergence` and
+:mod:`workbench.refinement`.
 """
 from __future__ import annotations
 
@@ -245,38 +251,18 @@ def mc_share_levels(claim, key: str, whole, half, quarter, dt: float) -> Levels:
     """A share finding (``claim``, on ``montecarlo.fraction.<key>`` or
     ``montecarlo.wilson.<key>.lo`` / ``.hi``) at the sweep's dt, dt/2 and
     dt/4, when all N runs ran at dt (``whole``: N bools) and only the first
-    n again at dt/2 and dt/4 (``half``, ``quarter``: n bools each).
-
-    At dt the count k is known. At dt/2 and dt/4 the n refined runs give
-    k_n, and the other N - n runs, not run there, may have the outcome or
-    not: the count lies in [k_n, k_n + N - n], a bound that holds whatever
-    they do. The claim is checked at every count of that range: a level
-    *decides* the claim when the verdict is the same over the whole range
-    (``holds`` / ``fails``), else it is ``undecided``. The finding has
-    converged when the three levels decide it the same way (the values
-    show the counts, :attr:`Levels.decides` the verdicts); n = N refines
-    every run and the range is the count itself.
+    n again at dt/2 and dt/4 (``half``, ``quarter``: n bools each): the
+    general :func:`workbench.features.convergence.share_levels` (a level
+    decides the claim when its verdict is the same over the whole range of
+    counts the unrefined runs allow), with this paper's quantity of a count
+    (:func:`_share`). The finding has converged when the three levels
+    decide it the same way (the values show the counts,
+    :attr:`Levels.decides` the verdicts).
     """
-    from ...claims import Verdict, check_claim
-    big, n = len(whole), len(half)
-    word = key.replace("_", " ")
-
-    def verdict(lo: int, hi: int) -> str:
-        got = {check_claim(claim, _share(claim.quantity, k, big)).verdict
-               for k in range(lo, hi + 1)}
-        if len(got) != 1:
-            return "undecided"
-        return {Verdict.PASS: "holds", Verdict.FAIL: "fails"}.get(got.pop(), "undecided")
-
-    k = sum(bool(x) for x in whole)
-    vals, dec = [f"{k} of {big} {word}: {verdict(k, k)}"], [verdict(k, k)]
-    for level in (half, quarter):
-        kn = sum(bool(x) for x in level)
-        v = verdict(kn, kn + big - n)
-        vals.append(f"{kn} of the first {n}, so {kn}-{kn + big - n} of {big} {word}: {v}"
-                    if n < big else f"{kn} of {big} {word}: {v}")
-        dec.append(v)
-    return Levels(tuple(vals), "montecarlo.dt", dt, decides=tuple(dec))
+    from ...features.convergence import share_levels
+    vals, dec = share_levels(claim, whole, half, quarter,
+                             lambda k, n: _share(claim.quantity, k, n), key.replace("_", " "))
+    return Levels(vals, "montecarlo.dt", dt, decides=dec)
 
 
 def _mc_quarter(design, result, n: int) -> dict:

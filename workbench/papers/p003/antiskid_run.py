@@ -18,13 +18,14 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import DesignError
+from ...features.convergence import agree
 from ...jsonable import OMIT, json_method
 from ...margins import DelayMargin, delay_margin_eig
 from ...reader import Reader
 from ...sim.batch import SchedulerUnreachable
 from ...sim.delay import SimResult, envelope_ratio, simulate_linear_dde, step_halving
 from ...sim.wheel_slip import PARAM_ORDER, model_functions
-from .antiskid_run_spec import (METRICS, Case, RunSpec, agree, case_mesh, case_metrics,
+from .antiskid_run_spec import (METRICS, Case, RunSpec, case_mesh, case_metrics,
                                 controller_settings, gain_for, load_run_spec, nominal_cruise,
                                 plant_values, run_settings)
 from .antiskid_scenario import simulate_antiskid
