@@ -118,3 +118,35 @@ def test_share_levels_bound_the_runs_not_refined():
     assert dec == ("holds", "fails", "fails")
     vals, dec = C.share_levels(claim, whole, whole, whole, share, "failed")
     assert vals == ("1 of 10 failed: holds",) * 3 and dec == ("holds",) * 3
+
+
+def test_verify_puts_a_studys_reason_on_unconverged_claims(monkeypatch):
+    """workbench.verify with a kind's ``unconverged(result)`` (claim id or
+    claimed quantity -> reason): a PASS claim becomes INCONCLUSIVE with it, a
+    claim whose quantity was not determined gets it instead of "not
+    determined" (issue 33), and a claim without a reason stays as it is."""
+    from workbench import kinds, verify
+    from workbench.claims import Verdict
+    from workbench.design import Design
+
+    class Study:
+        kind = "fake-conv"
+
+        def run(self, design):
+            return "result"
+
+        def quantities(self, res):
+            return {"a": 1.0, "b": None, "c": 2.0, "d": 3.0}
+
+        def unconverged(self, res):
+            return {"pass-a": "not converged: a", "b": "not converged: b", "c": "n/a"}
+
+    claims = (_claim("pass-a", "a", ">=", 0.0), _claim("undetermined-b", "b", ">=", 0.0),
+              _claim("fail-c", "c", "<=", 1.0), _claim("untouched-d", "d", ">=", 0.0))
+    monkeypatch.setattr(kinds, "REGISTRY", {"fake-conv": Study()})
+    ev = verify.evaluate_design(Design("f.toml", "fake", "fake-conv", "t", "s", None, claims))
+    got = {r.claim.id: (r.verdict, r.note) for r in ev.claims}
+    assert got["pass-a"] == (Verdict.INCONCLUSIVE, "not converged: a")
+    assert got["undetermined-b"] == (Verdict.INCONCLUSIVE, "not converged: b")
+    assert got["fail-c"] == (Verdict.INCONCLUSIVE, "n/a")       # keyed by quantity
+    assert got["untouched-d"][0] is Verdict.PASS

@@ -51,8 +51,8 @@ import numpy as np
 from ...refinement import Levels, screen
 from ...report.markdown import fmt
 
-__all__ = ["last_refine_seconds", "mc_share_levels", "quarter_cases", "refine_levels",
-           "three_level_metrics"]
+__all__ = ["CONVERGED_INSTEAD", "last_refine_seconds", "mc_share_levels", "quarter_cases",
+           "refine_levels", "three_level_metrics", "unconverged_reason"]
 
 _CASE = re.compile(r"^cases\[([^\]]+)\]\.")
 _SWITCH = re.compile(r"^switch\.(cruise|brake)\[([^\]]+)\]\.in_basin$")
@@ -290,6 +290,13 @@ def quarter_cases(design) -> frozenset:
     return frozenset(out)
 
 
+def _tolerances(spec, vals: dict) -> dict:
+    """metric -> the bound of its Richardson estimate: the tolerance of the
+    design's two-level screen, atol + rtol max(|q|) of the three levels."""
+    return {k: spec.conv_atol.get(k, 0.0) + spec.conv_rtol * max(
+        (abs(x) for x in v if math.isfinite(x)), default=0.0) for k, v in vals.items()}
+
+
 def three_level_metrics(spec, coarse: dict, fine: dict, quarter: dict) -> tuple:
     """(metric -> converged, metrics not converged) over dt, dt/2, dt/4:
     :func:`workbench.refinement.screen` with the tolerance of the design's
@@ -297,7 +304,34 @@ def three_level_metrics(spec, coarse: dict, fine: dict, quarter: dict) -> tuple:
     of each metric's Richardson estimate (issue 33 item 4)."""
     from .antiskid_run_spec import METRICS
     vals = {k: (coarse[k], fine[k], quarter[k]) for k in METRICS}
-    tol = {k: spec.conv_atol.get(k, 0.0) + spec.conv_rtol * max(
-        (abs(x) for x in vals[k] if math.isfinite(x)), default=0.0) for k in METRICS}
-    _, bad = screen(vals, tol)
+    _, bad = screen(vals, _tolerances(spec, vals))
     return {k: k not in bad for k in METRICS}, bad
+
+
+#: Paper 003: the case metric to claim instead of one that does not converge
+#: over dt, dt/2, dt/4 (the braking time to v_stop moves back and forth; the
+#: time to omega = 3 rad/s converges, as the designs' stop-duration claim says).
+CONVERGED_INSTEAD = {"braking_duration": "omega3_after_brake"}
+
+
+def unconverged_reason(spec, name: str, coarse: dict, fine: dict, quarter: dict,
+                       bad: tuple) -> str:
+    """Why ``cases[<name>].converged`` is INCONCLUSIVE (issue 33): every
+    metric of ``bad`` (:func:`three_level_metrics`) with its values at the
+    three levels, its Richardson error (:func:`workbench.refinement.
+    guarded_check`) and tolerance, and the quantity to use instead ("" when
+    every metric converged)."""
+    from ...refinement import guarded_check
+    vals = {k: (coarse[k], fine[k], quarter[k]) for k in bad}
+    tol = _tolerances(spec, vals)
+    parts = []
+    for k in bad:
+        est = guarded_check(*vals[k], tolerance=tol[k]).estimate
+        alt = CONVERGED_INSTEAD.get(k)
+        parts.append(f"cases[{name}].{k} {' / '.join(fmt(x, 6) for x in vals[k])} at dt, dt/2, "
+                     "dt/4, Richardson error " + ("not determined (a value is not finite)"
+                                                  if est is None else fmt(est, 2))
+                     + f" > tol {fmt(tol[k], 2)}; use "
+                     + (f"`cases[{name}].{alt}`" if alt and alt not in bad
+                        else "a metric of the case that converges") + " instead")
+    return "not converged: " + "; ".join(parts) if parts else ""
