@@ -150,3 +150,13 @@ def test_verify_puts_a_studys_reason_on_unconverged_claims(monkeypatch):
     assert got["undetermined-b"] == (Verdict.INCONCLUSIVE, "not converged: b")
     assert got["fail-c"] == (Verdict.INCONCLUSIVE, "n/a")       # keyed by quantity
     assert got["untouched-d"][0] is Verdict.PASS
+
+
+def test_not_converged_text_of_a_toy_metric():
+    values = C.by_metric(C.three_levels(_decay, 0.01))["y1"]
+    chk = C.level_checks({"y1": values}, tolerance=1e-6)["y1"]
+    text = C.not_converged_text("toy.y1", values, chk.estimate, 1e-6, "`toy.y2`")
+    assert text.startswith("toy.y1 0.366032 / 0.366958 / 0.367419 at dt, dt/2, dt/4, Richardson ")
+    assert text.endswith(" > tol 1e-6; use `toy.y2` instead") and "error 0.00046" in text
+    assert "error not determined (a value is not finite)" in C.not_converged_text(
+        "q", (1.0, math.nan, 2.0), None, 0.1, "p")

@@ -17,7 +17,8 @@ value of its runs at that numerical step); this module does the rest:
   tolerance (:func:`workbench.refinement.refinement_row`, tolerance by
   :func:`workbench.refinement.claim_tolerance`), :func:`unconverged` says
   which claims are then INCONCLUSIVE and why (a kind's
-  ``unconverged(result)``, applied by :mod:`workbench.verify`), and
+  ``unconverged(result)``, applied by :mod:`workbench.verify`;
+  :func:`not_converged_text` the words for one metric), and
   :func:`claim_table` is the report's table of those rows;
 * the dt-halving comparison of two levels: :func:`agree` (one value),
   :func:`compare_steps` (per-run metrics and outcomes at dt and dt/2);
@@ -41,7 +42,7 @@ from ..sim.convergence import Convergence, Refinement, refinement_check
 
 __all__ = ["LEVELS", "ClaimTarget", "Convergence", "agree", "by_metric", "claim_rows",
            "claim_table", "claim_targets", "compare_steps", "level_checks", "load_convergence",
-           "rows_of", "share_levels", "three_levels", "unconverged"]
+           "not_converged_text", "rows_of", "share_levels", "three_levels", "unconverged"]
 
 #: Refinement levels: the step divided by 2**k.
 LEVELS = (0, 1, 2)
@@ -160,6 +161,18 @@ def rows_of(pairs, reported: int = 0, *, determined=lambda x: not math.isnan(x))
 def unconverged(rows) -> dict[str, str]:
     """claim id -> reason, for the rows whose metric did not converge."""
     return {r.claim_id: r.reason for r in rows if not r.converged}
+
+
+def not_converged_text(quantity: str, values, estimate: float | None, tolerance: float,
+                       instead: str, levels: str = "dt, dt/2, dt/4") -> str:
+    """``<quantity> q1 / q2 / q4 at <levels>, Richardson error X > tol Y;
+    use <instead> instead``: what an INCONCLUSIVE claim says of a metric
+    that did not converge (issue 33; values to 6 digits, as the convergence
+    tables print them, the estimate and tolerance to 2)."""
+    from ..report.markdown import fmt
+    err = "not determined (a value is not finite)" if estimate is None else fmt(estimate, 2)
+    return (f"{quantity} {' / '.join(fmt(x, 6) for x in values)} at {levels}, Richardson "
+            f"error {err} > tol {fmt(tolerance, 2)}; use {instead} instead")
 
 
 def claim_table(rows) -> str:

@@ -317,21 +317,16 @@ CONVERGED_INSTEAD = {"braking_duration": "omega3_after_brake"}
 def unconverged_reason(spec, name: str, coarse: dict, fine: dict, quarter: dict,
                        bad: tuple) -> str:
     """Why ``cases[<name>].converged`` is INCONCLUSIVE (issue 33): every
-    metric of ``bad`` (:func:`three_level_metrics`) with its values at the
-    three levels, its Richardson error (:func:`workbench.refinement.
-    guarded_check`) and tolerance, and the quantity to use instead ("" when
-    every metric converged)."""
+    metric of ``bad`` (:func:`three_level_metrics`) in the words of
+    :func:`workbench.features.convergence.not_converged_text`, with its
+    Richardson error (:func:`workbench.refinement.guarded_check`) and the
+    quantity to use instead ("" when every metric converged)."""
+    from ...features.convergence import not_converged_text
     from ...refinement import guarded_check
     vals = {k: (coarse[k], fine[k], quarter[k]) for k in bad}
     tol = _tolerances(spec, vals)
-    parts = []
-    for k in bad:
-        est = guarded_check(*vals[k], tolerance=tol[k]).estimate
-        alt = CONVERGED_INSTEAD.get(k)
-        parts.append(f"cases[{name}].{k} {' / '.join(fmt(x, 6) for x in vals[k])} at dt, dt/2, "
-                     "dt/4, Richardson error " + ("not determined (a value is not finite)"
-                                                  if est is None else fmt(est, 2))
-                     + f" > tol {fmt(tol[k], 2)}; use "
-                     + (f"`cases[{name}].{alt}`" if alt and alt not in bad
-                        else "a metric of the case that converges") + " instead")
+    use = {k: f"`cases[{name}].{a}`" for k, a in CONVERGED_INSTEAD.items() if a not in bad}
+    parts = [not_converged_text(
+        f"cases[{name}].{k}", vals[k], guarded_check(*vals[k], tolerance=tol[k]).estimate,
+        tol[k], use.get(k, "a metric of the case that converges")) for k in bad]
     return "not converged: " + "; ".join(parts) if parts else ""
