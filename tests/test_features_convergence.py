@@ -101,6 +101,10 @@ def test_agree_and_the_dt_halving_comparison_of_a_toy_batch():
     assert same["y1"][:2] == (True, True) and same["y1"][2] is False
     assert c["stiff"] == (False, False, True) and f["stiff"] == (False,) * 3
     assert same["stiff"] == (True, True, False)
+    cmp = C.StepComparison(dt, 0.1, {"y1": 1e-3}, c, f, same)
+    assert cmp.n == 3 and cmp.run_agree == (True, True, False)
+    assert cmp.quantities("toy.halving") == {"toy.halving.runs": 3, "toy.halving.agree": 2,
+                                             "toy.halving.fraction_agree": 2 / 3}
 
 
 def test_share_levels_bound_the_runs_not_refined():

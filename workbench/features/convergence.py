@@ -21,7 +21,8 @@ value of its runs at that numerical step); this module does the rest:
   :func:`not_converged_text` the words for one metric), and
   :func:`claim_table` is the report's table of those rows;
 * the dt-halving comparison of two levels: :func:`agree` (one value),
-  :func:`compare_steps` (per-run metrics and outcomes at dt and dt/2);
+  :func:`compare_steps` (per-run metrics and outcomes at dt and dt/2) and
+  its result with the runs that agree, :class:`StepComparison`;
 * :func:`share_levels`: a claim on the share of runs with an outcome, when
   all runs ran at dt and only the first n again at dt/2 and dt/4.
 
@@ -40,7 +41,7 @@ from dataclasses import dataclass
 
 from ..sim.convergence import Convergence, Refinement, refinement_check
 
-__all__ = ["LEVELS", "ClaimTarget", "Convergence", "agree", "by_metric", "claim_rows",
+__all__ = ["LEVELS", "ClaimTarget", "Convergence", "StepComparison", "agree", "by_metric", "claim_rows",
            "claim_table", "claim_targets", "compare_steps", "level_checks", "load_convergence",
            "not_converged_text", "rows_of", "share_levels", "three_levels", "unconverged"]
 
@@ -222,6 +223,37 @@ def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict, metrics,
             for k in metrics}
     same.update({k: tuple(a == b for a, b in zip(c[k], f[k])) for k in outcomes})
     return c, f, same
+
+
+@dataclass(frozen=True)
+class StepComparison:
+    """The runs of a batch at dt and dt/2 compared (:func:`compare_steps`):
+    ``coarse``, ``fine`` and ``agree`` map a metric or outcome to one entry
+    per run; ``rtol`` and ``atol`` (metric -> absolute tolerance) are the
+    tolerances of the comparison."""
+
+    dt: float
+    rtol: float
+    atol: dict
+    coarse: dict
+    fine: dict
+    agree: dict
+
+    @property
+    def n(self) -> int:
+        return len(next(iter(self.agree.values()), ()))
+
+    @property
+    def run_agree(self) -> tuple:
+        """Per run: every metric and outcome agrees."""
+        return tuple(all(self.agree[k][i] for k in self.agree) for i in range(self.n))
+
+    def quantities(self, prefix: str) -> dict:
+        """``<prefix>.runs``, ``.agree`` (runs whose every metric and outcome
+        agrees) and ``.fraction_agree``."""
+        k = sum(self.run_agree)
+        return {f"{prefix}.runs": self.n, f"{prefix}.agree": k,
+                f"{prefix}.fraction_agree": k / self.n}
 
 
 def share_levels(claim, whole, half, quarter, value_of, word: str) -> tuple[tuple, tuple]:
