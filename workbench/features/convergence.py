@@ -28,6 +28,9 @@ value of its runs at that numerical step); this module does the rest:
 
 Used by ``switched-run``, ``delay-feedback``, ``stop-accuracy`` and paper
 003 (which keeps only which of its quantities are refined at which step).
+The numerical check and its enum stay in :mod:`workbench.sim.convergence`
+and the claim-level check (tolerance, reason) in :mod:`workbench.refinement`,
+which the committed reports name; this module is the one entry the kinds use.
 
 References
 ----------
@@ -41,9 +44,10 @@ from dataclasses import dataclass
 
 from ..sim.convergence import Convergence, Refinement, refinement_check
 
-__all__ = ["LEVELS", "ClaimTarget", "Convergence", "StepComparison", "agree", "by_metric", "claim_rows",
-           "claim_table", "claim_targets", "compare_steps", "level_checks", "load_convergence",
-           "not_converged_text", "rows_of", "share_levels", "three_levels", "unconverged"]
+__all__ = ["LEVELS", "ClaimTarget", "Convergence", "StepComparison", "agree", "by_metric",
+           "claim_rows", "claim_table", "claim_targets", "compare_steps", "level_checks",
+           "load_convergence", "not_converged_text", "rows_of", "share_levels", "three_levels",
+           "unconverged"]
 
 #: Refinement levels: the step divided by 2**k.
 LEVELS = (0, 1, 2)

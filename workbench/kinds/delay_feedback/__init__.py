@@ -125,7 +125,7 @@ class DelayFeedbackSpec:
     implementation: object = None   # delay_feedback_implementation.ImplementationSettings
     montecarlo: object = None   # features.montecarlo.MonteCarloSpec ([montecarlo], .montecarlo)
     convergence: bool = False   # [convergence]: dt, dt/2, dt/4 (features.convergence)
-    claims: tuple = ()          # features.convergence.ClaimTarget of every claim on a scenario metric
+    claims: tuple = ()          # ClaimTarget (features.convergence) per claim on a scenario metric
 
 
 def _variables(root: Reader, table: str, taken: set[str], min_len: int = 1
