@@ -1,6 +1,6 @@
 """``[convergence]`` on a ``delay-feedback`` design (issue 35, item 1): every
 claim on a scenario metric refined over dt, dt/2, dt/4 by the one
-implementation that ``switched-run`` uses (:mod:`workbench.kinds.convergence`);
+implementation that ``switched-run`` uses (:mod:`workbench.features.convergence`);
 an unconverged claim is INCONCLUSIVE."""
 from __future__ import annotations
 

@@ -104,3 +104,26 @@ def test_sampled_rate_row_prints_a_tie_of_sub_steps_with_one_more_digit():
     # 21 sub-steps of 0.5 ms above the requirement: 0.0105 s, a 2-digit tie
     cells = [_row("50", dict(m, time_above=t))[2] for t in (0.0105, math.nextafter(0.0105, 1))]
     assert cells == ["0.0105", "0.0105"]
+
+
+def test_the_unconverged_case_says_which_metric_and_what_to_use_instead():
+    """Issue 33: ``cases[compensated].converged`` INCONCLUSIVE names each
+    metric not converged, its three values, its Richardson error against its
+    tolerance, and the quantity to claim instead (the paper's choice for the
+    braking time; a converged metric of the case otherwise)."""
+    from workbench.papers.p003.antiskid_refine import CONVERGED_INSTEAD, unconverged_reason
+    lv = [{k: 1.0 for k in METRICS} for _ in range(3)]
+    for i in range(3):
+        lv[i].update(braking_duration=STOP[i], evs_max_tracking=EVS[i])
+    conv, bad = three_level_metrics(_spec(), *lv)
+    why = unconverged_reason(_spec(), "compensated", *lv, bad)
+    stop_est = guarded_check(*STOP, tolerance=0.0).estimate
+    assert why.startswith("not converged: cases[compensated].braking_duration 85.96 / 86.68 / "
+                          "86.1425 at dt, dt/2, dt/4, Richardson error ")
+    assert f"Richardson error {stop_est:.2g} > tol " in why
+    assert "use `cases[compensated].omega3_after_brake` instead" in why
+    assert CONVERGED_INSTEAD["braking_duration"] == "omega3_after_brake" and conv[
+        "omega3_after_brake"]
+    assert "; cases[compensated].evs_max_tracking 0.000530648 / 0.00196505 / 0.000119306" in why
+    assert why.endswith("use a metric of the case that converges instead")
+    assert unconverged_reason(_spec(), "compensated", *lv, ()) == ""

@@ -46,11 +46,19 @@ def evaluate_design(design: Design) -> Evaluation:
         checked = [_unconverged(r, by_id[r.claim.id]) if r.claim.id in by_id
                    and not by_id[r.claim.id].converged else r for r in checked]
     if hasattr(study, "unconverged"):    # a kind that refines its own metrics (switched-run)
-        why = study.unconverged(result)
-        checked = [ClaimResult(r.claim, r.got, Verdict.INCONCLUSIVE, why[r.claim.id])
-                   if r.claim.id in why and r.verdict is not Verdict.INCONCLUSIVE else r
+        why = study.unconverged(result)   # claim id or claimed quantity -> reason
+        checked = [_not_converged(r, why.get(r.claim.id, why.get(r.claim.quantity)))
                    for r in checked]
     return Evaluation(design, result, tuple(checked), table)
+
+
+def _not_converged(r: ClaimResult, why: str | None) -> ClaimResult:
+    """INCONCLUSIVE with the study's reason ``why`` (None: ``r`` as it is). A
+    claim INCONCLUSIVE already keeps its note, unless its quantity was not
+    determined: then the reason says why (issue 33)."""
+    if why is None or r.verdict is Verdict.INCONCLUSIVE and r.got is not None:
+        return r
+    return ClaimResult(r.claim, r.got, Verdict.INCONCLUSIVE, why)
 
 
 def _refined(design, study, q, checked, result):

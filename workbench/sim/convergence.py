@@ -14,13 +14,14 @@ and Richardson's estimate of the error left in the finest value ``q4`` is
 
 The check is a pure function of the three values (:func:`refinement_check`);
 it returns a small frozen :class:`Refinement` whose outcome is one of a
-closed set (:data:`OUTCOMES`):
+closed set, the enum :class:`Convergence` (:data:`OUTCOMES`; its members
+compare equal to their words, which the reports print):
 
 ``CONVERGED``
     ``E <= tolerance``, or every difference is at rounding level;
 ``NOT_CONVERGED``
     ``E > tolerance``;
-``INCONCLUSIVE``
+``INCONCLUSIVE`` (not determined)
     the sequence is not in its asymptotic range (observed order below
     :data:`P_MIN`) and its differences are too large to dismiss, or a value
     is not finite, so no estimate is trusted.
@@ -49,17 +50,27 @@ three-grid estimate).
 """
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass
 
-__all__ = ["CONVERGED", "INCONCLUSIVE", "NOT_CONVERGED", "OUTCOMES", "P_MAX", "P_MIN",
-           "Refinement", "refinement_check"]
+__all__ = ["CONVERGED", "Convergence", "INCONCLUSIVE", "NOT_CONVERGED", "OUTCOMES", "P_MAX",
+           "P_MIN", "Refinement", "refinement_check"]
 
-CONVERGED = "CONVERGED"
-NOT_CONVERGED = "NOT_CONVERGED"
-INCONCLUSIVE = "INCONCLUSIVE"
+
+class Convergence(enum.StrEnum):
+    """The verdict of a convergence check: converged, not converged, or not
+    determined (INCONCLUSIVE: no estimate is trusted). A member is its word
+    (``str``), as tables, JSON and claim notes print it."""
+
+    CONVERGED = "CONVERGED"
+    NOT_CONVERGED = "NOT_CONVERGED"
+    INCONCLUSIVE = "INCONCLUSIVE"
+
+
+CONVERGED, NOT_CONVERGED, INCONCLUSIVE = Convergence
 #: The closed set of outcomes of :func:`refinement_check`.
-OUTCOMES = (CONVERGED, NOT_CONVERGED, INCONCLUSIVE)
+OUTCOMES = tuple(Convergence)
 #: Observed orders outside [P_MIN, P_MAX] are guarded (module docstring).
 P_MIN, P_MAX = 0.5, 4.0
 _ROUNDING = 64 * 2.0 ** -52
@@ -85,7 +96,7 @@ class Refinement:
         not finite.
     tolerance : float
         The tolerance the estimate was compared with.
-    outcome : str
+    outcome : Convergence
         One of :data:`OUTCOMES`.
     note : str
         Which guard applied (empty when none).
@@ -96,7 +107,7 @@ class Refinement:
     order: float | None
     estimate: float | None
     tolerance: float
-    outcome: str
+    outcome: Convergence
     note: str = ""
 
     @property

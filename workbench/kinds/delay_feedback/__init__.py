@@ -37,7 +37,8 @@ Tables (see ``designs/antiskid-cruise-dry-generic.toml`` for a full file)::
     [montecarlo]   samples, seed, distributions   (optional: the scenarios with drawn
                    plant parameters, :mod:`.montecarlo`)
     [convergence]  (no keys; optional: every scenario also at dt/4, and every claim on
-                   a scenario metric refined over dt, dt/2, dt/4, :mod:`..convergence`)
+                   a scenario metric refined over dt, dt/2, dt/4,
+                   :mod:`workbench.features.convergence`)
 
 The design tables are read here (light: no sympy until the operating point
 is solved); :mod:`.run` computes, :mod:`.render`
@@ -123,8 +124,8 @@ class DelayFeedbackSpec:
     requirements: object = None   # delay_feedback_requirements.RequirementsSpec or None
     implementation: object = None   # delay_feedback_implementation.ImplementationSettings
     montecarlo: object = None   # features.montecarlo.MonteCarloSpec ([montecarlo], .montecarlo)
-    convergence: bool = False   # [convergence]: dt, dt/2, dt/4 (..convergence)
-    claims: tuple = ()          # ..convergence.ClaimTarget of every claim on a scenario metric
+    convergence: bool = False   # [convergence]: dt, dt/2, dt/4 (features.convergence)
+    claims: tuple = ()          # ClaimTarget (features.convergence) per claim on a scenario metric
 
 
 def _variables(root: Reader, table: str, taken: set[str], min_len: int = 1
@@ -408,10 +409,11 @@ MAX_FINE_STEPS = 4e6
 
 
 def _with_convergence(root: Reader, spec: DelayFeedbackSpec) -> DelayFeedbackSpec:
-    """The spec with ``[convergence]`` and the claims it refines (:mod:`..convergence`)."""
+    """The spec with ``[convergence]`` and the claims it refines
+    (:mod:`workbench.features.convergence`)."""
     from dataclasses import replace
 
-    from ..convergence import claim_targets, load_convergence
+    from ...features.convergence import claim_targets, load_convergence
     if not load_convergence(root):
         return spec
     for i, s in enumerate(spec.scenarios):
@@ -483,7 +485,7 @@ class DelayFeedback:
     def unconverged(self, res) -> dict[str, str]:
         """claim id -> reason, for the claims whose metric did not converge
         over dt, dt/2, dt/4 (``[convergence]``; used by :mod:`workbench.verify`)."""
-        from ..convergence import unconverged
+        from ...features.convergence import unconverged
         return unconverged(res.refinement)
 
 

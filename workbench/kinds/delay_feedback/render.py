@@ -273,8 +273,8 @@ def _simulation_section(spec, res):
 
 def _convergence_section(res) -> str:
     """``[convergence]``: every claimed scenario metric at dt, dt/2, dt/4."""
+    from ...features.convergence import claim_table
     from ...sim.convergence import P_MAX, P_MIN
-    from ..convergence import claim_table
     rows = [[f"`{x.quantity}`", *(fmt(v, 5) for v in x.values),
              "—" if x.check is None or x.check.order is None or not math.isfinite(
                  x.check.order) else fmt(x.check.order, 2)] for x in res.refinement]

@@ -287,7 +287,7 @@ def run(spec) -> DelayFeedbackResult:
         mc = run_montecarlo(spec, model, values, op, syn.K, reference, predict)
     rows = ()
     if spec.convergence:
-        from ..convergence import claim_rows
+        from ...features.convergence import claim_rows
         rows = tuple(x for s in scen for x in claim_rows(
             spec.claims, s.scenario.name, (s.metrics_coarse, s.metrics, s.metrics_fine),
             reported=1))
@@ -414,17 +414,12 @@ def input_history(r, m: int) -> np.ndarray:
 
 
 def agree(coarse: dict, fine: dict, rtol: float) -> bool:
-    """Every metric at dt within rtol of dt/2 (absolute floor: rtol x the
-    state's peak error, so a final error near zero compares on that scale)."""
-    for k, b in fine.items():
-        a = coarse[k]
-        if math.isnan(a) and math.isnan(b):
-            continue
-        name = k.split(".", 1)[-1]
-        floor = rtol * abs(fine.get(f"peak_error.{name}", b)) + 1e-15
-        if not abs(a - b) <= floor + rtol * max(abs(a), abs(b)):
-            return False
-    return True
+    """Every metric at dt within rtol of dt/2 (:func:`workbench.features.
+    convergence.agree`, absolute floor: rtol x the state's peak error, so a
+    final error near zero compares on that scale)."""
+    from ...features.convergence import agree as agree_value
+    return all(agree_value(coarse[k], b, rtol, rtol * abs(
+        fine.get(f"peak_error.{k.split('.', 1)[-1]}", b)) + 1e-15) for k, b in fine.items())
 
 
 def simulate_scenario(spec, model, values, op, K, scenario) -> ScenarioResult:

@@ -52,7 +52,7 @@ Tables::
     [montecarlo]   samples, seed, distributions = { factor = { dist = ... } }
                    (:mod:`workbench.features.montecarlo`)
     [convergence]  (no keys: every nominal and fault stop error at dt, dt/2, dt/4,
-                   :func:`workbench.sim.convergence.refinement_check`)
+                   :mod:`workbench.features.convergence`)
     [sim]          dt, dt_ctrl, t_end (s)
     [analysis]     module = "pNNN.name" (optional: a paper's module under
                    ``workbench.papers`` with an ``ANALYSIS`` object that reads the paper's

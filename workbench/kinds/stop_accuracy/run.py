@@ -14,8 +14,7 @@ refinement.
 * ``[[sections]]`` with ``[repeats]``: every repeating controller's stops on
   every section, in one batch (:func:`run_sections`, :mod:`.sections`);
 * ``[convergence]``: the nominal and fault batch again at dt/2 and dt/4, every
-  stop error through :func:`workbench.sim.convergence.refinement_check`, and
-  every claim on one through :func:`workbench.refinement.refinement_row`
+  stop error and every claim on one through :mod:`workbench.features.convergence`
   (a claim whose error has not converged is INCONCLUSIVE).
 
 References
@@ -348,14 +347,11 @@ def run(spec, claims=()) -> StopAccuracyResult:
         sections = run_sections(spec, laws, spec.dt)
     levels, checks, rows = {}, {}, ()
     if spec.convergence:
-        from ...refinement import refinement_row
-        from ...sim.convergence import refinement_check
-        finer = [_deterministic(spec, laws, spec.dt / 2 ** k, D)[0] for k in (1, 2)]
-        levels = {k: (v, finer[0][k], finer[1][k]) for k, v in q.items()}
-        checks = {k: refinement_check(*lv, tolerance=math.inf) for k, lv in levels.items()
-                  if all(math.isfinite(x) for x in lv)}
-        rows = tuple(refinement_row(c, levels[c.quantity], "dt", levels[c.quantity][0])
-                     for c in claims if c.quantity in levels
-                     and math.isfinite(levels[c.quantity][0]))
+        from ...features.convergence import by_metric, level_checks, rows_of, three_levels
+        levels = by_metric(three_levels(lambda h: _deterministic(spec, laws, h, D)[0], spec.dt,
+                                        first=q))
+        checks = level_checks(levels, finite=True)
+        rows = tuple(rows_of(((c, levels[c.quantity]) for c in claims if c.quantity in levels),
+                             determined=math.isfinite))
     return StopAccuracyResult(spec, D, nominal, faults, mc, levels, checks, rows, traces, grid,
                               sections)

@@ -38,7 +38,7 @@ import ast
 from dataclasses import dataclass
 
 from ...design import Reader
-from ..convergence import LEVELS, ClaimTarget, claim_targets, load_convergence
+from ...features.convergence import LEVELS, ClaimTarget, claim_targets, load_convergence
 from ..delay_feedback import NAME_PATTERN as _NAME
 from ..delay_feedback import read_plant
 from ..delay_feedback.spec import PlantSpec
@@ -320,7 +320,7 @@ class SwitchedRun:
     def unconverged(self, res) -> dict[str, str]:
         """claim id -> reason, for the claims whose metric did not converge
         over dt, dt/2, dt/4 (``[convergence]``; used by :mod:`workbench.verify`)."""
-        from ..convergence import unconverged
+        from ...features.convergence import unconverged
         return unconverged(res.refinement)
 
 

@@ -5,9 +5,9 @@ import math
 
 import numpy as np
 
+from ...features.convergence import claim_table
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...sim.convergence import P_MAX, P_MIN
-from ..convergence import claim_table
 from .quantities import scenario_metrics
 from .simulate import BOUND
 from .study import ALPHA, P_SHOWN, runs_for

@@ -3,7 +3,7 @@ features the design names.
 
 * the nominal run of each scenario (recorded for the figures);
 * ``[convergence]``: the scenario again at dt/2 and dt/4; every metric's
-  three values go through :func:`workbench.sim.convergence.refinement_check`
+  three values go through :func:`workbench.features.convergence.level_checks`
   (Richardson), and every claim on a scenario metric through
   :func:`workbench.refinement` 's row check against the claim's tolerance (the
   distance to the bound for ``<=``/``>=``), as the findings of other kinds
@@ -105,8 +105,7 @@ def _values(batch: Batch) -> dict:
 
 def run(spec) -> SwitchedRunResult:
     """Compute a design (see the module docstring)."""
-    from ...sim.convergence import refinement_check
-    from ..convergence import claim_rows
+    from ...features.convergence import by_metric, claim_rows, level_checks, three_levels
     comp = Compiled(spec)
     out, rows, rates = [], [], []
     for sc in spec.scenarios:
@@ -114,10 +113,9 @@ def run(spec) -> SwitchedRunResult:
         values = _values(nominal)
         levels, checks = (), ()
         if spec.convergence:
-            levels = (values,) + tuple(_values(simulate(spec, comp, sc, sc.dt / 2 ** k))
-                                       for k in (1, 2))
-            checks = tuple((m, refinement_check(*(lv[m] for lv in levels), tolerance=math.inf))
-                           for m in values)
+            levels = three_levels(lambda h: _values(simulate(spec, comp, sc, h)), sc.dt,
+                                  first=values)
+            checks = tuple(level_checks(by_metric(levels)).items())
             rows += claim_rows(spec.claims, sc.name, levels)
         mc = None
         if spec.montecarlo is not None:

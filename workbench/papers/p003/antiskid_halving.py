@@ -5,6 +5,10 @@ draws) as one batch at the design's dt and as one batch at dt / 2, and
 compares their metrics and outcomes per run with the design's convergence
 tolerances (:class:`HalvingCheck`; rendered by
 :func:`workbench.papers.p003.antiskid_montecarlo_render.halving_section`).
+The comparison is the general dt-halving one
+(:func:`workbench.features.convergence.compare_steps`); this module keeps
+what is paper 003's: which metrics and outcomes of its kernel's runs are
+compared, the traction-divergence rule, and the kernel batches.
 """
 from __future__ import annotations
 
@@ -13,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...features.convergence import StepComparison
 from ...sim.batch import PendingBatch
 from .antiskid_montecarlo import (SUMMARY_METRICS, SweepResult, chunk_payload, chunk_worker,
                                   per_run, run_lambda_opt, sweep_inputs)
@@ -26,54 +31,20 @@ HALVING_OUTCOMES = ("diverged", "stopped", "above_lambda_opt")
 
 
 @dataclass(frozen=True)
-class HalvingCheck:
-    """The first ``n`` runs of a design's sweep at dt and at dt / 2.
-
-    Attributes
-    ----------
-    case : str
-        The sweep's case.
-    seed : int
-    dt : float
-        The sweep's step (s): the n runs at dt (the sweep's own, or one
-        batch) and at dt / 2 (one batch).
-    rtol : float
-    atol : dict
-        Metric -> absolute tolerance (0 where the design gives none).
-    draws : dict
-        Sample name -> tuple of n draws (as :func:`draw_samples`).
-    coarse, fine : dict
-        Metric or outcome -> tuple of n values at dt and at dt / 2
-        (``lam_max_over_opt`` NaN for a run that diverged in traction at
-        either step: see :func:`compare_steps`).
-    agree : dict
-        Metric or outcome -> tuple of n bools.
-    seconds : float
-        Wall time (not compared).
-    workers : int
-        Processes (not compared).
-    """
+class HalvingCheck(StepComparison):
+    """The first ``n`` runs of a design's sweep at dt and at dt / 2: the
+    general :class:`~workbench.features.convergence.StepComparison` (``dt``
+    the sweep's step, ``atol`` 0 where the design gives none;
+    ``lam_max_over_opt`` NaN for a run that diverged in traction at either
+    step, see :func:`compare_steps`), and the sweep's ``case``, ``seed`` and
+    ``draws`` (sample name -> tuple of n draws, as :func:`draw_samples`);
+    ``seconds`` (wall time) and ``workers`` (processes) are not compared."""
 
     case: str
     seed: int
-    dt: float
-    rtol: float
-    atol: dict
     draws: dict
-    coarse: dict
-    fine: dict
-    agree: dict
     seconds: float = field(default=math.nan, compare=False)
     workers: int = field(default=1, compare=False)
-
-    @property
-    def n(self) -> int:
-        return len(self.draws["h"])
-
-    @property
-    def run_agree(self) -> tuple:
-        """Per run: every metric and outcome agrees."""
-        return tuple(all(self.agree[k][i] for k in self.agree) for i in range(self.n))
 
 
 def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict) -> tuple[dict, dict, dict]:
@@ -92,31 +63,25 @@ def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict) -> tuple[di
     Returns
     -------
     (coarse, fine, agree) : dict, dict, dict
-        Values (tuples per run) and agree flags. A metric agrees by
-        :func:`workbench.papers.p003.antiskid_run.agree` (both NaN agree, one
-        NaN disagrees); an outcome when it is equal. ``lam_max_over_opt``
-        is set NaN at both steps (not compared) for a run that diverged in
-        a traction phase (``phase_diverged`` < BRAKE_IN) at either step:
-        its maximum there is where the divergence test fired, as for the
-        nominal cases (:func:`~workbench.papers.p003.antiskid_run.case_metrics`).
+        Values (tuples per run) and agree flags, by the general comparison
+        :func:`workbench.features.convergence.compare_steps` (a metric by
+        :func:`~workbench.features.convergence.agree`: both NaN agree, one
+        NaN disagrees; an outcome when it is equal). Paper-specific:
+        ``lam_max_over_opt`` is set NaN at both steps (not compared) for a
+        run that diverged in a traction phase (``phase_diverged`` <
+        BRAKE_IN) at either step: its maximum there is where the divergence
+        test fired, as for the nominal cases
+        (:func:`~workbench.papers.p003.antiskid_run.case_metrics`).
     """
     from ...controllers.antiskid003_settings import BRAKE_IN
-    from .antiskid_run_spec import agree as agree_values
+    from ...features.convergence import compare_steps as compare
 
     traction = (np.asarray(coarse["phase_diverged"], float) < BRAKE_IN) | (
         np.asarray(fine["phase_diverged"], float) < BRAKE_IN)
-    out = []
-    for vals in (coarse, fine):
-        d = {k: tuple(float(x) for x in vals[k]) for k in HALVING_METRICS}
-        d["lam_max_over_opt"] = tuple(math.nan if t else x
-                                      for x, t in zip(d["lam_max_over_opt"], traction))
-        d.update({k: tuple(bool(x) for x in vals[k]) for k in HALVING_OUTCOMES})
-        out.append(d)
-    c, f = out
-    agree = {k: tuple(agree_values(a, b, rtol, atol.get(k, 0.0)) for a, b in zip(c[k], f[k]))
-             for k in HALVING_METRICS}
-    agree.update({k: tuple(a == b for a, b in zip(c[k], f[k])) for k in HALVING_OUTCOMES})
-    return c, f, agree
+    masked = [{**vals, "lam_max_over_opt": tuple(
+        math.nan if t else float(x) for x, t in zip(vals["lam_max_over_opt"], traction))}
+        for vals in (coarse, fine)]
+    return compare(*masked, rtol, atol, HALVING_METRICS, HALVING_OUTCOMES)
 
 
 def _step_values(metrics: dict, viol: dict) -> dict:
@@ -156,9 +121,9 @@ def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
 
     def check(steps: list, seconds: float, n_workers: int) -> HalvingCheck:
         c, f, agree = compare_steps(*steps, spec.conv_rtol, atol)
-        return HalvingCheck(ms.case, ms.seed, inp["dt"], spec.conv_rtol, atol,
+        return HalvingCheck(inp["dt"], spec.conv_rtol, atol, c, f, agree, ms.case, ms.seed,
                             {k: tuple(v.tolist()) for k, v in inp["draws"].items()},
-                            c, f, agree, seconds, n_workers)
+                            seconds, n_workers)
 
     def collect(outs: list, seconds: float, n_workers: int):
         lam_opt = run_lambda_opt(inp)
@@ -188,7 +153,5 @@ def halving_quantity_names() -> set[str]:
 
 def halving_quantities(hc: HalvingCheck) -> dict:
     """Runs checked, runs whose every metric and outcome agrees, and their
-    fraction."""
-    k = sum(hc.run_agree)
-    return {"montecarlo.halving.runs": hc.n, "montecarlo.halving.agree": k,
-            "montecarlo.halving.fraction_agree": k / hc.n}
+    fraction (:meth:`StepComparison.quantities`)."""
+    return hc.quantities("montecarlo.halving")

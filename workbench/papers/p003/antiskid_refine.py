@@ -32,6 +32,12 @@ level of what enters a finding, and only that:
 
 A finding whose metric is not among these is INCONCLUSIVE
 (:func:`workbench.refinement.refine_findings`).
+
+Why this stays in the paper: it defines which of paper 003's quantities
+are refined at which step and runs its kernels to get them; the checks
+themselves (three levels against the claim's tolerance, the share bound
+over partly refined runs) are :mod:`workbench.features.convergence` and
+:mod:`workbench.refinement`.
 """
 from __future__ import annotations
 
@@ -45,8 +51,8 @@ import numpy as np
 from ...refinement import Levels, screen
 from ...report.markdown import fmt
 
-__all__ = ["last_refine_seconds", "mc_share_levels", "quarter_cases", "refine_levels",
-           "three_level_metrics"]
+__all__ = ["CONVERGED_INSTEAD", "last_refine_seconds", "mc_share_levels", "quarter_cases",
+           "refine_levels", "three_level_metrics", "unconverged_reason"]
 
 _CASE = re.compile(r"^cases\[([^\]]+)\]\.")
 _SWITCH = re.compile(r"^switch\.(cruise|brake)\[([^\]]+)\]\.in_basin$")
@@ -245,38 +251,18 @@ def mc_share_levels(claim, key: str, whole, half, quarter, dt: float) -> Levels:
     """A share finding (``claim``, on ``montecarlo.fraction.<key>`` or
     ``montecarlo.wilson.<key>.lo`` / ``.hi``) at the sweep's dt, dt/2 and
     dt/4, when all N runs ran at dt (``whole``: N bools) and only the first
-    n again at dt/2 and dt/4 (``half``, ``quarter``: n bools each).
-
-    At dt the count k is known. At dt/2 and dt/4 the n refined runs give
-    k_n, and the other N - n runs, not run there, may have the outcome or
-    not: the count lies in [k_n, k_n + N - n], a bound that holds whatever
-    they do. The claim is checked at every count of that range: a level
-    *decides* the claim when the verdict is the same over the whole range
-    (``holds`` / ``fails``), else it is ``undecided``. The finding has
-    converged when the three levels decide it the same way (the values
-    show the counts, :attr:`Levels.decides` the verdicts); n = N refines
-    every run and the range is the count itself.
+    n again at dt/2 and dt/4 (``half``, ``quarter``: n bools each): the
+    general :func:`workbench.features.convergence.share_levels` (a level
+    decides the claim when its verdict is the same over the whole range of
+    counts the unrefined runs allow), with this paper's quantity of a count
+    (:func:`_share`). The finding has converged when the three levels
+    decide it the same way (the values show the counts,
+    :attr:`Levels.decides` the verdicts).
     """
-    from ...claims import Verdict, check_claim
-    big, n = len(whole), len(half)
-    word = key.replace("_", " ")
-
-    def verdict(lo: int, hi: int) -> str:
-        got = {check_claim(claim, _share(claim.quantity, k, big)).verdict
-               for k in range(lo, hi + 1)}
-        if len(got) != 1:
-            return "undecided"
-        return {Verdict.PASS: "holds", Verdict.FAIL: "fails"}.get(got.pop(), "undecided")
-
-    k = sum(bool(x) for x in whole)
-    vals, dec = [f"{k} of {big} {word}: {verdict(k, k)}"], [verdict(k, k)]
-    for level in (half, quarter):
-        kn = sum(bool(x) for x in level)
-        v = verdict(kn, kn + big - n)
-        vals.append(f"{kn} of the first {n}, so {kn}-{kn + big - n} of {big} {word}: {v}"
-                    if n < big else f"{kn} of {big} {word}: {v}")
-        dec.append(v)
-    return Levels(tuple(vals), "montecarlo.dt", dt, decides=tuple(dec))
+    from ...features.convergence import share_levels
+    vals, dec = share_levels(claim, whole, half, quarter,
+                             lambda k, n: _share(claim.quantity, k, n), key.replace("_", " "))
+    return Levels(vals, "montecarlo.dt", dt, decides=dec)
 
 
 def _mc_quarter(design, result, n: int) -> dict:
@@ -304,6 +290,13 @@ def quarter_cases(design) -> frozenset:
     return frozenset(out)
 
 
+def _tolerances(spec, vals: dict) -> dict:
+    """metric -> the bound of its Richardson estimate: the tolerance of the
+    design's two-level screen, atol + rtol max(|q|) of the three levels."""
+    return {k: spec.conv_atol.get(k, 0.0) + spec.conv_rtol * max(
+        (abs(x) for x in v if math.isfinite(x)), default=0.0) for k, v in vals.items()}
+
+
 def three_level_metrics(spec, coarse: dict, fine: dict, quarter: dict) -> tuple:
     """(metric -> converged, metrics not converged) over dt, dt/2, dt/4:
     :func:`workbench.refinement.screen` with the tolerance of the design's
@@ -311,7 +304,29 @@ def three_level_metrics(spec, coarse: dict, fine: dict, quarter: dict) -> tuple:
     of each metric's Richardson estimate (issue 33 item 4)."""
     from .antiskid_run_spec import METRICS
     vals = {k: (coarse[k], fine[k], quarter[k]) for k in METRICS}
-    tol = {k: spec.conv_atol.get(k, 0.0) + spec.conv_rtol * max(
-        (abs(x) for x in vals[k] if math.isfinite(x)), default=0.0) for k in METRICS}
-    _, bad = screen(vals, tol)
+    _, bad = screen(vals, _tolerances(spec, vals))
     return {k: k not in bad for k in METRICS}, bad
+
+
+#: Paper 003: the case metric to claim instead of one that does not converge
+#: over dt, dt/2, dt/4 (the braking time to v_stop moves back and forth; the
+#: time to omega = 3 rad/s converges, as the designs' stop-duration claim says).
+CONVERGED_INSTEAD = {"braking_duration": "omega3_after_brake"}
+
+
+def unconverged_reason(spec, name: str, coarse: dict, fine: dict, quarter: dict,
+                       bad: tuple) -> str:
+    """Why ``cases[<name>].converged`` is INCONCLUSIVE (issue 33): every
+    metric of ``bad`` (:func:`three_level_metrics`) in the words of
+    :func:`workbench.features.convergence.not_converged_text`, with its
+    Richardson error (:func:`workbench.refinement.guarded_check`) and the
+    quantity to use instead ("" when every metric converged)."""
+    from ...features.convergence import not_converged_text
+    from ...refinement import guarded_check
+    vals = {k: (coarse[k], fine[k], quarter[k]) for k in bad}
+    tol = _tolerances(spec, vals)
+    use = {k: f"`cases[{name}].{a}`" for k, a in CONVERGED_INSTEAD.items() if a not in bad}
+    parts = [not_converged_text(
+        f"cases[{name}].{k}", vals[k], guarded_check(*vals[k], tolerance=tol[k]).estimate,
+        tol[k], use.get(k, "a metric of the case that converges")) for k in bad]
+    return "not converged: " + "; ".join(parts) if parts else ""

@@ -18,13 +18,14 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import DesignError
+from ...features.convergence import agree
 from ...jsonable import OMIT, json_method
 from ...margins import DelayMargin, delay_margin_eig
 from ...reader import Reader
 from ...sim.batch import SchedulerUnreachable
 from ...sim.delay import SimResult, envelope_ratio, simulate_linear_dde, step_halving
 from ...sim.wheel_slip import PARAM_ORDER, model_functions
-from .antiskid_run_spec import (METRICS, Case, RunSpec, agree, case_mesh, case_metrics,
+from .antiskid_run_spec import (METRICS, Case, RunSpec, case_mesh, case_metrics,
                                 controller_settings, gain_for, load_run_spec, nominal_cruise,
                                 plant_values, run_settings)
 from .antiskid_scenario import simulate_antiskid
@@ -64,6 +65,8 @@ class CaseResult:
     quarter: tuple | None = None
     #: Metrics not converged over dt, dt/2, dt/4 (:func:`workbench.refinement.screen`).
     unconverged: tuple = ()
+    #: Why they did not (:func:`~workbench.papers.p003.antiskid_refine.unconverged_reason`).
+    why: str = ""
 
 
 @dataclass(frozen=True)
@@ -323,6 +326,12 @@ class AntiskidRun:
         return refine_levels(design, result, findings, quantities=self.quantities,
                              record_dt=RECORD_DT)
 
+    def unconverged(self, result: RunResult) -> dict[str, str]:
+        """Claimed quantity ``cases[<case>].converged`` -> why its case did
+        not converge over dt, dt/2, dt/4 (issue 33; :mod:`workbench.verify`
+        puts it on the INCONCLUSIVE claim instead of "not determined")."""
+        return {f"cases[{c.case.name}].converged": c.why for c in result.cases if c.why}
+
     def load(self, root: Reader) -> RunSpec:
         return load_run_spec(root)
 
@@ -431,13 +440,14 @@ class AntiskidRun:
                 u_peak = cs.u_range / spec.torque_range
                 comfort = tuple(comfort_of(r, spec.comfort, u_peak, RECORD_DT)
                                 for r in (run2, run1) + ((q4[1],) if q4 else ()))
-            bad = ()
+            bad, why = (), ""
             if q4 is not None:
-                from .antiskid_refine import three_level_metrics
+                from .antiskid_refine import three_level_metrics, unconverged_reason
                 conv, bad = three_level_metrics(spec, coarse, fine, q4[0])
+                why = unconverged_reason(spec, case.name, coarse, fine, q4[0], bad)
                 q4 = (q4[0], q4[1], comfort[2] if spec.comfort is not None else None)
             cases.append(CaseResult(case, fine, coarse, conv, run2, sw, *comfort[:2],
-                                    quarter=q4, unconverged=bad))
+                                    quarter=q4, unconverged=bad, why=why))
         return cases
 
     def quantities(self, res: RunResult) -> dict:

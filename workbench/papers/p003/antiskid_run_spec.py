@@ -280,13 +280,6 @@ def evs_floor(e: float) -> float:
     return 0.0 if abs(e) < EVS_FLOOR else e
 
 
-def agree(a: float, b: float, rtol: float, atol: float) -> bool:
-    """|a - b| <= atol + rtol max(|a|, |b|); two NaNs agree, NaN and a number do not."""
-    if math.isnan(a) and math.isnan(b):
-        return True
-    return abs(a - b) <= atol + rtol * max(abs(a), abs(b))
-
-
 def _range(t: Reader, key: str, **kw) -> tuple[float, float]:
     lo_hi = t.numbers(key, min_len=2, what="[low, high]")
     if len(lo_hi) != 2 or not lo_hi[0] <= lo_hi[1]:

@@ -1,0 +1,300 @@
+"""The convergence check of the simulating designs (issues 35 and 33): one
+implementation of the step refinement, for any model.
+
+A kind or a paper gives a ``metrics_at(step)`` callback (metric name ->
+value of its runs at that numerical step); this module does the rest:
+
+* :func:`three_levels` calls it at dt, dt/2 and dt/4 (:data:`LEVELS`), and
+  :func:`level_checks` gives each metric its observed order and Richardson
+  error estimate (:func:`workbench.sim.convergence.refinement_check`, the
+  numerical check with its guards);
+* the verdict is :class:`~workbench.sim.convergence.Convergence`, one enum:
+  CONVERGED, NOT_CONVERGED, or INCONCLUSIVE (not determined);
+* ``[convergence]`` of a design: :func:`load_convergence` reads the table (no
+  keys), :func:`claim_targets` picks the claims on a scenario metric
+  (``<prefix><scenario>.<metric>``), :func:`claim_rows` / :func:`rows_of`
+  check each claim's metric at the three levels against the claim's
+  tolerance (:func:`workbench.refinement.refinement_row`, tolerance by
+  :func:`workbench.refinement.claim_tolerance`), :func:`unconverged` says
+  which claims are then INCONCLUSIVE and why (a kind's
+  ``unconverged(result)``, applied by :mod:`workbench.verify`;
+  :func:`not_converged_text` the words for one metric), and
+  :func:`claim_table` is the report's table of those rows;
+* the dt-halving comparison of two levels: :func:`agree` (one value),
+  :func:`compare_steps` (per-run metrics and outcomes at dt and dt/2) and
+  its result with the runs that agree, :class:`StepComparison`;
+* :func:`share_levels`: a claim on the share of runs with an outcome, when
+  all runs ran at dt and only the first n again at dt/2 and dt/4.
+
+Used by ``switched-run``, ``delay-feedback``, ``stop-accuracy`` and paper
+003 (which keeps only which of its quantities are refined at which step).
+The numerical check and its enum stay in :mod:`workbench.sim.convergence`
+and the claim-level check (tolerance, reason) in :mod:`workbench.refinement`,
+which the committed reports name; this module is the one entry the kinds use.
+
+References
+----------
+L. F. Richardson, Phil. Trans. R. Soc. A 226:299-361, 1927.
+P. J. Roache, Annu. Rev. Fluid Mech. 29:123-160, 1997 (three-grid observed order).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..sim.convergence import Convergence, Refinement, refinement_check
+
+__all__ = ["LEVELS", "ClaimTarget", "Convergence", "StepComparison", "agree", "by_metric",
+           "claim_rows", "claim_table", "claim_targets", "compare_steps", "level_checks",
+           "load_convergence", "not_converged_text", "rows_of", "share_levels", "three_levels",
+           "unconverged"]
+
+#: Refinement levels: the step divided by 2**k.
+LEVELS = (0, 1, 2)
+
+
+def three_levels(metrics_at, step: float, *, first: dict | None = None) -> tuple:
+    """The metrics at ``step``, ``step / 2`` and ``step / 4``.
+
+    Parameters
+    ----------
+    metrics_at : callable
+        ``step -> dict`` (metric name -> value) of the model's runs at that
+        numerical step; everything else stays as designed.
+    step : float
+        The designed step.
+    first : dict, optional
+        The metrics at ``step`` when the caller has them already (not run again).
+
+    Returns
+    -------
+    tuple of dict
+        One metric dict per level of :data:`LEVELS`.
+    """
+    return tuple(first if k == 0 and first is not None else metrics_at(step / 2 ** k)
+                 for k in LEVELS)
+
+
+def by_metric(levels) -> dict:
+    """metric -> (q1, q2, q4), from the metric dicts of :func:`three_levels`
+    (the metrics of the first level, in its order)."""
+    return {m: tuple(lv[m] for lv in levels) for m in levels[0]}
+
+
+def level_checks(values: dict, *, tolerance: float = math.inf,
+                 finite: bool = False) -> dict[str, Refinement]:
+    """metric -> observed order and Richardson estimate of its three values
+    (:func:`workbench.sim.convergence.refinement_check` against
+    ``tolerance``; ``finite``: only the metrics finite at every level)."""
+    return {m: refinement_check(*v, tolerance=tolerance) for m, v in values.items()
+            if not finite or all(math.isfinite(x) for x in v)}
+
+
+@dataclass(frozen=True)
+class ClaimTarget:
+    """A claim on a scenario metric (read for Monte Carlo pass rates and the
+    convergence tolerance; :func:`workbench.claims.parse_claims` validates
+    the full claim)."""
+
+    claim: object            # workbench.claims.Claim
+    scenario: str
+    metric: str
+
+
+def load_convergence(root) -> bool:
+    """True when the design has a ``[convergence]`` table (it takes no keys:
+    an unknown key is a design error)."""
+    if not root.has("convergence"):
+        return False
+    root.table("convergence").finish()
+    return True
+
+
+def _number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def claim_targets(root, prefix: str, metrics_of) -> tuple[ClaimTarget, ...]:
+    """The claims of ``root`` whose quantity is ``<prefix><scenario>.<metric>``
+    with a numeric value, ``metrics_of(scenario)`` the metric names of a
+    scenario (an empty set for an unknown one). Built with the project's
+    :class:`~workbench.claims.Claim`; only well-typed claims are kept (the
+    others are rejected by :func:`workbench.claims.parse_claims` after this).
+    """
+    from ..claims import Claim
+    raw = root.data.get("claims", [])
+    out = []
+    for c in raw if isinstance(raw, list) else []:
+        q, cid = (c.get("quantity"), c.get("id")) if isinstance(c, dict) else (None, None)
+        if not (isinstance(q, str) and isinstance(cid, str) and q.startswith(prefix)):
+            continue
+        scen, _, metric = q[len(prefix):].partition(".")
+        v, tol = c.get("value"), c.get("tolerance", 0.0)
+        cmp_, digits = c.get("compare"), c.get("digits")
+        ok = (metric in metrics_of(scen) and _number(v) and _number(tol) and tol >= 0
+              and cmp_ in (">=", "<=", "==", "within")
+              and (digits is None or isinstance(digits, int) and not isinstance(digits, bool)))
+        if ok:
+            claim = Claim(cid, "", q, cmp_, float(v), float(tol), digits,
+                          c.get("rounding", "round") if c.get("rounding") in ("round", "truncate")
+                          else "round", "", False, "pass", "")
+            out.append(ClaimTarget(claim, scen, metric))
+    return tuple(out)
+
+
+def claim_rows(targets, scenario: str, levels, reported: int = 0) -> list:
+    """The refinement row of every claim of ``targets`` on a metric of
+    ``scenario``: ``levels`` are the metric dicts at dt, dt/2, dt/4 and
+    ``reported`` the index of the level whose value the claim compares (0
+    for ``switched-run``; 1 for ``delay-feedback``, which reports dt/2). A
+    metric that is not determined (nan at the reported level) is left out:
+    its claim is INCONCLUSIVE already."""
+    return rows_of(((c.claim, tuple(lv[c.metric] for lv in levels)) for c in targets
+                    if c.scenario == scenario), reported)
+
+
+def rows_of(pairs, reported: int = 0, *, determined=lambda x: not math.isnan(x)) -> list:
+    """The refinement row (:func:`workbench.refinement.refinement_row`) of
+    every ``(claim, (q1, q2, q4))`` of ``pairs`` whose value at level
+    ``reported`` is ``determined`` (the others are left out: their claim is
+    INCONCLUSIVE already)."""
+    from ..refinement import refinement_row
+    return [refinement_row(c, vals, "dt", vals[reported]) for c, vals in pairs
+            if determined(vals[reported])]
+
+
+def unconverged(rows) -> dict[str, str]:
+    """claim id -> reason, for the rows whose metric did not converge."""
+    return {r.claim_id: r.reason for r in rows if not r.converged}
+
+
+def not_converged_text(quantity: str, values, estimate: float | None, tolerance: float,
+                       instead: str, levels: str = "dt, dt/2, dt/4") -> str:
+    """``<quantity> q1 / q2 / q4 at <levels>, Richardson error X > tol Y;
+    use <instead> instead``: what an INCONCLUSIVE claim says of a metric
+    that did not converge (issue 33; values to 6 digits, as the convergence
+    tables print them, the estimate and tolerance to 2)."""
+    from ..report.markdown import fmt
+    err = "not determined (a value is not finite)" if estimate is None else fmt(estimate, 2)
+    return (f"{quantity} {' / '.join(fmt(x, 6) for x in values)} at {levels}, Richardson "
+            f"error {err} > tol {fmt(tolerance, 2)}; use {instead} instead")
+
+
+def claim_table(rows) -> str:
+    """Markdown: every claim on a scenario metric against its tolerance, or a
+    line saying there is none."""
+    from ..report.markdown import fmt, md_table
+    crow = [[f"`{x.claim_id}`", f"`{x.quantity}`", fmt(x.tolerance, 2),
+             "—" if x.check is None or x.check.estimate is None else fmt(x.check.estimate, 2),
+             f"**{x.outcome}**" + (f": {x.reason}" if x.reason else "")]
+            for x in rows]
+    return (md_table(["claim", "quantity", "tolerance", "estimate", "outcome"], crow, "llrrl")
+            if crow else "_No claim on a scenario metric._")
+
+
+def agree(a: float, b: float, rtol: float, atol: float) -> bool:
+    """A value at dt and at dt/2 agree: |a - b| <= atol + rtol max(|a|, |b|);
+    two NaNs agree (not reached at either step), NaN and a number do not."""
+    if math.isnan(a) and math.isnan(b):
+        return True
+    return abs(a - b) <= atol + rtol * max(abs(a), abs(b))
+
+
+def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict, metrics,
+                  outcomes=()) -> tuple[dict, dict, dict]:
+    """Per-run values at dt (``coarse``) and dt/2 (``fine``) compared.
+
+    Parameters
+    ----------
+    coarse, fine : dict
+        name -> values per run, for every name of ``metrics`` (numbers) and
+        ``outcomes`` (booleans).
+    rtol : float
+    atol : dict
+        Metric -> absolute tolerance (missing: 0).
+    metrics, outcomes : sequence of str
+
+    Returns
+    -------
+    (coarse, fine, agree) : dict, dict, dict
+        The values as tuples of float / bool, metrics first, and per name
+        a tuple of per-run agree flags (:func:`agree` for a metric,
+        equality for an outcome).
+    """
+    c, f = ({**{k: tuple(float(x) for x in vals[k]) for k in metrics},
+             **{k: tuple(bool(x) for x in vals[k]) for k in outcomes}} for vals in (coarse, fine))
+    same = {k: tuple(agree(a, b, rtol, atol.get(k, 0.0)) for a, b in zip(c[k], f[k]))
+            for k in metrics}
+    same.update({k: tuple(a == b for a, b in zip(c[k], f[k])) for k in outcomes})
+    return c, f, same
+
+
+@dataclass(frozen=True)
+class StepComparison:
+    """The runs of a batch at dt and dt/2 compared (:func:`compare_steps`):
+    ``coarse``, ``fine`` and ``agree`` map a metric or outcome to one entry
+    per run; ``rtol`` and ``atol`` (metric -> absolute tolerance) are the
+    tolerances of the comparison."""
+
+    dt: float
+    rtol: float
+    atol: dict
+    coarse: dict
+    fine: dict
+    agree: dict
+
+    @property
+    def n(self) -> int:
+        return len(next(iter(self.agree.values()), ()))
+
+    @property
+    def run_agree(self) -> tuple:
+        """Per run: every metric and outcome agrees."""
+        return tuple(all(self.agree[k][i] for k in self.agree) for i in range(self.n))
+
+    def quantities(self, prefix: str) -> dict:
+        """``<prefix>.runs``, ``.agree`` (runs whose every metric and outcome
+        agrees) and ``.fraction_agree``."""
+        k = sum(self.run_agree)
+        return {f"{prefix}.runs": self.n, f"{prefix}.agree": k,
+                f"{prefix}.fraction_agree": k / self.n}
+
+
+def share_levels(claim, whole, half, quarter, value_of, word: str) -> tuple[tuple, tuple]:
+    """A claim on the share of runs with an outcome, at dt, dt/2 and dt/4,
+    when all N runs ran at dt (``whole``: N bools) and only the first n
+    again at dt/2 and dt/4 (``half``, ``quarter``: n bools each).
+
+    At dt the count k is known. At dt/2 and dt/4 the n refined runs give
+    k_n, and the other N - n runs, not run there, may have the outcome or
+    not: the count lies in [k_n, k_n + N - n], a bound that holds whatever
+    they do. The claim is checked (``value_of(k, N)``: the claimed quantity
+    when k of N runs have the outcome) at every count of that range: a
+    level *decides* the claim when the verdict is the same over the whole
+    range (``holds`` / ``fails``), else it is ``undecided``. n = N refines
+    every run and the range is the count itself.
+
+    Returns
+    -------
+    (values, decides) : tuple of str, tuple of str
+        Per level the counts behind it (``word`` names the outcome) and its
+        decision; the claim has converged when the three decisions agree.
+    """
+    from ..claims import Verdict, check_claim
+    big, n = len(whole), len(half)
+
+    def verdict(lo: int, hi: int) -> str:
+        got = {check_claim(claim, value_of(k, big)).verdict for k in range(lo, hi + 1)}
+        if len(got) != 1:
+            return "undecided"
+        return {Verdict.PASS: "holds", Verdict.FAIL: "fails"}.get(got.pop(), "undecided")
+
+    k = sum(bool(x) for x in whole)
+    vals, dec = [f"{k} of {big} {word}: {verdict(k, k)}"], [verdict(k, k)]
+    for level in (half, quarter):
+        kn = sum(bool(x) for x in level)
+        v = verdict(kn, kn + big - n)
+        vals.append(f"{kn} of the first {n}, so {kn}-{kn + big - n} of {big} {word}: {v}"
+                    if n < big else f"{kn} of {big} {word}: {v}")
+        dec.append(v)
+    return tuple(vals), tuple(dec)
