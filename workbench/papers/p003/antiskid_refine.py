@@ -16,7 +16,7 @@ level of what enters a finding, and only that:
 * ``sampled.<variant>.rate[<f>].*``: the levels are plant_step (reported),
   plant_step/2 and plant_step/4; at a rate up to 1 kHz the study has run
   them already (its three-level check of every claimed rate metric,
-  :func:`~workbench.papers.p003.antiskid_sampled.run_variant`), above it
+  :func:`~workbench.features.rate_sweep.sweep_variant`), above it
   the rate is run here at /2 and /4;
 * ``montecarlo.*``: a share claim is refined on the outcome behind it,
   per run: all N runs of the sweep at its dt, the first n
