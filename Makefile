@@ -36,21 +36,25 @@ report: install
 ## `workbench check --jobs $(JOBS)` runs each study once (a pool of processes)
 ## and leaves the results in a run folder; the test session (pytest-xdist,
 ## $(JOBS) workers, tests marked `slow` deselected: `make test-full`) reads
-## them instead of computing them again. Ends with the wall time and the
-## five slowest studies and tests.
+## them instead of computing them again. The test session starts with the
+## check: its workers import and collect the tests meanwhile (on the core the
+## check's last tasks leave idle) and the first test runs once the check is
+## done (WORKBENCH_TESTS_AFTER names the file that says so, tests/conftest.py).
+## Ends with the wall time and the five slowest studies and tests.
 # the lines of a check's output shown: problems, summaries and the claims not ok
 NOT_OK := awk '!/^\| / || /✗/'
 JOBS ?= $(shell $(PYTHON) -c "import os; print(max(1, len(os.sched_getaffinity(0))))")
 test: install
-	@t0=$$(date +%s); run=$$(mktemp -d); times=$$(mktemp); \
+	@t0=$$(date +%s); run=$$(mktemp -d); times=$$(mktemp); log=$$(mktemp); \
+	WORKBENCH_STUDY_CACHE=$$run WORKBENCH_TESTS_AFTER=$$log.done $(PY) -m pytest -n $(JOBS) \
+	  -m "not slow and not wheel" --durations=5 -p no:cacheprovider > $$log 2>&1 & pid=$$!; \
 	echo "== workbench check --jobs $(JOBS) (every claim, report freshness)"; \
 	WORKBENCH_STUDY_CACHE=$$run $(WB) check --jobs $(JOBS) 2> $$times | $(NOT_OK); \
-	  checked=$${PIPESTATUS[0]}; \
+	  checked=$${PIPESTATUS[0]}; touch $$log.done; \
 	echo "== check done after $$(( $$(date +%s) - t0 )) s"; \
-	echo "== pytest -n $(JOBS) (not slow)"; \
-	WORKBENCH_STUDY_CACHE=$$run $(PY) -m pytest -n $(JOBS) -m "not slow and not wheel" \
-	  --durations=5 -p no:cacheprovider; tests=$$?; \
-	rm -rf $$run; \
+	echo "== pytest -n $(JOBS) (not slow; collected while the check ran)"; \
+	tail -n +1 -f --pid=$$pid $$log; wait $$pid; tests=$$?; \
+	rm -rf $$run $$log $$log.done; \
 	echo; echo "== five slowest studies (workbench check; the whole table: workbench check --jobs $(JOBS))"; \
 	grep -A 6 -- '| task | kind | wall s | cpu s |' $$times | sed 's/.*\(| task | kind\)/\1/'; \
 	grep -v '^|\|^$$\|per-task time' $$times; rm -f $$times; \
