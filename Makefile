@@ -23,8 +23,13 @@ $(STAMP): pyproject.toml constraints.txt
 	touch $(STAMP)
 
 # The compiled kernels compile once per machine and source (issue 36): here, not
-# in the timed check (a few seconds when the disk cache is already warm).
+# in the timed check (a few seconds when the disk cache is already warm). So does
+# the bytecode of the package and the tests: written here, it is read by every
+# process of the check and of the test session, even where PYTHONDONTWRITEBYTECODE
+# is set (then each process would compile every module it imports, about 3.5 CPU s
+# per test worker); compileall skips a module whose bytecode is current.
 install: $(STAMP)
+	@$(PY) -m compileall -q workbench tests
 	@$(PY) -m workbench.papers.p003.antiskid_warm
 
 ## main job: every shipped design -> reports/<design>.md, figures, index
