@@ -44,7 +44,9 @@ report: install
 ## them instead of computing them again. The test session starts with the
 ## check: its workers import and collect the tests meanwhile (on the core the
 ## check's last tasks leave idle) and the first test runs once the check is
-## done (WORKBENCH_TESTS_AFTER names the file that says so, tests/conftest.py).
+## done (WORKBENCH_TESTS_AFTER names the file that says so, tests/conftest.py;
+## the check creates it as soon as every study result is in the run folder,
+## WORKBENCH_STUDIES_DONE, and it is created when the check ends in any case).
 ## Ends with the wall time and the five slowest studies and tests.
 # the lines of a check's output shown: problems, summaries and the claims not ok
 NOT_OK := awk '!/^\| / || /✗/'
@@ -54,7 +56,8 @@ test: install
 	WORKBENCH_STUDY_CACHE=$$run WORKBENCH_TESTS_AFTER=$$log.done $(PY) -m pytest -n $(JOBS) \
 	  -m "not slow and not wheel" --durations=5 -p no:cacheprovider > $$log 2>&1 & pid=$$!; \
 	echo "== workbench check --jobs $(JOBS) (every claim, report freshness)"; \
-	WORKBENCH_STUDY_CACHE=$$run $(WB) check --jobs $(JOBS) 2> $$times | $(NOT_OK); \
+	WORKBENCH_STUDY_CACHE=$$run WORKBENCH_STUDIES_DONE=$$log.done $(WB) check --jobs $(JOBS) \
+	  2> $$times | $(NOT_OK); \
 	  checked=$${PIPESTATUS[0]}; touch $$log.done; \
 	echo "== check done after $$(( $$(date +%s) - t0 )) s"; \
 	echo "== pytest -n $(JOBS) (not slow; collected while the check ran)"; \
