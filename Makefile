@@ -46,7 +46,8 @@ report: install
 ## check's last tasks leave idle) and the first test runs once the check is
 ## done (WORKBENCH_TESTS_AFTER names the file that says so, tests/conftest.py;
 ## the check creates it as soon as every study result is in the run folder,
-## WORKBENCH_STUDIES_DONE, and it is created when the check ends in any case).
+## WORKBENCH_STUDIES_DONE, and it is created when the check ends in any case;
+## an interrupted `make test` ends the waiting session: it ignores Ctrl-C).
 ## Ends with the wall time and the five slowest studies and tests.
 # the lines of a check's output shown: problems, summaries and the claims not ok
 NOT_OK := awk '!/^\| / || /✗/'
@@ -55,13 +56,14 @@ test: install
 	@t0=$$(date +%s); run=$$(mktemp -d); times=$$(mktemp); log=$$(mktemp); \
 	WORKBENCH_STUDY_CACHE=$$run WORKBENCH_TESTS_AFTER=$$log.done $(PY) -m pytest -n $(JOBS) \
 	  -m "not slow and not wheel" --durations=5 -p no:cacheprovider > $$log 2>&1 & pid=$$!; \
+	trap 'kill $$pid 2>/dev/null' EXIT; trap 'exit 130' INT TERM; \
 	echo "== workbench check --jobs $(JOBS) (every claim, report freshness)"; \
 	WORKBENCH_STUDY_CACHE=$$run WORKBENCH_STUDIES_DONE=$$log.done $(WB) check --jobs $(JOBS) \
 	  2> $$times | $(NOT_OK); \
 	  checked=$${PIPESTATUS[0]}; touch $$log.done; \
 	echo "== check done after $$(( $$(date +%s) - t0 )) s"; \
 	echo "== pytest -n $(JOBS) (not slow; collected while the check ran)"; \
-	tail -n +1 -f --pid=$$pid $$log; wait $$pid; tests=$$?; \
+	tail -n +1 -f --pid=$$pid $$log; wait $$pid; tests=$$?; trap - EXIT; \
 	rm -rf $$run $$log $$log.done; \
 	echo; echo "== five slowest studies (workbench check; the whole table: workbench check --jobs $(JOBS))"; \
 	grep -A 6 -- '| task | kind | wall s | cpu s |' $$times | sed 's/.*\(| task | kind\)/\1/'; \
