@@ -23,8 +23,13 @@ $(STAMP): pyproject.toml constraints.txt
 	touch $(STAMP)
 
 # The compiled kernels compile once per machine and source (issue 36): here, not
-# in the timed check (a few seconds when the disk cache is already warm).
+# in the timed check (a few seconds when the disk cache is already warm). So does
+# the bytecode of the package and the tests: written here, it is read by every
+# process of the check and of the test session, even where PYTHONDONTWRITEBYTECODE
+# is set (then each process would compile every module it imports, about 3.5 CPU s
+# per test worker); compileall skips a module whose bytecode is current.
 install: $(STAMP)
+	@$(PY) -m compileall -q workbench tests
 	@$(PY) -m workbench.papers.p003.antiskid_warm
 
 ## main job: every shipped design -> reports/<design>.md, figures, index
@@ -36,21 +41,30 @@ report: install
 ## `workbench check --jobs $(JOBS)` runs each study once (a pool of processes)
 ## and leaves the results in a run folder; the test session (pytest-xdist,
 ## $(JOBS) workers, tests marked `slow` deselected: `make test-full`) reads
-## them instead of computing them again. Ends with the wall time and the
-## five slowest studies and tests.
+## them instead of computing them again. The test session starts with the
+## check: its workers import and collect the tests meanwhile (on the core the
+## check's last tasks leave idle) and the first test runs once the check is
+## done (WORKBENCH_TESTS_AFTER names the file that says so, tests/conftest.py;
+## the check creates it as soon as every study result is in the run folder,
+## WORKBENCH_STUDIES_DONE, and it is created when the check ends in any case;
+## an interrupted `make test` ends the waiting session: it ignores Ctrl-C).
+## Ends with the wall time and the five slowest studies and tests.
 # the lines of a check's output shown: problems, summaries and the claims not ok
 NOT_OK := awk '!/^\| / || /✗/'
 JOBS ?= $(shell $(PYTHON) -c "import os; print(max(1, len(os.sched_getaffinity(0))))")
 test: install
-	@t0=$$(date +%s); run=$$(mktemp -d); times=$$(mktemp); \
+	@t0=$$(date +%s); run=$$(mktemp -d); times=$$(mktemp); log=$$(mktemp); \
+	WORKBENCH_STUDY_CACHE=$$run WORKBENCH_TESTS_AFTER=$$log.done $(PY) -m pytest -n $(JOBS) \
+	  -m "not slow and not wheel" --durations=5 -p no:cacheprovider > $$log 2>&1 & pid=$$!; \
+	trap 'kill $$pid 2>/dev/null' EXIT; trap 'exit 130' INT TERM; \
 	echo "== workbench check --jobs $(JOBS) (every claim, report freshness)"; \
-	WORKBENCH_STUDY_CACHE=$$run $(WB) check --jobs $(JOBS) 2> $$times | $(NOT_OK); \
-	  checked=$${PIPESTATUS[0]}; \
+	WORKBENCH_STUDY_CACHE=$$run WORKBENCH_STUDIES_DONE=$$log.done $(WB) check --jobs $(JOBS) \
+	  2> $$times | $(NOT_OK); \
+	  checked=$${PIPESTATUS[0]}; touch $$log.done; \
 	echo "== check done after $$(( $$(date +%s) - t0 )) s"; \
-	echo "== pytest -n $(JOBS) (not slow)"; \
-	WORKBENCH_STUDY_CACHE=$$run $(PY) -m pytest -n $(JOBS) -m "not slow and not wheel" \
-	  --durations=5 -p no:cacheprovider; tests=$$?; \
-	rm -rf $$run; \
+	echo "== pytest -n $(JOBS) (not slow; collected while the check ran)"; \
+	tail -n +1 -f --pid=$$pid $$log; wait $$pid; tests=$$?; trap - EXIT; \
+	rm -rf $$run $$log $$log.done; \
 	echo; echo "== five slowest studies (workbench check; the whole table: workbench check --jobs $(JOBS))"; \
 	grep -A 6 -- '| task | kind | wall s | cpu s |' $$times | sed 's/.*\(| task | kind\)/\1/'; \
 	grep -v '^|\|^$$\|per-task time' $$times; rm -f $$times; \

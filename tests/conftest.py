@@ -28,6 +28,30 @@ def pytest_sessionstart(session):
     _TIMELINE["t0"] = time.monotonic()
 
 
+# `make test` starts the test session while `workbench check` still runs (issue
+# 36): pytest-xdist's workers import and collect the test files meanwhile (about
+# 10 CPU s each, on the core the check's last tasks leave idle), and the session
+# runs its first test only once the check has left every study result in the run
+# folder (WORKBENCH_STUDY_CACHE): the file named by WORKBENCH_TESTS_AFTER exists.
+AFTER_ENV = "WORKBENCH_TESTS_AFTER"
+
+
+def wait_for(flag: str | None, poll: float = 0.2) -> None:
+    """Return once the file ``flag`` exists (at once when ``flag`` is empty)."""
+    import os
+    import time
+    while flag and not os.path.exists(flag):
+        time.sleep(poll)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_runtestloop(session):
+    """Hold the first test until the check is done (see :data:`AFTER_ENV`):
+    the xdist controller hands out no test before, a plain session runs none."""
+    import os
+    wait_for(os.environ.get(AFTER_ENV))
+
+
 def pytest_runtest_logstart(nodeid, location):
     import os
     import sys

@@ -1,6 +1,9 @@
 """The order in which the xdist workers receive the test files (tests/conftest.py,
-issue 36): longest measured file first, each file's tests in their own order."""
-from conftest import COSTS, file_costs, longest_files_first
+issue 36): longest measured file first, each file's tests in their own order; and
+the wait for the check's end before the first test (`make test`)."""
+import threading
+
+from conftest import COSTS, file_costs, longest_files_first, wait_for
 
 
 def test_files_go_out_longest_first_and_keep_their_inner_order():
@@ -22,3 +25,16 @@ def test_the_committed_costs_parse(tmp_path):
     p = tmp_path / "costs.txt"
     p.write_text("# comment\n\n2.5 tests/test_x.py\n", encoding="utf-8")
     assert file_costs(p) == {"tests/test_x.py": 2.5}
+
+
+def test_the_first_test_waits_for_the_check(tmp_path):
+    """``wait_for`` returns at once without a flag file name, and otherwise not
+    before the file exists (written here by a thread after a short delay)."""
+    wait_for(None)
+    wait_for("")
+    flag = tmp_path / "check-done"
+    timer = threading.Timer(0.3, flag.touch)
+    timer.start()
+    wait_for(str(flag), poll=0.01)
+    assert flag.exists()            # returned only once the thread wrote it
+    timer.join()

@@ -9,8 +9,11 @@ figure, :func:`workbench.report.writer.check_reports`) and leaves the study
 result in the run folder (:mod:`workbench.memo`, ``WORKBENCH_STUDY_CACHE``).
 The parent then prints ``workbench verify``'s table from those results,
 checks the index and the reports the workers did not, and prints the time of
-every task. A test session started afterwards with the same run folder
-(``make test``) reads the same results instead of computing them again.
+every task. A test session with the same run folder (``make test``) reads
+the same results instead of computing them again: started beside the check,
+it runs its first test once the file named by ``WORKBENCH_STUDIES_DONE``
+exists, which the check creates as soon as every study result is in the run
+folder (before the verdicts and the index, which the tests do not need).
 """
 from __future__ import annotations
 
@@ -32,6 +35,9 @@ __all__ = ["TaskTime", "check_parallel", "prefetch", "report_parallel", "run_fol
 _SLOW_KINDS = ("antiskid-run", "delay-benchmark", "antiskid-robust", "platoon")
 #: Kinds whose studies compile the numba kernels on a cold disk cache.
 _COMPILED_KINDS = ("antiskid-run",)
+#: Environment variable naming the file created once every study result is in
+#: the run folder (see the module docstring).
+DONE_ENV = "WORKBENCH_STUDIES_DONE"
 
 
 @dataclass(frozen=True)
@@ -150,6 +156,8 @@ def check_parallel(designs, out: str | None, jobs: int, verify, report) -> int:
     with run_folder():
         checked, problems, times = prefetch(designs, [m.name for m in proof_modules()],
                                             folder, jobs)
+        if os.environ.get(DONE_ENV):
+            Path(os.environ[DONE_ENV]).touch()
         code = verify()
         print()
         code = max(code, report(checked, problems))
