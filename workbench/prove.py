@@ -19,6 +19,8 @@ from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
 
+import sympy as sp
+
 from .claims import ROUNDING_RTOL
 from .errors import DesignError
 from .report.findings import (Finding, Labels, Summary, index_row, ordered, render_findings,
@@ -348,6 +350,55 @@ def _traceability(pairs) -> str:
             "step of the paper, `our choice` for a corrected form the workbench adds).")
 
 
+_SYMBOL_FACTS = ("positive", "nonnegative", "negative", "nonpositive", "integer", "real")
+
+
+def _symbol_facts(c) -> str:
+    """The declared sympy assumptions of the symbols a claim's two sides use
+    (the strongest of :data:`_SYMBOL_FACTS` each symbol is declared with)."""
+    exprs = [e for e in (c.lhs, c.rhs) if isinstance(e, sp.Basic)]
+    syms = sorted(set().union(*(e.free_symbols for e in exprs)) if exprs else set(), key=str)
+    groups: dict[str, list[str]] = {}
+    for x in syms:
+        fact = next((f for f in _SYMBOL_FACTS if x.assumptions0.get(f)), None)
+        if fact is not None:
+            groups.setdefault(fact, []).append(f"${sp.latex(x)}$")
+    return "; ".join(f"{', '.join(v)} {k}" for k, v in groups.items())
+
+
+def _assumptions(pairs) -> str:
+    """``## Assumptions`` of a paper's proof report (issue 33, item 3): what each
+    proof uses beyond the paper's equations, read off the claim itself — its
+    hypotheses, the substitutions it is given, the symbols assumed nonzero and
+    the declared signs of its symbols. A PROVED verdict holds under these only."""
+    rows = []
+    for _, r in pairs:
+        c = r.claim
+        parts = []
+        if c.hypotheses:
+            parts.append("hypotheses " + ", ".join(f"${sp.latex(h.relational)}$"
+                                                   for h in c.hypotheses))
+        if c.given:
+            parts.append("given " + ", ".join(f"${sp.latex(a)} = {sp.latex(b)}$"
+                                              for a, b in c.given))
+        if c.nonzero:
+            parts.append("nonzero " + ", ".join(f"${sp.latex(x)}$" for x in c.nonzero))
+        facts = _symbol_facts(c)
+        if facts:
+            parts.append("declared: " + facts)
+        if c.kind == "value":
+            parts.append(f"the printed value stands for the exact one to its {c.digits} "
+                         "printed decimals (the paper's rounding is not an error)")
+        if parts:
+            rows.append([f"`{c.id}`", "; ".join(parts)])
+    effect = ("A PROVED verdict holds only where these hold; the falsification search "
+              "samples only points where they hold; outside them the step is not claimed.")
+    if not rows:
+        return "## Assumptions\n\n_No proof here uses an assumption beyond its equations._"
+    return ("## Assumptions\n\n" + md_table(["claim", "assumed"], rows, "ll")
+            + "\n\n" + effect)
+
+
 def render_paper_report(paper: str, pairs, ident: str = "") -> str:
     """Markdown of one paper's proof report (pure function of the results;
     ``ident``: the configuration lines of the provenance section)."""
@@ -375,7 +426,8 @@ def render_paper_report(paper: str, pairs, ident: str = "") -> str:
             "by hand.")
     return "\n\n".join([head, _verdict(results), _findings(results),
                         "## Claims\n\n" + how + "\n\n" + table,
-                        "## Checked steps", *body, prov, _traceability(pairs)]) + "\n"
+                        "## Checked steps", *body, _assumptions(pairs), prov,
+                        _traceability(pairs)]) + "\n"
 
 
 def report_files() -> list:
