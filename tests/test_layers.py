@@ -33,8 +33,8 @@ ALLOWED = {
     "margins": {"margins", "errors"},
     "sim": {"sim", "plants", "errors"},
     "controllers": {"controllers", "sim", "plants", "errors"},
-    "report": {"report", "claims", "errors", "outcome"},
-    "roa": {"roa", "errors", "outcome"},
+    "report": {"report", "claims", "errors", "outcome", "printed_grid"},
+    "roa": {"roa", "errors", "outcome", "printed_grid"},
 }
 
 #: (importer package, imported package) pairs the issue names explicitly.

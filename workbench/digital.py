@@ -46,7 +46,7 @@ import numpy as np
 
 from .jsonable import to_json as jsonable
 from .lmi.core import DEFAULT_MARGIN, Outcome
-from .printed_grid import directed
+from .printed_grid import directed, sig_round
 from .margins.sampled import PeriodicStableSet, alternating_radius, periodic_stable_set
 
 __all__ = ["ImplementationResult", "implementation", "synthesize_sampled"]
@@ -169,8 +169,7 @@ def _sig(x: float, digits: int, how) -> float:
     """x rounded with ``how`` (floor, ceil or round) to ``digits`` significant digits."""
     if not (math.isfinite(x) and x > 0):
         return x
-    q = 10.0 ** (math.floor(math.log10(x)) - (digits - 1))
-    return float(f"{how(x / q + (1e-12 if how is math.floor else 0.0)) * q:.{digits + 2}g}")
+    return float(f"{sig_round(x, digits, how, 1e-12 if how is math.floor else 0.0):.{digits + 2}g}")
 
 
 def render_markdown(r: ImplementationResult) -> str:

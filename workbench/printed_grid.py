@@ -14,10 +14,12 @@ plotted values to a resolution relative to their decade (:func:`quantised`).
 from __future__ import annotations
 
 import math
+from decimal import Decimal
 
 import numpy as np
 
-__all__ = ["AXIS_DIGITS", "TIE_BAND", "directed", "axis_end", "printed_digits", "quantised"]
+__all__ = ["AXIS_DIGITS", "TIE_BAND", "sig_round", "directed", "axis_end", "printed_digits",
+           "quantised"]
 
 #: Significant digits of a figure's data-derived axis end (:func:`axis_end`).
 AXIS_DIGITS = 2
@@ -28,14 +30,39 @@ AXIS_DIGITS = 2
 TIE_BAND = 1e-9
 
 
+#: Decimal exponents of the rounding step within which the step 10**e is a
+#: normal float (and x / 10**e loses nothing): outside it (x subnormal, or
+#: above 1e300) :func:`sig_round` scales in exact decimal arithmetic.
+_FLOAT_STEP = range(-290, 291)
+
+
+def sig_round(x: float, sig: int, how, nudge: float = 0.0) -> float:
+    """x rounded with ``how`` (``math.floor``, ``math.ceil`` or ``round``) to
+    ``sig`` significant digits: ``how(x / q + nudge) * q`` with the step
+    ``q = 10**(floor(log10|x|) - sig + 1)``.
+
+    The one place printed values are cut to their digits. For every x whose
+    step is a normal float this is that float expression, bit for bit; for a
+    subnormal x (5e-324, where 10**e underflows to 0) or a huge one the step
+    is applied in exact decimal arithmetic instead, so no finite input divides
+    by zero (fuzz campaign 3202, round 3). Zero and non-finite x are returned
+    unchanged."""
+    if x == 0 or not math.isfinite(x):
+        return x
+    e = math.floor(math.log10(abs(x))) - sig + 1
+    if e in _FLOAT_STEP:
+        q = 10.0 ** e
+        return how(x / q + nudge) * q
+    return float(Decimal(how(float(Decimal(x).scaleb(-e)) + nudge)).scaleb(e))
+
+
 def directed(x: float, *, up: bool, sig: int = 4) -> float:
     """x to ``sig`` significant digits, rounded up (a lower end) or down (an upper
     end): an interval quantity never claims more than was certified, and its
     last digits, which differ between CPUs, are dropped."""
     if x == 0 or math.isinf(x) or math.isnan(x):
         return x
-    q = 10.0 ** (math.floor(math.log10(abs(x))) - sig + 1)
-    return float(f"{(math.ceil(x / q) if up else math.floor(x / q)) * q:.{sig}g}")
+    return float(f"{sig_round(x, sig, math.ceil if up else math.floor):.{sig}g}")
 
 
 def axis_end(x: float, sig: int = AXIS_DIGITS) -> float:
@@ -60,7 +87,10 @@ def quantised(values, digits: int = 4, scale: float | None = None) -> np.ndarray
     s = scale if scale is not None else (float(finite.max()) if finite.size else 0.0)
     if not s > 0:
         return v.copy()
-    q = 10.0 ** (math.floor(math.log10(s)) - digits + 1)
+    e = math.floor(math.log10(s)) - digits + 1
+    if e not in _FLOAT_STEP:   # a subnormal or huge scale: nothing to snap to
+        return v.copy()
+    q = 10.0 ** e
     return np.round(v / q) * q
 
 
@@ -78,6 +108,9 @@ def printed_digits(x, sig: int = 4) -> int:
     x = abs(float(x))
     if x == 0 or not math.isfinite(x):
         return sig
-    q = 10.0 ** (math.floor(math.log10(x)) - sig + 1)
+    e = math.floor(math.log10(x)) - sig + 1
+    if e not in _FLOAT_STEP:
+        return sig
+    q = 10.0 ** e
     frac = x / q - math.floor(x / q)
     return sig + 1 if abs(frac - 0.5) * q <= TIE_BAND * x else sig

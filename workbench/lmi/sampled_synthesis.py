@@ -30,6 +30,7 @@ import cvxpy as cp
 import numpy as np
 import scipy.linalg as sl
 
+from ..printed_grid import sig_round
 from .core import guarded_solve
 
 __all__ = ["synthesize_sampled_gain"]
@@ -42,8 +43,7 @@ def _round(K: np.ndarray, digits: int) -> np.ndarray:
     out = np.zeros_like(K)
     for idx, k in np.ndenumerate(K):
         if k != 0 and math.isfinite(k):
-            e = math.floor(math.log10(abs(k))) - (digits - 1)
-            out[idx] = round(k / 10.0 ** e) * 10.0 ** e
+            out[idx] = sig_round(k, digits, round)
     return out
 
 

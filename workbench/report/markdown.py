@@ -10,6 +10,8 @@ import re
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
+from ..printed_grid import sig_round
+
 
 @dataclass(frozen=True)
 class Figure:
@@ -64,8 +66,7 @@ def fmt_floor(x: float, sig: int = 2) -> str:
     digits (a lower bound may only be rounded down). For LMI bounds of a given
     gain, whose last digits depend on the bisection's path and hence on the
     CPU's BLAS kernels."""
-    q = 10.0 ** (math.floor(math.log10(x)) - (sig - 1))
-    return fmt(math.floor(x / q + 1e-12) * q, sig)
+    return fmt(sig_round(x, sig, math.floor, 1e-12), sig)
 
 
 def fmt(x, sig: int = 4) -> str:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 from ..outcome import Outcome
+from ..printed_grid import sig_round
 from .check import BasinCheck
 
 
@@ -24,10 +25,8 @@ INNER_NEGLIGIBLE = 1e-12
 def _sig(x: float, direction: str, digits: int = 4) -> str:
     if x == 0 or not math.isfinite(x):
         return "0" if x == 0 else "∞"
-    e = math.floor(math.log10(abs(x))) - digits + 1
-    q = x / 10.0**e
-    q = math.floor(q) if direction == "down" else math.ceil(q)
-    return f"{q * 10.0**e:.{digits}g}"
+    how = math.floor if direction == "down" else math.ceil
+    return f"{sig_round(x, digits, how):.{digits}g}"
 
 
 def fmt_level(x: float, direction: str = "down") -> str:

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from ...printed_grid import sig_round
 from ...report.markdown import fmt, fmt_floor, md_table
 
 __all__ = ["gain_text", "requirements_rows", "requirements_section", "requirements_table",
@@ -43,8 +44,7 @@ def _ceil(x, sig: int = 2) -> str:
     """A positive upper bound rounded *up* to ``sig`` significant digits."""
     if x is None or not math.isfinite(x) or x <= 0:
         return fmt(x)
-    q = 10.0 ** (math.floor(math.log10(x)) - (sig - 1))
-    return fmt(math.ceil(x / q - 1e-12) * q, sig)
+    return fmt(sig_round(x, sig, math.ceil, -1e-12), sig)
 
 
 def requirements_table(spec, r) -> str:

@@ -11,6 +11,7 @@ import math
 
 from ...features.basin_plot import BasinPlotStyle
 from ...features.basin_plot import plot_basin as draw_basin
+from ...printed_grid import sig_round
 from ...report.markdown import fmt, md_table
 from ...roa.render import fmt_level, render_basin_markdown
 from .antiskid_basin import LAM_DIVERGED
@@ -64,13 +65,11 @@ def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—"
 
 
 def _floor(x: float, digits: int = 2) -> str:
-    e = math.floor(math.log10(x)) - digits + 1
-    return fmt(math.floor(x / 10.0**e) * 10.0**e, digits)
+    return fmt(sig_round(x, digits, math.floor), digits)
 
 
 def _ceil(x: float, digits: int = 2) -> str:
-    e = math.floor(math.log10(x)) - digits + 1
-    return fmt(math.ceil(x / 10.0**e) * 10.0**e, digits)
+    return fmt(sig_round(x, digits, math.ceil), digits)
 
 
 def brake_text(brake) -> str:
