@@ -1,5 +1,5 @@
 """CPU of the antiskid-cruise study with the printed rows' eps matching
-decided by one solve per step (:mod:`workbench.papers.p003.antiskid_cruise_match`)
+decided by one solve per step (:mod:`workbench.features.eps_match`)
 against the full delay bisection per step (:func:`workbench.synthesis.eps_for_bound`,
 the path before issue 36), in one process, and whether the study's
 quantities agree (they must: the two return the same eps bit for bit).
@@ -31,7 +31,7 @@ def _cpu() -> float:
 
 def main(argv) -> int:
     from workbench.design import load_design
-    from workbench.papers.p003 import antiskid_cruise_match as M
+    from workbench.features import eps_match as M
     from workbench.papers.p003.antiskid_cruise import STUDY
     from workbench.synthesis import eps_for_bound
     rev = "--reverse" in argv

@@ -1,10 +1,10 @@
 """eps_matching (one solve per eps step where it settles the step) returns
-eps_for_bound's eps bit for bit (workbench.papers.p003.antiskid_cruise_match),
+eps_for_bound's eps bit for bit (workbench.features.eps_match),
 with fewer solves."""
 import pytest
 
 from workbench.lmi import freeweighting003 as FW
-from workbench.papers.p003.antiskid_cruise_match import eps_matching
+from workbench.features.eps_match import eps_matching
 from workbench.plants.adhesion import NumericAdhesion
 from workbench.symbolic.linearise import linearise_cruise
 from workbench.synthesis import SynthesisSettings, eps_for_bound

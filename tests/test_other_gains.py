@@ -8,7 +8,7 @@ import pytest
 
 from workbench.design import load_design
 from workbench.papers.p003.antiskid_cruise import operating_point
-from workbench.papers.p003.antiskid_cruise_gains import check_other_gains, other_gain_quantities
+from workbench.features.other_gains import check_other_gains, other_gain_quantities
 from workbench.report.findings import section_link
 from workbench.report.markdown import slug
 

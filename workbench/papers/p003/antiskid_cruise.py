@@ -9,7 +9,15 @@ to the synthesis itself) and the optional ``[tight]`` (Wirtinger-based
 synthesis with its scalar searched automatically,
 :mod:`workbench.lmi.tight_synthesis`, shown next to the paper's row) and
 ``[[other_gains]]`` (gains designed elsewhere, checked on this loop:
-:mod:`workbench.papers.p003.antiskid_cruise_gains`).
+:mod:`workbench.features.other_gains`).
+
+The general pieces live in :mod:`workbench.features` (the printed-row
+comparison :mod:`~workbench.features.published_rows`, the foreign gains
+:mod:`~workbench.features.other_gains`, the eps sweep's figures
+:mod:`~workbench.features.eps_sweep`) and serve ``delay-feedback`` designs
+too. This module keeps what is paper 003's: the cruise linearisation of its
+adhesion plant (eqs 17-32, :func:`operating_point`), the design tables in
+its parameter names and the quantity names of its reports.
 """
 from __future__ import annotations
 
@@ -20,9 +28,11 @@ from ...errors import DesignError, ModelError
 from ...jsonable import json_method
 from ...plants.units import ADHESION_003 as PARAMETER_UNITS
 from ...reader import Quantity, Reader
-from .antiskid_cruise_gains import (GainCheck, OtherGain, check_other_gains, load_other_gains,
-                                    other_gain_quantities)
-from .antiskid_cruise_gains import quantity_names as other_gain_names
+from ...features.other_gains import (GainCheck, OtherGain, check_other_gains, load_other_gains,
+                                     other_gain_quantities)
+from ...features.other_gains import quantity_names as other_gain_names
+from ...features.published_rows import (Published, PublishedCheck, load_published,
+                                        published_quantities, published_quantity_names)
 
 if TYPE_CHECKING:   # the solvers and the symbolic model load when a design runs
     from ...crosscheck import PointCheck
@@ -37,16 +47,6 @@ PARAM_DOC = {
     "m": "mass (quarter train)", "zeta": "viscous friction", "c0": "resistance, constant",
     "c1": "resistance, linear", "c2": "resistance, quadratic", "g": "gravity",
 }
-
-
-@dataclass(frozen=True)
-class Published:
-    """A row a paper printed: eps, h_m and K (for comparison only)."""
-
-    eps: float
-    h_m: float
-    K: tuple[float, ...]
-    source: str
 
 
 @dataclass(frozen=True)
@@ -83,33 +83,6 @@ class CruiseSpec:
     compare_published: bool
     tight: TightSettings | None = None
     other_gains: tuple[OtherGain, ...] = ()
-
-
-@dataclass(frozen=True)
-class PublishedCheck:
-    """What we find for a printed row.
-
-    Attributes
-    ----------
-    row : Published
-    h_ours : float or None
-        Our h_certified at the same eps (None if eps not in the sweep).
-    h_paper_K : float
-        Largest delay the same criterion certifies with the printed K.
-    h_paper_K_refuted : float
-    exact_paper_K : DelayMargin
-        Exact margin of the loop closed with the printed K.
-    eps_matching : float or None
-        The eps at which our bound equals the printed h_m (None: not found
-        in [eps_lo, eps_hi] of the sweep).
-    """
-
-    row: Published
-    h_ours: float | None
-    h_paper_K: float
-    h_paper_K_refuted: float
-    exact_paper_K: DelayMargin
-    eps_matching: float | None
 
 
 @dataclass(frozen=True)
@@ -157,7 +130,7 @@ class CruiseResult:
     #: (h, spectral abscissa of x' = A x + B K x(t - h)) for the canonical gain
     #: of the row with the largest certified bound (the figure of the loop's set)
     abscissa_vs_h: tuple = ()
-    #: gains of ``[[other_gains]]`` on this loop (:mod:`.antiskid_cruise_gains`)
+    #: gains of ``[[other_gains]]`` on this loop (:mod:`workbench.features.other_gains`)
     other_gains: tuple[GainCheck, ...] = ()
 
     def row(self, eps: float) -> SynthesisRow:
@@ -225,15 +198,7 @@ class AntiskidCruise:
             gain_digits=int(syn.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
                                        lo=2, hi=8)),
         )
-        published = []
-        for pr in syn.tables("published", default=[]):
-            e = pr.number("eps", positive=True)
-            h = pr.number("h_m", positive=True)
-            K = pr.numbers("K", min_len=2, what="gain entries")
-            if len(K) != 2:
-                raise pr.fail("K", list(K), "two gain entries [k1, k2]")
-            published.append(Published(e, h, K, pr.string("source")))
-            pr.finish()
+        published = load_published(syn)
         compare = syn.boolean("compare_published", default=True)
         syn.finish()
         tight = self._load_tight(root, eps) if root.has("tight") else None
@@ -245,7 +210,7 @@ class AntiskidCruise:
         except ModelError as exc:
             raise DesignError(root.path, "operating_point.v_d", v_d.value,
                               f"a speed with a creep-region equilibrium ({exc})") from None
-        return CruiseSpec(rail, params, v_d, pinned, eps, settings, tuple(published), compare,
+        return CruiseSpec(rail, params, v_d, pinned, eps, settings, published, compare,
                           tight, other)
 
     @staticmethod
@@ -275,36 +240,24 @@ class AntiskidCruise:
             for f in ("h_certified", "h_refuted", "K1", "K2", "exact_margin",
                       "exact_margin_siso", "ratio", "status"):
                 names.add(f"synthesis.rows[eps={_eps_key(e)}].{f}")
-        for p in spec.published:
-            for f in ("h_paper_K", "exact_margin_paper_K", "eps_matching"):
-                names.add(f"published[eps={_eps_key(p.eps)}].{f}")
+        names |= published_quantity_names(spec.published)
         if spec.tight:
             names |= {f"tight.{k}" for k in TIGHT_QUANTITIES}
         return names | other_gain_names(spec.other_gains)
 
     # -- run -------------------------------------------------------------------
     def run(self, design) -> CruiseResult:
-        import numpy as np
-
-        from ...margins import delay_margin_eig
-        from ...synthesis import certify_given_gain, synthesize_delay_bound
-        from .antiskid_cruise_match import eps_matching
+        from ...features.eps_sweep import abscissa_vs_h
+        from ...features.published_rows import check_published
+        from ...synthesis import synthesize_delay_bound
         spec: CruiseSpec = design.spec
         lam_opt, lam_solved, lam_used, lin = operating_point(spec)
         rows = synthesize_delay_bound(lin.A, lin.B, spec.eps, spec.settings)
-        checks = []
-        if spec.compare_published:
-            eps_lo, eps_hi = min(spec.eps) / 2, max(spec.eps) * 1.5
-            for p in spec.published:
-                ours = next((r.h_certified for r in rows if r.eps == p.eps), None)
-                K = np.array([p.K])
-                br = certify_given_gain(lin.A, lin.B, K, p.eps, spec.settings)
-                em = delay_margin_eig(lin.A, lin.B @ K)
-                match = eps_matching(lin.A, lin.B, p.h_m, eps_lo, eps_hi, spec.settings)
-                checks.append(PublishedCheck(p, ours, br.h_certified, br.h_refuted, em, match))
+        checks = (check_published(lin.A, lin.B, rows, spec.published, spec.eps, spec.settings)
+                  if spec.compare_published else ())
         tight = _run_tight(spec, lin, rows) if spec.tight else None
-        return CruiseResult(lam_opt, lam_solved, lam_used, lin, rows, tuple(checks), tight,
-                            _abscissa_vs_h(lin, rows),
+        return CruiseResult(lam_opt, lam_solved, lam_used, lin, rows, checks, tight,
+                            abscissa_vs_h(lin.A, lin.B, rows),
                             check_other_gains(lin.A, lin.B, spec.other_gains))
 
     def quantities(self, res: CruiseResult) -> dict:
@@ -327,11 +280,7 @@ class AntiskidCruise:
         best = max(res.rows, key=lambda r: r.h_certified)
         q["synthesis.best.h_certified"] = best.h_certified if best.h_certified > 0 else None
         q["exact_margin"] = best.exact.h if best.exact else None
-        for c in res.published:
-            base = f"published[eps={_eps_key(c.row.eps)}]"
-            q[f"{base}.h_paper_K"] = c.h_paper_K
-            q[f"{base}.exact_margin_paper_K"] = c.exact_paper_K.h
-            q[f"{base}.eps_matching"] = c.eps_matching
+        q.update(published_quantities(res.published))
         if res.tight:
             q.update(_tight_quantities(res.tight))
         q.update(other_gain_quantities(res.other_gains))
@@ -344,27 +293,6 @@ class AntiskidCruise:
 TIGHT_QUANTITIES = ("eps", "h_certified", "h_analysis", "exact_margin", "exact_margin_siso",
                     "K1", "K2", "at_cap", "ratio_to_reference", "reference.h_analysis", "paper_K.h_analysis",
                     "paper_K.exact_margin")
-
-
-def _abscissa_vs_h(lin: Linearisation, rows) -> tuple:
-    """Spectral abscissa of the loop with the best row's canonical gain on a
-    log grid of delays from 1/100 to 100 times its certified bound (the exact
-    side: :func:`workbench.margins.spectral_abscissa`; a delay where the
-    adaptive collocation does not converge is left out, never guessed)."""
-    import numpy as np
-
-    from ...margins import SpectrumNotConverged, spectral_abscissa
-    best = max((r for r in rows if r.K is not None), key=lambda r: r.h_certified, default=None)
-    if best is None or not best.h_certified > 0:
-        return ()
-    Ad = lin.B @ np.array([best.K])
-    out = []
-    for h in np.geomspace(best.h_certified / 100, best.h_certified * 100, 25):
-        try:
-            out.append((float(h), float(spectral_abscissa(lin.A, Ad, h))))
-        except SpectrumNotConverged:
-            continue
-    return tuple(out)
 
 
 def _run_tight(spec: CruiseSpec, lin: Linearisation, rows) -> TightComparison:

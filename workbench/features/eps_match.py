@@ -1,6 +1,10 @@
-"""The eps at which problem (60) certifies a printed delay bound, with one
-solve per bisection step (issue 36, item 4).
+"""The eps at which the free-weighting criterion certifies a given delay
+bound (a printed one, say), with one solve per bisection step (issue 36,
+item 4).
 
+The criterion is the descriptor free-weighting LMI with the slack scalar eps
+(:class:`workbench.lmi.freeweighting003.FreeWeighting003`, the
+``free-weighting-003`` synthesis of :mod:`workbench.synthesis`).
 :func:`workbench.synthesis.eps_for_bound` decides each step of its eps
 bisection with a whole delay bisection, ``bisect_delay(guess=h_target)``,
 and asks only whether its ``h_certified`` is below ``h_target``. That
@@ -22,12 +26,6 @@ updates with the new data, scaled with the equilibration of its first solve
 -- which both make at (eps_lo, h_target). So every decision, and the returned
 eps, equal :func:`eps_for_bound`'s bit for bit;
 ``tests/test_antiskid_cruise_match.py`` compares the two.
-
-References
-----------
-.. [003] Cai L., Yue Y., Huang D., "Antiskid control of high-speed trains
-   with input delay", Control Theory & Applications 43(3), 2026: problem
-   (60), Remark 3, Table 3.
 """
 from __future__ import annotations
 
@@ -36,7 +34,7 @@ __all__ = ["eps_matching"]
 
 def eps_matching(A, B, h_target: float, eps_lo: float, eps_hi: float, settings,
                  rel_tol: float = 1e-3) -> float | None:
-    """The eps at which problem (60)'s certified bound equals ``h_target``:
+    """The eps at which the free-weighting certified bound equals ``h_target``:
     :func:`workbench.synthesis.eps_for_bound` (same bisection on eps, same
     result), each step decided by one solve where it can be (module
     docstring).
@@ -44,11 +42,11 @@ def eps_matching(A, B, h_target: float, eps_lo: float, eps_hi: float, settings,
     Parameters
     ----------
     A, B : array_like
-        Error system (eq 32).
+        The loop x' = A x + B u(t - h).
     h_target : float
-        The printed delay bound (s).
+        The delay bound to match (s), e.g. a printed one.
     eps_lo, eps_hi : float
-        Bisection range of Remark 3's scalar eps; the bound is assumed to grow
+        Bisection range of the slack scalar eps; the bound is assumed to grow
         with eps there (checked at the ends; ``None`` when ``h_target`` is not
         bracketed).
     settings : workbench.synthesis.SynthesisSettings
@@ -61,9 +59,9 @@ def eps_matching(A, B, h_target: float, eps_lo: float, eps_hi: float, settings,
     """
     import numpy as np
 
-    from ...lmi.core import Outcome, bisect_delay
-    from ...lmi.freeweighting003 import FreeWeighting003
-    from ...lmi.scaling import balancing
+    from ..lmi.core import Outcome, bisect_delay
+    from ..lmi.freeweighting003 import FreeWeighting003
+    from ..lmi.scaling import balancing
     A, B = np.asarray(A, float), np.asarray(B, float).reshape(np.shape(A)[0], -1)
     T = balancing(A)                   # the balanced system of eps_for_bound, as it computes it
     Tinv = np.diag(1.0 / np.diag(T))
