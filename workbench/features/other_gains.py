@@ -82,10 +82,12 @@ def gain_entries(t: Reader, n: int) -> tuple[float, ...]:
     return tuple(float(k) for k in K)
 
 
-def load_other_gains(root: Reader, n: int = 2) -> tuple[OtherGain, ...]:
-    """``[[other_gains]]`` of a design (none when absent); ``n`` entries per K."""
+def load_other_gains(root: Reader, n: int = 2, table: str = "other_gains"
+                     ) -> tuple[OtherGain, ...]:
+    """``[[other_gains]]`` (or ``[[table]]``) of a design (none when absent);
+    ``n`` entries per K."""
     out, seen = [], set()
-    for t in root.tables("other_gains", default=[]):
+    for t in root.tables(table, default=[]):
         name = t.string("name")
         if not name or not set(name) <= _NAME_CHARS or name in seen:
             raise t.fail("name", name, "a new name of letters, digits and _ . - only")

@@ -39,10 +39,12 @@ Tables (see ``designs/antiskid-cruise-dry-generic.toml`` for a full file)::
     [convergence]  (no keys; optional: every scenario also at dt/4, and every claim on
                    a scenario metric refined over dt, dt/2, dt/4,
                    :mod:`workbench.features.convergence`)
+    [[synthesis.published]] eps, h_m, K, source; [[other_gains]] name, K, source;
+                   [eps_sweep] (no keys)   (optional: printed rows vs ours, gains designed
+                   elsewhere on this loop, the eps sweep's table and figures; :mod:`.gain_tables`)
 
 The design tables are read here (light: no sympy until the operating point
-is solved); :mod:`.run` computes, :mod:`.render`
-renders.
+is solved); :mod:`.run` computes, :mod:`.render` renders.
 """
 from __future__ import annotations
 
@@ -84,6 +86,7 @@ class SynthesisChoice:
     order: int
     settings: object   # workbench.synthesis.SynthesisSettings
     decay_rate: float = 0.0   # 1/s, robust-descriptor only
+    published: tuple = ()     # [[synthesis.published]] (.gain_tables)
 
 
 @dataclass(frozen=True)
@@ -126,6 +129,7 @@ class DelayFeedbackSpec:
     montecarlo: object = None   # features.montecarlo.MonteCarloSpec ([montecarlo], .montecarlo)
     convergence: bool = False   # [convergence]: dt, dt/2, dt/4 (features.convergence)
     claims: tuple = ()          # ClaimTarget (features.convergence) per claim on a scenario metric
+    gain_tables: object = None  # .gain_tables.GainTables (printed rows, other gains, eps sweep)
 
 
 def _variables(root: Reader, table: str, taken: set[str], min_len: int = 1
@@ -240,7 +244,7 @@ def _delay(root: Reader) -> DelaySpec:
                      else f"{lo.source}; {hi.source}")
 
 
-def _synthesis(root: Reader, delay: DelaySpec) -> SynthesisChoice:
+def _synthesis(root: Reader, delay: DelaySpec, n: int) -> SynthesisChoice:
     from ...lmi.core import DEFAULT_MARGIN
     from ...lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
     from ...synthesis import H_MAX_RANGE, SynthesisSettings
@@ -283,8 +287,10 @@ def _synthesis(root: Reader, delay: DelaySpec) -> SynthesisChoice:
     if settings.h_max < delay.h_max:
         raise s.fail("h_max", settings.h_max, f"a search cap at least the design's delay, "
                      f"delay.max = {delay.h_max:g} s")
+    from ...features.published_rows import load_published
+    published = load_published(s, n)
     s.finish()
-    return SynthesisChoice(method, eps, grid, order, settings, alpha)
+    return SynthesisChoice(method, eps, grid, order, settings, alpha, published)
 
 
 def _vertices(root: Reader, plant: PlantSpec) -> tuple[Vertex, ...]:
@@ -434,7 +440,7 @@ class DelayFeedback:
     def load(self, root: Reader) -> DelayFeedbackSpec:
         plant = _plant(root)
         delay = _delay(root)
-        syn = _synthesis(root, delay)
+        syn = _synthesis(root, delay, len(plant.states))
         vertices = _vertices(root, plant)
         scenarios = _scenarios(root, plant, delay)
         ex = root.table("exact", default=None)
@@ -446,10 +452,12 @@ class DelayFeedback:
         from .requirements import load_requirements
         req = load_requirements(root, plant, delay)
         from ...features.sampled import load_implementation_settings
+        from .gain_tables import load_gain_tables
         from .montecarlo import load_montecarlo_table
         spec = DelayFeedbackSpec(plant, delay, syn, vertices, scenarios, horizon, basin, req,
                                  load_implementation_settings(root),
-                                 load_montecarlo_table(root, plant))
+                                 load_montecarlo_table(root, plant),
+                                 gain_tables=load_gain_tables(root, plant, syn))
         spec = _with_convergence(root, spec)
         from .model import PlantModel
         from .run import nominal_point

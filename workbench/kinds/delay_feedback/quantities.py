@@ -167,6 +167,16 @@ def _montecarlo_values(r):
     return montecarlo_values(r)
 
 
+def _gain_tables_names(spec):
+    from .gain_tables import gain_tables_names
+    return gain_tables_names(spec)
+
+
+def _gain_tables_values(r):
+    from .gain_tables import gain_tables_values
+    return gain_tables_values(r)
+
+
 #: Every claimable quantity of a ``delay-feedback`` design.
 TABLE = (
     Declared("operating_point.{k}", "{unit}",
@@ -215,4 +225,5 @@ TABLE = (
           present=lambda spec: spec.implementation is not None),
     Group(_montecarlo_names, _montecarlo_values,
           present=lambda spec: spec.montecarlo is not None),
+    Group(_gain_tables_names, _gain_tables_values, present=lambda spec: bool(spec.gain_tables)),
 )

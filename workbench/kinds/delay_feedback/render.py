@@ -120,9 +120,13 @@ def render(design, res) -> Rendered:
         f"Eigenvalues of A (1/s): {_eigs(ev)}.")
     sections.append(_synthesis_section(spec, res))
     sections.append(_exact_section(spec, res))
-    figs = []
+    from .gain_tables import gain_tables_sections
+    gsec, gfigs, anchors = gain_tables_sections(spec, res)
+    sections += gsec
+    figs = list(gfigs)
     if res.scenarios:
-        sec, figs = _simulation_section(spec, res)
+        sec, sfigs = _simulation_section(spec, res)
+        figs += sfigs
         sections.append(sec)
         if spec.convergence:
             sections.append(_convergence_section(res))
@@ -142,7 +146,7 @@ def render(design, res) -> Rendered:
     if spec.montecarlo is not None:
         from .montecarlo import montecarlo_section
         sections.append(montecarlo_section(spec, res))
-    return Rendered(tuple(sections), tuple(figs))
+    return Rendered(tuple(sections), tuple(figs), anchors)
 
 
 def _residual(r: float) -> str:

@@ -126,6 +126,7 @@ class DelayFeedbackResult:
     spec: object = None        # DelayFeedbackSpec (indexes the declared quantities)
     montecarlo: tuple | None = None   # montecarlo.MonteCarloScenario per drawn scenario
     refinement: tuple = ()     # refinement.RefinementRow per claim on a metric ([convergence])
+    gain_tables: object = None  # gain_tables.GainTablesResult or None
 
     #: The JSON of the result (:func:`workbench.jsonable.to_json`).
     JSON_FIELDS = {"A": "A", "B": "B", "x_op": "op.x", "u_op": "op.u",
@@ -291,10 +292,12 @@ def run(spec) -> DelayFeedbackResult:
         rows = tuple(x for s in scen for x in claim_rows(
             spec.claims, s.scenario.name, (s.metrics_coarse, s.metrics, s.metrics_fine),
             reported=1))
+    from .gain_tables import run_gain_tables
+    tables = run_gain_tables(spec.gain_tables, A, B, syn, spec.synthesis, points)
     return DelayFeedbackResult(op, A, B, syn, exact, tuple(windows), stable, checks, scen,
                                points, spec.delay,
                                spec.plant.state_names + spec.plant.input_names, basin, impl,
-                               spec, mc, rows)
+                               spec, mc, rows, tables)
 
 
 # -- simulation -----------------------------------------------------------------------

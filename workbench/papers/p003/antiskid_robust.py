@@ -11,6 +11,11 @@ settings); ``[[compare]]`` (printed gains to check at every point).
 Each operating point is the cruise linearisation of paper 003 (eqs 17-32,
 :func:`~workbench.symbolic.linearise.linearise_cruise`) at its solved
 equilibrium lambda_d. Certificates hold at the listed points only.
+
+The gains compared at every point and their table are general
+(:mod:`workbench.features.point_gains`, rows read as
+:class:`~workbench.features.other_gains.OtherGain`); this module keeps paper
+003's operating points (its adhesion plant per rail, speed and mass).
 """
 from __future__ import annotations
 
@@ -20,6 +25,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...errors import DesignError, ModelError
+from ...features.other_gains import OtherGain, load_other_gains
 from ...jsonable import json_method
 from ...plants.units import ADHESION_003 as PARAMETER_UNITS
 from ...reader import Quantity, Reader
@@ -49,13 +55,6 @@ class Point:
 
 
 @dataclass(frozen=True)
-class Compare:
-    name: str
-    K: tuple[float, ...]
-    source: str
-
-
-@dataclass(frozen=True)
 class RobustSpec:
     common: dict
     rails: dict
@@ -69,14 +68,14 @@ class RobustSpec:
     order: int
     gain_fraction: float
     gain_digits: int
-    compare: tuple[Compare, ...]
+    compare: tuple[OtherGain, ...]
     requirements: object = None     # RequirementsSpec ([requirements]) or None
 
 
 @dataclass(frozen=True)
 class RobustResult:
     points: tuple[Point, ...]
-    compare: tuple[Compare, ...]
+    compare: tuple[OtherGain, ...]
     alpha: float
     order: int
     synthesis: RobustSynthesis
@@ -153,15 +152,9 @@ class AntiskidRobust:
             gain_digits=int(syn.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
                                        lo=2, hi=8)))
         syn.finish()
-        compare = []
-        for c in root.tables("compare", default=[]):
-            K = c.numbers("K", min_len=2, what="gain entries")
-            if len(K) != points[0].B.shape[0]:
-                raise c.fail("K", list(K), f"{points[0].B.shape[0]} gain entries")
-            compare.append(Compare(c.string("name"), K, c.string("source")))
-            c.finish()
+        compare = load_other_gains(root, points[0].B.shape[0], "compare")
         from ...kinds.delay_feedback.requirements import load_rate_requirements
-        return RobustSpec(common, rails, points, compare=tuple(compare),
+        return RobustSpec(common, rails, points, compare=compare,
                           requirements=load_rate_requirements(root), **spec)
 
     def quantity_names(self, spec: RobustSpec) -> set[str]:
@@ -175,10 +168,8 @@ class AntiskidRobust:
         from ...kinds.delay_feedback.requirements import requirement_quantity_names
         names |= requirement_quantity_names(spec.requirements)
         names |= {"requirements.K1", "requirements.K2"} if spec.requirements else set()
-        for c in spec.compare:
-            names |= {f"compare[{c.name}].unstable_points", f"compare[{c.name}].all_stable"}
-            names |= {f"compare[{c.name}].points[{p.id}].exact_margin" for p in spec.points}
-        return names
+        from ...features.point_gains import compare_quantity_names
+        return names | compare_quantity_names([p.id for p in spec.points], spec.compare)
 
     def run(self, design) -> RobustResult:
         s: RobustSpec = design.spec
@@ -195,8 +186,8 @@ class AntiskidRobust:
             checks = check_gain(pts, syn.K, N=s.order, margin=s.margin)
             h = syn.gain.h_certified          # what the rounded canonical K certifies
             absc = tuple(spectral_abscissa(A, B @ syn.K, h) for A, B in pts)
-        compared = tuple(check_gain(pts, np.array([c.K]), N=s.order, margin=s.margin)
-                         for c in s.compare)
+        from ...features.point_gains import check_named_gains
+        compared = check_named_gains(pts, s.compare, s.order, s.margin)
         req = None
         if s.requirements is not None:       # the design to requirements (issue 31)
             from ...requirements import Requirements, design_to_requirements
@@ -233,14 +224,8 @@ class AntiskidRobust:
             K = res.requirements.K
             q["requirements.K1"] = None if K is None else float(K[0, 0])
             q["requirements.K2"] = None if K is None else float(K[0, 1])
-        for c, checks in zip(res.compare, res.compared):
-            q[f"compare[{c.name}].unstable_points"] = float(sum(not k.stable_at_zero
-                                                                for k in checks))
-            q[f"compare[{c.name}].all_stable"] = \
-                "yes" if all(k.stable_at_zero for k in checks) else "no"
-            for p, k in zip(spec_points, checks):
-                q[f"compare[{c.name}].points[{p.id}].exact_margin"] = k.exact.h
-        return q
+        from ...features.point_gains import compare_quantities
+        return q | compare_quantities([p.id for p in spec_points], res.compare, res.compared)
 
 
 STUDY = AntiskidRobust()

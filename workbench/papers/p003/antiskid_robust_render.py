@@ -1,17 +1,13 @@
-"""Markdown and figure of the ``antiskid-robust`` study (pure rendering)."""
+"""Markdown and figure of the ``antiskid-robust`` study (pure rendering); the
+per-point and compared-gain tables are :mod:`workbench.features.point_gains`'."""
 from __future__ import annotations
 
 import math
 
 import numpy as np
 
-from ...report.markdown import Figure, Rendered, fmt, fmt_floor, latex_matrix, md_table
-
-
-def _margin(pc) -> str:
-    if not pc.stable_at_zero:
-        return "**UNSTABLE at h = 0**"
-    return fmt(pc.exact.h, 4)
+from ...features.point_gains import compare_section, point_table
+from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
 
 
 def _requirements(spec, res) -> str:
@@ -64,26 +60,11 @@ def render(design, res) -> Rendered:
             f"one solution, unlike the degenerate optimum), rounded to {g.digits} significant "
             "digits; h above is what that rounded K certifies on its own (same LMI, V = K Y "
             "fixed).\n\n"
-            + md_table(["point", "exact margin h* (s)",
-                        f"certified, BL N={res.order} (s, 2 digits, rounded down)",
-                        "spectral abscissa at h (1/s)"],
-                       [[f"`{p.id}`", _margin(c), _bound(c.h_certified), fmt(a, 3)]
-                        for p, c, a in zip(pts, res.checks, res.abscissa)], "lrrr")
+            + point_table([p.id for p in pts], res.checks, res.abscissa, res.order)
             + f"\n\nEvery spectral abscissa at h must be <= -alpha = {fmt(-res.alpha)} "
             "(the decay-rate certificate, cross-checked).")
-    rows, warn = [], []
-    for c, checks in zip(res.compare, res.compared):
-        bad = [p.id for p, k in zip(pts, checks) if not k.stable_at_zero]
-        if bad:
-            warn.append(f"> **WARNING — `{c.name}` (K = [{', '.join(fmt(k, 5) for k in c.K)}], "
-                        f"{c.source}) is UNSTABLE without any delay at {len(bad)} of {len(pts)} "
-                        f"points: {', '.join(f'`{b}`' for b in bad)}.**")
-        rows.append([f"`{c.name}`"] + [_margin(k) for k in checks])
-    rows.append(["robust K (this design)"] + [_margin(k) for k in res.checks])
-    cmp_ = ("## Compared with printed gains\n\nExact delay margin (s) of each gain at each "
-            "point (∞: stable for every constant delay).\n\n" + "\n\n".join(warn)
-            + ("\n\n" if warn else "")
-            + md_table(["gain"] + [f"`{p.id}`" for p in pts], rows, "l" + "r" * len(pts)))
+    cmp_ = compare_section([p.id for p in pts], res.compare, res.compared, res.checks,
+                           "robust K (this design)")
     fig = Figure("eps-search", "Certified delay of the robust synthesis against eps "
                  "(automatic search).", lambda f: _draw_eps(f, res))
     return Rendered((prob, gain, cmp_, f"## eps search\n\n![eps]({{figdir}}/{fig.name}.png)"),
@@ -102,9 +83,3 @@ def _draw_eps(fig, res) -> None:
     if not math.isfinite(float(np.max(h))):
         ax.set_ylim(0, None)
 
-
-def _bound(h: float) -> str:
-    """The order-N bound of the robust K at a point, rounded down to 2 digits:
-    its 4th digit depends on the BLAS kernel (47.22 / 47.21 s at `dry-v50-m1.05`
-    under Haswell / Sandybridge)."""
-    return fmt_floor(h, 2) if math.isfinite(h) and h > 0 else fmt(h)
