@@ -177,7 +177,7 @@ def test_claim_on_a_synthesis_without_gain_is_inconclusive():
                                                     inputs=(SimpleNamespace(name="u", unit="N"),)),
                               synthesis=SimpleNamespace(eps=()), vertices=(), scenarios=(),
                               requirements=None, basin=None, implementation=None,
-                                  montecarlo=None))
+                                  montecarlo=None, gain_tables=None))
     q = quantities(res)
     claim = Claim("h", "h", "synthesis.h_certified", ">=", 0.5, 0.0, None, "round", "", False,
                   "pass", "")

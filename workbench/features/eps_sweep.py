@@ -94,10 +94,10 @@ def eps_sweep_notes(st) -> str:
 def infinite_note(rows) -> str:
     """What the exact margins say about the LMI bounds."""
     if all_infinite(rows):
-        return ("**Every exact margin is infinite**: with each synthesised gain the characteristic "
-                "equation det(sI − A − BK e^{−sh}) = 0 has no root on the imaginary axis for any "
-                "h (no crossover: |K(jωI − A)⁻¹B| < 1 at all ω), so the closed loop is stable for "
-                "every constant delay. The LMI bounds above are therefore not delay limits of "
+        return ("**Every exact margin is infinite**: with each synthesised gain the "
+                "characteristic equation det(sI − A − BK e^{−sh}) = 0 has no root on the "
+                "imaginary axis for any h (no crossover: |K(jωI − A)⁻¹B| < 1 at all ω), so the "
+                "closed loop is stable for every constant delay. The LMI bounds above are therefore not delay limits of "
                 "the loop: they are where this particular Lyapunov-Krasovskii criterion stops "
                 "being able to prove stability. A delay larger than h_certified is not shown "
                 "dangerous by this table.")

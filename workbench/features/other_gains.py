@@ -183,4 +183,5 @@ def other_gains_section(checks, where: str, A, B, law: str = "the feedback law")
                        rows, "lllllll")
             + "\n\n" + trace + "A gain with a positive rightmost root is no design for this "
             "loop: the error grows like e^(t Re s) from the moment "
-            f"{law} takes over, whatever the delay, so no delay bound of any criterion applies to it.")
+            f"{law} takes over, whatever the delay, so no delay bound of any criterion "
+            "applies to it.")

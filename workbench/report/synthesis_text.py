@@ -1,7 +1,8 @@
 """Printed forms of synthesis results shared by the reports of every kind that
-synthesises a delay-feedback gain (``delay-feedback``, paper 003's
-``antiskid-cruise``): exact margins, capped certified bounds, closed-loop
-eigenvalues and the per-block re-check table of a certificate.
+synthesises a delay-feedback gain (``delay-feedback``, ``antiskid-cruise``) and
+by the gain comparisons of :mod:`workbench.features` (``eps_sweep``,
+``other_gains``, ``published_rows``): exact margins, capped certified bounds,
+closed-loop eigenvalues and the per-block re-check table of a certificate.
 """
 from __future__ import annotations
 

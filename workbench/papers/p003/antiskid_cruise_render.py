@@ -12,7 +12,8 @@ import math
 import numpy as np
 import sympy as sp
 
-from ...features.eps_sweep import eps_sweep_figures, eps_sweep_notes, eps_sweep_table, infinite_note
+from ...features.eps_sweep import (eps_sweep_figures, eps_sweep_notes, eps_sweep_table,
+                                   infinite_note)
 from ...features.other_gains import ANCHOR, other_gains_section
 from ...features.other_gains import gain_text as _gain
 from ...features.published_rows import published_section
