@@ -23,8 +23,7 @@ import math
 import numpy as np
 
 from ..report.markdown import Figure, fmt, md_table
-from ..report.synthesis_text import exact_margin_text
-from .other_gains import gain_text
+from ..report.synthesis_text import exact_margin_text, gain_text
 
 __all__ = ["abscissa_vs_h", "all_infinite", "eps_sweep_figures", "eps_sweep_notes",
            "eps_sweep_table", "infinite_note"]

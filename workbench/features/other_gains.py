@@ -137,14 +137,6 @@ def other_gain_quantities(checks: tuple[GainCheck, ...]) -> dict:
 
 
 # -- rendering ---------------------------------------------------------------------------
-def gain_text(K, digits: int = 4) -> str:
-    """A gain as printed: ``[k1, k2]`` to ``digits`` significant digits, ``—`` for None."""
-    import numpy as np
-
-    from ..report.markdown import fmt
-    return "—" if K is None else "[" + ", ".join(fmt(float(k), digits) for k in np.ravel(K)) + "]"
-
-
 def _eig_text(e: complex) -> str:
     from ..report.markdown import fmt
     if abs(e.imag) < 1e-9 * max(1.0, abs(e.real)):
@@ -160,7 +152,7 @@ def other_gains_section(checks, where: str, A, B, law: str = "the feedback law")
     import numpy as np
 
     from ..report.markdown import fmt, md_table
-    from ..report.synthesis_text import exact_margin_text
+    from ..report.synthesis_text import exact_margin_text, gain_text
     k2_max = -(A[0, 0] + A[1, 1]) if np.shape(A) == (2, 2) else None
     above = sum(c.gain.K[1] >= k2_max for c in checks) if k2_max is not None else 0
     trace = ("With B = [0, 1]ᵀ the gain adds to the second row of A, so stability needs "

@@ -10,7 +10,18 @@ import numpy as np
 
 from .markdown import fmt, margin_text, md_table
 
-__all__ = ["capped_text", "closed_loop_eigs_text", "exact_margin_text", "recheck_table"]
+__all__ = ["capped_text", "closed_loop_eigs_text", "exact_margin_text", "gain_text",
+           "recheck_table"]
+
+
+def gain_text(K, digits: int = 4) -> str:
+    """A gain matrix as printed: rows in brackets, ``digits`` significant
+    digits (one row: ``[k1, k2]``); ``—`` for None."""
+    if K is None:
+        return "—"
+    K = np.atleast_2d(K)
+    rows = ["[" + ", ".join(fmt(float(k), digits) for k in row) + "]" for row in K]
+    return rows[0] if len(rows) == 1 else "[" + ", ".join(rows) + "]"
 
 
 def exact_margin_text(dm) -> str:

@@ -8,18 +8,10 @@ import numpy as np
 
 from ...printed_grid import sig_round
 from ...report.markdown import fmt, fmt_floor, md_table
+from ...report.synthesis_text import gain_text
 
 __all__ = ["gain_text", "requirements_rows", "requirements_section", "requirements_table",
            "varying_section"]
-
-
-def gain_text(K, digits: int) -> str:
-    """A gain matrix as printed: rows in brackets, ``digits`` significant digits."""
-    if K is None:
-        return "—"
-    K = np.atleast_2d(K)
-    rows = ["[" + ", ".join(fmt(float(k), digits) for k in row) + "]" for row in K]
-    return rows[0] if len(rows) == 1 else "[" + ", ".join(rows) + "]"
 
 
 _WHAT = {

@@ -15,12 +15,12 @@ import sympy as sp
 from ...features.eps_sweep import (eps_sweep_figures, eps_sweep_notes, eps_sweep_table,
                                    infinite_note)
 from ...features.other_gains import ANCHOR, other_gains_section
-from ...features.other_gains import gain_text as _gain
 from ...features.published_rows import published_section
 from ...plants.adhesion import adhesion_model
 from ...report.markdown import Rendered, fmt, latex_matrix, md_table
 from ...report.synthesis_text import (capped_text, closed_loop_eigs_text, exact_margin_text,
                                       recheck_table)
+from ...report.synthesis_text import gain_text as _gain
 
 
 def _model_section() -> str:
