@@ -142,3 +142,15 @@ def test_case_figure_colours_snapped_data_and_grid_ends():
     assert not np.array_equal(moved, y["slow"])
     plt.close(fig)
     assert time_window(12.3, 1.0, 4.0) == (11, 15.0)
+
+
+def test_binned_fractions_last_bin_closed_and_empty_bin_dashed():
+    from workbench.report.binned_fractions import binned_fraction_rows
+    gain = np.array([0.0, 0.1, 0.3, 0.6, 1.0, 1.0])         # a sampled toy gain
+    unstable = gain < 0.2                                   # a flag per run
+    rows = binned_fraction_rows(gain, 0.0, 1.0, 4, [unstable, ~unstable])
+    assert [r[0] for r in rows] == ["[0, 0.25)", "[0.25, 0.5)", "[0.5, 0.75)", "[0.75, 1]"]
+    assert [r[1] for r in rows] == [2, 1, 1, 2]             # 1.0 falls in the closed last bin
+    assert rows[0][2:] == ["1", "0"] and rows[3][2:] == ["0", "1"]
+    empty = binned_fraction_rows(gain, 0.0, 2.0, 4, [unstable])
+    assert empty[3][1:] == [0, "—"] and sum(r[1] for r in empty) == len(gain)

@@ -10,11 +10,10 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
 from ...printed_grid import quantised
 from ...refinement import P_MIN
+from ...report.binned_fractions import binned_fraction_rows
 from ...report.case_tables import CaseLevels, case_convergence_table, case_metric_table, case_rows
 from ...report.delay_cross_check import delay_cross_check, plot_envelopes
 from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
@@ -280,17 +279,8 @@ def _montecarlo_section(design, mc, halving=None) -> str:
             ["true input delay h (s)", rng(ms.h, 4) + " (the predictor keeps "
              + fmt(design.spec.scenario["h"], 4) + " s)"],
             ["v(0) (m/s)", rng(ms.v0)]] + _perturbation_rows(ms, rng)
-    s = np.asarray(mc.samples["adhesion"], float)
-    div = np.asarray(mc.violations["diverged"], bool)
-    above = np.asarray(mc.violations["above_lambda_opt"], bool)
-    edges = np.linspace(ms.adhesion[0], ms.adhesion[1], 5)
-    brows = []
-    for i, (lo, hi) in enumerate(zip(edges[:-1], edges[1:])):
-        sel = (s >= lo) & ((s < hi) if i < 3 else (s <= hi))
-        n = int(sel.sum())
-        brows.append([f"[{fmt(lo, 3)}, {fmt(hi, 3)}" + ("]" if i == 3 else ")"), n,
-                      fmt(div[sel].mean(), 2) if n else "—",
-                      fmt(above[sel].mean(), 2) if n else "—"])
+    brows = binned_fraction_rows(mc.samples["adhesion"], *ms.adhesion, 4,
+                                 [mc.violations["diverged"], mc.violations["above_lambda_opt"]])
     return (
         "## Monte Carlo robustness (reduced sample)\n\n"
         f"{mc.n} runs of case `{ms.case}` with seed {ms.seed} at dt = "
