@@ -6,6 +6,7 @@ import math
 import numpy as np
 
 from ...features.convergence import claim_table
+from ...report.case_tables import MISSING, fmt_finite
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...sim.convergence import P_MAX, P_MIN
 from .quantities import scenario_metrics
@@ -133,8 +134,7 @@ def _convergence(spec, res) -> str:
     for r in res.scenarios:
         for m, c in r.checks:
             rows.append([f"`{r.scenario.name}`", f"`{m}`", *(fmt(x, 5) for x in c.values),
-                         "—" if c.order is None or not math.isfinite(c.order) else fmt(c.order, 2),
-                         "—" if c.estimate is None else fmt(c.estimate, 2)])
+                         fmt_finite(c.order, 2), fmt(c.estimate, 2)])
     return ("## Convergence\n\nEvery scenario again at dt/2 and dt/4 (the delay and the "
             "control period unchanged: they are whole numbers of the finest step). Observed "
             "order p = log2(|q1 − q2| / |q2 − q4|) and Richardson's estimate of the error "
@@ -163,8 +163,8 @@ def _montecarlo(spec, res):
         rows = []
         for k, v in m.metrics.items():
             ok = ~np.isnan(v)
-            rows.append([f"`{k}`", fmt(np.min(v[ok]), 4) if ok.any() else "—",
-                         fmt(np.max(v[ok]), 4) if ok.any() else "—", units[k]])
+            rows.append([f"`{k}`", fmt(np.min(v[ok]), 4) if ok.any() else MISSING,
+                         fmt(np.max(v[ok]), 4) if ok.any() else MISSING, units[k]])
         bad = sorted({x for x in m.reasons if x not in ("until", "t_end")})[:3]
         parts.append(
             f"### Scenario `{sc.name}`\n\n{m.samples} runs: {int(m.metrics['completed'].sum())} "

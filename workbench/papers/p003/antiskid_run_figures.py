@@ -1,6 +1,11 @@
 """Figures of the ``antiskid-run`` study: draw functions of matplotlib
 figures, pure functions of the study result (see
-:mod:`workbench.papers.p003.antiskid_run_render`)."""
+:mod:`workbench.papers.p003.antiskid_run_render`).
+
+The layout (cases on shared axes, a colour per case, snapped data, axis
+ends on a grid) is :mod:`workbench.report.case_figures`; what stays here is
+paper 003's: which quantities are drawn (wheel speed, creep ratio against
+lambda_opt, the creep-speed error of eq (76), the adhesion curve)."""
 from __future__ import annotations
 
 import math
@@ -8,36 +13,24 @@ import math
 import numpy as np
 
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, CreepSpeedProfile
-from ...printed_grid import axis_end, quantised
+from ...printed_grid import axis_end
+from ...report.case_figures import Palette, plot_cases, time_window
 from ...sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
 
-_COLORS = {"paper": "tab:red", "compensated": "tab:blue", "uncompensated": "tab:orange",
-           "recursive": "tab:purple"}
-
-
-def color_of(name: str) -> str:
-    """The colour of a case in every figure."""
-    return _COLORS.get(name, "tab:green")
-
-
-#: Plotted speeds and creep ratios are snapped to 1e-5 of their decade
-#: (:func:`workbench.printed_grid.quantised`; a step far below a pixel, far
-#: above the runs' last-bit noise of 1e-13). The figures that differed under
-#: a 3-ulp move of the inputs were fixed by the axis ends on a grid (below);
-#: the snap alone did not fix them and is kept as a guard for the data.
-PLOT_DIGITS = 6
+#: The colour of a case in every figure.
+color_of = Palette({"paper": "tab:red", "compensated": "tab:blue", "uncompensated": "tab:orange",
+                    "recursive": "tab:purple"})
 
 
 def plot_speed(fig, res):
     ax = fig.add_subplot(111)
     vmax = max(float(np.nanmax(c.run.x[0])) for c in res.cases)
-    snap = lambda x: quantised(x, PLOT_DIGITS, scale=vmax)
     for c in res.cases:
-        r = c.run
+        r, name = c.run, c.case.name
         v, lam = r.x
         vw = np.where(lam >= 0, v / (1 - np.minimum(lam, 0.999)), v * (1 + lam))
-        ax.plot(r.t, snap(v), color=color_of(c.case.name), label=f"{c.case.name}: v")
-        ax.plot(r.t, snap(vw), color=color_of(c.case.name), ls=":", label=f"{c.case.name}: v_w")
+        plot_cases(ax, [(name, r.t, v, f"{name}: v")], color_of, vmax)
+        plot_cases(ax, [(name, r.t, vw, f"{name}: v_w")], color_of, vmax, ls=":")
     ax.set_ylim(-5.0, axis_end(1.3 * vmax))   # a data-derived end moves every pixel
     ax.set_xlabel("t (s)")
     ax.set_ylabel("speed (m/s), clipped")
@@ -47,10 +40,8 @@ def plot_speed(fig, res):
 def plot_creep(fig, res):
     ax1, ax2 = fig.subplots(2, 1)
     for ax in (ax1, ax2):
-        for c in res.cases:
-            r = c.run
-            ax.plot(r.t, quantised(np.clip(r.x[1], -1, 1), PLOT_DIGITS, scale=1.0),
-                    color=color_of(c.case.name), label=c.case.name)
+        plot_cases(ax, [(c.case.name, c.run.t, np.clip(c.run.x[1], -1, 1), c.case.name)
+                        for c in res.cases], color_of, 1.0)
         ax.axhline(res.lambda_opt, color="k", ls="--", lw=0.8, label="lambda_opt (traction)")
         ax.axhline(-res.lambda_opt, color="k", ls="-.", lw=0.8, label="−lambda_opt (braking)")
         ax.axhline(res.lambda_d, color="gray", ls=":", lw=0.8, label="lambda_d")
@@ -58,8 +49,7 @@ def plot_creep(fig, res):
     t_c = min((c.metrics["t_cruise"] for c in res.cases
                if not math.isnan(c.metrics["t_cruise"])), default=0.0)
     ax1.set_ylim(-0.2, 0.3)
-    t0 = math.floor(t_c - 1.0)    # whole seconds: a data-derived end moves every pixel
-    ax2.set_xlim(t0, t0 + 4.0)
+    ax2.set_xlim(*time_window(t_c, 1.0, 4.0))
     ax2.set_ylim(-0.1, 1.0)
     ax2.set_xlabel("t (s)")
     ax1.legend(fontsize=7, ncol=3)
@@ -106,13 +96,4 @@ def plot_evs(fig, res, spec):
     ax.set_xlabel("t (s)")
     ax.set_ylabel("e_vs = v_s - v_s* (m/s)")
     ax.set_ylim(-0.3, 0.3)
-    ax.legend(fontsize=7)
-
-
-def plot_linear(fig, res):
-    ax = fig.add_subplot(111)
-    for (fac, h, _), r in zip(res.linear.ratios_finite, res.linear.runs):
-        ax.semilogy(r.t, np.linalg.norm(r.x, axis=0) + 1e-300, label=f"h = {fac:g} h*")
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("|E|")
     ax.legend(fontsize=7)

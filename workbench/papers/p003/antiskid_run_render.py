@@ -1,20 +1,28 @@
-"""Markdown and figures of the ``antiskid-run`` study (pure rendering)."""
+"""Markdown and figures of the ``antiskid-run`` study (pure rendering).
+
+The layout is general (:mod:`workbench.report.case_tables`: per-case metrics
+and convergence tables, rows per case; :mod:`workbench.report.delay_cross_check`:
+the linear cross-check of the LMI delay bound; :mod:`workbench.report.case_figures`).
+What stays here is paper 003's: the wording of the scenario, of the phase
+switches of controller (75) and of the numerics, the metric labels, the
+creep-ratio and lambda_opt lines."""
 from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
 from ...printed_grid import quantised
 from ...refinement import P_MIN
+from ...report.binned_fractions import binned_fraction_rows
+from ...report.case_tables import CaseLevels, case_convergence_table, case_metric_table, case_rows
+from ...report.delay_cross_check import delay_cross_check, plot_envelopes
 from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
 from ...sim.wheel_slip import MAX_DLAMBDA, MAX_HALVINGS
 from .antiskid_basin_render import HEADING as BASIN_HEADING
 from .antiskid_comfort_render import (HEADING, PATTERN, TORQUE_CAPTION, comfort_figure,
                                       comfort_section, torque_figure)
 from .antiskid_run import HALVING_PROBLEM
-from .antiskid_run_figures import plot_adhesion, plot_creep, plot_evs, plot_linear, plot_speed
+from .antiskid_run_figures import plot_adhesion, plot_creep, plot_evs, plot_speed
 
 _LABELS = {  # metric -> (label, unit, sig)
     "t_cruise": ("time to reach v_d", "s", 4),
@@ -93,7 +101,8 @@ def render(design, res) -> Rendered:
         Figure("creep-speed-error", "Creep-speed tracking error in braking.",
                lambda fig, res=res, sp=spec: plot_evs(fig, res, sp), (7.0, 4.0)),
         Figure("linear-checks", "Linear error system E' = A E + B K E(t-h).",
-               lambda fig, res=res: plot_linear(fig, res), (7.0, 4.0)),
+               lambda fig, lc=res.linear: plot_envelopes(
+                   fig, (f for f, _, _ in lc.ratios_finite), lc.runs), (7.0, 4.0)),
         Figure("adhesion", "The plant's adhesion curve with each run's operating points.",
                lambda fig, res=res, sp=spec: plot_adhesion(fig, res, sp), (9.0, 3.8)),
     )
@@ -145,18 +154,13 @@ def _cases_text(spec) -> str:
 
 
 def _results_section(res) -> str:
-    names = [c.case.name for c in res.cases]
-    rows = []
-    for key in ("t_cruise", "lam_max_traction", "lam_max_over_opt", "v_max", "v_err_at_brake",
-                "braking_duration", "omega3_after_brake", "lam_min_brake", "evs_max_tracking",
-                "evs_last"):
-        label, unit, sig = _LABELS[key]
-        rows.append([label, unit] + [fmt(None if math.isnan(c.metrics[key]) else c.metrics[key],
-                                         sig) for c in res.cases])
-    rows.append(["diverged", ""] + [_diverged_text(c) for c in res.cases])
+    keys = ("t_cruise", "lam_max_traction", "lam_max_over_opt", "v_max", "v_err_at_brake",
+            "braking_duration", "omega3_after_brake", "lam_min_brake", "evs_max_tracking",
+            "evs_last")
     return ("## What happens\n\n"
-            + md_table(["metric", "unit"] + [f"`{n}`" for n in names], rows,
-                       "ll" + "r" * len(names))
+            + case_metric_table([c.case.name for c in res.cases], [c.metrics for c in res.cases],
+                                keys, _LABELS,
+                                [["diverged", ""] + [_diverged_text(c) for c in res.cases]])
             + "\n\nAll values at dt/2 (see the convergence table). '—': not reached (the run "
             "ended before).")
 
@@ -170,30 +174,23 @@ A_DIGITS = 6
 
 
 def _switch_section(res, spec) -> str:
-    rows = []
-    for c in res.cases:
-        sw = c.switch
-        if sw is None:
-            rows.append([f"`{c.case.name}`", "—", "—", "—", "—", "—", "—"])
-            continue
+    def at_switch(sw):
         m = sw.margin
         mtxt = ("unstable at h = 0" if m.reason == "unstable-at-zero-delay" else
                 "∞ (delay-independent)" if math.isinf(m.h) else fmt(m.h, 3) + " s")
-        rows.append([f"`{c.case.name}`", fmt(sw.v, 4), fmt(sw.lam, 4), fmt(sw.dmu_dlam, 3),
-                     f"${latex_matrix(quantised(sw.A_loc, A_DIGITS), 3)}$", fmt(sw.abscissa, 3),
-                     mtxt])
-    brows = []
-    for c in res.cases:
-        lb = c.metrics["lam_at_brake"]
-        if math.isnan(lb):
-            brows.append([f"`{c.case.name}`", "—", "— (braking not reached)", "—"])
-            continue
-        dv = c.metrics["t_diverged"]
+        return [fmt(sw.v, 4), fmt(sw.lam, 4), fmt(sw.dmu_dlam, 3),
+                f"${latex_matrix(quantised(sw.A_loc, A_DIGITS), 3)}$", fmt(sw.abscissa, 3), mtxt]
+
+    def at_brake(m):
+        lb, dv = m["lam_at_brake"], m["t_diverged"]
         after = ("diverged at t = " + fmt(dv, 4) + " s" if not math.isnan(dv) else
-                 "lambda < 0 after " + fmt(c.metrics["t_lam_negative"] - c.metrics["t_brake"], 3)
+                 "lambda < 0 after " + fmt(m["t_lam_negative"] - m["t_brake"], 3)
                  + " s; stopped")
-        brows.append([f"`{c.case.name}`", fmt(lb, 4),
-                      "no (lambda > 0: traction side)" if lb > 0 else "yes", after])
+        return [fmt(lb, 4), "no (lambda > 0: traction side)" if lb > 0 else "yes", after]
+
+    rows = case_rows([(c.case.name, c.switch) for c in res.cases], at_switch, ["—"] * 6)
+    brows = case_rows([(c.case.name, None if math.isnan(c.metrics["lam_at_brake"]) else c.metrics)
+                       for c in res.cases], at_brake, ["—", "— (braking not reached)", "—"])
     return (
         "## Phase switches: is the state where the next controller works?\n\n"
         "**Acceleration → cruise.** The LMI certificate of law (61) is local to the cruise "
@@ -245,20 +242,10 @@ def _switch_note(res) -> str:
 
 
 def _convergence_section(res, spec) -> str:
-    rows = []
-    for c in res.cases:
-        for key in _LABELS:
-            a, b = c.metrics_coarse[key], c.metrics[key]
-            q4 = math.nan if c.quarter is None else c.quarter[0][key]
-            if math.isnan(a) and math.isnan(b) and math.isnan(q4):
-                continue
-            label, unit, sig = _LABELS[key]
-            if c.quarter is None:
-                verdict = "(dt, dt/2 " + ("agree)" if c.converged[key] else "differ)")
-            else:
-                verdict = "yes" if key not in c.unconverged else "**no**"
-            rows.append([f"`{c.case.name}`", label, fmt(a, 6), fmt(b, 6),
-                         "—" if c.quarter is None else fmt(q4, 6), verdict])
+    levels = [CaseLevels(c.case.name, c.metrics_coarse, c.metrics,
+                         None if c.quarter is None else c.quarter[0],
+                         c.converged if c.quarter is None
+                         else {k: k not in c.unconverged for k in _LABELS}) for c in res.cases]
     return ("## Convergence in the step size\n\nEvery metric computed at dt = "
             f"{fmt(res.dt)} s and dt/2 = {fmt(res.dt / 2)} s (reported), and at dt/4 for a "
             "case whose convergence a claim states. Converged: the Richardson error "
@@ -268,37 +255,18 @@ def _convergence_section(res, spec) -> str:
             f"rtol = {fmt(spec.conv_rtol)} of the largest |value| plus the design's atol. "
             "A case without a dt/4 run shows only whether dt and dt/2 agree within that "
             "tolerance, which is no convergence.\n\n"
-            + md_table(["case", "metric", "dt", "dt/2", "dt/4", "converged"], rows, "llrrrl"))
+            + case_convergence_table(levels, _LABELS))
 
 
 def _linear_section(res) -> str:
     lc = res.linear
-    fm = lc.finite_margin
-    rows = [[fmt(f, 3), fmt(h, 4), fmt(r, 3), "decays" if r < 1 else "grows"]
-            for f, h, r in lc.ratios_finite]
-    prow = [[fmt(h, 3), fmt(r, 3), "decays" if r < 1 else "grows"] for h, r in lc.ratios_paper]
-    pm = lc.paper_margin
-    ha, hh, ht = HALVING_PROBLEM
-    ptxt = "∞ (no crossing: stable for every constant delay)" if math.isinf(pm.h) else fmt(pm.h, 4)
-    return (
-        "## Linear cross-checks of the delay bound\n\n"
-        "E' = A E + B K E(t - h) on the cruise linearisation, simulated by Heun's method on "
-        "a grid with h = N dt. Accuracy, by step halving against the exact method-of-steps "
-        f"solution of x' = -{'' if ha == 1 else fmt(ha) + ' '}x(t - {fmt(hh)}), x = 1 on "
-        f"[-{fmt(hh)}, 0], over {fmt(ht)} s:\n\n"
-        + md_table(["dt (s)", "max error", "observed order"],
-                   [[fmt(r.dt, 3), fmt(r.error, 3), fmt(r.order, 3)] for r in lc.halving],
-                   "rrr")
-        + "\n\nThe envelope ratio is max |E| over the last window / over the second window.\n\n"
-        f"Gain with a finite exact margin, K = [{', '.join(fmt(k, 3) for k in lc.K_finite)}]: "
-        f"h* = {fmt(fm.h, 4)} s at omega = {fmt(fm.omega, 4)} rad/s.\n\n"
-        + md_table(["h / h*", "h (s)", "envelope ratio", "verdict"], rows, "rrrl")
-        + f"\n\nSynthesised gain K = [{', '.join(fmt(k, 4) for k in lc.K_paper)}]: exact "
-        f"margin {ptxt}.\n\n"
-        + md_table(["h (s)", "envelope ratio", "verdict"], prow, "rrl")
-        + "\n\nThe LMI bound h_m is where the Lyapunov-Krasovskii criterion stops proving "
-        "stability, not where the loop stops being stable: with this gain the loop decays at "
-        "delays two orders of magnitude above h_m, as its infinite exact margin says.")
+    return delay_cross_check(
+        linearisation="the cruise linearisation", test_problem=HALVING_PROBLEM,
+        halving=lc.halving, K_finite=lc.K_finite, finite_margin=lc.finite_margin,
+        ratios_finite=lc.ratios_finite, K_synth=lc.K_paper, synth_margin=lc.paper_margin,
+        ratios_synth=lc.ratios_paper,
+        closing=": with this gain the loop decays at delays two orders of magnitude above h_m, "
+        "as its infinite exact margin says.")
 
 
 def _montecarlo_section(design, mc, halving=None) -> str:
@@ -311,17 +279,8 @@ def _montecarlo_section(design, mc, halving=None) -> str:
             ["true input delay h (s)", rng(ms.h, 4) + " (the predictor keeps "
              + fmt(design.spec.scenario["h"], 4) + " s)"],
             ["v(0) (m/s)", rng(ms.v0)]] + _perturbation_rows(ms, rng)
-    s = np.asarray(mc.samples["adhesion"], float)
-    div = np.asarray(mc.violations["diverged"], bool)
-    above = np.asarray(mc.violations["above_lambda_opt"], bool)
-    edges = np.linspace(ms.adhesion[0], ms.adhesion[1], 5)
-    brows = []
-    for i, (lo, hi) in enumerate(zip(edges[:-1], edges[1:])):
-        sel = (s >= lo) & ((s < hi) if i < 3 else (s <= hi))
-        n = int(sel.sum())
-        brows.append([f"[{fmt(lo, 3)}, {fmt(hi, 3)}" + ("]" if i == 3 else ")"), n,
-                      fmt(div[sel].mean(), 2) if n else "—",
-                      fmt(above[sel].mean(), 2) if n else "—"])
+    brows = binned_fraction_rows(mc.samples["adhesion"], *ms.adhesion, 4,
+                                 [mc.violations["diverged"], mc.violations["above_lambda_opt"]])
     return (
         "## Monte Carlo robustness (reduced sample)\n\n"
         f"{mc.n} runs of case `{ms.case}` with seed {ms.seed} at dt = "

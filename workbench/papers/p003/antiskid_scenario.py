@@ -8,6 +8,15 @@ parameter samples, optionally on a refined mesh (:class:`Mesh`).
 :class:`MetricsRecorder` accumulates the run's metrics (:class:`RunMetrics`)
 sample by sample; the controller's own phase events (handover, divergence)
 are merged in at the end.
+
+Why this stays paper code: every metric here is a definition of paper 003's
+study (time to v_d, creep ratio in traction and braking against lambda_opt,
+the creep-speed error of Theorem 3 against the profile of eq (76), the lock
+onset), and :class:`Mesh` is set by the creep-ratio rate of the wheel-slip
+plant. The batch form is mirrored bit for bit by the compiled kernel
+(:mod:`workbench.papers.p003.antiskid_kernel`), so its operations stay as
+they are. Its tables and figures are rendered by the general
+:mod:`workbench.report.case_tables` and :mod:`workbench.report.case_figures`.
 """
 from __future__ import annotations
 

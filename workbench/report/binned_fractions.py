@@ -1,0 +1,35 @@
+"""Fractions of flagged runs per bin of one sampled parameter (Monte Carlo).
+
+The parameter's range is cut into equal bins, half-open except the last,
+which is closed (it holds the range's upper end); each bin's row gives its
+interval, its number of runs and, per flag, the fraction of its runs
+flagged (:data:`~workbench.report.case_tables.MISSING` for an empty bin).
+
+Used by the ``antiskid-run`` study's Monte Carlo section (paper 003);
+``tests/test_case_tables.py`` renders a toy.
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from .case_tables import MISSING
+from .markdown import fmt
+
+
+def binned_fraction_rows(samples, lo: float, hi: float, bins: int,
+                         flags: Sequence, sig: int = 3, frac_sig: int = 2) -> list[list]:
+    """Rows ``[interval, runs, fraction of flags[0], ...]`` of ``bins`` equal
+    bins of [lo, hi] (``samples`` and each flag: one value per run)."""
+    s = np.asarray(samples, float)
+    flags = [np.asarray(f, bool) for f in flags]
+    edges = np.linspace(lo, hi, bins + 1)
+    rows = []
+    for i, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
+        last = i == bins - 1
+        sel = (s >= a) & ((s <= b) if last else (s < b))
+        n = int(sel.sum())
+        rows.append([f"[{fmt(a, sig)}, {fmt(b, sig)}" + ("]" if last else ")"), n]
+                    + [fmt(f[sel].mean(), frac_sig) if n else MISSING for f in flags])
+    return rows

@@ -1,0 +1,52 @@
+"""Figures of several cases of one run on shared axes, a colour per case.
+
+Each case keeps one colour in every figure of a report (:class:`Palette`).
+Plotted data are snapped to a grid (:func:`snapped`) and axis ends are set
+on a grid (:func:`~workbench.printed_grid.axis_end`, :func:`time_window`), so
+that a few-ulp change of the inputs does not move a pixel: a data-derived
+axis end moves every pixel of a figure.
+
+Used by the ``antiskid-run`` study (paper 003); ``tests/test_case_tables.py``
+draws a toy.
+"""
+from __future__ import annotations
+
+import math
+from typing import Iterable, Mapping
+
+from ..printed_grid import quantised
+
+#: Plotted values are snapped to 1e-5 of their decade (a step far below a
+#: pixel, far above last-bit noise of ~1e-13 relative).
+PLOT_DIGITS = 6
+
+
+class Palette:
+    """The colour of a case in every figure: ``colors[name]``, else ``default``."""
+
+    def __init__(self, colors: Mapping[str, str], default: str = "tab:green"):
+        self.colors, self.default = dict(colors), default
+
+    def __call__(self, name: str) -> str:
+        return self.colors.get(name, self.default)
+
+
+def snapped(values, scale: float, digits: int = PLOT_DIGITS):
+    """``values`` on the grid of 10^(1 - digits) of the decade of ``scale``
+    (:func:`~workbench.printed_grid.quantised`)."""
+    return quantised(values, digits, scale=scale)
+
+
+def plot_cases(ax, traces: Iterable[tuple], color_of, scale: float, **style) -> None:
+    """One line per trace (case name, t, y, legend label), in the case's
+    colour, y snapped on the grid of ``scale`` (:func:`snapped`); ``style``
+    passes to ``ax.plot``."""
+    for name, t, y, label in traces:
+        ax.plot(t, snapped(y, scale), color=color_of(name), label=label, **style)
+
+
+def time_window(t_event: float, before: float, width: float) -> tuple[float, float]:
+    """An x range of ``width`` seconds from the whole second at or below
+    ``t_event - before``: ends on a grid, not on the data."""
+    t0 = math.floor(t_event - before)
+    return t0, t0 + width
