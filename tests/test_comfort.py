@@ -1,14 +1,16 @@
-"""Comfort and torque of an antiskid run (issue 19, item 5), on runs whose
-acceleration and jerk are known in closed form."""
+"""Comfort: the general feature :mod:`workbench.features.comfort` on toy
+speeds (issue 35), and the comfort and torque of an antiskid run (issue 19,
+item 5), on runs whose acceleration and jerk are known in closed form."""
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from workbench.papers.p003.antiskid_comfort import ComfortSpec, comfort_of, comfort_quantities
+from workbench.features.comfort import ComfortLimits
+from workbench.papers.p003.antiskid_comfort import comfort_of, comfort_quantities
 from workbench.reader import Quantity
 
-SPEC = ComfortSpec(Quantity(1.0, "m/s^2", "test"), Quantity(0.75, "m/s^3", "test"),
+SPEC = ComfortLimits(Quantity(1.0, "m/s^2", "test"), Quantity(0.75, "m/s^3", "test"),
                    Quantity(1.0, "s", "test"))
 
 
@@ -72,7 +74,7 @@ def test_switch_to_braking_is_given_at_t_brake(t_show):
 def test_feature_on_a_sine_speed_gives_the_centred_difference_exactly():
     """v = A sin(t): the centred differences over T are a = A c cos t and
     j = -A c² sin t with c = 2 sin(T/2) / T (exact, whatever the step)."""
-    from workbench.features.comfort import ComfortLimits, comfort_of_speed
+    from workbench.features.comfort import comfort_of_speed
     A, T, step = 2.0, 0.1, 0.01
     t = np.arange(0.0, 4 * np.pi, step)
     lim = ComfortLimits(Quantity(1.0, "m/s^2", "toy"), Quantity(1.5, "m/s^3", "toy"),
@@ -96,8 +98,7 @@ def test_running_peaks_are_the_one_step_window_recipe():
     """Feeding acceleration samples one step at a time (a batch of runs) gives
     the peaks and times above of the recorded recipe with a one-step window,
     to the last bit, and nothing of a run after it stopped."""
-    from workbench.features.comfort import (ComfortLimits, RunningComfort, peak_abs, rate,
-                                            time_above)
+    from workbench.features.comfort import RunningComfort, peak_abs, rate, time_above
     rng = np.random.default_rng(1)
     step, a = 0.05, rng.normal(size=(200, 3))
     lim = ComfortLimits(Quantity(1.0, "m/s^2", "toy"), Quantity(20.0, "m/s^3", "toy"))

@@ -21,11 +21,7 @@ import numpy as np
 from ...features.comfort import Comfort, ComfortLimits, comfort_of_speed, read_limits
 from ...reader import Reader
 
-#: The ``[comfort]`` table of a run design (:class:`~workbench.features.comfort.ComfortLimits`).
-ComfortSpec = ComfortLimits
-
-
-def load_comfort(root: Reader) -> ComfortSpec | None:
+def load_comfort(root: Reader) -> ComfortLimits | None:
     """The ``[comfort]`` table of a run design (None when absent)."""
     if not root.has("comfort"):
         return None
@@ -49,7 +45,7 @@ class RunComfort(Comfort):
     u_max_over_peak: float
 
 
-def comfort_of(run, spec: ComfortSpec, u_peak: float, step: float) -> RunComfort:
+def comfort_of(run, spec: ComfortLimits, u_peak: float, step: float) -> RunComfort:
     """:class:`RunComfort` of a recorded run (``run.t``, ``run.x[0]`` = v,
     ``run.u``) on a uniform grid of ``step`` seconds."""
     c = comfort_of_speed(run.t, run.x[0], spec, step)
