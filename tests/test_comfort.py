@@ -1,14 +1,16 @@
-"""Comfort and torque of an antiskid run (issue 19, item 5), on runs whose
-acceleration and jerk are known in closed form."""
+"""Comfort: the general feature :mod:`workbench.features.comfort` on toy
+speeds (issue 35), and the comfort and torque of an antiskid run (issue 19,
+item 5), on runs whose acceleration and jerk are known in closed form."""
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from workbench.papers.p003.antiskid_comfort import ComfortSpec, comfort_of, comfort_quantities
+from workbench.features.comfort import ComfortLimits
+from workbench.papers.p003.antiskid_comfort import comfort_of, comfort_quantities
 from workbench.reader import Quantity
 
-SPEC = ComfortSpec(Quantity(1.0, "m/s^2", "test"), Quantity(0.75, "m/s^3", "test"),
+SPEC = ComfortLimits(Quantity(1.0, "m/s^2", "test"), Quantity(0.75, "m/s^3", "test"),
                    Quantity(1.0, "s", "test"))
 
 
@@ -65,3 +67,61 @@ def test_switch_to_braking_is_given_at_t_brake(t_show):
     c = SimpleNamespace(run=run, metrics={"t_brake": 300.0, "omega3_after_brake": np.nan})
     assert _switches(c, SimpleNamespace(profile={"omega_switch": 3.0})) == [
         (300.0, "cruise → braking")]
+
+
+# The general feature (workbench.features.comfort) on a toy speed, no train model.
+
+def test_feature_on_a_sine_speed_gives_the_centred_difference_exactly():
+    """v = A sin(t): the centred differences over T are a = A c cos t and
+    j = -A c² sin t with c = 2 sin(T/2) / T (exact, whatever the step)."""
+    from workbench.features.comfort import comfort_of_speed
+    A, T, step = 2.0, 0.1, 0.01
+    t = np.arange(0.0, 4 * np.pi, step)
+    lim = ComfortLimits(Quantity(1.0, "m/s^2", "toy"), Quantity(1.5, "m/s^3", "toy"),
+                        Quantity(T, "s", "toy"))
+    c = comfort_of_speed(t, A * np.sin(t), lim, step)
+    k = 2 * np.sin(T / 2) / T
+    assert c.a == pytest.approx(A * k * np.cos(c.t_a), abs=1e-9)
+    assert c.j == pytest.approx(-A * k**2 * np.sin(c.t_j), abs=1e-7)
+    assert c.a_max_abs == pytest.approx(A * k, rel=1e-4)
+    # |a| = 2 k |cos t| > 1 for |cos t| > 1 / (2k): 4 arcs of 2 arccos(1/(2k)) in [0, 4 pi],
+    # less T/2 at either end (a starts T/2 after the first sample, ends T/2 before the last)
+    assert c.time_above_a == pytest.approx(8 * np.arccos(1 / (2 * k)) - T, abs=3 * step)
+    # |j| > 1.5 on 4 stretches around t = pi/2, 3 pi/2, 5 pi/2, 7 pi/2
+    mids = [(t0 + t1) / 2 for t0, t1, _ in c.jerk_windows]
+    assert mids == pytest.approx([np.pi / 2, 3 * np.pi / 2, 5 * np.pi / 2, 7 * np.pi / 2],
+                                 abs=2 * step)
+    assert all(p > 1.5 for *_, p in c.jerk_windows)
+
+
+def test_running_peaks_are_the_one_step_window_recipe():
+    """Feeding acceleration samples one step at a time (a batch of runs) gives
+    the peaks and times above of the recorded recipe with a one-step window,
+    to the last bit, and nothing of a run after it stopped."""
+    from workbench.features.comfort import RunningComfort, peak_abs, rate, time_above
+    rng = np.random.default_rng(1)
+    step, a = 0.05, rng.normal(size=(200, 3))
+    lim = ComfortLimits(Quantity(1.0, "m/s^2", "toy"), Quantity(20.0, "m/s^3", "toy"))
+    rc = RunningComfort(3, step, lim)
+    active = np.ones(3, bool)
+    for k, row in enumerate(a):
+        active[2] = k < 100                      # run 2 stops at sample 100
+        rc.add(row, active)
+    m = rc.metrics()
+    for r in range(2):
+        j = rate(a[1:, r], a[:-1, r], step)
+        assert m["peak_abs_accel"][r] == peak_abs(a[:, r])
+        assert m["peak_abs_jerk"][r] == peak_abs(j)
+        assert m["time_above_accel"][r] == time_above(a[:, r], 1.0, step)
+        assert m["time_above_jerk"][r] == time_above(j, 20.0, step)
+    assert m["peak_abs_accel"][2] == peak_abs(a[:100, 2])
+    no_limits = RunningComfort(3, step)
+    no_limits.add(a[0], active)
+    assert set(no_limits.metrics()) == {"peak_abs_accel", "peak_abs_jerk"}
+
+
+def test_rate_units():
+    from workbench.features.comfort import rate_units
+    assert rate_units("m/s") == ("m/s^2", "m/s^3")
+    assert rate_units("km/h") == ("(km/h)/s", "(km/h)/s^2")
+    assert rate_units("rad") == ("(rad)/s", "(rad)/s^2")

@@ -418,3 +418,39 @@ def test_with_convergence_the_delay_is_a_multiple_of_the_designed_step(tmp_path,
     text = GUARD.replace("H", "0.25").replace("dt = 0.125", "dt = 0.1") + "\n[convergence]\n"
     line = _cli_error(write(tmp_path, text), capsys)
     assert "scenarios[0].dt" in line and "2.5 steps" in line, line
+
+
+#: v' = u: u = 1 m/s^2 until v reaches 1 m/s (t = 1 s), then 0.
+COMFORT = GUARD.replace("H", "0.0").replace('x = { unit = "m", source = "test" }',
+                                            'x = { unit = "m/s", source = "test" }').replace(
+    'u = { unit = "m/s", source = "test" }', 'u = { unit = "m/s^2", source = "test" }').replace(
+    'one = { value = 1.0, unit = "m", ', 'one = { value = 1.0, unit = "m/s", ').replace(
+    'speed = { value = 1.0, unit = "m/s", ', 'speed = { value = 1.0, unit = "m/s^2", ').replace(
+    'x = "a*x + u"', 'x = "u"') + """
+[comfort]
+speed = "x"
+LIMITS
+"""
+LIMITS = ('a_max = { value = 0.5, unit = "m/s^2", source = "test" }\n'
+          'jerk_max = { value = 4.0, unit = "m/s^3", source = "test" }')
+
+
+def test_comfort_limits_give_the_time_above_them(tmp_path, monkeypatch, capsys):
+    """The general comfort feature in the switched-run kind: a = 1 m/s^2 on the
+    8 steps before t = 1 s, then 0: peak |a| 1, peak |jerk| 1 / dt = 8 m/s^3;
+    above 0.5 m/s^2 for 1 s, above 4 m/s^3 for one step (0.125 s). Without
+    limits, only the peaks are metrics."""
+    spec, b = run_once(write(tmp_path, COMFORT.replace("LIMITS", LIMITS)))
+    m = {k: float(v[0]) for k, v in b.metrics.items()}
+    assert (m["peak_abs_accel"], m["peak_abs_jerk"]) == (1.0, 8.0)
+    assert (m["time_above_accel"], m["time_above_jerk"]) == (1.0, 0.125)
+    from workbench.kinds.switched_run.quantities import scenario_metrics
+    units = scenario_metrics(spec, "s")
+    assert units["time_above_accel"] == "s" and units["peak_abs_jerk"] == "(m/s)/s^2"
+    spec, b = run_once(write(tmp_path, COMFORT.replace("LIMITS", "")))
+    assert "time_above_accel" not in b.metrics and b.metrics["peak_abs_jerk"][0] == 8.0
+    assert "time_above_accel" not in scenario_metrics(spec, "s")
+    monkeypatch.chdir(tmp_path)
+    line = _cli_error(write(tmp_path, COMFORT.replace("LIMITS", LIMITS.replace("m/s^3", "m/s^2"))),
+                      capsys)
+    assert "comfort.jerk_max.unit" in line and '"m/s^3"' in line, line

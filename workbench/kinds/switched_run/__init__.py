@@ -19,7 +19,9 @@ Tables::
     [[scenarios]] name, x0 = { state = value } (every state), t_end, dt, phase (initial),
                   parameters = { p = value } (overrides), target = { state = value },
                   max_switch_rate (1/s, default 10: more switches within 1 s is chattering)
-    [comfort]     speed = "state"          (optional: peak |acceleration| and |jerk|)
+    [comfort]     speed = "state"          (optional: peak |acceleration| and |jerk|),
+                  a_max, jerk_max = { value, unit = speed unit / s, / s^2, source }
+                  (optional: the time above each; :mod:`workbench.features.comfort`)
     [montecarlo]  samples, seed, distributions = { parameter = { dist = ... } }
     [sampled]     period (s, a multiple of dt), quantisation = { state = step }
     [convergence] (no keys: every scenario metric at dt, dt/2, dt/4)
@@ -98,6 +100,7 @@ class SwitchedRunSpec:
     convergence: bool = False
     claims: tuple[ClaimTarget, ...] = ()
     usable: tuple[str, ...] = ()       # definitions a law may use (no input in them)
+    comfort: object = None             # workbench.features.comfort.ComfortLimits ([comfort])
 
 
 def _names_in(tree) -> set[str]:
@@ -269,10 +272,13 @@ class SwitchedRun:
         sampled = _sampled(root, plant)
         convergence = load_convergence(root)
         scenarios = _scenarios(root, plant, phases, hq.value, convergence, sampled)
-        speed = None
+        speed = comfort = None
         if root.has("comfort"):
+            from ...features.comfort import read_limits
             ct = root.table("comfort")
             speed = ct.string("speed", choices=plant.state_names)
+            unit = next(v.unit for v in plant.states if v.name == speed)
+            comfort = read_limits(ct, unit, required=False, window=False)
             ct.finish()
         mc = None
         if root.has("montecarlo"):
@@ -289,7 +295,7 @@ class SwitchedRun:
         model.check_finite(plant.values(), "parameters")
         _check_law_units(plant, model, phases, usable)
         spec = SwitchedRunSpec(plant, hq.value, hq.source, predictor, phases, scenarios, speed,
-                               mc, sampled, convergence, (), usable)
+                               mc, sampled, convergence, (), usable, comfort)
         from .quantities import scenario_metrics
         known = {s.name for s in scenarios}
         claims = claim_targets(root, "scenario.", lambda s: scenario_metrics(spec, s)

@@ -12,6 +12,7 @@ designed step)::
     switches end_time completed       count; s; 1 when `until` ended the run
     diverged diverged_time            1 when the run diverged or chattered; s
     peak_abs_accel peak_abs_jerk      with [comfort]: |d speed/dt|, |d^2 speed/dt^2|
+    time_above_accel time_above_jerk  with a_max, jerk_max in [comfort]: s above the limit
 
 With ``[montecarlo]``: ``montecarlo.<s>.runs``, ``.diverged``,
 ``.completed`` (counts), ``montecarlo.<s>.max.<metric>`` and ``.min.<metric>``
@@ -45,8 +46,9 @@ def scenario_metrics(spec, scenario: str) -> dict[str, str]:
     out |= {"switches": "1", "end_time": "s", "completed": "1", "diverged": "1",
             "diverged_time": "s"}
     if spec.speed is not None:
+        from ...features.comfort import metric_units
         u = next(v.unit for v in plant.states if v.name == spec.speed)
-        out |= {"peak_abs_accel": f"({u})/s", "peak_abs_jerk": f"({u})/s^2"}
+        out |= metric_units(u, spec.comfort)
     return out
 
 

@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 
+from ...features.comfort import TIMES
 from ...features.convergence import claim_table
 from ...report.case_tables import MISSING, fmt_finite
 from ...report.markdown import Figure, Rendered, fmt, md_table
@@ -98,10 +99,21 @@ def _runs(spec, res):
           "one second "
           "than the scenario's cap (chattering) — the run then stops there; "
           "`peak_abs_accel`/`peak_abs_jerk`: the largest |d speed/dt| (the plant's right-hand "
-          "side) and |d² speed/dt²| (its step-to-step difference / dt).\n\n"
+          "side) and |d² speed/dt²| (its step-to-step difference / dt)." + _limits_text(spec)
+          + "\n\n"
           + md_table(["scenario", "metric", "value", "unit"], rows, "llrl")
           + "\n\n" + "\n\n".join(f"![{f.caption}]({{figdir}}/{f.name}.png)" for f in figs))
     return md, figs
+
+
+def _limits_text(spec) -> str:
+    """The comfort limits of ``[comfort]`` behind the ``time_above_*`` metrics ("" without)."""
+    lim = spec.comfort
+    given = [] if lim is None else [
+        f"`{name}`: the time with |{what}| > {fmt(q.value)} {q.unit} ({q.source})"
+        for name, what, q in zip(TIMES, ("d speed/dt", "d² speed/dt²"), (lim.a_max, lim.jerk_max))
+        if q is not None]
+    return "".join(f" {g}." for g in given)
 
 
 def _plot_run(fig, r, spec):

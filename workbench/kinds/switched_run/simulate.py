@@ -32,6 +32,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...features.comfort import RunningComfort
+
 __all__ = ["BOUND", "Compiled", "Batch", "simulate"]
 
 #: A state beyond BOUND (1 + |x0|) in magnitude has diverged.
@@ -185,7 +187,7 @@ def _loop(spec, comp, sc, dt, N, Pc, Pp, record):
     first = {(a, b): nan.copy() for a, p in enumerate(spec.phases) for b, _ in comp.guards[a]}
     switches = np.zeros(N)
     history: dict[int, list] = {}
-    amax, jmax, a_prev = np.zeros(N), np.zeros(N), None
+    comfort = None if comp.speed is None else RunningComfort(N, dt, spec.comfort)
     rec = [] if record else None
     for step in range(steps + 1):
         t = step * dt
@@ -250,10 +252,7 @@ def _loop(spec, comp, sc, dt, N, Pc, Pp, record):
         Xn, k1 = _rk4(comp.f, X, ua, Pp, dt)
         a = k1[comp.speed] if comp.speed is not None else None
         if a is not None:
-            amax = np.where(act, np.fmax(amax, np.abs(a)), amax)
-            if a_prev is not None:
-                jmax = np.where(act, np.fmax(jmax, np.abs(a - a_prev) / dt), jmax)
-            a_prev = a
+            comfort.add(a, act)
         umax = np.where(act, np.fmax(umax, np.abs(U)), umax)
         for p in range(P):
             tin[p] += dt * (act & (ph == p))
@@ -283,8 +282,8 @@ def _loop(spec, comp, sc, dt, N, Pc, Pp, record):
     out["switches"] = cut(switches)
     out["end_time"], out["completed"] = cut(end_t), completed
     out["diverged"], out["diverged_time"] = diverged, div_t
-    if comp.speed is not None:
-        out["peak_abs_accel"], out["peak_abs_jerk"] = cut(amax), cut(jmax)
+    if comfort is not None:
+        out |= {k: cut(v) for k, v in comfort.metrics().items()}
     if rec is None:
         return Batch(out, tuple(reasons), dt)
     t_, x_, u_, p_, a_ = zip(*rec)

@@ -1,10 +1,17 @@
 """Markdown and figures of an antiskid run's comfort and torque
-(:mod:`workbench.papers.p003.antiskid_comfort`; pure rendering)."""
+(:mod:`workbench.papers.p003.antiskid_comfort`; pure rendering).
+
+The comfort columns and the acceleration/jerk figure are the general
+:mod:`workbench.features.comfort_render`; what stays here is paper 003's:
+the controller's phase switches near each stretch above the jerk limit, the
+wheel torque against T_adh and the section's wording."""
 from __future__ import annotations
 
 import numpy as np
 
 from ...controllers.antiskid003_settings import PHASE_NAMES
+from ...features.comfort_render import comfort_cells, comfort_headers
+from ...features.comfort_render import plot_comfort as plot_comfort_traces
 from ...report.markdown import Figure, fmt, md_table
 from ...refinement import P_MIN
 from .antiskid_comfort import COMFORT_RTOL, comfort_quantities
@@ -68,9 +75,7 @@ def comfort_section(res, spec) -> str:
                                    None if c.quarter is None else c.quarter[2])[
             f"cases[{c.case.name}].comfort_converged"]
         agree = "—" if c.quarter is None else (agree or "**not converged**")
-        rows.append([f"`{c.case.name}`", fmt(m.a_max_abs, 3), fmt(m.time_above_a, 3),
-                     fmt(m.jerk_max_abs, 2), fmt(m.time_above_jerk, 2),
-                     fmt(m.u_max_over_peak, 3), agree])
+        rows.append([f"`{c.case.name}`", *comfort_cells(m), fmt(m.u_max_over_peak, 3), agree])
     done = [c for c in res.cases if np.isnan(c.metrics["t_diverged"])]
     where = "".join(f"\n\n`{c.case.name}`: |jerk| > {fmt(cf.jerk_max.value)} m/s³ at "
                     + (_windows_text(c, spec) or "no time") + "." for c in done)
@@ -92,9 +97,8 @@ def comfort_section(res, spec) -> str:
         "model, the most the rail transmits in steady state (the paper gives no drive or "
         f"brake limit; the design's only torque bound, `torque_range` = "
         f"{fmt(spec.torque_range)} T_adh, is its divergence test).\n\n"
-        + md_table(["case", "max |a| (m/s²)", f"time |a| > {fmt(cf.a_max.value)} (s)",
-                    "max |jerk| (m/s³)", f"time |jerk| > {fmt(cf.jerk_max.value)} (s)",
-                    "max |u| / T_adh", f"converged, dt to dt/4 ({fmt(100 * COMFORT_RTOL)} %)"],
+        + md_table(["case", *comfort_headers(cf), "max |u| / T_adh",
+                    f"converged, dt to dt/4 ({fmt(100 * COMFORT_RTOL)} %)"],
                    rows, "lrrrrrl")
         + "\n\nConverged: the |a| and |jerk| peaks at dt, dt/2 and dt/4 have a Richardson "
         f"error estimate within {fmt(100 * COMFORT_RTOL)} % of the peak (levels whose "
@@ -130,26 +134,9 @@ TORQUE_CAPTION = ("Commanded torque u(t) of every case (it acts h later) against
 
 
 def plot_comfort(fig, res, spec):
-    cf = spec.comfort
-    ax_a, ax_j = fig.subplots(2, 1, sharex=True)
-    for c in res.cases:
-        m = c.comfort
-        ax_a.plot(m.t_a, m.a, color=color_of(c.case.name), lw=0.8, label=c.case.name)
-        ax_j.plot(m.t_j, m.j, color=color_of(c.case.name), lw=0.8, label=c.case.name)
-    for ax, lim in ((ax_a, cf.a_max.value), (ax_j, cf.jerk_max.value)):
-        for s in (lim, -lim):
-            ax.axhline(s, color="k", ls="--", lw=0.8)
     ref = next((c for c in res.cases if np.isnan(c.metrics["t_diverged"])), None)
-    if ref is not None:
-        for ts, _ in _switches(ref, spec):
-            for ax in (ax_a, ax_j):
-                ax.axvline(ts, color="gray", ls=":", lw=0.6)
-    ax_a.set_ylabel("a (m/s²)")
-    ax_j.set_ylabel("jerk (m/s³)")
-    ax_j.set_xlabel("t (s)")
-    ax_a.legend(fontsize=7, ncol=4, loc="upper right")
-    ax_a.set_title(f"averaged over {fmt(cf.window.value)} s; limits ±{fmt(cf.a_max.value)} m/s², "
-                   f"±{fmt(cf.jerk_max.value)} m/s³", fontsize=8)
+    plot_comfort_traces(fig, [(c.case.name, color_of(c.case.name), c.comfort) for c in res.cases],
+                        spec.comfort, () if ref is None else [ts for ts, _ in _switches(ref, spec)])
 
 
 def plot_torque(fig, res, spec):

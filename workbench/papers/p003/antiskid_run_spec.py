@@ -72,7 +72,7 @@ class RunSpec:
     periods: float
     montecarlo: object = None      # antiskid_montecarlo.SweepSpec or None
     basin: object = None           # antiskid_basin_run.BasinSettings or None ([basin] table)
-    comfort: object = None         # antiskid_comfort.ComfortSpec or None ([comfort] table)
+    comfort: object = None         # features.comfort.ComfortLimits or None ([comfort] table)
     sampled: object = None         # antiskid_sampled.SampledSpec or None ([sampled] table)
 
 
