@@ -25,10 +25,12 @@ Results:
 
 Only the closed loop (law (61) at v_d on the adhesion plant, its domain and
 the |lambda| = 0.9 divergence event) and the weight grid are paper 003's and
-stay here; trajectories and fates (:mod:`workbench.features.basin_trajectory`),
-the choice of P among candidates and the staged estimate
-(:mod:`workbench.features.basin_select`), the best verdict and the gain sweep
-(:mod:`workbench.features.basin_sweep`) and the figure
+stay here; the gain loop's derivatives and modal problem
+(:mod:`workbench.features.basin_loop`), the switch states' verdicts, the
+best verdict over the grid and the sampled starts
+(:mod:`workbench.features.basin_points`, on :mod:`~workbench.features.basin_select`
+and :mod:`~workbench.features.basin_sweep`), trajectories and fates
+(:mod:`workbench.features.basin_trajectory`) and the figure
 (:mod:`workbench.features.basin_plot`) are the general basin feature's.
 
 References

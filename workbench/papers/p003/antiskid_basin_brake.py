@@ -19,11 +19,12 @@ one-state verdict, :func:`workbench.features.basin_scalar.scalar_verdict`:
 REFUTED when no equilibrium lies between the switch state and the end it
 moves to (the sign of g proven), the level-set certificate of the nearest
 stable equilibrium otherwise. Only the frozen loop (law (69) on the adhesion
-plant), the limit and the time-varying check below are paper 003's.
+plant), the limit and the time-varying loop below are paper 003's.
 
 The verdict is checked against the **time-varying** delay-free loop
 (v and lambda both integrated, v_s*(t) and d v_s*/dt of eq 76 as printed)
-from the switch state: its fate.
+from the switch state: its fate (the general
+:func:`workbench.features.basin_trajectory.time_varying_fate`).
 
 References
 ----------

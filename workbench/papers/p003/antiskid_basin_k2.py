@@ -7,7 +7,7 @@ decides whether the switch state is CERTIFIED (inside {V <= c_certified}
 for some P = modal_P(A + B K, [1, w]) of the grid) or not, and simulates
 the delay-free trajectory from it; the edge between the largest certified
 grid value and the next one is then bisected
-(:func:`workbench.features.basin_sweep.gain_edge`). Gains given for comparison
+(:func:`workbench.features.basin_points.sweep_gain_entry`). Gains given for comparison
 (e.g. the rows of 003's Table 3) are judged the same way, with their own k1.
 
 The rule is *sufficient*: a state outside every certified level set may

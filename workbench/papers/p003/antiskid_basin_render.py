@@ -4,7 +4,8 @@
 
 Paper 003's wording (laws (61), (69), eqs (75)-(76), the k2 rule) and the
 cruise figure's look stay here; the figure itself is the general
-:func:`workbench.features.basin_plot.plot_basin`."""
+:func:`workbench.features.basin_plot.plot_basin`, the switch-state and gain
+tables those of :mod:`workbench.features.basin_points_render`."""
 from __future__ import annotations
 
 import math

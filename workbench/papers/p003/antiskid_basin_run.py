@@ -20,9 +20,11 @@ each case's state at t_brake against the braking law (69) frozen at that
 instant (:mod:`.antiskid_basin_brake`). The basin uses the controller's nominal
 model (a design's plant mass factor is not in it; the report says so).
 
-What stays here is paper 003's: the table's gain rows, where the switches are
-in a case's metrics and the claim names; the table opener and the level and
-point quantities are the general ones of :mod:`workbench.features.basin`.
+What stays here is paper 003's: the k2 key, where the switches are in a
+case's metrics and the claim names; the table opener and the level and point
+quantities are the general ones of :mod:`workbench.features.basin`, the sweep's
+keys (``compare_*``, ``bisect``) those of
+:func:`workbench.features.basin_points.read_gain_sweep`.
 """
 from __future__ import annotations
 
