@@ -27,7 +27,7 @@ def switch():
 @pytest.fixture(scope="module")
 def deferred(switch):
     """One weight of the grid at the printed switch, K of the design: REFUTED."""
-    return AB._Deferred(VALS, 70.0, K, switch, 100.0, 0)
+    return SEL.DeferredEstimate(*AB._cruise_problem(VALS, 70.0, K, [switch], 100.0), 0)
 
 
 def test_refuted_point_needs_no_cover(deferred, switch, monkeypatch):
@@ -63,7 +63,7 @@ def test_first_stage_settles_the_refuted_switch(switch, monkeypatch):
     monkeypatch.delenv(AB.EAGER_ENV, raising=False)
     ran = []
     monkeypatch.setattr(F, "minimize", lambda *a, **k: ran.append(1) or pytest.fail("SLSQP"))
-    d = AB._Deferred(VALS, 70.0, K, switch, 100.0, 0)
+    d = SEL.DeferredEstimate(*AB._cruise_problem(VALS, 70.0, K, [switch], 100.0), 0)
     path = np.array([switch, (switch[0] * 2, switch[1] * 1.5)])
     assert d.outcome(switch) is Outcome.REFUTED and d.enters(path) is False
     assert d._stage._done is None and d._est is None and not ran
@@ -122,7 +122,7 @@ def test_k2_sweep_is_shared_through_the_run_folder(tmp_path, monkeypatch):
 
     def fake(*key):
         calls.append(key)
-        return K2.K2Sweep(key[3], key[2], (), (), None, min(key[4]), False)
+        return K2.K2Sweep(key[3], (key[2], 0.0), 1, (), (), None, min(key[4]), False)
 
     monkeypatch.setenv(memo.CACHE_ENV, str(tmp_path))
     monkeypatch.setattr(K2, "_sweep", fake)

@@ -119,3 +119,25 @@ def decays(path, V) -> bool:
     v = V(path)
     return bool(np.all(np.isfinite(v)) and np.all(np.diff(v) <= 1e-6 * v[0])
                 and v[-1] <= 0.01 * v[0])
+
+
+def limit_event(index: int, limit: float, offset: float = 0.0):
+    """Terminal ``solve_ivp`` event: |x[index] + offset| reaches ``limit`` (e.g.
+    a state leaving the range its model holds on, in shifted coordinates)."""
+    def reached(t, x):
+        return limit - abs(x[index] + offset)
+    reached.terminal = True
+    return reached
+
+
+def time_varying_fate(fn, x0, t0: float, T: float, settled, *, events=(), rtol: float = 1e-8,
+                      max_step: float = math.inf, escape: str = "diverges",
+                      settled_word: str = "tracks") -> tuple[str, float | None]:
+    """Fate of the time-varying loop x' = fn(t, *x) from x0 at t0 over [t0, t0 + T]
+    (Radau) and when it escaped (time after t0): the ``escape`` word when a
+    terminal event fired or the step failed, ``settled_word`` when
+    ``settled(t, x)`` holds at the end, else "undecided" (no time)."""
+    sol = integrate(fn, x0, T, events=events, rtol=rtol, max_step=max_step, t0=t0)
+    if escaped(sol):
+        return escape, float(sol.t[-1] - t0)
+    return (settled_word if settled(sol.t[-1], sol.y[:, -1]) else "undecided"), None

@@ -25,10 +25,12 @@ Results:
 
 Only the closed loop (law (61) at v_d on the adhesion plant, its domain and
 the |lambda| = 0.9 divergence event) and the weight grid are paper 003's and
-stay here; trajectories and fates (:mod:`workbench.features.basin_trajectory`),
-the choice of P among candidates and the staged estimate
-(:mod:`workbench.features.basin_select`), the best verdict and the gain sweep
-(:mod:`workbench.features.basin_sweep`) and the figure
+stay here; the gain loop's derivatives and modal problem
+(:mod:`workbench.features.basin_loop`), the switch states' verdicts, the
+best verdict over the grid and the sampled starts
+(:mod:`workbench.features.basin_points`, on :mod:`~workbench.features.basin_select`
+and :mod:`~workbench.features.basin_sweep`), trajectories and fates
+(:mod:`workbench.features.basin_trajectory`) and the figure
 (:mod:`workbench.features.basin_plot`) are the general basin feature's.
 
 References
@@ -47,15 +49,15 @@ import sympy as sp
 
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import ModelError
+from ...features.basin_loop import at_gain, derivatives, modal_problem
+from ...features.basin_points import PointVerdict, check_points, point_in_basin, sampled_starts
 # EAGER_ENV: re-exported, the switch of every staged certificate below (benchmarks, tests)
-from ...features.basin_select import EAGER_ENV, DeferredEstimate, best_estimate  # noqa: F401
-from ...features.basin_sweep import best_verdict
-from ...features.basin_trajectory import Trajectory, escaped, integrate, trajectory
-from ...outcome import Outcome
+from ...features.basin_select import EAGER_ENV  # noqa: F401
+from ...features.basin_trajectory import Trajectory, integrate, limit_event, trajectory
 from ...plants.adhesion import NumericAdhesion, adhesion_model
 from ...plants.lambdify_cache import lambdify
-from ...roa import BasinProblem, estimate_basin, modal_P
-from ...roa.check import BasinCheck, PointCheck, search_level
+from ...roa import estimate_basin
+from ...roa.check import BasinCheck
 from ...symbolic.linearise import linearise_cruise
 
 #: Weights w of the fast (creep-ratio) mode against the slow (speed) mode
@@ -96,7 +98,7 @@ class CruiseBasin:
 
 @lru_cache(maxsize=8)
 def _loop_symbolic(values: tuple, v_d: float):
-    """(f, jacobian, hessians, states, gain symbols, linearisation, lambda_d,
+    """(f, (jacobian, hessians), states, gain symbols, linearisation, lambda_d,
     lambda_opt) of the delay-free cruise loop with the gain (k1, k2) as
     symbols: derived once per plant and cruise speed."""
     vals = dict(values)
@@ -116,23 +118,17 @@ def _loop_symbolic(values: tuple, v_d: float):
     f = [sp.Piecewise((sub(y1), trac), (sub(z1), True)),
          sp.Piecewise((sub(y2) + sub(y3) * u, trac), (sub(z2) + sub(z3) * u, True))]
     states = (ve, le)
-    J = [[sp.diff(fi, s) for s in states] for fi in f]
-    H = [[[sp.diff(Jki, s) for s in states] for Jki in row] for row in J]
-    return f, J, H, states, (k1, k2), lin, lam_d, plant.lambda_opt()
+    return f, derivatives(f, states), states, (k1, k2), lin, lam_d, plant.lambda_opt()
 
 
 @lru_cache(maxsize=8)
 def _loop(values: tuple, v_d: float, K: tuple):
     """(f, derivatives, states, A_cl, lambda_d, lambda_opt) at the gain K
     (once per gain: the weights of the grid and the fate share it)."""
-    f, J, H, states, ks, lin, lam_d, lam_opt = _loop_symbolic(values, v_d)
-    rep = {ks[0]: sp.Float(float(K[0])), ks[1]: sp.Float(float(K[1]))}
-    put = lambda e: e.xreplace(rep)
-    f = [put(e) for e in f]
-    J = [[put(e) for e in row] for row in J]
-    H = [[[put(e) for e in r] for r in Hk] for Hk in H]
+    f, derivs, states, ks, lin, lam_d, lam_opt = _loop_symbolic(values, v_d)
+    f, derivs = at_gain(f, derivs, ks, K)
     A_cl = lin.A + lin.B @ np.array([K], float)
-    return f, (J, H), states, A_cl, lam_d, lam_opt
+    return f, derivs, states, A_cl, lam_d, lam_opt
 
 
 def _domain(v_d: float, lam_d: float):
@@ -142,10 +138,9 @@ def _domain(v_d: float, lam_d: float):
 def _cruise_problem(values, v_d, K, points, w, c_search=None):
     """(problem, level searched) of :func:`estimate_cruise`."""
     f, derivs, states, A_cl, lam_d, _ = _loop(values, v_d, tuple(K))
-    P = modal_P(A_cl, [1.0, w])
-    prob = BasinProblem(f, states, (0.0, 0.0), P, P_source="optimised",
-                        names=("v - v_d (m/s)", "lambda - lambda_d"), derivatives=derivs)
-    return prob, search_level(prob, points, _domain(v_d, lam_d), c_search)
+    return modal_problem(f, states, (0.0, 0.0), A_cl, [1.0, w], derivs=derivs,
+                         names=("v - v_d (m/s)", "lambda - lambda_d"), points=points,
+                         domain=_domain(v_d, lam_d), c_search=c_search)
 
 
 def estimate_cruise(values, v_d, K, points, w, *, seed=0, c_search=None):
@@ -156,15 +151,10 @@ def estimate_cruise(values, v_d, K, points, w, *, seed=0, c_search=None):
     return prob, estimate_basin(prob, c, seed=seed)
 
 
-def _Deferred(values, v_d, K, x, w, seed) -> DeferredEstimate:
-    """The estimate of :func:`estimate_cruise` at one switch state ``x``, staged
-    (:class:`workbench.features.basin_select.DeferredEstimate`)."""
-    return DeferredEstimate(*_cruise_problem(values, v_d, K, [x], w), seed)
-
-
 def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
                  n_traj: int = 24, t_traj: float = 3.0) -> CruiseBasin:
-    """Certified basin of law (61) and the verdict for each switch state.
+    """Certified basin of law (61) and the verdict for each switch state
+    (:func:`workbench.features.basin_points.check_points` over :data:`W_GRID`).
 
     Parameters
     ----------
@@ -185,16 +175,21 @@ def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
         Their horizon (s).
     """
     vals = tuple(sorted((k, float(v)) for k, v in values.items()))
-    lam_d, lam_opt = _loop_symbolic(vals, v_d)[6:8]
+    lam_d, lam_opt = _loop_symbolic(vals, v_d)[5:7]
     pts = [(lab, (float(v) - v_d, float(l) - lam_d)) for lab, (v, l) in switch_points]
-    xs = [x for _, x in pts]
-    best = best_estimate(W_GRID, lambda q: _cruise_problem(vals, v_d, K, xs, q), xs, seed=seed)
+    best = check_points(W_GRID, lambda q, xs: _cruise_problem(vals, v_d, K, xs, q), pts,
+                        loop=LOOP, seed=seed)
     if best is None:
         raise ModelError(f"cruise loop with K = {tuple(K)} has no Hurwitz linearisation")
-    q, prob, est = best
-    checks = tuple(PointCheck(lab, x, est.point_verdict(x)) for lab, x in pts)
-    check = BasinCheck(est, checks, LOOP)
-    trajs = _trajectories(prob, est, pts, seed, n_traj, t_traj, lam_d)
+    q, prob, check = best
+    est = check.estimate
+    # the sampled starts: a box around the switch states (2 x |v_e| + 1 m/s,
+    # 1.5 x |lambda_e| + 0.02)
+    starts = sampled_starts([x for _, x in pts], n_traj, seed=seed, scale=(2, 1.5),
+                            pad=(1.0, 0.02), default=(2, 0.1))
+    fm = lambdify(prob.states, list(prob.f), "math")
+    inside = lambda p: prob.V(p) <= est.c_certified
+    trajs = tuple(_trajectory(fm, x0, lam_d, t_traj, inside) for x0 in starts)
     return CruiseBasin(check, tuple(float(k) for k in K), q, v_d, lam_d, lam_opt, trajs)
 
 
@@ -204,10 +199,7 @@ LAM_DIVERGED = ControllerSettings.lam_diverged
 
 def _spin(lam_d: float):
     """Terminal event: |lambda| reaches LAM_DIVERGED (the wheel spins or locks)."""
-    def spin(t, x):
-        return LAM_DIVERGED - abs(x[1] + lam_d)
-    spin.terminal = True
-    return spin
+    return limit_event(1, LAM_DIVERGED, lam_d)
 
 
 def _delay_free(fn, x0, lam_d: float, T: float):
@@ -232,74 +224,22 @@ def _trajectory(fn, x0, lam_d: float, T: float, inside_at) -> Trajectory:
                       max_step=0.05, path_dt=PATH_DT)
 
 
-def _trajectories(prob, est, pts, seed, n, T, lam_d):
-    """Delay-free trajectories (:func:`_trajectory`, certified set {V <=
-    c_certified}) from each switch state and a seeded set of states around
-    the basin."""
-    rng = np.random.default_rng(np.random.SeedSequence([seed, 1]))
-    half = np.array([max(abs(x[0]) for _, x in pts) * 2 + 1.0,
-                     max(abs(x[1]) for _, x in pts) * 1.5 + 0.02]) if pts else np.array([2, 0.1])
-    starts = [tuple(x) for _, x in pts]
-    starts += [tuple(rng.uniform(-1, 1, 2) * half) for _ in range(n)]
-    fm = lambdify(prob.states, list(prob.f), "math")
-    inside = lambda p: prob.V(p) <= est.c_certified
-    return tuple(_trajectory(fm, x0, lam_d, T, inside) for x0 in starts)
-
-
-@dataclass(frozen=True)
-class SwitchVerdict:
-    """Best verdict over the weight grid for one switch state and gain.
-
-    Attributes
-    ----------
-    outcome : Outcome
-        CERTIFIED if some P of the grid certifies the state; REFUTED if each
-        P that exists refutes its level, or A + B K is not Hurwitz (no basin).
-    w : float or None
-        Weight of the deciding P (None: no Hurwitz linearisation).
-    hurwitz : bool
-    fate : str
-        The delay-free trajectory from the state: "converges" (enters a
-        certified level set, from which it converges), "diverges" (lambda
-        reaches 0.9: the wheel spins), "undecided" (neither within 10 s).
-    """
-
-    outcome: Outcome
-    w: float | None
-    hurwitz: bool
-    fate: str
-
-
 def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0,
-                    t_sim: float = 10.0) -> SwitchVerdict:
+                    t_sim: float = 10.0) -> PointVerdict:
     """Is the switch state ``point`` (absolute (v, lambda)) inside a certified
-    basin of law (61) with gain K? Best verdict over :data:`W_GRID`, and the
-    fate of the delay-free trajectory from it (:class:`SwitchVerdict`)."""
+    basin of law (61) with gain K? Best verdict over :data:`W_GRID` (w: the
+    deciding weight), and the fate of the delay-free trajectory from it
+    ("diverges": lambda reaches 0.9, the wheel spins; "undecided": neither
+    that nor a certified level set within 10 s)
+    (:func:`workbench.features.basin_points.point_in_basin`)."""
     vals = tuple(sorted((k, float(v)) for k, v in values.items()))
-    lam_d = _loop_symbolic(vals, v_d)[6]
+    f, _, states, _, lam_d, _ = _loop(vals, v_d, tuple(K))
     x = (float(point[0]) - v_d, float(point[1]) - lam_d)
-    sets = []
-
-    def judge(w):
-        sets.append(_Deferred(vals, v_d, K, x, w, seed))
-        return sets[-1].outcome(x)
-    try:
-        best = best_verdict(W_GRID, judge)
-    except ModelError:
-        return SwitchVerdict(Outcome.REFUTED, None, False, _fate(vals, v_d, K, x, lam_d, [], t_sim))
-    return SwitchVerdict(best[0], best[1], True, _fate(vals, v_d, K, x, lam_d, sets, t_sim))
-
-
-def _fate(vals, v_d, K, x0, lam_d, sets, T) -> str:
-    """Fate of the delay-free trajectory from x0 (see :class:`SwitchVerdict`);
-    ``sets``: the :class:`_Deferred` estimates of the weight grid."""
-    f, _, states, *_ = _loop(vals, v_d, tuple(K))
-    sol = _delay_free(lambdify(states, f, "math"), x0, lam_d, T)
-    if any(stage.enters(sol.y.T) for stage in sets):
-        return "converges"
-    return "diverges" if escaped(sol) else "undecided"
+    return point_in_basin(W_GRID, lambda w, xs: _cruise_problem(vals, v_d, K, xs, w), x,
+                          lambdify(states, f, "math"), t_sim, events=[_spin(lam_d)],
+                          max_step=0.05, seed=seed)
 
 
 def cruise_lambda_d(values: tuple, v_d: float) -> float:
     """lambda_d of the cruise loop (``values`` as sorted (name, value) pairs)."""
-    return _loop_symbolic(values, v_d)[6]
+    return _loop_symbolic(values, v_d)[5]

@@ -19,11 +19,12 @@ one-state verdict, :func:`workbench.features.basin_scalar.scalar_verdict`:
 REFUTED when no equilibrium lies between the switch state and the end it
 moves to (the sign of g proven), the level-set certificate of the nearest
 stable equilibrium otherwise. Only the frozen loop (law (69) on the adhesion
-plant), the limit and the time-varying check below are paper 003's.
+plant), the limit and the time-varying loop below are paper 003's.
 
 The verdict is checked against the **time-varying** delay-free loop
 (v and lambda both integrated, v_s*(t) and d v_s*/dt of eq 76 as printed)
-from the switch state: its fate.
+from the switch state: its fate (the general
+:func:`workbench.features.basin_trajectory.time_varying_fate`).
 
 References
 ----------
@@ -39,7 +40,8 @@ from functools import lru_cache
 import sympy as sp
 
 from ...features.basin_scalar import scalar_verdict
-from ...features.basin_trajectory import escaped, integrate
+from ...features.basin_trajectory import limit_event
+from ...features.basin_trajectory import time_varying_fate as fate_from
 from ...outcome import Outcome
 from ...plants.adhesion import adhesion_model
 from ...plants.lambdify_cache import lambdify
@@ -173,13 +175,8 @@ def time_varying_fate(values: dict, x0, profile, k_de: float) -> tuple[str, floa
             return [Y1(v, la), Y2(v, la) + Y3(v, la) * u]
         return [Z1(v, la), Z2(v, la) + Z3(v, la) * u]
 
-    def spin(t, x):
-        return LAM_LIMIT - abs(x[1])
-    spin.terminal = True
-    t0 = profile.t_brake
-    sol = integrate(rhs, x0, T_FATE, events=[spin], rtol=FATE_RTOL, max_step=0.05, t0=t0)
-    if escaped(sol):
-        return "diverges", float(sol.t[-1] - t0)
-    v, la = sol.y[:, -1]
-    _, vs = law(sol.t[-1], v, la)
-    return ("tracks" if la < 0 and abs(v * la - vs) < TRACK_TOL else "undecided"), None
+    def tracks(t, x):
+        v, la = x
+        return la < 0 and abs(v * la - law(t, v, la)[1]) < TRACK_TOL
+    return fate_from(rhs, x0, profile.t_brake, T_FATE, tracks,
+                     events=[limit_event(1, LAM_LIMIT)], rtol=FATE_RTOL, max_step=0.05)

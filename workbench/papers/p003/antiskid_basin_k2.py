@@ -7,14 +7,14 @@ decides whether the switch state is CERTIFIED (inside {V <= c_certified}
 for some P = modal_P(A + B K, [1, w]) of the grid) or not, and simulates
 the delay-free trajectory from it; the edge between the largest certified
 grid value and the next one is then bisected
-(:func:`workbench.features.basin_sweep.gain_edge`). Gains given for comparison
+(:func:`workbench.features.basin_points.sweep_gain_entry`). Gains given for comparison
 (e.g. the rows of 003's Table 3) are judged the same way, with their own k1.
 
 The rule is *sufficient*: a state outside every certified level set may
 still converge (the "fate" column says what the delay-free trajectory does).
 
 Only the gain parameterisation (k2 of law (61), k1 kept, Table 3's rows) is
-paper 003's; the sweep is :func:`workbench.features.basin_sweep.gain_edge`.
+paper 003's; the sweep is :func:`workbench.features.basin_points.sweep_gain_entry`.
 
 References
 ----------
@@ -24,72 +24,23 @@ References
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import lru_cache
 
-from ...features.basin_sweep import gain_edge
+from ...features.basin_points import GainSweep, sweep_gain_entry
 from ...memo import shared
-from ...outcome import Outcome
-from .antiskid_basin import SwitchVerdict, switch_in_basin
+from .antiskid_basin import switch_in_basin
 
-
-@dataclass(frozen=True)
-class K2Row:
-    """One gain judged at the switch state."""
-
-    k1: float
-    k2: float
-    verdict: SwitchVerdict
-    source: str            # "grid", "edge" (bisection) or the comparison label
-
-
-@dataclass(frozen=True)
-class K2Sweep:
-    """Result of :func:`safe_k2_range` (no rendering).
-
-    Attributes
-    ----------
-    point : (v, lambda)
-        Switch state judged (absolute).
-    k1 : float
-        k1 kept along the sweep.
-    rows : tuple of K2Row
-        Grid and bisection rows, by k2.
-    compared : tuple of K2Row
-        The comparison gains.
-    edge : (float, float) or None
-        (largest certified k2, smallest k2 above it found not certified);
-        None when no grid value, or every grid value, is certified.
-    k2_min : float
-        Smallest k2 of the grid (the certified range is reported from there).
-    certified_below_edge : bool
-        Every grid value from k2_min to the edge's lower end is certified.
-    """
-
-    point: tuple
-    k1: float
-    rows: tuple
-    compared: tuple
-    edge: tuple | None
-    k2_min: float
-    certified_below_edge: bool
-
-
-def _ok(row: K2Row) -> bool:
-    return row.verdict.outcome is Outcome.CERTIFIED
+#: Result of :func:`safe_k2_range`: a :class:`~workbench.features.basin_points.GainSweep`
+#: of k2 (entry 1) with k1 = ``gain[0]`` kept; ``grid_min`` the smallest k2 of the grid.
+K2Sweep = GainSweep
 
 
 @lru_cache(maxsize=8)
 def _sweep(values: tuple, v_d: float, k1: float, point: tuple, grid: tuple, compare: tuple,
            bisect: int, seed: int) -> K2Sweep:
     vals = dict(values)
-    judge = lambda k1_, k2_, src: K2Row(k1_, k2_, switch_in_basin(vals, v_d, (k1_, k2_), point,
-                                                                   seed=seed), src)
-    sw = gain_edge(lambda k2, src: judge(k1, k2, src), grid, ok=_ok, gain=lambda r: r.k2,
-                   bisect=bisect)
-    compared = tuple(judge(float(g[0]), float(g[1]), label) for label, g in compare)
-    return K2Sweep(tuple(point), k1, sw.rows, compared, sw.edge, min(grid),
-                   sw.certified_below_edge)
+    judge = lambda K: switch_in_basin(vals, v_d, K, point, seed=seed)
+    return sweep_gain_entry(judge, point, (k1, 0.0), 1, grid, compare=compare, bisect=bisect)
 
 
 def safe_k2_range(values: dict, v_d: float, k1: float, point, *, grid, compare=(),

@@ -4,13 +4,15 @@
 
 Paper 003's wording (laws (61), (69), eqs (75)-(76), the k2 rule) and the
 cruise figure's look stay here; the figure itself is the general
-:func:`workbench.features.basin_plot.plot_basin`."""
+:func:`workbench.features.basin_plot.plot_basin`, the switch-state and gain
+tables those of :mod:`workbench.features.basin_points_render`."""
 from __future__ import annotations
 
 import math
 
 from ...features.basin_plot import BasinPlotStyle
 from ...features.basin_plot import plot_basin as draw_basin
+from ...features.basin_points_render import gain_sweep_table, points_table
 from ...printed_grid import sig_round
 from ...report.markdown import fmt, md_table
 from ...roa.render import fmt_level, render_basin_markdown
@@ -48,14 +50,10 @@ def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—"
         "V = E' P E with P = S^-T diag(1, w) S^-1 in the modal coordinates of A + B K "
         f"(w = {fmt(basin.q)}: the grid value that certifies the switch states best).\n\n")
     body = render_basin_markdown(basin.check, heading="### Certified level set")
-    rows = []
-    for p, tr in zip(basin.check.points, basin.trajectories):
-        v, lam = p.x[0] + basin.v_d, p.x[1] + basin.lambda_d
-        rows.append([f"`{p.label}`", fmt(v, 4), fmt(lam, 4), fmt_level(p.verdict.level, "up"),
-                     p.verdict.outcome.name, tr.fate])
     sw = ("\n### Switch states (acceleration → cruise)\n\n"
-          + md_table(["case", "v (m/s)", "lambda", "V", "in the certified basin?",
-                      "delay-free trajectory"], rows, "lrrrll")
+          + points_table(basin.check, [tr.fate for tr in basin.trajectories],
+                         ["case", "v (m/s)", "lambda", "V", "in the certified basin?",
+                          "delay-free trajectory"], shift=(basin.v_d, basin.lambda_d))
           + "\n\nCERTIFIED: V at the state is below c_certified, so the delay-free loop "
             "converges from it. REFUTED: its level holds a point with V' >= 0, so this V "
             "cannot certify it; the last column says what the delay-free trajectory does "
@@ -130,16 +128,13 @@ def brake_text(brake) -> str:
 
 def _k2_text(sweep, compare_source) -> str:
     v, lam = sweep.point
-    rows = [[fmt(r.k1, 4), fmt(r.k2, 5), r.source, r.verdict.outcome.name,
-             "—" if r.verdict.w is None else fmt(r.verdict.w), r.verdict.fate]
-            for r in (*sweep.rows, *sweep.compared)]
     if sweep.edge is None:
         rule = "No edge between certified and non-certified gains was found on the grid."
     else:
         lo, hi = sweep.edge
-        rule = (f"**Certified switching rule.** With k1 = {fmt(sweep.k1, 4)}, the switch at "
+        rule = (f"**Certified switching rule.** With k1 = {fmt(sweep.gain[0], 4)}, the switch at "
                 f"(v_d, lambda_opt) lands in a certified basin for k2 <= {fmt(lo, 4)} (every "
-                f"grid value from {fmt(sweep.k2_min)} up to it is certified"
+                f"grid value from {fmt(sweep.grid_min)} up to it is certified"
                 + ("" if sweep.certified_below_edge else " — except where the table says not")
                 + f"), and not for k2 >= {fmt(hi, 4)}: the edge lies in "
                   f"[{fmt(lo, 4)}, {fmt(hi, 4)}] (bisected).")
@@ -148,8 +143,8 @@ def _k2_text(sweep, compare_source) -> str:
             f"{fmt(lam, 4)}. Each k2 is judged with every P of the weight grid (CERTIFIED if "
             "one certifies the state); the gains compared (" + compare_source + ") are judged "
             "with their own k1.\n\n"
-            + md_table(["k1", "k2", "row", "switch state in a certified basin?", "w",
-                        "delay-free trajectory"], rows, "rrllrl")
+            + gain_sweep_table(sweep, ["k1", "k2", "row", "switch state in a certified basin?",
+                                       "w", "delay-free trajectory"], digits=(4, 5))
             + "\n\n" + rule + " The rule is sufficient (a quadratic V); where the "
             "trajectory column says \"diverges\" the state is outside the true basin of the "
             "delay-free loop as well.\n")

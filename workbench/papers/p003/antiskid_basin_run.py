@@ -20,15 +20,18 @@ each case's state at t_brake against the braking law (69) frozen at that
 instant (:mod:`.antiskid_basin_brake`). The basin uses the controller's nominal
 model (a design's plant mass factor is not in it; the report says so).
 
-What stays here is paper 003's: the table's gain rows, where the switches are
-in a case's metrics and the claim names; the table opener and the level and
-point quantities are the general ones of :mod:`workbench.features.basin`.
+What stays here is paper 003's: the k2 key, where the switches are in a
+case's metrics and the claim names; the table opener and the level and point
+quantities are the general ones of :mod:`workbench.features.basin`, the sweep's
+keys (``compare_*``, ``bisect``) those of
+:func:`workbench.features.basin_points.read_gain_sweep`.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 
+from ...features.basin_points import GainSweepSettings, read_gain_sweep
 from ...features.basin import (LEVEL_QUANTITIES, basin_table, level_quantities,
                                 point_quantities, point_quantity_names)
 from .antiskid_basin import CruiseBasin, cruise_basin
@@ -37,12 +40,11 @@ from .antiskid_basin_k2 import K2Sweep, safe_k2_range
 
 @dataclass(frozen=True)
 class BasinSettings:
-    """The design's ``[basin]`` table."""
+    """The design's ``[basin]`` table: the k2 sweep's keys
+    (:class:`~workbench.features.basin_points.GainSweepSettings`, ``grid`` the
+    k2 values, ``compare`` rows (label, (k1, k2))) and the seed."""
 
-    k2_grid: tuple
-    compare: tuple            # ((label, (k1, k2)), ...)
-    compare_source: str
-    bisect: int
+    sweep: GainSweepSettings
     seed: int
 
 
@@ -64,28 +66,9 @@ def load_basin_settings(root) -> BasinSettings | None:
     if table is None:
         return None
     b, enabled, seed = table
-    grid = b.numbers("k2_grid", min_len=2, what="cruise gains k2")
-    gains = b.raw("compare_gains", default=[])
-    if not isinstance(gains, list):
-        raise b.fail("compare_gains", gains, "a list of [k1, k2] pairs")
-    rows = []
-    for i, g in enumerate(gains):
-        ok = (isinstance(g, list) and len(g) == 2 and all(
-            isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-            for x in g))
-        if not ok:
-            raise b.fail(f"compare_gains[{i}]", g, "a pair [k1, k2] of finite numbers")
-        rows.append((float(g[0]), float(g[1])))
-    labels = b.raw("compare_labels", default=[f"row {i + 1}" for i in range(len(rows))])
-    if (not isinstance(labels, list) or len(labels) != len(rows)
-            or not all(isinstance(x, str) and x.strip() for x in labels)):
-        raise b.fail("compare_labels", labels, f"{len(rows)} non-empty strings, one per gain")
-    source = b.string("compare_source", default="—")
-    bisect = b.number("bisect", integer=True, default=4, lo=0, hi=12, what="integer")
+    sweep = read_gain_sweep(b, "k2_grid", 2, what="cruise gains k2")
     b.finish()
-    if not enabled:
-        return None
-    return BasinSettings(tuple(sorted(grid)), tuple(zip(labels, rows)), source, bisect, seed)
+    return BasinSettings(sweep, seed) if enabled else None
 
 
 #: Key of a case's acceleration -> cruise switch quantities.
@@ -140,14 +123,15 @@ def run_basin(settings: BasinSettings, values: dict, v_d: float, K, lambda_opt: 
         Gain of the braking law (69) (1/s).
     """
     basin = cruise_basin(values, v_d, K, switch_points(cases), seed=settings.seed)
-    sweep = safe_k2_range(values, v_d, float(K[0]), (v_d, lambda_opt), grid=settings.k2_grid,
-                          compare=settings.compare, bisect=settings.bisect, seed=settings.seed)
+    sw = settings.sweep
+    sweep = safe_k2_range(values, v_d, float(K[0]), (v_d, lambda_opt), grid=sw.grid,
+                          compare=sw.compare, bisect=sw.bisect, seed=settings.seed)
     brake = ()
     if profile is not None and k_de is not None:
         from .antiskid_basin_brake import brake_switch
         brake = tuple(brake_switch(values, lab, pt, profile=profile, k_de=k_de,
                                    seed=settings.seed) for lab, pt in brake_points(cases, v_d))
-    return BasinResult(basin, sweep, settings.compare_source, mass_factor, brake)
+    return BasinResult(basin, sweep, settings.sweep.compare_source, mass_factor, brake)
 
 
 def basin_quantities(basin, sweep, labels=(), brake=()) -> dict:

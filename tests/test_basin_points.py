@@ -1,0 +1,148 @@
+"""The general switch-state feature (workbench.features.basin_points and its
+tables, the escape event and the time-varying fate of basin_trajectory) on toy
+loops that belong to no paper: z' = -g0 z + g1 z^3, whose basin is
+|z| < sqrt(g0 / g1), and x' = +-x."""
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from workbench.errors import DesignError, ModelError
+from workbench.features import basin_points as BP
+from workbench.features.basin_points_render import gain_sweep_table, points_table
+from workbench.features.basin_trajectory import limit_event, time_varying_fate
+from workbench.outcome import Outcome
+from workbench.reader import Reader
+from workbench.features.basin_loop import at_gain, derivatives, modal_problem
+from workbench.roa.check import largest_level_in_box
+
+Z = sp.symbols("z", real=True)
+
+
+def _loop(gain):
+    return [-sp.Float(gain[0]) * Z + sp.Float(gain[1]) * Z**3]
+
+
+G = sp.symbols("g0 g1", real=True)
+F_G = [-G[0] * Z + G[1] * Z**3]                 # the loop with its gain as symbols
+D_G = derivatives(F_G, (Z,))
+
+
+def _make(gain):
+    """candidate p -> (problem with V = (p / (2 g0)) z^2 (modal P), level of the box
+    |z| <= 3), the loop's derivatives taken once with the gain symbolic."""
+    f, derivs = at_gain(F_G, D_G, G, gain)
+
+    def make(p, xs):
+        return modal_problem(f, (Z,), (0.0,), [[-gain[0]]], [p], derivs=derivs, names=("z",),
+                             points=xs, domain=((-3.0,), (3.0,)), c_search=math.inf)
+    return make
+
+
+def test_gain_loop_and_its_modal_problem():
+    f, (J, H) = at_gain(F_G, D_G, G, (2.0, 0.5))
+    direct = derivatives(_loop((2.0, 0.5)), (Z,))
+    assert sp.simplify(f[0] - _loop((2.0, 0.5))[0]) == 0
+    assert sp.simplify(J[0][0] - direct[0][0][0]) == 0 and sp.simplify(H[0][0][0] - 3.0 * Z) == 0
+    prob, c = _make((2.0, 0.5))(1.0, [(0.5,)])
+    assert prob.P_source == "optimised" and prob.P[0][0] > 0
+    assert c == largest_level_in_box(prob.P, np.zeros(1), (-3.0,), (3.0,))
+
+
+def _unstable(p, xs):
+    raise ModelError("no Hurwitz linearisation")
+
+
+def _judge(gain, x=(0.5,)):
+    fn = sp.lambdify((Z,), _loop(gain), "math")
+    return BP.point_in_basin((1.0, 2.0), _make(gain), x, fn, 20.0,
+                             events=[limit_event(0, 3.0)])
+
+
+def test_point_in_basin_and_fate():
+    inside, outside = _judge((1.0, 1.0)), _judge((1.0, 1.0), (1.5,))
+    assert (inside.outcome, inside.w, inside.hurwitz, inside.fate) == (
+        Outcome.CERTIFIED, 1.0, True, "converges")
+    assert (outside.outcome, outside.fate) == (Outcome.REFUTED, "diverges")
+    # z' = +z + z^3 has no Hurwitz linearisation: no candidate gives a problem
+    fn = sp.lambdify((Z,), [Z + Z**3], "math")
+    v = BP.point_in_basin((1.0,), _unstable, (0.5,), fn, 5.0, events=[limit_event(0, 3.0)])
+    assert (v.outcome, v.w, v.hurwitz, v.fate) == (Outcome.REFUTED, None, False, "diverges")
+
+
+def test_check_points_and_their_table():
+    pts = [("in", (0.5,)), ("out", (1.5,))]
+    q, prob, chk = BP.check_points((1.0, 2.0), _make((1.0, 1.0)), pts, loop="toy", seed=0)
+    assert q in (1.0, 2.0) and prob.P[0][0] == q and chk.loop == "toy"
+    assert [p.verdict.outcome for p in chk.points] == [Outcome.CERTIFIED, Outcome.REFUTED]
+    text = points_table(chk, ["converges", "diverges", "extra"], ["state", "z + 10", "V",
+                                                                   "verdict", "fate"],
+                        shift=(10.0,))
+    lines = text.splitlines()
+    assert lines[1] == "| :--- | ---: | ---: | :--- | :--- |" and len(lines) == 4
+    assert lines[2].startswith("| `in` | 10.5 | ") and lines[2].endswith("| CERTIFIED | converges |")
+    assert lines[3].startswith("| `out` | 11.5 | ") and "REFUTED | diverges" in lines[3]
+    assert BP.check_points((1.0, 2.0), _unstable, pts, loop="toy") is None
+
+
+def test_sampled_starts_box():
+    st = BP.sampled_starts([(1.0, -0.5), (-2.0, 0.1)], 50, seed=3, scale=(2, 1.5),
+                           pad=(1.0, 0.02), default=(2, 0.1))
+    assert st[:2] == [(1.0, -0.5), (-2.0, 0.1)] and len(st) == 52
+    arr = np.array(st[2:])
+    assert np.all(np.abs(arr[:, 0]) <= 5.0) and np.all(np.abs(arr[:, 1]) <= 0.77)
+    assert st == BP.sampled_starts([(1.0, -0.5), (-2.0, 0.1)], 50, seed=3, scale=(2, 1.5),
+                                   pad=(1.0, 0.02), default=(2, 0.1))
+    none = np.array(BP.sampled_starts([], 20, seed=0, scale=(1,), pad=(0,), default=(0.5,)))
+    assert none.shape == (20, 1) and np.all(np.abs(none) <= 0.5)
+
+
+def test_gain_entry_sweep_brackets_the_true_edge_and_its_table():
+    """z = 0.5 is in the basin iff g1 < 4 g0: with g0 = 1 the edge is g1 = 4."""
+    sw = BP.sweep_gain_entry(_judge, (0.5,), (1.0, 99.0), 1, [8.0, 0.5, 2.0], bisect=3,
+                             compare=[("half", (0.5, 1.0)), ("double", (2.0, 1.0))])
+    lo, hi = sw.edge
+    assert 2.0 <= lo < 4.0 < hi and hi - lo == pytest.approx(6.0 / 8)
+    assert sw.certified_below_edge and sw.grid_min == 0.5 and sw.gain == (1.0, 99.0)
+    assert [r.gain[1] for r in sw.rows] == sorted(r.gain[1] for r in sw.rows)
+    assert all(r.gain[0] == 1.0 for r in sw.rows) and sum(r.source == "edge" for r in sw.rows) == 3
+    # g1 / g0 = 2 (certified), 0.5 (certified): the comparison rows keep their own g0
+    assert [(r.source, r.verdict.outcome) for r in sw.compared] == [
+        ("half", Outcome.CERTIFIED), ("double", Outcome.CERTIFIED)]
+    text = gain_sweep_table(sw, ["g0", "g1", "row", "verdict", "p", "fate"], digits=(3, 5))
+    lines = text.splitlines()
+    assert lines[1] == "| ---: | ---: | :--- | :--- | ---: | :--- |"
+    assert len(lines) == 2 + len(sw.rows) + 2
+    assert "| 1 | 8 | grid | REFUTED |" in text and lines[-1].startswith("| 2 | 1 | double |")
+
+
+def test_read_gain_sweep_of_a_toy_table():
+    b = Reader("toy.toml", {"g_grid": [3.0, 1.0], "compare_gains": [[1.0, 2.0, 3]],
+                            "bisect": 2}, "basin")
+    s = BP.read_gain_sweep(b, "g_grid", 3)
+    b.finish()
+    assert s == BP.GainSweepSettings((1.0, 3.0), (("row 1", (1.0, 2.0, 3.0)),), "—", 2)
+    bad = Reader("toy.toml", {"g_grid": [1.0, 2.0], "compare_gains": [[1.0, math.inf, 3.0]]},
+                 "basin")
+    with pytest.raises(DesignError, match=r"basin\.compare_gains\[0\]"):
+        BP.read_gain_sweep(bad, "g_grid", 3)
+    labels = Reader("toy.toml", {"g_grid": [1.0, 2.0], "compare_gains": [[1.0]],
+                                 "compare_labels": ["a", "b"]}, "basin")
+    with pytest.raises(DesignError, match=r"basin\.compare_labels"):
+        BP.read_gain_sweep(labels, "g_grid", 1)
+
+
+def test_time_varying_fate_of_toy_loops():
+    ev = [limit_event(0, 3.0)]
+    assert time_varying_fate(lambda t, x: [-x], (1.0,), 2.0, 10.0,
+                             lambda t, x: abs(x[0]) < 1e-3, events=ev) == ("tracks", None)
+    fate, t = time_varying_fate(lambda t, x: [x], (1.0,), 2.0, 10.0,
+                                lambda t, x: True, events=ev)
+    assert fate == "diverges" and t == pytest.approx(math.log(3.0), rel=1e-3)
+    # a shifted limit: |x + 1| reaches 3 at x = 2
+    _, t2 = time_varying_fate(lambda t, x: [x], (1.0,), 0.0, 10.0, lambda t, x: True,
+                              events=[limit_event(0, 3.0, 1.0)])
+    assert t2 == pytest.approx(math.log(2.0), rel=1e-3)
+    assert time_varying_fate(lambda t, x: [math.sin(t)], (0.0,), 0.0, 1.0,
+                             lambda t, x: False, events=ev) == ("undecided", None)

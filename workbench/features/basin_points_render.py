@@ -1,0 +1,34 @@
+"""Markdown tables of judged states and of a gain sweep (pure rendering of
+:class:`~workbench.roa.check.BasinCheck` points and of
+:class:`~workbench.features.basin_points.GainSweep`); the headings and the
+words around them are the caller's."""
+from __future__ import annotations
+
+from ..report.markdown import fmt, md_table
+from ..roa.render import fmt_level
+
+
+def points_table(check, fates, header, *, shift=None, digits: int = 4) -> str:
+    """One row per judged state: its label, coordinates (plus ``shift``, e.g.
+    back to absolute ones; ``digits`` significant digits), level V (rounded
+    up), verdict and the fate of its trajectory (``fates``, one per state).
+    ``header``: the column titles (label, one per coordinate, V, verdict, fate)."""
+    rows = []
+    for p, fate in zip(check.points, fates):
+        xs = p.x if shift is None else [x + s for x, s in zip(p.x, shift)]
+        rows.append([f"`{p.label}`", *(fmt(x, digits) for x in xs),
+                     fmt_level(p.verdict.level, "up"), p.verdict.outcome.name, fate])
+    n = len(header) - 4
+    return md_table(header, rows, "l" + "r" * (n + 1) + "ll")
+
+
+def gain_sweep_table(sweep, header, *, digits=None) -> str:
+    """One row per gain of a :class:`~workbench.features.basin_points.GainSweep`
+    (grid and bisection rows, then the gains compared): its entries (``digits``
+    significant digits per entry, default 4), source, verdict, deciding
+    candidate and fate. ``header``: the column titles."""
+    n = len(sweep.gain)
+    digits = digits or (4,) * n
+    rows = [[*(fmt(g, d) for g, d in zip(r.gain, digits)), r.source, r.verdict.outcome.name,
+             fmt(r.verdict.w), r.verdict.fate] for r in (*sweep.rows, *sweep.compared)]
+    return md_table(header, rows, "r" * n + "llrl")
