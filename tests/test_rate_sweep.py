@@ -198,6 +198,15 @@ def test_the_words_of_a_toy_sweep():
     (table,) = RR.rate_tables((v,), label, ["f_c (Hz)", "x_end", "ok"],
                               lambda f, m: [f, f"{m['x_end']:.3g}", m["ok"]])
     assert table.count("(bisection)") == len(v.probes) and "| 100 |" in table
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+    ax = Figure().add_subplot(111)
+    traces = [SimpleNamespace(variant="p", rate=f, t=np.arange(3.0), x=np.ones(3) * f)
+              for f in (20.0, 50.0)]
+    RR.plot_traces(ax, traces, "x", lambda tr: "k", lambda tr: f"{tr.rate:g} Hz", {20.0: "-"})
+    assert [ln.get_label() for ln in ax.lines] == ["20 Hz", "50 Hz"]
+    assert [ln.get_linestyle() for ln in ax.lines] == ["-", ":"]
 
 
 def test_replay_windows_of_two_toy_runs():

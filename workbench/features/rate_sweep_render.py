@@ -14,7 +14,7 @@ from ..report.markdown import fmt, md_table
 from ..sim.convergence import P_MAX, P_MIN
 
 __all__ = ["bound", "variant_label", "variant_sources", "summary_lines", "rate_tables",
-           "mesh_table", "mesh_text", "three_level_text", "plot_rate_metric"]
+           "mesh_table", "mesh_text", "three_level_text", "plot_rate_metric", "plot_traces"]
 
 
 def variant_label(v, input_name: str, unit: str) -> str:
@@ -177,3 +177,13 @@ def plot_rate_metric(ax, variants, key: str, failed: str, color, label, *,
     if reference is not None and not math.isnan(reference):
         ax.axhline(reference - shift, color="k", ls="--", lw=0.8, label=reference_label)
     ax.set_xscale("log")
+
+
+def plot_traces(ax, traces, y: str, color, label, styles: dict) -> None:
+    """Time traces on one axis: per trace (``.variant``, ``.rate``, ``.t``
+    and the values in attribute ``y``) a line of ``color(trace)``, labelled
+    ``label(trace)``, dashed as ``styles`` says of its rate (dotted for a
+    rate not in it)."""
+    for tr in traces:
+        ax.plot(tr.t, getattr(tr, y), color=color(tr), lw=0.8, ls=styles.get(tr.rate, ":"),
+                label=label(tr))

@@ -194,12 +194,10 @@ def plot_sampled(fig, res):
 
 def plot_traces(fig, res):
     ax = fig.add_subplot(111)
-    styles = {100.0: "-", 1000.0: "--"}
-    for tr in res.traces:
-        c = _COLORS.get(tr.variant, "tab:green")
-        label = (EMULATION if tr.variant == "emulation" else
-                 f"{variant_label(res.variant(tr.variant))}, {fmt(tr.rate)} Hz")
-        ax.plot(tr.t, tr.excess, color=c, lw=0.8, ls=styles.get(tr.rate, ":"), label=label)
+    RR.plot_traces(ax, res.traces, "excess", lambda tr: _COLORS.get(tr.variant, "tab:green"),
+                   lambda tr: EMULATION if tr.variant == "emulation" else
+                   f"{variant_label(res.variant(tr.variant))}, {fmt(tr.rate)} Hz",
+                   {100.0: "-", 1000.0: "--"})
     ax.axhline(res.spec.creep_margin, color="dimgrey", ls=":", lw=1.0)
     ax.axhline(0.0, color="grey", lw=0.8)
     ax.set_ylim(-3 * res.spec.creep_margin, 2 * res.spec.creep_margin)
