@@ -166,3 +166,85 @@ def test_quantities_of_a_toy_variant():
     assert q["toy.p.gap_to_reference.x_end"] == v.row(100.0).metrics["x_end"]
     assert q["toy.p.rate[20].x_end_minus_reference"] == q["toy.p.rate[20].x_end"]
     assert RS.quantity_value(math.nan) is None and RS.quantity_value("no") == "no"
+
+
+def test_the_words_of_a_toy_sweep():
+    """The general rendering of a sweep (:mod:`workbench.features.rate_sweep_render`)
+    on the toy loop: its input is a voltage in V."""
+    from types import SimpleNamespace
+
+    from workbench.features import rate_sweep_render as RR
+    from workbench.reader import Quantity
+    runs, _ = _counted()
+    v = RS.sweep_variant(runs, DECL, RATES, 1e-4, "p", 0.0, 0.0, bisect=4)
+    zoh = SimpleNamespace(name="zoh", q=0.0, tau=0.0)
+    qt = SimpleNamespace(name="zoh_q_tau", q=0.5, tau=0.002)
+    assert RR.variant_label(zoh, "voltage", "V") == "ZOH (exact samples, unquantised voltage)"
+    assert RR.variant_label(qt, "voltage", "V") == (
+        "ZOH, voltage quantised to 0.5 V, measurement delay 2 ms")
+    src = RR.variant_sources(Quantity(0.5, "V", "an 8-bit DAC"), None, "V")
+    assert src == " Quantisation: 0.5 V (an 8-bit DAC)."
+    label = lambda w: "proportional"                     # noqa: E731
+    why = lambda w, row: "decay" if row.metrics["decays"] == "no" else "bound"  # noqa: E731
+    (line,) = RR.summary_lines((v,), label, why, requirement="the decay", short="it")
+    lo, hi = v.bracket
+    assert line.startswith("- **proportional**: lowest rate of the grid meeting the decay "
+                           "(and every higher grid rate) **20 Hz**")
+    assert f"fails at {lo:g} Hz, meets at {hi:g} Hz; at {lo:g} Hz it fails in decay." in line
+    text = RR.mesh_text((v,), label, DECL.mesh_atol, max_rate=50.0, step=1e-4)
+    assert "every grid rate up to 50 Hz again with sub-steps of at most 0.05 ms" in text
+    assert "(tolerances: x_end 0.01; the outcomes must agree)" in text
+    assert text.count("| proportional |") == 4 and "**no**" in text     # 5 and 10 Hz
+    (table,) = RR.rate_tables((v,), label, ["f_c (Hz)", "x_end", "ok"],
+                              lambda f, m: [f, f"{m['x_end']:.3g}", m["ok"]])
+    assert table.count("(bisection)") == len(v.probes) and "| 100 |" in table
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+    ax = Figure().add_subplot(111)
+    traces = [SimpleNamespace(variant="p", rate=f, t=np.arange(3.0), x=np.ones(3) * f)
+              for f in (20.0, 50.0)]
+    RR.plot_traces(ax, traces, "x", lambda tr: "k", lambda tr: f"{tr.rate:g} Hz", {20.0: "-"})
+    assert [ln.get_label() for ln in ax.lines] == ["20 Hz", "50 Hz"]
+    assert [ln.get_linestyle() for ln in ax.lines] == ["-", ":"]
+
+
+def test_replay_windows_of_two_toy_runs():
+    """Windows of two runs of x' = -x + u replayed (:func:`replay_windows`):
+    one record per run spanning its windows, the windows in their order,
+    a window without two mesh points left out."""
+    from workbench.features.mesh_replay import replay_windows, window
+
+    def exact(x0, u0):
+        t = np.linspace(0.0, 2.0, 201)
+        u = np.where(t <= 1.0, u0, -u0)
+        x = np.empty_like(t)
+        x[0] = x0
+        for i in range(1, len(t)):
+            x[i] = u[i] + (x[i - 1] - u[i]) * math.exp(-(t[i] - t[i - 1]))
+        return np.column_stack([t, x, u])
+    made = []
+
+    def record(run, a, b):
+        made.append((run, a, b))
+        return window(exact(*run), a, b)
+    wins = [("a early", 0.1, 0.5, (2.0, 1.0)), ("b", 0.9, 1.3, (0.0, 3.0)),
+            ("a late", 0.8, 1.6, (2.0, 1.0)), ("a none", 1.601, 1.605, (2.0, 1.0))]
+    out = replay_windows(lambda v: lambda s, y: -y + v, wins, record, 1e-10, 1e-12)
+    assert made == [((2.0, 1.0), 0.1, 1.605), ((0.0, 3.0), 0.9, 1.3)]
+    assert [w.name for w in out] == ["a early", "b", "a late"]
+    assert [w.pieces for w in out] == [1, 2, 2]
+    assert all(w.d_abs[0] <= 1e-8 for w in out) and out[0].rec[0, 0] >= 0.1
+
+
+def test_a_sweep_table_is_read_and_checked():
+    from workbench.errors import DesignError
+    from workbench.reader import Reader
+    t = Reader("toy.toml", {"rates_hz": [5.0, 10.0], "quantisation": {
+        "value": 0.5, "unit": "V", "source": "DAC"}}, "sampled")
+    assert RS.read_rates(t) == (5.0, 10.0)
+    q, tau = RS.read_inputs(t, "V")
+    assert q.value == 0.5 and tau is None
+    assert RS.variants(q.value, 0.0)[1] == ("zoh_q_tau", 0.5, 0.0)
+    with pytest.raises(DesignError, match="sampled.rates_hz"):
+        RS.read_rates(Reader("toy.toml", {"rates_hz": [10.0, 5.0]}, "sampled"))

@@ -7,16 +7,71 @@ every mesh point (issue 20, made general in issue 35).
 
 A record is an array with rows (t, x_1, ..., x_n, u): the state at the end
 of a sub-step and the input held over the sub-step ending at t; its first
-row is the initial state. Test on a system of no paper:
-``tests/test_rate_sweep.py``.
+row is the initial state. :func:`replay_windows` cuts windows out of the
+records of one or more runs (one record per run, spanning its windows) and
+replays each. Test on a system of no paper: ``tests/test_rate_sweep.py``.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
-__all__ = ["replay"]
+__all__ = ["replay", "window", "WindowReplay", "replay_windows"]
+
+
+@dataclass(frozen=True)
+class WindowReplay:
+    """One window replayed: its name, its rows of the record and
+    :func:`replay`'s per-state differences and pieces."""
+
+    name: str
+    rec: np.ndarray
+    d_abs: tuple
+    d_rel: tuple
+    pieces: int
+
+
+def window(rec: np.ndarray, t0: float, t1: float) -> np.ndarray:
+    """The rows of a mesh record with t0 <= t <= t1: what a run recording
+    only that window records (when the mesh does not depend on where the
+    record ends)."""
+    return rec[(rec[:, 0] >= t0) & (rec[:, 0] <= t1)]
+
+
+def replay_windows(rhs: Callable, windows, record: Callable, rtol: float, atol) -> tuple:
+    """Replay windows of runs against Radau.
+
+    Parameters
+    ----------
+    rhs : callable
+        As for :func:`replay`.
+    windows : iterable
+        ((name, t0, t1, run), ...): a window of run ``run`` (any key).
+    record : callable
+        ``record(run, a, b)`` -> a mesh record of ``run`` holding every row
+        with a <= t <= b (one call per run, [a, b] spanning its windows).
+    rtol, atol
+        As for :func:`replay`.
+
+    Returns
+    -------
+    tuple of WindowReplay
+        In the order of ``windows``; a window with fewer than two rows is
+        left out.
+    """
+    windows = list(windows)
+    recs = {}
+    for run in dict.fromkeys(w[3] for w in windows):
+        mine = [(a, b) for _, a, b, r in windows if r == run]
+        recs[run] = record(run, min(a for a, _ in mine), max(b for _, b in mine))
+    out = []
+    for name, a, b, run in windows:
+        rec = window(recs[run], a, b)
+        if len(rec) >= 2:
+            out.append(WindowReplay(name, rec, *replay(rhs, rec, rtol, atol)))
+    return tuple(out)
 
 
 def replay(rhs: Callable, rec: np.ndarray, rtol: float, atol) -> tuple:

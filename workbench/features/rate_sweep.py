@@ -45,7 +45,7 @@ from ..sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
 
 __all__ = ["RateMetrics", "Runs", "RateRow", "Variant", "ThreeLevel", "three_level_check",
            "rate_row", "partial_row", "sweep_variant", "claimed_rate_metrics", "variants",
-           "quantity_names", "quantities", "quantity_value"]
+           "read_rates", "read_inputs", "quantity_names", "quantities", "quantity_value"]
 
 
 def variants(q: float, tau: float) -> tuple:
@@ -53,6 +53,25 @@ def variants(q: float, tau: float) -> tuple:
     and ``zoh_q_tau`` (commands quantised to ``q``, measurements ``tau``
     old) when either is not 0."""
     return (("zoh", 0.0, 0.0),) + ((("zoh_q_tau", q, tau),) if q or tau else ())
+
+
+def read_rates(t, key: str = "rates_hz") -> tuple:
+    """The grid of rates (Hz) of a design table ``t`` (a
+    :class:`workbench.reader.Reader`): positive, increasing, within [1, 1e5]."""
+    rates = t.numbers(key, positive=True, what="rates (Hz)")
+    if any(not b > a for a, b in zip(rates, rates[1:])) or not 1.0 <= rates[0] or \
+            not rates[-1] <= 1e5:
+        raise t.fail(key, list(rates), "rates in Hz, increasing, within [1, 100000]")
+    return rates
+
+
+def read_inputs(t, unit: str) -> tuple:
+    """(quantisation, measurement_delay) of a design table ``t``: optional
+    quantities, the command's step in ``unit`` (positive) and the
+    measurements' age in s (within [0, 0.5]); None when absent. Their values
+    give the variants (:func:`variants`)."""
+    return (t.quantity("quantisation", unit, positive=True, default=None),
+            t.quantity("measurement_delay", "s", nonneg=True, hi=0.5, default=None))
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,8 @@
 """Tables, text and figure panels of a rate sweep
 (:mod:`workbench.features.rate_sweep`; pure rendering). The caller gives the
-words of its system: a variant's label, the cells of a rate's row, the
-metrics drawn."""
+words of its system: what its input is (:func:`variant_label`), the cells of
+a rate's row, the metrics drawn, why a rate fails. Test on a system of no
+paper: ``tests/test_rate_sweep.py``."""
 from __future__ import annotations
 
 import math
@@ -12,7 +13,58 @@ from ..printed_grid import printed_digits
 from ..report.markdown import fmt, md_table
 from ..sim.convergence import P_MAX, P_MIN
 
-__all__ = ["bound", "rate_tables", "mesh_table", "three_level_text", "plot_rate_metric"]
+__all__ = ["bound", "variant_label", "variant_sources", "summary_lines", "rate_tables",
+           "mesh_table", "mesh_text", "three_level_text", "plot_rate_metric", "plot_traces"]
+
+
+def variant_label(v, input_name: str, unit: str) -> str:
+    """What a variant of :func:`workbench.features.rate_sweep.variants` is,
+    in words (``input_name``: the quantised command, ``unit``: its unit)."""
+    if v.name == "zoh":
+        return f"ZOH (exact samples, unquantised {input_name})"
+    parts = [f"{input_name} quantised to {fmt(v.q)} {unit}" if v.q else "",
+             f"measurement delay {fmt(1e3 * v.tau)} ms" if v.tau else ""]
+    return "ZOH, " + ", ".join(p for p in parts if p)
+
+
+def variant_sources(quantisation, measurement_delay, unit: str) -> str:
+    """`` Quantisation: <q> <unit> (<source>). Measurement delay: <ms> ms
+    (<source>).`` for the given :class:`workbench.reader.Quantity` (None:
+    not given)."""
+    out = ""
+    if quantisation is not None:
+        out += f" Quantisation: {fmt(quantisation.value)} {unit} ({quantisation.source})."
+    if measurement_delay is not None:
+        out += (f" Measurement delay: {fmt(1e3 * measurement_delay.value)} ms "
+                f"({measurement_delay.source}).")
+    return out
+
+
+def summary_lines(variants, label, why=None, *, requirement: str = "both requirements",
+                  short: str = "both") -> list[str]:
+    """One line per variant: the lowest passing rate and its bisection
+    bracket; ``why(v, row)``: which requirement the row of the highest
+    failing rate misses (appended after "; at <f> Hz it fails in"), None for
+    nothing; ``requirement``/``short``: what a passing rate meets, in words."""
+    out = []
+    for v in variants:
+        if v.min_rate is None:
+            out.append(f"- **{label(v)}**: no rate of the grid meets {requirement} "
+                       f"from {fmt(v.bracket[0])} Hz up.")
+            continue
+        lo, hi = v.bracket
+        if lo is None:
+            refine = (f"every rate of the grid meets {short}; the grid does not go below "
+                      f"{fmt(v.min_rate)} Hz")
+        else:
+            row = next(r for r in v.rows + v.probes if r.rate == lo)
+            miss = "" if why is None else f"; at {fmt(lo)} Hz it fails in " + why(v, row)
+            refine = (f"bisection between the grid rates ({len(v.probes)} steps on log f_c, "
+                      f"whole Hz, assuming one crossing): fails at {fmt(lo)} Hz, meets at "
+                      f"{fmt(hi)} Hz" + miss)
+        out.append(f"- **{label(v)}**: lowest rate of the grid meeting {requirement} "
+                   f"(and every higher grid rate) **{fmt(v.min_rate)} Hz**; " + refine + ".")
+    return out
 
 
 def bound(x: float) -> str:
@@ -57,6 +109,16 @@ def mesh_table(variants, label, atol: dict) -> str:
             for v in variants for rate, agree, d in v.mesh]
     return md_table(["variant", "f_c (Hz)", "agree"] + list(atol), rows,
                     "lrl" + "r" * len(atol))
+
+
+def mesh_text(variants, label, atol: dict, *, max_rate: float, step: float) -> str:
+    """*Mesh, two levels*: the words and the table (:func:`mesh_table`) of
+    the mesh check of grid rates up to ``max_rate`` at ``step`` / 2 (s)."""
+    tol = ", ".join(f"{k} {fmt(t)}" for k, t in atol.items())
+    return (f"*Mesh, two levels*: every grid rate up to {fmt(max_rate)} Hz again with "
+            f"sub-steps of at most {fmt(1e3 * step / 2)} ms; largest differences of the "
+            f"metrics (tolerances: {tol}; the outcomes must agree):\n\n"
+            + mesh_table(variants, label, atol))
 
 
 def three_level_text(variants, label, *, max_rate: float, step: float, scenarios: str,
@@ -115,3 +177,13 @@ def plot_rate_metric(ax, variants, key: str, failed: str, color, label, *,
     if reference is not None and not math.isnan(reference):
         ax.axhline(reference - shift, color="k", ls="--", lw=0.8, label=reference_label)
     ax.set_xscale("log")
+
+
+def plot_traces(ax, traces, y: str, color, label, styles: dict) -> None:
+    """Time traces on one axis: per trace (``.variant``, ``.rate``, ``.t``
+    and the values in attribute ``y``) a line of ``color(trace)``, labelled
+    ``label(trace)``, dashed as ``styles`` says of its rate (dotted for a
+    rate not in it)."""
+    for tr in traces:
+        ax.plot(tr.t, getattr(tr, y), color=color(tr), lw=0.8, ls=styles.get(tr.rate, ":"),
+                label=label(tr))

@@ -18,6 +18,11 @@ implementations:
 Scope: the linearisation at the cruise point only. The simulated lowest rate
 also covers traction from rest and the entry into braking (law 69), which the
 linearisation does not see; the two rates answer different questions.
+
+Why it stays in papers/: the general certificate is
+:func:`workbench.digital.implementation` (any A, B, K, delays); what is here
+is paper 003's choice of loop (its cruise linearisation, a printed row of
+Table 3 and its h_m).
 """
 from __future__ import annotations
 

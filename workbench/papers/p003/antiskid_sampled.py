@@ -36,7 +36,8 @@ The *emulation* row is the case's controller as the other sections run it
 stepped with the control step), in the same two scenarios.
 
 The sweep itself is general (:mod:`workbench.features.rate_sweep`: the
-grid, the lowest passing rate and its bisection bracket, the mesh check of
+table's grid and inputs, the variants, the grid, the lowest passing rate
+and its bisection bracket, the mesh check of
 every grid rate up to :data:`MESH_CHECK_MAX_HZ` at ``plant_step`` / 2 within
 :data:`MESH_ATOL`, the three levels plant_step, /2, /4 of every rate metric a
 claim compares, every run made once). What stays here is paper 003's: the
@@ -119,17 +120,13 @@ def load_sampled(root, case_names) -> SampledSpec | None:
         return None
     t = root.table("sampled")
     case = t.string("case", choices=tuple(case_names))
-    rates = t.numbers("rates_hz", positive=True, what="rates (Hz)")
-    if any(not b > a for a, b in zip(rates, rates[1:])) or not 1.0 <= rates[0] or \
-            not rates[-1] <= 1e5:
-        raise t.fail("rates_hz", list(rates), "rates in Hz, increasing, within [1, 100000]")
+    rates = RS.read_rates(t)
     out = SampledSpec(
         case, rates, t.number("creep_margin", nonneg=True, hi=0.1),
         t.number("plant_step", positive=True, hi=1e-3, what="number (s)"),
         t.number("predictor_step", positive=True, hi=0.1, what="number (s)"),
         t.number("bisect", integer=True, default=4, lo=0, hi=12, what="integer"),
-        t.quantity("quantisation", "N m", positive=True, default=None),
-        t.quantity("measurement_delay", "s", nonneg=True, hi=0.5, default=None))
+        *RS.read_inputs(t, "N m"))
     t.finish()
     return dataclasses.replace(out, three_level=claimed_rate_metrics(
         out, root.data.get("claims", [])))

@@ -6,8 +6,9 @@ exponential-Euler sub-steps of at most ``plant_step``. Here the torque the
 wheel received in a window of a run (piecewise constant: the held,
 delayed commands) is replayed open loop into scipy's Radau and both
 trajectories are compared at every mesh point of the window (the general
-replay: :mod:`workbench.features.mesh_replay`). What stays here is paper
-003's: the windows, the tolerances and the right-hand side. The right-hand
+replay of windows of runs: :func:`workbench.features.mesh_replay.replay_windows`).
+What stays here is paper 003's: where the windows are, the tolerances, the
+kernel's recording and the right-hand side. The right-hand
 side is the lambdified sympy model of :mod:`workbench.sim.wheel_slip` (the
 traction form for lambda >= 0, the braking form otherwise; speed floored as
 the plant step floors it), not a retyped one.
@@ -26,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...features.mesh_replay import replay as mesh_replay
+from ...features.mesh_replay import replay as mesh_replay, replay_windows, window as _window
 from ...sim.wheel_slip import model_functions
 from .antiskid_sampled_kernel import run_once
 
@@ -79,12 +80,6 @@ def replay(p, rec: np.ndarray) -> tuple[float, float, int]:
     return dl, dv, pieces
 
 
-def _window(rec: np.ndarray, t0: float, t1: float) -> np.ndarray:
-    """The rows of a mesh record with t0 <= t <= t1 (the kernel's own test):
-    what a run recording only that window records."""
-    return rec[(rec[:, 0] >= t0) & (rec[:, 0] <= t1)]
-
-
 def radau_checks(ctx, spec, runs=None, traction: dict | None = None) -> tuple:
     """:class:`RadauCheck` of every window at every rate of
     :data:`RADAU_RATES_HZ` in the design's grid (``zoh``, unquantised).
@@ -109,27 +104,20 @@ def radau_checks(ctx, spec, runs=None, traction: dict | None = None) -> tuple:
         starts = (ctx.h, brake["t_omega3"] - length / 2, brake["t_stop"] - length)
         wins = [(name, t0 - half, t0 + length - half, scen)
                 for name, t0, scen in zip(WINDOWS, starts, (0, 1, 1)) if not math.isnan(t0)]
-        recs = {}
-        for scen in (0, 1):
-            mine = [(a, b) for _, a, b, s in wins if s == scen]
-            if not mine:
-                continue
-            a, b = min(a for a, _ in mine), max(b for _, b in mine)
-            have = (traction or {}).get(rate) if scen == 0 else None
+        have = (traction or {}).get(rate)
+
+        def record(scen, a, b, rate=rate, have=have, kw=kw):
             # the stretch holding b ends by b + 1 / rate: before the record's run ended
-            if have is not None and len(have) and have[0, 0] <= a and b + 2 / rate <= have[-1, 0]:
-                recs[scen] = have
-                continue
+            if scen == 0 and have is not None and len(have) and have[0, 0] <= a and \
+                    b + 2 / rate <= have[-1, 0]:
+                return have
             cap = int((b - a) / spec.plant_step * 1.5) + 4 * int((b - a) * rate) + 16
-            recs[scen] = run_once(ctx, rate, scen, record=(a, b, cap), **kw)[1][0]
-        for name, a, b, scen in wins:
-            rec = _window(recs[scen], a, b)
-            if len(rec) < 2:
-                continue
-            dl, dv, pieces = replay(ctx.plant, rec)
-            out.append(RadauCheck(rate, name, float(rec[0, 0]), float(rec[-1, 0]),
-                                  float(rec[:, 1].min()), float(rec[:, 1].max()), pieces,
-                                  len(rec), dl, dv))
+            return run_once(ctx, rate, scen, record=(a, b, cap), **kw)[1][0]
+        for w in replay_windows(lambda u: _rhs(ctx.plant, u), wins, record, RTOL, ATOL):
+            rec = w.rec
+            out.append(RadauCheck(rate, w.name, float(rec[0, 0]), float(rec[-1, 0]),
+                                  float(rec[:, 1].min()), float(rec[:, 1].max()), w.pieces,
+                                  len(rec), w.d_abs[1], w.d_rel[0]))
     return tuple(out)
 
 

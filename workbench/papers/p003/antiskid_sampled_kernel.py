@@ -31,6 +31,15 @@ constant ~ v/4000 s) to resolve; scipy's Radau, restarted from Python, costs
 about a millisecond per restart, a quarter of an hour per 5 kHz run. Radau is
 kept as the independent check of this mesh (:mod:`.antiskid_sampled_check`).
 
+Why this loop stays in papers/ (issue 35): it is paper 003's controller
+(the laws, the predictor over the commands it sent, the mismatch-free hold)
+compiled together with the adhesion plant's event mesh in one numba loop;
+nothing of it serves another system. The general sampled-data machinery
+calls it only through the sweep's ``run`` callback
+(:func:`.antiskid_sampled.runs_of`, :class:`workbench.features.rate_sweep.Runs`)
+and the replay's ``record`` callback (:mod:`.antiskid_sampled_check`,
+:func:`workbench.features.mesh_replay.replay_windows`).
+
 :func:`kernel` is the loop, :func:`run_once` runs one scenario with it;
 :data:`OUT` names its results.
 """

@@ -1,5 +1,12 @@
 """Markdown and figures of the sampled-data section of an antiskid run
-(:mod:`workbench.papers.p003.antiskid_sampled`; pure rendering)."""
+(:mod:`workbench.papers.p003.antiskid_sampled`; pure rendering).
+
+The tables, the variants' words, the summary of the lowest rates, the mesh
+checks' text and the figure panels are general
+(:mod:`workbench.features.rate_sweep_render`); what stays here is paper
+003's wording: the cells of a rate (creep ratio, stop, e_vs), why a rate
+fails (traction or braking), the section's prose, the Radau table and the
+two figures' layout."""
 from __future__ import annotations
 
 import math
@@ -24,12 +31,9 @@ EVS_BOUND = 0.01
 
 
 def variant_label(v) -> str:
-    """What a variant is, in words."""
-    if v.name == "zoh":
-        return "ZOH (exact samples, unquantised torque)"
-    parts = [f"torque quantised to {fmt(v.q)} N m" if v.q else "",
-             f"measurement delay {fmt(1e3 * v.tau)} ms" if v.tau else ""]
-    return "ZOH, " + ", ".join(p for p in parts if p)
+    """What a variant is, in words (the torque in N m:
+    :func:`workbench.features.rate_sweep_render.variant_label`)."""
+    return RR.variant_label(v, "torque", "N m")
 
 
 def _outcome(m: dict, which: str) -> str:
@@ -52,48 +56,16 @@ def _row(label: str, m: dict) -> list:
             _outcome(m, "braking")]
 
 
-def _why(v, spec) -> str:
+def _why(v, row) -> str:
     """Which requirement the highest failing rate misses (for the summary)."""
-    lo = v.bracket[0]
-    if lo is None:
-        return ""
-    row = next(r for r in v.rows + v.probes if r.rate == lo)
     miss = [w for w in ("traction", "braking") if row.metrics[f"{w}_ok"] == "no"]
-    return f"; at {fmt(lo)} Hz it fails in " + " and ".join(
-        f"{w} ({_outcome(row.metrics, w)})" for w in miss)
-
-
-def summary_lines(res) -> list[str]:
-    """One line per variant: the lowest passing rate and its bracket."""
-    out = []
-    for v in res.variants:
-        if v.min_rate is None:
-            out.append(f"- **{variant_label(v)}**: no rate of the grid meets both "
-                       f"requirements from {fmt(v.bracket[0])} Hz up.")
-            continue
-        lo, hi = v.bracket
-        if lo is None:
-            refine = (f"every rate of the grid meets both; the grid does not go below "
-                      f"{fmt(v.min_rate)} Hz")
-        else:
-            refine = (f"bisection between the grid rates ({len(v.probes)} steps on log f_c, "
-                      f"whole Hz, assuming one crossing): fails at {fmt(lo)} Hz, meets at "
-                      f"{fmt(hi)} Hz" + _why(v, res.spec))
-        out.append(f"- **{variant_label(v)}**: lowest rate of the grid meeting both "
-                   f"requirements (and every higher grid rate) **{fmt(v.min_rate)} Hz**; "
-                   + refine + ".")
-    return out
+    return " and ".join(f"{w} ({_outcome(row.metrics, w)})" for w in miss)
 
 
 def sampled_section(res, rail: str) -> str:
     """``## Sampled-data controller: rate f_c, zero-order hold``."""
     sp = res.spec
-    q, tau = sp.quantisation, sp.measurement_delay
-    hw = ""
-    if q is not None:
-        hw += f" Quantisation: {fmt(q.value)} N m ({q.source})."
-    if tau is not None:
-        hw += f" Measurement delay: {fmt(1e3 * tau.value)} ms ({tau.source})."
+    hw = RR.variant_sources(sp.quantisation, sp.measurement_delay, "N m")
     head = ["f_c (Hz)", "max λ/λ_opt", f"time λ > λ_opt (1 + {fmt(sp.creep_margin)}) (s)",
             "time to v_d (s)", "traction", "t_brake → stop (s)", "stop distance (m)",
             "min λ, braking", "max e_vs (m/s)", "max |u| / T_adh", "braking"]
@@ -130,7 +102,7 @@ def sampled_section(res, rail: str) -> str:
         f"T_adh: the peak adhesion torque mu(lambda_opt) m g r = {fmt(res.u_peak / 1e3, 3)} "
         "kN m.\n\n"
         f"**Lowest control rate meeting both requirements, {rail} rail:**\n\n"
-        + "\n".join(summary_lines(res)) + "\n\n" + "\n\n".join(tables)
+        + "\n".join(RR.summary_lines(res.variants, variant_label, _why)) + "\n\n" + "\n\n".join(tables)
         + "\n\n![sampled]({figdir}/sampled.png)\n\n" + SAMPLED_CAPTION
         + "\n\n![sampled traction]({figdir}/sampled-traction.png)\n\n"
         + TRACE_CAPTION + "\n\n" + _checks_text(res))
@@ -164,13 +136,10 @@ def _checks_text(res) -> str:
     radau = [[fmt(c.rate), c.window, f"{fmt(c.t0, 5)}–{fmt(c.t1, 5)}",
               f"{fmt(c.v_lo, 2)}–{fmt(c.v_hi, 2)}", str(c.pieces),
               bound(c.max_dlam / res.lambda_opt), bound(c.max_dv_rel)] for c in res.radau]
-    tol = ", ".join(f"{k} {fmt(t)}" for k, t in MESH_ATOL.items())
     return (
-        "**Checks of the plant's integration.** *Mesh, two levels*: every grid rate up to "
-        f"{fmt(MESH_CHECK_MAX_HZ)} Hz again with sub-steps of at most "
-        f"{fmt(1e3 * sp.plant_step / 2)} ms; largest differences of the metrics (tolerances: "
-        f"{tol}; the outcomes must agree):\n\n"
-        + RR.mesh_table(res.variants, variant_label, MESH_ATOL)
+        "**Checks of the plant's integration.** "
+        + RR.mesh_text(res.variants, variant_label, MESH_ATOL, max_rate=MESH_CHECK_MAX_HZ,
+                       step=sp.plant_step)
         + "\n\n" + three_level_text(res)
         + "\n\n*Radau*: the torque the wheel received in a window of "
         f"{WINDOW_SAMPLES} samples (ZOH variant) replayed into scipy's "
@@ -225,12 +194,10 @@ def plot_sampled(fig, res):
 
 def plot_traces(fig, res):
     ax = fig.add_subplot(111)
-    styles = {100.0: "-", 1000.0: "--"}
-    for tr in res.traces:
-        c = _COLORS.get(tr.variant, "tab:green")
-        label = (EMULATION if tr.variant == "emulation" else
-                 f"{variant_label(res.variant(tr.variant))}, {fmt(tr.rate)} Hz")
-        ax.plot(tr.t, tr.excess, color=c, lw=0.8, ls=styles.get(tr.rate, ":"), label=label)
+    RR.plot_traces(ax, res.traces, "excess", lambda tr: _COLORS.get(tr.variant, "tab:green"),
+                   lambda tr: EMULATION if tr.variant == "emulation" else
+                   f"{variant_label(res.variant(tr.variant))}, {fmt(tr.rate)} Hz",
+                   {100.0: "-", 1000.0: "--"})
     ax.axhline(res.spec.creep_margin, color="dimgrey", ls=":", lw=1.0)
     ax.axhline(0.0, color="grey", lw=0.8)
     ax.set_ylim(-3 * res.spec.creep_margin, 2 * res.spec.creep_margin)
