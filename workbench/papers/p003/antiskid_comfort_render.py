@@ -6,7 +6,7 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import PHASE_NAMES
 from ...report.markdown import Figure, fmt, md_table
-from ...refinement import P_MIN
+from ...sim.convergence import P_MIN
 from .antiskid_comfort import COMFORT_RTOL, comfort_quantities
 from .antiskid_run import RECORD_DT
 from .antiskid_run_figures import color_of

@@ -7,7 +7,7 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
 from ...printed_grid import quantised
-from ...refinement import P_MIN
+from ...sim.convergence import P_MIN
 from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
 from ...sim.wheel_slip import MAX_DLAMBDA, MAX_HALVINGS
 from .antiskid_basin_render import HEADING as BASIN_HEADING
