@@ -24,7 +24,8 @@ level of what enters a finding, and only that:
   here, compiled kernel when the sweep uses it). At dt/2 and dt/4 the
   other N - n runs are bounded, not run: the count lies in [k_n, k_n + N -
   n] whatever they do, and a level decides the claim only when its verdict
-  is the same over that whole range (:func:`mc_share_levels`; our choice:
+  is the same over that whole range
+  (:func:`workbench.features.refinement.share_claim_levels`; our choice:
   all 64 runs at dt/2 and dt/4 cost about 6 and 18 CPU s, against 1.2 and
   2.7 s for the first 16);
 * ``basin.*`` of the k2 sweep: no step (a certificate at the printed switch
