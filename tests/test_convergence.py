@@ -113,7 +113,7 @@ def test_converged_instead_names_a_quantity_of_the_design(tmp_path):
 
 
 def test_claim_tolerance_is_what_could_change_the_verdict():
-    from workbench.refinement import claim_tolerance
+    from workbench.features.refinement import claim_tolerance
     assert claim_tolerance(_finding("a", 1.0, "within", 0.2), 1.1) == 0.2
     assert claim_tolerance(_finding("b", 1.0, "<="), 0.7) == pytest.approx(0.3)
     assert claim_tolerance(_finding("c", 1.0, ">=", 0.1), 1.5) == pytest.approx(0.6)

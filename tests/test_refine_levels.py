@@ -6,7 +6,7 @@ from dataclasses import dataclass, replace
 import pytest
 
 from workbench.claims import Claim, ClaimResult, Verdict
-from workbench.refinement import Levels
+from workbench.features.refinement import Levels
 from workbench.sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
 
 #: benchmarks/stop_refinement.py on designs/antiskid-run-dry.toml (compensated
@@ -107,7 +107,7 @@ def test_refinement_section_names_each_parameter(monkeypatch):
 def test_designs_without_own_levels_keep_their_table():
     """The parameter column appears only for studies that refine their own
     parameters (the reports of p000, p002, p004 keep their bytes)."""
-    from workbench.refinement import RefinementRow, RefinementTable
+    from workbench.features.refinement import RefinementRow, RefinementTable
     from workbench.report.writer import refinement_section
     row = RefinementRow("f", "x", (1.0, 1.1, 1.15), 0.5, CONVERGED)
     text = refinement_section(RefinementTable("dt", "s", 0.01, (row,)))[0]
@@ -173,7 +173,7 @@ def test_dry_stop_duration_levels_and_the_converged_instead():
     from workbench.papers.p003.antiskid_refine import refine_levels
     from workbench.papers.p003.antiskid_run import RECORD_DT, STUDY, RunResult, linear_check
     from workbench.papers.p003.antiskid_run_spec import gain_for, nominal_cruise
-    from workbench.refinement import _own_row
+    from workbench.features.refinement import _own_row
 
     design = load_design(Path(__file__).resolve().parents[1] / "designs/antiskid-run-dry.toml")
     spec = replace(design.spec, cases=tuple(c for c in design.spec.cases

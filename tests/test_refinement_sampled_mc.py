@@ -13,8 +13,7 @@ import pytest
 from workbench.claims import Claim, ClaimResult, Verdict, check_claim
 from workbench.papers.p003 import antiskid_sampled as S
 from workbench.papers.p003.antiskid_montecarlo_render import refined_runs_text
-from workbench.papers.p003.antiskid_refine import _share, mc_share_levels
-from workbench.refinement import _own_row
+from workbench.features.refinement import _own_row, share_claim_levels, share_value
 from workbench.sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
 
 DRY = Path("designs/antiskid-run-dry.toml")
@@ -145,12 +144,13 @@ def test_mc_share_levels_bound_the_runs_not_refined(quantity, compare, value, de
     completion of the 48 unrefined runs by a count (the metric depends on the
     count only)."""
     c = _claim("mc", quantity, compare, value)
-    lv = mc_share_levels(c, "diverged", (True,) * 64, (True,) * 16, (True,) * 16, 0.005)
+    lv = share_claim_levels(c, (True,) * 64, (True,) * 16, (True,) * 16, "diverged",
+                            "montecarlo.dt", 0.005)
     assert lv.decides == decided and lv.parameter == "montecarlo.dt" and lv.step == 0.005
     assert lv.values[0] == f"64 of 64 diverged: {decided[0]}"
     assert lv.values[1] == f"16 of the first 16, so 16-64 of 64 diverged: {decided[1]}"
     for k in range(16, 65):    # every count the 48 unrefined runs allow at dt/2, dt/4
-        v = check_claim(c, _share(quantity, k, 64)).verdict
+        v = check_claim(c, share_value(quantity, k, 64)).verdict
         if decided[1] != "undecided":
             assert v is {"holds": Verdict.PASS, "fails": Verdict.FAIL}[decided[1]]
     row = _own_row(ClaimResult(c, 1.0, Verdict.PASS), lv, "dt")
@@ -165,7 +165,7 @@ def test_mc_share_levels_with_every_run_refined_use_the_counts():
     c = _claim("mc", "montecarlo.wilson.diverged.lo", ">=", 0.776)
     rng = np.random.default_rng(33)
     whole = tuple(bool(x) for x in rng.random(64) < 0.95)
-    lv = mc_share_levels(c, "diverged", whole, whole, whole, 0.005)
+    lv = share_claim_levels(c, whole, whole, whole, "diverged", "montecarlo.dt", 0.005)
     k = sum(whole)
     assert lv.values == (f"{k} of 64 diverged: {lv.decides[0]}",) * 3
     assert len(set(lv.decides)) == 1 and lv.decides[0] in ("holds", "fails")

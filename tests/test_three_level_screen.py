@@ -9,7 +9,7 @@ import pytest
 
 from workbench.papers.p003.antiskid_refine import quarter_cases, three_level_metrics
 from workbench.papers.p003.antiskid_run_spec import METRICS
-from workbench.refinement import guarded_check, screen
+from workbench.features.refinement import guarded_check, screen
 from workbench.sim.convergence import CONVERGED, INCONCLUSIVE, refinement_check
 
 #: braking time to v_stop (s) at dt, dt/2, dt/4: as designed, and moved +3 ulp.

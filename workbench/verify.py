@@ -68,7 +68,7 @@ def _refined(design, study, q, checked, result):
     reads nothing else), so the verify phase of ``workbench check`` and the
     test session reuse what the check's workers computed."""
     from .memo import computed_once, spec_key
-    from .refinement import refine_findings
+    from .features.refinement import refine_findings
     spec, claims = spec_key(design.spec), spec_key(tuple(checked))
     compute = lambda: refine_findings(design, study, q, checked, result)   # noqa: E731
     if spec is None or claims is None:

@@ -23,14 +23,18 @@ value of its runs at that numerical step); this module does the rest:
 * the dt-halving comparison of two levels: :func:`agree` (one value),
   :func:`compare_steps` (per-run metrics and outcomes at dt and dt/2) and
   its result with the runs that agree, :class:`StepComparison`;
-* :func:`share_levels`: a claim on the share of runs with an outcome, when
-  all runs ran at dt and only the first n again at dt/2 and dt/4.
+* :func:`share_levels` (of :mod:`workbench.features.refinement`, re-exported
+  here): a claim on the share of runs with an outcome, when all runs ran at
+  dt and only the first n again at dt/2 and dt/4.
 
 Used by ``switched-run``, ``delay-feedback``, ``stop-accuracy`` and paper
 003 (which keeps only which of its quantities are refined at which step).
 The numerical check and its enum stay in :mod:`workbench.sim.convergence`
-and the claim-level check (tolerance, reason) in :mod:`workbench.refinement`,
-which the committed reports name; this module is the one entry the kinds use.
+(the sim layer's pure function) and the claim-level check (tolerance,
+reason, the rows of a study's findings, the share bound) is
+:mod:`workbench.features.refinement`, which this module owns; the committed
+reports name ``workbench/sim/convergence.py`` and ``workbench/refinement.py``
+(the latter re-exports :mod:`workbench.features.refinement`).
 
 References
 ----------
@@ -42,16 +46,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..sim.convergence import Convergence, Refinement, refinement_check
+from ..sim.convergence import LEVELS, Convergence, Refinement, refinement_check
+from .refinement import not_converged_text, refinement_row, share_levels
 
 __all__ = ["LEVELS", "ClaimTarget", "Convergence", "StepComparison", "agree", "by_metric",
            "claim_rows", "claim_table", "claim_targets", "compare_steps", "level_checks",
            "load_convergence", "not_converged_text", "rows_of", "share_levels", "three_levels",
            "unconverged"]
-
-#: Refinement levels: the step divided by 2**k.
-LEVELS = (0, 1, 2)
-
 
 def three_levels(metrics_at, step: float, *, first: dict | None = None) -> tuple:
     """The metrics at ``step``, ``step / 2`` and ``step / 4``.
@@ -158,7 +159,7 @@ def rows_of(pairs, reported: int = 0, *, determined=lambda x: not math.isnan(x))
     every ``(claim, (q1, q2, q4))`` of ``pairs`` whose value at level
     ``reported`` is ``determined`` (the others are left out: their claim is
     INCONCLUSIVE already)."""
-    from ..refinement import refinement_row
+    from .refinement import refinement_row
     return [refinement_row(c, vals, "dt", vals[reported]) for c, vals in pairs
             if determined(vals[reported])]
 
@@ -166,18 +167,6 @@ def rows_of(pairs, reported: int = 0, *, determined=lambda x: not math.isnan(x))
 def unconverged(rows) -> dict[str, str]:
     """claim id -> reason, for the rows whose metric did not converge."""
     return {r.claim_id: r.reason for r in rows if not r.converged}
-
-
-def not_converged_text(quantity: str, values, estimate: float | None, tolerance: float,
-                       instead: str, levels: str = "dt, dt/2, dt/4") -> str:
-    """``<quantity> q1 / q2 / q4 at <levels>, Richardson error X > tol Y;
-    use <instead> instead``: what an INCONCLUSIVE claim says of a metric
-    that did not converge (issue 33; values to 6 digits, as the convergence
-    tables print them, the estimate and tolerance to 2)."""
-    from ..report.markdown import fmt
-    err = "not determined (a value is not finite)" if estimate is None else fmt(estimate, 2)
-    return (f"{quantity} {' / '.join(fmt(x, 6) for x in values)} at {levels}, Richardson "
-            f"error {err} > tol {fmt(tolerance, 2)}; use {instead} instead")
 
 
 def claim_table(rows) -> str:
@@ -258,43 +247,3 @@ class StepComparison:
         k = sum(self.run_agree)
         return {f"{prefix}.runs": self.n, f"{prefix}.agree": k,
                 f"{prefix}.fraction_agree": k / self.n}
-
-
-def share_levels(claim, whole, half, quarter, value_of, word: str) -> tuple[tuple, tuple]:
-    """A claim on the share of runs with an outcome, at dt, dt/2 and dt/4,
-    when all N runs ran at dt (``whole``: N bools) and only the first n
-    again at dt/2 and dt/4 (``half``, ``quarter``: n bools each).
-
-    At dt the count k is known. At dt/2 and dt/4 the n refined runs give
-    k_n, and the other N - n runs, not run there, may have the outcome or
-    not: the count lies in [k_n, k_n + N - n], a bound that holds whatever
-    they do. The claim is checked (``value_of(k, N)``: the claimed quantity
-    when k of N runs have the outcome) at every count of that range: a
-    level *decides* the claim when the verdict is the same over the whole
-    range (``holds`` / ``fails``), else it is ``undecided``. n = N refines
-    every run and the range is the count itself.
-
-    Returns
-    -------
-    (values, decides) : tuple of str, tuple of str
-        Per level the counts behind it (``word`` names the outcome) and its
-        decision; the claim has converged when the three decisions agree.
-    """
-    from ..claims import Verdict, check_claim
-    big, n = len(whole), len(half)
-
-    def verdict(lo: int, hi: int) -> str:
-        got = {check_claim(claim, value_of(k, big)).verdict for k in range(lo, hi + 1)}
-        if len(got) != 1:
-            return "undecided"
-        return {Verdict.PASS: "holds", Verdict.FAIL: "fails"}.get(got.pop(), "undecided")
-
-    k = sum(bool(x) for x in whole)
-    vals, dec = [f"{k} of {big} {word}: {verdict(k, k)}"], [verdict(k, k)]
-    for level in (half, quarter):
-        kn = sum(bool(x) for x in level)
-        v = verdict(kn, kn + big - n)
-        vals.append(f"{kn} of the first {n}, so {kn}-{kn + big - n} of {big} {word}: {v}"
-                    if n < big else f"{kn} of {big} {word}: {v}")
-        dec.append(v)
-    return tuple(vals), tuple(dec)

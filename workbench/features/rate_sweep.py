@@ -40,7 +40,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Callable, Mapping
 
-from ..refinement import guarded_check
+from .refinement import guarded_check
 from ..sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
 
 __all__ = ["RateMetrics", "Runs", "RateRow", "Variant", "ThreeLevel", "three_level_check",

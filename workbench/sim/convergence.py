@@ -54,8 +54,8 @@ import enum
 import math
 from dataclasses import dataclass
 
-__all__ = ["CONVERGED", "Convergence", "INCONCLUSIVE", "NOT_CONVERGED", "OUTCOMES", "P_MAX",
-           "P_MIN", "Refinement", "refinement_check"]
+__all__ = ["CONVERGED", "Convergence", "INCONCLUSIVE", "LEVELS", "NOT_CONVERGED", "OUTCOMES",
+           "P_MAX", "P_MIN", "ROUNDING", "Refinement", "refinement_check"]
 
 
 class Convergence(enum.StrEnum):
@@ -71,9 +71,13 @@ class Convergence(enum.StrEnum):
 CONVERGED, NOT_CONVERGED, INCONCLUSIVE = Convergence
 #: The closed set of outcomes of :func:`refinement_check`.
 OUTCOMES = tuple(Convergence)
+#: Refinement levels: the step divided by 2**k (q1, q2, q4).
+LEVELS = (0, 1, 2)
 #: Observed orders outside [P_MIN, P_MAX] are guarded (module docstring).
 P_MIN, P_MAX = 0.5, 4.0
-_ROUNDING = 64 * 2.0 ** -52
+#: Differences at or below this times the largest |value| are rounding noise
+#: (the default floor of :func:`refinement_check`).
+ROUNDING = 64 * 2.0 ** -52
 
 
 @dataclass(frozen=True)
@@ -151,7 +155,7 @@ def refinement_check(q1: float, q2: float, q4: float, *, ratio: float = 2.0,
         return Refinement(vals, ratio, None, None, tolerance, INCONCLUSIVE,
                           "a value is not finite")
     if floor is None:
-        floor = _ROUNDING * max(abs(v) for v in vals)
+        floor = ROUNDING * max(abs(v) for v in vals)
     d1, d2 = abs(vals[0] - vals[1]), abs(vals[1] - vals[2])
     if d1 <= floor and d2 <= floor:
         out = CONVERGED if floor <= tolerance else NOT_CONVERGED

@@ -77,7 +77,7 @@ def comfort_quantities(name: str, fine: RunComfort, coarse: RunComfort,
     b = f"cases[{name}]"
     conv = None
     if quarter is not None:
-        from ...refinement import screen
+        from ...features.refinement import screen
         keys = ("a_max_abs", "jerk_max_abs")
         vals = {k: tuple(getattr(x, k) for x in (coarse, fine, quarter)) for k in keys}
         conv = screen(vals, {k: rtol * max(abs(x) for x in vals[k]) for k in keys})[0]

@@ -13,7 +13,7 @@ from ...controllers.antiskid003_settings import PHASE_NAMES
 from ...features.comfort_render import comfort_cells, comfort_headers
 from ...features.comfort_render import plot_comfort as plot_comfort_traces
 from ...report.markdown import Figure, fmt, md_table
-from ...refinement import P_MIN
+from ...sim.convergence import P_MIN
 from .antiskid_comfort import COMFORT_RTOL, comfort_quantities
 from .antiskid_run import RECORD_DT
 from .antiskid_run_figures import color_of

@@ -21,7 +21,7 @@ _DRAW_LABELS = (("mass", "mass factor"), ("adhesion", "adhesion s"), ("h", "h (s
 def refined_runs_text(n: int, big: int | None) -> str:
     """What the three-level refinement of the Monte Carlo findings covers
     when only the first ``n`` of ``big`` runs are run at dt/2 and dt/4
-    (:func:`workbench.papers.p003.antiskid_refine.mc_share_levels`; empty
+    (:func:`workbench.features.refinement.share_claim_levels`; empty
     when every run is)."""
     if big is None or n >= big:
         return ""

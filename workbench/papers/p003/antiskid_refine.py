@@ -24,20 +24,24 @@ level of what enters a finding, and only that:
   here, compiled kernel when the sweep uses it). At dt/2 and dt/4 the
   other N - n runs are bounded, not run: the count lies in [k_n, k_n + N -
   n] whatever they do, and a level decides the claim only when its verdict
-  is the same over that whole range (:func:`mc_share_levels`; our choice:
+  is the same over that whole range
+  (:func:`workbench.features.refinement.share_claim_levels`; our choice:
   all 64 runs at dt/2 and dt/4 cost about 6 and 18 CPU s, against 1.2 and
   2.7 s for the first 16);
 * ``basin.*`` of the k2 sweep: no step (a certificate at the printed switch
   state (v_d, lambda_opt)), the same value at every level.
 
 A finding whose metric is not among these is INCONCLUSIVE
-(:func:`workbench.refinement.refine_findings`).
+(:func:`workbench.features.refinement.refine_by_readers`).
 
-Why this stays in the paper: it defines which of paper 003's quantities
-are refined at which step and runs its kernels to get them; the checks
-themselves (three levels against the claim's tolerance, the share bound
-over partly refined runs) are :mod:`workbench.features.convergence` and
-:mod:`workbench.refinement`.
+Why this stays in the paper: it says which of paper 003's quantities are
+refined at which step (:data:`READERS`, quantity pattern -> metric reader)
+and runs its kernels to read them, and which case metric to claim instead
+of one that does not converge (:data:`CONVERGED_INSTEAD`). The checks
+themselves (three levels against the claim's tolerance, the screen of the
+case metrics, the share bound over partly refined runs, the dispatch on
+the quantity) are :mod:`workbench.features.convergence` and
+:mod:`workbench.features.refinement`.
 """
 from __future__ import annotations
 
@@ -48,15 +52,12 @@ import time
 
 import numpy as np
 
-from ...refinement import Levels, screen
+from ...features.refinement import (Levels, refine_by_readers, screen_levels, screen_reason,
+                                    share_claim_levels)
 from ...report.markdown import fmt
 
-__all__ = ["CONVERGED_INSTEAD", "last_refine_seconds", "mc_share_levels", "quarter_cases",
+__all__ = ["CONVERGED_INSTEAD", "READERS", "last_refine_seconds", "quarter_cases",
            "refine_levels", "three_level_metrics", "unconverged_reason"]
-
-_CASE = re.compile(r"^cases\[([^\]]+)\]\.")
-_SWITCH = re.compile(r"^switch\.(cruise|brake)\[([^\]]+)\]\.in_basin$")
-_RATE = re.compile(r"^sampled\.([a-z_]+)\.rate\[([^\]]+)\]\.")
 #: Monte Carlo quantity -> per-run outcome behind it (HalvingCheck keys).
 MC_OUTCOMES = {"montecarlo.fraction.diverged": "diverged",
                "montecarlo.wilson.diverged.lo": "diverged",
@@ -73,8 +74,9 @@ def last_refine_seconds(name: str) -> tuple:
 
 
 def refine_levels(design, result, findings, *, quantities, record_dt: float) -> dict:
-    """claim id -> :class:`workbench.refinement.Levels` for every finding
-    of an ``antiskid-run`` design (module docstring).
+    """claim id -> :class:`workbench.features.refinement.Levels` for every
+    finding of an ``antiskid-run`` design (module docstring), read by
+    :data:`READERS`.
 
     Parameters
     ----------
@@ -89,27 +91,9 @@ def refine_levels(design, result, findings, *, quantities, record_dt: float) -> 
         Record step (s) of the study's runs (the comfort peaks).
     """
     t0, c0 = time.perf_counter(), time.process_time()
-    spec = design.spec
     cache: dict = {"quantities": quantities, "record_dt": record_dt}
-    out = {}
-    for r in findings:
-        qn = r.claim.quantity
-        m_case, m_sw, m_rate = _CASE.match(qn), _SWITCH.match(qn), _RATE.match(qn)
-        if m_sw:
-            lv = _switch_levels(spec, result, cache, m_sw.group(1), m_sw.group(2), r.got)
-        elif m_case:
-            qs = _case_quantities(spec, result, cache, m_case.group(1))
-            lv = Levels(tuple(q.get(qn) for q in qs), "dt", spec.dt)
-        elif m_rate:
-            lv = _rate_levels(spec, result, cache, m_rate.group(1), float(m_rate.group(2)), qn)
-        elif qn in MC_OUTCOMES or qn == "montecarlo.halving.fraction_agree":
-            lv = _mc_levels(design, result, cache, qn, r.claim)
-        elif qn.startswith("basin."):
-            v = fmt(r.got, 6)
-            lv = Levels((v, v, v), "none (a certificate at the printed switch state, no step)")
-        else:
-            lv = Levels((), reason=f"no three-level check of `{qn}` in this study")
-        out[r.claim.id] = lv
+    out = refine_by_readers(findings, [(p, lambda m, r, f=f: f(design, result, cache, m, r))
+                                       for p, f in READERS])
     _SECONDS[design.name] = (time.perf_counter() - t0, time.process_time() - c0)
     return out
 
@@ -142,21 +126,24 @@ def _case_levels(spec, result, cache, name):
     return cache[key]
 
 
-def _case_quantities(spec, result, cache, name) -> tuple:
-    """The study's quantities of one case at dt, dt/2, dt/4."""
+def _case_quantity(design, result, cache, m, r) -> Levels:
+    """A case quantity at dt, dt/2, dt/4 (the study's quantities of the case
+    at each level)."""
     bare = dataclasses.replace(result, montecarlo=None, halving=None, basin=None, sampled=None)
-    return tuple(cache["quantities"](dataclasses.replace(bare, cases=(c,)))
-                 for c in _case_levels(spec, result, cache, name))
+    return Levels(tuple(cache["quantities"](dataclasses.replace(bare, cases=(c,))).get(
+        r.claim.quantity) for c in _case_levels(design.spec, result, cache, m.group(1))),
+        "dt", design.spec.dt)
 
 
-def _switch_levels(spec, result, cache, which: str, name: str, got) -> Levels:
+def _switch_levels(design, result, cache, m, r) -> Levels:
     """The basin verdict of the case's switch state at dt, dt/2, dt/4, by
     the study's own method: the cruise switch judged in one
     :func:`~workbench.papers.p003.antiskid_basin.cruise_basin` call with the
     study's switch states (the weight is chosen over all of them, as in the
     study) plus this case's at dt and dt/4; the brake switch by
     :func:`~workbench.papers.p003.antiskid_basin_brake.brake_switch` at dt and
-    dt/4 (dt/2: the study's verdict, ``got``)."""
+    dt/4 (dt/2: the study's verdict, the finding's value)."""
+    spec, (which, name), got = design.spec, m.groups(), r.got
     if spec.basin is None:
         return Levels((), reason="the design has no basin check")
     from .antiskid_basin_run import brake_points, switch_points
@@ -185,8 +172,9 @@ def _switch_levels(spec, result, cache, which: str, name: str, got) -> Levels:
     return Levels(vals, "dt", spec.dt)
 
 
-def _rate_levels(spec, result, cache, variant: str, rate: float, qn: str) -> Levels:
+def _rate_levels(design, result, cache, m, r) -> Levels:
     """A sampled rate's metric at plant_step (reported), /2 and /4."""
+    spec, variant, rate, qn = design.spec, m.group(1), float(m.group(2)), r.claim.quantity
     from .antiskid_run_spec import sampled_context
     from .antiskid_sampled import TO_EMULATION, rate_row, sampled_quantities
     sp = spec.sampled
@@ -221,10 +209,11 @@ def _rate_levels(spec, result, cache, variant: str, rate: float, qn: str) -> Lev
     return Levels(tuple(vals), "plant_step", sp.plant_step)
 
 
-def _mc_levels(design, result, cache, qn: str, claim) -> Levels:
-    """A Monte Carlo share finding at the sweep's dt, dt/2, dt/4 (the
-    runs the halving check refines, :func:`mc_share_levels`)."""
-    hc = result.halving
+def _mc_levels(design, result, cache, m, r) -> Levels:
+    """A Monte Carlo share finding at the sweep's dt, dt/2, dt/4 (the runs
+    the halving check refines,
+    :func:`workbench.features.refinement.share_claim_levels`)."""
+    hc, qn = result.halving, r.claim.quantity
     if hc is None:
         return Levels((), reason="the design has no step check of its Monte Carlo runs")
     if qn == "montecarlo.halving.fraction_agree":
@@ -234,35 +223,14 @@ def _mc_levels(design, result, cache, qn: str, claim) -> Levels:
     if "mc" not in cache:
         cache["mc"] = _mc_quarter(design, result, hc.n)
     key = MC_OUTCOMES[qn]
-    whole = result.montecarlo.violations[key]
-    return mc_share_levels(claim, key, whole, hc.fine[key], cache["mc"][key], hc.dt)
+    return share_claim_levels(r.claim, result.montecarlo.violations[key], hc.fine[key],
+                              cache["mc"][key], key.replace("_", " "), "montecarlo.dt", hc.dt)
 
 
-def _share(qn: str, k: int, n: int) -> float:
-    """The value of Monte Carlo quantity ``qn`` when k of n runs have its outcome."""
-    from ...features.montecarlo import wilson_interval
-    if qn.startswith("montecarlo.fraction."):
-        return k / n
-    _, _, _, lo, hi = wilson_interval(k, n)
-    return lo if qn.endswith(".lo") else hi
-
-
-def mc_share_levels(claim, key: str, whole, half, quarter, dt: float) -> Levels:
-    """A share finding (``claim``, on ``montecarlo.fraction.<key>`` or
-    ``montecarlo.wilson.<key>.lo`` / ``.hi``) at the sweep's dt, dt/2 and
-    dt/4, when all N runs ran at dt (``whole``: N bools) and only the first
-    n again at dt/2 and dt/4 (``half``, ``quarter``: n bools each): the
-    general :func:`workbench.features.convergence.share_levels` (a level
-    decides the claim when its verdict is the same over the whole range of
-    counts the unrefined runs allow), with this paper's quantity of a count
-    (:func:`_share`). The finding has converged when the three levels
-    decide it the same way (the values show the counts,
-    :attr:`Levels.decides` the verdicts).
-    """
-    from ...features.convergence import share_levels
-    vals, dec = share_levels(claim, whole, half, quarter,
-                             lambda k, n: _share(claim.quantity, k, n), key.replace("_", " "))
-    return Levels(vals, "montecarlo.dt", dt, decides=dec)
+def _basin_levels(design, result, cache, m, r) -> Levels:
+    """A basin finding: no step, the same printed value at every level."""
+    v = fmt(r.got, 6)
+    return Levels((v, v, v), "none (a certificate at the printed switch state, no step)")
 
 
 def _mc_quarter(design, result, n: int) -> dict:
@@ -290,22 +258,13 @@ def quarter_cases(design) -> frozenset:
     return frozenset(out)
 
 
-def _tolerances(spec, vals: dict) -> dict:
-    """metric -> the bound of its Richardson estimate: the tolerance of the
-    design's two-level screen, atol + rtol max(|q|) of the three levels."""
-    return {k: spec.conv_atol.get(k, 0.0) + spec.conv_rtol * max(
-        (abs(x) for x in v if math.isfinite(x)), default=0.0) for k, v in vals.items()}
-
-
 def three_level_metrics(spec, coarse: dict, fine: dict, quarter: dict) -> tuple:
-    """(metric -> converged, metrics not converged) over dt, dt/2, dt/4:
-    :func:`workbench.refinement.screen` with the tolerance of the design's
-    two-level screen, atol + rtol max(|q|) of the three levels, as the bound
-    of each metric's Richardson estimate (issue 33 item 4)."""
+    """(metric -> converged, metrics not converged) of the case metrics over
+    dt, dt/2, dt/4: :func:`workbench.features.refinement.screen_levels` with
+    the design's two-level screen (rtol, atol)."""
     from .antiskid_run_spec import METRICS
-    vals = {k: (coarse[k], fine[k], quarter[k]) for k in METRICS}
-    _, bad = screen(vals, _tolerances(spec, vals))
-    return {k: k not in bad for k in METRICS}, bad
+    return screen_levels({k: (coarse[k], fine[k], quarter[k]) for k in METRICS},
+                         spec.conv_rtol, spec.conv_atol)
 
 
 #: Paper 003: the case metric to claim instead of one that does not converge
@@ -317,16 +276,21 @@ CONVERGED_INSTEAD = {"braking_duration": "omega3_after_brake"}
 def unconverged_reason(spec, name: str, coarse: dict, fine: dict, quarter: dict,
                        bad: tuple) -> str:
     """Why ``cases[<name>].converged`` is INCONCLUSIVE (issue 33): every
-    metric of ``bad`` (:func:`three_level_metrics`) in the words of
-    :func:`workbench.features.convergence.not_converged_text`, with its
-    Richardson error (:func:`workbench.refinement.guarded_check`) and the
-    quantity to use instead ("" when every metric converged)."""
-    from ...features.convergence import not_converged_text
-    from ...refinement import guarded_check
-    vals = {k: (coarse[k], fine[k], quarter[k]) for k in bad}
-    tol = _tolerances(spec, vals)
+    metric of ``bad`` (:func:`three_level_metrics`) by
+    :func:`workbench.features.refinement.screen_reason`, with the quantity
+    to use instead (:data:`CONVERGED_INSTEAD`; "" when every metric
+    converged)."""
     use = {k: f"`cases[{name}].{a}`" for k, a in CONVERGED_INSTEAD.items() if a not in bad}
-    parts = [not_converged_text(
-        f"cases[{name}].{k}", vals[k], guarded_check(*vals[k], tolerance=tol[k]).estimate,
-        tol[k], use.get(k, "a metric of the case that converges")) for k in bad]
-    return "not converged: " + "; ".join(parts) if parts else ""
+    return screen_reason({k: (coarse[k], fine[k], quarter[k]) for k in bad}, spec.conv_rtol,
+                         spec.conv_atol, lambda k: f"cases[{name}].{k}", use,
+                         "a metric of the case that converges")
+
+
+#: Quantity pattern -> metric reader ``(design, result, cache, match, finding)
+#: -> Levels`` of the findings this study refines (module docstring).
+READERS = ((re.compile(r"switch\.(cruise|brake)\[([^\]]+)\]\.in_basin$"), _switch_levels),
+           (re.compile(r"cases\[([^\]]+)\]\."), _case_quantity),
+           (re.compile(r"sampled\.([a-z_]+)\.rate\[([^\]]+)\]\."), _rate_levels),
+           (re.compile("(" + "|".join(map(re.escape, MC_OUTCOMES))
+                       + r"|montecarlo\.halving\.fraction_agree)$"), _mc_levels),
+           (re.compile(r"basin\."), _basin_levels))

@@ -12,11 +12,11 @@ import math
 
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
 from ...printed_grid import quantised
-from ...refinement import P_MIN
 from ...report.binned_fractions import binned_fraction_rows
 from ...report.case_tables import CaseLevels, case_convergence_table, case_metric_table, case_rows
 from ...report.delay_cross_check import delay_cross_check, plot_envelopes
 from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
+from ...sim.convergence import P_MIN
 from ...sim.wheel_slip import MAX_DLAMBDA, MAX_HALVINGS
 from .antiskid_basin_render import HEADING as BASIN_HEADING
 from .antiskid_comfort_render import (HEADING, PATTERN, TORQUE_CAPTION, comfort_figure,
