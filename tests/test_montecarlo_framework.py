@@ -3,8 +3,12 @@ paper's: seeded draws of declared distributions
 (:mod:`workbench.features.montecarlo`), chunked and resumable chunk files run
 in-process or in a process pool (:mod:`workbench.features.montecarlo_chunks`)
 and the statistics of the runs with Wilson intervals
-(:mod:`workbench.features.montecarlo_stats`). The toy: exponential decay
-x' = -a x from x(0) = x0, exact solution, the rate ``a`` and ``x0`` drawn."""
+(:mod:`workbench.features.montecarlo_stats`), the streaming driver (one
+``.npz`` per range of runs, resume, read back), the step-halving check of a
+sweep's first runs (:mod:`workbench.features.montecarlo_halving`) and the
+tables (:mod:`workbench.features.montecarlo_render`). The toy: exponential
+decay x' = -a x from x(0) = x0, exact solution (or explicit Euler at a step
+for the halving check), the rate ``a`` and ``x0`` drawn."""
 from __future__ import annotations
 
 import math
@@ -15,9 +19,14 @@ import pytest
 
 from workbench.features.montecarlo import (Distribution, MonteCarloSpec, draw, drawn_factors,
                                            wilson_interval)
-from workbench.features.montecarlo_chunks import (Chunk, FolderTaken, Group, chunk_ranges,
-                                                  default_chunk, read_npz, run_chunks,
-                                                  start_chunks, write_npz)
+from workbench.features.convergence import compare_steps
+from workbench.features.montecarlo_chunks import (Chunk, FolderTaken, Group, chunk_file,
+                                                  chunk_ranges, default_chunk, read_npz,
+                                                  read_streamed, run_chunks, start_batches,
+                                                  start_chunks, start_streaming, write_npz)
+from workbench.features.montecarlo_halving import (HalvingCheck, halving_quantity_names,
+                                                   start_halving)
+from workbench.features.montecarlo_render import halving_tables, summary_tables
 from workbench.features.montecarlo_stats import (OK, RunsResult, finite_span, quantity_names,
                                                  summary_row)
 
@@ -123,3 +132,111 @@ def test_statistics_of_the_runs():
     assert summary_row("x", [math.nan]) == ["x", 0, None, None, None, None]
     assert finite_span([math.nan, 2.0, -1.0]) == (-1.0, 2.0)
     assert finite_span([math.nan]) == (None, None)
+
+
+def decay_range(payload: dict) -> dict:
+    """Runs ``i0 <= i < i1`` of the toy sweep, drawn by the worker itself
+    (the streaming driver's run function)."""
+    i0, i1 = payload["i0"], payload["i1"]
+    d = {k: v[i0:i1] for k, v in drawn_factors(SPEC, ORDER).items()}
+    return {"index": np.arange(i0, i1), **{f"draw.{k}": v for k, v in d.items()},
+            **decay_chunk(d)}
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_batches_in_memory_agree_with_one_batch(workers):
+    d, compiled = drawn_factors(SPEC, ORDER), []
+
+    def collect(outs, seconds, n_workers):
+        return {k: np.concatenate([o[k] for o in outs]) for k in outs[0]}, n_workers
+
+    got, n_workers = start_batches(decay_chunk, lambda i0, i1: {k: v[i0:i1] for k, v in d.items()},
+                                   N, 10, collect, workers=workers, pool=workers > 1,
+                                   before_pool=lambda: compiled.append(1)).result()
+    assert n_workers == workers and compiled == [1] * (workers > 1)
+    for k, v in decay_chunk(d).items():
+        np.testing.assert_array_equal(got[k], v)
+
+
+def test_streaming_driver_writes_resumes_and_reads_back(tmp_path):
+    out, man = tmp_path / "s", {"toy": 1, "samples": N, "chunk": 10}
+    payload = lambda i0, i1: {"i0": i0, "i1": i1}      # noqa: E731
+    compiled = []
+
+    def go(resume=False, workers=1):
+        return start_streaming(out, man, payload, decay_range,
+                               lambda s, w: read_streamed(out, lambda k: True)[1],
+                               resume=resume, workers=workers,
+                               before_pool=lambda: compiled.append(1)).result()
+
+    whole = decay_range({"i0": 0, "i1": N})
+    got = go()
+    assert sorted(p.name for p in out.glob("chunk-*.npz")) == [
+        chunk_file(out, i0, i1).name for i0, i1 in chunk_ranges(N, 10)]
+    for k in whole:
+        np.testing.assert_array_equal(got[k], whole[k])
+    chunk_file(out, 10, 20).unlink()
+    chunk_file(out, 20, 30).unlink()
+    with pytest.raises(FileNotFoundError, match="2 of 4 chunks not written"):
+        read_streamed(out, lambda k: True)
+    with pytest.raises(FolderTaken, match="already holds a sweep"):
+        go()
+    again = go(resume=True, workers=2)      # the two missing chunks, in a pool
+    assert compiled == [1]
+    for k in whole:
+        np.testing.assert_array_equal(again[k], whole[k])
+    assert read_streamed(out, lambda k: k == "x_end")[0] == man
+
+
+def euler_chunk(payload: dict) -> dict:
+    """The toy by explicit Euler at ``payload["dt"]`` up to T: x_end and
+    whether x grew (a batch run function of the halving check)."""
+    a, x = np.asarray(payload["a"]), np.asarray(payload["x0"], float).copy()
+    for _ in range(round(T / payload["dt"])):
+        x = x - payload["dt"] * a * x
+    return {"x_end": x, "grew": x > np.asarray(payload["x0"])}
+
+
+class EulerRuns(RunsResult):
+    SUMMARY: ClassVar[tuple] = ("x_end",)
+    OUTCOMES: ClassVar[tuple] = ("grew", OK)
+
+
+@pytest.mark.parametrize("rtol", [0.3, 1e-6])
+def test_halving_check_of_a_toy_sweep(rtol):
+    d, n, dt = drawn_factors(SPEC, ORDER), 12, 0.1
+    first = {k: v[:n] for k, v in d.items()}
+
+    def values(metrics, viol):
+        return {"x_end": np.asarray(metrics["x_end"], float),
+                "grew": np.asarray(viol["grew"], bool)}
+
+    def check(c, f, seconds, workers):
+        cv, fv, agree = compare_steps(c, f, rtol, {"x_end": 0.0}, ("x_end",), ("grew",))
+        return HalvingCheck(dt, rtol, {"x_end": 0.0}, cv, fv, agree, "toy", SPEC.seed,
+                            {k: tuple(v.tolist()) for k, v in first.items()}, seconds, workers)
+
+    def runs_of(o):
+        return {"x_end": o["x_end"]}, {"grew": o["grew"]}
+
+    def start(coarse):
+        return start_halving(euler_chunk, lambda step: {**first, "dt": step}, runs_of,
+                             values, check, dt, n, coarse=coarse, pool=False)
+
+    hc = start(True).result()
+    assert hc.n == n and hc.coarse["x_end"] == tuple(euler_chunk({**first, "dt": dt})["x_end"])
+    assert hc.fine["x_end"] == tuple(euler_chunk({**first, "dt": dt / 2})["x_end"])
+    # Euler at dt and dt / 2 differ by up to ~22 % (a = 2): within 30 %, never within 1e-6
+    assert sum(hc.run_agree) == (n if rtol == 0.3 else 0)
+    sweep = euler_chunk({**d, "dt": dt})
+    res = EulerRuns({k: v.tolist() for k, v in d.items()}, {"x_end": sweep["x_end"].tolist()},
+                    {"grew": sweep["grew"].tolist()}, math.nan, 1)
+    assert start(False).result()(res) == hc       # the dt side taken from the sweep
+    with pytest.raises(ValueError, match="the sweep has 3 runs"):
+        start(False).result()(EulerRuns({}, {"x_end": [1.0] * 3}, {"grew": [False] * 3},
+                                        math.nan, 1))
+    assert set(hc.quantities("toy.halving")) == halving_quantity_names("toy.halving")
+    text = halving_tables(hc, ("x_end",), ("grew",), (("a", "rate a"),))
+    assert text.count("| `x_end` |") == 1 + (0 if rtol == 0.3 else n)
+    assert text.endswith(" none.") == (rtol == 0.3)
+    assert "| outcome | runs" in summary_tables(res, 3, {"grew": "grew", OK: "ok"})

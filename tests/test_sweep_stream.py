@@ -10,6 +10,7 @@ import pytest
 
 from workbench.cli import main
 from workbench.design import load_design
+from workbench.features.montecarlo_chunks import chunk_file
 from workbench.papers.p003 import antiskid_stream as S
 from workbench.papers.p003.antiskid_montecarlo import sweep
 from workbench.sim.batch import uniform_draws
@@ -54,7 +55,7 @@ def test_stream_resume_and_refusals(short, in_memory, tmp_path, monkeypatch):
     out = tmp_path / "run"
     res = S.start_streaming(short, N, 5, out, workers=1, chunk=CHUNK).result()
     files = sorted(out.glob("chunk-*.npz"))
-    assert [f.name for f in files] == [S.chunk_file(out, i, i + CHUNK).name
+    assert [f.name for f in files] == [chunk_file(out, i, i + CHUNK).name
                                        for i in range(0, N, CHUNK)]
     assert_identical(res, in_memory)
     assert_identical(S.load_sweep(out), in_memory)

@@ -13,7 +13,10 @@ manifest is this sweep's (:func:`claim_folder`). Every chunk file is written
 atomically (a temporary name, then renamed), so a crash never leaves a
 half-written chunk and resuming needs no index.
 
-Two chunk formats: ``.npz`` arrays (:func:`write_npz`, :func:`read_npz`) and
+A sweep held in memory is cut the same way (:func:`start_batches`). Two
+chunk formats: ``.npz`` arrays (:func:`write_npz`, :func:`read_npz`; the
+streaming driver :func:`start_streaming` writes one ``chunk-<i0>-<i1>.npz``
+per range of runs and :func:`read_streamed` reads a finished folder back) and
 the CSV of :func:`run_chunks`, ``workbench sweep --out DIR [--resume]`` of
 every kind whose sweep is a batch of independent runs (``switched-run``,
 ``stop-accuracy``, ``delay-feedback``): runs cut into chunks of :data:`CHUNK`
@@ -35,8 +38,9 @@ from typing import Callable
 import numpy as np
 
 __all__ = ["CHUNK", "DEFAULT_CHUNKS", "MANIFEST", "MAX_CHUNK", "Chunk", "ChunkRuns",
-           "FolderTaken", "Group", "check_resume", "chunk_ranges", "claim_folder",
-           "default_chunk", "read_npz", "run_chunks", "start_chunks", "write_npz"]
+           "FolderTaken", "Group", "check_resume", "chunk_file", "chunk_ranges", "claim_folder",
+           "default_chunk", "read_npz", "read_streamed", "run_chunks", "start_batches",
+           "start_chunks", "start_streaming", "write_npz"]
 
 #: The manifest of a sweep's folder.
 MANIFEST = "sweep.json"
@@ -60,6 +64,41 @@ def chunk_ranges(n: int, chunk: int) -> list[tuple[int, int]]:
     """(i0, i1) of each chunk of runs ``0 <= i < n``, ``chunk`` runs each
     (the last may hold fewer); the partition depends on n and chunk only."""
     return [(i0, min(i0 + chunk, n)) for i0 in range(0, n, chunk)]
+
+
+def start_batches(run: Callable, payload: Callable, samples: int, chunk: int,
+                  collect: Callable, *, workers: int = 1, pool: bool = False,
+                  scheduler: str | None = None, before_pool: Callable | None = None):
+    """Start a sweep held in memory: runs ``0 <= i < samples`` cut into
+    chunks of ``chunk`` runs (:func:`chunk_ranges`), one batch each.
+
+    Parameters
+    ----------
+    run : callable
+        ``run(payload) -> output``: one chunk's runs (module-level when it
+        runs in a pool or on Dask).
+    payload : callable
+        ``payload(i0, i1)``: the payload of runs ``i0 <= i < i1``.
+    collect : callable
+        ``collect(outputs, seconds, workers)``: the result, from the chunks'
+        outputs in run order.
+    workers, pool, scheduler
+        As :class:`workbench.sim.batch.PendingBatch`.
+    before_pool : callable, optional
+        Called once before more than one chunk is run in a local pool (e.g. to
+        compile a kernel the forked workers inherit).
+
+    Returns
+    -------
+    workbench.sim.batch.PendingBatch
+    """
+    from ..sim.batch import PendingBatch
+    ranges = chunk_ranges(samples, chunk)
+    payloads = [payload(i0, i1) for i0, i1 in ranges]
+    if before_pool is not None and pool and len(payloads) > 1 and scheduler is None:
+        before_pool()
+    return PendingBatch(run, payloads, collect, workers, pool,
+                        sizes=[i1 - i0 for i0, i1 in ranges], unit="run", scheduler=scheduler)
 
 
 class FolderTaken(FileExistsError):
@@ -157,6 +196,71 @@ def read_npz(paths, select: Callable) -> dict:
                 if select(k):
                     cols.setdefault(k, []).append(z[k])
     return {k: np.concatenate(v) for k, v in cols.items()}
+
+
+def chunk_file(out, i0: int, i1: int) -> Path:
+    """The ``.npz`` file of runs ``i0 <= i < i1`` of a streamed sweep."""
+    return Path(out) / f"chunk-{i0:09d}-{i1:09d}.npz"
+
+
+def start_streaming(out, manifest: dict, payload: Callable, run: Callable, collect: Callable,
+                    *, resume: bool, workers: int = 1, scheduler: str | None = None,
+                    before_pool: Callable | None = None):
+    """Start a sweep whose chunks are written to ``out`` as ``.npz`` files
+    (:func:`chunk_file`) as they finish.
+
+    Parameters
+    ----------
+    out, resume
+        As :func:`claim_folder`.
+    manifest : dict
+        What identifies the sweep; it holds at least ``samples`` (the runs)
+        and ``chunk`` (runs per file), which fix the files
+        (:func:`chunk_ranges`).
+    payload : callable
+        ``payload(i0, i1)``: the run function's payload of runs ``i0 <= i < i1``.
+    run : callable
+        ``run(payload) -> dict`` of arrays: one chunk file's contents
+        (module-level when it runs in a pool or on Dask).
+    collect : callable
+        ``collect(seconds, workers)``: the result, once every chunk is written
+        (typically from :func:`read_streamed`).
+    workers, scheduler, before_pool
+        As :func:`start_batches` (a pool when ``workers > 1``).
+
+    Returns
+    -------
+    workbench.sim.batch.PendingBatch
+    """
+    chunks = [Chunk(chunk_file(out, i0, i1), payload(i0, i1), i1 - i0)
+              for i0, i1 in chunk_ranges(manifest["samples"], manifest["chunk"])]
+    if before_pool is not None and scheduler is None and workers > 1 and \
+            sum(not c.path.exists() for c in chunks) > 1:
+        before_pool()
+    return start_chunks(out, manifest, chunks, run, write_npz,
+                        lambda paths, seconds, n_workers: collect(seconds, n_workers),
+                        resume=resume, workers=workers, pool=workers > 1, scheduler=scheduler)
+
+
+def read_streamed(out, select: Callable) -> tuple[dict, dict]:
+    """(manifest, arrays) of a streamed sweep's folder: the arrays whose
+    name ``select(name)`` accepts, concatenated over the chunk files in run
+    order (:func:`read_npz`).
+
+    Raises
+    ------
+    FileNotFoundError
+        A chunk file is missing (the sweep is to be resumed).
+    """
+    out = Path(out)
+    man = json.loads((out / MANIFEST).read_text())
+    ranges = chunk_ranges(man["samples"], man["chunk"])
+    missing = [r for r in ranges if not chunk_file(out, *r).exists()]
+    if missing:
+        raise FileNotFoundError(f"{out}: {len(missing)} of {len(ranges)} chunks not written "
+                                f"(first: runs {missing[0][0]}-{missing[0][1] - 1}); "
+                                "resume the sweep")
+    return man, read_npz([chunk_file(out, *r) for r in ranges], select)
 
 
 @dataclass(frozen=True)

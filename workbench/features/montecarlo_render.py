@@ -1,7 +1,9 @@
 """Rendering of a Monte Carlo sweep's runs (pure): the summary and outcome
 tables, the outcome rates with their Wilson intervals, and histograms of the
-summarised metrics of a :class:`~workbench.features.montecarlo_stats.RunsResult`.
-A study supplies only its words (outcome labels, units, marked values)."""
+summarised metrics of a :class:`~workbench.features.montecarlo_stats.RunsResult`,
+and the tables of a step-halving check of its runs
+(:class:`~workbench.features.montecarlo_halving.HalvingCheck`). A study
+supplies only its words (outcome labels, units, marked values, draw labels)."""
 from __future__ import annotations
 
 import math
@@ -10,7 +12,7 @@ import numpy as np
 
 from ..report.markdown import fmt, md_table
 
-__all__ = ["draw_histograms", "draw_rates", "rate_text", "summary_tables"]
+__all__ = ["draw_histograms", "draw_rates", "halving_tables", "rate_text", "summary_tables"]
 
 
 def rate_text(k: int, n: int, lo: float, hi: float) -> str:
@@ -31,6 +33,38 @@ def summary_tables(res, sig: int, labels: dict) -> str:
                     [[labels[o], k, fmt(p, 3), rate_text(k, n, lo, hi)]
                      for o, k, n, p, lo, hi in res.outcome_rates()], "lrrr")
     return stats + "\n\n" + viol
+
+
+def halving_tables(hc, metrics, outcomes, labels, sig: int = 3) -> str:
+    """Markdown of a step-halving check ``hc``: a row per metric of
+    ``metrics`` (its atol, runs finite at both steps, runs that agree,
+    largest |difference| over the runs finite at both), a row per outcome of
+    ``outcomes`` (runs with it at each step, runs that agree), and the runs
+    that disagree with their draws (``labels``: (draw, column label) pairs)
+    and values (``sig`` significant digits)."""
+    n = hc.n
+    rows = []
+    for m in metrics:
+        a, b = np.asarray(hc.coarse[m], float), np.asarray(hc.fine[m], float)
+        both = np.isfinite(a) & np.isfinite(b)
+        diff = float(np.max(np.abs(a[both] - b[both]))) if both.any() else None
+        rows.append([f"`{m}`", fmt(hc.atol[m]), int(both.sum()), sum(hc.agree[m]),
+                     fmt(diff, 2)])
+    text = md_table(["metric", "atol", "finite at both", f"agree (of {n})",
+                     "largest |difference|"], rows, "lrrrr")
+    text += "\n\n" + md_table(
+        ["outcome", "runs at dt", "runs at dt / 2", f"agree (of {n})"],
+        [[f"`{o}`", sum(hc.coarse[o]), sum(hc.fine[o]), sum(hc.agree[o])]
+         for o in outcomes], "lrrr")
+    bad = [[i] + [fmt(hc.draws[d][i], 4) for d, _ in labels]
+           + [f"`{key}`", fmt(hc.coarse[key][i], sig), fmt(hc.fine[key][i], sig)]
+           for i in range(n) for key in hc.agree if not hc.agree[key][i]]
+    text += "\n\nRuns that disagree:"
+    if not bad:
+        return text + " none."
+    return text + "\n\n" + md_table(["run"] + [lab for _, lab in labels]
+                                    + ["metric or outcome", "at dt", "at dt / 2"],
+                                    bad, "r" * (1 + len(labels)) + "lrr")
 
 
 def draw_histograms(fig, res, units: dict, marks: dict | None = None) -> None:

@@ -3,24 +3,27 @@
 :func:`start_halving` simulates the first n runs of the sweep (the same
 draws) as one batch at the design's dt and as one batch at dt / 2, and
 compares their metrics and outcomes per run with the design's convergence
-tolerances (:class:`HalvingCheck`; rendered by
-:func:`workbench.papers.p003.antiskid_montecarlo_render.halving_section`).
-The comparison is the general dt-halving one
-(:func:`workbench.features.convergence.compare_steps`); this module keeps
-what is paper 003's: which metrics and outcomes of its kernel's runs are
-compared, the traction-divergence rule, and the kernel batches.
+tolerances (:class:`~workbench.features.montecarlo_halving.HalvingCheck`;
+rendered by :func:`workbench.papers.p003.antiskid_montecarlo_render.halving_section`).
+The batches and the check are the general
+:func:`workbench.features.montecarlo_halving.start_halving` and the comparison
+the general :func:`workbench.features.convergence.compare_steps`; this module
+keeps what is paper 003's: which metrics and outcomes of its kernel's runs are
+compared, the traction-divergence rule, and its kernel's payloads.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
-from ...features.convergence import StepComparison
+from ...features.montecarlo_halving import HalvingCheck
+from ...features.montecarlo_halving import halving_quantity_names as general_names
+from ...features.montecarlo_halving import start_halving as start_batches
 from ...sim.batch import PendingBatch
-from .antiskid_montecarlo import (SUMMARY_METRICS, SweepResult, chunk_payload, chunk_worker,
-                                  per_run, run_lambda_opt, sweep_inputs)
+from .antiskid_montecarlo import (SUMMARY_METRICS, chunk_payload, chunk_worker, per_run,
+                                  run_lambda_opt, sweep_inputs)
 from .antiskid_run_spec import SweepSpec
 
 #: Metrics compared at dt and dt / 2 by :func:`start_halving`.
@@ -29,22 +32,8 @@ HALVING_METRICS = SUMMARY_METRICS + ("t_diverged",)
 #: Outcomes compared (as booleans) at dt and dt / 2.
 HALVING_OUTCOMES = ("diverged", "stopped", "above_lambda_opt")
 
-
-@dataclass(frozen=True)
-class HalvingCheck(StepComparison):
-    """The first ``n`` runs of a design's sweep at dt and at dt / 2: the
-    general :class:`~workbench.features.convergence.StepComparison` (``dt``
-    the sweep's step, ``atol`` 0 where the design gives none;
-    ``lam_max_over_opt`` NaN for a run that diverged in traction at either
-    step, see :func:`compare_steps`), and the sweep's ``case``, ``seed`` and
-    ``draws`` (sample name -> tuple of n draws, as :func:`draw_samples`);
-    ``seconds`` (wall time) and ``workers`` (processes) are not compared."""
-
-    case: str
-    seed: int
-    draws: dict
-    seconds: float = field(default=math.nan, compare=False)
-    workers: int = field(default=1, compare=False)
+#: The prefix of the check's quantities.
+PREFIX = "montecarlo.halving"
 
 
 def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict) -> tuple[dict, dict, dict]:
@@ -95,16 +84,12 @@ def _step_values(metrics: dict, viol: dict) -> dict:
 def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
                   coarse: bool = True, kernel: str | None = None) -> PendingBatch:
     """Start the step-halving check of the first ``n`` runs of an
-    ``antiskid-run`` design's sweep (its ``[montecarlo]`` seed and draws).
-
-    The n runs are simulated as one batch at the sweep's dt and as one
-    batch at dt / 2. ``pool``: the batches run in a process pool now, so
-    the caller can work meanwhile, else in-process in
-    :meth:`PendingBatch.result`, which returns the :class:`HalvingCheck`.
-    ``coarse=False``: only the dt / 2 batch runs and ``result()`` returns a
-    function of the sweep's :class:`SweepResult` (whose first n runs are the
-    dt side: each run of a batch follows its single-run trajectory, whatever
-    its chunk) that makes the :class:`HalvingCheck`. ``K``: as
+    ``antiskid-run`` design's sweep (its ``[montecarlo]`` seed and draws):
+    the general :func:`~workbench.features.montecarlo_halving.start_halving`
+    on this paper's kernel batches. ``result()`` returns the
+    :class:`~workbench.features.montecarlo_halving.HalvingCheck` (``atol`` 0
+    where the design gives none), or with ``coarse=False`` a function of the
+    sweep's :class:`SweepResult` that makes it. ``K``: as
     :func:`~workbench.papers.p003.antiskid_montecarlo.start_sweep`; ``kernel``: as
     there (default: compiled when numba is installed).
     """
@@ -115,43 +100,32 @@ def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
     if not n >= 1:
         raise ValueError(f"halving check of {n} runs: need at least 1")
     inp = sweep_inputs(design, n, ms.seed, K)
-    payloads = ([chunk_payload(inp, 0, n, inp["dt"], kernel)] if coarse else []) + [
-        chunk_payload(inp, 0, n, inp["dt"] / 2, kernel)]
     atol = {k: spec.conv_atol.get(k, 0.0) for k in HALVING_METRICS}
 
-    def check(steps: list, seconds: float, n_workers: int) -> HalvingCheck:
-        c, f, agree = compare_steps(*steps, spec.conv_rtol, atol)
+    @lru_cache(maxsize=1)
+    def lam_opt() -> np.ndarray:     # once, when the first batch is back
+        return run_lambda_opt(inp)
+
+    def runs_of(out: dict) -> tuple[dict, dict]:
+        raw = {k: np.asarray(v, float) for k, v in out["metrics"].items()}
+        return per_run(raw, lam_opt(), inp["scenario"]["t_brake"])
+
+    def check(at_dt: dict, at_half: dict, seconds: float, n_workers: int) -> HalvingCheck:
+        c, f, agree = compare_steps(at_dt, at_half, spec.conv_rtol, atol)
         return HalvingCheck(inp["dt"], spec.conv_rtol, atol, c, f, agree, ms.case, ms.seed,
                             {k: tuple(v.tolist()) for k, v in inp["draws"].items()},
                             seconds, n_workers)
 
-    def collect(outs: list, seconds: float, n_workers: int):
-        lam_opt = run_lambda_opt(inp)
-        steps = []
-        for o in outs:
-            raw = {k: np.asarray(v, float) for k, v in o["metrics"].items()}
-            steps.append(_step_values(*per_run(raw, lam_opt, inp["scenario"]["t_brake"])))
-        if coarse:
-            return check(steps, seconds, n_workers)
-
-        def with_sweep(res: SweepResult) -> HalvingCheck:
-            if res.n < n:
-                raise ValueError(f"the sweep has {res.n} runs; the check needs its first {n}")
-            first = _step_values({k: v[:n] for k, v in res.metrics.items()},
-                                 {k: v[:n] for k, v in res.violations.items()})
-            return check([first, steps[0]], seconds, n_workers)
-        return with_sweep
-
-    return PendingBatch(chunk_worker, payloads, collect, len(payloads) if pool else 1, pool)
+    return start_batches(chunk_worker, lambda step: chunk_payload(inp, 0, n, step, kernel),
+                         runs_of, _step_values, check, inp["dt"], n, coarse=coarse, pool=pool)
 
 
 def halving_quantity_names() -> set[str]:
     """Quantities of :func:`halving_quantities`."""
-    return {"montecarlo.halving.runs", "montecarlo.halving.agree",
-            "montecarlo.halving.fraction_agree"}
+    return general_names(PREFIX)
 
 
 def halving_quantities(hc: HalvingCheck) -> dict:
     """Runs checked, runs whose every metric and outcome agrees, and their
     fraction (:meth:`StepComparison.quantities`)."""
-    return hc.quantities("montecarlo.halving")
+    return hc.quantities(PREFIX)

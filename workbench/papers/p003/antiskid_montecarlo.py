@@ -18,8 +18,14 @@ depends on the sample count (and ``chunk``) only, never on the worker count.
 The controller always uses the design's nominal model (dry rail, nominal
 mass): the sweep measures robustness, not re-tuning.
 
-The step-size check of the sweep's runs is :mod:`workbench.papers.p003.antiskid_halving`;
-the rendering is :mod:`workbench.papers.p003.antiskid_montecarlo_render`.
+The chunked driver (chunks, pool or Dask, progress) is the general
+:func:`workbench.features.montecarlo_chunks.start_batches` and the statistics
+of the runs :class:`workbench.features.montecarlo_stats.RunsResult`; this
+module keeps what is paper 003's: what a run draws, its kernel's payloads and
+call, and its metrics and outcomes (the creep ratio against each run's own
+lambda_opt). The step-size check of the sweep's runs is
+:mod:`workbench.papers.p003.antiskid_halving`; the rendering is
+:mod:`workbench.papers.p003.antiskid_montecarlo_render`.
 """
 from __future__ import annotations
 
@@ -29,7 +35,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ...features.montecarlo_chunks import chunk_ranges, default_chunk
+from ...features.montecarlo_chunks import default_chunk, start_batches
 from ...features.montecarlo_stats import OK, RunsResult, quantity_names
 from ...sim.batch import PendingBatch, available_cpus, uniform_draws
 from .antiskid_run_spec import SweepSpec
@@ -256,18 +262,11 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
     ``scheduler``: run the chunks on Dask (``"local"`` or a scheduler's
     address; :class:`~workbench.sim.batch.PendingBatch`). ``workers``
     defaults to the CPUs granted (:func:`~workbench.sim.batch.available_cpus`)."""
-    from .antiskid_kernel import default_kernel
+    from .antiskid_kernel import compile_kernel, default_kernel
 
     inp = sweep_inputs(design, samples, seed, K)
     workers = max(1, workers or available_cpus())
-    chunk = chunk or default_chunk(samples)
     kernel = kernel or default_kernel()
-    pool = workers > 1 if pool is None else pool
-    payloads = [chunk_payload(inp, i0, i1, inp["dt"], kernel)
-                for i0, i1 in chunk_ranges(samples, chunk)]
-    if kernel == "compiled" and pool and len(payloads) > 1 and scheduler is None:
-        from .antiskid_kernel import compile_kernel
-        compile_kernel()     # once, here: the forked workers inherit it
 
     def collect(outs: list, seconds: float, n_workers: int) -> SweepResult:
         raw = {k: np.concatenate([o["metrics"][k] for o in outs]) for k in outs[0]["metrics"]}
@@ -276,8 +275,13 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
                            {k: v.tolist() for k, v in metrics.items()},
                            {k: v.tolist() for k, v in viol.items()}, seconds, n_workers)
 
-    return PendingBatch(chunk_worker, payloads, collect, workers, pool,
-                        sizes=[len(p["h"]) for p in payloads], unit="run", scheduler=scheduler)
+    def payload(i0: int, i1: int) -> dict:
+        return chunk_payload(inp, i0, i1, inp["dt"], kernel)
+
+    return start_batches(chunk_worker, payload, samples, chunk or default_chunk(samples),
+                         collect, workers=workers,
+                         pool=workers > 1 if pool is None else pool, scheduler=scheduler,
+                         before_pool=compile_kernel if kernel == "compiled" else None)
 
 
 def sweep(design, samples: int, seed: int, *, workers: int | None = None,

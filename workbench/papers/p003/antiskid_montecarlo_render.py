@@ -1,15 +1,17 @@
 """Rendering of the Monte Carlo sweep and its step-halving check (pure): the
-paper's words, units and figures; the tables, rates and histograms are
-:mod:`workbench.features.montecarlo_render`."""
+paper's words, units and figures; the tables (summary, outcome rates,
+step-halving), rates and histograms are :mod:`workbench.features.montecarlo_render`."""
 from __future__ import annotations
 
 import numpy as np
 
+from ...features.montecarlo_halving import HalvingCheck
 from ...features.montecarlo_render import draw_histograms as general_histograms
 from ...features.montecarlo_render import draw_rates  # noqa: F401  (the report's figure)
+from ...features.montecarlo_render import halving_tables
 from ...features.montecarlo_render import summary_tables as general_tables
-from ...report.markdown import fmt, md_table
-from .antiskid_halving import HALVING_METRICS, HALVING_OUTCOMES, HalvingCheck
+from ...report.markdown import fmt
+from .antiskid_halving import HALVING_METRICS, HALVING_OUTCOMES
 from .antiskid_montecarlo import SUMMARY_METRICS, VIOLATIONS, SweepResult
 
 
@@ -61,30 +63,9 @@ def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
             f"**{k} of {n} runs agree in every metric and outcome.**")
     text += refined_runs_text(n, None if spec is None or spec.montecarlo is None else
                               spec.montecarlo.samples) + "\n\n"
-    rows = []
-    for m in HALVING_METRICS:
-        a, b = np.asarray(hc.coarse[m], float), np.asarray(hc.fine[m], float)
-        both = np.isfinite(a) & np.isfinite(b)
-        diff = float(np.max(np.abs(a[both] - b[both]))) if both.any() else None
-        rows.append([f"`{m}`", fmt(hc.atol[m]), int(both.sum()), sum(hc.agree[m]),
-                     fmt(diff, 2)])
-    text += md_table(["metric", "atol", "finite at both", f"agree (of {n})",
-                      "largest |difference|"], rows, "lrrrr")
-    text += "\n\n" + md_table(
-        ["outcome", "runs at dt", "runs at dt / 2", f"agree (of {n})"],
-        [[f"`{o}`", sum(hc.coarse[o]), sum(hc.fine[o]), sum(hc.agree[o])]
-         for o in HALVING_OUTCOMES], "lrrr")
     labels = tuple(("delay_period", "h(t) period (s)") if d == "h" and "delay_period" in hc.draws
                    else (d, lab) for d, lab in _DRAW_LABELS)    # the h draw unused then
-    bad = [[i] + [fmt(hc.draws[d][i], 4) for d, _ in labels]
-           + [f"`{key}`", fmt(hc.coarse[key][i], sig), fmt(hc.fine[key][i], sig)]
-           for i in range(n) for key in hc.agree if not hc.agree[key][i]]
-    text += "\n\nRuns that disagree:"
-    if not bad:
-        return text + " none."
-    return text + "\n\n" + md_table(["run"] + [lab for _, lab in labels]
-                                    + ["metric or outcome", "at dt", "at dt / 2"],
-                                    bad, "rrrrrlrr")
+    return text + halving_tables(hc, HALVING_METRICS, HALVING_OUTCOMES, labels, sig)
 
 
 def draw_histograms(fig, res: SweepResult) -> None:

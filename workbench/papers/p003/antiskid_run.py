@@ -250,6 +250,7 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     from pathlib import Path
 
     from ...errors import DesignError
+    from ...features.montecarlo_chunks import check_resume
     from ...report.markdown import Figure
     from .antiskid_montecarlo import sweep
     from .antiskid_montecarlo_render import draw_histograms, summary_tables
@@ -273,8 +274,7 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
             raise DesignError("<cli>", "--scheduler", scheduler,
                               "no flag here: dask.distributed is not installed "
                               "(pip install 'traincontrol-workbench[scale]')")
-    if resume and not out:
-        raise DesignError("<cli>", "--resume", True, "with --out DIR (the folder to resume)")
+    check_resume(out, resume)
     try:
         if out:
             from .antiskid_stream import start_streaming

@@ -12,10 +12,11 @@ refused.
 
 Why ``.npz`` per chunk and not one Parquet file: each chunk is one atomic
 file, numpy reads it without a new dependency (pyarrow is a ~40 MB wheel); a
-chunk of 250 runs is ~50 kB. The folder, its manifest, resuming and the
-executors are the general :mod:`workbench.features.montecarlo_chunks`; this
-module keeps what is paper 003's: what a chunk file holds and how the sweep's
-metrics and outcomes are made from it.
+chunk of 250 runs is ~50 kB. The streaming driver (the chunk files, the
+folder and its manifest, resuming, reading back, the executors) is the
+general :func:`workbench.features.montecarlo_chunks.start_streaming`; this
+module keeps what is paper 003's: what a chunk file holds, what identifies
+its sweep, and how the sweep's metrics and outcomes are made from the files.
 
 File ``chunk-<i0>-<i1>.npz`` (runs i0 <= i < i1): ``index``, ``draw.<name>``
 (the samples), ``raw.<field>`` (the :class:`RunMetrics` of each run) and
@@ -28,23 +29,17 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 
-from ...features.montecarlo_chunks import (MANIFEST, Chunk, chunk_ranges, default_chunk,
-                                           read_npz, start_chunks, write_npz)
+from ...features.montecarlo_chunks import default_chunk, read_streamed
+from ...features.montecarlo_chunks import start_streaming as stream
 from ...sim.batch import PendingBatch, available_cpus
 from .antiskid_montecarlo import (SweepResult, chunk_payload, chunk_worker, lambda_opt_of,
                                   per_run, sweep_inputs)
 
 #: Raw metrics :func:`load_sweep` reads (what :func:`per_run` needs).
 READ = ("lam_max_traction", "t_cruise", "t_omega3", "t_diverged", "phase_diverged", "t_stop")
-
-
-def chunk_file(out: Path, i0: int, i1: int) -> Path:
-    """The file of runs ``i0 <= i < i1``."""
-    return Path(out) / f"chunk-{i0:09d}-{i1:09d}.npz"
 
 
 def range_worker(payload: dict) -> dict:
@@ -88,41 +83,27 @@ def start_streaming(design, samples: int, seed: int, out, *, resume: bool = Fals
     """
     from .antiskid_kernel import compile_kernel, default_kernel
     from .antiskid_run_spec import gain_for
-    out = Path(out)
     workers = max(1, workers or available_cpus())
     chunk = chunk or default_chunk(samples)
     kernel = kernel or default_kernel()
     K = tuple(gain_for(design.spec)[0] if K is None else K)
-    chunks = [Chunk(chunk_file(out, i0, i1), {"design": design, "K": K, "seed": seed,
-                                             "i0": i0, "i1": i1, "kernel": kernel}, i1 - i0)
-              for i0, i1 in chunk_ranges(samples, chunk)]
-    if kernel == "compiled" and scheduler is None and workers > 1 and \
-            sum(not c.path.exists() for c in chunks) > 1:
-        compile_kernel()     # once, here: the forked workers inherit it
 
-    def collect(paths: list, seconds: float, n_workers: int) -> SweepResult:
+    def collect(seconds: float, n_workers: int) -> SweepResult:
         res = load_sweep(out)
         return SweepResult(res.samples, res.metrics, res.violations, seconds, n_workers)
 
-    return start_chunks(out, _manifest(design, samples, seed, chunk, kernel, K), chunks,
-                        range_worker, write_npz, collect, resume=resume, workers=workers,
-                        pool=workers > 1, scheduler=scheduler)
+    return stream(out, _manifest(design, samples, seed, chunk, kernel, K),
+                  lambda i0, i1: {"design": design, "K": K, "seed": seed, "i0": i0, "i1": i1,
+                                  "kernel": kernel},
+                  range_worker, collect, resume=resume, workers=workers, scheduler=scheduler,
+                  before_pool=compile_kernel if kernel == "compiled" else None)
 
 
 def load_sweep(out) -> SweepResult:
     """The :class:`SweepResult` of a streamed sweep, from its chunk files
     (only the columns the summaries use are read)."""
-    out = Path(out)
-    man = json.loads((out / MANIFEST).read_text())
-    n, chunk = man["samples"], man["chunk"]
-    ranges = chunk_ranges(n, chunk)
-    missing = [r for r in ranges if not chunk_file(out, *r).exists()]
-    if missing:
-        raise FileNotFoundError(f"{out}: {len(missing)} of {len(ranges)} chunks not written "
-                                f"(first: runs {missing[0][0]}-{missing[0][1] - 1}); resume the sweep")
     keep = {"lambda_opt", *(f"raw.{k}" for k in READ)}
-    col = read_npz([chunk_file(out, *r) for r in ranges],
-                   lambda k: k in keep or k.startswith("draw."))
+    man, col = read_streamed(out, lambda k: k in keep or k.startswith("draw."))
     raw = {k: col[f"raw.{k}"] for k in READ}
     metrics, viol = per_run(raw, col["lambda_opt"], float(man["t_brake"]))
     draws = {k[5:]: v.tolist() for k, v in col.items() if k.startswith("draw.")}
