@@ -89,7 +89,7 @@ def test_non_finite_is_inconclusive_and_bad_arguments_raise():
         refinement_check(1.0, 1.0, 1.0, tolerance=-1.0)
 
 
-# -- findings on converged numbers (workbench.refinement, workbench.verify) ---------------
+# -- findings on converged numbers (workbench.features.refinement, workbench.verify) ---------------
 def _finding(cid, value, compare, tol=0.0, expect="pass", allow=False):
     from workbench.claims import Claim
     return Claim(cid, f"claim {cid}", "x", compare, value, tol, None, "round", "workbench",

@@ -31,7 +31,7 @@ def evaluate_design(design: Design) -> Evaluation:
 
     A study with a ``refine_field`` (the spec's numerical step; for the
     designs its ``refines(spec)`` accepts, when it has one) has every
-    finding's metric checked at the step, its half and its quarter (:func:`workbench.refinement.refine_findings`, issue 33 item 4):
+    finding's metric checked at the step, its half and its quarter (:func:`workbench.features.refinement.refine_findings`, issue 33 item 4):
     a finding whose metric has not converged within the claim's tolerance
     is INCONCLUSIVE ("not converged: ...")."""
     study = kinds.REGISTRY[design.kind]
@@ -62,7 +62,7 @@ def _not_converged(r: ClaimResult, why: str | None) -> ClaimResult:
 
 
 def _refined(design, study, q, checked, result):
-    """:func:`workbench.refinement.refine_findings`, computed once per run: kept
+    """:func:`workbench.features.refinement.refine_findings`, computed once per run: kept
     in this process and in the run folder (:func:`workbench.memo.shared`) under
     the exact key of the design's kind, spec and claim results (the refinement
     reads nothing else), so the verify phase of ``workbench check`` and the

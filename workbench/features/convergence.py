@@ -14,8 +14,8 @@ value of its runs at that numerical step); this module does the rest:
   keys), :func:`claim_targets` picks the claims on a scenario metric
   (``<prefix><scenario>.<metric>``), :func:`claim_rows` / :func:`rows_of`
   check each claim's metric at the three levels against the claim's
-  tolerance (:func:`workbench.refinement.refinement_row`, tolerance by
-  :func:`workbench.refinement.claim_tolerance`), :func:`unconverged` says
+  tolerance (:func:`workbench.features.refinement.refinement_row`, tolerance by
+  :func:`workbench.features.refinement.claim_tolerance`), :func:`unconverged` says
   which claims are then INCONCLUSIVE and why (a kind's
   ``unconverged(result)``, applied by :mod:`workbench.verify`;
   :func:`not_converged_text` the words for one metric), and
@@ -32,9 +32,8 @@ Used by ``switched-run``, ``delay-feedback``, ``stop-accuracy`` and paper
 The numerical check and its enum stay in :mod:`workbench.sim.convergence`
 (the sim layer's pure function) and the claim-level check (tolerance,
 reason, the rows of a study's findings, the share bound) is
-:mod:`workbench.features.refinement`, which this module owns; the committed
-reports name ``workbench/sim/convergence.py`` and ``workbench/refinement.py``
-(the latter re-exports :mod:`workbench.features.refinement`).
+:mod:`workbench.features.refinement`, which this module owns (the reports
+name both files).
 
 References
 ----------
@@ -155,7 +154,7 @@ def claim_rows(targets, scenario: str, levels, reported: int = 0) -> list:
 
 
 def rows_of(pairs, reported: int = 0, *, determined=lambda x: not math.isnan(x)) -> list:
-    """The refinement row (:func:`workbench.refinement.refinement_row`) of
+    """The refinement row (:func:`workbench.features.refinement.refinement_row`) of
     every ``(claim, (q1, q2, q4))`` of ``pairs`` whose value at level
     ``reported`` is ``determined`` (the others are left out: their claim is
     INCONCLUSIVE already)."""

@@ -177,7 +177,7 @@ def three_level_check(variant: str, rate: float, metric: str, values: tuple,
     """The three-level check of one rate metric (``values`` at plant_step,
     /2, /4): an outcome converges when the three agree; a number when every
     level is NaN (not reached), or by
-    :func:`workbench.refinement.guarded_check` within ``tolerance`` (the
+    :func:`workbench.features.refinement.guarded_check` within ``tolerance`` (the
     mesh check's; 0, rounding only, for a metric without one); NaN at some
     levels only is INCONCLUSIVE."""
     if any(isinstance(x, str) for x in values):

@@ -20,7 +20,7 @@ of Monte Carlo runs with an outcome refined over partly refined runs
 (:func:`share_levels`).
 
 The control period and every other design variable stay as designed: only
-the integration step is refined. ``workbench/refinement.py``, which the
+the integration step is refined. ``workbench/features/refinement.py``, which the
 committed reports name, re-exports this module.
 """
 from __future__ import annotations

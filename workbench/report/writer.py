@@ -58,7 +58,7 @@ def claims_table(results: tuple[ClaimResult, ...]) -> str:
 
 def refinement_section(table) -> list[str]:
     """The three-level refinement of the findings' metrics (issue 33, item
-    4), from a :class:`workbench.refinement.RefinementTable` (empty list
+    4), from a :class:`workbench.features.refinement.RefinementTable` (empty list
     when the study has no refined step)."""
     if table is None:
         return []

@@ -289,7 +289,7 @@ def _convergence_section(res) -> str:
             f"(`workbench/sim/convergence.py`: p clipped to [{fmt(P_MIN)}, {fmt(P_MAX)}]; "
             "differences at rounding level count as converged); the tolerance is the claim's "
             "for `within`, the distance from the value to the bound for `<=`/`>=` "
-            "(`workbench/refinement.py`). A claim whose metric has not converged is "
+            "(`workbench/features/refinement.py`). A claim whose metric has not converged is "
             "INCONCLUSIVE with this reason.\n\n"
             + (md_table(["quantity", "q1 (dt)", "q2 (dt/2)", "q4 (dt/4)", "p"], rows, "lrrrr")
                + "\n\n" if rows else "")

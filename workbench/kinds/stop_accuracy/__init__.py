@@ -58,7 +58,7 @@ Tables::
                    ``workbench.papers`` with an ``ANALYSIS`` object that reads the paper's
                    own tables, runs the design through this kind's simulation and names
                    the claims' quantities and the report; its findings are refined at
-                   dt/2 and dt/4, :mod:`workbench.refinement`)
+                   dt/2 and dt/4, :mod:`workbench.features.refinement`)
 
 A law sees ``x`` (m since braking began), ``v`` (the measured speed, m/s),
 ``decel`` (the measured deceleration, m/s^2, >= 0), ``d_go = D - x`` (m),

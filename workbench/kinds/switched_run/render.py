@@ -159,7 +159,7 @@ def _convergence(spec, res) -> str:
                         "estimate"], rows, "llrrrrr")
             + "\n\nEvery claim on a scenario metric against its tolerance (the claim's "
             "tolerance for `within`, the distance from the value to the bound for `<=`/`>=`, "
-            "half a printed unit for `==` with digits; `workbench/refinement.py`): a claim "
+            "half a printed unit for `==` with digits; `workbench/features/refinement.py`): a claim "
             "whose metric has not converged is INCONCLUSIVE with this reason.\n\n"
             + claim_table(res.refinement))
 

@@ -5,7 +5,7 @@ features the design names.
 * ``[convergence]``: the scenario again at dt/2 and dt/4; every metric's
   three values go through :func:`workbench.features.convergence.level_checks`
   (Richardson), and every claim on a scenario metric through
-  :func:`workbench.refinement` 's row check against the claim's tolerance (the
+  :func:`workbench.features.refinement` 's row check against the claim's tolerance (the
   distance to the bound for ``<=``/``>=``), as the findings of other kinds
   are: a claim whose metric has not converged is INCONCLUSIVE with the
   reason (:meth:`workbench.kinds.switched_run.SwitchedRun.unconverged`);

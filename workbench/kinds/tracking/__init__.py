@@ -49,7 +49,7 @@ class Tracking:
     """The ``tracking`` study object (see the module docstring)."""
 
     kind = "tracking"
-    #: numerical step refined (dt/2, dt/4) for the findings (workbench.refinement)
+    #: numerical step refined (dt/2, dt/4) for the findings (workbench.features.refinement)
     refine_field, refine_unit = "dt", "s"
     uses_solver = False    # no convex solver runs: the report says so
 

@@ -70,7 +70,7 @@ def comfort_quantities(name: str, fine: RunComfort, coarse: RunComfort,
     """The :data:`COMFORT_QUANTITIES` of one case (reported from dt/2).
 
     ``comfort_converged``: the |a| and |jerk| peaks at dt, dt/2 and dt/4
-    (``quarter``) pass :func:`workbench.refinement.screen` with tolerance
+    (``quarter``) pass :func:`workbench.features.refinement.screen` with tolerance
     ``rtol`` times the largest peak: "yes", else None (not determined,
     INCONCLUSIVE; also without a dt/4 run: a two-level agreement is no
     convergence, issue 33 item 4)."""

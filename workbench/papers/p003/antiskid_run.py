@@ -63,7 +63,7 @@ class CaseResult:
     comfort_coarse: object = None  # the same at dt
     #: The case at dt / 4 (:func:`quarter_cases`): (metrics, run, comfort), or None.
     quarter: tuple | None = None
-    #: Metrics not converged over dt, dt/2, dt/4 (:func:`workbench.refinement.screen`).
+    #: Metrics not converged over dt, dt/2, dt/4 (:func:`workbench.features.refinement.screen`).
     unconverged: tuple = ()
     #: Why they did not (:func:`~workbench.papers.p003.antiskid_refine.unconverged_reason`).
     why: str = ""

@@ -249,7 +249,7 @@ def _convergence_section(res, spec) -> str:
     return ("## Convergence in the step size\n\nEvery metric computed at dt = "
             f"{fmt(res.dt)} s and dt/2 = {fmt(res.dt / 2)} s (reported), and at dt/4 for a "
             "case whose convergence a claim states. Converged: the Richardson error "
-            "estimate of the three levels (`workbench.refinement.guarded_check`; levels "
+            "estimate of the three levels (`workbench.features.refinement.guarded_check`; levels "
             "whose differences change sign are not in the asymptotic range and are "
             f"estimated from the larger difference at order {fmt(P_MIN)}) is within "
             f"rtol = {fmt(spec.conv_rtol)} of the largest |value| plus the design's atol. "
