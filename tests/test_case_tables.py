@@ -16,8 +16,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from workbench.report.case_figures import Palette, plot_cases, snapped, time_window  # noqa: E402
-from workbench.report.case_tables import (CaseLevels, case_convergence_table,  # noqa: E402
-                                          case_metric_table, case_rows, fmt_finite)
+from workbench.report.case_tables import (CaseLevels, case_convergence_section,  # noqa: E402
+                                          case_convergence_table, case_metric_table, case_rows,
+                                          fmt_finite)
 from workbench.report.delay_cross_check import (delay_cross_check, envelope_verdict,  # noqa: E402
                                                 plot_envelopes)
 
@@ -80,6 +81,11 @@ def test_convergence_table_verdicts_and_rows_left_out():
     assert any(r.endswith("| **no** |") for r in fast)   # first order: 1e-3 not met at dt = 0.1
     tight = case_convergence_table([_levels("fast", 2.0, 1e-4, 1e-3, True)], LABELS)
     assert "**no**" not in tight and tight.count("| yes |") == 3
+    sec = case_convergence_section([_levels("fast", 2.0, 1e-4, 1e-3, True)], LABELS, 0.1,
+                                   1e-3, 0.5)
+    assert sec.startswith("## Convergence in the step size\n\nEvery metric computed at "
+                          "dt = 0.1 s and dt/2 = 0.05 s") and sec.endswith(tight)
+    assert "at order 0.5)" in sec and "rtol = 0.001 of" in sec
 
 
 def test_case_rows_placeholder_for_missing_item():

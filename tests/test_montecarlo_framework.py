@@ -26,7 +26,9 @@ from workbench.features.montecarlo_chunks import (Chunk, FolderTaken, Group, chu
                                                   start_chunks, start_streaming, write_npz)
 from workbench.features.montecarlo_halving import (HalvingCheck, halving_quantity_names,
                                                    start_halving)
-from workbench.features.montecarlo_render import halving_tables, summary_tables
+from workbench.features.montecarlo_render import (draw_outcome_scatter, halving_section,
+                                                  halving_tables, montecarlo_figures,
+                                                  summary_tables)
 from workbench.features.montecarlo_stats import (OK, RunsResult, finite_span, quantity_names,
                                                  summary_row)
 
@@ -240,3 +242,38 @@ def test_halving_check_of_a_toy_sweep(rtol):
     assert text.count("| `x_end` |") == 1 + (0 if rtol == 0.3 else n)
     assert text.endswith(" none.") == (rtol == 0.3)
     assert "| outcome | runs" in summary_tables(res, 3, {"grew": "grew", OK: "ok"})
+    md = halving_section(hc, ("x_end",), ("grew",), (("a", "rate a"),), N,
+                         " (the toy's note)", "; nothing left out")
+    assert md.startswith(f"The first {n} of the sweep's {N} runs (seed {SPEC.seed}, case `toy`")
+    assert "at dt / 2 (the toy's note). " in md and "do not; nothing left out. " in md
+    assert f"**{sum(hc.run_agree)} of {n} runs agree" in md and md.endswith(text)
+    assert f"between k and k + {N - n} of the {N} runs" in md        # the refinement it covers
+    assert "Refinement" not in halving_section(hc, ("x_end",), ("grew",), (), None)
+
+
+def test_outcome_scatter_and_report_figures_of_a_toy_sweep():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    d = drawn_factors(SPEC, ORDER)
+    m = decay_chunk(d)
+    res = Decay({k: v.tolist() for k, v in d.items()}, {"x_end": m["x_end"].tolist()},
+                {"grew": m["grew"].tolist()}, math.nan, 1)
+    grew = np.asarray(m["grew"])
+    fig = plt.figure()
+    draw_outcome_scatter(fig, res.samples, (("a", "x0", "rate a", "x(0)"),),
+                         (("grew", grew, "tab:red", "x"), ("decayed", ~grew, "tab:blue", "o"),
+                          ("never", np.zeros(N, bool), "k", "s")), N,
+                         ("grew", np.asarray(m["x_end"]), "x at T"))
+    (ax,) = [a for a in fig.axes if a.get_label() != "<colorbar>"]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels == [f"grew: {grew.sum()} of {N}", f"decayed: {N - grew.sum()} of {N}"]
+    assert len(fig.axes) == 2 and ax.get_xlabel() == "rate a"     # the shaded group's bar
+    plt.close(fig)
+    figs = montecarlo_figures(res, lambda fig, r: fig.subplots(), lambda fig, r: None)
+    assert [f.name for f in figs] == ["montecarlo-histograms", "montecarlo-rates",
+                                      "montecarlo-outcomes"]
+    fig = plt.figure()
+    figs[1].draw(fig)                                              # the rates of the toy
+    assert len(fig.axes[0].get_yticklabels()) == len(res.outcome_rates())
+    plt.close(fig)

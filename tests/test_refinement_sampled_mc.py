@@ -12,7 +12,7 @@ import pytest
 
 from workbench.claims import Claim, ClaimResult, Verdict, check_claim
 from workbench.papers.p003 import antiskid_sampled as S
-from workbench.papers.p003.antiskid_montecarlo_render import refined_runs_text
+from workbench.features.montecarlo_render import refined_runs_text
 from workbench.features.refinement import _own_row, share_claim_levels, share_value
 from workbench.sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
 

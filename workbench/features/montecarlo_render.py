@@ -2,17 +2,24 @@
 tables, the outcome rates with their Wilson intervals, and histograms of the
 summarised metrics of a :class:`~workbench.features.montecarlo_stats.RunsResult`,
 and the tables of a step-halving check of its runs
-(:class:`~workbench.features.montecarlo_halving.HalvingCheck`). A study
-supplies only its words (outcome labels, units, marked values, draw labels)."""
+(:class:`~workbench.features.montecarlo_halving.HalvingCheck`) with what it
+covers, the runs at their draws marked by outcome, and the figures of a sweep
+in a report. A study supplies only its words (outcome labels, units, marked
+values, draw labels, what its kernel guarantees).
+
+Used by the ``antiskid-run`` study (paper 003);
+``tests/test_montecarlo_framework.py`` renders a toy sweep with it."""
 from __future__ import annotations
 
 import math
 
 import numpy as np
 
-from ..report.markdown import fmt, md_table
+from ..report.markdown import Figure, fmt, md_table
 
-__all__ = ["draw_histograms", "draw_rates", "halving_tables", "rate_text", "summary_tables"]
+__all__ = ["draw_histograms", "draw_outcome_scatter", "draw_rates", "halving_section",
+           "halving_tables", "montecarlo_figures", "rate_text", "refined_runs_text",
+           "summary_tables"]
 
 
 def rate_text(k: int, n: int, lo: float, hi: float) -> str:
@@ -65,6 +72,89 @@ def halving_tables(hc, metrics, outcomes, labels, sig: int = 3) -> str:
     return text + "\n\n" + md_table(["run"] + [lab for _, lab in labels]
                                     + ["metric or outcome", "at dt", "at dt / 2"],
                                     bad, "r" * (1 + len(labels)) + "lrr")
+
+
+def refined_runs_text(n: int, big: int | None) -> str:
+    """What the three-level refinement of a sweep's findings covers when
+    only the first ``n`` of ``big`` runs are run at dt/2 and dt/4
+    (:func:`workbench.features.refinement.share_claim_levels`; empty when
+    every run is)."""
+    if big is None or n >= big:
+        return ""
+    return (f" **Refinement of the Monte Carlo findings.** A finding on the share of an "
+            f"outcome is checked at the sweep's dt (all {big} runs), dt / 2 (the first {n}: "
+            f"this check) and dt / 4 (the first {n} once more; see the refinement of the "
+            f"findings). The other {big - n} runs are not run at dt / 2 and dt / 4 but bounded: "
+            f"if k of the first {n} have the outcome there, between k and k + {big - n} of the "
+            f"{big} runs have it, whatever the others do. A level decides a finding when its "
+            f"verdict is the same at every count of that range; the finding has converged "
+            f"when dt, dt / 2 and dt / 4 decide it the same way, and is INCONCLUSIVE otherwise "
+            f"(the refinement table shows each level's count and verdict). A claim that no "
+            f"run has the outcome is decided by one refined run that has it at every level; a "
+            f"bound on the rate (a Wilson interval's end) may need more of the {big} runs than "
+            f"the {n} refined, and is then INCONCLUSIVE.")
+
+
+def halving_section(hc, metrics, outcomes, labels, samples: int | None = None,
+                    batch_note: str = "", not_compared: str = "", sig: int = 3) -> str:
+    """Markdown (no heading) of a step-halving check ``hc``: what was done
+    and the agreement rule, the refinement it covers (``samples``: the size
+    of the sweep, None when not known; :func:`refined_runs_text`), then
+    :func:`halving_tables` (``metrics``, ``outcomes``, ``labels``, ``sig``).
+    The study's words: ``batch_note`` (what a batch guarantees, after "one
+    batch at dt / 2"), ``not_compared`` (values left out of the comparison,
+    after the missing-value rule)."""
+    n, k = hc.n, sum(hc.run_agree)
+    of = "the sweep's runs" if samples is None else f"the sweep's {samples} runs"
+    tol = ", ".join(f"`{m}` {fmt(a)}" for m, a in hc.atol.items() if a > 0) or "none"
+    text = (f"The first {n} of {of} (seed {hc.seed}, case `{hc.case}`, the same draws), "
+            f"run at the sweep's dt = {fmt(hc.dt)} s, were simulated again as one batch at "
+            f"dt / 2{batch_note}. A metric agrees when "
+            f"|a − b| <= atol + rtol max(|a|, |b|), rtol = {fmt(hc.rtol)}, atol: {tol} "
+            f"(else 0); two missing values agree, a missing and a finite one do not"
+            f"{not_compared}. An outcome agrees when it is the same at both steps. "
+            f"**{k} of {n} runs agree in every metric and outcome.**")
+    return (text + refined_runs_text(n, samples) + "\n\n"
+            + halving_tables(hc, metrics, outcomes, labels, sig))
+
+
+def draw_outcome_scatter(fig, draws, panels, groups, n: int, shade=None) -> None:
+    """Each run at its draws, one panel per (x draw, y draw, x label, y
+    label) of ``panels``, marked by its group: ``groups`` (label, mask over
+    the runs, colour, marker), each counted "k of ``n``" in the legend of
+    the first panel (empty groups left out). ``shade``: (group label, a
+    value per run, colour-bar label): that group's runs are coloured by the
+    value when it is finite for all of them, so that a sweep where every
+    run falls in the group still shows where the draws put each run."""
+    for ax, (kx, ky, lx, ly) in zip(fig.subplots(1, len(panels), squeeze=False)[0], panels):
+        x, y = np.asarray(draws[kx], float), np.asarray(draws[ky], float)
+        for label, sel, color, marker in groups:
+            if not sel.any():
+                continue
+            count = f"{label}: {int(sel.sum())} of {n}"
+            if shade is not None and label == shade[0] and np.isfinite(shade[1][sel]).all():
+                sc = ax.scatter(x[sel], y[sel], s=16, c=shade[1][sel], cmap="plasma",
+                                marker=marker, label=count)
+                fig.colorbar(sc, ax=ax, label=shade[2])
+            else:
+                ax.scatter(x[sel], y[sel], s=14, c=color, marker=marker, label=count)
+        ax.set_xlabel(lx)
+        ax.set_ylabel(ly)
+    fig.axes[0].legend(fontsize=7)
+
+
+def montecarlo_figures(res, histograms, outcomes) -> tuple[Figure, ...]:
+    """The report figures of a sweep ``res``: histograms of its summary
+    metrics (``histograms(fig, res)``), its outcome rates
+    (:func:`draw_rates`) and its runs at their draws (``outcomes(fig, res)``),
+    named ``montecarlo-histograms``, ``-rates``, ``-outcomes``."""
+    return (
+        Figure("montecarlo-histograms", "Monte Carlo: histograms of the summary metrics.",
+               lambda fig: histograms(fig, res), (9.0, 3.2)),
+        Figure("montecarlo-rates", "Monte Carlo: outcome rates, Wilson 95 % intervals.",
+               lambda fig: draw_rates(fig, res), (6.0, 2.8)),
+        Figure("montecarlo-outcomes", "Monte Carlo: outcome of each run against its draws.",
+               lambda fig: outcomes(fig, res), (9.0, 3.8)))
 
 
 def draw_histograms(fig, res, units: dict, marks: dict | None = None) -> None:

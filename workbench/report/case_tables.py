@@ -8,7 +8,8 @@ functions only lay the values out:
 
 * :func:`case_metric_table`: one row per metric, one column per case;
 * :func:`case_convergence_table`: each case's metrics at dt, dt/2 and, when
-  run, dt/4, with the convergence verdict;
+  run, dt/4, with the convergence verdict; :func:`case_convergence_section`:
+  that table under a heading that says how the levels are judged;
 * :func:`case_rows`: one row per case with a placeholder row for a case
   without the item (a phase switch never reached, say).
 
@@ -94,6 +95,27 @@ def case_convergence_table(cases: Iterable[CaseLevels], labels: Labels,
             rows.append([f"`{c.name}`", label, fmt(a, sig), fmt(b, sig),
                          MISSING if c.quarter is None else fmt(q4, sig), verdict])
     return md_table(["case", "metric", "dt", "dt/2", "dt/4", "converged"], rows, "llrrrl")
+
+
+def case_convergence_section(cases: Iterable[CaseLevels], labels: Labels, dt: float,
+                             rtol: float, p_min: float) -> str:
+    """A ``## Convergence in the step size`` section: the levels run (dt,
+    dt/2 reported, dt/4 where a claim states convergence), the verdict (the
+    guarded Richardson estimate of
+    :func:`workbench.features.refinement.guarded_check` within ``rtol`` of
+    the largest |value| plus the design's atol; ``p_min``: the order it
+    assumes where the differences change sign), then
+    :func:`case_convergence_table`."""
+    return ("## Convergence in the step size\n\nEvery metric computed at dt = "
+            f"{fmt(dt)} s and dt/2 = {fmt(dt / 2)} s (reported), and at dt/4 for a "
+            "case whose convergence a claim states. Converged: the Richardson error "
+            "estimate of the three levels (`workbench.features.refinement.guarded_check`; levels "
+            "whose differences change sign are not in the asymptotic range and are "
+            f"estimated from the larger difference at order {fmt(p_min)}) is within "
+            f"rtol = {fmt(rtol)} of the largest |value| plus the design's atol. "
+            "A case without a dt/4 run shows only whether dt and dt/2 agree within that "
+            "tolerance, which is no convergence.\n\n"
+            + case_convergence_table(cases, labels))
 
 
 def case_rows(items: Iterable[tuple[str, object]], cells: Callable[[object], Sequence[object]],

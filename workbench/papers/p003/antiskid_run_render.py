@@ -13,7 +13,8 @@ import math
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
 from ...printed_grid import quantised
 from ...report.binned_fractions import binned_fraction_rows
-from ...report.case_tables import CaseLevels, case_convergence_table, case_metric_table, case_rows
+from ...features.montecarlo_render import montecarlo_figures
+from ...report.case_tables import CaseLevels, case_convergence_section, case_metric_table, case_rows
 from ...report.delay_cross_check import delay_cross_check, plot_envelopes
 from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
 from ...sim.convergence import P_MIN
@@ -114,14 +115,8 @@ def render(design, res) -> Rendered:
         figs += (Figure("basin", "Certified basin of the cruise law (61), switch states.",
                         lambda fig, b=res.basin.basin: plot_basin(fig, b), (7.0, 5.0)),)
     if res.montecarlo is not None:
-        from .antiskid_montecarlo_render import draw_histograms, draw_outcomes, draw_rates
-        figs += (
-            Figure("montecarlo-histograms", "Monte Carlo: histograms of the summary metrics.",
-                   lambda fig, mc=res.montecarlo: draw_histograms(fig, mc), (9.0, 3.2)),
-            Figure("montecarlo-rates", "Monte Carlo: outcome rates, Wilson 95 % intervals.",
-                   lambda fig, mc=res.montecarlo: draw_rates(fig, mc), (6.0, 2.8)),
-            Figure("montecarlo-outcomes", "Monte Carlo: outcome of each run against its draws.",
-                   lambda fig, mc=res.montecarlo: draw_outcomes(fig, mc), (9.0, 3.8)))
+        from .antiskid_montecarlo_render import draw_histograms, draw_outcomes
+        figs += montecarlo_figures(res.montecarlo, draw_histograms, draw_outcomes)
     sections.append(
         "## Figures\n\n"
         "![speed]({figdir}/speed.png)\n\nSpeed and wheel speed of every case (a case "
@@ -246,16 +241,7 @@ def _convergence_section(res, spec) -> str:
                          None if c.quarter is None else c.quarter[0],
                          c.converged if c.quarter is None
                          else {k: k not in c.unconverged for k in _LABELS}) for c in res.cases]
-    return ("## Convergence in the step size\n\nEvery metric computed at dt = "
-            f"{fmt(res.dt)} s and dt/2 = {fmt(res.dt / 2)} s (reported), and at dt/4 for a "
-            "case whose convergence a claim states. Converged: the Richardson error "
-            "estimate of the three levels (`workbench.features.refinement.guarded_check`; levels "
-            "whose differences change sign are not in the asymptotic range and are "
-            f"estimated from the larger difference at order {fmt(P_MIN)}) is within "
-            f"rtol = {fmt(spec.conv_rtol)} of the largest |value| plus the design's atol. "
-            "A case without a dt/4 run shows only whether dt and dt/2 agree within that "
-            "tolerance, which is no convergence.\n\n"
-            + case_convergence_table(levels, _LABELS))
+    return case_convergence_section(levels, _LABELS, res.dt, spec.conv_rtol, P_MIN)
 
 
 def _linear_section(res) -> str:
