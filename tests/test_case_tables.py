@@ -15,7 +15,8 @@ import pytest
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from workbench.report.case_figures import Palette, plot_cases, snapped, time_window  # noqa: E402
+from workbench.report.case_figures import (Palette, plot_cases, plot_phase_plane,  # noqa: E402
+                                           snapped, time_window)
 from workbench.report.case_tables import (CaseLevels, case_convergence_section,  # noqa: E402
                                           case_convergence_table, case_metric_table, case_rows,
                                           fmt_finite)
@@ -148,6 +149,15 @@ def test_case_figure_colours_snapped_data_and_grid_ends():
     assert not np.array_equal(moved, y["slow"])
     plt.close(fig)
     assert time_window(12.3, 1.0, 4.0) == (11, 15.0)
+    fig = plt.figure()
+    ax = fig.add_subplot(111)
+    plot_phase_plane(ax, [(n, t, y[n]) for n in CASES], color_of, lw=0.8)
+    path, start, end = ax.get_lines()[:3]                    # the slow case: path, o, x
+    assert path.get_label() == "slow" and path.get_linewidth() == 0.8
+    assert (start.get_marker(), end.get_marker()) == ("o", "x")
+    assert end.get_xydata().tolist() == [[2.0, y["slow"][-1]]]
+    assert {ln.get_color() for ln in ax.get_lines()[3:]} == {"tab:green"}
+    plt.close(fig)
 
 
 def test_binned_fractions_last_bin_closed_and_empty_bin_dashed():

@@ -26,8 +26,9 @@ from workbench.features.montecarlo_chunks import (Chunk, FolderTaken, Group, chu
                                                   start_chunks, start_streaming, write_npz)
 from workbench.features.montecarlo_halving import (HalvingCheck, halving_quantity_names,
                                                    start_halving)
-from workbench.features.montecarlo_render import (draw_outcome_scatter, halving_section,
-                                                  halving_tables, montecarlo_figures,
+from workbench.features.montecarlo_render import (DRAWS_TEXT, draw_outcome_scatter,
+                                                  halving_section, halving_tables,
+                                                  montecarlo_figures, rates_text,
                                                   summary_tables)
 from workbench.features.montecarlo_stats import (OK, RunsResult, finite_span, quantity_names,
                                                  summary_row)
@@ -273,6 +274,9 @@ def test_outcome_scatter_and_report_figures_of_a_toy_sweep():
     figs = montecarlo_figures(res, lambda fig, r: fig.subplots(), lambda fig, r: None)
     assert [f.name for f in figs] == ["montecarlo-histograms", "montecarlo-rates",
                                       "montecarlo-outcomes"]
+    for f in figs:                          # the report's text shows each figure
+        assert f"({{figdir}}/{f.name}.png)" in rates_text(N) + DRAWS_TEXT
+    assert f"(the {N} runs as independent trials;" in rates_text(N)
     fig = plt.figure()
     figs[1].draw(fig)                                              # the rates of the toy
     assert len(fig.axes[0].get_yticklabels()) == len(res.outcome_rates())

@@ -17,9 +17,15 @@ import numpy as np
 
 from ..report.markdown import Figure, fmt, md_table
 
-__all__ = ["draw_histograms", "draw_outcome_scatter", "draw_rates", "halving_section",
-           "halving_tables", "montecarlo_figures", "rate_text", "refined_runs_text",
-           "summary_tables"]
+__all__ = ["DRAWS_TEXT", "draw_histograms", "draw_outcome_scatter", "draw_rates",
+           "halving_section", "halving_tables", "montecarlo_figures", "rate_text",
+           "rates_text", "refined_runs_text", "summary_tables"]
+
+#: Markdown of the histograms and outcome figures of :func:`montecarlo_figures`.
+DRAWS_TEXT = ("![Monte Carlo histograms]({figdir}/montecarlo-histograms.png)\n\n"
+              "Histograms of the summary metrics (finite values only).\n\n"
+              "![Monte Carlo outcomes]({figdir}/montecarlo-outcomes.png)\n\n"
+              "Each run at its draws, marked by its outcome.")
 
 
 def rate_text(k: int, n: int, lo: float, hi: float) -> str:
@@ -28,6 +34,15 @@ def rate_text(k: int, n: int, lo: float, hi: float) -> str:
     down = math.floor(1000 * lo) / 10
     up = math.ceil(1000 * hi) / 10
     return f"{k} / {n} = {100 * k / n:.1f} % [{down:.1f}, {up:.1f}] %"
+
+
+def rates_text(n: int) -> str:
+    """Markdown under :func:`summary_tables` of ``n`` runs: how its rates'
+    intervals are computed and printed, and the rates figure of
+    :func:`montecarlo_figures`."""
+    return ("Each outcome's rate is given with its Wilson 95 % score interval (the "
+            f"{n} runs as independent trials; the interval's ends rounded outwards).\n\n"
+            "![Monte Carlo rates]({figdir}/montecarlo-rates.png)")
 
 
 def summary_tables(res, sig: int, labels: dict) -> str:

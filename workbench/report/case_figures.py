@@ -45,6 +45,17 @@ def plot_cases(ax, traces: Iterable[tuple], color_of, scale: float, **style) -> 
         ax.plot(t, snapped(y, scale), color=color_of(name), label=label, **style)
 
 
+def plot_phase_plane(ax, traces: Iterable[tuple], color_of, **style) -> None:
+    """One path per trace (case name, x, y) in the case's colour, labelled
+    with the name, its start marked ``o`` and its end ``x``; the data as
+    given (snap them, :func:`snapped`, where a few ulp could move a pixel);
+    ``style`` passes to the path's ``ax.plot``."""
+    for name, x, y in traces:
+        ax.plot(x, y, color=color_of(name), label=name, **style)
+        ax.plot(x[0], y[0], "o", color=color_of(name), ms=4)
+        ax.plot(x[-1], y[-1], "x", color=color_of(name), ms=6)
+
+
 def time_window(t_event: float, before: float, width: float) -> tuple[float, float]:
     """An x range of ``width`` seconds from the whole second at or below
     ``t_event - before``: ends on a grid, not on the data."""

@@ -14,7 +14,7 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, CreepSpeedProfile
 from ...printed_grid import axis_end
-from ...report.case_figures import Palette, plot_cases, time_window
+from ...report.case_figures import Palette, plot_cases, plot_phase_plane, time_window
 from ...sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
 
 #: The colour of a case in every figure.
@@ -65,11 +65,8 @@ def plot_adhesion(fig, res, spec):
     for c in res.cases:
         x = np.clip(c.run.x[1], -0.6, 0.6)
         ax_mu.plot(x, mu(x), ".", ms=2, color=color_of(c.case.name), label=c.case.name)
-        ax_pp.plot(c.run.x[0], np.clip(c.run.x[1], -1, 1), color=color_of(c.case.name), lw=0.8,
-                   label=c.case.name)
-        ax_pp.plot(c.run.x[0][0], c.run.x[1][0], "o", color=color_of(c.case.name), ms=4)
-        ax_pp.plot(c.run.x[0][-1], np.clip(c.run.x[1][-1], -1, 1), "x",
-                   color=color_of(c.case.name), ms=6)
+    plot_phase_plane(ax_pp, [(c.case.name, c.run.x[0], np.clip(c.run.x[1], -1, 1))
+                             for c in res.cases], color_of, lw=0.8)
     for a in (res.lambda_opt, -res.lambda_opt):
         ax_mu.axvline(a, color="gray", ls="--", lw=0.8)
     ax_mu.set_xlabel("creep ratio lambda")

@@ -13,7 +13,7 @@ import math
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
 from ...printed_grid import quantised
 from ...report.binned_fractions import binned_fraction_rows
-from ...features.montecarlo_render import montecarlo_figures
+from ...features.montecarlo_render import DRAWS_TEXT, montecarlo_figures, rates_text
 from ...report.case_tables import CaseLevels, case_convergence_section, case_metric_table, case_rows
 from ...report.delay_cross_check import delay_cross_check, plot_envelopes
 from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
@@ -291,19 +291,13 @@ def _montecarlo_section(design, mc, halving=None) -> str:
         "transient at dt |J| ~ 40, is not resolved by the fixed step on mismatched plants "
         "(in the halving check dt/2 moved it by up to 13 s); whether a run stops is the "
         "`not stopped` row):\n\n"
-        + summary_tables(mc, 3)
-        + "\n\nEach outcome's rate is given with its Wilson 95 % score interval (the "
-        f"{mc.n} runs as independent trials; the interval's ends rounded outwards).\n\n"
-        "![Monte Carlo rates]({figdir}/montecarlo-rates.png)\n\n"
-        "The rates of the table with their intervals (the claims `mc-*-vs-full` and "
+        + summary_tables(mc, 3) + "\n\n" + rates_text(mc.n) + "\n\nThe rates of the table "
+        "with their intervals (the claims `mc-*-vs-full` and "
         "`mc-perturbations-raise-divergence` compare these intervals with full sweeps)."
         + "\n\nBy adhesion (s = 0 wet, s = 1 dry):\n\n"
         + md_table(["adhesion s", "runs", "fraction diverged", "fraction above lambda_opt"],
                    brows, "lrrr")
-        + "\n\n![Monte Carlo histograms]({figdir}/montecarlo-histograms.png)\n\n"
-        "Histograms of the summary metrics (finite values only).\n\n"
-        "![Monte Carlo outcomes]({figdir}/montecarlo-outcomes.png)\n\n"
-        "Each run at its draws, marked by its outcome."
+        + "\n\n" + DRAWS_TEXT
         + ("" if halving is None else "\n\n### Step-size check of the Monte Carlo runs\n\n"
            + halving_section(halving, design.spec)))
 
