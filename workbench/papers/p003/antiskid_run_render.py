@@ -2,8 +2,9 @@
 
 The layout is general (:mod:`workbench.report.case_tables`: per-case metrics
 and convergence tables, rows per case; :mod:`workbench.report.delay_cross_check`:
-the linear cross-check of the LMI delay bound; :mod:`workbench.report.case_figures`).
-What stays here is paper 003's: the wording of the scenario, of the phase
+the linear cross-check of the LMI delay bound; :mod:`workbench.report.case_figures`;
+:mod:`workbench.features.montecarlo_render`: the Monte Carlo tables, figures and
+their text). What stays here is paper 003's: the wording of the scenario, of the phase
 switches of controller (75) and of the numerics, the metric labels, the
 creep-ratio and lambda_opt lines."""
 from __future__ import annotations
