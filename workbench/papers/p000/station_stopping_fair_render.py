@@ -4,8 +4,6 @@ Carlo (pure rendering of a
 :class:`~workbench.papers.p000.station_stopping_run.StopResult`)."""
 from __future__ import annotations
 
-import numpy as np
-
 from ...kinds.stop_accuracy.render import mc_section, moving, plot_mc_panels
 from ...report.markdown import Figure, fmt, md_table
 from .station_stopping_run import loop_dead_time
