@@ -276,3 +276,21 @@ def test_error_colours_threshold_at_the_synthetic_tolerance():
     assert colour(0.99 * tol) == "#a6d96a" and colour(0.1 * tol) == "#1a9850"
     assert colour(1.01 * tol) == "#fdae61"
     assert colour(3.5 * tol) == "#67001f"
+
+
+@pytest.mark.parametrize("name", ["stopping-line5", "closed-loop-brake-004"])
+def test_every_paper_quantity_has_a_unit(name):
+    """Papers 000 and 004 declare their quantities once (Declared tables): every
+    claimable name has a unit, ``""`` only for the words ``order`` and ``best``
+    of paper 000; paper 004's worked numbers are distances, decelerations and
+    shares of section 1.3."""
+    d = load_design(ROOT / "designs" / f"{name}.toml")
+    study = REGISTRY[d.kind]
+    got = study.quantity_units(d.spec)
+    assert set(got) == study.quantity_names(d.spec)
+    assert all(u != "?" for u in got.values())
+    assert {n for n, u in got.items() if u == ""} <= {"order", "best"}
+    if name == "closed-loop-brake-004":
+        assert (got["worked.d1"], got["worked.a2"], got["worked.share[15permille,1]"]) == (
+            "m", "m/s^2", "%")
+    assert any(u == "m" for u in got.values()) and any(u == "1" for u in got.values())

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...features.quantities import Declared, names, values
+from ...features.quantities import Declared, names, units, values
 from ...kinds.stop_accuracy.quantities import mc_family, over
 from .station_stopping_spec import (ABLATION, COMPENSATED, CONTROLLERS, DAMPING, MC_CONTROLLERS,
                                     PAPER_CONTROLLERS, UNCOMPENSATED, load)
@@ -85,6 +85,9 @@ class StationStopping:
 
     def quantity_names(self, spec) -> set[str]:
         return names(TABLE, spec)
+
+    def quantity_units(self, spec) -> dict[str, str]:
+        return units(TABLE, spec)
 
     def run(self, spec):
         from .station_stopping_run import run_station_stops

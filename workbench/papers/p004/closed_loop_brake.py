@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...features.quantities import Declared, names, values
+from ...features.quantities import Declared, names, units, values
 from ...kinds.stop_accuracy.pipeline import open_loop_distance
 from ...kinds.stop_accuracy.quantities import mc_family
 from ...kinds.stop_accuracy.run import speed_key
@@ -188,8 +188,9 @@ _CH = {"ch": CHANNELS}
 
 #: The quantities paper 004's claims name, declared once.
 TABLE = (
-    Declared("worked.{k}", "", lambda r, k: r.worked[k],
-             over=lambda spec: [{"k": k} for k in compute_worked(spec.paper.worked)]),
+    Declared("worked.{k}", "{u}", lambda r, k, u: r.worked[k], over=lambda spec: [
+        {"k": k, "u": "%" if k.startswith("share") else "m/s^2" if k.startswith("a2") else "m"}
+        for k in compute_worked(spec.paper.worked)]),
     *(Declared("{b}.%s.max_abs_m" % m, "m", lambda r, b, s, m=m: r.max_abs(**_grid(r, s, m)),
                over=_speeds) for m in ("open", "ato-open")),
     Declared("{b}.closed.{ch}.max_abs_m", "m",
@@ -238,6 +239,9 @@ class ClosedLoopBrake:
 
     def quantity_names(self, spec) -> set[str]:
         return names(TABLE, spec)
+
+    def quantity_units(self, spec) -> dict[str, str]:
+        return units(TABLE, spec)
 
     def run(self, spec) -> Result004:
         return run_grid(view(spec))
