@@ -208,3 +208,89 @@ def test_monte_carlo_report_pieces_on_a_non_paper_design():
     x, y = ax.lines[0].get_data()
     assert list(x) == [-0.2, 0.1, 0.5] and y[-1] == 1.0 and len(ax.lines) == 3
     plt.close(fig)
+
+
+def test_monte_carlo_section_and_panels_on_a_non_paper_design():
+    """The Monte Carlo section and ECDF panels papers 000 and 004 share
+    (kinds/stop_accuracy/render.py) on the synthetic design: the heading at the
+    asked level with the design's tolerance, the draws and seed, one row per
+    member with its key cells and statistics; one panel per group on shared
+    axes, an ECDF per member scaled to the unit, the tolerance dashed."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from workbench.features.montecarlo import stop_statistics
+    from workbench.kinds.stop_accuracy.render import mc_section, plot_mc_panels
+    spec = load_design(SYNTH).spec
+    st = stop_statistics([0.1, -0.2, 0.5, 0.25], spec.tolerance)
+    text = mc_section(spec, "###", ", a note):", [(("a", "x"), st), (("b", "y"), st)],
+                      heads=("key", "group"), align="ll", unit="cm", error=lambda x: "E",
+                      alt="alt")
+    lines = text.splitlines()
+    assert lines[0].startswith("### Monte Carlo: P(|e| ≤ ")
+    assert f"{spec.montecarlo.samples} draws (seed {spec.montecarlo.seed};" in text
+    assert "a note):" in text and text.endswith("![alt]({figdir}/mc-stop-errors.png)")
+    rows = [ln for ln in lines if ln.startswith("| a ") or ln.startswith("| b ")]
+    assert len(rows) == 2 and "| x |" in rows[0] and rows[0].count("| E ") == 2
+    fig = plt.figure()
+    plot_mc_panels(fig, [("one", [("a", [0.1, -0.2])]), ("two", [("a", [0.3]), ("b", [0.0])])],
+                   0.3, unit="cm", scale=100)
+    one, two = fig.axes
+    assert [len(ax.lines) for ax in (one, two)] == [1 + 2, 2 + 2]
+    assert list(one.lines[0].get_xdata()) == [-20.0, 10.0]
+    assert [ln.get_xdata()[0] for ln in one.lines[1:]] == [-30.0, 30.0]
+    assert two.get_shared_x_axes().joined(one, two) and one.get_ylabel() and not two.get_ylabel()
+    assert two.get_xlabel() == "stop error (cm, + overshoot)"
+    plt.close(fig)
+
+
+def test_declared_families_on_a_non_paper_design():
+    """``over`` and ``mc_family`` (kinds/stop_accuracy/quantities.py) on the
+    synthetic design: a family per fixed name, and every Monte Carlo statistic
+    of every member with its unit, read from the member's statistics."""
+    from workbench.features.montecarlo import MC_QUANTITIES, stop_statistics
+    from workbench.features.quantities import names, units, values
+    from workbench.kinds.stop_accuracy.quantities import mc_family, over
+    spec = load_design(SYNTH).spec
+    st = {"a": stop_statistics([0.1, -0.2], 0.3), "b": stop_statistics([0.5], 0.3)}
+    table = (mc_family("{c}.mc", over(("a", "b")), lambda r, c: r[c]),)
+    assert names(table, spec) == {f"{c}.mc.{k}" for c in "ab" for k in MC_QUANTITIES}
+    assert units(table, spec)["a.mc.p95_abs_m"] == "m"
+    assert units(table, spec)["b.mc.p_within"] == "1"
+    q = values(table, spec, st)
+    assert q["a.mc.p_within"] == 1.0 and q["b.mc.p_within"] == 0.0
+    assert q["b.mc.mean_m"] == 0.5
+
+
+def test_error_colours_threshold_at_the_synthetic_tolerance():
+    """``error_colours`` (kinds/stop_accuracy/render.py) at the synthetic design's
+    tolerance: an |error| just inside it maps to a green, just beyond it to
+    orange, beyond three tolerances to the over colour."""
+    from matplotlib.colors import to_hex
+
+    from workbench.kinds.stop_accuracy.render import error_colours
+    tol = load_design(SYNTH).spec.tolerance
+    cmap, norm = error_colours(tol)
+    colour = lambda x: to_hex(cmap(norm(x)))
+    assert colour(0.99 * tol) == "#a6d96a" and colour(0.1 * tol) == "#1a9850"
+    assert colour(1.01 * tol) == "#fdae61"
+    assert colour(3.5 * tol) == "#67001f"
+
+
+@pytest.mark.parametrize("name", ["stopping-line5", "closed-loop-brake-004"])
+def test_every_paper_quantity_has_a_unit(name):
+    """Papers 000 and 004 declare their quantities once (Declared tables): every
+    claimable name has a unit, ``""`` only for the words ``order`` and ``best``
+    of paper 000; paper 004's worked numbers are distances, decelerations and
+    shares of section 1.3."""
+    d = load_design(ROOT / "designs" / f"{name}.toml")
+    study = REGISTRY[d.kind]
+    got = study.quantity_units(d.spec)
+    assert set(got) == study.quantity_names(d.spec)
+    assert all(u != "?" for u in got.values())
+    assert {n for n, u in got.items() if u == ""} <= {"order", "best"}
+    if name == "closed-loop-brake-004":
+        assert (got["worked.d1"], got["worked.a2"], got["worked.share[15permille,1]"]) == (
+            "m", "m/s^2", "%")
+    assert any(u == "m" for u in got.values()) and any(u == "1" for u in got.values())

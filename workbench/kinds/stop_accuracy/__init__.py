@@ -472,8 +472,8 @@ class StopAccuracy:
     def quantity_units(self, spec: StopAccuracySpec) -> dict[str, str]:
         from ...features.quantities import units
         from .quantities import TABLE
-        if spec.analysis is not None:
-            return {}
+        if spec.analysis is not None:   # a paper's module declares its own (or none)
+            return getattr(paper_analysis(spec.analysis), "quantity_units", lambda _: {})(spec)
         return units(TABLE, spec)
 
     def run(self, design):

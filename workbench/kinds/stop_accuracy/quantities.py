@@ -39,10 +39,35 @@ from ...features.montecarlo import MC_QUANTITIES
 from ...features.quantities import Declared
 from .run import speed_key
 
-__all__ = ["TABLE", "feasible"]
+__all__ = ["MC_UNITS", "TABLE", "feasible", "mc_family", "over"]
 
-_MC_UNITS = {"p_within": "1", "within_lo": "1", "within_hi": "1", "p95_abs_m": "m",
-             "mean_m": "m", "overshoot_share": "1"}
+#: Unit of each Monte Carlo statistic of :data:`~workbench.features.montecarlo.MC_QUANTITIES`.
+MC_UNITS = {"p_within": "1", "within_lo": "1", "within_hi": "1", "p95_abs_m": "m",
+            "mean_m": "m", "overshoot_share": "1"}
+
+
+def over(names, key: str = "c"):
+    """An ``over`` of :class:`Declared`: one member per name of ``names``
+    (fixed by the study, not read from the spec), as ``{key: name}``."""
+    return lambda spec: [{key: n} for n in names]
+
+
+def mc_family(prefix: str, members, stats) -> Declared:
+    """The Monte Carlo statistics ``<prefix>.<stat>`` (``stat`` of
+    :data:`~workbench.features.montecarlo.MC_QUANTITIES`) of every member.
+
+    Parameters
+    ----------
+    prefix : str
+        Name template over the members' keys (``"{s}.{c}.mc"``).
+    members : callable
+        ``members(spec) -> iterable of dict``: the index of each member.
+    stats : callable
+        ``stats(result, **index) -> StopStatistics`` of one member.
+    """
+    return Declared(prefix + ".{k}", "{u}", lambda r, k, u, **ix: getattr(
+        stats(r, **ix), MC_QUANTITIES[k]), over=lambda spec: [
+            x | {"k": k, "u": MC_UNITS[k]} for x in members(spec) for k in MC_QUANTITIES])
 
 
 def _speeds(spec):
@@ -59,9 +84,7 @@ def _faults(spec):
 
 
 def _mc(spec):
-    if spec.montecarlo is None:
-        return []
-    return [x | {"k": k, "u": _MC_UNITS[k]} for x in _cases(spec) for k in MC_QUANTITIES]
+    return [] if spec.montecarlo is None else _cases(spec)
 
 
 def _grid(spec):
@@ -135,8 +158,7 @@ TABLE = (
     Declared("{s}.{c}.fault[{f}].change_m", "m",
              lambda r, s, speed, c, f: _finite(abs(r.faults[speed, c, f] - r.nominal[speed, c])),
              over=_faults),
-    Declared("{s}.{c}.mc.{k}", "{u}", lambda r, s, speed, c, k, u: getattr(
-        r.mc[speed, c], MC_QUANTITIES[k]), over=_mc),
+    mc_family("{s}.{c}.mc", _mc, lambda r, s, speed, c: r.mc[speed, c]),
     Declared("{s}.{c}.grid.max_abs_m", "m", _grid_max, over=_grid),
     Declared("{s}.{c}.grid.failing_corners", "1", lambda r, s, speed, c: float(sum(
         not abs(x) <= r.spec.tolerance for x in r.grid[speed, c])), over=_grid),

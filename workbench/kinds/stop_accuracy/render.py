@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from ...report.markdown import Rendered, fmt, md_table
 
-__all__ = ["distribution_table", "mc_cells", "plot_ecdf", "render", "tolerance_lines"]
+__all__ = ["distribution_table", "error_colours", "mc_cells", "mc_section", "moving",
+           "plot_ecdf", "plot_mc_panels", "quantity_table", "render", "tolerance_lines"]
 
 
 def _mm(x) -> str:
@@ -42,8 +43,6 @@ def render(design, res) -> Rendered:
 
 
 def _problem(spec) -> str:
-    par = [[f"`{k}`", fmt(q.value, 6), q.unit, q.source] for k, q in spec.params.items()]
-    const = [[f"`{k}`", fmt(q.value, 6), q.unit, q.source] for k, q in spec.constants.items()]
     ctl = [[f"`{c.name}`", "; ".join(f"{k} = `{t}`" for k, t in c.definitions) or "—",
             _law_text(c)] for c in spec.controllers]
     target = (f"D = {fmt(spec.distance, 6)} m" if spec.distance is not None else
@@ -57,9 +56,9 @@ def _problem(spec) -> str:
            "the design's text, parsed by `workbench/expr.py` (never evaluated) and checked "
            "to be in m/s². Stop error = standstill position − D (+ = overshoot); "
            f"platform tolerance ±{fmt(spec.tolerance)} m.\n\n"
-           + md_table(["parameter", "value", "unit", "source"], par, "lrll"))
-    if const:
-        out += "\n\n" + md_table(["constant", "value", "unit", "source"], const, "lrll")
+           + quantity_table("parameter", spec.params, 6))
+    if spec.constants:
+        out += "\n\n" + quantity_table("constant", spec.constants, 6)
     out += "\n\n" + md_table(["controller", "definitions", "brake command (m/s²)"], ctl, "lll")
     if spec.factors:
         rows = [[f"`{f.name}`", f.effect + (" " + ", ".join(f.parameters) if f.parameters
@@ -81,6 +80,13 @@ def _problem(spec) -> str:
                     "maximum; where every axle is s or f the loop is off (the law alone). "
                     "A controller without the module does not read the axles.")
     return out
+
+
+def quantity_table(head: str, quantities: dict, digits: int) -> str:
+    """The table of ``quantities`` (name -> :class:`~workbench.reader.Quantity`):
+    name (column ``head``), value to ``digits`` significant digits, unit, source."""
+    rows = [[f"`{k}`", fmt(q.value, digits), q.unit, q.source] for k, q in quantities.items()]
+    return md_table([head, "value", "unit", "source"], rows, "lrll")
 
 
 def _law_text(c) -> str:
@@ -264,3 +270,62 @@ def tolerance_lines(ax, tol: float) -> None:
     """Dashed vertical lines at -tol and +tol on ``ax``."""
     for x in (-tol, tol):
         ax.axvline(x, color="k", ls="--", lw=0.8)
+
+
+def mc_section(spec, level: str, intro: str, rows, *, heads, align: str, unit: str, error,
+               alt: str) -> str:
+    """A Monte Carlo section of an ``[analysis]`` report: its heading (``level``:
+    ``"##"``, ``"###"``), the draws and ``intro``, the ``[montecarlo]``
+    distributions and one row per ``(key cells, StopStatistics)`` of ``rows``
+    (columns ``heads`` aligned ``align``, then :func:`mc_cells` with errors
+    in ``unit`` written by ``error``), and the figure ``mc-stop-errors``."""
+    tol, mc = fmt(spec.tolerance), spec.montecarlo
+    return (f"{level} Monte Carlo: P(|e| ≤ {tol} m) over continuous distributions\n\n"
+            f"{mc.samples} draws (seed {mc.seed}; `workbench/studies/stopping_mc.py`{intro}\n\n"
+            + distribution_table(spec) + "\n\n"
+            + md_table(list(heads) + [f"stops within {tol} m", f"P(|e| ≤ {tol} m)",
+                                      "Wilson 95 % interval", f"95th percentile of |e| ({unit})",
+                                      f"mean e ({unit})", "overshoots (%)"],
+                       [list(k) + mc_cells(st, error) for k, st in rows], align + "rrrrrr")
+            + f"\n\n![{alt}]({{figdir}}/mc-stop-errors.png)")
+
+
+def plot_mc_panels(fig, panels, tol: float, *, unit: str = "m", scale: float = 1.0,
+                   linthresh: float | None = None) -> None:
+    """The empirical distributions of Monte Carlo stop errors, one panel per
+    ``(title, ((label, errors (m)), ...))`` of ``panels``, side by side on
+    shared axes, with the tolerance ``tol`` (m) dashed; errors and tolerance
+    drawn times ``scale`` in ``unit`` (symlog axis with ``linthresh``)."""
+    import numpy as np
+    first = None
+    for i, (title, curves) in enumerate(panels):
+        ax = fig.add_subplot(1, len(panels), i + 1, sharex=first, sharey=first)
+        first = first or ax
+        for k, (label, errors) in enumerate(curves):
+            plot_ecdf(ax, scale * np.asarray(errors, float), color=f"C{k}", label=label)
+        tolerance_lines(ax, scale * tol)
+        if linthresh is not None:
+            ax.set_xscale("symlog", linthresh=linthresh)
+        ax.set_xlabel(f"stop error ({unit}, + overshoot)")
+        ax.set_title(title, fontsize=9)
+        ax.legend(fontsize=7, loc="upper left")
+    first.set_ylabel("fraction of stops ≤ error")
+
+
+def error_colours(tol: float):
+    """A threshold colour map of |stop error| for a tolerance ``tol`` (m):
+    greens within the tolerance, orange to dark red beyond it (no failing
+    cell can look green), and its norm (bounds 0, tol/2, tol, 1.5 tol, 2 tol,
+    3 tol; darker above): ``(cmap, norm)`` for ``imshow``."""
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    cmap = ListedColormap(["#1a9850", "#a6d96a", "#fdae61", "#f46d43", "#d73027"])
+    cmap.set_over("#67001f")
+    bounds = [0.0, tol / 2, tol, 1.5 * tol, 2 * tol, 3 * tol]
+    return cmap, BoundaryNorm(bounds, cmap.N)
+
+
+def moving(v):
+    """Mask of the samples of a speed trace ``v`` up to the first standstill
+    (the first sample, then every one with ``v > 0``): where a stop's curve is drawn."""
+    import numpy as np
+    return np.concatenate(([True], v[1:] > 0))[:len(v)]

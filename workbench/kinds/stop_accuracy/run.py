@@ -31,9 +31,9 @@ import numpy as np
 from ...jsonable import json_method
 from .pipeline import LAW_NAMES, apply_factors, group_statistics, open_loop_distance
 
-__all__ = ["StopAccuracyResult", "compile_laws", "montecarlo_draws", "run", "run_sections",
-           "section_runs", "section_statistics", "simulate_cases", "simulate_runs",
-           "stopping_points", "speed_key"]
+__all__ = ["StopAccuracyResult", "compile_laws", "montecarlo_draws", "montecarlo_statistics",
+           "run", "run_sections", "section_runs", "section_statistics", "simulate_cases",
+           "simulate_runs", "stopping_points", "speed_key"]
 
 
 def speed_key(s: float) -> str:
@@ -262,6 +262,16 @@ def montecarlo_draws(spec, mc) -> dict:
     return {k: v for k, v in d.items() if k in mc.distributions}
 
 
+def montecarlo_statistics(spec, laws, cases, keys, dt_rec=None) -> dict:
+    """key -> :class:`~workbench.features.montecarlo.StopStatistics` (m) of
+    each of ``cases`` [(speed km/h, controller index, fault or None, D m)]
+    over the ``[montecarlo]`` draws of ``spec``, every case meeting the same
+    draws (common random numbers); ``keys`` names the cases in order."""
+    mc = spec.montecarlo
+    tr, D = simulate_cases(spec, laws, spec.dt, cases, montecarlo_draws(spec, mc), dt_rec=dt_rec)
+    return group_statistics(tr.x_stop - D, keys, mc.samples, spec.tolerance)
+
+
 def section_runs(spec, laws, dt: float):
     """Every repeating controller's repeats on every section, in one batch
     (:func:`simulate_runs`; [[sections]], [repeats], :mod:`.sections`).
@@ -326,12 +336,9 @@ def run(spec, claims=()) -> StopAccuracyResult:
               for s in spec.speeds_kmh for c in spec.controllers for f in spec.faults}
     mc = {}
     if spec.montecarlo is not None:
-        m = spec.montecarlo
-        d = montecarlo_draws(spec, m)
         cases = [(s, i, None, D[s]) for s in spec.speeds_kmh for i in range(len(laws))]
-        err, _ = _simulate(spec, laws, spec.dt, cases, draws=d)
-        mc = group_statistics(err, [(s, spec.controllers[i].name) for s, i, _, _ in cases],
-                              m.samples, spec.tolerance)
+        mc = montecarlo_statistics(spec, laws, cases,
+                                   [(s, spec.controllers[i].name) for s, i, _, _ in cases])
     grid = {}
     if spec.grid:
         import itertools

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...fit import FITTED, FitResult, existing_rmse, fit, model_speeds, synthetic_log
+from ...features.quantities import Declared, names, values
 from ...jsonable import json_method
 from ...kinds.stop_accuracy.pipeline import read_brake_plant
 from ...reader import Reader
@@ -83,18 +84,45 @@ def _load(root: Reader) -> FitSpec:
             raise b.fail(k, [lo, hi], "two bounds [lo, hi] with lo < hi")
         bounds.append((lo, hi))
     b.finish()
-    spec = FitSpec(params, tuple(logs), *noise, bounds=np.array(bounds),
-                   flies=ft.number("flies", integer=True, lo=4, hi=1000),
-                   iterations=ft.number("iterations", integer=True, lo=1, hi=10000),
-                   dt=ft.number("dt", positive=True, hi=0.1))
-    if abs(spec.dt_log / spec.dt - round(spec.dt_log / spec.dt)) > 1e-9:
-        raise ft.fail("dt", spec.dt, "a step dividing noise.dt_log")
+    flies = ft.number("flies", integer=True, lo=4, hi=1000)
+    iterations = ft.number("iterations", integer=True, lo=1, hi=10000)
+    dt = ft.number("dt", positive=True, hi=0.1)
+    if abs(noise[0] / dt - round(noise[0] / dt)) > 1e-9:
+        raise ft.fail("dt", dt, "a step dividing noise.dt_log")
     ft.finish()
     ex = root.table("existing")
-    spec = FitSpec(**{**spec.__dict__, "delay": ex.quantity("delay", "s", positive=True).value,
-                      "lag": ex.quantity("lag", "s", positive=True).value})
+    spec = FitSpec(params, tuple(logs), *noise, bounds=np.array(bounds), flies=flies,
+                   iterations=iterations, dt=dt,
+                   delay=ex.quantity("delay", "s", positive=True).value,
+                   lag=ex.quantity("lag", "s", positive=True).value)
     ex.finish()
     return spec
+
+
+def _with_ratio(values: dict) -> dict:
+    """``values`` (name -> value of :data:`~workbench.fit.FITTED`) and K1/K2,
+    the ratio eq 7 identifies (K1 and K2 alone are not)."""
+    return {**values, "K1/K2": values["K1"] / values["K2"]}
+
+
+def _relative_errors(res: FitStudyResult, r: FitResult) -> dict:
+    """name -> fitted / true - 1 of the fit ``r`` (with K1/K2)."""
+    got, tru = _with_ratio(dict(zip(FITTED, r.values))), _with_ratio(res.truth)
+    return {k: got[k] / tru[k] - 1 for k in got}
+
+
+#: The claimable quantities of a ``brake-fit`` design, declared once.
+TABLE = (
+    Declared("rmse.precise_foa", "cm/s", lambda r: r.foa.rmse),
+    Declared("rmse.precise_de", "cm/s", lambda r: r.de.rmse),
+    Declared("rmse.truth", "cm/s", lambda r: r.rmse_truth),
+    Declared("rmse.existing", "cm/s", lambda r: r.rmse_existing),
+    Declared("rmse.ratio_existing_over_precise", "1", lambda r: r.rmse_existing / r.foa.rmse),
+    Declared("{m}.{k}.rel_error", "1",
+             lambda r, m, k: abs(_relative_errors(r, getattr(r, m))[k]),
+             over=lambda spec: [{"m": m, "k": k} for m in ("foa", "de")
+                                for k in FITTED + ("K1/K2",)]),
+)
 
 
 class BrakeFit:
@@ -105,11 +133,7 @@ class BrakeFit:
         return _load(root)
 
     def quantity_names(self, spec) -> set[str]:
-        names = {"rmse.precise_foa", "rmse.precise_de", "rmse.truth", "rmse.existing",
-                 "rmse.ratio_existing_over_precise"}
-        for m in ("foa", "de"):
-            names |= {f"{m}.{k}.rel_error" for k in FITTED + ("K1/K2",)}
-        return names
+        return names(TABLE, spec)
 
     def run(self, design) -> FitStudyResult:
         s: FitSpec = design.spec
@@ -136,28 +160,18 @@ class BrakeFit:
                               ex, curves)
 
     def quantities(self, res: FitStudyResult) -> dict:
-        q = {"rmse.precise_foa": res.foa.rmse, "rmse.precise_de": res.de.rmse,
-             "rmse.truth": res.rmse_truth, "rmse.existing": res.rmse_existing,
-             "rmse.ratio_existing_over_precise": res.rmse_existing / res.foa.rmse}
-        for r in (res.foa, res.de):
-            got = dict(zip(FITTED, r.values))
-            got["K1/K2"] = got["K1"] / got["K2"]
-            tru = dict(res.truth, **{"K1/K2": res.truth["K1"] / res.truth["K2"]})
-            for k in got:
-                q[f"{r.method}.{k}.rel_error"] = abs(got[k] / tru[k] - 1)
-        return q
+        return values(TABLE, None, res)
 
 
 def recovery_rows(res: FitStudyResult):
     """Header and rows of the recovery table (shared by the report and the CLI)."""
-    tru = dict(res.truth, **{"K1/K2": res.truth["K1"] / res.truth["K2"]})
+    tru = _with_ratio(res.truth)
+    rel = [_relative_errors(res, r) for r in (res.foa, res.de)]
     rows = []
-    for k in FITTED + ("K1/K2",):
+    for k in tru:
         row = [k, fmt(tru[k], 5)]
-        for r in (res.foa, res.de):
-            got = dict(zip(FITTED, r.values))
-            got["K1/K2"] = got["K1"] / got["K2"]
-            row += [fmt(got[k], 5), fmt(100 * (got[k] / tru[k] - 1), 3)]
+        for r, e in zip((res.foa, res.de), rel):
+            row += [fmt(_with_ratio(dict(zip(FITTED, r.values)))[k], 5), fmt(100 * e[k], 3)]
         rows.append(row)
     rows.append(["RMSE (cm/s)", fmt(res.rmse_truth, 4), fmt(res.foa.rmse, 4), "",
                  fmt(res.de.rmse, 4), ""])

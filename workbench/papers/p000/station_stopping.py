@@ -13,11 +13,68 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...features.montecarlo import MC_QUANTITIES
-from .station_stopping_spec import (COMPENSATED, CONTROLLERS, DAMPING, MC_CONTROLLERS,
-                                    PAPER_CONTROLLERS, UNCOMPENSATED, VARIANTS, load)
+from ...features.quantities import Declared, names, units, values
+from ...kinds.stop_accuracy.quantities import mc_family, over
+from .station_stopping_spec import (ABLATION, COMPENSATED, CONTROLLERS, DAMPING, MC_CONTROLLERS,
+                                    PAPER_CONTROLLERS, UNCOMPENSATED, load)
 
-__all__ = ["ANALYSIS", "StationStopping"]
+__all__ = ["ANALYSIS", "StationStopping", "TABLE"]
+
+
+def _per(r, c: str, attr: str) -> list:
+    """``attr`` of the section statistics of controller ``c``, per section."""
+    return [getattr(r.stats[c, i], attr) for i in range(len(r.sections))]
+
+
+def _order(r) -> list:
+    """The paper's controllers by mean |stop error| over the sections, best first."""
+    return sorted(PAPER_CONTROLLERS, key=r.overall)
+
+
+def _cells(spec) -> list:
+    return [{"c": c, "k": i + 1, "i": i} for c in CONTROLLERS
+            for i in range(len(spec.sections.sections))]
+
+
+def _mc(r, group) -> list:
+    return [r.mc[c] for c in group]
+
+
+#: The quantities paper 000's claims name (the paper's rows), declared once.
+TABLE = (
+    Declared("{c}.mean_abs_cm", "cm", lambda r, c: r.overall(c), over=over(CONTROLLERS)),
+    Declared("{c}.worst_section_mean_abs_cm", "cm", lambda r, c: max(_per(r, c, "mean_abs")),
+             over=over(CONTROLLERS)),
+    Declared("{c}.worst_section_var_cm2", "cm^2", lambda r, c: max(_per(r, c, "var")),
+             over=over(CONTROLLERS)),
+    Declared("{c}.best_section_mean_abs_cm", "cm", lambda r, c: min(_per(r, c, "mean_abs")),
+             over=over(CONTROLLERS)),
+    Declared("{c}.jerk_mean", "m/s^3", lambda r, c: float(np.mean(_per(r, c, "jerk_mean"))),
+             over=over(CONTROLLERS)),
+    Declared("{c}.sections[{k}].mean_abs_cm", "cm", lambda r, c, k, i: r.stats[c, i].mean_abs,
+             over=_cells),
+    Declared("{c}.sections[{k}].var_cm2", "cm^2", lambda r, c, k, i: r.stats[c, i].var,
+             over=_cells),
+    Declared("order", "", lambda r: "<".join(_order(r))),
+    Declared("best", "", lambda r: _order(r)[0]),
+    Declared("{c}.nominal_m", "m", lambda r, c: r.nominal[c].error,
+             over=over(MC_CONTROLLERS + ABLATION)),
+    mc_family("{c}.mc", over(MC_CONTROLLERS), lambda r, c: r.mc[c]),
+    Declared("{c}.damping_zeta", "1", lambda r, c: r.damping[c].zeta, over=over(DAMPING)),
+    Declared("{c}.damping_period_s", "s", lambda r, c: r.damping[c].period, over=over(DAMPING)),
+    Declared("{c}.speed_sign_changes", "1", lambda r, c: float(r.nominal[c].sign_changes),
+             over=over(DAMPING)),
+    Declared("mc.compensation_margin", "1", lambda r: min(s.lo for s in _mc(r, COMPENSATED))
+             - max(s.hi for s in _mc(r, UNCOMPENSATED))),
+    Declared("mc.compensated_max_abs_mean_m", "m",
+             lambda r: max(abs(s.mean) for s in _mc(r, COMPENSATED))),
+    Declared("mc.uncompensated_min_overshoot_share", "1",
+             lambda r: min(s.overshoot for s in _mc(r, UNCOMPENSATED))),
+    Declared("mc.compensated_spread", "1", lambda r: max(s.p for s in _mc(r, COMPENSATED))
+             - min(s.p for s in _mc(r, COMPENSATED))),
+    Declared("nominal.compensated_max_abs_m", "m",
+             lambda r: max(abs(r.nominal[c].error) for c in COMPENSATED)),
+)
 
 
 class StationStopping:
@@ -27,57 +84,17 @@ class StationStopping:
         return load(root, spec)
 
     def quantity_names(self, spec) -> set[str]:
-        names = {"order", "best", "mc.compensation_margin", "mc.compensated_max_abs_mean_m",
-                 "mc.uncompensated_min_overshoot_share", "mc.compensated_spread",
-                 "nominal.compensated_max_abs_m"}
-        for c in CONTROLLERS:
-            names |= {f"{c}.mean_abs_cm", f"{c}.worst_section_mean_abs_cm",
-                      f"{c}.worst_section_var_cm2",
-                      f"{c}.best_section_mean_abs_cm", f"{c}.jerk_mean"}
-            for i in range(len(spec.sections.sections)):
-                names |= {f"{c}.sections[{i + 1}].mean_abs_cm", f"{c}.sections[{i + 1}].var_cm2"}
-        for c in MC_CONTROLLERS:
-            names |= {f"{c}.nominal_m"} | {f"{c}.mc.{k}" for k in MC_QUANTITIES}
-        for c in DAMPING:
-            names |= {f"{c}.damping_zeta", f"{c}.damping_period_s", f"{c}.speed_sign_changes"}
-        names |= {f"{c}.nominal_m" for c in VARIANTS if "+" in c}
-        return names
+        return names(TABLE, spec)
+
+    def quantity_units(self, spec) -> dict[str, str]:
+        return units(TABLE, spec)
 
     def run(self, spec):
         from .station_stopping_run import run_station_stops
         return run_station_stops(spec)
 
     def quantities(self, res) -> dict:
-        q = {}
-        ns = len(res.sections)
-        for c in CONTROLLERS:
-            per = [res.stats[c, i].mean_abs for i in range(ns)]
-            q[f"{c}.mean_abs_cm"] = res.overall(c)
-            q[f"{c}.worst_section_mean_abs_cm"] = max(per)
-            q[f"{c}.worst_section_var_cm2"] = max(res.stats[c, i].var for i in range(ns))
-            q[f"{c}.best_section_mean_abs_cm"] = min(per)
-            q[f"{c}.jerk_mean"] = float(np.mean([res.stats[c, i].jerk_mean for i in range(ns)]))
-            for i in range(ns):
-                q[f"{c}.sections[{i + 1}].mean_abs_cm"] = res.stats[c, i].mean_abs
-                q[f"{c}.sections[{i + 1}].var_cm2"] = res.stats[c, i].var
-        order = sorted(PAPER_CONTROLLERS, key=res.overall)
-        q["order"] = "<".join(order)
-        q["best"] = order[0]
-        for c, run in res.nominal.items():
-            q[f"{c}.nominal_m"] = run.error
-        for c, st in res.mc.items():
-            q |= {f"{c}.mc.{k}": getattr(st, a) for k, a in MC_QUANTITIES.items()}
-        for c, d in res.damping.items():
-            q[f"{c}.damping_zeta"] = d.zeta
-            q[f"{c}.damping_period_s"] = d.period
-            q[f"{c}.speed_sign_changes"] = float(res.nominal[c].sign_changes)
-        comp, unc = [res.mc[c] for c in COMPENSATED], [res.mc[c] for c in UNCOMPENSATED]
-        q["mc.compensation_margin"] = min(s.lo for s in comp) - max(s.hi for s in unc)
-        q["mc.compensated_max_abs_mean_m"] = max(abs(s.mean) for s in comp)
-        q["mc.uncompensated_min_overshoot_share"] = min(s.overshoot for s in unc)
-        q["mc.compensated_spread"] = max(s.p for s in comp) - min(s.p for s in comp)
-        q["nominal.compensated_max_abs_m"] = max(abs(res.nominal[c].error) for c in COMPENSATED)
-        return q
+        return values(TABLE, res.spec, res)
 
     def render(self, design, res):
         from .station_stopping_render import render

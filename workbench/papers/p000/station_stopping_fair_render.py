@@ -4,9 +4,7 @@ Carlo (pure rendering of a
 :class:`~workbench.papers.p000.station_stopping_run.StopResult`)."""
 from __future__ import annotations
 
-import numpy as np
-
-from ...kinds.stop_accuracy.render import distribution_table, mc_cells, plot_ecdf, tolerance_lines
+from ...kinds.stop_accuracy.render import mc_section, moving, plot_mc_panels
 from ...report.markdown import Figure, fmt, md_table
 from .station_stopping_run import loop_dead_time
 from .station_stopping_spec import (ABLATION_LAWS, COMPENSATED, DAMPING, MC_CONTROLLERS,
@@ -24,7 +22,7 @@ def _cm(x_m: float) -> str:
 
 def fair_section(spec, res) -> str:
     """``## Fair baselines``: compensation, PID tuning, nominal row, Monte Carlo."""
-    comp, tol = spec.compensation, res.tolerance
+    comp = spec.compensation
     intro = (
         "## Fair baselines: known-delay compensation, damped PID, nominal row, Monte Carlo\n\n"
         "The paper's controllers act on the measured state, while every command reaches the "
@@ -58,7 +56,7 @@ def fair_section(spec, res) -> str:
         "balise error, no speed quantisation), so the compensated stops are an upper bound of "
         "what the scheme achieves; the residual errors are the model mismatch alone.")
     return "\n\n".join([intro, _pid_part(spec, res), _nominal_part(res),
-                        _mc_part(spec, res, tol)])
+                        _mc_part(spec, res)])
 
 
 def _pid_part(spec, res) -> str:
@@ -116,21 +114,14 @@ def _nominal_part(res) -> str:
         "\n\n![final approach]({figdir}/final-approach.png)")
 
 
-def _mc_part(spec, res, tol: float) -> str:
-    mc = spec.montecarlo
-    rows = [[label(c), GROUP[c]] + mc_cells(res.mc[c], _cm) for c in MC_CONTROLLERS]
-    return (
-        f"### Monte Carlo: P(|e| ≤ {fmt(tol)} m) over continuous distributions\n\n"
-        f"{mc.samples} draws (seed {mc.seed}; `workbench/studies/stopping_mc.py`: inverse CDF "
-        "of seeded uniforms, one stream per factor), the same draws for every controller "
-        "(common random numbers), on section 1's braking phase (every section reaches v_max "
-        "before braking, so their braking phases are the same):\n\n"
-        + distribution_table(spec)
-        + "\n\n" + md_table(["controller", "group", f"stops within {fmt(tol)} m",
-                             f"P(|e| ≤ {fmt(tol)} m)", "Wilson 95 % interval",
-                             "95th percentile of |e| (cm)", "mean e (cm)", "overshoots (%)"],
-                            rows, "llrrrrrr")
-        + "\n\n![Monte Carlo stop errors]({figdir}/mc-stop-errors.png)")
+def _mc_part(spec, res) -> str:
+    return mc_section(
+        spec, "###", ": inverse CDF of seeded uniforms, one stream per factor), the same draws "
+        "for every controller (common random numbers), on section 1's braking phase (every "
+        "section reaches v_max before braking, so their braking phases are the same):",
+        [((label(c), GROUP[c]), res.mc[c]) for c in MC_CONTROLLERS], heads=("controller",
+                                                                         "group"),
+        align="ll", unit="cm", error=_cm, alt="Monte Carlo stop errors")
 
 
 def figures(res) -> tuple[Figure, ...]:
@@ -148,8 +139,8 @@ def _plot_pid(fig, res):
     ax = fig.add_subplot(111)
     for k, c in enumerate(DAMPING):
         n = res.nominal[c]
-        moving = np.concatenate(([True], n.v[1:] > 0))
-        ax.plot(n.t[moving], 100 * (n.v - n.v_d)[moving], color=f"C{k}", label=label(c))
+        keep = moving(n.v)
+        ax.plot(n.t[keep], 100 * (n.v - n.v_d)[keep], color=f"C{k}", label=label(c))
     ax.axhline(0, color="k", lw=0.6)
     ax.set_xlabel("time from braking start (s)")
     ax.set_ylabel("speed error v − v_d (cm/s)")
@@ -163,7 +154,7 @@ def _plot_final(fig, res):
         ax = fig.add_subplot(1, 3, i + 1)
         for k, c in enumerate((plain, comp)):
             n = res.nominal[c]
-            keep = (n.dx > -40) & np.concatenate(([True], n.v[1:] > 0))
+            keep = (n.dx > -40) & moving(n.v)
             ax.plot(n.dx[keep], 3.6 * n.v[keep], color=f"C{k}")
             ax.plot([n.error], [0.0], "o", color=f"C{k}", ms=4,
                     label=("as in paper" if k == 0 else "compensated")
@@ -179,17 +170,6 @@ def _plot_final(fig, res):
 def _plot_mc(fig, res):
     groups = (("as in paper 000", UNCOMPENSATED),
               ("with known-delay compensation", COMPENSATED + ("smarc-comp-nogain",)))
-    tol = 100 * res.tolerance
-    axes = []
-    for i, (title, ctls) in enumerate(groups):
-        ax = fig.add_subplot(1, 2, i + 1, sharex=axes[0] if axes else None,
-                             sharey=axes[0] if axes else None)
-        axes.append(ax)
-        for k, c in enumerate(ctls):
-            plot_ecdf(ax, 100 * np.asarray(res.mc[c].errors), color=f"C{k}", label=label(c))
-        tolerance_lines(ax, tol)
-        ax.set_xscale("symlog", linthresh=1.0)
-        ax.set_xlabel("stop error (cm, + overshoot)")
-        ax.set_title(title, fontsize=9)
-        ax.legend(fontsize=7, loc="upper left")
-    axes[0].set_ylabel("fraction of stops ≤ error")
+    plot_mc_panels(fig, [(title, [(label(c), res.mc[c].errors) for c in ctls])
+                         for title, ctls in groups], res.tolerance, unit="cm", scale=100,
+                   linthresh=1.0)

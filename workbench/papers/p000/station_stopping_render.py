@@ -7,7 +7,7 @@ import numpy as np
 import sympy as sp
 
 from ...features.montecarlo import within_rate
-from ...kinds.stop_accuracy.render import plot_ecdf
+from ...kinds.stop_accuracy.render import moving, plot_ecdf, quantity_table
 from ...plants.brake000 import brake_model
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .station_stopping_fair_render import fair_section, figures
@@ -40,7 +40,6 @@ def model_section() -> str:
 
 def render(design, res) -> Rendered:
     spec = design.spec
-    prow = [[f"`{k}`", fmt(q.value, 5), q.unit, q.source] for k, q in spec.params.items()]
     urow = [[f"`{k}`", factor(spec, k).what, f"[{fmt(lo)}, {fmt(hi)}]", factor(spec, k).unit]
             for k, lo, hi in spec.sections.ranges]
     srow = [[i + 1, s.name, fmt(s.length, 5), fmt(t, 4), s.source]
@@ -53,7 +52,7 @@ def render(design, res) -> Rendered:
         f"{fmt(ref.a_dec, 3)} m/s²) begins to brake and tracks it to the stopping point. "
         f"{rp.count} repeats per section (seed {rp.seed}); the three controllers meet the "
         "same uncertain plants.\n\n"
-        + md_table(["parameter", "value", "unit", "source"], prow, "lrll")
+        + quantity_table("parameter", spec.params, 5)
         + "\n\nUncertainty (uniform, per repeat):\n\n"
         + md_table(["factor", "meaning", "range", "unit"], urow, "llll")
         + "\n\n" + md_table(["#", "section", "length (m)", "planned braking time (s)",
@@ -212,7 +211,7 @@ def _plot_curves(fig, res):
     ax1, ax2 = fig.add_subplot(121), fig.add_subplot(122)
     for k, c in enumerate(CONTROLLERS):
         t, dx, v, _, vd = res.example[c]
-        keep = np.concatenate(([True], v[1:] > 0)) if len(v) > 1 else np.ones(len(v), bool)
+        keep = moving(v)
         ax1.plot(dx[keep], v[keep] * 3.6, color=f"C{k}", label=label(c))
         ax2.plot(t[keep], (v[keep] - vd[keep]) * 100, color=f"C{k}", label=label(c))
     t, _, _, xd, vd = res.example["pid"]

@@ -110,8 +110,7 @@ def _sections(spec, laws):
 def run_station_stops(spec) -> StopResult:
     """The per-section repeats, the nominal row (every controller) and the
     Monte Carlo (:data:`MC_CONTROLLERS`) of the design ``spec``."""
-    from ...kinds.stop_accuracy.pipeline import group_statistics
-    from ...kinds.stop_accuracy.run import compile_laws, montecarlo_draws, simulate_cases
+    from ...kinds.stop_accuracy.run import compile_laws, montecarlo_statistics, simulate_cases
     from ...tuning.pid import damping, speed_loop
     laws = compile_laws(spec)
     stats, example, planned, theta = _sections(spec, laws)
@@ -124,11 +123,8 @@ def run_station_stops(spec) -> StopResult:
     nominal = {k: NominalRun(float(tr.x_stop[j] - D[j]), tr.t, tr.x[:, j] - D[j], tr.v[:, j], vd,
                              _sign_changes((tr.v[:, j] - vd)[track]))
                for j, k in enumerate(nom)}
-    mc = spec.montecarlo
-    tr, D = simulate_cases(spec, laws, spec.dt, [(speed, index[k], None, L)
-                                                 for k in MC_CONTROLLERS],
-                           montecarlo_draws(spec, mc))
-    mcs = group_statistics(tr.x_stop - D, MC_CONTROLLERS, mc.samples, spec.tolerance)
+    mcs = montecarlo_statistics(spec, laws, [(speed, index[k], None, L) for k in MC_CONTROLLERS],
+                                MC_CONTROLLERS)
     P1, T2 = spec.params["P1"].value, spec.params["T2"].value
     damp = {k: damping(*speed_loop(**gains(spec, k), P1=P1, T2=T2), loop_dead_time(spec, k))
             for k in DAMPING}

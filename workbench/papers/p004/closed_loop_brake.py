@@ -33,8 +33,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...features.montecarlo import MC_QUANTITIES
+from ...features.quantities import Declared, names, units, values
 from ...kinds.stop_accuracy.pipeline import open_loop_distance
+from ...kinds.stop_accuracy.quantities import mc_family
+from ...kinds.stop_accuracy.run import speed_key
 from ...reader import Reader
 from ...tuning.pid import Damping, damping, deceleration_loop
 from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, FAULTS, FULL, MC_MODES,
@@ -42,7 +44,7 @@ from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, FAULTS, FULL, MC_MODE
 from .closed_loop_brake_spec import Paper004, Spec004, compute_worked, load, view
 
 __all__ = ["ANALYSIS", "Result004", "Run", "Spec004", "compute_worked", "decel_damping",
-           "run_grid", "stopping_point", "view"]
+           "run_grid", "stopping_point", "TABLE", "view"]
 
 
 @dataclass(frozen=True)
@@ -151,8 +153,82 @@ def decel_damping(spec: Spec004) -> Damping:
                                       tau=spec.tau_filter), p["T1"] + spec.dt_ctrl)
 
 
-def _key(x: float) -> str:
-    return f"{x:g}"
+def _speeds(spec, **more) -> list:
+    """Per speed ``s`` (km/h): ``{"b": "v<s>", "s": s}``, times the members ``more``."""
+    out = [{"b": speed_key(s), "s": s} for s in spec.speeds_kmh]
+    for k, vals in more.items():
+        out = [x | {k: v} for x in out for v in vals]
+    return out
+
+
+#: The error grid of one mode and channel at a speed (healthy sensors, electric brake on).
+def _grid(r, s, m, ch="analogue") -> dict:
+    return dict(speed_kmh=s, mode=m, channel=ch, fault="healthy", electric=True)
+
+
+def _nominal(r, s, **kw) -> float:
+    """Stop error (m) at the nominal corner (closed loop, analogue, healthy unless ``kw``)."""
+    return r.select(**{**dict(speed_kmh=s, mode="closed", channel="analogue", force_error=0.0,
+                              gradient=0.0, friction=1.0, electric=True, fault="healthy"),
+                       **kw})[0][1]
+
+
+def _feasible_abs(r, s, ch) -> list:
+    return [abs(e) for x, e in r.select(**_grid(r, s, "closed", ch))
+            if r.feasible[r.runs.index(x)]]
+
+
+def _feasible_max(r, s, ch):
+    feas = _feasible_abs(r, s, ch)
+    return max(feas) if feas else None
+
+
+_FAULTS = tuple(f for f in FAULTS if f != "healthy")
+_CH = {"ch": CHANNELS}
+
+#: The quantities paper 004's claims name, declared once.
+TABLE = (
+    Declared("worked.{k}", "{u}", lambda r, k, u: r.worked[k], over=lambda spec: [
+        {"k": k, "u": "%" if k.startswith("share") else "m/s^2" if k.startswith("a2") else "m"}
+        for k in compute_worked(spec.paper.worked)]),
+    *(Declared("{b}.%s.max_abs_m" % m, "m", lambda r, b, s, m=m: r.max_abs(**_grid(r, s, m)),
+               over=_speeds) for m in ("open", "ato-open")),
+    Declared("{b}.closed.{ch}.max_abs_m", "m",
+             lambda r, b, s, ch: r.max_abs(**_grid(r, s, "closed", ch)),
+             over=lambda spec: _speeds(spec, **_CH)),
+    Declared("{b}.closed.{ch}.failing_corners", "1",
+             lambda r, b, s, ch: float(len(r.failing(**_grid(r, s, "closed", ch)))),
+             over=lambda spec: _speeds(spec, **_CH)),
+    Declared("{b}.closed.{ch}.failing_feasible_corners", "1", lambda r, b, s, ch: float(sum(
+        r.feasible[r.runs.index(x)] for x, _ in r.failing(**_grid(r, s, "closed", ch)))),
+             over=lambda spec: _speeds(spec, **_CH)),
+    Declared("{b}.closed.{ch}.feasible_max_abs_m", "m",
+             lambda r, b, s, ch: _feasible_max(r, s, ch), over=lambda spec: _speeds(spec, **_CH)),
+    Declared("{b}.closed.3bit_minus_analogue_m", "m",
+             lambda r, b, s: _feasible_max(r, s, "3bit") - _feasible_max(r, s, "analogue"),
+             over=_speeds),
+    Declared("{b}.fault[{f}].abs_m", "m", lambda r, b, s, f: r.max_abs(speed_kmh=s, fault=f),
+             over=lambda spec: _speeds(spec, f=_FAULTS)),
+    Declared("{b}.fault[{f}].error_m", "m", lambda r, b, s, f: _nominal(r, s, fault=f),
+             over=lambda spec: _speeds(spec, f=_FAULTS)),
+    Declared("{b}.fault[{f}].change_vs_healthy_m", "m",
+             lambda r, b, s, f: abs(_nominal(r, s, fault=f) - _nominal(r, s)),
+             over=lambda spec: _speeds(spec, f=_FAULTS)),
+    Declared("{b}.nominal.closed.analogue.abs_m", "m", lambda r, b, s: abs(_nominal(r, s)),
+             over=_speeds),
+    Declared("{b}.nominal.closed.3bit.abs_m", "m",
+             lambda r, b, s: abs(_nominal(r, s, channel="3bit")), over=_speeds),
+    Declared("{b}.nominal.ato-open.abs_m", "m",
+             lambda r, b, s: abs(_nominal(r, s, mode="ato-open")), over=_speeds),
+    Declared("{b}.electric_loss.{m}.abs_m", "m",
+             lambda r, b, s, m: r.max_abs(speed_kmh=s, mode=m, electric=False),
+             over=lambda spec: _speeds(spec, m=("closed", "ato-open"))),
+    mc_family("{b}.mc.{m}", lambda spec: _speeds(spec, m=MC_MODES),
+              lambda r, b, s, m: r.mc[s, m]),
+    Declared("{b}.mc.closed_minus_ato-open_p", "1",
+             lambda r, b, s: r.mc[s, "closed"].p - r.mc[s, "ato-open"].p, over=_speeds),
+    Declared("pid.damping_zeta", "1", lambda r: r.damping.zeta),
+)
 
 
 class ClosedLoopBrake:
@@ -162,72 +238,16 @@ class ClosedLoopBrake:
         return load(root, spec)
 
     def quantity_names(self, spec) -> set[str]:
-        spec = view(spec)
-        names = {f"worked.{k}" for k in compute_worked(spec.worked)}
-        for s in spec.speeds_kmh:
-            b = f"v{_key(s)}"
-            names |= {f"{b}.open.max_abs_m", f"{b}.ato-open.max_abs_m",
-                      f"{b}.closed.analogue.max_abs_m", f"{b}.closed.3bit.max_abs_m",
-                      f"{b}.closed.analogue.failing_corners", f"{b}.closed.3bit.failing_corners",
-                      f"{b}.closed.analogue.failing_feasible_corners",
-                      f"{b}.closed.3bit.failing_feasible_corners",
-                      f"{b}.closed.analogue.feasible_max_abs_m",
-                      f"{b}.closed.3bit.feasible_max_abs_m",
-                      f"{b}.electric_loss.closed.abs_m", f"{b}.electric_loss.ato-open.abs_m"}
-            names |= {f"{b}.fault[{f}].{k}" for f in FAULTS if f != "healthy"
-                      for k in ("abs_m", "error_m", "change_vs_healthy_m")}
-            names |= {f"{b}.closed.3bit_minus_analogue_m", f"{b}.nominal.closed.analogue.abs_m",
-                      f"{b}.nominal.closed.3bit.abs_m", f"{b}.nominal.ato-open.abs_m"}
-            names |= {f"{b}.mc.{m}.{k}" for m in MC_MODES for k in MC_QUANTITIES}
-            names.add(f"{b}.mc.closed_minus_ato-open_p")
-        return names | {"pid.damping_zeta"}
+        return names(TABLE, spec)
+
+    def quantity_units(self, spec) -> dict[str, str]:
+        return units(TABLE, spec)
 
     def run(self, spec) -> Result004:
         return run_grid(view(spec))
 
     def quantities(self, res: Result004) -> dict:
-        q = {f"worked.{k}": v for k, v in res.worked.items()}
-        for s in res.distance:
-            b = f"v{_key(s)}"
-            grid = dict(speed_kmh=s, fault="healthy", electric=True)
-            q[f"{b}.open.max_abs_m"] = res.max_abs(mode="open", **grid)
-            q[f"{b}.ato-open.max_abs_m"] = res.max_abs(mode="ato-open", **grid)
-            for ch in CHANNELS:
-                sel = res.select(mode="closed", channel=ch, **grid)
-                q[f"{b}.closed.{ch}.max_abs_m"] = res.max_abs(mode="closed", channel=ch, **grid)
-                q[f"{b}.closed.{ch}.failing_corners"] = float(len(res.failing(
-                    mode="closed", channel=ch, **grid)))
-                q[f"{b}.closed.{ch}.failing_feasible_corners"] = float(sum(
-                    res.feasible[res.runs.index(r)] for r, _ in res.failing(
-                        mode="closed", channel=ch, **grid)))
-                feas = [abs(e) for r, e in sel if res.feasible[res.runs.index(r)]]
-                q[f"{b}.closed.{ch}.feasible_max_abs_m"] = max(feas) if feas else None
-            q[f"{b}.closed.3bit_minus_analogue_m"] = (q[f"{b}.closed.3bit.feasible_max_abs_m"]
-                                                      - q[f"{b}.closed.analogue.feasible_max_abs_m"])
-            nominal = dict(speed_kmh=s, mode="closed", channel="analogue", force_error=0.0,
-                           gradient=0.0, friction=1.0, electric=True)
-            healthy = res.select(fault="healthy", **nominal)[0][1]
-            for f in FAULTS:
-                if f != "healthy":
-                    q[f"{b}.fault[{f}].abs_m"] = res.max_abs(speed_kmh=s, fault=f)
-                    q[f"{b}.fault[{f}].error_m"] = res.select(fault=f, **nominal)[0][1]
-                    q[f"{b}.fault[{f}].change_vs_healthy_m"] = abs(
-                        res.select(fault=f, **nominal)[0][1] - healthy)
-            q[f"{b}.nominal.closed.analogue.abs_m"] = abs(healthy)
-            q[f"{b}.nominal.closed.3bit.abs_m"] = abs(res.select(
-                fault="healthy", **{**nominal, "channel": "3bit"})[0][1])
-            q[f"{b}.nominal.ato-open.abs_m"] = abs(res.select(
-                fault="healthy", **{**nominal, "mode": "ato-open"})[0][1])
-            for mode in ("closed", "ato-open"):
-                q[f"{b}.electric_loss.{mode}.abs_m"] = res.max_abs(speed_kmh=s, mode=mode,
-                                                                   electric=False)
-            for m in MC_MODES:
-                st = res.mc[s, m]
-                q |= {f"{b}.mc.{m}.{k}": getattr(st, a) for k, a in MC_QUANTITIES.items()}
-            q[f"{b}.mc.closed_minus_ato-open_p"] = res.mc[s, "closed"].p - res.mc[s, "ato-open"].p
-        q["pid.damping_zeta"] = res.damping.zeta
-        return q
-
+        return values(TABLE, res.spec, res)
 
     def render(self, design, res):
         from .closed_loop_brake_render import render

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...kinds.stop_accuracy.render import distribution_table, mc_cells, plot_ecdf, tolerance_lines
+from ...kinds.stop_accuracy.render import mc_section, plot_mc_panels
 from ...report.markdown import Figure, fmt, md_table
 from .closed_loop_brake_run import FAULTS, MC_MODES
 
@@ -59,21 +59,13 @@ def fault_text(spec) -> str:
             "service.\n\n![sensor faults]({figdir}/sensor-faults.png)")
 
 
-def mc_section(spec, res) -> str:
-    mc = spec.montecarlo
-    rows = [[fmt(s), MODE_LABEL[m]] + mc_cells(st, lambda x: fmt(x, 3))
-            for (s, m), st in res.mc.items()]
-    tol = fmt(res.tolerance)
-    return (
-        f"## Monte Carlo: P(|e| ≤ {tol} m) over continuous distributions\n\n"
-        f"{mc.samples} draws (seed {mc.seed}; `workbench/studies/stopping_mc.py`), the same "
-        "draws for both modes and both speeds, analogue channel, healthy sensors; the stopping "
-        "point D is the nominal one of each speed.\n\n"
-        + distribution_table(spec.kind)
-        + "\n\n" + md_table(["km/h", "mode", f"stops within {tol} m", f"P(|e| ≤ {tol} m)",
-                             "Wilson 95 % interval", "95th percentile of |e| (m)",
-                             "mean e (m)", "overshoots (%)"], rows, "rlrrrrrr")
-        + "\n\n![Monte Carlo]({figdir}/mc-stop-errors.png)")
+def monte_carlo(spec, res) -> str:
+    """``## Monte Carlo``: both modes at both speeds over the same draws."""
+    return mc_section(
+        spec.kind, "##", "), the same draws for both modes and both speeds, analogue channel, "
+        "healthy sensors; the stopping point D is the nominal one of each speed.",
+        [((fmt(s), MODE_LABEL[m]), st) for (s, m), st in res.mc.items()], heads=("km/h", "mode"),
+        align="rl", unit="m", error=lambda x: fmt(x, 3), alt="Monte Carlo")
 
 
 def figures(spec, res) -> tuple[Figure, ...]:
@@ -120,16 +112,6 @@ def _plot_faults(fig, res):
 
 
 def _plot_mc(fig, res):
-    speeds = sorted({s for s, _ in res.mc})
-    first = None
-    for i, s in enumerate(speeds):
-        ax = fig.add_subplot(1, len(speeds), i + 1, sharex=first, sharey=first)
-        first = first or ax
-        for k, m in enumerate(MC_MODES):
-            plot_ecdf(ax, res.mc[s, m].errors, color=f"C{k}", label=MODE_LABEL[m])
-        tolerance_lines(ax, res.tolerance)
-        ax.set_xlabel("stop error (m, + overshoot)")
-        if i == 0:
-            ax.set_ylabel("fraction of stops ≤ error")
-        ax.set_title(f"{fmt(s)} km/h", fontsize=9)
-        ax.legend(fontsize=7, loc="upper left")
+    plot_mc_panels(fig, [(f"{fmt(s)} km/h", [(MODE_LABEL[m], res.mc[s, m].errors)
+                                             for m in MC_MODES])
+                         for s in sorted({s for s, _ in res.mc})], res.tolerance)

@@ -6,9 +6,10 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from ...kinds.stop_accuracy.render import error_colours, moving, quantity_table
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .closed_loop_brake_spec import view, worked_formulas
-from .closed_loop_brake_fair_render import fault_text, figures, mc_section, retune_section
+from .closed_loop_brake_fair_render import fault_text, figures, monte_carlo, retune_section
 from .closed_loop_brake_run import CHANNELS, FAULTS, MODES
 
 MODE_TEXT = {"open": "open loop, single command",
@@ -37,7 +38,6 @@ def _worked_section(res, spec) -> str:
 
 def render(design, res) -> Rendered:
     spec = view(design.spec)
-    prow = [[f"`{k}`", fmt(q.value, 5), q.unit, q.source] for k, q in spec.params.items()]
     sections = [
         "## Problem\n\nPaper 004 argues qualitatively that closing the loop on the measured "
         "deceleration cancels force errors, gradient and friction scatter; it gives no "
@@ -55,7 +55,7 @@ def render(design, res) -> Rendered:
         f"controller when |a_req − a_meas| > {fmt(spec.e_switch)} m/s² and PID below, and "
         "falls back to the ATO open loop when all four axles are failed or sliding. The "
         f"3-bit channel sends round(7 c / {fmt(spec.c_full)}) levels.\n\n"
-        + md_table(["parameter", "value", "unit", "source"], prow, "lrll"),
+        + quantity_table("parameter", spec.params, 5),
         _worked_section(res, spec),
         retune_section(spec, res),
     ]
@@ -100,7 +100,7 @@ def render(design, res) -> Rendered:
     sections.append("## Speed against distance\n\nFrom " + fmt(spec.speeds_kmh[0]) + " km/h at "
                     "the nominal corner and with the lowest force error (gradient 0, friction ×1)."
                     "\n\n![curves]({figdir}/speed-distance.png)")
-    sections.append(mc_section(spec, res))
+    sections.append(monte_carlo(spec, res))
     figs = (Figure("speed-distance", "Speed against position relative to the stopping point.",
                    lambda fig, res=res: _plot_curves(fig, res), size=(7.0, 4.0)),
             Figure("error-grid", "Closed-loop stop error per grid corner (analogue channel), "
@@ -115,7 +115,7 @@ def _plot_curves(fig, res):
     for i, fe in enumerate(corners):
         ax = fig.add_subplot(1, len(corners), i + 1)
         for k, (r, dx, v) in enumerate(c for c in res.curves if c[0].force_error == fe):
-            keep = np.concatenate(([True], v[1:] > 0))
+            keep = moving(v)
             ax.plot(dx[keep], 3.6 * v[keep], color=f"C{k}", label=f"{r.mode} ({r.channel})")
         ax.axvline(0, color="k", lw=0.6)
         ax.set_xlabel("position − D (m)")
@@ -144,19 +144,8 @@ def _corner_details(res) -> str:
             + "\n\n</details>")
 
 
-def _error_colours(tol: float):
-    """A threshold colour map of |stop error|: greens within the tolerance,
-    orange to dark red beyond it (no failing cell can look green), and its
-    norm (bounds 0, tol/2, tol, 1.5 tol, 2 tol, 3 tol; darker above)."""
-    from matplotlib.colors import BoundaryNorm, ListedColormap
-    cmap = ListedColormap(["#1a9850", "#a6d96a", "#fdae61", "#f46d43", "#d73027"])
-    cmap.set_over("#67001f")
-    bounds = [0.0, tol / 2, tol, 1.5 * tol, 2 * tol, 3 * tol]
-    return cmap, BoundaryNorm(bounds, cmap.N)
-
-
 def _plot_grid(fig, res, spec):
-    cmap, norm = _error_colours(res.tolerance)
+    cmap, norm = error_colours(res.tolerance)
     speeds = list(res.distance)
     nf = len(spec.friction)
     gs = fig.add_gridspec(len(speeds), nf + 1, width_ratios=[1.0] * nf + [0.06])

@@ -11,9 +11,9 @@ and the names its report and claims use (``ato-open``, ``3bit``, "1 sliding").
 """
 from __future__ import annotations
 
-import numpy as np
+from dataclasses import replace
 
-from ...kinds.stop_accuracy.pipeline import group_statistics
+import numpy as np
 
 MODES = ("open", "ato-open", "closed")
 #: not a control mode: full service from t = 0, to test each corner's feasibility
@@ -73,17 +73,15 @@ def run_montecarlo(spec, distance: dict) -> dict:
     """Stop statistics per (speed km/h, mode) over the Monte Carlo draws
     (analogue channel, healthy sensors; every mode and speed meets the same
     draws), the kind's Monte Carlo batch
-    (:func:`~workbench.kinds.stop_accuracy.run.simulate_cases`):
-    {(speed, mode): StopStatistics}."""
-    from ...kinds.stop_accuracy.run import compile_laws, montecarlo_draws, simulate_cases
-    mc = spec.montecarlo
-    ks = spec.kind
+    (:func:`~workbench.kinds.stop_accuracy.run.montecarlo_statistics`) at the
+    view's draws, tolerance and step: {(speed, mode): StopStatistics}."""
+    from ...kinds.stop_accuracy.run import compile_laws, montecarlo_statistics
     names = list(CONTROLLERS.values())
     cases = [(s, m) for s in spec.speeds_kmh for m in MC_MODES]
-    tr, D = simulate_cases(ks, compile_laws(ks), spec.dt, [
+    ks = replace(spec.kind, montecarlo=spec.montecarlo, tolerance=spec.tolerance, dt=spec.dt)
+    return montecarlo_statistics(ks, compile_laws(ks), [
         (s, names.index(CONTROLLERS[m, "analogue"]), None, distance[s]) for s, m in cases],
-        montecarlo_draws(ks, mc), dt_rec=0.5)
-    return group_statistics(tr.x_stop - D, cases, mc.samples, spec.tolerance)
+        cases, dt_rec=0.5)
 
 
 def run_horizon_sweep(spec, distance: dict) -> tuple:
