@@ -39,7 +39,8 @@ def test_small_k2_makes_the_printed_switch_safe(lam_opt):
 
 def test_cruise_loop_linearisation_matches_A_plus_BK():
     vals = tuple(sorted(DRY.items()))
-    f, _, states, A_cl, lam_d, _ = AB._loop(vals, 70.0, K)
+    loop = AB.cruise_loop(vals, 70.0)[0]
+    (f, _, A_cl), states = loop.at(K), loop.states
     import sympy as sp
     fn = sp.lambdify(states, f, "math")
     assert max(abs(c) for c in fn(0.0, 0.0)) < 1e-12          # equilibrium at E = 0
@@ -51,7 +52,7 @@ def test_cruise_loop_linearisation_matches_A_plus_BK():
 
 def test_certified_cruise_level_holds_no_sampled_point_with_vdot_nonnegative(lam_opt):
     vals = tuple(sorted(DRY.items()))
-    lam_d = AB.cruise_lambda_d(vals, 70.0)
+    lam_d = AB.cruise_loop(vals, 70.0)[1]
     prob, est = AB.estimate_cruise(vals, 70.0, K, [(0.0, lam_opt - lam_d)], 100.0)
     assert 0 < est.c_certified < est.c_refuted < prob.V(np.array([[0.0, lam_opt - lam_d]]))[0]
     rng = np.random.default_rng(5)
