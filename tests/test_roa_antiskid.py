@@ -117,10 +117,11 @@ def test_brake_switch_at_lambda_d_is_in_no_basin_and_spins():
     from workbench.papers.p003.antiskid_basin_render import brake_text
     b = brake_switch(DRY, "compensated", (70.0126, 0.01954),
                      profile=CreepSpeedProfile(t_brake=300.0), k_de=10.0)
-    assert b.outcome is Outcome.REFUTED and b.why == "no equilibrium up to spin"
-    assert b.rate > 0 and b.fate == "diverges" and 0 < b.t_fate < 0.1
+    assert b.outcome is Outcome.REFUTED and b.verdict.why == "no equilibrium"
+    assert b.verdict.direction > 0 and b.verdict.rate > 0 and b.fate == "diverges" and 0 < b.t_fate < 0.1
     text = brake_text([b])
     assert "frozen at the switch instant" in text and "| REFUTED |" in text
+    assert "no equilibrium from the state up to lambda = 0.9: \\|lambda'\\| >= " in text
 
 
 def test_brake_switch_on_the_braking_side_is_certified():
@@ -131,9 +132,9 @@ def test_brake_switch_on_the_braking_side_is_certified():
     from workbench.papers.p003.antiskid_basin_brake import brake_switch
     b = brake_switch(DRY, "later", (69.0, -0.01), profile=CreepSpeedProfile(t_brake=300.0),
                      k_de=10.0, t=301.0)
-    assert b.outcome is Outcome.CERTIFIED and b.lam_star < 0 and b.fate == "tracks"
+    assert b.outcome is Outcome.CERTIFIED and b.verdict.star < 0 and b.fate == "tracks"
     # the frozen equilibrium is the law's own: k_de (v lambda - v_s*) = -lambda z1
-    assert abs(b.lam_star - b.vs_frozen / b.v) < 0.1 * abs(b.lam_star)
+    assert abs(b.verdict.star - b.vs_frozen / b.v) < 0.1 * abs(b.verdict.star)
 
 
 def test_brake_switch_claims_are_known_quantities():

@@ -8,12 +8,10 @@ cruise figure's look stay here; the figure itself is the general
 tables those of :mod:`workbench.features.basin_points_render`."""
 from __future__ import annotations
 
-import math
-
 from ...features.basin_plot import BasinPlotStyle
 from ...features.basin_plot import plot_basin as draw_basin
 from ...features.basin_points_render import gain_sweep_table, points_table
-from ...printed_grid import sig_round
+from ...printed_grid import directed
 from ...report.markdown import fmt, md_table
 from ...roa.render import fmt_level, render_basin_markdown
 from .antiskid_basin import LAM_DIVERGED
@@ -62,12 +60,9 @@ def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—"
             + (_k2_text(sweep, compare_source) if sweep is not None else ""))
 
 
-def _floor(x: float, digits: int = 2) -> str:
-    return fmt(sig_round(x, digits, math.floor), digits)
-
-
-def _ceil(x: float, digits: int = 2) -> str:
-    return fmt(sig_round(x, digits, math.ceil), digits)
+def _directed(x: float, up: bool) -> str:
+    """x rounded up or down to 2 significant digits (a proven bound's direction)."""
+    return fmt(directed(x, up=up, sig=2), 2)
 
 
 def brake_text(brake) -> str:
@@ -75,18 +70,19 @@ def brake_text(brake) -> str:
     from .antiskid_basin_brake import FATE_RTOL, LAM_LIMIT, T_FATE, TRACK_TOL
     rows = []
     for b in brake:
-        if b.why.startswith("no equilibrium"):
-            side = "up to" if b.why.endswith("spin") else "down to"
-            frozen = (f"no equilibrium from the state {side} lambda = "
-                      f"{'' if side == 'up to' else '−'}{fmt(LAM_LIMIT)}: |lambda'| >= "
-                      f"{_floor(b.rate)} 1/s proven, so it gets there within "
-                      f"{_ceil((LAM_LIMIT - abs(b.lam)) / b.rate)} s")
-        elif b.lam_star is not None:
-            frozen = (f"equilibrium lambda* = {fmt(b.lam_star, 4)} ({b.why}"
-                      + (f"; V = {fmt_level(b.level[0], 'up')}, c_certified = "
-                         f"{fmt_level(b.level[1])}" if b.level else "") + ")")
+        sv = b.verdict
+        if sv.why == "no equilibrium":
+            up = sv.direction > 0
+            frozen = (f"no equilibrium from the state {'up to' if up else 'down to'} lambda = "
+                      f"{'' if up else '−'}{fmt(LAM_LIMIT)}: |lambda'| >= "
+                      f"{_directed(sv.rate, False)} 1/s proven, so it gets there within "
+                      f"{_directed((LAM_LIMIT - abs(b.lam)) / sv.rate, True)} s")
+        elif sv.star is not None:
+            frozen = (f"equilibrium lambda* = {fmt(sv.star, 4)} ({sv.why}"
+                      + (f"; V = {fmt_level(sv.level[0], 'up')}, c_certified = "
+                         f"{fmt_level(sv.level[1])}" if sv.level else "") + ")")
         else:
-            frozen = b.why
+            frozen = sv.why.replace("sign not", "sign of lambda' not")
         fate = (f"diverges: |lambda| = {fmt(LAM_LIMIT)} at t_brake + {fmt(b.t_fate, 2)} s"
                 if b.fate == "diverges" else b.fate)
         rows.append([f"`{b.label}`", fmt(b.v, 4), fmt(b.lam, 4), fmt(b.vs_frozen, 4), frozen,
