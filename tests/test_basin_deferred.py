@@ -44,10 +44,10 @@ def test_diverging_path_above_c_top_needs_no_cover(deferred, switch):
 
 def test_deferred_answers_are_the_full_estimate(deferred, switch):
     """The shortcut's premise and its answers, against the full estimate of
-    the same problem (estimate_cruise's, bit for bit)."""
+    the same problem (GainLoop.estimate's, bit for bit)."""
     out_short = deferred.outcome(switch)
     est = deferred.est                                  # the cover now runs
-    _, full = AB.estimate_cruise(VALS, 70.0, K, [switch], 100.0, seed=0)
+    _, full = AB.cruise_loop(VALS, 70.0)[0].estimate(K, 100.0, [switch], seed=0)
     assert est == full
     assert est.c_certified <= deferred.c_top <= est.c_refuted
     assert out_short is est.point_verdict(switch).outcome

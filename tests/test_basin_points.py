@@ -10,7 +10,7 @@ import sympy as sp
 
 from workbench.errors import DesignError, ModelError
 from workbench.features import basin_points as BP
-from workbench.features.basin_points_render import gain_sweep_table, points_table
+from workbench.features.basin_points_render import gain_edge_text, gain_sweep_table, points_table
 from workbench.features.basin_trajectory import limit_event, time_varying_fate
 from workbench.outcome import Outcome
 from workbench.reader import Reader
@@ -115,6 +115,12 @@ def test_gain_entry_sweep_brackets_the_true_edge_and_its_table():
     assert lines[1] == "| ---: | ---: | :--- | :--- | ---: | :--- |"
     assert len(lines) == 2 + len(sw.rows) + 2
     assert "| 1 | 8 | grid | REFUTED |" in text and lines[-1].startswith("| 2 | 1 | double |")
+    rule = gain_edge_text(sw, "g1", "z = 0.5", kept="With g0 = 1, ")
+    assert rule.startswith(f"With g0 = 1, z = 0.5 lands in a certified basin for g1 <= {lo:.4g} "
+                           "(every grid value from 0.5 up to it is certified), and not for g1 >= ")
+    assert rule.endswith(f"[{lo:.4g}, {hi:.4g}] (bisected).")
+    none = BP.GainSweep((0.5,), (1.0, 1.0), 1, sw.rows, (), None, 0.5, False)
+    assert gain_edge_text(none, "g1", "z").startswith("No edge between certified")
 
 
 def test_read_gain_sweep_of_a_toy_table():
@@ -184,6 +190,9 @@ def test_gain_loop_on_a_toy_system():
     near, far = loop.judge(K, (0.2, 0.0), 20.0), loop.judge(K, (3.0, 0.0), 20.0)
     assert (near.outcome, near.fate) == (Outcome.CERTIFIED, "converges")
     assert (far.outcome, far.fate) == (Outcome.REFUTED, "diverges")
+    prob, est = loop.estimate(K, 1.0, [(0.2, 0.0)])
+    assert prob.P_source == "optimised" and 0 < est.c_certified <= est.c_refuted
+    assert est.point_verdict((0.2, 0.0)).outcome is Outcome.CERTIFIED
     # k1 > 0: no Hurwitz linearisation, hence no basin
     assert loop.basin((1.0, -3.0), [("near", (0.2, 0.0))], n_traj=0, T=1.0, scale=(1, 1),
                       pad=(0, 0), default=(1, 1)) is None

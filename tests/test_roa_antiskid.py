@@ -53,7 +53,7 @@ def test_cruise_loop_linearisation_matches_A_plus_BK():
 def test_certified_cruise_level_holds_no_sampled_point_with_vdot_nonnegative(lam_opt):
     vals = tuple(sorted(DRY.items()))
     lam_d = AB.cruise_loop(vals, 70.0)[1]
-    prob, est = AB.estimate_cruise(vals, 70.0, K, [(0.0, lam_opt - lam_d)], 100.0)
+    prob, est = AB.cruise_loop(vals, 70.0)[0].estimate(K, 100.0, [(0.0, lam_opt - lam_d)])
     assert 0 < est.c_certified < est.c_refuted < prob.V(np.array([[0.0, lam_opt - lam_d]]))[0]
     rng = np.random.default_rng(5)
     u = rng.standard_normal((100_000, 2))

@@ -20,7 +20,7 @@ import numpy as np
 import sympy as sp
 
 from ..plants.lambdify_cache import lambdify
-from ..roa import BasinProblem, modal_P
+from ..roa import BasinProblem, estimate_basin, modal_P
 from ..roa.check import search_level
 from .basin_points import PointVerdict, check_points, point_in_basin, sampled_starts
 from .basin_trajectory import Trajectory, trajectory
@@ -117,6 +117,11 @@ class GainLoop:
         return modal_problem(f, self.states, self.x_eq, A_cl, self.weights(w), derivs=derivs,
                              names=self.names, points=points, domain=self.domain,
                              c_search=c_search)
+
+    def estimate(self, K, w, points, *, seed: int = 0, c_search=None) -> tuple:
+        """(problem, its :func:`~workbench.roa.estimate_basin`) of candidate ``w`` at ``K``."""
+        prob, c = self.problem(K, w, points, c_search)
+        return prob, estimate_basin(prob, c, seed=seed)
 
     def numeric(self, K):
         """The numeric vector field ``fn(*x)`` at ``K``."""

@@ -51,7 +51,6 @@ from ...features.basin_points import PointVerdict
 from ...features.basin_select import EAGER_ENV  # noqa: F401
 from ...features.basin_trajectory import integrate, limit_event
 from ...plants.adhesion import NumericAdhesion, adhesion_model
-from ...roa import estimate_basin
 from ...roa.check import BasinCheck
 from ...symbolic.linearise import linearise_cruise
 
@@ -133,14 +132,6 @@ def cruise_loop(values: tuple, v_d: float) -> tuple:
 
 def _values(values: dict) -> tuple:
     return tuple(sorted((k, float(v)) for k, v in values.items()))
-
-
-def estimate_cruise(values, v_d, K, points, w, *, seed=0, c_search=None):
-    """Basin estimate with P = modal_P(A + B K, [1, w]) (slow mode weight 1,
-    fast mode w); c_search: 4 x the largest level of ``points`` (capped by
-    the model's domain) unless given."""
-    prob, c = cruise_loop(values, v_d)[0].problem(K, w, points, c_search)
-    return prob, estimate_basin(prob, c, seed=seed)
 
 
 def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,

@@ -5,12 +5,13 @@
 Paper 003's wording (laws (61), (69), eqs (75)-(76), the k2 rule) and the
 cruise figure's look stay here; the figure itself is the general
 :func:`workbench.features.basin_plot.plot_basin`, the switch-state and gain
-tables those of :mod:`workbench.features.basin_points_render`."""
+tables and the certified gain range's sentence those of
+:mod:`workbench.features.basin_points_render`."""
 from __future__ import annotations
 
 from ...features.basin_plot import BasinPlotStyle
 from ...features.basin_plot import plot_basin as draw_basin
-from ...features.basin_points_render import gain_sweep_table, points_table
+from ...features.basin_points_render import gain_edge_text, gain_sweep_table, points_table
 from ...printed_grid import directed
 from ...report.markdown import fmt, md_table
 from ...roa.render import fmt_level, render_basin_markdown
@@ -124,16 +125,8 @@ def brake_text(brake) -> str:
 
 def _k2_text(sweep, compare_source) -> str:
     v, lam = sweep.point
-    if sweep.edge is None:
-        rule = "No edge between certified and non-certified gains was found on the grid."
-    else:
-        lo, hi = sweep.edge
-        rule = (f"**Certified switching rule.** With k1 = {fmt(sweep.gain[0], 4)}, the switch at "
-                f"(v_d, lambda_opt) lands in a certified basin for k2 <= {fmt(lo, 4)} (every "
-                f"grid value from {fmt(sweep.grid_min)} up to it is certified"
-                + ("" if sweep.certified_below_edge else " — except where the table says not")
-                + f"), and not for k2 >= {fmt(hi, 4)}: the edge lies in "
-                  f"[{fmt(lo, 4)}, {fmt(hi, 4)}] (bisected).")
+    rule = gain_edge_text(sweep, "k2", "the switch at (v_d, lambda_opt)",
+                          kept=f"**Certified switching rule.** With k1 = {fmt(sweep.gain[0], 4)}, ")
     return ("\n### Which cruise gains make the printed switch safe?\n\n"
             f"Switch state of eq (75) as printed: v = {fmt(v, 4)} m/s, lambda = lambda_opt = "
             f"{fmt(lam, 4)}. Each k2 is judged with every P of the weight grid (CERTIFIED if "
