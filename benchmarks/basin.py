@@ -54,8 +54,8 @@ def main() -> None:
         vt = tuple(sorted(vals.items()))
         for label in ("first (symbolic set-up)", "second (model cached)"):
             t0, c0 = time.perf_counter(), time.process_time()
-            _, est = AB.estimate_cruise(vt, v_d, K, [(0.0, lam_opt - AB.cruise_lambda_d(vt, v_d))],
-                                        100.0)
+            loop, lam_d, _ = AB.cruise_loop(vt, v_d)
+            _, est = loop.estimate(K, 100.0, [(0.0, lam_opt - lam_d)])
             wall, cpu = time.perf_counter() - t0, time.process_time() - c0
             print(f"| 003 cruise law (61), {rail}, w = 100, {label} | {est.c_certified:.6g} | "
                   f"{est.c_refuted:.6g} | {est.boxes} | {est.samples} | {wall:.2f} | {cpu:.2f} |")

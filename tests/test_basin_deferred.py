@@ -21,13 +21,13 @@ VALS = tuple(sorted(DRY.items()))
 def switch():
     """The printed switch state (v_d, lambda_opt) in error coordinates."""
     lam_opt = NumericAdhesion.from_dict(DRY).lambda_opt()
-    return (0.0, lam_opt - AB.cruise_lambda_d(VALS, 70.0))
+    return (0.0, lam_opt - AB.cruise_loop(VALS, 70.0)[1])
 
 
 @pytest.fixture(scope="module")
 def deferred(switch):
     """One weight of the grid at the printed switch, K of the design: REFUTED."""
-    return SEL.DeferredEstimate(*AB._cruise_problem(VALS, 70.0, K, [switch], 100.0), 0)
+    return SEL.DeferredEstimate(*AB.cruise_loop(VALS, 70.0)[0].problem(K, 100.0, [switch]), 0)
 
 
 def test_refuted_point_needs_no_cover(deferred, switch, monkeypatch):
@@ -44,10 +44,10 @@ def test_diverging_path_above_c_top_needs_no_cover(deferred, switch):
 
 def test_deferred_answers_are_the_full_estimate(deferred, switch):
     """The shortcut's premise and its answers, against the full estimate of
-    the same problem (estimate_cruise's, bit for bit)."""
+    the same problem (GainLoop.estimate's, bit for bit)."""
     out_short = deferred.outcome(switch)
     est = deferred.est                                  # the cover now runs
-    _, full = AB.estimate_cruise(VALS, 70.0, K, [switch], 100.0, seed=0)
+    _, full = AB.cruise_loop(VALS, 70.0)[0].estimate(K, 100.0, [switch], seed=0)
     assert est == full
     assert est.c_certified <= deferred.c_top <= est.c_refuted
     assert out_short is est.point_verdict(switch).outcome
@@ -63,7 +63,7 @@ def test_first_stage_settles_the_refuted_switch(switch, monkeypatch):
     monkeypatch.delenv(AB.EAGER_ENV, raising=False)
     ran = []
     monkeypatch.setattr(F, "minimize", lambda *a, **k: ran.append(1) or pytest.fail("SLSQP"))
-    d = SEL.DeferredEstimate(*AB._cruise_problem(VALS, 70.0, K, [switch], 100.0), 0)
+    d = SEL.DeferredEstimate(*AB.cruise_loop(VALS, 70.0)[0].problem(K, 100.0, [switch]), 0)
     path = np.array([switch, (switch[0] * 2, switch[1] * 1.5)])
     assert d.outcome(switch) is Outcome.REFUTED and d.enters(path) is False
     assert d._stage._done is None and d._est is None and not ran
@@ -106,7 +106,7 @@ def test_falsified_top_is_the_estimates_falsifier(deferred):
 def test_switch_verdict_equals_the_eager_path(switch, k2, monkeypatch):
     """Every certificate computed (the path before issue 36) gives the same
     verdict, weight and fate as the deferred one (> 20 s: slow tier)."""
-    pt = (70.0, switch[1] + AB.cruise_lambda_d(VALS, 70.0))
+    pt = (70.0, switch[1] + AB.cruise_loop(VALS, 70.0)[1])
     fast = AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt)
     monkeypatch.setenv(AB.EAGER_ENV, "1")
     assert AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt) == fast
@@ -152,7 +152,7 @@ def test_cruise_basin_coarse_pass_equals_every_cover(monkeypatch):
     and gives the same estimate, verdicts and trajectories as with every
     weight's cover computed (the path before issue 36), and skips some."""
     lam_opt = NumericAdhesion.from_dict(DRY).lambda_opt()
-    pts = [("printed", (70.0, lam_opt)), ("near", (69.5, AB.cruise_lambda_d(VALS, 70.0) + 0.002))]
+    pts = [("printed", (70.0, lam_opt)), ("near", (69.5, AB.cruise_loop(VALS, 70.0)[1] + 0.002))]
     calls = []
     orig = SEL.estimate_basin
     monkeypatch.setattr(SEL, "estimate_basin", lambda *a, **k: calls.append(1) or orig(*a, **k))

@@ -17,10 +17,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from workbench.features.basin_trajectory import integrate, limit_event, trajectory
 from workbench.outcome import Outcome
 from workbench.papers.p003 import antiskid_basin as AB
 from workbench.papers.p003.antiskid_basin_render import plot_basin
-from workbench.plants.lambdify_cache import lambdify
 from workbench.report.figures import figure_png
 from workbench.report.markdown import Figure
 
@@ -49,23 +49,25 @@ def _run(n: int):
     """(PNG, fates, raw solver step times of the paper trajectory, drawn
     paths) with every input moved by n ulp."""
     Kn = tuple(_ulps(k, n) for k in K)
-    f, _, states, _, lam_d, lam_opt = AB._loop(VALS, V_D, Kn)
-    fm = lambdify(states, f, "math")
+    loop, lam_d, lam_opt = AB.cruise_loop(VALS, V_D)
+    fm = loop.numeric(Kn)
     fn = lambda a, b: [_ulps(float(v), n) for v in fm(a, b)]
     lam_n = _ulps(lam_d, n)
     # the run's switch state moves by ~3e-14 when the plant moves by 3 ulp (its simulation)
     x0 = (_ulps(PAPER[0] - V_D + n * 1e-14, n), _ulps(PAPER[1] - lam_d + n * 1e-14, n))
-    prob = AB._cruise_problem(VALS, V_D, Kn, [x0], W)[0]
+    prob = loop.problem(Kn, W, [x0])[0]
     inside = lambda p: prob.V(p) <= C_CERT
     starts = [x0] + [tuple(_ulps(v, n) for v in s) for s in SAMPLED]
-    trajs = [AB._trajectory(fn, s, lam_n, 3.0, inside) for s in starts]
+    spin = [limit_event(1, AB.LAM_DIVERGED, lam_n)]          # the loop's escape, at lam_n
+    trajs = [trajectory(fn, s, 3.0, inside, events=spin, escape="diverges", max_step=0.05,
+                        path_dt=AB.PATH_DT) for s in starts]
     est = SimpleNamespace(P=prob.P, x_eq=prob.x_eq, c_certified=C_CERT, c_refuted=math.inf,
                           counterexample=None)
     point = SimpleNamespace(label="paper", x=x0, verdict=SimpleNamespace(outcome=Outcome.REFUTED))
     basin = SimpleNamespace(check=SimpleNamespace(estimate=est, points=(point,)),
                             trajectories=tuple(trajs), lambda_opt=lam_opt, lambda_d=lam_d)
     png = figure_png(Figure("basin", "", lambda fig: plot_basin(fig, basin), (7.0, 5.0)))
-    raw = AB._delay_free(fn, x0, lam_n, 3.0)
+    raw = integrate(fn, x0, 3.0, events=spin, max_step=0.05, dense=True)
     return png, [t.fate for t in trajs], raw.t, [t.path for t in trajs]
 
 

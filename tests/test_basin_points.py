@@ -10,7 +10,7 @@ import sympy as sp
 
 from workbench.errors import DesignError, ModelError
 from workbench.features import basin_points as BP
-from workbench.features.basin_points_render import gain_sweep_table, points_table
+from workbench.features.basin_points_render import gain_edge_text, gain_sweep_table, points_table
 from workbench.features.basin_trajectory import limit_event, time_varying_fate
 from workbench.outcome import Outcome
 from workbench.reader import Reader
@@ -115,6 +115,12 @@ def test_gain_entry_sweep_brackets_the_true_edge_and_its_table():
     assert lines[1] == "| ---: | ---: | :--- | :--- | ---: | :--- |"
     assert len(lines) == 2 + len(sw.rows) + 2
     assert "| 1 | 8 | grid | REFUTED |" in text and lines[-1].startswith("| 2 | 1 | double |")
+    rule = gain_edge_text(sw, "g1", "z = 0.5", kept="With g0 = 1, ")
+    assert rule.startswith(f"With g0 = 1, z = 0.5 lands in a certified basin for g1 <= {lo:.4g} "
+                           "(every grid value from 0.5 up to it is certified), and not for g1 >= ")
+    assert rule.endswith(f"[{lo:.4g}, {hi:.4g}] (bisected).")
+    none = BP.GainSweep((0.5,), (1.0, 1.0), 1, sw.rows, (), None, 0.5, False)
+    assert gain_edge_text(none, "g1", "z").startswith("No edge between certified")
 
 
 def test_read_gain_sweep_of_a_toy_table():
@@ -133,6 +139,17 @@ def test_read_gain_sweep_of_a_toy_table():
         BP.read_gain_sweep(labels, "g_grid", 1)
 
 
+
+def test_load_gain_sweep_of_a_toy_design():
+    top = lambda basin: Reader("toy.toml", {"basin": basin})
+    s = BP.load_gain_sweep(top({"g_grid": [2.0, 1.0], "seed": 3}), "g_grid", 1)
+    assert s == BP.GainSweepSettings((1.0, 2.0), (), "—", 4, 3)
+    assert BP.load_gain_sweep(top({"g_grid": [2.0, 1.0], "enabled": False}), "g_grid", 1) is None
+    assert BP.load_gain_sweep(Reader("toy.toml", {}), "g_grid", 1) is None
+    with pytest.raises(DesignError, match=r"basin\.typo"):
+        BP.load_gain_sweep(top({"g_grid": [2.0, 1.0], "typo": 1}), "g_grid", 1)
+
+
 def test_time_varying_fate_of_toy_loops():
     ev = [limit_event(0, 3.0)]
     assert time_varying_fate(lambda t, x: [-x], (1.0,), 2.0, 10.0,
@@ -146,3 +163,36 @@ def test_time_varying_fate_of_toy_loops():
     assert t2 == pytest.approx(math.log(2.0), rel=1e-3)
     assert time_varying_fate(lambda t, x: [math.sin(t)], (0.0,), 0.0, 1.0,
                              lambda t, x: False, events=ev) == ("undecided", None)
+
+
+def _duffing():
+    """GainLoop of x1' = x2, x2' = u + x1^3 under u = k1 x1 + k2 x2 (no paper):
+    linearisation A + B K, a finite basin (x1^3 wins far out), escape |x1| = 4."""
+    from workbench.features.basin_loop import GainLoop
+    x1, x2, k1, k2 = sp.symbols("x1 x2 k1 k2", real=True)
+    return GainLoop([x2, k1 * x1 + k2 * x2 + x1**3], (x1, x2), (k1, k2),
+                    np.array([[0.0, 1.0], [0.0, 0.0]]), np.array([[0.0], [1.0]]), (0.0, 0.0),
+                    ("x1", "x2"), ((-4.0, -20.0), (4.0, 20.0)), (1.0, 10.0),
+                    lambda w: [1.0, w], (limit_event(0, 4.0),), loop="toy Duffing")
+
+
+def test_gain_loop_on_a_toy_system():
+    loop, K = _duffing(), (-2.0, -3.0)
+    f, (J, _), A_cl = loop.at(K)
+    assert np.allclose(A_cl, [[0.0, 1.0], [-2.0, -3.0]])
+    assert sp.simplify(J[1][0] - (-2.0 + 3 * loop.states[0] ** 2)) == 0
+    assert loop.numeric(K)(1.0, 0.5) == [0.5, -2.0 - 1.5 + 1.0]
+    w, chk, trajs = loop.basin(K, [("near", (0.2, 0.0)), ("far", (3.0, 0.0))], n_traj=3,
+                               T=20.0, scale=(1, 1), pad=(0, 0), default=(1, 1))
+    assert w in loop.candidates and chk.loop == "toy Duffing"
+    assert [p.verdict.outcome for p in chk.points] == [Outcome.CERTIFIED, Outcome.REFUTED]
+    assert [t.fate for t in trajs[:2]] == ["converges", "diverges"] and len(trajs) == 5
+    near, far = loop.judge(K, (0.2, 0.0), 20.0), loop.judge(K, (3.0, 0.0), 20.0)
+    assert (near.outcome, near.fate) == (Outcome.CERTIFIED, "converges")
+    assert (far.outcome, far.fate) == (Outcome.REFUTED, "diverges")
+    prob, est = loop.estimate(K, 1.0, [(0.2, 0.0)])
+    assert prob.P_source == "optimised" and 0 < est.c_certified <= est.c_refuted
+    assert est.point_verdict((0.2, 0.0)).outcome is Outcome.CERTIFIED
+    # k1 > 0: no Hurwitz linearisation, hence no basin
+    assert loop.basin((1.0, -3.0), [("near", (0.2, 0.0))], n_traj=0, T=1.0, scale=(1, 1),
+                      pad=(0, 0), default=(1, 1)) is None

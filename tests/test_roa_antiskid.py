@@ -39,7 +39,8 @@ def test_small_k2_makes_the_printed_switch_safe(lam_opt):
 
 def test_cruise_loop_linearisation_matches_A_plus_BK():
     vals = tuple(sorted(DRY.items()))
-    f, _, states, A_cl, lam_d, _ = AB._loop(vals, 70.0, K)
+    loop = AB.cruise_loop(vals, 70.0)[0]
+    (f, _, A_cl), states = loop.at(K), loop.states
     import sympy as sp
     fn = sp.lambdify(states, f, "math")
     assert max(abs(c) for c in fn(0.0, 0.0)) < 1e-12          # equilibrium at E = 0
@@ -51,8 +52,8 @@ def test_cruise_loop_linearisation_matches_A_plus_BK():
 
 def test_certified_cruise_level_holds_no_sampled_point_with_vdot_nonnegative(lam_opt):
     vals = tuple(sorted(DRY.items()))
-    lam_d = AB.cruise_lambda_d(vals, 70.0)
-    prob, est = AB.estimate_cruise(vals, 70.0, K, [(0.0, lam_opt - lam_d)], 100.0)
+    lam_d = AB.cruise_loop(vals, 70.0)[1]
+    prob, est = AB.cruise_loop(vals, 70.0)[0].estimate(K, 100.0, [(0.0, lam_opt - lam_d)])
     assert 0 < est.c_certified < est.c_refuted < prob.V(np.array([[0.0, lam_opt - lam_d]]))[0]
     rng = np.random.default_rng(5)
     u = rng.standard_normal((100_000, 2))
@@ -116,10 +117,11 @@ def test_brake_switch_at_lambda_d_is_in_no_basin_and_spins():
     from workbench.papers.p003.antiskid_basin_render import brake_text
     b = brake_switch(DRY, "compensated", (70.0126, 0.01954),
                      profile=CreepSpeedProfile(t_brake=300.0), k_de=10.0)
-    assert b.outcome is Outcome.REFUTED and b.why == "no equilibrium up to spin"
-    assert b.rate > 0 and b.fate == "diverges" and 0 < b.t_fate < 0.1
+    assert b.outcome is Outcome.REFUTED and b.verdict.why == "no equilibrium"
+    assert b.verdict.direction > 0 and b.verdict.rate > 0 and b.fate == "diverges" and 0 < b.t_fate < 0.1
     text = brake_text([b])
     assert "frozen at the switch instant" in text and "| REFUTED |" in text
+    assert "no equilibrium from the state up to lambda = 0.9: \\|lambda'\\| >= " in text
 
 
 def test_brake_switch_on_the_braking_side_is_certified():
@@ -130,9 +132,9 @@ def test_brake_switch_on_the_braking_side_is_certified():
     from workbench.papers.p003.antiskid_basin_brake import brake_switch
     b = brake_switch(DRY, "later", (69.0, -0.01), profile=CreepSpeedProfile(t_brake=300.0),
                      k_de=10.0, t=301.0)
-    assert b.outcome is Outcome.CERTIFIED and b.lam_star < 0 and b.fate == "tracks"
+    assert b.outcome is Outcome.CERTIFIED and b.verdict.star < 0 and b.fate == "tracks"
     # the frozen equilibrium is the law's own: k_de (v lambda - v_s*) = -lambda z1
-    assert abs(b.lam_star - b.vs_frozen / b.v) < 0.1 * abs(b.lam_star)
+    assert abs(b.verdict.star - b.vs_frozen / b.v) < 0.1 * abs(b.verdict.star)
 
 
 def test_brake_switch_claims_are_known_quantities():

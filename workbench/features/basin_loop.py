@@ -5,14 +5,25 @@ candidate modal Lyapunov matrix: what a gain sweep of a basin verdict
 General: the loop is any sympy vector field in its states and gain symbols;
 its Jacobian and Hessians are derived once (symbolically, with the gain
 free) and the gain substituted per value, so that a sweep over gains does not
-differentiate again.
+differentiate again. :class:`GainLoop` bundles such a loop with its
+linearisation, domain, candidate Lyapunov matrices and escape, and answers the
+basin questions per gain (the verdicts of given states, the trajectories).
 """
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cached_property, lru_cache
+
+import numpy as np
 import sympy as sp
 
-from ..roa import BasinProblem, modal_P
+from ..plants.lambdify_cache import lambdify
+from ..roa import BasinProblem, estimate_basin, modal_P
 from ..roa.check import search_level
+from .basin_points import PointVerdict, check_points, point_in_basin, sampled_starts
+from .basin_trajectory import Trajectory, trajectory
 
 
 def derivatives(f, states) -> tuple:
@@ -38,3 +49,117 @@ def modal_problem(f, states, x_eq, A_cl, weights, *, derivs=None, names=None, po
     P = modal_P(A_cl, weights)
     prob = BasinProblem(f, states, x_eq, P, P_source=P_source, names=names, derivatives=derivs)
     return prob, search_level(prob, points, domain, c_search)
+
+
+@dataclass(frozen=True, eq=False)
+class GainLoop:
+    """A closed loop x' = f(x; K) whose gain K enters ``f`` as ``symbols``, in
+    coordinates with its equilibrium at ``x_eq`` for every gain, and its basin
+    per gain: the modal problems over the ``candidates`` (each mapped by
+    ``weights`` to the weights of :func:`~workbench.roa.modal_P` (A + B K, .)),
+    the verdicts of given states, the trajectories and their fates.
+
+    Attributes
+    ----------
+    f : list of sympy expressions
+        In ``states`` and the gain ``symbols``.
+    states, symbols : tuple of sympy Symbol
+    A, B : ndarray
+        Linearisation at x_eq (A + B K: the closed loop's).
+    x_eq : tuple
+    names : tuple of str
+        Display names of the states.
+    domain : (lo, hi)
+        Box the model holds on (caps the level searched).
+    candidates : tuple
+        Candidates of P, best first on ties (e.g. weights of a fast mode).
+    weights : callable
+        candidate -> weights of :func:`~workbench.roa.modal_P`.
+    events : tuple of callable
+        Terminal ``solve_ivp`` events of the escape (e.g. :func:`~.basin_trajectory.limit_event`).
+    escape : str
+        Fate word of an escaped trajectory.
+    max_step : float
+        Largest integration step (s).
+    loop : str
+        Description of the loop (:class:`~workbench.roa.check.BasinCheck`).
+    """
+
+    f: list
+    states: tuple
+    symbols: tuple
+    A: np.ndarray
+    B: np.ndarray
+    x_eq: tuple
+    names: tuple
+    domain: tuple
+    candidates: tuple
+    weights: Callable
+    events: tuple = ()
+    escape: str = "diverges"
+    max_step: float = math.inf
+    loop: str = ""
+
+    @cached_property
+    def derivs(self) -> tuple:
+        """(Jacobian, Hessians) with the gain symbolic (derived once)."""
+        return derivatives(self.f, self.states)
+
+    @lru_cache(maxsize=16)
+    def at(self, K: tuple) -> tuple:
+        """(f, derivatives, A + B K) at the gain ``K`` (a tuple of floats)."""
+        f, derivs = at_gain(self.f, self.derivs, self.symbols, K)
+        return f, derivs, self.A + self.B @ np.array([K], float)
+
+    def problem(self, K, w, points, c_search=None) -> tuple:
+        """(problem, level searched) of candidate ``w`` at ``K`` (:func:`modal_problem`)."""
+        f, derivs, A_cl = self.at(tuple(K))
+        return modal_problem(f, self.states, self.x_eq, A_cl, self.weights(w), derivs=derivs,
+                             names=self.names, points=points, domain=self.domain,
+                             c_search=c_search)
+
+    def estimate(self, K, w, points, *, seed: int = 0, c_search=None) -> tuple:
+        """(problem, its :func:`~workbench.roa.estimate_basin`) of candidate ``w`` at ``K``."""
+        prob, c = self.problem(K, w, points, c_search)
+        return prob, estimate_basin(prob, c, seed=seed)
+
+    def numeric(self, K):
+        """The numeric vector field ``fn(*x)`` at ``K``."""
+        return lambdify(self.states, self.at(tuple(K))[0], "math")
+
+    def check(self, K, points, *, seed: int = 0):
+        """(candidate, problem, BasinCheck) of the best candidate for the labelled
+        ``points`` (:func:`~.basin_points.check_points`), or None (no Hurwitz loop)."""
+        return check_points(self.candidates, lambda w, xs: self.problem(K, w, xs), points,
+                            loop=self.loop, seed=seed)
+
+    def judge(self, K, x, T: float, *, seed: int = 0) -> PointVerdict:
+        """Best verdict over the candidates for the state ``x`` and the fate of the
+        trajectory from it over [0, T] (:func:`~.basin_points.point_in_basin`)."""
+        return point_in_basin(self.candidates, lambda w, xs: self.problem(K, w, xs), x,
+                              self.numeric(K), T, events=self.events, escape=self.escape,
+                              max_step=self.max_step, seed=seed)
+
+    def trajectory(self, fn, x0, T: float, inside, *, path_dt=None) -> Trajectory:
+        """One trajectory of x' = fn(*x) from x0 and its fate, escaping by the
+        loop's events (:func:`~.basin_trajectory.trajectory`)."""
+        return trajectory(fn, x0, T, inside, events=self.events, escape=self.escape,
+                          max_step=self.max_step, path_dt=path_dt)
+
+    def basin(self, K, points, *, n_traj: int, T: float, scale, pad, default, seed: int = 0,
+              path_dt=None):
+        """(candidate, BasinCheck, trajectories) of the best candidate for the
+        labelled ``points`` (:meth:`check`; None: no Hurwitz loop), with the
+        trajectories from the points and from ``n_traj`` seeded starts around them
+        (:func:`~.basin_points.sampled_starts` with ``scale``, ``pad``, ``default``)
+        over [0, T], "converges" once in the certified level set."""
+        best = self.check(K, points, seed=seed)
+        if best is None:
+            return None
+        w, prob, check = best
+        starts = sampled_starts([x for _, x in points], n_traj, seed=seed, scale=scale, pad=pad,
+                                default=default)
+        fn, c = self.numeric(K), check.estimate.c_certified
+        inside = lambda p: prob.V(p) <= c
+        return w, check, tuple(self.trajectory(fn, x0, T, inside, path_dt=path_dt)
+                               for x0 in starts)

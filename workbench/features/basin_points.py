@@ -17,7 +17,8 @@ terminal events of its escape; nothing here knows the plant or the law.
 * :func:`sweep_gain_entry` -- :func:`point_in_basin` along one entry of a gain
   (:func:`~workbench.features.basin_sweep.gain_edge`), plus labelled gains
   compared;
-* :func:`read_gain_sweep` -- the ``[basin]`` table's keys of that sweep.
+* :func:`read_gain_sweep`, :func:`load_gain_sweep` -- the ``[basin]`` table's
+  keys of that sweep.
 """
 from __future__ import annotations
 
@@ -187,15 +188,34 @@ def sweep_gain_entry(judge, point, gain, index: int, grid, *, compare=(),
 
 @dataclass(frozen=True)
 class GainSweepSettings:
-    """The ``[basin]`` keys of a gain sweep (:func:`read_gain_sweep`)."""
+    """The ``[basin]`` keys of a gain sweep (:func:`read_gain_sweep`) and the
+    table's falsifier seed."""
 
     grid: tuple
     compare: tuple            # ((label, gain), ...)
     compare_source: str
     bisect: int
+    seed: int = 0
 
 
-def read_gain_sweep(b, grid_key: str, width: int, *, what: str = "gains") -> GainSweepSettings:
+def load_gain_sweep(root, grid_key: str, width: int, *, what: str = "gains"
+                    ) -> GainSweepSettings | None:
+    """A design's ``[basin]`` table (``root``: a :class:`workbench.reader.Reader`)
+    holding a gain sweep: ``enabled`` and ``seed``
+    (:func:`~workbench.features.basin.basin_table`), then the keys of
+    :func:`read_gain_sweep`; None when the table is absent or disabled."""
+    from .basin import basin_table
+    table = basin_table(root)
+    if table is None:
+        return None
+    b, enabled, seed = table
+    sweep = read_gain_sweep(b, grid_key, width, what=what, seed=seed)
+    b.finish()
+    return sweep if enabled else None
+
+
+def read_gain_sweep(b, grid_key: str, width: int, *, what: str = "gains",
+                    seed: int = 0) -> GainSweepSettings:
     """Read the sweep's keys from a ``[basin]`` table reader ``b``: ``grid_key``
     (at least two values, sorted), ``compare_gains`` (rows of ``width`` finite
     numbers), ``compare_labels`` (one non-empty string per row, default "row i"),
@@ -218,4 +238,4 @@ def read_gain_sweep(b, grid_key: str, width: int, *, what: str = "gains") -> Gai
         raise b.fail("compare_labels", labels, f"{len(rows)} non-empty strings, one per gain")
     source = b.string("compare_source", default="—")
     bisect = b.number("bisect", integer=True, default=4, lo=0, hi=12, what="integer")
-    return GainSweepSettings(tuple(sorted(grid)), tuple(zip(labels, rows)), source, bisect)
+    return GainSweepSettings(tuple(sorted(grid)), tuple(zip(labels, rows)), source, bisect, seed)

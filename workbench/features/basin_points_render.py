@@ -1,4 +1,5 @@
-"""Markdown tables of judged states and of a gain sweep (pure rendering of
+"""Markdown tables of judged states and of a gain sweep, and the sentence of
+the sweep's certified range (pure rendering of
 :class:`~workbench.roa.check.BasinCheck` points and of
 :class:`~workbench.features.basin_points.GainSweep`); the headings and the
 words around them are the caller's."""
@@ -32,3 +33,17 @@ def gain_sweep_table(sweep, header, *, digits=None) -> str:
     rows = [[*(fmt(g, d) for g, d in zip(r.gain, digits)), r.source, r.verdict.outcome.name,
              fmt(r.verdict.w), r.verdict.fate] for r in (*sweep.rows, *sweep.compared)]
     return md_table(header, rows, "r" * n + "llrl")
+
+
+def gain_edge_text(sweep, entry: str, state: str, *, kept: str = "") -> str:
+    """The certified range of a :class:`~workbench.features.basin_points.GainSweep`
+    in one sentence: ``state`` lands in a certified basin for ``entry`` up to the
+    edge's lower end and not from its upper end (``kept``: the words before, e.g.
+    the entries held; only when an edge was found)."""
+    if sweep.edge is None:
+        return "No edge between certified and non-certified gains was found on the grid."
+    lo, hi = (fmt(e, 4) for e in sweep.edge)
+    return (f"{kept}{state} lands in a certified basin for {entry} <= {lo} (every grid value "
+            f"from {fmt(sweep.grid_min)} up to it is certified"
+            + ("" if sweep.certified_below_edge else " — except where the table says not")
+            + f"), and not for {entry} >= {hi}: the edge lies in [{lo}, {hi}] (bisected).")

@@ -25,13 +25,10 @@ Results:
 
 Only the closed loop (law (61) at v_d on the adhesion plant, its domain and
 the |lambda| = 0.9 divergence event) and the weight grid are paper 003's and
-stay here; the gain loop's derivatives and modal problem
-(:mod:`workbench.features.basin_loop`), the switch states' verdicts, the
-best verdict over the grid and the sampled starts
-(:mod:`workbench.features.basin_points`, on :mod:`~workbench.features.basin_select`
-and :mod:`~workbench.features.basin_sweep`), trajectories and fates
-(:mod:`workbench.features.basin_trajectory`) and the figure
-(:mod:`workbench.features.basin_plot`) are the general basin feature's.
+stay here: a :class:`workbench.features.basin_loop.GainLoop`, whose general
+methods give the modal problems, the switch states' verdicts, the best verdict
+over the grid, the sampled starts and the trajectories' fates; the figure is
+:mod:`workbench.features.basin_plot`'s.
 
 References
 ----------
@@ -44,19 +41,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 
-import numpy as np
 import sympy as sp
 
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import ModelError
-from ...features.basin_loop import at_gain, derivatives, modal_problem
-from ...features.basin_points import PointVerdict, check_points, point_in_basin, sampled_starts
+from ...features.basin_loop import GainLoop
+from ...features.basin_points import PointVerdict
 # EAGER_ENV: re-exported, the switch of every staged certificate below (benchmarks, tests)
 from ...features.basin_select import EAGER_ENV  # noqa: F401
-from ...features.basin_trajectory import Trajectory, integrate, limit_event, trajectory
+from ...features.basin_trajectory import integrate, limit_event
 from ...plants.adhesion import NumericAdhesion, adhesion_model
-from ...plants.lambdify_cache import lambdify
-from ...roa import estimate_basin
 from ...roa.check import BasinCheck
 from ...symbolic.linearise import linearise_cruise
 
@@ -96,11 +90,22 @@ class CruiseBasin:
     trajectories: tuple
 
 
+#: |lambda| at which a delay-free trajectory has diverged (the runs' own test).
+LAM_DIVERGED = ControllerSettings.lam_diverged
+#: Time step (s) of a trajectory's drawn path: the dense output on this fixed
+#: grid (:func:`workbench.features.basin_trajectory.drawn_path`), for every
+#: fate (issue 36 item 5: a failing trajectory's accepted steps bunch up where
+#: it diverges and move by ~1e-7 s under a 3-ulp change of the start).
+PATH_DT = 0.01
+
+
 @lru_cache(maxsize=8)
-def _loop_symbolic(values: tuple, v_d: float):
-    """(f, (jacobian, hessians), states, gain symbols, linearisation, lambda_d,
-    lambda_opt) of the delay-free cruise loop with the gain (k1, k2) as
-    symbols: derived once per plant and cruise speed."""
+def cruise_loop(values: tuple, v_d: float) -> tuple:
+    """(GainLoop, lambda_d, lambda_opt) of the delay-free cruise loop in the
+    error coordinates, the gain (k1, k2) as symbols (``values``: the plant's
+    constants as sorted (name, value) pairs); derived once per plant and
+    cruise speed. Its escape: |lambda| reaches :data:`LAM_DIVERGED` (the wheel
+    spins or locks), integrated with steps of at most 0.05 s."""
     vals = dict(values)
     plant = NumericAdhesion.from_dict(vals)
     lam_d = plant.cruise_lambda(v_d)
@@ -117,44 +122,22 @@ def _loop_symbolic(values: tuple, v_d: float):
     trac = sp.Float(lam_d) + le >= 0
     f = [sp.Piecewise((sub(y1), trac), (sub(z1), True)),
          sp.Piecewise((sub(y2) + sub(y3) * u, trac), (sub(z2) + sub(z3) * u, True))]
-    states = (ve, le)
-    return f, derivatives(f, states), states, (k1, k2), lin, lam_d, plant.lambda_opt()
+    loop = GainLoop(f, (ve, le), (k1, k2), lin.A, lin.B, (0.0, 0.0),
+                    ("v - v_d (m/s)", "lambda - lambda_d"),
+                    ((V_MIN - v_d, LAM_LO - lam_d), (v_d, LAM_HI - lam_d)), W_GRID,
+                    lambda w: [1.0, w], (limit_event(1, LAM_DIVERGED, lam_d),), max_step=0.05,
+                    loop=LOOP)
+    return loop, lam_d, plant.lambda_opt()
 
 
-@lru_cache(maxsize=8)
-def _loop(values: tuple, v_d: float, K: tuple):
-    """(f, derivatives, states, A_cl, lambda_d, lambda_opt) at the gain K
-    (once per gain: the weights of the grid and the fate share it)."""
-    f, derivs, states, ks, lin, lam_d, lam_opt = _loop_symbolic(values, v_d)
-    f, derivs = at_gain(f, derivs, ks, K)
-    A_cl = lin.A + lin.B @ np.array([K], float)
-    return f, derivs, states, A_cl, lam_d, lam_opt
-
-
-def _domain(v_d: float, lam_d: float):
-    return ((V_MIN - v_d, LAM_LO - lam_d), (v_d, LAM_HI - lam_d))
-
-
-def _cruise_problem(values, v_d, K, points, w, c_search=None):
-    """(problem, level searched) of :func:`estimate_cruise`."""
-    f, derivs, states, A_cl, lam_d, _ = _loop(values, v_d, tuple(K))
-    return modal_problem(f, states, (0.0, 0.0), A_cl, [1.0, w], derivs=derivs,
-                         names=("v - v_d (m/s)", "lambda - lambda_d"), points=points,
-                         domain=_domain(v_d, lam_d), c_search=c_search)
-
-
-def estimate_cruise(values, v_d, K, points, w, *, seed=0, c_search=None):
-    """Basin estimate with P = modal_P(A + B K, [1, w]) (slow mode weight 1,
-    fast mode w); c_search: 4 x the largest level of ``points`` (capped by
-    the model's domain) unless given."""
-    prob, c = _cruise_problem(values, v_d, K, points, w, c_search)
-    return prob, estimate_basin(prob, c, seed=seed)
+def _values(values: dict) -> tuple:
+    return tuple(sorted((k, float(v)) for k, v in values.items()))
 
 
 def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
                  n_traj: int = 24, t_traj: float = 3.0) -> CruiseBasin:
     """Certified basin of law (61) and the verdict for each switch state
-    (:func:`workbench.features.basin_points.check_points` over :data:`W_GRID`).
+    (:meth:`workbench.features.basin_loop.GainLoop.basin` over :data:`W_GRID`).
 
     Parameters
     ----------
@@ -174,54 +157,24 @@ def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
     t_traj : float
         Their horizon (s).
     """
-    vals = tuple(sorted((k, float(v)) for k, v in values.items()))
-    lam_d, lam_opt = _loop_symbolic(vals, v_d)[5:7]
+    loop, lam_d, lam_opt = cruise_loop(_values(values), v_d)
     pts = [(lab, (float(v) - v_d, float(l) - lam_d)) for lab, (v, l) in switch_points]
-    best = check_points(W_GRID, lambda q, xs: _cruise_problem(vals, v_d, K, xs, q), pts,
-                        loop=LOOP, seed=seed)
-    if best is None:
-        raise ModelError(f"cruise loop with K = {tuple(K)} has no Hurwitz linearisation")
-    q, prob, check = best
-    est = check.estimate
     # the sampled starts: a box around the switch states (2 x |v_e| + 1 m/s,
     # 1.5 x |lambda_e| + 0.02)
-    starts = sampled_starts([x for _, x in pts], n_traj, seed=seed, scale=(2, 1.5),
-                            pad=(1.0, 0.02), default=(2, 0.1))
-    fm = lambdify(prob.states, list(prob.f), "math")
-    inside = lambda p: prob.V(p) <= est.c_certified
-    trajs = tuple(_trajectory(fm, x0, lam_d, t_traj, inside) for x0 in starts)
+    best = loop.basin(tuple(K), pts, n_traj=n_traj, T=t_traj, scale=(2, 1.5), pad=(1.0, 0.02),
+                      default=(2, 0.1), seed=seed, path_dt=PATH_DT)
+    if best is None:
+        raise ModelError(f"cruise loop with K = {tuple(K)} has no Hurwitz linearisation")
+    q, check, trajs = best
     return CruiseBasin(check, tuple(float(k) for k in K), q, v_d, lam_d, lam_opt, trajs)
 
 
-#: |lambda| at which a delay-free trajectory has diverged (the runs' own test).
-LAM_DIVERGED = ControllerSettings.lam_diverged
-
-
-def _spin(lam_d: float):
-    """Terminal event: |lambda| reaches LAM_DIVERGED (the wheel spins or locks)."""
-    return limit_event(1, LAM_DIVERGED, lam_d)
-
-
-def _delay_free(fn, x0, lam_d: float, T: float):
-    """The delay-free loop x' = fn(x) from x0 over [0, T]
-    (:func:`workbench.features.basin_trajectory.integrate`, max step 0.05 s),
-    stopped when |lambda| reaches 0.9."""
-    return integrate(fn, x0, T, events=[_spin(lam_d)], max_step=0.05, dense=True)
-
-
-#: Time step (s) of a trajectory's drawn path: the dense output on this fixed
-#: grid (:func:`workbench.features.basin_trajectory.drawn_path`), for every
-#: fate (issue 36 item 5: a failing trajectory's accepted steps bunch up where
-#: it diverges and move by ~1e-7 s under a 3-ulp change of the start).
-PATH_DT = 0.01
-
-
-def _trajectory(fn, x0, lam_d: float, T: float, inside_at) -> Trajectory:
-    """One delay-free trajectory from x0 (:func:`_delay_free`) and its fate:
-    "converges" (a solver step satisfies ``inside_at``), "diverges" (lambda
-    leaves (-0.9, 0.9) or the step fails), else "undecided" within T."""
-    return trajectory(fn, x0, T, inside_at, events=[_spin(lam_d)], escape="diverges",
-                      max_step=0.05, path_dt=PATH_DT)
+def delay_free(fn, x0, lam_d: float, T: float):
+    """The delay-free loop x' = fn(x) from x0 over [0, T] (max step 0.05 s,
+    dense output), stopped when |lambda| reaches 0.9 (the solver's own steps:
+    tests/test_basin_perturb.py)."""
+    return integrate(fn, x0, T, events=[limit_event(1, LAM_DIVERGED, lam_d)], max_step=0.05,
+                     dense=True)
 
 
 def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0,
@@ -231,15 +184,7 @@ def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0,
     deciding weight), and the fate of the delay-free trajectory from it
     ("diverges": lambda reaches 0.9, the wheel spins; "undecided": neither
     that nor a certified level set within 10 s)
-    (:func:`workbench.features.basin_points.point_in_basin`)."""
-    vals = tuple(sorted((k, float(v)) for k, v in values.items()))
-    f, _, states, _, lam_d, _ = _loop(vals, v_d, tuple(K))
-    x = (float(point[0]) - v_d, float(point[1]) - lam_d)
-    return point_in_basin(W_GRID, lambda w, xs: _cruise_problem(vals, v_d, K, xs, w), x,
-                          lambdify(states, f, "math"), t_sim, events=[_spin(lam_d)],
-                          max_step=0.05, seed=seed)
-
-
-def cruise_lambda_d(values: tuple, v_d: float) -> float:
-    """lambda_d of the cruise loop (``values`` as sorted (name, value) pairs)."""
-    return _loop_symbolic(values, v_d)[5]
+    (:meth:`workbench.features.basin_loop.GainLoop.judge`)."""
+    loop, lam_d, _ = cruise_loop(_values(values), v_d)
+    return loop.judge(tuple(K), (float(point[0]) - v_d, float(point[1]) - lam_d), t_sim,
+                      seed=seed)

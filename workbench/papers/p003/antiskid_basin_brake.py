@@ -39,7 +39,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from ...features.basin_scalar import scalar_verdict
+from ...features.basin_scalar import ScalarVerdict, scalar_verdict
 from ...features.basin_trajectory import limit_event
 from ...features.basin_trajectory import time_varying_fate as fate_from
 from ...outcome import Outcome
@@ -68,16 +68,9 @@ class BrakeSwitch:
         The state at t_brake.
     vs_frozen : float
         v_s*(t_brake) (m/s), frozen.
-    outcome : Outcome
-    why : str
-        "no equilibrium up to spin" / "no equilibrium down to lock" /
-        "level set" / what left it INCONCLUSIVE.
-    lam_star : float or None
-        Equilibrium of the frozen loop the state moves to (None: none).
-    rate : float or None
-        REFUTED: proven lower bound of |lambda'| between lambda_s and the limit (1/s).
-    level : (float, float) or None
-        Level-set case: (V at the state (upper bound), c_certified).
+    verdict : ScalarVerdict
+        Of the frozen loop on [-0.9, 0.9] (``star``: its equilibrium the state
+        moves to; ``rate``: proven lower bound of |lambda'| on the way, 1/s).
     fate : str
         Time-varying delay-free loop: "diverges" (|lambda| reaches 0.9 or a step
         fails), "tracks" (lambda < 0 and |v lambda - v_s*| < 0.01 m/s at T_FATE),
@@ -90,13 +83,13 @@ class BrakeSwitch:
     v: float
     lam: float
     vs_frozen: float
-    outcome: Outcome
-    why: str
-    lam_star: float | None
-    rate: float | None
-    level: tuple | None
+    verdict: ScalarVerdict
     fate: str
     t_fate: float | None
+
+    @property
+    def outcome(self) -> Outcome:
+        return self.verdict.outcome
 
 
 @lru_cache(maxsize=4)
@@ -148,11 +141,7 @@ def brake_switch(values: dict, label: str, point, *, profile, k_de: float,
     g, lam = frozen_loop(values, v, vs, k_de)
     fate, t_fate = time_varying_fate(values, (v, lam_s), profile, k_de)
     sv = scalar_verdict(g, lam, lam_s, -LAM_LIMIT, LAM_LIMIT, name="lambda", seed=seed)
-    why = {"no equilibrium": "no equilibrium up to spin" if sv.direction > 0
-           else "no equilibrium down to lock",
-           "sign not proven": "sign of lambda' not proven"}.get(sv.why, sv.why)
-    return BrakeSwitch(label=label, v=v, lam=lam_s, vs_frozen=vs, outcome=sv.outcome, why=why,
-                       lam_star=sv.star, rate=sv.rate, level=sv.level, fate=fate, t_fate=t_fate)
+    return BrakeSwitch(label, v, lam_s, vs, sv, fate, t_fate)
 
 
 def time_varying_fate(values: dict, x0, profile, k_de: float) -> tuple[str, float | None]:

@@ -5,15 +5,14 @@
 Paper 003's wording (laws (61), (69), eqs (75)-(76), the k2 rule) and the
 cruise figure's look stay here; the figure itself is the general
 :func:`workbench.features.basin_plot.plot_basin`, the switch-state and gain
-tables those of :mod:`workbench.features.basin_points_render`."""
+tables and the certified gain range's sentence those of
+:mod:`workbench.features.basin_points_render`."""
 from __future__ import annotations
-
-import math
 
 from ...features.basin_plot import BasinPlotStyle
 from ...features.basin_plot import plot_basin as draw_basin
-from ...features.basin_points_render import gain_sweep_table, points_table
-from ...printed_grid import sig_round
+from ...features.basin_points_render import gain_edge_text, gain_sweep_table, points_table
+from ...printed_grid import directed
 from ...report.markdown import fmt, md_table
 from ...roa.render import fmt_level, render_basin_markdown
 from .antiskid_basin import LAM_DIVERGED
@@ -62,12 +61,9 @@ def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—"
             + (_k2_text(sweep, compare_source) if sweep is not None else ""))
 
 
-def _floor(x: float, digits: int = 2) -> str:
-    return fmt(sig_round(x, digits, math.floor), digits)
-
-
-def _ceil(x: float, digits: int = 2) -> str:
-    return fmt(sig_round(x, digits, math.ceil), digits)
+def _directed(x: float, up: bool) -> str:
+    """x rounded up or down to 2 significant digits (a proven bound's direction)."""
+    return fmt(directed(x, up=up, sig=2), 2)
 
 
 def brake_text(brake) -> str:
@@ -75,18 +71,19 @@ def brake_text(brake) -> str:
     from .antiskid_basin_brake import FATE_RTOL, LAM_LIMIT, T_FATE, TRACK_TOL
     rows = []
     for b in brake:
-        if b.why.startswith("no equilibrium"):
-            side = "up to" if b.why.endswith("spin") else "down to"
-            frozen = (f"no equilibrium from the state {side} lambda = "
-                      f"{'' if side == 'up to' else '−'}{fmt(LAM_LIMIT)}: |lambda'| >= "
-                      f"{_floor(b.rate)} 1/s proven, so it gets there within "
-                      f"{_ceil((LAM_LIMIT - abs(b.lam)) / b.rate)} s")
-        elif b.lam_star is not None:
-            frozen = (f"equilibrium lambda* = {fmt(b.lam_star, 4)} ({b.why}"
-                      + (f"; V = {fmt_level(b.level[0], 'up')}, c_certified = "
-                         f"{fmt_level(b.level[1])}" if b.level else "") + ")")
+        sv = b.verdict
+        if sv.why == "no equilibrium":
+            up = sv.direction > 0
+            frozen = (f"no equilibrium from the state {'up to' if up else 'down to'} lambda = "
+                      f"{'' if up else '−'}{fmt(LAM_LIMIT)}: |lambda'| >= "
+                      f"{_directed(sv.rate, False)} 1/s proven, so it gets there within "
+                      f"{_directed((LAM_LIMIT - abs(b.lam)) / sv.rate, True)} s")
+        elif sv.star is not None:
+            frozen = (f"equilibrium lambda* = {fmt(sv.star, 4)} ({sv.why}"
+                      + (f"; V = {fmt_level(sv.level[0], 'up')}, c_certified = "
+                         f"{fmt_level(sv.level[1])}" if sv.level else "") + ")")
         else:
-            frozen = b.why
+            frozen = sv.why.replace("sign not", "sign of lambda' not")
         fate = (f"diverges: |lambda| = {fmt(LAM_LIMIT)} at t_brake + {fmt(b.t_fate, 2)} s"
                 if b.fate == "diverges" else b.fate)
         rows.append([f"`{b.label}`", fmt(b.v, 4), fmt(b.lam, 4), fmt(b.vs_frozen, 4), frozen,
@@ -128,16 +125,8 @@ def brake_text(brake) -> str:
 
 def _k2_text(sweep, compare_source) -> str:
     v, lam = sweep.point
-    if sweep.edge is None:
-        rule = "No edge between certified and non-certified gains was found on the grid."
-    else:
-        lo, hi = sweep.edge
-        rule = (f"**Certified switching rule.** With k1 = {fmt(sweep.gain[0], 4)}, the switch at "
-                f"(v_d, lambda_opt) lands in a certified basin for k2 <= {fmt(lo, 4)} (every "
-                f"grid value from {fmt(sweep.grid_min)} up to it is certified"
-                + ("" if sweep.certified_below_edge else " — except where the table says not")
-                + f"), and not for k2 >= {fmt(hi, 4)}: the edge lies in "
-                  f"[{fmt(lo, 4)}, {fmt(hi, 4)}] (bisected).")
+    rule = gain_edge_text(sweep, "k2", "the switch at (v_d, lambda_opt)",
+                          kept=f"**Certified switching rule.** With k1 = {fmt(sweep.gain[0], 4)}, ")
     return ("\n### Which cruise gains make the printed switch safe?\n\n"
             f"Switch state of eq (75) as printed: v = {fmt(v, 4)} m/s, lambda = lambda_opt = "
             f"{fmt(lam, 4)}. Each k2 is judged with every P of the weight grid (CERTIFIED if "

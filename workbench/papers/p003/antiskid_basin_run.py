@@ -21,31 +21,21 @@ instant (:mod:`.antiskid_basin_brake`). The basin uses the controller's nominal
 model (a design's plant mass factor is not in it; the report says so).
 
 What stays here is paper 003's: the k2 key, where the switches are in a
-case's metrics and the claim names; the table opener and the level and point
-quantities are the general ones of :mod:`workbench.features.basin`, the sweep's
-keys (``compare_*``, ``bisect``) those of
-:func:`workbench.features.basin_points.read_gain_sweep`.
+case's metrics and the claim names; the level and point quantities are the
+general ones of :mod:`workbench.features.basin`, the table (``enabled``,
+``seed``, ``compare_*``, ``bisect``) is read by
+:func:`workbench.features.basin_points.load_gain_sweep`.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 
-from ...features.basin_points import GainSweepSettings, read_gain_sweep
-from ...features.basin import (LEVEL_QUANTITIES, basin_table, level_quantities,
-                                point_quantities, point_quantity_names)
+from ...features.basin import (LEVEL_QUANTITIES, level_quantities, point_quantities,
+                                point_quantity_names)
+from ...features.basin_points import GainSweepSettings, load_gain_sweep
 from .antiskid_basin import CruiseBasin, cruise_basin
 from .antiskid_basin_k2 import K2Sweep, safe_k2_range
-
-
-@dataclass(frozen=True)
-class BasinSettings:
-    """The design's ``[basin]`` table: the k2 sweep's keys
-    (:class:`~workbench.features.basin_points.GainSweepSettings`, ``grid`` the
-    k2 values, ``compare`` rows (label, (k1, k2))) and the seed."""
-
-    sweep: GainSweepSettings
-    seed: int
 
 
 @dataclass(frozen=True)
@@ -59,16 +49,11 @@ class BasinResult:
     brake: tuple = ()          # antiskid_basin_brake.BrakeSwitch per case that braked
 
 
-def load_basin_settings(root) -> BasinSettings | None:
-    """Read ``[basin]`` from a design (a :class:`workbench.reader.Reader`);
-    None when the table is absent or ``enabled = false``."""
-    table = basin_table(root)
-    if table is None:
-        return None
-    b, enabled, seed = table
-    sweep = read_gain_sweep(b, "k2_grid", 2, what="cruise gains k2")
-    b.finish()
-    return BasinSettings(sweep, seed) if enabled else None
+def load_basin_settings(root) -> GainSweepSettings | None:
+    """Read ``[basin]`` from a design (a :class:`workbench.reader.Reader`): ``grid``
+    the k2 values, ``compare`` rows (label, (k1, k2)); None when the table is
+    absent or ``enabled = false``."""
+    return load_gain_sweep(root, "k2_grid", 2, what="cruise gains k2")
 
 
 #: Key of a case's acceleration -> cruise switch quantities.
@@ -97,14 +82,14 @@ def brake_points(cases, v_d: float) -> list:
     return out
 
 
-def run_basin(settings: BasinSettings, values: dict, v_d: float, K, lambda_opt: float, cases,
+def run_basin(settings: GainSweepSettings, values: dict, v_d: float, K, lambda_opt: float, cases,
               mass_factor: float = 1.0, *, profile=None, k_de: float | None = None
               ) -> BasinResult:
     """The basin check of one antiskid-run design.
 
     Parameters
     ----------
-    settings : BasinSettings
+    settings : GainSweepSettings
     values : dict
         Nominal plant constants (SI) the controller is built on.
     v_d : float
@@ -123,15 +108,14 @@ def run_basin(settings: BasinSettings, values: dict, v_d: float, K, lambda_opt: 
         Gain of the braking law (69) (1/s).
     """
     basin = cruise_basin(values, v_d, K, switch_points(cases), seed=settings.seed)
-    sw = settings.sweep
-    sweep = safe_k2_range(values, v_d, float(K[0]), (v_d, lambda_opt), grid=sw.grid,
-                          compare=sw.compare, bisect=sw.bisect, seed=settings.seed)
+    sweep = safe_k2_range(values, v_d, float(K[0]), (v_d, lambda_opt), grid=settings.grid,
+                          compare=settings.compare, bisect=settings.bisect, seed=settings.seed)
     brake = ()
     if profile is not None and k_de is not None:
         from .antiskid_basin_brake import brake_switch
         brake = tuple(brake_switch(values, lab, pt, profile=profile, k_de=k_de,
                                    seed=settings.seed) for lab, pt in brake_points(cases, v_d))
-    return BasinResult(basin, sweep, settings.sweep.compare_source, mass_factor, brake)
+    return BasinResult(basin, sweep, settings.compare_source, mass_factor, brake)
 
 
 def basin_quantities(basin, sweep, labels=(), brake=()) -> dict:

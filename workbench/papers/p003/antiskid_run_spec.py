@@ -71,7 +71,7 @@ class RunSpec:
     far_delays: tuple
     periods: float
     montecarlo: object = None      # antiskid_montecarlo.SweepSpec or None
-    basin: object = None           # antiskid_basin_run.BasinSettings or None ([basin] table)
+    basin: object = None           # basin_points.GainSweepSettings or None ([basin] table)
     comfort: object = None         # features.comfort.ComfortLimits or None ([comfort] table)
     sampled: object = None         # antiskid_sampled.SampledSpec or None ([sampled] table)
 
