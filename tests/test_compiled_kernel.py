@@ -21,8 +21,8 @@ from workbench.controllers.antiskid003_settings import ControllerSettings, Creep
 from workbench.design import load_design  # noqa: E402
 from workbench.sim.wheel_slip import PARAM_ORDER  # noqa: E402
 from workbench.papers.p003.antiskid_kernel import LANES, METRIC_FIELDS, simulate_batch  # noqa: E402
-from workbench.papers.p003.antiskid_montecarlo import (chunk_payload, chunk_worker, per_run,  # noqa: E402
-                                                   run_lambda_opt, sweep_inputs)
+from workbench.papers.p003.antiskid_montecarlo import (chunk_payload, chunk_worker,  # noqa: E402
+                                                   lambda_opt_of, per_run, sweep_inputs)
 from workbench.papers.p003.antiskid_run_spec import gain_for  # noqa: E402
 from workbench.papers.p003.antiskid_scenario import RunSettings  # noqa: E402
 
@@ -142,7 +142,7 @@ def test_first_64_runs_of_the_dry_sweep_agree(dry):
     outs = {k: chunk_worker(chunk_payload(inp, 0, n, inp["dt"], k))["metrics"]
             for k in ("compiled", "numpy")}
     assert_close(outs["compiled"], outs["numpy"], METRIC_FIELDS)
-    lam_opt, t_brake = run_lambda_opt(inp), inp["scenario"]["t_brake"]
+    lam_opt, t_brake = lambda_opt_of(inp["plant"]), inp["scenario"]["t_brake"]
     (mc, vc), (mn, vn) = (per_run({k: np.asarray(v) for k, v in outs[p].items()}, lam_opt,
                                   t_brake) for p in ("compiled", "numpy"))
     assert_close(mc, mn, mc)

@@ -22,7 +22,8 @@ from workbench.features.montecarlo import (Distribution, MonteCarloSpec, draw, d
 from workbench.features.convergence import compare_steps
 from workbench.features.montecarlo_chunks import (Chunk, FolderTaken, Group, chunk_file,
                                                   chunk_ranges, default_chunk, read_npz,
-                                                  read_streamed, run_chunks, start_batches,
+                                                  read_streamed, run_chunks, run_groups,
+                                                  start_batches,
                                                   start_chunks, start_streaming, write_npz)
 from workbench.features.montecarlo_halving import (HalvingCheck, halving_quantity_names,
                                                    start_halving)
@@ -116,6 +117,30 @@ def test_csv_chunks_read_back_bit_for_bit(tmp_path):
     np.testing.assert_array_equal(got["decay"].metrics["x_end"], decay_chunk(d)["x_end"])
     again = run_chunks(tmp_path / "out", {"toy": 1}, [Group("decay", d)], compute, True)
     assert calls == [50, 50, 20] and again["decay"].reasons == got["decay"].reasons
+
+
+def test_one_path_in_memory_or_through_chunk_files(tmp_path):
+    """run_groups: one batch per group held in memory, or the CSV chunk files
+    (and their resume) when given a folder; the same runs either way."""
+    d = drawn_factors(MonteCarloSpec(70, 5, SPEC.distributions), ORDER)
+    calls = []
+
+    def compute(g, part):
+        calls.append((g.name, len(part["a"])))
+        m = decay_chunk(part)
+        return {"x_end": m["x_end"] * (2.0 if g.name == "twice" else 1.0)}, \
+            (["grew" if x else "decayed" for x in m["grew"]] if g.name == "once" else None)
+
+    groups = [Group("once", d), Group("twice", d)]
+    mem = run_groups(groups, compute)
+    assert calls == [("once", 70), ("twice", 70)] and mem["twice"].reasons == []
+    files = run_groups(groups, compute, tmp_path / "out", {"toy": 2})
+    assert calls[2:] == [("once", 50), ("once", 20), ("twice", 50), ("twice", 20)]
+    for g in ("once", "twice"):
+        np.testing.assert_array_equal(files[g].metrics["x_end"], mem[g].metrics["x_end"])
+        assert files[g].reasons == mem[g].reasons
+    assert run_groups(groups, compute, tmp_path / "out", {"toy": 2}, resume=True
+                      )["once"].reasons == mem["once"].reasons and len(calls) == 6
 
 
 def test_statistics_of_the_runs():

@@ -205,7 +205,7 @@ def test_antiskid_refine_maps_findings_without_running():
     reason (INCONCLUSIVE), and mc-converged's two-step comparison too."""
     from types import SimpleNamespace
 
-    from workbench.papers.p003.antiskid_refine import last_refine_seconds, refine_levels
+    from workbench.papers.p003.antiskid_refine import refine_levels
     design = SimpleNamespace(name="fake-run", spec=SimpleNamespace(dt=0.01))
     found = [ClaimResult(_claim("cert", "basin.compared_certified", "==", 0.0), 0.0,
                          Verdict.PASS),
@@ -218,5 +218,3 @@ def test_antiskid_refine_maps_findings_without_running():
     assert lv["cert"].values == ("0", "0", "0") and "no step" in lv["cert"].parameter
     assert lv["lin"].values == () and "linear.paper.exact_margin" in lv["lin"].reason
     assert lv["mc"].values == () and "no step check" in lv["mc"].reason
-    wall, cpu = last_refine_seconds("fake-run")
-    assert wall >= 0 and cpu >= 0

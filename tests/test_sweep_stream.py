@@ -11,7 +11,7 @@ import pytest
 from workbench.cli import main
 from workbench.design import load_design
 from workbench.features.montecarlo_chunks import chunk_file
-from workbench.papers.p003 import antiskid_stream as S
+from workbench.papers.p003 import antiskid_montecarlo as S
 from workbench.papers.p003.antiskid_montecarlo import sweep
 from workbench.sim.batch import uniform_draws
 

@@ -39,7 +39,7 @@ import numpy as np
 
 __all__ = ["CHUNK", "DEFAULT_CHUNKS", "MANIFEST", "MAX_CHUNK", "Chunk", "ChunkRuns",
            "FolderTaken", "Group", "check_resume", "chunk_file", "chunk_ranges", "claim_folder",
-           "default_chunk", "read_npz", "read_streamed", "run_chunks", "start_batches",
+           "default_chunk", "read_npz", "read_streamed", "run_chunks", "run_groups", "start_batches",
            "start_chunks", "start_streaming", "write_npz"]
 
 #: The manifest of a sweep's folder.
@@ -350,6 +350,28 @@ def run_chunks(folder: Path, manifest: dict, groups, compute: Callable, resume: 
     except OSError as e:
         raise DesignError("<cli>", "--out", str(folder), f"a folder the chunks can be "
                           f"written to ({type(e).__name__}: {e})") from None
+
+
+def run_groups(groups, compute: Callable, folder=None, manifest: dict | None = None,
+               resume: bool = False) -> dict[str, ChunkRuns]:
+    """The runs of every group, the one Monte Carlo path of a kind's report
+    and of its ``sweep [--out DIR [--resume]]``: without ``folder`` each
+    group's runs are one batch ``compute(group, group.draws)`` held in
+    memory; with it they go through the chunk files of :func:`run_chunks`
+    (``manifest``, ``resume``: as there).
+
+    Returns
+    -------
+    dict
+        Group name -> :class:`ChunkRuns`.
+    """
+    if folder is not None:
+        return run_chunks(Path(folder), manifest, groups, compute, resume)
+    out = {}
+    for g in groups:
+        metrics, reasons = compute(g, g.draws)
+        out[g.name] = ChunkRuns(dict(metrics), [] if reasons is None else list(reasons))
+    return out
 
 
 def _chunk_csv(draws, metrics, reasons) -> str:

@@ -215,7 +215,7 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool = False,
     """``workbench sweep`` of a ``delay-feedback`` design with ``[montecarlo]``:
     its distributions with ``samples`` draws and ``seed``, on every scenario
     without a parameter schedule, the gain and operating point nominal
-    (:func:`.montecarlo.run_montecarlo`, as in the report); prints the
+    (:func:`.montecarlo.run_montecarlo`, the report's path); prints the
     diverged runs and every metric's largest value; exit 0 (1 when no gain
     was certified).
 
@@ -238,30 +238,11 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool = False,
     if got is None:
         return 1
     model, values, op, A, B, s = got
-    if out:
-        res = _chunked_montecarlo(design, spec, model, values, op, s.K, Path(out), resume)
-    else:
-        res = run_montecarlo(spec, model, values, op, s.K, reference, predict)
+    res = run_montecarlo(spec, model, values, op, s.K, reference, predict,
+                         folder=Path(out) if out else None, design=design.name, resume=resume)
     q = montecarlo_values(SimpleNamespace(montecarlo=res))
     return print_run({"design": design.name, "samples": samples, "seed": seed,
                       "quantities": q},
                      f"{design.name}: Monte Carlo, {samples} runs per scenario, seed {seed}, "
                      f"K = {gain_text(s.K, spec.synthesis.settings.gain_digits)}",
                      {k: math.nan if v is None else v for k, v in q.items()}, as_json)
-
-
-def _chunked_montecarlo(design, spec, model, values, op, K, folder, resume):
-    """The Monte Carlo of :func:`sweep_command` through the chunk files."""
-    from ...features.montecarlo import drawn_factors
-    from ...features.montecarlo_chunks import Group, run_chunks
-    from .montecarlo import MonteCarloScenario, drawn_scenarios, montecarlo_batch
-    from .run import predict, reference
-    mc = spec.montecarlo
-    draws = drawn_factors(mc, tuple(spec.plant.parameters))
-    batch = montecarlo_batch(spec, model, values, op, K, reference, predict)
-    scen = {sc.name: sc for sc in drawn_scenarios(spec)}
-    got = run_chunks(folder, {"design": design.name, "scenarios": list(scen),
-                              "samples": mc.samples, "seed": mc.seed},
-                     [Group(name, draws) for name in scen],
-                     lambda g, d: (batch(scen[g.name], d).metrics, None), resume)
-    return tuple(MonteCarloScenario(name, mc.samples, got[name].metrics) for name in scen)

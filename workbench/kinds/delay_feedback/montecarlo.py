@@ -28,7 +28,7 @@ import numpy as np
 
 from ...features.montecarlo_stats import finite_span
 
-__all__ = ["MonteCarloScenario", "drawn_scenarios", "load_montecarlo_table",
+__all__ = ["MonteCarloScenario", "load_montecarlo_table",
            "montecarlo_batch", "montecarlo_names", "montecarlo_values", "run_montecarlo",
            "montecarlo_section"]
 
@@ -85,20 +85,29 @@ def montecarlo_values(r) -> dict:
     return out
 
 
-def run_montecarlo(spec, model, values, op, K, reference, predict
-                   ) -> tuple[MonteCarloScenario, ...]:
+def run_montecarlo(spec, model, values, op, K, reference, predict, *, folder=None,
+                   design: str = "", resume: bool = False) -> tuple[MonteCarloScenario, ...]:
     """Every scenario without a parameter schedule, with the plant's
     parameters drawn (see the module docstring); ``reference`` and
-    ``predict`` are the nominal run's (:mod:`.run`, which calls this)."""
-    from ...features.montecarlo import draw
-    drawn = draw(spec.montecarlo, tuple(spec.plant.parameters), values)
+    ``predict`` are the nominal run's (:mod:`.run`, which calls this).
+    The one path of the report and of ``workbench sweep``
+    (:func:`workbench.features.montecarlo_chunks.run_groups`): one batch per
+    scenario, or with ``folder`` (``sweep --out``) the chunk files of
+    :func:`~workbench.features.montecarlo_chunks.run_chunks` (its manifest:
+    the ``design``'s name, the scenarios, samples and seed); a chunk's runs equal the one batch's up to the last
+    bits of the gain's matrix product (the only operation not elementwise
+    over the runs)."""
+    from ...features.montecarlo import drawn_factors
+    from ...features.montecarlo_chunks import Group, run_groups
+    mc = spec.montecarlo
+    draws = drawn_factors(mc, tuple(spec.plant.parameters))
     batch = montecarlo_batch(spec, model, values, op, K, reference, predict)
-    return tuple(batch(s, drawn) for s in drawn_scenarios(spec))
-
-
-def drawn_scenarios(spec) -> list:
-    """The scenarios a Monte Carlo draws (those without a parameter schedule)."""
-    return _drawn(spec)
+    scen = {sc.name: sc for sc in _drawn(spec)}
+    got = run_groups([Group(name, draws) for name in scen],
+                     lambda g, d: (batch(scen[g.name], d).metrics, None), folder,
+                     {"design": design, "scenarios": list(scen), "samples": mc.samples,
+                      "seed": mc.seed}, resume)
+    return tuple(MonteCarloScenario(name, mc.samples, got[name].metrics) for name in scen)
 
 
 def montecarlo_batch(spec, model, values, op, K, reference, predict):

@@ -101,7 +101,7 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool, case: str |
     from ...errors import DesignError
     from ...features.montecarlo import drawn_factors
     from ..capabilities import sweep_draws
-    from ...features.montecarlo_chunks import check_resume
+    from ...features.montecarlo_chunks import Group, check_resume, run_groups
     from . import MAX_WORK
     from .study import MonteCarloRun
     spec = design.spec
@@ -112,15 +112,10 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool, case: str |
         raise DesignError("<cli>", "--samples", samples, f"at most {MAX_WORK:g} samples x "
                           "steps")
     draws = drawn_factors(mc, tuple(spec.plant.parameters))
-    if out:
-        from ...features.montecarlo_chunks import Group, run_chunks
-        got = run_chunks(Path(out), {"design": design.name, "scenario": sc.name,
-                                     "samples": samples, "seed": seed},
-                         [Group(sc.name, draws)], lambda g, d: _run(spec, sc, d), resume)
-        metrics, reasons = got[sc.name].metrics, got[sc.name].reasons
-    else:
-        metrics, reasons = _run(spec, sc, draws)
-    res = MonteCarloRun(samples, seed, draws, metrics, tuple(reasons))
+    got = run_groups([Group(sc.name, draws)], lambda g, d: _run(spec, sc, d), out or None,
+                     {"design": design.name, "scenario": sc.name, "samples": samples,
+                      "seed": seed}, resume)[sc.name]
+    res = MonteCarloRun(samples, seed, draws, got.metrics, tuple(got.reasons))
     _print_summary(design, sc, res, as_json)
     return 0
 

@@ -9,12 +9,13 @@ The batches and the check are the general
 :func:`workbench.features.montecarlo_halving.start_halving` and the comparison
 the general :func:`workbench.features.convergence.compare_steps`; this module
 keeps what is paper 003's: which metrics and outcomes of its kernel's runs are
-compared, the traction-divergence rule, and its kernel's payloads.
+compared and the traction-divergence rule; its batches are the sweep's own
+chunk function (:func:`~workbench.papers.p003.antiskid_montecarlo.range_worker`)
+at the two steps.
 """
 from __future__ import annotations
 
 import math
-from functools import lru_cache
 
 import numpy as np
 
@@ -22,8 +23,7 @@ from ...features.montecarlo_halving import HalvingCheck
 from ...features.montecarlo_halving import halving_quantity_names as general_names
 from ...features.montecarlo_halving import start_halving as start_batches
 from ...sim.batch import PendingBatch
-from .antiskid_montecarlo import (SUMMARY_METRICS, chunk_payload, chunk_worker, per_run,
-                                  run_lambda_opt, sweep_inputs)
+from .antiskid_montecarlo import SUMMARY_METRICS, range_runs, range_worker, sweep_inputs
 from .antiskid_run_spec import SweepSpec
 
 #: Metrics compared at dt and dt / 2 by :func:`start_halving`.
@@ -94,21 +94,15 @@ def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
     there (default: compiled when numba is installed).
     """
     from .antiskid_kernel import default_kernel
+    from .antiskid_run_spec import gain_for
     kernel = kernel or default_kernel()
     spec = design.spec
     ms: SweepSpec = spec.montecarlo
     if not n >= 1:
         raise ValueError(f"halving check of {n} runs: need at least 1")
+    K = tuple(gain_for(spec)[0] if K is None else K)
     inp = sweep_inputs(design, n, ms.seed, K)
     atol = {k: spec.conv_atol.get(k, 0.0) for k in HALVING_METRICS}
-
-    @lru_cache(maxsize=1)
-    def lam_opt() -> np.ndarray:     # once, when the first batch is back
-        return run_lambda_opt(inp)
-
-    def runs_of(out: dict) -> tuple[dict, dict]:
-        raw = {k: np.asarray(v, float) for k, v in out["metrics"].items()}
-        return per_run(raw, lam_opt(), inp["scenario"]["t_brake"])
 
     def check(at_dt: dict, at_half: dict, seconds: float, n_workers: int) -> HalvingCheck:
         c, f, agree = compare_steps(at_dt, at_half, spec.conv_rtol, atol)
@@ -116,8 +110,11 @@ def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
                             {k: tuple(v.tolist()) for k, v in inp["draws"].items()},
                             seconds, n_workers)
 
-    return start_batches(chunk_worker, lambda step: chunk_payload(inp, 0, n, step, kernel),
-                         runs_of, _step_values, check, inp["dt"], n, coarse=coarse, pool=pool)
+    return start_batches(range_worker, lambda step: {"design": design, "K": K, "seed": ms.seed,
+                                                     "i0": 0, "i1": n, "kernel": kernel,
+                                                     "step": step},
+                         lambda out: range_runs(out, spec.scenario["t_brake"]), _step_values,
+                         check, inp["dt"], n, coarse=coarse, pool=pool)
 
 
 def halving_quantity_names() -> set[str]:

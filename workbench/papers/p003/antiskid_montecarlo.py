@@ -18,24 +18,48 @@ depends on the sample count (and ``chunk``) only, never on the worker count.
 The controller always uses the design's nominal model (dry rail, nominal
 mass): the sweep measures robustness, not re-tuning.
 
-The chunked driver (chunks, pool or Dask, progress) is the general
-:func:`workbench.features.montecarlo_chunks.start_batches` and the statistics
-of the runs :class:`workbench.features.montecarlo_stats.RunsResult`; this
-module keeps what is paper 003's: what a run draws, its kernel's payloads and
-call, and its metrics and outcomes (the creep ratio against each run's own
-lambda_opt). The step-size check of the sweep's runs is
+One path (:func:`start_sweep`): a chunk is a pure function of (design,
+gain, seed, sample range, step), :func:`range_worker`, which draws its own
+samples (from ``start``), so a payload is a few kilobytes whatever the
+sweep's size. The chunks' arrays are held in memory
+(:func:`workbench.features.montecarlo_chunks.start_batches`) or, with
+``out`` (``workbench sweep --out DIR [--resume]``), streamed: one ``.npz``
+file per chunk written as it finishes, ``resume`` skipping the files
+already written and a folder of another sweep (other design data, seed,
+size, chunking or step path) refused
+(:func:`workbench.features.montecarlo_chunks.start_streaming`; why ``.npz``
+per chunk and not one Parquet file: each chunk is one atomic file that numpy
+reads without a new dependency, ~50 kB for 250 runs). Either way the
+result is made from the same arrays, so a streamed sweep equals the
+in-memory one bit for bit. File ``chunk-<i0>-<i1>.npz`` (runs i0 <= i < i1):
+``index``, ``draw.<name>`` (the samples), ``raw.<field>`` (the
+:class:`RunMetrics` of each run) and ``lambda_opt`` (of each run's adhesion
+curve); ``sweep.json``: design, size, seed, chunking, step path, t_brake and
+a hash of the data every run shares.
+
+The drivers (chunks, pool or Dask, progress, files, resume) are the general
+:mod:`workbench.features.montecarlo_chunks` and the statistics of the runs
+:class:`workbench.features.montecarlo_stats.RunsResult`; this module keeps
+what is paper 003's: what a run draws, its kernel's payloads and call, what
+identifies its sweep, and its metrics and outcomes (the creep ratio against
+each run's own lambda_opt). The step-size check of the sweep's runs is
 :mod:`workbench.papers.p003.antiskid_halving`; the rendering is
 :mod:`workbench.papers.p003.antiskid_montecarlo_render`.
 """
 from __future__ import annotations
 
+import dataclasses
+import hashlib
+import json
+import math
 from dataclasses import asdict, dataclass
 from functools import lru_cache
 from typing import ClassVar
 
 import numpy as np
 
-from ...features.montecarlo_chunks import default_chunk, start_batches
+from ...features.montecarlo_chunks import (default_chunk, read_streamed, start_batches,
+                                           start_streaming as stream)
 from ...features.montecarlo_stats import OK, RunsResult, quantity_names
 from ...sim.batch import PendingBatch, available_cpus, uniform_draws
 from .antiskid_run_spec import SweepSpec
@@ -226,11 +250,6 @@ def lambda_opt_of(plant: dict) -> np.ndarray:
     return out
 
 
-def run_lambda_opt(inp: dict) -> np.ndarray:
-    """lambda_opt of each run's own adhesion curve (:func:`lambda_opt_of`)."""
-    return lambda_opt_of(inp["plant"])
-
-
 def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]:
     """(metrics, violations) per run, as arrays, from a batch's raw
     :class:`~workbench.papers.p003.antiskid_scenario.RunMetrics` arrays."""
@@ -249,45 +268,59 @@ def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]
     return metrics, viol
 
 
+#: Raw metrics a run's outcomes are made from (what :func:`per_run` needs).
+READ = ("lam_max_traction", "t_cruise", "t_omega3", "t_diverged", "phase_diverged", "t_stop")
+
+
+def range_worker(payload: dict) -> dict:
+    """Simulate runs ``i0 <= i < i1`` of a design's sweep (payload: design,
+    K, seed, i0, i1, kernel; ``step``: the step if not the sweep's) and
+    return the arrays of its chunk (module docstring)."""
+    d, i0, i1 = payload["design"], payload["i0"], payload["i1"]
+    inp = sweep_inputs(d, i1, payload["seed"], payload["K"], start=i0)
+    out = chunk_worker(chunk_payload(inp, 0, i1 - i0, payload.get("step") or inp["dt"],
+                                     payload["kernel"]))
+    arrays = {"index": np.arange(i0, i1), "lambda_opt": lambda_opt_of(inp["plant"])}
+    arrays.update({f"draw.{k}": np.asarray(v) for k, v in inp["draws"].items()})
+    arrays.update({f"raw.{k}": np.asarray(v, float) for k, v in out["metrics"].items()})
+    return arrays
+
+
+def range_runs(arrays: dict, t_brake: float) -> tuple[dict, dict]:
+    """(metrics, violations) per run (:func:`per_run`) of :func:`range_worker` arrays."""
+    return per_run({k: arrays[f"raw.{k}"] for k in READ}, arrays["lambda_opt"], t_brake)
+
+
+def runs_result(arrays: dict, t_brake: float, seconds: float = math.nan,
+                workers: int = 0) -> SweepResult:
+    """The :class:`SweepResult` of a sweep's :func:`range_worker` arrays
+    (concatenated over its chunks, in run order)."""
+    metrics, viol = range_runs(arrays, t_brake)
+    return SweepResult({k[5:]: v.tolist() for k, v in arrays.items() if k.startswith("draw.")},
+                       {k: v.tolist() for k, v in metrics.items()},
+                       {k: v.tolist() for k, v in viol.items()}, seconds, workers)
+
+
+def _manifest(design, samples: int, seed: int, chunk: int, kernel: str, K) -> dict:
+    """What identifies a streamed sweep (its folder's ``sweep.json``)."""
+    ms = design.spec.montecarlo
+    inp = sweep_inputs(design, 1, seed, K)      # the data every run shares
+    shared = {k: inp[k] for k in ("base", "controller", "scenario", "dt")}
+    shared["ranges"] = [ms.mass, ms.adhesion, ms.h, ms.v0, sorted(ms.wet.items())]
+    if ms.perturb is not None:      # absent: the digest of a sweep without perturbations
+        shared["perturb"] = ms.perturb
+    digest = hashlib.sha256(json.dumps(shared, sort_keys=True, default=repr).encode())
+    return {"design": design.name, "samples": samples, "seed": seed, "chunk": chunk,
+            "kernel": kernel, "t_brake": inp["scenario"]["t_brake"],
+            "inputs_sha256": digest.hexdigest()}
+
+
 def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
                 chunk: int | None = None, pool: bool | None = None,
                 K: tuple | None = None, kernel: str | None = None,
-                scheduler: str | None = None) -> PendingBatch:
-    """Draw the samples of an ``antiskid-run`` design's sweep and start its
-    chunks (see :func:`sweep`); ``pool`` (default: ``workers > 1``) runs them
-    in a process pool now, so the caller can work meanwhile, else in-process
-    in :meth:`PendingBatch.result`. ``K``: the cruise gain if the caller has
-    it (default: :func:`~workbench.papers.p003.antiskid_run.gain_for`). ``kernel``:
-    "compiled" or "numpy" (default: compiled when numba is installed).
-    ``scheduler``: run the chunks on Dask (``"local"`` or a scheduler's
-    address; :class:`~workbench.sim.batch.PendingBatch`). ``workers``
-    defaults to the CPUs granted (:func:`~workbench.sim.batch.available_cpus`)."""
-    from .antiskid_kernel import compile_kernel, default_kernel
-
-    inp = sweep_inputs(design, samples, seed, K)
-    workers = max(1, workers or available_cpus())
-    kernel = kernel or default_kernel()
-
-    def collect(outs: list, seconds: float, n_workers: int) -> SweepResult:
-        raw = {k: np.concatenate([o["metrics"][k] for o in outs]) for k in outs[0]["metrics"]}
-        metrics, viol = per_run(raw, run_lambda_opt(inp), inp["scenario"]["t_brake"])
-        return SweepResult({k: v.tolist() for k, v in inp["draws"].items()},
-                           {k: v.tolist() for k, v in metrics.items()},
-                           {k: v.tolist() for k, v in viol.items()}, seconds, n_workers)
-
-    def payload(i0: int, i1: int) -> dict:
-        return chunk_payload(inp, i0, i1, inp["dt"], kernel)
-
-    return start_batches(chunk_worker, payload, samples, chunk or default_chunk(samples),
-                         collect, workers=workers,
-                         pool=workers > 1 if pool is None else pool, scheduler=scheduler,
-                         before_pool=compile_kernel if kernel == "compiled" else None)
-
-
-def sweep(design, samples: int, seed: int, *, workers: int | None = None,
-          chunk: int | None = None, progress: bool = True,
-          kernel: str | None = None, scheduler: str | None = None) -> SweepResult:
-    """Run the Monte Carlo sweep of an ``antiskid-run`` design.
+                scheduler: str | None = None, out=None, resume: bool = False) -> PendingBatch:
+    """Start the Monte Carlo sweep of an ``antiskid-run`` design;
+    :meth:`PendingBatch.result` returns its :class:`SweepResult`.
 
     Parameters
     ----------
@@ -295,13 +328,19 @@ def sweep(design, samples: int, seed: int, *, workers: int | None = None,
         Of kind ``antiskid-run`` with a ``[montecarlo]`` table.
     samples, seed : int
     workers : int, optional
-        Process count (default: CPU count); 1 runs in-process.
+        Process count (default: the CPUs granted,
+        :func:`~workbench.sim.batch.available_cpus`); 1 runs in-process.
     chunk : int, optional
         Samples per batch (default:
         :func:`~workbench.features.montecarlo_chunks.default_chunk`).
         The results depend on it, not on ``workers``.
-    progress : bool
-        Progress bar on stderr.
+    pool : bool, optional
+        Run the chunks in a process pool now, so the caller can work
+        meanwhile (default: ``workers > 1``), else in-process in
+        :meth:`PendingBatch.result`.
+    K : tuple, optional
+        The cruise gain if the caller has it (default:
+        :func:`~workbench.papers.p003.antiskid_run.gain_for`).
     kernel : {"compiled", "numpy"}, optional
         The stepping path (default: compiled when numba is installed); the
         results agree to rounding (``tests/test_compiled_kernel.py``).
@@ -310,6 +349,63 @@ def sweep(design, samples: int, seed: int, *, workers: int | None = None,
         LocalCluster of ``workers`` processes) or a scheduler address. The
         results do not depend on the executor, the worker count or the
         chunking (``tests/test_sweep_executors.py``).
+    out : path, optional
+        Write each chunk to this folder as it finishes (module docstring; a
+        pool when ``workers > 1``); the result is read back from the files.
+    resume : bool
+        With ``out``: skip the chunk files already written.
+
+    Raises
+    ------
+    FileExistsError
+        ``out`` holds chunk files or another sweep and ``resume`` is false,
+        or it holds another sweep (its ``sweep.json`` differs).
     """
+    from .antiskid_kernel import compile_kernel, default_kernel
+    from .antiskid_run_spec import gain_for
+    workers = max(1, workers or available_cpus())
+    chunk = chunk or default_chunk(samples)
+    kernel = kernel or default_kernel()
+    K = tuple(gain_for(design.spec)[0] if K is None else K)
+    t_brake = design.spec.scenario["t_brake"]
+    before = compile_kernel if kernel == "compiled" else None
+
+    def payload(i0: int, i1: int) -> dict:
+        return {"design": design, "K": K, "seed": seed, "i0": i0, "i1": i1, "kernel": kernel}
+
+    if out is not None:
+        return stream(out, _manifest(design, samples, seed, chunk, kernel, K), payload,
+                      range_worker, lambda seconds, n_workers: dataclasses.replace(
+                          load_sweep(out), seconds=seconds, workers=n_workers),
+                      resume=resume, workers=workers, scheduler=scheduler, before_pool=before)
+
+    def collect(outs: list, seconds: float, n_workers: int) -> SweepResult:
+        return runs_result({k: np.concatenate([o[k] for o in outs]) for k in outs[0]},
+                           t_brake, seconds, n_workers)
+
+    return start_batches(range_worker, payload, samples, chunk, collect, workers=workers,
+                         pool=workers > 1 if pool is None else pool, scheduler=scheduler,
+                         before_pool=before)
+
+
+def start_streaming(design, samples: int, seed: int, out, **kw) -> PendingBatch:
+    """:func:`start_sweep` written to the folder ``out`` (the CLI's ``--out``)."""
+    return start_sweep(design, samples, seed, out=out, **kw)
+
+
+def load_sweep(out) -> SweepResult:
+    """The :class:`SweepResult` of a streamed sweep, from its chunk files
+    (only the columns the summaries use are read)."""
+    keep = {"lambda_opt", *(f"raw.{k}" for k in READ)}
+    man, col = read_streamed(out, lambda k: k in keep or k.startswith("draw."))
+    return runs_result(col, float(man["t_brake"]))
+
+
+def sweep(design, samples: int, seed: int, *, workers: int | None = None,
+          chunk: int | None = None, progress: bool = True,
+          kernel: str | None = None, scheduler: str | None = None) -> SweepResult:
+    """Run the Monte Carlo sweep of an ``antiskid-run`` design in memory
+    (:func:`start_sweep`, same parameters), a progress bar on stderr when
+    ``progress``."""
     return start_sweep(design, samples, seed, workers=workers, chunk=chunk,
                        kernel=kernel, scheduler=scheduler).result(progress)

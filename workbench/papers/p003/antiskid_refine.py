@@ -46,31 +46,18 @@ the quantity) are :mod:`workbench.features.convergence` and
 from __future__ import annotations
 
 import dataclasses
-import math
 import re
-import time
-
-import numpy as np
 
 from ...features.refinement import (Levels, refine_by_readers, screen_levels, screen_reason,
                                     share_claim_levels)
 from ...report.markdown import fmt
 
-__all__ = ["CONVERGED_INSTEAD", "READERS", "last_refine_seconds", "quarter_cases",
+__all__ = ["CONVERGED_INSTEAD", "READERS", "quarter_cases",
            "refine_levels", "three_level_metrics", "unconverged_reason"]
 #: Monte Carlo quantity -> per-run outcome behind it (HalvingCheck keys).
 MC_OUTCOMES = {"montecarlo.fraction.diverged": "diverged",
                "montecarlo.wilson.diverged.lo": "diverged",
                "montecarlo.fraction.above_lambda_opt": "above_lambda_opt"}
-
-_SECONDS: dict = {}
-
-
-def last_refine_seconds(name: str) -> tuple:
-    """(wall, CPU) seconds :func:`refine_levels` last spent on design
-    ``name`` in this process ((NaN, NaN) if never; for benchmarks, not
-    printed in reports)."""
-    return _SECONDS.get(name, (math.nan, math.nan))
 
 
 def refine_levels(design, result, findings, *, quantities, record_dt: float) -> dict:
@@ -90,12 +77,9 @@ def refine_levels(design, result, findings, *, quantities, record_dt: float) -> 
     record_dt : float
         Record step (s) of the study's runs (the comfort peaks).
     """
-    t0, c0 = time.perf_counter(), time.process_time()
     cache: dict = {"quantities": quantities, "record_dt": record_dt}
-    out = refine_by_readers(findings, [(p, lambda m, r, f=f: f(design, result, cache, m, r))
-                                       for p, f in READERS])
-    _SECONDS[design.name] = (time.perf_counter() - t0, time.process_time() - c0)
-    return out
+    return refine_by_readers(findings, [(p, lambda m, r, f=f: f(design, result, cache, m, r))
+                                        for p, f in READERS])
 
 
 def _case_levels(spec, result, cache, name):
@@ -221,7 +205,7 @@ def _mc_levels(design, result, cache, m, r) -> Levels:
                       "outcomes behind the Monte Carlo findings are refined three levels in "
                       "the rows of the share findings (first runs at dt, dt/2, dt/4)")
     if "mc" not in cache:
-        cache["mc"] = _mc_quarter(design, result, hc.n)
+        cache["mc"] = _mc_quarter(design, result, hc.n, hc.dt / 4)
     key = MC_OUTCOMES[qn]
     return share_claim_levels(r.claim, result.montecarlo.violations[key], hc.fine[key],
                               cache["mc"][key], key.replace("_", " "), "montecarlo.dt", hc.dt)
@@ -233,16 +217,16 @@ def _basin_levels(design, result, cache, m, r) -> Levels:
     return Levels((v, v, v), "none (a certificate at the printed switch state, no step)")
 
 
-def _mc_quarter(design, result, n: int) -> dict:
-    """Outcomes of the first n sweep runs at the sweep's dt/4."""
+def _mc_quarter(design, result, n: int, step: float) -> dict:
+    """Outcomes of the first n sweep runs at ``step``, the sweep's dt/4 (the sweep's
+    own chunk function, :func:`~workbench.papers.p003.antiskid_montecarlo.range_worker`)."""
     from .antiskid_halving import _step_values
     from .antiskid_kernel import default_kernel
-    from .antiskid_montecarlo import chunk_payload, chunk_worker, per_run, run_lambda_opt, \
-        sweep_inputs
-    inp = sweep_inputs(design, n, design.spec.montecarlo.seed, result.K)
-    o = chunk_worker(chunk_payload(inp, 0, n, inp["dt"] / 4, default_kernel()))
-    raw = {k: np.asarray(v, float) for k, v in o["metrics"].items()}
-    vals = _step_values(*per_run(raw, run_lambda_opt(inp), inp["scenario"]["t_brake"]))
+    from .antiskid_montecarlo import range_runs, range_worker
+    out = range_worker({"design": design, "K": tuple(result.K), "i0": 0, "i1": n,
+                        "seed": design.spec.montecarlo.seed, "kernel": default_kernel(),
+                        "step": step})
+    vals = _step_values(*range_runs(out, design.spec.scenario["t_brake"]))
     return {k: tuple(bool(x) for x in vals[k]) for k in ("diverged", "above_lambda_opt")}
 
 

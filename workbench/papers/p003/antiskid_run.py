@@ -277,7 +277,7 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     check_resume(out, resume)
     try:
         if out:
-            from .antiskid_stream import start_streaming
+            from .antiskid_montecarlo import start_streaming
             try:
                 pending = start_streaming(design, samples, seed, out, resume=resume,
                                           workers=workers, kernel=kernel, scheduler=scheduler)
