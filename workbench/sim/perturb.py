@@ -155,3 +155,30 @@ class VaryingDelayLine:
         a = self._buf[(n - N) % self._L, self._cols]
         b = self._buf[(n - N - 1) % self._L, self._cols]
         return (1.0 - f) * a + f * b
+
+
+#: Entries of the kernel's ``pert`` array (:func:`perturbation_arrays`): what a compiled
+#: loop reads of :class:`Perturbations`.
+PERT = ("noise_v", "noise_omega", "noise_every", "graded", "grade_lo", "grade_hi", "segment",
+        "varying", "h_lo", "h_hi")
+
+
+def perturbation_arrays(pt, B: int):
+    """(keys (B, 3) uint64, pert (:data:`PERT`), period (B,), phase (B,)) of
+    the :class:`Perturbations` ``pt`` (None: none), as plain arrays a compiled
+    loop of B runs takes (the operations on them are those of
+    :mod:`workbench.sim.wheel_slip_jit`)."""
+    keys = np.zeros((B, 3), np.uint64)
+    period, phase = np.ones(B), np.zeros(B)
+    if pt is None:
+        return keys, np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]), period, phase
+    for j, c in enumerate(("v", "omega", "grade")):
+        if c in pt.keys:
+            keys[:, j] = np.asarray(pt.keys[c], np.uint64)
+    g, d = pt.grade or (0.0, 0.0), pt.delay or (0.0, 0.0)
+    if pt.delay is not None:
+        period, phase = np.asarray(pt.period, float), np.asarray(pt.phase, float)
+    pert = np.array([pt.noise_v, pt.noise_omega, float(pt.noise_every),
+                     float(pt.grade is not None), g[0], g[1], pt.segment,
+                     float(pt.delay is not None), d[0], d[1]])
+    return keys, pert, period, phase

@@ -41,6 +41,7 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED
 from ...sim.history import split_delay
+from ...sim.perturb import perturbation_arrays
 from .antiskid_scenario import RunMetrics, RunSettings
 
 #: The stepping paths of a sweep: "compiled" (numba, this module) or "numpy"
@@ -176,8 +177,9 @@ def _build():
                   keys, pert, period, phase, out):
         """Simulate each run i (plant parameters ``plant[i]``, input delay
         (Np[i] + fp[i]) dt, initial speed v0[i]) into ``out[i]``; ``keys[i]``
-        (v, omega, grade streams), ``pert`` (:data:`PERT`), ``period[i]``,
-        ``phase[i]``: the perturbations of :mod:`workbench.sim.perturb`.
+        (v, omega, grade streams), ``pert`` (:data:`~workbench.sim.perturb.PERT`), ``period[i]``,
+        ``phase[i]``: the perturbations of :mod:`workbench.sim.perturb`
+        (:func:`~workbench.sim.perturb.perturbation_arrays`).
 
         :data:`LANES` runs are in flight at a time, each with its own state and
         clock; a lane that ends takes the next run. Per sample, the lanes'
@@ -361,30 +363,6 @@ def simulate_batch_compiled(run: RunSettings, dt: float, *,
             np.asarray(cs.params, float), float(evs_settle), st0, ub0, m0,
             keys, pert, period, phase, out)
     return RunMetrics(**{k: out[:, j].copy() for j, k in enumerate(METRIC_FIELDS)})
-
-
-#: Entries of the kernel's ``pert`` array (:func:`perturbation_arrays`).
-PERT = ("noise_v", "noise_omega", "noise_every", "graded", "grade_lo", "grade_hi", "segment",
-        "varying", "h_lo", "h_hi")
-
-
-def perturbation_arrays(pt, B: int):
-    """(keys (B, 3) uint64, pert (:data:`PERT`), period (B,), phase (B,)) of
-    the :class:`~workbench.sim.perturb.Perturbations` ``pt`` (None: none)."""
-    keys = np.zeros((B, 3), np.uint64)
-    period, phase = np.ones(B), np.zeros(B)
-    if pt is None:
-        return keys, np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]), period, phase
-    for j, c in enumerate(("v", "omega", "grade")):
-        if c in pt.keys:
-            keys[:, j] = np.asarray(pt.keys[c], np.uint64)
-    g, d = pt.grade or (0.0, 0.0), pt.delay or (0.0, 0.0)
-    if pt.delay is not None:
-        period, phase = np.asarray(pt.period, float), np.asarray(pt.phase, float)
-    pert = np.array([pt.noise_v, pt.noise_omega, float(pt.noise_every),
-                     float(pt.grade is not None), g[0], g[1], pt.segment,
-                     float(pt.delay is not None), d[0], d[1]])
-    return keys, pert, period, phase
 
 
 def simulate_batch(run: RunSettings, dt: float, kernel: Kernel) -> RunMetrics:
