@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .counter_rng import uniform
+from .counter_rng import normal4, uniform
 from .wheel_slip import ArrayOps, wheel_speed
 
 
@@ -94,6 +94,22 @@ def measured_state(v, lam, zv, zw, sv, sw, r_plant, r_ctrl, v_floor):
     with np.errstate(divide="ignore", invalid="ignore"):
         lm = np.where(vw >= vm, 1.0 - vm / vw, vw / vm - 1.0)
     return vm, lm
+
+
+def noisy_measure(pt: Perturbations, r_plant, r_ctrl, v_floor: float):
+    """The ``measure(v, lam) -> (v_m, lambda_m)`` of a batch with the
+    measurement noise of ``pt`` (:func:`measured_state`; radii and floor as
+    there), called once a sample: sample k sees noise number
+    k // noise_every of each run's "v" and "omega" streams."""
+    kv, kw = (np.asarray(pt.keys[c], np.uint64) for c in ("v", "omega"))
+    count = [0]
+
+    def measure(v, lam):
+        k = count[0] // pt.noise_every
+        count[0] += 1
+        return measured_state(v, lam, normal4(kv, k), normal4(kw, k), pt.noise_v,
+                              pt.noise_omega, r_plant, r_ctrl, v_floor)
+    return measure
 
 
 def grade_at(pos, key, lo: float, hi: float, segment: float):

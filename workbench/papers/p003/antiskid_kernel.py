@@ -82,6 +82,8 @@ def _build():
     from ...controllers import antiskid003_jit as C
     from ...sim.counter_rng import jit_functions
     from ...sim.jit_cache import cached
+    from ...sim.jit_tuples import tuple_readers
+    from ...sim.wheel_slip import PARAM_ORDER
     from ...sim.wheel_slip_jit import (BY_SIGN, GRADED, creep_speed, delay_at, fmax, fmin, forms,
                                        measured_state, split_delay, stiff_step_at, wheel_speed)
 
@@ -99,7 +101,10 @@ def _build():
     V_D, L_D, L_OPT, DT = C.V_D, C.LAMBDA_D, C.LAMBDA_OPT, C.DT
     WS, TB = C.OMEGA_SWITCH, C.T_BRAKE
     profile, control_pre, control_post = C.profile, C.control_pre, C.control_post
-    params_tuple, row_tuple, cfg_tuple = _tuples(jit)
+    # the model parameters (PARAM_ORDER, then the slope: 0 for the
+    # controller's model) and the settings (:data:`C.CFG`) as tuples of floats
+    params_tuple, row_tuple = tuple_readers(jit, len(PARAM_ORDER), 1)
+    cfg_tuple, _ = tuple_readers(jit, len(C.CFG))
 
     @jit
     def load(j, i, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf, st, ubuf, m, rs,
@@ -286,25 +291,6 @@ def _build():
                     go[j] = False
 
     return cached(run_batch, "antiskid_kernel.run_batch")
-
-
-def _tuples(jit):
-    """(params_tuple(p), row_tuple(a, j), cfg_tuple(c)), compiled: the model
-    parameters (PARAM_ORDER, then the slope) as a tuple of floats, from an
-    array ``p`` (slope 0) or from row ``j`` of a 2-D array; the settings
-    array ``c`` (:data:`~workbench.controllers.antiskid003_jit.CFG`) as a
-    tuple. Tuple entries are values: a loop over them reloads nothing and
-    creates no array view (no reference counting). The source is generated
-    from the two name lists, as :func:`workbench.sim.wheel_slip_jit._unpacked`."""
-    from ...controllers import antiskid003_jit as C
-    from ...sim.wheel_slip import PARAM_ORDER
-    n = len(PARAM_ORDER)
-    ns = {}
-    exec(f"def params_tuple(p):\n    return ({', '.join(f'p[{i}]' for i in range(n))}, 0.0)\n"
-         f"def row_tuple(a, j):\n    return ({', '.join(f'a[j, {i}]' for i in range(n + 1))})\n"
-         f"def cfg_tuple(c):\n    return ({', '.join(f'c[{i}]' for i in range(len(C.CFG)))})\n",
-         ns)
-    return jit(ns["params_tuple"]), jit(ns["row_tuple"]), jit(ns["cfg_tuple"])
 
 
 _KERNEL = None

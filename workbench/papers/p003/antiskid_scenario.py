@@ -34,10 +34,9 @@ import numpy as np
 
 from ...controllers.antiskid003 import Antiskid003, PhaseEvents
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED, ControllerSettings
-from ...sim.counter_rng import normal4
 from ...sim.delay import SimResult, simulate_closed_loop
 from ...sim.history import BatchDelayLine
-from ...sim.perturb import Perturbations, VaryingDelayLine, grade_at, measured_state
+from ...sim.perturb import Perturbations, VaryingDelayLine, grade_at, noisy_measure
 from ...sim.rate_mesh import RateMesh as Mesh
 from ...sim.wheel_slip import (PARAM_ORDER, ArrayOps, ScalarOps, creep_rate_coefficient,
                                creep_speed, model_functions, plant_step, wheel_speed)
@@ -272,7 +271,9 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     if pt is not None and (batch is None or mesh is not None):
         raise ValueError("perturbations are for batches on the fixed step")
     if pt is not None and pt.noisy:
-        ctrl.measure = _measure(pt, p, run.controller)
+        i_r = PARAM_ORDER.index("r")
+        ctrl.measure = noisy_measure(pt, p[i_r], run.controller.params[i_r],
+                                     run.controller.v_floor)
     pos, plant_fns = [zero], fns
     if pt is not None and pt.grade is not None:
         plant_fns = model_functions("numpy", graded=True)
@@ -321,18 +322,3 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     for k, v in vars(ctrl.events).items():      # the phase logic's events
         setattr(rec.m, k, v)
     return res, rec.m
-
-
-def _measure(pt: Perturbations, p: tuple, cs: ControllerSettings):
-    """The controller's ``measure`` of a batch with measurement noise: sample k
-    sees noise number k // noise_every of each run's streams."""
-    kv, kw = (np.asarray(pt.keys[c], np.uint64) for c in ("v", "omega"))
-    r_p, r_c = p[PARAM_ORDER.index("r")], cs.params[PARAM_ORDER.index("r")]
-    count = [0]
-
-    def measure(v, lam):
-        k = count[0] // pt.noise_every
-        count[0] += 1
-        return measured_state(v, lam, normal4(kv, k), normal4(kw, k), pt.noise_v,
-                              pt.noise_omega, r_p, r_c, cs.v_floor)
-    return measure

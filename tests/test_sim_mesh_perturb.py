@@ -1,14 +1,18 @@
 """The general refined mesh (:class:`workbench.sim.rate_mesh.RateMesh`) on a
 toy plant, and the compiled loops' perturbation arrays
-(:func:`workbench.sim.perturb.perturbation_arrays`), away from any paper."""
+(:func:`workbench.sim.perturb.perturbation_arrays`) and noisy measurement
+(:func:`workbench.sim.perturb.noisy_measure`), away from any paper."""
 from __future__ import annotations
 
 import math
 
 import numpy as np
+import pytest
 
 from workbench.sim.delay import simulate_closed_loop
-from workbench.sim.perturb import PERT, Perturbations, perturbation_arrays
+from workbench.sim.counter_rng import normal4
+from workbench.sim.perturb import (PERT, Perturbations, measured_state, noisy_measure,
+                                   perturbation_arrays)
 from workbench.sim.rate_mesh import RateMesh
 
 
@@ -56,3 +60,39 @@ def test_perturbation_arrays_name_every_entry():
     np.testing.assert_array_equal(keys, np.array([[5, 0, 7], [6, 0, 8]], np.uint64))
     np.testing.assert_array_equal(period, [2.0, 3.0])
     np.testing.assert_array_equal(phase, [0.0, 0.5])
+
+
+def test_noisy_measure_holds_each_noise_value_for_noise_every_samples():
+    pt = Perturbations(run=(0, 1), keys={"v": (11, 12), "omega": (21, 22)}, noise_v=0.2,
+                       noise_omega=0.5, noise_every=2)
+    v, lam = np.array([10.0, 20.0]), np.array([0.01, -0.02])
+    measure = noisy_measure(pt, 0.5, 0.52, 0.1)
+    a, b, c = (measure(v, lam) for _ in range(3))
+    for x, y in zip(a, b):
+        np.testing.assert_array_equal(x, y)
+    assert not np.array_equal(a[0], c[0])
+    kv, kw = np.array([11, 12], np.uint64), np.array([21, 22], np.uint64)
+    for k, got in ((0, a), (1, c)):
+        want = measured_state(v, lam, normal4(kv, k), normal4(kw, k), 0.2, 0.5, 0.5, 0.52, 0.1)
+        for x, y in zip(got, want):
+            np.testing.assert_array_equal(x, y)
+
+
+def test_tuple_readers_read_vectors_and_rows_into_padded_tuples():
+    numba = pytest.importorskip("numba")
+    from workbench.sim.jit_tuples import tuple_readers
+    jit = numba.njit(nogil=True)
+    vector, row = tuple_readers(jit, 3, 1)
+    a = np.arange(8.0).reshape(2, 4)
+
+    @jit
+    def total(p, a, j):         # a loop reading the tuples, as a kernel does
+        s = 0.0
+        for _ in range(3):
+            x, y = vector(p), row(a, j)
+            s += x[0] + x[1] + x[2] + x[3] + y[3]
+        return s
+    assert vector(np.array([1.0, 2.0, 3.0])) == (1.0, 2.0, 3.0, 0.0)
+    assert row(a, 1) == (4.0, 5.0, 6.0, 7.0)
+    assert total(np.array([1.0, 2.0, 3.0]), a, 1) == 3 * (6.0 + 7.0)
+    assert tuple_readers(jit, 2)[0](np.array([5.0, 6.0, 7.0])) == (5.0, 6.0)
