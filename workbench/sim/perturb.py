@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .counter_rng import uniform
+from .counter_rng import normal4, uniform
 from .wheel_slip import ArrayOps, wheel_speed
 
 
@@ -96,6 +96,22 @@ def measured_state(v, lam, zv, zw, sv, sw, r_plant, r_ctrl, v_floor):
     return vm, lm
 
 
+def noisy_measure(pt: Perturbations, r_plant, r_ctrl, v_floor: float):
+    """The ``measure(v, lam) -> (v_m, lambda_m)`` of a batch with the
+    measurement noise of ``pt`` (:func:`measured_state`; radii and floor as
+    there), called once a sample: sample k sees noise number
+    k // noise_every of each run's "v" and "omega" streams."""
+    kv, kw = (np.asarray(pt.keys[c], np.uint64) for c in ("v", "omega"))
+    count = [0]
+
+    def measure(v, lam):
+        k = count[0] // pt.noise_every
+        count[0] += 1
+        return measured_state(v, lam, normal4(kv, k), normal4(kw, k), pt.noise_v,
+                              pt.noise_omega, r_plant, r_ctrl, v_floor)
+    return measure
+
+
 def grade_at(pos, key, lo: float, hi: float, segment: float):
     """Slope at positions ``pos`` (m, arrays) of the runs with gradient keys ``key``."""
     j = np.floor(np.maximum(pos, 0.0) / segment).astype(np.int64)
@@ -155,3 +171,30 @@ class VaryingDelayLine:
         a = self._buf[(n - N) % self._L, self._cols]
         b = self._buf[(n - N - 1) % self._L, self._cols]
         return (1.0 - f) * a + f * b
+
+
+#: Entries of the kernel's ``pert`` array (:func:`perturbation_arrays`): what a compiled
+#: loop reads of :class:`Perturbations`.
+PERT = ("noise_v", "noise_omega", "noise_every", "graded", "grade_lo", "grade_hi", "segment",
+        "varying", "h_lo", "h_hi")
+
+
+def perturbation_arrays(pt, B: int):
+    """(keys (B, 3) uint64, pert (:data:`PERT`), period (B,), phase (B,)) of
+    the :class:`Perturbations` ``pt`` (None: none), as plain arrays a compiled
+    loop of B runs takes (the operations on them are those of
+    :mod:`workbench.sim.wheel_slip_jit`)."""
+    keys = np.zeros((B, 3), np.uint64)
+    period, phase = np.ones(B), np.zeros(B)
+    if pt is None:
+        return keys, np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]), period, phase
+    for j, c in enumerate(("v", "omega", "grade")):
+        if c in pt.keys:
+            keys[:, j] = np.asarray(pt.keys[c], np.uint64)
+    g, d = pt.grade or (0.0, 0.0), pt.delay or (0.0, 0.0)
+    if pt.delay is not None:
+        period, phase = np.asarray(pt.period, float), np.asarray(pt.phase, float)
+    pert = np.array([pt.noise_v, pt.noise_omega, float(pt.noise_every),
+                     float(pt.grade is not None), g[0], g[1], pt.segment,
+                     float(pt.delay is not None), d[0], d[1]])
+    return keys, pert, period, phase

@@ -41,6 +41,7 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED
 from ...sim.history import split_delay
+from ...sim.perturb import perturbation_arrays
 from .antiskid_scenario import RunMetrics, RunSettings
 
 #: The stepping paths of a sweep: "compiled" (numba, this module) or "numpy"
@@ -81,6 +82,8 @@ def _build():
     from ...controllers import antiskid003_jit as C
     from ...sim.counter_rng import jit_functions
     from ...sim.jit_cache import cached
+    from ...sim.jit_tuples import tuple_readers
+    from ...sim.wheel_slip import PARAM_ORDER
     from ...sim.wheel_slip_jit import (BY_SIGN, GRADED, creep_speed, delay_at, fmax, fmin, forms,
                                        measured_state, split_delay, stiff_step_at, wheel_speed)
 
@@ -98,7 +101,10 @@ def _build():
     V_D, L_D, L_OPT, DT = C.V_D, C.LAMBDA_D, C.LAMBDA_OPT, C.DT
     WS, TB = C.OMEGA_SWITCH, C.T_BRAKE
     profile, control_pre, control_post = C.profile, C.control_pre, C.control_post
-    params_tuple, row_tuple, cfg_tuple = _tuples(jit)
+    # the model parameters (PARAM_ORDER, then the slope: 0 for the
+    # controller's model) and the settings (:data:`C.CFG`) as tuples of floats
+    params_tuple, row_tuple = tuple_readers(jit, len(PARAM_ORDER), 1)
+    cfg_tuple, _ = tuple_readers(jit, len(C.CFG))
 
     @jit
     def load(j, i, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf, st, ubuf, m, rs,
@@ -176,8 +182,9 @@ def _build():
                   keys, pert, period, phase, out):
         """Simulate each run i (plant parameters ``plant[i]``, input delay
         (Np[i] + fp[i]) dt, initial speed v0[i]) into ``out[i]``; ``keys[i]``
-        (v, omega, grade streams), ``pert`` (:data:`PERT`), ``period[i]``,
-        ``phase[i]``: the perturbations of :mod:`workbench.sim.perturb`.
+        (v, omega, grade streams), ``pert`` (:data:`~workbench.sim.perturb.PERT`), ``period[i]``,
+        ``phase[i]``: the perturbations of :mod:`workbench.sim.perturb`
+        (:func:`~workbench.sim.perturb.perturbation_arrays`).
 
         :data:`LANES` runs are in flight at a time, each with its own state and
         clock; a lane that ends takes the next run. Per sample, the lanes'
@@ -286,25 +293,6 @@ def _build():
     return cached(run_batch, "antiskid_kernel.run_batch")
 
 
-def _tuples(jit):
-    """(params_tuple(p), row_tuple(a, j), cfg_tuple(c)), compiled: the model
-    parameters (PARAM_ORDER, then the slope) as a tuple of floats, from an
-    array ``p`` (slope 0) or from row ``j`` of a 2-D array; the settings
-    array ``c`` (:data:`~workbench.controllers.antiskid003_jit.CFG`) as a
-    tuple. Tuple entries are values: a loop over them reloads nothing and
-    creates no array view (no reference counting). The source is generated
-    from the two name lists, as :func:`workbench.sim.wheel_slip_jit._unpacked`."""
-    from ...controllers import antiskid003_jit as C
-    from ...sim.wheel_slip import PARAM_ORDER
-    n = len(PARAM_ORDER)
-    ns = {}
-    exec(f"def params_tuple(p):\n    return ({', '.join(f'p[{i}]' for i in range(n))}, 0.0)\n"
-         f"def row_tuple(a, j):\n    return ({', '.join(f'a[j, {i}]' for i in range(n + 1))})\n"
-         f"def cfg_tuple(c):\n    return ({', '.join(f'c[{i}]' for i in range(len(C.CFG)))})\n",
-         ns)
-    return jit(ns["params_tuple"]), jit(ns["row_tuple"]), jit(ns["cfg_tuple"])
-
-
 _KERNEL = None
 
 
@@ -361,30 +349,6 @@ def simulate_batch_compiled(run: RunSettings, dt: float, *,
             np.asarray(cs.params, float), float(evs_settle), st0, ub0, m0,
             keys, pert, period, phase, out)
     return RunMetrics(**{k: out[:, j].copy() for j, k in enumerate(METRIC_FIELDS)})
-
-
-#: Entries of the kernel's ``pert`` array (:func:`perturbation_arrays`).
-PERT = ("noise_v", "noise_omega", "noise_every", "graded", "grade_lo", "grade_hi", "segment",
-        "varying", "h_lo", "h_hi")
-
-
-def perturbation_arrays(pt, B: int):
-    """(keys (B, 3) uint64, pert (:data:`PERT`), period (B,), phase (B,)) of
-    the :class:`~workbench.sim.perturb.Perturbations` ``pt`` (None: none)."""
-    keys = np.zeros((B, 3), np.uint64)
-    period, phase = np.ones(B), np.zeros(B)
-    if pt is None:
-        return keys, np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]), period, phase
-    for j, c in enumerate(("v", "omega", "grade")):
-        if c in pt.keys:
-            keys[:, j] = np.asarray(pt.keys[c], np.uint64)
-    g, d = pt.grade or (0.0, 0.0), pt.delay or (0.0, 0.0)
-    if pt.delay is not None:
-        period, phase = np.asarray(pt.period, float), np.asarray(pt.phase, float)
-    pert = np.array([pt.noise_v, pt.noise_omega, float(pt.noise_every),
-                     float(pt.grade is not None), g[0], g[1], pt.segment,
-                     float(pt.delay is not None), d[0], d[1]])
-    return keys, pert, period, phase
 
 
 def simulate_batch(run: RunSettings, dt: float, kernel: Kernel) -> RunMetrics:

@@ -4,7 +4,10 @@
 :mod:`workbench.controllers.antiskid003` on the delayed wheel-slip plant
 (:mod:`workbench.sim.wheel_slip`, stepped by
 :func:`workbench.sim.delay.simulate_closed_loop`), single runs or a batch of
-parameter samples, optionally on a refined mesh (:class:`Mesh`).
+parameter samples, optionally on a refined mesh (:class:`Mesh`, the general
+:class:`workbench.sim.rate_mesh.RateMesh` with S / v the fastest creep-ratio
+rate, :func:`~workbench.sim.wheel_slip.creep_rate_coefficient`, ~3800/v 1/s
+on dry rail).
 :class:`MetricsRecorder` accumulates the run's metrics (:class:`RunMetrics`)
 sample by sample; the controller's own phase events (handover, divergence)
 are merged in at the end.
@@ -12,10 +15,14 @@ are merged in at the end.
 Why this stays paper code: every metric here is a definition of paper 003's
 study (time to v_d, creep ratio in traction and braking against lambda_opt,
 the creep-speed error of Theorem 3 against the profile of eq (76), the lock
-onset), and :class:`Mesh` is set by the creep-ratio rate of the wheel-slip
-plant. The batch form is mirrored bit for bit by the compiled kernel
-(:mod:`workbench.papers.p003.antiskid_kernel`), so its operations stay as
-they are. Its tables and figures are rendered by the general
+onset). The runs without the predictor need the refined mesh: at low speed
+that loop is close to neutral (near a creep ratio with slope J,
+lambda' ~ J lambda - (J + k) lambda(t - h), roots decaying at only
+(1/h) ln(|J| / |J + k|)), so fast features of width ~1/|J| set at the start
+persist for seconds; the exponential step keeps them stable but only a step
+below 1/|J| resolves them. The batch form is mirrored bit for bit by the
+compiled kernel (:mod:`workbench.papers.p003.antiskid_kernel`), so its
+operations stay as they are. Its tables and figures are rendered by the general
 :mod:`workbench.report.case_tables` and :mod:`workbench.report.case_figures`.
 """
 from __future__ import annotations
@@ -27,10 +34,10 @@ import numpy as np
 
 from ...controllers.antiskid003 import Antiskid003, PhaseEvents
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED, ControllerSettings
-from ...sim.counter_rng import normal4
 from ...sim.delay import SimResult, simulate_closed_loop
 from ...sim.history import BatchDelayLine
-from ...sim.perturb import Perturbations, VaryingDelayLine, grade_at, measured_state
+from ...sim.perturb import Perturbations, VaryingDelayLine, grade_at, noisy_measure
+from ...sim.rate_mesh import RateMesh as Mesh
 from ...sim.wheel_slip import (PARAM_ORDER, ArrayOps, ScalarOps, creep_rate_coefficient,
                                creep_speed, model_functions, plant_step, wheel_speed)
 
@@ -228,33 +235,6 @@ class RunSettings:
     perturb: Perturbations | None = None    # batches only: noise, gradient, varying delay
 
 
-@dataclass(frozen=True)
-class Mesh:
-    """Refined mesh of a single run, set by the creep-ratio time constant.
-
-    The step is dt / 2**k with k the smallest level (at most ``k_max``) with
-    (dt_ref / 2**k) S / v <= ``courant``, S / v the fastest creep-ratio rate
-    (:func:`~workbench.sim.wheel_slip.creep_rate_coefficient`, ~3800/v 1/s on dry rail). ``dt_ref``
-    is the design's step: a run at dt_ref / 2 then takes exactly half of
-    every step of the run at dt_ref, so step halving still compares a mesh
-    with its refinement.
-
-    Why: without the predictor, the loop at low speed is close to neutral
-    (near a creep ratio with slope J, lambda' ~ J lambda - (J + k) lambda(t - h),
-    roots decaying at only (1/h) ln(|J| / |J + k|)), so fast features of
-    width ~1/|J| set at the start persist for seconds; the exponential step
-    keeps them stable but only a step below 1/|J| resolves them.
-    """
-
-    dt_ref: float
-    courant: float
-    k_max: int
-
-    def level(self, v: float, S: float) -> int:
-        rate = self.dt_ref * S / (self.courant * max(v, 1e-3))
-        return 0 if rate <= 1.0 else min(self.k_max, math.ceil(math.log2(rate)))
-
-
 def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 0.05,
                       batch: int | None = None,
                       mesh: Mesh | None = None) -> tuple[SimResult | None, RunMetrics]:
@@ -291,7 +271,9 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     if pt is not None and (batch is None or mesh is not None):
         raise ValueError("perturbations are for batches on the fixed step")
     if pt is not None and pt.noisy:
-        ctrl.measure = _measure(pt, p, run.controller)
+        i_r = PARAM_ORDER.index("r")
+        ctrl.measure = noisy_measure(pt, p[i_r], run.controller.params[i_r],
+                                     run.controller.v_floor)
     pos, plant_fns = [zero], fns
     if pt is not None and pt.grade is not None:
         plant_fns = model_functions("numpy", graded=True)
@@ -340,18 +322,3 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     for k, v in vars(ctrl.events).items():      # the phase logic's events
         setattr(rec.m, k, v)
     return res, rec.m
-
-
-def _measure(pt: Perturbations, p: tuple, cs: ControllerSettings):
-    """The controller's ``measure`` of a batch with measurement noise: sample k
-    sees noise number k // noise_every of each run's streams."""
-    kv, kw = (np.asarray(pt.keys[c], np.uint64) for c in ("v", "omega"))
-    r_p, r_c = p[PARAM_ORDER.index("r")], cs.params[PARAM_ORDER.index("r")]
-    count = [0]
-
-    def measure(v, lam):
-        k = count[0] // pt.noise_every
-        count[0] += 1
-        return measured_state(v, lam, normal4(kv, k), normal4(kw, k), pt.noise_v,
-                              pt.noise_omega, r_p, r_c, cs.v_floor)
-    return measure
