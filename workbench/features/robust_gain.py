@@ -73,10 +73,11 @@ def load_robust_settings(syn: Reader) -> RobustSettings:
     calls ``syn.finish()``)."""
     from ..lmi.core import DEFAULT_MARGIN
     from ..lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
+    from .eps_sweep import EPS_RANGE
     return RobustSettings(
         alpha=syn.number("alpha", nonneg=True, hi=10.0, what="decay rate (1/s)"),
         eps_grid=syn.numbers("eps_grid", positive=True, min_len=2, what="eps values",
-                             lo=1e-6, hi=1e6),
+                             lo=EPS_RANGE[0], hi=EPS_RANGE[1]),
         golden_steps=int(syn.number("golden_steps", default=3, integer=True, lo=0, hi=20)),
         rel_tol=syn.number("rel_tol", default=1e-2, positive=True, hi=0.1),
         h_max=syn.number("h_max", default=10.0, lo=1e-3, hi=1e4, what="number (s)"),

@@ -110,10 +110,8 @@ def load_tight(root: Reader, eps: tuple[float, ...]) -> TightSettings | None:
     t = root.table("tight")
     enable = t.boolean("enable", default=True)
     h_max = t.number("h_max", default=10.0, lo=1e-3, hi=1e3, what="number (s)")
-    grid = t.numbers("grid", default=(0.01, 0.1, 1.0, 10.0, 100.0), positive=True,
-                     min_len=2, what="eps values", lo=1e-6, hi=1e6)
-    if list(grid) != sorted(set(grid)):
-        raise t.fail("grid", list(grid), "distinct eps values in increasing order")
+    from .eps_sweep import read_grid
+    grid = read_grid(t)
     order = t.number("order", default=2, integer=True, lo=0, hi=8, what="integer N")
     ref = t.number("reference_eps", default=eps[0], positive=True)
     if ref not in eps:

@@ -32,6 +32,7 @@ from ...reader import Quantity, Reader
 from ...features.other_gains import (GainCheck, OtherGain, check_other_gains, load_other_gains,
                                      other_gain_quantities)
 from ...features.other_gains import quantity_names as other_gain_names
+from ...features.eps_sweep import read_eps, read_settings
 from ...features.published_rows import (Published, PublishedCheck, load_published,
                                         published_quantities, published_quantity_names)
 from ...features.tight_compare import (TIGHT_QUANTITIES, TightComparison, TightSettings,
@@ -128,21 +129,7 @@ class AntiskidCruise:
         op.finish()
         syn = root.table("synthesis")
         syn.string("method", choices=("free-weighting-003",))
-        eps = syn.numbers("eps", positive=True, what="eps values", lo=1e-6, hi=1e6)
-        if len(set(eps)) != len(eps):
-            raise syn.fail("eps", list(eps), "distinct eps values")
-        from ...lmi.core import DEFAULT_MARGIN
-        from ...lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
-        from ...synthesis import SynthesisSettings
-        settings = SynthesisSettings(
-            margin=syn.number("margin", default=DEFAULT_MARGIN, positive=True, hi=1e-2),
-            rel_tol=syn.number("rel_tol", default=1e-4, positive=True, hi=0.1),
-            h_max=syn.number("h_max", default=100.0, lo=1e-3, hi=1e4, what="number (s)"),
-            gain_fraction=syn.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
-                                     hi=1.0, what="fraction of h_certified"),
-            gain_digits=int(syn.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
-                                       lo=2, hi=8)),
-        )
+        eps, settings = read_eps(syn), read_settings(syn)
         published = load_published(syn)
         compare = syn.boolean("compare_published", default=True)
         syn.finish()
