@@ -125,3 +125,25 @@ def test_rate_units():
     assert rate_units("m/s") == ("m/s^2", "m/s^3")
     assert rate_units("km/h") == ("(km/h)/s", "(km/h)/s^2")
     assert rate_units("rad") == ("(rad)/s", "(rad)/s^2")
+
+
+def test_general_peaks_converged_and_table_on_a_toy():
+    """features.comfort.load_comfort / peaks_converged on no paper's run: a
+    speed ramp whose slope moves with the level, read as three Comfort results."""
+    from workbench.errors import DesignError
+    from workbench.features.comfort import comfort_of_speed, load_comfort, peaks_converged
+    from workbench.reader import Reader
+    q = lambda v, u: {"value": v, "unit": u, "source": "toy"}
+    root = Reader("toy.toml", {"comfort": {"a_max": q(1.0, "m/s^2"), "jerk_max": q(0.5, "m/s^3"),
+                                           "window": q(1.0, "s")}})
+    lim = load_comfort(root)
+    assert (lim.a_max.value, lim.jerk_max.value, lim.window.value) == (1.0, 0.5, 1.0)
+    assert load_comfort(Reader("toy.toml", {})) is None
+    with pytest.raises(DesignError, match="comfort.window"):
+        load_comfort(Reader("toy.toml", {"comfort": {"a_max": q(1.0, "m/s^2"),
+                                                     "jerk_max": q(0.5, "m/s^3")}}))
+    t = np.arange(0.0, 20.0 + 1e-9, 0.05)
+    ramp = lambda k: comfort_of_speed(t, np.where(t < 5, k * t, 5 * k), lim, 0.05)
+    assert peaks_converged((ramp(0.8), ramp(0.8), ramp(0.8))) == "yes"
+    assert peaks_converged((ramp(0.84), ramp(0.8), ramp(0.798))) == "yes"
+    assert peaks_converged((ramp(0.88), ramp(0.8), ramp(0.72))) is None

@@ -34,7 +34,8 @@ import numpy as np
 
 from ..reader import Quantity, Reader
 
-__all__ = ["ComfortLimits", "Comfort", "RunningComfort", "read_limits", "rate", "peak_abs",
+__all__ = ["ComfortLimits", "Comfort", "RunningComfort", "load_comfort", "peaks_converged",
+           "read_limits", "rate", "peak_abs",
            "time_above", "stretches", "acceleration_jerk", "comfort_of_speed", "rate_units",
            "metric_units", "PEAKS", "TIMES"]
 
@@ -85,6 +86,17 @@ def read_limits(t: Reader, speed_unit: str = "m/s", *, required: bool = True,
                          t.quantity("jerk_max", uj, positive=True, **opt),
                          t.quantity("window", "s", positive=True, hi=10.0, **opt)
                          if window else None)
+
+
+def load_comfort(root: Reader) -> ComfortLimits | None:
+    """The ``[comfort]`` table of a design with every limit and the window
+    required (None when the design has none)."""
+    if not root.has("comfort"):
+        return None
+    t = root.table("comfort")
+    out = read_limits(t)
+    t.finish()
+    return out
 
 
 def rate(new: np.ndarray, old: np.ndarray, T: float) -> np.ndarray:
@@ -169,6 +181,21 @@ def comfort_of_speed(t: np.ndarray, v: np.ndarray, limits: ComfortLimits,
     lim_a, lim_j = limits.a_max.value, limits.jerk_max.value
     return Comfort(t_a, a, t_j, j, peak_abs(a), peak_abs(j), time_above(a, lim_a, step),
                    time_above(j, lim_j, step), stretches(t_j, j, lim_j))
+
+
+#: Relative tolerance of :func:`peaks_converged` (of the largest peak).
+COMFORT_RTOL = 0.01
+
+
+def peaks_converged(levels, rtol: float = COMFORT_RTOL) -> str | None:
+    """Whether the |a| and |jerk| peaks of :class:`Comfort` results at a step,
+    its half and its quarter (``levels``, three) converged: they pass
+    :func:`workbench.features.refinement.screen` with a tolerance of ``rtol``
+    times the largest peak. "yes", else None (not determined, INCONCLUSIVE)."""
+    from .refinement import screen
+    keys = ("a_max_abs", "jerk_max_abs")
+    vals = {k: tuple(getattr(x, k) for x in levels) for k in keys}
+    return screen(vals, {k: rtol * max(abs(x) for x in vals[k]) for k in keys})[0]
 
 
 class RunningComfort:

@@ -14,7 +14,9 @@ what a report shows of it:
   the loop's Bode and Nyquist plots, and the abscissa against h.
 
 A ``delay-feedback`` design turns it on with an ``[eps_sweep]`` table
-(:mod:`workbench.kinds.delay_feedback`).
+(:mod:`workbench.kinds.delay_feedback`). :func:`read_eps` and
+:func:`read_settings` read the sweep's keys of a ``[synthesis]`` table,
+:func:`read_grid` the grid of an automatic eps search.
 """
 from __future__ import annotations
 
@@ -26,7 +28,47 @@ from ..report.markdown import Figure, fmt, md_table
 from ..report.synthesis_text import exact_margin_text, gain_text
 
 __all__ = ["abscissa_vs_h", "all_infinite", "eps_sweep_figures", "eps_sweep_notes",
-           "eps_sweep_table", "infinite_note"]
+           "eps_sweep_table", "infinite_note", "read_eps", "read_grid", "read_settings"]
+
+#: eps values a synthesis may try (1e-300 left the robust bisection solving for minutes).
+EPS_RANGE = (1e-6, 1e6)
+
+
+def read_eps(t) -> tuple[float, ...]:
+    """The distinct values ``eps`` of a ``[synthesis]`` table (its
+    :class:`~workbench.reader.Reader` ``t``)."""
+    eps = t.numbers("eps", positive=True, what="eps values", lo=EPS_RANGE[0], hi=EPS_RANGE[1])
+    if len(set(eps)) != len(eps):
+        raise t.fail("eps", list(eps), "distinct eps values")
+    return eps
+
+
+def read_grid(t) -> tuple[float, ...]:
+    """The log grid ``grid`` of an automatic eps search (distinct, increasing;
+    default 0.01 ... 100) of a table ``t``."""
+    grid = t.numbers("grid", default=(0.01, 0.1, 1.0, 10.0, 100.0), positive=True,
+                     min_len=2, what="eps values", lo=EPS_RANGE[0], hi=EPS_RANGE[1])
+    if list(grid) != sorted(set(grid)):
+        raise t.fail("grid", list(grid), "distinct eps values in increasing order")
+    return grid
+
+
+def read_settings(t, *, rel_tol: float = 1e-4, h_max: float = 100.0):
+    """The :class:`~workbench.synthesis.SynthesisSettings` of a ``[synthesis]``
+    table ``t`` (LMI margin, bisection tolerance, delay search cap in s,
+    canonical gain's fraction and digits), with these defaults."""
+    from ..lmi.core import DEFAULT_MARGIN
+    from ..lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
+    from ..synthesis import H_MAX_RANGE, SynthesisSettings
+    return SynthesisSettings(
+        margin=t.number("margin", default=DEFAULT_MARGIN, positive=True, hi=1e-2),
+        rel_tol=t.number("rel_tol", default=rel_tol, positive=True, hi=0.1),
+        h_max=t.number("h_max", default=h_max, lo=H_MAX_RANGE[0], hi=H_MAX_RANGE[1],
+                       what="number (s)"),
+        gain_fraction=t.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
+                               hi=1.0, what="fraction of h_certified"),
+        gain_digits=int(t.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
+                                 lo=2, hi=8)))
 
 
 def _best(rows):

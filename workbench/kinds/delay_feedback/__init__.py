@@ -57,8 +57,6 @@ from .spec import OperatingEntry, PlantSpec, Variable
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 METHODS = ("free-weighting-003", "wirtinger", "bessel-legendre")
-#: eps values a synthesis may try (1e-300 left the robust bisection solving for minutes).
-EPS_RANGE = (1e-6, 1e6)
 #: Metrics of every scenario (per state / input where marked).
 SIM_METRICS = ("peak_error", "final_error", "peak_input_dev", "diverged")
 
@@ -245,9 +243,7 @@ def _delay(root: Reader) -> DelaySpec:
 
 
 def _synthesis(root: Reader, delay: DelaySpec, n: int) -> SynthesisChoice:
-    from ...lmi.core import DEFAULT_MARGIN
-    from ...lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
-    from ...synthesis import H_MAX_RANGE, SynthesisSettings
+    from ...features.eps_sweep import read_eps, read_grid, read_settings
     req = root.has("requirements")
     s = root.table("synthesis", default=None) if req else root.table("synthesis")
     method = s.string("method", choices=METHODS + ("robust-descriptor", "requirements"),
@@ -258,32 +254,17 @@ def _synthesis(root: Reader, delay: DelaySpec, n: int) -> SynthesisChoice:
         raise s.fail("method", method, '"robust-descriptor" exactly when [[vertices]] are given')
     eps = grid = ()
     if method == "free-weighting-003":
-        eps = s.numbers("eps", positive=True, what="eps values", lo=EPS_RANGE[0],
-                        hi=EPS_RANGE[1])
-        if len(set(eps)) != len(eps):
-            raise s.fail("eps", list(eps), "distinct eps values")
+        eps = read_eps(s)
     elif method != "requirements":
-        grid = s.numbers("grid", default=(0.01, 0.1, 1.0, 10.0, 100.0), positive=True,
-                         min_len=2, what="eps values", lo=EPS_RANGE[0], hi=EPS_RANGE[1])
-        if list(grid) != sorted(set(grid)):
-            raise s.fail("grid", list(grid), "distinct eps values in increasing order")
+        grid = read_grid(s)
     order = int(s.number("order", default=2, integer=True, lo=0, hi=8, what="integer N"))
     alpha = 0.0
     if method == "robust-descriptor":
         alpha = s.number("decay_rate", default=0.0, nonneg=True, hi=10.0,
                          what="decay rate (1/s)")
-    settings = SynthesisSettings(
-        margin=s.number("margin", default=DEFAULT_MARGIN, positive=True, hi=1e-2),
-        rel_tol=s.number("rel_tol", default=1e-4 if method == METHODS[0] else 1e-3,
-                         positive=True, hi=0.1),
-        h_max=s.number("h_max", default=max(100.0 if method == METHODS[0] else 10.0,
-                                            4 * delay.h_max), lo=H_MAX_RANGE[0],
-                       hi=H_MAX_RANGE[1],
-                       what="number (s)"),
-        gain_fraction=s.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
-                               hi=1.0, what="fraction of h_certified"),
-        gain_digits=int(s.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
-                                 lo=2, hi=8)))
+    settings = read_settings(s, rel_tol=1e-4 if method == METHODS[0] else 1e-3,
+                             h_max=max(100.0 if method == METHODS[0] else 10.0,
+                                       4 * delay.h_max))
     if settings.h_max < delay.h_max:
         raise s.fail("h_max", settings.h_max, f"a search cap at least the design's delay, "
                      f"delay.max = {delay.h_max:g} s")

@@ -38,6 +38,17 @@ def synthesis_table(rows, settings) -> str:
     return "\n".join(out)
 
 
+def print_sweep(name: str, header: str, rows, settings, as_json: bool) -> int:
+    """Print an eps sweep's rows under ``header`` (:func:`synthesis_table`),
+    or as JSON; exit 0 if every row is certified, else 1."""
+    if as_json:
+        print(json.dumps({"design": name, "rows": [r.to_json() for r in rows]}, indent=2))
+    else:
+        print(header)
+        print(synthesis_table(rows, settings))
+    return 0 if all(r.status.value == "certified" for r in rows) else 1
+
+
 def _op_text(spec, op) -> str:
     from ...report.markdown import fmt
     vals = op.as_dict(spec.plant)
@@ -74,15 +85,8 @@ def synthesize_command(design, *, eps=None, as_json: bool = False) -> int:
                 h_cap=spec.synthesis.settings.h_max)
     st = spec.synthesis.settings
     if spec.synthesis.method == "free-weighting-003":
-        ok = all(r.status.value == "certified" for r in s.rows)
-        if as_json:
-            print(json.dumps({"design": design.name, "rows": [r.to_json() for r in s.rows]},
-                             indent=2))
-            return 0 if ok else 1
-        print(f"{design.name}: problem (60) of paper 003 on the linearisation at "
-              f"{_op_text(spec, op)}")
-        print(synthesis_table(s.rows, st))
-        return 0 if ok else 1
+        return print_sweep(design.name, f"{design.name}: problem (60) of paper 003 on the "
+                           f"linearisation at {_op_text(spec, op)}", s.rows, st, as_json)
     from ...margins import exact_margin
     ex = exact_margin(A, B @ s.K) if s.K is not None else None
     ok = s.status == "certified"

@@ -7,6 +7,9 @@ the limits are the design's choice and carry their source). Everything is
 computed from the runs the study records anyway (every case at dt and dt/2,
 recorded every ``record_dt``; no extra simulation).
 
+The ``[comfort]`` table (:func:`~workbench.features.comfort.load_comfort`)
+and the convergence of the peaks over three steps
+(:func:`~workbench.features.comfort.peaks_converged`) are general too.
 What stays here is paper 003's: the torque is the controller's commanded
 u(t) against the peak adhesion torque T_adh = mu(lambda_opt) m g r of the
 nominal model (the most the rail transmits in steady state), and the
@@ -18,17 +21,10 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ...features.comfort import Comfort, ComfortLimits, comfort_of_speed, read_limits
-from ...reader import Reader
+from ...features.comfort import (COMFORT_RTOL, Comfort, ComfortLimits, comfort_of_speed,
+                                 peaks_converged)
 
-def load_comfort(root: Reader) -> ComfortLimits | None:
-    """The ``[comfort]`` table of a run design (None when absent)."""
-    if not root.has("comfort"):
-        return None
-    t = root.table("comfort")
-    out = read_limits(t)
-    t.finish()
-    return out
+__all__ = ["COMFORT_QUANTITIES", "RunComfort", "comfort_of", "comfort_quantities"]
 
 
 @dataclass(frozen=True)
@@ -60,25 +56,14 @@ _MEASURES = ("a_max_abs", "jerk_max_abs", "time_above_a", "time_above_jerk", "u_
 COMFORT_QUANTITIES = _MEASURES + ("comfort_converged",)
 
 
-#: Relative tolerance of the Richardson estimate of the |a| and |jerk| peaks
-#: over dt, dt/2, dt/4 for ``comfort_converged``.
-COMFORT_RTOL = 0.01
-
-
 def comfort_quantities(name: str, fine: RunComfort, coarse: RunComfort,
                        quarter: RunComfort | None = None, rtol: float = COMFORT_RTOL) -> dict:
     """The :data:`COMFORT_QUANTITIES` of one case (reported from dt/2).
 
-    ``comfort_converged``: the |a| and |jerk| peaks at dt, dt/2 and dt/4
-    (``quarter``) pass :func:`workbench.features.refinement.screen` with tolerance
-    ``rtol`` times the largest peak: "yes", else None (not determined,
-    INCONCLUSIVE; also without a dt/4 run: a two-level agreement is no
-    convergence, issue 33 item 4)."""
+    ``comfort_converged``: the peaks at dt, dt/2 and dt/4 (``quarter``) pass
+    :func:`workbench.features.comfort.peaks_converged`: "yes", else None (not
+    determined, INCONCLUSIVE; also without a dt/4 run: a two-level agreement
+    is no convergence, issue 33 item 4)."""
     b = f"cases[{name}]"
-    conv = None
-    if quarter is not None:
-        from ...features.refinement import screen
-        keys = ("a_max_abs", "jerk_max_abs")
-        vals = {k: tuple(getattr(x, k) for x in (coarse, fine, quarter)) for k in keys}
-        conv = screen(vals, {k: rtol * max(abs(x) for x in vals[k]) for k in keys})[0]
+    conv = None if quarter is None else peaks_converged((coarse, fine, quarter), rtol)
     return {f"{b}.{k}": getattr(fine, k) for k in _MEASURES} | {f"{b}.comfort_converged": conv}

@@ -10,11 +10,12 @@ from __future__ import annotations
 import numpy as np
 
 from ...controllers.antiskid003_settings import PHASE_NAMES
+from ...features.comfort import COMFORT_RTOL
 from ...features.comfort_render import comfort_cells, comfort_headers
 from ...features.comfort_render import plot_comfort as plot_comfort_traces
 from ...report.markdown import Figure, fmt, md_table
 from ...sim.convergence import P_MIN
-from .antiskid_comfort import COMFORT_RTOL, comfort_quantities
+from .antiskid_comfort import comfort_quantities
 from .antiskid_run import RECORD_DT
 from .antiskid_run_figures import color_of
 from .antiskid_run_spec import peak_adhesion_torque

@@ -12,10 +12,12 @@ Each operating point is the cruise linearisation of paper 003 (eqs 17-32,
 :func:`~workbench.symbolic.linearise.linearise_cruise`) at its solved
 equilibrium lambda_d. Certificates hold at the listed points only.
 
-The gains compared at every point and their table are general
+The robust synthesis, its per-point checks (:mod:`workbench.features.robust_gain`),
+the gains compared at every point and their table are general
 (:mod:`workbench.features.point_gains`, rows read as
 :class:`~workbench.features.other_gains.OtherGain`); this module keeps paper
-003's operating points (its adhesion plant per rail, speed and mass).
+003's operating points (its adhesion plant per rail, speed and mass, and
+their lambda_d quantities).
 """
 from __future__ import annotations
 
@@ -26,13 +28,14 @@ import numpy as np
 
 from ...errors import DesignError, ModelError
 from ...features.other_gains import OtherGain, load_other_gains
+from ...features.robust_gain import (RobustGain, RobustSettings, load_robust_settings,
+                                     robust_quantities, robust_quantity_names, run_robust)
 from ...jsonable import json_method
 from ...plants.units import ADHESION_003 as PARAMETER_UNITS
 from ...reader import Quantity, Reader
 
 if TYPE_CHECKING:   # the solvers load when a design runs
     from ...crosscheck import PointCheck
-    from ...lmi.robust import RobustSynthesis
 
 RAIL_KEYS = ("a", "b", "c")
 
@@ -59,15 +62,7 @@ class RobustSpec:
     common: dict
     rails: dict
     points: tuple[Point, ...]
-    alpha: float
-    eps_grid: tuple[float, ...]
-    golden_steps: int
-    rel_tol: float
-    h_max: float
-    margin: float
-    order: int
-    gain_fraction: float
-    gain_digits: int
+    settings: RobustSettings
     compare: tuple[OtherGain, ...]
     requirements: object = None     # RequirementsSpec ([requirements]) or None
 
@@ -76,17 +71,14 @@ class RobustSpec:
 class RobustResult:
     points: tuple[Point, ...]
     compare: tuple[OtherGain, ...]
-    alpha: float
-    order: int
-    synthesis: RobustSynthesis
-    checks: tuple[PointCheck, ...]           # robust K, per point
-    abscissa: tuple[float, ...]              # spectral abscissa at h_certified, per point
+    robust: RobustGain                       # the robust K and its per-point checks
     compared: tuple[tuple[PointCheck, ...], ...]
     requirements: object = None     # workbench.requirements.RequirementResult or None
 
     #: The JSON of the result (:func:`workbench.jsonable.to_json`).
-    JSON_FIELDS = {"eps": "synthesis.eps", "h_certified": "synthesis.bracket.h_certified",
-                   "K": "synthesis.K", "reason": "synthesis.reason"}
+    JSON_FIELDS = {"eps": "robust.synthesis.eps",
+                   "h_certified": "robust.synthesis.bracket.h_certified",
+                   "K": "robust.synthesis.K", "reason": "robust.synthesis.reason"}
     to_json = json_method
 
 
@@ -136,88 +128,41 @@ class AntiskidRobust:
         plant.finish()
         points = _points(root.path, common, rails, root.table("operating_points"))
         syn = root.table("synthesis")
-        from ...lmi.core import DEFAULT_MARGIN
-        from ...lmi.gain import DEFAULT_DIGITS, DEFAULT_FRACTION
-        spec = dict(
-            alpha=syn.number("alpha", nonneg=True, hi=10.0, what="decay rate (1/s)"),
-            eps_grid=syn.numbers("eps_grid", positive=True, min_len=2, what="eps values",
-                                 lo=1e-6, hi=1e6),
-            golden_steps=int(syn.number("golden_steps", default=3, integer=True, lo=0, hi=20)),
-            rel_tol=syn.number("rel_tol", default=1e-2, positive=True, hi=0.1),
-            h_max=syn.number("h_max", default=10.0, lo=1e-3, hi=1e4, what="number (s)"),
-            margin=syn.number("margin", default=DEFAULT_MARGIN, positive=True, hi=1e-2),
-            order=int(syn.number("analysis_order", default=2, integer=True, lo=0, hi=6)),
-            gain_fraction=syn.number("gain_fraction", default=DEFAULT_FRACTION, positive=True,
-                                     hi=1.0, what="fraction of h_certified"),
-            gain_digits=int(syn.number("gain_digits", default=DEFAULT_DIGITS, integer=True,
-                                       lo=2, hi=8)))
+        settings = load_robust_settings(syn)
         syn.finish()
         compare = load_other_gains(root, points[0].B.shape[0], "compare")
         from ...kinds.delay_feedback.requirements import load_rate_requirements
-        return RobustSpec(common, rails, points, compare=compare,
-                          requirements=load_rate_requirements(root), **spec)
+        return RobustSpec(common, rails, points, settings, compare,
+                          load_rate_requirements(root))
 
     def quantity_names(self, spec: RobustSpec) -> set[str]:
-        names = {"synthesis.h_certified", "synthesis.h_gain", "synthesis.eps", "synthesis.K1",
-                 "synthesis.K2",
-                 "robust.all_stable", "robust.min_exact_margin", "robust.max_abscissa_at_h",
-                 "robust.min_exact_over_certified"}
-        for p in spec.points:
-            names |= {f"points[{p.id}].{f}" for f in ("exact_margin", "h_certified",
-                                                        "abscissa_at_h", "lambda_d")}
+        ids = [p.id for p in spec.points]
+        names = robust_quantity_names(ids, spec.points[0].A.shape[0])
+        names |= {f"points[{i}].lambda_d" for i in ids}
         from ...kinds.delay_feedback.requirements import requirement_quantity_names
         names |= requirement_quantity_names(spec.requirements)
         names |= {"requirements.K1", "requirements.K2"} if spec.requirements else set()
         from ...features.point_gains import compare_quantity_names
-        return names | compare_quantity_names([p.id for p in spec.points], spec.compare)
+        return names | compare_quantity_names(ids, spec.compare)
 
     def run(self, design) -> RobustResult:
         s: RobustSpec = design.spec
         pts = [(p.A, p.B) for p in s.points]
-        from ...crosscheck import check_gain
-        from ...lmi.robust import synthesize_robust
-        from ...margins import spectral_abscissa
-        syn = synthesize_robust(pts, alpha=s.alpha, eps_grid=s.eps_grid,
-                                golden_steps=s.golden_steps, rel_tol=s.rel_tol,
-                                margin=s.margin, h_hi=s.h_max, gain_fraction=s.gain_fraction,
-                                gain_digits=s.gain_digits)
-        checks, absc = (), ()
-        if syn.K is not None:
-            checks = check_gain(pts, syn.K, N=s.order, margin=s.margin)
-            h = syn.gain.h_certified          # what the rounded canonical K certifies
-            absc = tuple(spectral_abscissa(A, B @ syn.K, h) for A, B in pts)
         from ...features.point_gains import check_named_gains
-        compared = check_named_gains(pts, s.compare, s.order, s.margin)
+        robust = run_robust(pts, s.settings)
+        compared = check_named_gains(pts, s.compare, s.settings.order, s.settings.margin)
         req = None
         if s.requirements is not None:       # the design to requirements (issue 31)
             from ...requirements import Requirements, design_to_requirements
             r = s.requirements
             req = design_to_requirements(pts, Requirements(r.delay, r.decay_rate,
                                                            objective=r.objective))
-        return RobustResult(s.points, s.compare, s.alpha, s.order, syn, checks, absc, compared,
-                            req)
+        return RobustResult(s.points, s.compare, robust, compared, req)
 
     def quantities(self, res: RobustResult) -> dict:
-        syn = res.synthesis
-        h = syn.bracket.h_certified
-        h_gain = syn.gain.h_certified if syn.gain else 0.0
-        q = {"synthesis.h_certified": h if h > 0 and syn.K is not None else None,  # no gain
-             "synthesis.h_gain": h_gain if h_gain > 0 else None, "synthesis.eps": syn.eps,
-             "synthesis.K1": None if syn.K is None else float(syn.K[0, 0]),
-             "synthesis.K2": None if syn.K is None else float(syn.K[0, 1])}
-        spec_points = res.points
-        if res.checks:
-            q["robust.all_stable"] = "yes" if all(c.stable_at_zero for c in res.checks) else "no"
-            q["robust.min_exact_margin"] = min(c.exact.h for c in res.checks)
-            q["robust.max_abscissa_at_h"] = max(res.abscissa)
-            q["robust.min_exact_over_certified"] = (min(c.exact.h for c in res.checks) / h_gain
-                                                    if h_gain > 0 else None)
-            for p, c, a in zip(spec_points, res.checks, res.abscissa):
-                q[f"points[{p.id}].exact_margin"] = c.exact.h
-                q[f"points[{p.id}].h_certified"] = c.h_certified
-                q[f"points[{p.id}].abscissa_at_h"] = a
-        for p in spec_points:
-            q[f"points[{p.id}].lambda_d"] = p.lambda_d
+        ids = [p.id for p in res.points]
+        q = robust_quantities(ids, res.points[0].A.shape[0], res.robust)
+        q |= {f"points[{p.id}].lambda_d": p.lambda_d for p in res.points}
         if res.requirements is not None:
             from ...kinds.delay_feedback.requirements import requirement_quantities
             q.update(requirement_quantities(res.requirements))
@@ -225,7 +170,7 @@ class AntiskidRobust:
             q["requirements.K1"] = None if K is None else float(K[0, 0])
             q["requirements.K2"] = None if K is None else float(K[0, 1])
         from ...features.point_gains import compare_quantities
-        return q | compare_quantities([p.id for p in spec_points], res.compare, res.compared)
+        return q | compare_quantities(ids, res.compare, res.compared)
 
 
 STUDY = AntiskidRobust()

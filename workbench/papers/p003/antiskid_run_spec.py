@@ -412,7 +412,7 @@ def load_run_spec(root: Reader) -> RunSpec:
                           f"at most samples = {mc.samples} (the check re-runs the first runs)")
         mt.finish()
     from .antiskid_basin_run import load_basin_settings
-    from .antiskid_comfort import load_comfort
+    from ...features.comfort import load_comfort
     from .antiskid_sampled import load_sampled
     vals = {k: q.value for k, q in params.items()}
     try:

@@ -1,0 +1,55 @@
+"""The general robust gain (workbench/features/robust_gain.py) on loops of no
+paper: the Fridman & Shaked 2002 (IEEE TAC 47(11)) example A = [[0, 0],
+[0, 1]], B = [1; 1], and the same loop with its unstable pole moved to 1.2."""
+import numpy as np
+import pytest
+
+from workbench.errors import DesignError
+from workbench.features.robust_gain import (load_robust_settings, robust_quantities,
+                                            robust_quantity_names, run_robust)
+from workbench.features.robust_gain_render import eps_search_figure, robust_gain_section
+from workbench.margins import spectral_abscissa
+from workbench.reader import Reader
+
+B = np.array([[1.0], [1.0]])
+POINTS = [(np.array([[0.0, 0.0], [0.0, a]]), B) for a in (1.0, 1.2)]
+IDS = ["a1", "a1.2"]
+TABLE = {"alpha": 0.05, "eps_grid": [0.1, 1.0, 10.0], "golden_steps": 1, "h_max": 5.0}
+
+
+def test_settings_defaults_and_bad_input():
+    s = load_robust_settings(Reader("toy.toml", TABLE, "synthesis"))
+    assert (s.alpha, s.eps_grid, s.golden_steps, s.order, s.rel_tol) == \
+        (0.05, (0.1, 1.0, 10.0), 1, 2, 1e-2)
+    with pytest.raises(DesignError, match="synthesis.alpha"):
+        load_robust_settings(Reader("toy.toml", {**TABLE, "alpha": -0.1}, "synthesis"))
+
+
+@pytest.fixture(scope="module")
+def robust():
+    return run_robust(POINTS, load_robust_settings(Reader("toy.toml", TABLE, "synthesis")))
+
+
+def test_one_gain_certified_at_every_point(robust):
+    syn = robust.synthesis
+    assert syn.K is not None and syn.gain.h_certified > 0
+    assert len(robust.checks) == len(POINTS) == len(robust.abscissa)
+    for (A, B_), c, a in zip(POINTS, robust.checks, robust.abscissa):
+        assert c.stable_at_zero and c.exact.h >= syn.gain.h_certified * (1 - 1e-3)
+        # the decay rate certified at h holds at every point (cross-check)
+        assert a <= -0.05 + 1e-6
+        assert a == pytest.approx(spectral_abscissa(A, B_ @ syn.K, syn.gain.h_certified))
+    # beyond the exact margin of the worse point the same K loses stability
+    h_bad = 1.01 * min(c.exact.h for c in robust.checks)
+    assert max(spectral_abscissa(A, B_ @ syn.K, h_bad) for A, B_ in POINTS) > 0
+
+
+def test_quantities_match_their_names(robust):
+    q = robust_quantities(IDS, 2, robust)
+    assert set(q) == robust_quantity_names(IDS, 2)
+    assert q["robust.all_stable"] == "yes"
+    assert q["synthesis.K2"] == float(robust.synthesis.K[0, 1])
+    assert q["points[a1.2].exact_margin"] == robust.checks[1].exact.h
+    text = robust_gain_section(IDS, robust)
+    assert text.startswith("## Robust gain") and "`a1.2`" in text
+    assert eps_search_figure(robust).name == "eps-search"
