@@ -19,11 +19,12 @@ import numpy as np
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import DesignError
 from ...features.convergence import agree
+from ...features.linear_delay_check import LinearDelayCheck, linear_delay_check
 from ...jsonable import OMIT, json_method
 from ...margins import DelayMargin, delay_margin_eig
 from ...reader import Reader
 from ...sim.batch import SchedulerUnreachable
-from ...sim.delay import SimResult, envelope_ratio, simulate_linear_dde, step_halving
+from ...sim.delay import SimResult
 from ...sim.wheel_slip import PARAM_ORDER, model_functions
 from .antiskid_run_spec import (METRICS, Case, RunSpec, case_mesh, case_metrics,
                                 controller_settings, gain_for, load_run_spec, nominal_cruise,
@@ -32,8 +33,6 @@ from .antiskid_scenario import simulate_antiskid
 
 #: Record step (s) of the runs (figures, comfort) at dt and dt / 2.
 RECORD_DT = 0.05
-#: (a, h, t_end) of the step-halving check x' = -a x(t - h), x = 1 on [-h, 0], over t_end s.
-HALVING_PROBLEM = (1.0, 0.7, 10.0)
 
 @dataclass(frozen=True)
 class SwitchCheck:
@@ -70,20 +69,6 @@ class CaseResult:
 
 
 @dataclass(frozen=True)
-class LinearCheck:
-    A: np.ndarray
-    B: np.ndarray
-    K_paper: tuple
-    K_finite: tuple
-    finite_margin: DelayMargin
-    ratios_finite: tuple      # (factor, h, envelope ratio)
-    paper_margin: DelayMargin
-    ratios_paper: tuple       # (h, envelope ratio)
-    runs: tuple               # SimResult per finite factor (for the figure)
-    halving: tuple = ()       # HalvingRow of x' = -x(t - 0.7) against the exact solution
-
-
-@dataclass(frozen=True)
 class RunResult:
     lambda_opt: float
     lambda_d: float
@@ -91,7 +76,7 @@ class RunResult:
     K_how: str
     h_certified: float | None
     cases: tuple
-    linear: LinearCheck
+    linear: LinearDelayCheck
     dt: float
     montecarlo: object = None   # antiskid_montecarlo.SweepResult or None
     halving: object = None      # antiskid_halving.HalvingCheck or None
@@ -142,32 +127,10 @@ def _dmu(params):
     return lambdify(mdl.lam, mdl.substitute(sp.diff(mdl.mu_traction, mdl.lam), vals), "math")
 
 
-def linear_check(spec: RunSpec, A, B, K) -> LinearCheck:
-    """E' = A E + B K E(t - h) simulated (Heun, :func:`simulate_linear_dde`)."""
-    E0 = np.array([1.0, 0.01])
-    Kf = np.array([spec.finite_gain])
-    fin = delay_margin_eig(A, B @ Kf)
-    ratios_f, runs = [], []
-    if math.isfinite(fin.h) and fin.h > 0:
-        period = 2 * math.pi / fin.omega
-        for fac in spec.factors:
-            h = fac * fin.h
-            r = simulate_linear_dde(A, B @ Kf, h, E0, spec.periods * period,
-                                    min(period, h) / 50)
-            ratios_f.append((fac, h, envelope_ratio(r, period)))
-            runs.append(r)
-    Kp = np.array([K])
-    pm = delay_margin_eig(A, B @ Kp)
-    ratios_p = []
-    rate = max(abs(np.linalg.eigvals(A)).max(), 1.0)
-    slow = abs(np.max(np.linalg.eigvals(A + B @ Kp).real))
-    for h in spec.far_delays:
-        window = max(10 * h, 3 / slow)
-        r = simulate_linear_dde(A, B @ Kp, h, E0, 3 * window, min(h, 1 / rate) / 5)
-        ratios_p.append((h, envelope_ratio(r, window)))
-    halving = step_halving(*HALVING_PROBLEM, (0.1, 0.05, 0.025, 0.0125))
-    return LinearCheck(A, B, tuple(K), tuple(spec.finite_gain), fin, tuple(ratios_f), pm,
-                       tuple(ratios_p), tuple(runs), halving)
+def linear_check(spec: RunSpec, A, B, K) -> LinearDelayCheck:
+    """The linear cross-check of the LMI delay bound on the cruise error system
+    E' = A E + B K E(t - h), from E = (1, 0.01) (:func:`linear_delay_check`)."""
+    return linear_delay_check(spec.linear, A, B, K, np.array([1.0, 0.01]))
 
 
 #: Recording interval (s) of the trajectory ``workbench simulate --csv`` writes.
@@ -339,7 +302,7 @@ class AntiskidRun:
         names = {"operating_point.lambda_opt", "operating_point.lambda_d", "gain.K1", "gain.K2",
                  "gain.h_certified", "linear.finite.h_star", "linear.paper.exact_margin",
                  "linear.paper.max_envelope_ratio"}
-        names |= {f"linear.finite.ratio[{f:g}]" for f in spec.factors}
+        names |= {f"linear.finite.ratio[{f:g}]" for f in spec.linear.factors}
         for c in spec.cases:
             b = f"cases[{c.name}]"
             names |= {f"{b}.{m}" for m in METRICS}
@@ -455,8 +418,8 @@ class AntiskidRun:
         q = {"operating_point.lambda_opt": res.lambda_opt, "operating_point.lambda_d": res.lambda_d,
              "gain.K1": res.K[0], "gain.K2": res.K[1], "gain.h_certified": res.h_certified,
              "linear.finite.h_star": res.linear.finite_margin.h,
-             "linear.paper.exact_margin": res.linear.paper_margin.h,
-             "linear.paper.max_envelope_ratio": max(r for _, r in res.linear.ratios_paper)}
+             "linear.paper.exact_margin": res.linear.margin.h,
+             "linear.paper.max_envelope_ratio": max(r for _, r in res.linear.ratios)}
         for fac, _, r in res.linear.ratios_finite:
             q[f"linear.finite.ratio[{fac:g}]"] = r
         for c in res.cases:

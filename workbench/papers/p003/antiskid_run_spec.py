@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 from ...controllers.antiskid003_settings import BRAKE_IN, ControllerSettings, CreepSpeedProfile
 from ...errors import DesignError, ModelError
+from ...features.linear_delay_check import LinearCheckSpec, load_linear_check
 from ...plants.adhesion import PARAMETER_UNITS, NumericAdhesion
 from ...reader import Reader
 from ...sim.wheel_slip import PARAM_ORDER
@@ -66,10 +67,7 @@ class RunSpec:
     conv_rtol: float
     conv_atol: dict
     cases: tuple
-    finite_gain: tuple
-    factors: tuple
-    far_delays: tuple
-    periods: float
+    linear: LinearCheckSpec        # [linear_check]
     montecarlo: object = None      # antiskid_montecarlo.SweepSpec or None
     basin: object = None           # antiskid_basin_run.BasinSettings or None ([basin] table)
     comfort: object = None         # features.comfort.ComfortLimits or None ([comfort] table)
@@ -385,12 +383,7 @@ def load_run_spec(root: Reader) -> RunSpec:
     names = [c.name for c in cases]
     if not cases or len(set(names)) != len(names):
         raise DesignError(root.path, "cases", names, "at least one case, distinct names")
-    lc = root.table("linear_check")
-    fg = lc.numbers("finite_gain", min_len=2)
-    factors = lc.numbers("factors", positive=True)
-    far = lc.numbers("far_delays", positive=True)
-    periods = lc.number("periods", positive=True, hi=200.0)
-    lc.finish()
+    linear = load_linear_check(root)
     mc = None
     if root.has("montecarlo"):
         mt = root.table("montecarlo")
@@ -421,6 +414,6 @@ def load_run_spec(root: Reader) -> RunSpec:
         raise DesignError(root.path, "scenario.v_d", scen["v_d"],
                           f"a speed with a creep-region equilibrium ({exc})") from None
     return RunSpec(rail, params, mass_factor, scen, gain, eps, K_table, K_source, k_ac, k_de,
-                   profile, dt, v_stop, band, torque_range, mesh_courant, mesh_levels, rtol, atol, tuple(cases), tuple(fg),
-                   factors, far, periods, mc, load_basin_settings(root), load_comfort(root),
+                   profile, dt, v_stop, band, torque_range, mesh_courant, mesh_levels, rtol, atol,
+                   tuple(cases), linear, mc, load_basin_settings(root), load_comfort(root),
                    load_sampled(root, names))
