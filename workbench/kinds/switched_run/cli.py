@@ -28,11 +28,9 @@ __all__ = ["CHUNK", "simulate_command", "sweep_command", "trajectory_csv"]
 
 
 def _scenario(design, case):
-    from ...errors import DesignError
+    from ...features.cli_plumbing import pick_case
     names = [s.name for s in design.spec.scenarios]
-    if case is not None and case not in names:
-        raise DesignError("<cli>", "--case", case, "one of " + ", ".join(names))
-    return design.spec.scenarios[names.index(case) if case else 0]
+    return design.spec.scenarios[names.index(pick_case(names, case))]
 
 
 def _step(spec, sc, dt) -> float:

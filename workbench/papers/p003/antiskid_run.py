@@ -18,12 +18,14 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import DesignError
+from ...features.cli_plumbing import pick_case, trajectory_csv
 from ...features.convergence import agree
+from ...features.frozen_loop import freeze
+from ...features.linear_delay_check import LinearDelayCheck, linear_delay_check
 from ...jsonable import OMIT, json_method
-from ...margins import DelayMargin, delay_margin_eig
+from ...margins import DelayMargin
 from ...reader import Reader
-from ...sim.batch import SchedulerUnreachable
-from ...sim.delay import SimResult, envelope_ratio, simulate_linear_dde, step_halving
+from ...sim.delay import SimResult
 from ...sim.wheel_slip import PARAM_ORDER, model_functions
 from .antiskid_run_spec import (METRICS, Case, RunSpec, case_mesh, case_metrics,
                                 controller_settings, gain_for, load_run_spec, nominal_cruise,
@@ -32,8 +34,6 @@ from .antiskid_scenario import simulate_antiskid
 
 #: Record step (s) of the runs (figures, comfort) at dt and dt / 2.
 RECORD_DT = 0.05
-#: (a, h, t_end) of the step-halving check x' = -a x(t - h), x = 1 on [-h, 0], over t_end s.
-HALVING_PROBLEM = (1.0, 0.7, 10.0)
 
 @dataclass(frozen=True)
 class SwitchCheck:
@@ -70,20 +70,6 @@ class CaseResult:
 
 
 @dataclass(frozen=True)
-class LinearCheck:
-    A: np.ndarray
-    B: np.ndarray
-    K_paper: tuple
-    K_finite: tuple
-    finite_margin: DelayMargin
-    ratios_finite: tuple      # (factor, h, envelope ratio)
-    paper_margin: DelayMargin
-    ratios_paper: tuple       # (h, envelope ratio)
-    runs: tuple               # SimResult per finite factor (for the figure)
-    halving: tuple = ()       # HalvingRow of x' = -x(t - 0.7) against the exact solution
-
-
-@dataclass(frozen=True)
 class RunResult:
     lambda_opt: float
     lambda_d: float
@@ -91,7 +77,7 @@ class RunResult:
     K_how: str
     h_certified: float | None
     cases: tuple
-    linear: LinearCheck
+    linear: LinearDelayCheck
     dt: float
     montecarlo: object = None   # antiskid_montecarlo.SweepResult or None
     halving: object = None      # antiskid_halving.HalvingCheck or None
@@ -110,7 +96,8 @@ class RunResult:
 
 def switch_check(cs: ControllerSettings, v: float, lam: float) -> SwitchCheck:
     """Frozen linearisation of the cruise loop (eq 61 on the traction form)
-    at (v, lambda), by central differences of the lambdified model."""
+    at (v, lambda), by central differences of the lambdified model
+    (:func:`workbench.features.frozen_loop.freeze`)."""
     fn = model_functions("math")["traction"]
     p, c = cs.params, cs.lin
 
@@ -120,17 +107,10 @@ def switch_check(cs: ControllerSettings, v: float, lam: float) -> SwitchCheck:
         den = c["d4"] * (vv - cs.v_d) + c["d5"] * (ll - cs.lambda_d) + c["d6"]
         return np.array([y1, y2 - y3 / den * c["d3"]]), y3 / den
 
-    x0 = np.array([v, lam])
-    A = np.zeros((2, 2))
-    for j, step in enumerate((1e-4 * max(v, 1.0), 1e-7)):
-        e = np.zeros(2)
-        e[j] = step
-        A[:, j] = (rhs(x0 + e)[0] - rhs(x0 - e)[0]) / (2 * step)
-    gain = rhs(x0)[1]
+    gain = rhs(np.array([v, lam]))[1]
     Ad = gain * np.array([[0.0], [1.0]]) @ np.array([cs.K])
-    mdl_dmu = _dmu(cs.params)
-    return SwitchCheck(v, lam, float(mdl_dmu(lam)), A,
-                       float(np.max(np.linalg.eigvals(A + Ad).real)), delay_margin_eig(A, Ad))
+    fl = freeze(lambda x: rhs(x)[0], (v, lam), (1e-4 * max(v, 1.0), 1e-7), Ad)
+    return SwitchCheck(v, lam, float(_dmu(cs.params)(lam)), fl.A, fl.abscissa, fl.margin)
 
 
 def _dmu(params):
@@ -142,32 +122,10 @@ def _dmu(params):
     return lambdify(mdl.lam, mdl.substitute(sp.diff(mdl.mu_traction, mdl.lam), vals), "math")
 
 
-def linear_check(spec: RunSpec, A, B, K) -> LinearCheck:
-    """E' = A E + B K E(t - h) simulated (Heun, :func:`simulate_linear_dde`)."""
-    E0 = np.array([1.0, 0.01])
-    Kf = np.array([spec.finite_gain])
-    fin = delay_margin_eig(A, B @ Kf)
-    ratios_f, runs = [], []
-    if math.isfinite(fin.h) and fin.h > 0:
-        period = 2 * math.pi / fin.omega
-        for fac in spec.factors:
-            h = fac * fin.h
-            r = simulate_linear_dde(A, B @ Kf, h, E0, spec.periods * period,
-                                    min(period, h) / 50)
-            ratios_f.append((fac, h, envelope_ratio(r, period)))
-            runs.append(r)
-    Kp = np.array([K])
-    pm = delay_margin_eig(A, B @ Kp)
-    ratios_p = []
-    rate = max(abs(np.linalg.eigvals(A)).max(), 1.0)
-    slow = abs(np.max(np.linalg.eigvals(A + B @ Kp).real))
-    for h in spec.far_delays:
-        window = max(10 * h, 3 / slow)
-        r = simulate_linear_dde(A, B @ Kp, h, E0, 3 * window, min(h, 1 / rate) / 5)
-        ratios_p.append((h, envelope_ratio(r, window)))
-    halving = step_halving(*HALVING_PROBLEM, (0.1, 0.05, 0.025, 0.0125))
-    return LinearCheck(A, B, tuple(K), tuple(spec.finite_gain), fin, tuple(ratios_f), pm,
-                       tuple(ratios_p), tuple(runs), halving)
+def linear_check(spec: RunSpec, A, B, K) -> LinearDelayCheck:
+    """The linear cross-check of the LMI delay bound on the cruise error system
+    E' = A E + B K E(t - h), from E = (1, 0.01) (:func:`linear_delay_check`)."""
+    return linear_delay_check(spec.linear, A, B, K, np.array([1.0, 0.01]))
 
 
 #: Recording interval (s) of the trajectory ``workbench simulate --csv`` writes.
@@ -181,10 +139,7 @@ def simulate_design(design, case_name: str | None, dt: float | None,
     also the trajectory (``"run"``, a SimResult recorded every :data:`CSV_DT` s)."""
     import time
     spec: RunSpec = design.spec
-    names = [c.name for c in spec.cases]
-    name = case_name or names[0]
-    if name not in names:
-        raise DesignError("<cli>", "--case", name, "one of " + ", ".join(names))
+    name = pick_case([c.name for c in spec.cases], case_name)
     dt = dt or spec.dt
     if not (dt > 0 and (dt <= spec.scenario["h"] or spec.scenario["h"] == 0)):
         raise DesignError("<cli>", "--dt", dt, "a positive step no larger than the delay (s)")
@@ -204,39 +159,26 @@ def simulate_design(design, case_name: str | None, dt: float | None,
             "realtime_factor": float(end) / wall, **({"run": run} if record else {})}
 
 
-def _trajectory_csv(run) -> str:
-    """CSV of a recorded antiskid run: t, the states, u(t) and u(t - h) (SI units)."""
-    names = list(run.state_names) or [f"x{i}" for i in range(run.x.shape[0])]
-    ins = list(run.input_names) or [f"u{i}" for i in range(run.u.shape[0])]
-    head = ["t_s"] + names + ins + [f"{u}_applied" for u in ins]
-    cols = np.vstack([run.t[None, :], run.x, run.u, run.u_applied])
-    return ",".join(head) + "\n" + "".join(",".join(f"{v:.9g}" for v in row) + "\n"
-                                          for row in cols.T)
-
-
 def simulate_command(design, *, case: str | None, dt: float | None, as_json: bool,
                      csv: str | None = None) -> int:
     """``workbench simulate`` on a loaded ``antiskid-run`` design: print the
     metrics of one case (with ``csv`` also write its trajectory, every
-    :data:`CSV_DT` s); exit 0."""
-    import json
+    :data:`CSV_DT` s, :func:`~workbench.features.cli_plumbing.trajectory_csv`); exit 0."""
     from pathlib import Path
 
+    from ...kinds.delay_feedback.cli import print_run
     from ...report.files import atomic_write
-    from ...report.markdown import fmt, md_table
+    from ...report.markdown import fmt
     out = simulate_design(design, case, dt, record=bool(csv))
     if csv:
-        atomic_write(Path(csv), _trajectory_csv(out.pop("run")))
+        atomic_write(Path(csv), trajectory_csv(out.pop("run")))
         print(f"wrote {csv}")
-    if as_json:
-        print(json.dumps(out, indent=2, default=lambda x: None))
-        return 0
-    print(f"{out['design']} / {out['case']}: dt = {fmt(out['dt'])} s, K = {out['K']} "
-          f"({out['K_source']})")
-    print(md_table(["metric", "value"], [[k, fmt(v, 6)] for k, v in out["metrics"].items()
-                                         if not (isinstance(v, float) and math.isnan(v))], "lr"))
-    print(f"simulated {fmt(out['simulated_s'], 4)} s in {out['wall_s']:.2f} s wall: "
-          f"{out['realtime_factor']:.0f}x real time")
+    print_run(out, f"{out['design']} / {out['case']}: dt = {fmt(out['dt'])} s, K = {out['K']} "
+              f"({out['K_source']})", {k: v for k, v in out["metrics"].items()
+                                       if not (isinstance(v, float) and math.isnan(v))}, as_json)
+    if not as_json:
+        print(f"simulated {fmt(out['simulated_s'], 4)} s in {out['wall_s']:.2f} s wall: "
+              f"{out['realtime_factor']:.0f}x real time")
     return 0
 
 
@@ -249,15 +191,12 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     import json
     from pathlib import Path
 
-    from ...errors import DesignError
+    from ...features.cli_plumbing import check_scheduler, check_sweep_flags, sweep_errors
     from ...features.montecarlo_chunks import check_resume
     from ...report.markdown import Figure
     from .antiskid_montecarlo import sweep
     from .antiskid_montecarlo_render import draw_histograms, summary_tables
-    if not samples >= 1:
-        raise DesignError("<cli>", "--samples", samples, "a positive integer")
-    if workers is not None and not workers >= 1:
-        raise DesignError("<cli>", "--workers", workers, "a positive integer")
+    check_sweep_flags(samples, workers)
     if design.spec.montecarlo is None:
         raise DesignError(design.path, "montecarlo", "<missing>",
                           "an antiskid-run design with a [montecarlo] table")
@@ -268,14 +207,9 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
         raise DesignError("<cli>", "--kernel", kernel,
                           "numpy here: numba is not installed "
                           "(pip install 'traincontrol-workbench[fast]')")
-    if scheduler is not None:
-        from importlib.util import find_spec
-        if find_spec("distributed") is None:
-            raise DesignError("<cli>", "--scheduler", scheduler,
-                              "no flag here: dask.distributed is not installed "
-                              "(pip install 'traincontrol-workbench[scale]')")
+    check_scheduler(scheduler)
     check_resume(out, resume)
-    try:
+    with sweep_errors(out, scheduler):
         if out:
             from .antiskid_montecarlo import start_streaming
             try:
@@ -288,14 +222,6 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
         else:
             res = sweep(design, samples, seed, workers=workers, kernel=kernel,
                         progress=not as_json, scheduler=scheduler)
-    except SchedulerUnreachable as e:
-        raise DesignError("<cli>", "--scheduler", scheduler,
-                          f"'local' or the address of a running Dask scheduler ({e})") from None
-    except OSError as e:       # writing a chunk file (--out), not the scheduler
-        if not out:
-            raise
-        raise DesignError("<cli>", "--out", out, f"a folder the chunks can be written to "
-                          f"({type(e).__name__}: {e})") from None
     if figure:
         from ...report.figures import save_figure
         save_figure(Figure(Path(figure).stem, "Monte Carlo histograms",
@@ -339,7 +265,7 @@ class AntiskidRun:
         names = {"operating_point.lambda_opt", "operating_point.lambda_d", "gain.K1", "gain.K2",
                  "gain.h_certified", "linear.finite.h_star", "linear.paper.exact_margin",
                  "linear.paper.max_envelope_ratio"}
-        names |= {f"linear.finite.ratio[{f:g}]" for f in spec.factors}
+        names |= {f"linear.finite.ratio[{f:g}]" for f in spec.linear.factors}
         for c in spec.cases:
             b = f"cases[{c.name}]"
             names |= {f"{b}.{m}" for m in METRICS}
@@ -455,8 +381,8 @@ class AntiskidRun:
         q = {"operating_point.lambda_opt": res.lambda_opt, "operating_point.lambda_d": res.lambda_d,
              "gain.K1": res.K[0], "gain.K2": res.K[1], "gain.h_certified": res.h_certified,
              "linear.finite.h_star": res.linear.finite_margin.h,
-             "linear.paper.exact_margin": res.linear.paper_margin.h,
-             "linear.paper.max_envelope_ratio": max(r for _, r in res.linear.ratios_paper)}
+             "linear.paper.exact_margin": res.linear.margin.h,
+             "linear.paper.max_envelope_ratio": max(r for _, r in res.linear.ratios)}
         for fac, _, r in res.linear.ratios_finite:
             q[f"linear.finite.ratio[{fac:g}]"] = r
         for c in res.cases:

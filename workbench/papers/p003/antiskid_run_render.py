@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
+from ...features.linear_delay_check import TEST_PROBLEM as HALVING_PROBLEM
 from ...printed_grid import quantised
 from ...report.binned_fractions import binned_fraction_rows
 from ...features.montecarlo_render import DRAWS_TEXT, montecarlo_figures, rates_text
@@ -23,7 +24,6 @@ from ...sim.wheel_slip import MAX_DLAMBDA, MAX_HALVINGS
 from .antiskid_basin_render import HEADING as BASIN_HEADING
 from .antiskid_comfort_render import (HEADING, PATTERN, TORQUE_CAPTION, comfort_figure,
                                       comfort_section, torque_figure)
-from .antiskid_run import HALVING_PROBLEM
 from .antiskid_run_figures import plot_adhesion, plot_creep, plot_evs, plot_speed
 
 _LABELS = {  # metric -> (label, unit, sig)
@@ -250,8 +250,8 @@ def _linear_section(res) -> str:
     return delay_cross_check(
         linearisation="the cruise linearisation", test_problem=HALVING_PROBLEM,
         halving=lc.halving, K_finite=lc.K_finite, finite_margin=lc.finite_margin,
-        ratios_finite=lc.ratios_finite, K_synth=lc.K_paper, synth_margin=lc.paper_margin,
-        ratios_synth=lc.ratios_paper,
+        ratios_finite=lc.ratios_finite, K_synth=lc.K, synth_margin=lc.margin,
+        ratios_synth=lc.ratios,
         closing=": with this gain the loop decays at delays two orders of magnitude above h_m, "
         "as its infinite exact margin says.")
 

@@ -22,6 +22,8 @@ from dataclasses import dataclass
 
 from ...controllers.antiskid003_settings import BRAKE_IN, ControllerSettings, CreepSpeedProfile
 from ...errors import DesignError, ModelError
+from ...features.linear_delay_check import LinearCheckSpec, load_linear_check
+from ...features.spec_readers import event_time, read_range, read_step_tolerances
 from ...plants.adhesion import PARAMETER_UNITS, NumericAdhesion
 from ...reader import Reader
 from ...sim.wheel_slip import PARAM_ORDER
@@ -66,10 +68,7 @@ class RunSpec:
     conv_rtol: float
     conv_atol: dict
     cases: tuple
-    finite_gain: tuple
-    factors: tuple
-    far_delays: tuple
-    periods: float
+    linear: LinearCheckSpec        # [linear_check]
     montecarlo: object = None      # antiskid_montecarlo.SweepSpec or None
     basin: object = None           # basin_points.GainSweepSettings or None ([basin] table)
     comfort: object = None         # features.comfort.ComfortLimits or None ([comfort] table)
@@ -129,7 +128,7 @@ def load_perturbations(mt: Reader) -> SweepPerturbations | None:
             out[k], src[k] = q.value, q.source
     if mt.has("gradient"):
         g = mt.table("gradient")
-        out["gradient"] = _range(g, "range", lo=-100.0, hi=100.0)
+        out["gradient"] = read_range(g, "range", lo=-100.0, hi=100.0)
         if g.string("unit") != "per mille":
             raise g.fail("unit", g.raw("unit"), '"per mille"')
         out["segment"] = g.number("segment", positive=True, what="number (m)")
@@ -137,7 +136,7 @@ def load_perturbations(mt: Reader) -> SweepPerturbations | None:
         g.finish()
     if mt.has("delay_variation"):
         d = mt.table("delay_variation")
-        out["delay_period"] = _range(d, "period", positive=True)
+        out["delay_period"] = read_range(d, "period", positive=True)
         if d.string("unit") != "s":
             raise d.fail("unit", d.raw("unit"), '"s"')
         src["delay_variation"] = d.string("source")
@@ -247,25 +246,6 @@ def case_metrics(m, cs: ControllerSettings, t_brake: float) -> dict:
     return out
 
 
-#: Significant digits of the event times of a scenario (:func:`event_time`).
-EVENT_DIGITS = 12
-
-
-def event_time(t: float) -> float:
-    """An event time of the scenario (t_brake, t_end) on the grid of
-    :data:`EVENT_DIGITS` significant digits.
-
-    The braking law starts at the first step at or after t_brake, and
-    t_brake = 300 s is a step time of dt, dt/2 and dt/4: which step fires
-    then depends on t_brake's last bit. Moved +3 ulp (the last-bit
-    perturbation test, issue 36 item 5) the switch came one step later, and
-    the braking run moved by 1 s in its stop time and several-fold in its
-    creep-speed error, while the runs agreed to 4e-13 m/s up to 300 s. On
-    the 12-digit grid (our choice: a design's times are decimals of a few
-    digits) a last-bit move cannot change the step."""
-    return float(f"{t:.{EVENT_DIGITS}g}")
-
-
 #: Creep-speed error (m/s) below which the error at the stop is rounding noise.
 EVS_FLOOR = 1e-12
 
@@ -278,17 +258,6 @@ def evs_floor(e: float) -> float:
     whose digits change with the last bit of the inputs (our choice: 1e-12
     m/s, 1e4 times eps at 1 m/s)."""
     return 0.0 if abs(e) < EVS_FLOOR else e
-
-
-def _range(t: Reader, key: str, **kw) -> tuple[float, float]:
-    lo_hi = t.numbers(key, min_len=2, what="[low, high]")
-    if len(lo_hi) != 2 or not lo_hi[0] <= lo_hi[1]:
-        raise t.fail(key, list(lo_hi), "a range [low, high] with low <= high")
-    for x in lo_hi:
-        if kw.get("positive") and not x > 0 or "lo" in kw and x < kw["lo"] or \
-                "hi" in kw and x > kw["hi"]:
-            raise t.fail(key, list(lo_hi), f"a range within the allowed values ({kw})")
-    return lo_hi
 
 
 #: gain_for's answers in this process, keyed by what they depend on (the
@@ -332,6 +301,7 @@ def load_run_spec(root: Reader) -> RunSpec:
             "u_init": sc.quantity("u_init", "N m").value,
             "h": sc.quantity("h", "s", nonneg=True, hi=1.0).value,
             "v_d": sc.quantity("v_d", "m/s", positive=True, hi=150.0).value,
+            # t_brake = 300 s is a step time of dt, dt/2 and dt/4 (see event_time)
             "t_brake": event_time(sc.quantity("t_brake", "s", positive=True).value),
             "t_end": event_time(sc.quantity("t_end", "s", positive=True, hi=5000.0).value)}
     sc.finish()
@@ -363,13 +333,7 @@ def load_run_spec(root: Reader) -> RunSpec:
     mesh_courant = nu.number("mesh_courant", positive=True, hi=100.0)
     mesh_levels = nu.number("mesh_levels", integer=True, lo=0, hi=8,
                             what="integer (halvings of dt, 0 = no refinement)")
-    rtol = nu.number("convergence_rtol", positive=True, hi=0.1)
-    atol_t = nu.table("convergence_atol")
-    atol = {k: atol_t.number(k, nonneg=True) for k in list(atol_t.data)}
-    for k in atol:
-        if k not in METRICS:
-            raise atol_t.fail(k, atol[k], "a metric name: " + ", ".join(METRICS))
-    atol_t.finish()
+    rtol, atol = read_step_tolerances(nu, METRICS)
     nu.finish()
     if scen["h"] < dt and scen["h"] > 0:
         raise DesignError(root.path, "numerics.dt", dt, f"a step no larger than h = {scen['h']}")
@@ -385,16 +349,11 @@ def load_run_spec(root: Reader) -> RunSpec:
     names = [c.name for c in cases]
     if not cases or len(set(names)) != len(names):
         raise DesignError(root.path, "cases", names, "at least one case, distinct names")
-    lc = root.table("linear_check")
-    fg = lc.numbers("finite_gain", min_len=2)
-    factors = lc.numbers("factors", positive=True)
-    far = lc.numbers("far_delays", positive=True)
-    periods = lc.number("periods", positive=True, hi=200.0)
-    lc.finish()
+    linear = load_linear_check(root)
     mc = None
     if root.has("montecarlo"):
         mt = root.table("montecarlo")
-        rng = lambda k, **kw: _range(mt, k, **kw)
+        rng = lambda k, **kw: read_range(mt, k, **kw)
         wet = {k: mt.quantity(f"wet_{k}", "1", positive=True).value for k in ("a", "b", "c")}
         count = lambda k, **kw: mt.number(k, integer=True, what="integer", **kw)
         mc = SweepSpec(rng("mass_factor", positive=True), wet,
@@ -421,6 +380,6 @@ def load_run_spec(root: Reader) -> RunSpec:
         raise DesignError(root.path, "scenario.v_d", scen["v_d"],
                           f"a speed with a creep-region equilibrium ({exc})") from None
     return RunSpec(rail, params, mass_factor, scen, gain, eps, K_table, K_source, k_ac, k_de,
-                   profile, dt, v_stop, band, torque_range, mesh_courant, mesh_levels, rtol, atol, tuple(cases), tuple(fg),
-                   factors, far, periods, mc, load_basin_settings(root), load_comfort(root),
+                   profile, dt, v_stop, band, torque_range, mesh_courant, mesh_levels, rtol, atol,
+                   tuple(cases), linear, mc, load_basin_settings(root), load_comfort(root),
                    load_sampled(root, names))

@@ -1,0 +1,55 @@
+"""The shared plumbing of ``simulate`` / ``sweep`` (:mod:`workbench.features.cli_plumbing`)
+on toys that name no paper: a linear delayed loop's SimResult, toy sweeps."""
+from __future__ import annotations
+
+import errno
+
+import numpy as np
+import pytest
+
+from workbench.errors import DesignError
+from workbench.features.cli_plumbing import (check_sweep_flags, pick_case, sweep_errors,
+                                             trajectory_csv)
+from workbench.sim.batch import SchedulerUnreachable
+from workbench.sim.delay import simulate_linear_dde
+
+
+def test_pick_case():
+    assert pick_case(["a", "b"], None) == "a"
+    assert pick_case(["a", "b"], "b") == "b"
+    with pytest.raises(DesignError, match="--case = 'c'; expected one of a, b"):
+        pick_case(["a", "b"], "c")
+
+
+def test_trajectory_csv_of_a_linear_run_reads_back():
+    r = simulate_linear_dde([[-1.0, 0.0], [0.0, -2.0]], [[0.0, 0.0], [0.0, -0.5]], 0.1,
+                            [1.0, 2.0], 0.5, 0.05)
+    text = trajectory_csv(r)
+    head, *rows = text.splitlines()
+    assert head == "t_s,x0,x1"                      # no inputs, unnamed states
+    back = np.array([[float(v) for v in row.split(",")] for row in rows])
+    np.testing.assert_allclose(back[:, 0], r.t, rtol=1e-8)
+    np.testing.assert_allclose(back[:, 1:].T, r.x, rtol=1e-8)
+
+
+def test_sweep_flags():
+    check_sweep_flags(1, None)
+    with pytest.raises(DesignError, match="--samples"):
+        check_sweep_flags(0, None)
+    with pytest.raises(DesignError, match="--workers"):
+        check_sweep_flags(3, 0)
+
+
+def test_sweep_errors_name_the_flag():
+    with pytest.raises(DesignError, match="--scheduler = 'tcp://x'"):
+        with sweep_errors(None, "tcp://x"):
+            raise SchedulerUnreachable("nobody there")
+    with pytest.raises(DesignError, match="--out = 'dir'.*No space"):
+        with sweep_errors("dir", None):
+            raise OSError(errno.ENOSPC, "No space left on device")
+    with pytest.raises(OSError):                  # without --out: not a flag's problem
+        with sweep_errors(None, None):
+            raise OSError(errno.ENOSPC, "No space left on device")
+    with pytest.raises(ValueError):
+        with sweep_errors("dir", None):
+            raise ValueError("a bug")

@@ -1,0 +1,29 @@
+"""The loop frozen at a state (:mod:`workbench.features.frozen_loop`) on toys
+that name no paper: a pendulum-like f and a scalar delayed loop with known
+exact answers."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from workbench.features.frozen_loop import central_jacobian, freeze
+
+
+def test_central_jacobian_of_a_known_field():
+    f = lambda x: np.array([x[1], -math.sin(x[0]) - 0.5 * x[1] ** 2])
+    A = central_jacobian(f, (0.3, 2.0), (1e-5, 1e-5))
+    np.testing.assert_allclose(A, [[0.0, 1.0], [-math.cos(0.3), -2.0]], atol=1e-8)
+
+
+def test_freeze_scalar_delayed_loop_margin_and_abscissa():
+    # x' = -x + k x(t - h), k = -2: delay-free abscissa -3; omega* = sqrt(3),
+    # h* = acos(-1/2) / sqrt(3)
+    fl = freeze(lambda x: np.array([-x[0] + 0.1 * x[0] ** 3]), (0.0,), (1e-6,),
+                np.array([[-2.0]]))
+    assert fl.A[0, 0] == pytest.approx(-1.0, abs=1e-9)
+    assert fl.abscissa == pytest.approx(-3.0, abs=1e-9)
+    assert fl.margin.h == pytest.approx(math.acos(-0.5) / math.sqrt(3.0), rel=1e-6)
+    # |k| < 1: stable for every delay
+    assert math.isinf(freeze(lambda x: -x, (1.0,), (1e-6,), np.array([[0.5]])).margin.h)

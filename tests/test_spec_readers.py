@@ -1,0 +1,44 @@
+"""General design-table readers (:mod:`workbench.features.spec_readers`) on
+toy tables that name no paper."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from workbench.errors import DesignError
+from workbench.features.spec_readers import event_time, read_range, read_step_tolerances
+from workbench.reader import Reader
+
+
+def test_read_range_checks_order_and_bounds():
+    t = Reader("toy.toml", {"gain": [0.5, 2.0], "down": [2.0, 1.0], "neg": [-1.0, 1.0],
+                            "three": [1.0, 2.0, 3.0]}, "toy")
+    assert tuple(read_range(t, "gain", positive=True, hi=5.0)) == (0.5, 2.0)
+    with pytest.raises(DesignError, match="low <= high"):
+        read_range(t, "down")
+    with pytest.raises(DesignError, match="low <= high"):
+        read_range(t, "three")
+    with pytest.raises(DesignError, match=r"allowed values \(\{'positive': True\}\)"):
+        read_range(t, "neg", positive=True)
+    with pytest.raises(DesignError, match="allowed values"):
+        read_range(t, "gain", lo=1.0)
+
+
+def test_event_time_absorbs_last_bit_moves():
+    t = 300.0
+    moved = np.nextafter(np.nextafter(np.nextafter(t, 1e9), 1e9), 1e9)
+    assert moved != t and event_time(float(moved)) == t == event_time(t)
+    assert event_time(12.345) == 12.345
+
+
+def test_step_tolerances_per_metric():
+    t = Reader("toy.toml", {"convergence_rtol": 1e-3, "convergence_atol": {"peak": 0.1}},
+               "numerics")
+    assert read_step_tolerances(t, ("peak", "final")) == (1e-3, {"peak": 0.1})
+    bad = Reader("toy.toml", {"convergence_rtol": 1e-3, "convergence_atol": {"nope": 0.1}},
+                 "numerics")
+    with pytest.raises(DesignError, match="a metric name: peak, final"):
+        read_step_tolerances(bad, ("peak", "final"))
+    big = Reader("toy.toml", {"convergence_rtol": 0.5, "convergence_atol": {}}, "numerics")
+    with pytest.raises(DesignError, match="convergence_rtol"):
+        read_step_tolerances(big, ("peak",))

@@ -1,0 +1,73 @@
+"""Plumbing of the ``workbench simulate`` and ``workbench sweep`` commands that
+every simulating kind shares (issue 35): picking the ``--case``, the trajectory
+CSV of a recorded :class:`~workbench.sim.delay.SimResult`, the checks of the
+sweep's flags, and the translation of a sweep's failures (an unreachable Dask
+scheduler, an ``--out`` folder that cannot be written) into one clear
+:class:`~workbench.errors.DesignError` each (exit 2, no traceback).
+"""
+from __future__ import annotations
+
+from contextlib import contextmanager
+
+import numpy as np
+
+from ..errors import DesignError
+
+__all__ = ["check_scheduler", "check_sweep_flags", "pick_case", "sweep_errors", "trajectory_csv"]
+
+
+def pick_case(names, case: str | None) -> str:
+    """``case`` if it is one of ``names``, the first name when None;
+    DesignError on ``--case`` otherwise."""
+    if case is not None and case not in names:
+        raise DesignError("<cli>", "--case", case, "one of " + ", ".join(names))
+    return case if case is not None else names[0]
+
+
+def trajectory_csv(run) -> str:
+    """CSV of a recorded run: ``t_s``, the states, u(t) and u(t - h) (columns
+    ``<input>_applied``), nine significant digits; states and inputs without
+    names are ``x0``, ``x1``, ... and ``u0``, ..."""
+    names = list(run.state_names) or [f"x{i}" for i in range(run.x.shape[0])]
+    ins = list(run.input_names) or [f"u{i}" for i in range(run.u.shape[0])]
+    head = ["t_s"] + names + ins + [f"{u}_applied" for u in ins]
+    cols = np.vstack([run.t[None, :], run.x, run.u, run.u_applied])
+    return ",".join(head) + "\n" + "".join(",".join(f"{v:.9g}" for v in row) + "\n"
+                                          for row in cols.T)
+
+
+def check_sweep_flags(samples, workers) -> None:
+    """``--samples`` and ``--workers`` (None: the default) positive integers."""
+    if not samples >= 1:
+        raise DesignError("<cli>", "--samples", samples, "a positive integer")
+    if workers is not None and not workers >= 1:
+        raise DesignError("<cli>", "--workers", workers, "a positive integer")
+
+
+def check_scheduler(scheduler) -> None:
+    """``--scheduler`` (None: none) only where dask.distributed is installed."""
+    if scheduler is not None:
+        from importlib.util import find_spec
+        if find_spec("distributed") is None:
+            raise DesignError("<cli>", "--scheduler", scheduler,
+                              "no flag here: dask.distributed is not installed "
+                              "(pip install 'traincontrol-workbench[scale]')")
+
+
+@contextmanager
+def sweep_errors(out: str | None, scheduler: str | None):
+    """Around a sweep: an unreachable ``--scheduler``
+    (:class:`~workbench.sim.batch.SchedulerUnreachable`) and, with ``--out``,
+    an OSError writing its chunks become a DesignError on that flag; any
+    other error passes."""
+    from ..sim.batch import SchedulerUnreachable
+    try:
+        yield
+    except SchedulerUnreachable as e:
+        raise DesignError("<cli>", "--scheduler", scheduler,
+                          f"'local' or the address of a running Dask scheduler ({e})") from None
+    except OSError as e:       # writing a chunk file (--out), not the scheduler
+        if not out:
+            raise
+        raise DesignError("<cli>", "--out", out, f"a folder the chunks can be written to "
+                          f"({type(e).__name__}: {e})") from None

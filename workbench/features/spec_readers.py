@@ -1,0 +1,57 @@
+"""Readers of design-table entries that any simulating study can use (issue 35):
+a ``[low, high]`` range, an event time on a decimal grid, and the step-halving
+tolerances of a ``[numerics]`` table (one relative tolerance and an absolute
+one per metric). Bad input is a :class:`~workbench.errors.DesignError` naming
+the key (exit 2 at the CLI).
+"""
+from __future__ import annotations
+
+__all__ = ["EVENT_DIGITS", "event_time", "read_range", "read_step_tolerances"]
+
+#: Significant digits of the event times of a scenario (:func:`event_time`).
+EVENT_DIGITS = 12
+
+
+def event_time(t: float) -> float:
+    """An event time of a scenario (a switch time, the horizon) on the grid of
+    :data:`EVENT_DIGITS` significant digits.
+
+    A law that starts at the first step at or after an event time t_e that is
+    itself a step time (of dt, dt/2 and dt/4) fires at a step that depends on
+    t_e's last bit: moved by a few ulp (the last-bit perturbation test,
+    ``WORKBENCH_PERTURB_ULPS``) the switch comes one step later, and a run
+    sensitive to its switch time changes its digits. On the 12-digit grid (our
+    choice: a design's times are decimals of a few digits) a last-bit move
+    cannot change the step."""
+    return float(f"{t:.{EVENT_DIGITS}g}")
+
+
+def read_range(t, key: str, **kw) -> tuple[float, float]:
+    """``key = [low, high]`` of the table ``t`` (a :class:`workbench.reader.Reader`)
+    with low <= high; ``kw``: ``positive=True``, ``lo=`` and ``hi=`` bounds of
+    both ends (named in the message when violated)."""
+    lo_hi = t.numbers(key, min_len=2, what="[low, high]")
+    if len(lo_hi) != 2 or not lo_hi[0] <= lo_hi[1]:
+        raise t.fail(key, list(lo_hi), "a range [low, high] with low <= high")
+    for x in lo_hi:
+        if kw.get("positive") and not x > 0 or "lo" in kw and x < kw["lo"] or \
+                "hi" in kw and x > kw["hi"]:
+            raise t.fail(key, list(lo_hi), f"a range within the allowed values ({kw})")
+    return lo_hi
+
+
+def read_step_tolerances(t, metrics, *, rtol_key: str = "convergence_rtol",
+                         atol_key: str = "convergence_atol",
+                         rtol_max: float = 0.1) -> tuple[float, dict]:
+    """(rtol, metric -> atol) of a step-halving comparison
+    (:func:`workbench.features.convergence.agree`): ``rtol_key`` in
+    (0, ``rtol_max``] and the table ``atol_key`` of non-negative absolute
+    tolerances, each keyed by one of ``metrics`` (a metric left out: 0)."""
+    rtol = t.number(rtol_key, positive=True, hi=rtol_max)
+    at = t.table(atol_key)
+    atol = {k: at.number(k, nonneg=True) for k in list(at.data)}
+    for k in atol:
+        if k not in metrics:
+            raise at.fail(k, atol[k], "a metric name: " + ", ".join(metrics))
+    at.finish()
+    return rtol, atol
