@@ -31,7 +31,7 @@ def deferred(switch):
 
 
 def test_refuted_point_needs_no_cover(deferred, switch, monkeypatch):
-    monkeypatch.delenv(AB.EAGER_ENV, raising=False)
+    monkeypatch.delenv(SEL.EAGER_ENV, raising=False)
     assert deferred.outcome(switch) is Outcome.REFUTED
     assert deferred._est is None                       # the cover did not run
 
@@ -60,7 +60,7 @@ def test_first_stage_settles_the_refuted_switch(switch, monkeypatch):
     optimiser (SLSQP) and the cover never run, and the answers equal the full
     ones (issue 36, item 4)."""
     from workbench.roa import falsify as F
-    monkeypatch.delenv(AB.EAGER_ENV, raising=False)
+    monkeypatch.delenv(SEL.EAGER_ENV, raising=False)
     ran = []
     monkeypatch.setattr(F, "minimize", lambda *a, **k: ran.append(1) or pytest.fail("SLSQP"))
     d = SEL.DeferredEstimate(*AB.cruise_loop(VALS, 70.0)[0].problem(K, 100.0, [switch]), 0)
@@ -108,7 +108,7 @@ def test_switch_verdict_equals_the_eager_path(switch, k2, monkeypatch):
     verdict, weight and fate as the deferred one (> 20 s: slow tier)."""
     pt = (70.0, switch[1] + AB.cruise_loop(VALS, 70.0)[1])
     fast = AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt)
-    monkeypatch.setenv(AB.EAGER_ENV, "1")
+    monkeypatch.setenv(SEL.EAGER_ENV, "1")
     assert AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt) == fast
 
 
@@ -156,10 +156,10 @@ def test_cruise_basin_coarse_pass_equals_every_cover(monkeypatch):
     calls = []
     orig = SEL.estimate_basin
     monkeypatch.setattr(SEL, "estimate_basin", lambda *a, **k: calls.append(1) or orig(*a, **k))
-    monkeypatch.delenv(AB.EAGER_ENV, raising=False)
+    monkeypatch.delenv(SEL.EAGER_ENV, raising=False)
     fast = AB.cruise_basin(DRY, 70.0, K, pts, n_traj=2)
     n_fast = len(calls)
-    monkeypatch.setenv(AB.EAGER_ENV, "1")
+    monkeypatch.setenv(SEL.EAGER_ENV, "1")
     eager = AB.cruise_basin(DRY, 70.0, K, pts, n_traj=2)
     assert n_fast < len(calls) - n_fast == len(AB.W_GRID)
     assert (fast.q, fast.check, fast.K, fast.lambda_d) == (eager.q, eager.check, eager.K,

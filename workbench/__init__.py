@@ -26,25 +26,23 @@ def version() -> str:
         return "unknown"
 
 
-#: Public API names loaded on first use (``import workbench`` stays light).
-_API = ("delay_bound", "simulate_delay", "DelayBoundResult", "implementation",
-        "ImplementationResult", "synthesize_sampled")
-
-
-#: Loaded from :mod:`workbench.api_design` (design to requirements).
-_DESIGN_API = ("design_gain",)
+#: Public API names loaded on first use (``import workbench`` stays light):
+#: name -> the module that defines it.
+_LAZY = {
+    "delay_bound": "api", "simulate_delay": "api", "DelayBoundResult": "api",
+    "implementation": "digital", "ImplementationResult": "digital",
+    "synthesize_sampled": "digital",
+    "design_gain": "api_design",          # design to requirements
+}
 
 
 def __getattr__(name):
-    """Lazy access to :mod:`workbench.api` (``workbench.delay_bound`` etc.)."""
-    if name in _DESIGN_API:
-        from . import api_design
-        return getattr(api_design, name)
-    if name in _API:
-        from . import api
-        return getattr(api, name)
+    """Lazy access to the public API (``workbench.delay_bound`` etc.)."""
+    if name in _LAZY:
+        from importlib import import_module
+        return getattr(import_module(f".{_LAZY[name]}", __name__), name)
     raise AttributeError(f"module 'workbench' has no attribute {name!r}")
 
 
 def __dir__():
-    return sorted(list(globals()) + list(_API) + list(_DESIGN_API))
+    return sorted(list(globals()) + list(_LAZY))

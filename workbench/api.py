@@ -28,7 +28,6 @@ from typing import Literal, Sequence
 
 import numpy as np
 
-from .digital import ImplementationResult, implementation, synthesize_sampled  # noqa: F401
 from .jsonable import to_json as jsonable
 
 Method = Literal["bessel-legendre", "wirtinger", "free-weighting-003", "jensen",

@@ -148,7 +148,7 @@ def check_parallel(designs, out: str | None, jobs: int, verify, report) -> int:
     then ``verify()`` and ``report(checked, problems)`` (the CLI's verbs, which
     find every study result in the folder); the task times on stderr."""
     import sys
-    from .design import display_path
+    from .reader import display_path
     from .project import find_project
     from .prove import proof_modules
     t0 = time.perf_counter()
@@ -170,7 +170,7 @@ def report_parallel(designs, args, jobs: int, finish) -> int:
     or checked with ``--check``) on a pool of N processes, then
     ``finish(names, lines)`` (the CLI's verb) writes or checks the rest: the
     index, the hazard log and the proof reports."""
-    from .design import display_path
+    from .reader import display_path
     from .project import find_project
     folder = Path(args.out or display_path(find_project().reports))
     with run_folder():

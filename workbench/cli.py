@@ -148,7 +148,7 @@ def cmd_report(args, *, checked=frozenset(), problems=()) -> int:
     if index:
         from .prove import report_files
         files += report_files()
-    from .design import display_path
+    from .reader import display_path
     from .project import find_project
     out = Path(args.out or display_path(find_project().reports))
     if args.check:

@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import DesignError
-from .reader import Quantity, Reader, display_path  # noqa: F401  (re-exported)
+from .reader import Reader, display_path
 from .report.files import SAFE_NAME
 from .toml_input import load_toml
 

@@ -64,9 +64,8 @@ from ..sim.wheel_slip import (PARAM_ORDER, ArrayOps, ScalarOps,
                               exp_euler, model_functions, phi1, plant_forms, plant_step,
                               stiff_step, wheel_speed)
 from .antiskid003_scalar import ScalarSample, _scalar_stiff_step
-from .antiskid003_settings import (ACCEL, BRAKE, BRAKE_IN, CRUISE, DIVERGED, DIVERGED_HOW,  # noqa: F401
-                                   HANDOVER, PHASE_NAMES, STOPPED, ControllerSettings,
-                                   CreepSpeedProfile)
+from .antiskid003_settings import (ACCEL, BRAKE, BRAKE_IN, CRUISE, DIVERGED, DIVERGED_HOW,
+                                   HANDOVER, STOPPED, ControllerSettings)
 
 
 @dataclass

@@ -52,7 +52,7 @@ import keyword
 import re
 from dataclasses import dataclass
 
-from ...design import Reader
+from ...reader import Reader
 from .spec import OperatingEntry, PlantSpec, Variable
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")

@@ -39,7 +39,7 @@ from __future__ import annotations
 import ast
 from dataclasses import dataclass
 
-from ...design import Reader
+from ...reader import Reader
 from ...features.convergence import LEVELS, ClaimTarget, claim_targets, load_convergence
 from ..delay_feedback import NAME_PATTERN as _NAME
 from ..delay_feedback import read_plant

@@ -47,8 +47,6 @@ from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import ModelError
 from ...features.basin_loop import GainLoop
 from ...features.basin_points import PointVerdict
-# EAGER_ENV: re-exported, the switch of every staged certificate below (benchmarks, tests)
-from ...features.basin_select import EAGER_ENV  # noqa: F401
 from ...features.basin_trajectory import integrate, limit_event
 from ...plants.adhesion import NumericAdhesion, adhesion_model
 from ...roa.check import BasinCheck
