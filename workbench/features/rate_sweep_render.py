@@ -14,7 +14,7 @@ from ..report.markdown import fmt, md_table
 from ..sim.convergence import P_MAX, P_MIN
 
 __all__ = ["bound", "variant_label", "variant_sources", "summary_lines", "rate_tables",
-           "mesh_table", "mesh_text", "three_level_text", "plot_rate_metric", "plot_traces"]
+           "mesh_table", "mesh_text", "three_level_text", "replay_table", "plot_rate_metric", "plot_traces"]
 
 
 def variant_label(v, input_name: str, unit: str) -> str:
@@ -155,6 +155,18 @@ def three_level_text(variants, label, *, max_rate: float, step: float, scenarios
     return text + "\n\n" + md_table(
         ["variant", "f_c (Hz)", "metric", "plant_step", "/2", "/4", "estimate", "tolerance",
          "outcome"], rows, "lrlrrrrrl")
+
+
+def replay_table(checks, head: list, differences) -> str:
+    """The windows replayed against Radau
+    (:class:`workbench.features.mesh_replay.WindowCheck`): per window its
+    key, name, times, state range and input pieces, then each of
+    ``differences`` (check -> a difference, printed by :func:`bound`);
+    ``head``: the headings of these columns."""
+    rows = [[fmt(c.key), c.name, f"{fmt(c.t0, 5)}–{fmt(c.t1, 5)}",
+             f"{fmt(c.lo, 2)}–{fmt(c.hi, 2)}", str(c.pieces)] + [bound(d(c)) for d in differences]
+            for c in checks]
+    return md_table(head, rows, "lllr" + "r" * len(differences))
 
 
 def plot_rate_metric(ax, variants, key: str, failed: str, color, label, *,

@@ -12,9 +12,8 @@ from __future__ import annotations
 import math
 
 from ...features import rate_sweep_render as RR
-from ...features.rate_sweep_render import bound
 from ...printed_grid import printed_digits
-from ...report.markdown import Figure, fmt, md_table
+from ...report.markdown import Figure, fmt
 from .antiskid_sampled import MESH_ATOL, MESH_CHECK_MAX_HZ, TRACE_SECONDS
 from .antiskid_sampled_check import RTOL, WINDOW_SAMPLES
 from .antiskid_sampled_kernel import BRAKING_LEAD, EVS_SETTLE, TRACTION_TAIL
@@ -133,9 +132,6 @@ def three_level_text(res) -> str:
 
 def _checks_text(res) -> str:
     sp = res.spec
-    radau = [[fmt(c.rate), c.window, f"{fmt(c.t0, 5)}–{fmt(c.t1, 5)}",
-              f"{fmt(c.v_lo, 2)}–{fmt(c.v_hi, 2)}", str(c.pieces),
-              bound(c.max_dlam / res.lambda_opt), bound(c.max_dv_rel)] for c in res.radau]
     return (
         "**Checks of the plant's integration.** "
         + RR.mesh_text(res.variants, variant_label, MESH_ATOL, max_rate=MESH_CHECK_MAX_HZ,
@@ -146,8 +142,9 @@ def _checks_text(res) -> str:
         f"`solve_ivp(method=\"Radau\")` (rtol {fmt(RTOL)}), restarted from its own state at "
         "every change of the torque, against the mesh at each of its points (the same "
         "lambdified model):\n\n"
-        + md_table(["f_c (Hz)", "window", "t (s)", "v (m/s)", "torque pieces",
-                    "max |Δλ| / λ_opt", "max |Δv| / v"], radau, "lllrrrr")
+        + RR.replay_table(res.radau, ["f_c (Hz)", "window", "t (s)", "v (m/s)",
+                                      "torque pieces", "max |Δλ| / λ_opt", "max |Δv| / v"],
+                          (lambda c: c.d_abs[1] / res.lambda_opt, lambda c: c.d_rel[0]))
         + "\n\nWhy not Radau for every run: a sampled run restarts the integration at every "
         "sample and every arriving command (10 000 restarts per simulated second at 5 kHz), "
         "each with a creep-ratio transient of time constant ~v/4000 s to resolve; scipy's "
