@@ -203,11 +203,20 @@ def test_the_words_of_a_toy_sweep():
     matplotlib.use("Agg")
     from matplotlib.figure import Figure
     ax = Figure().add_subplot(111)
-    traces = [SimpleNamespace(variant="p", rate=f, t=np.arange(3.0), x=np.ones(3) * f)
-              for f in (20.0, 50.0)]
-    RR.plot_traces(ax, traces, "x", lambda tr: "k", lambda tr: f"{tr.rate:g} Hz", {20.0: "-"})
+    traces = [RS.Trace("p", f, np.arange(3.0), np.ones(3) * f) for f in (20.0, 50.0)]
+    RR.plot_traces(ax, traces, "y", lambda tr: "k", lambda tr: f"{tr.rate:g} Hz", {20.0: "-"})
     assert [ln.get_label() for ln in ax.lines] == ["20 Hz", "50 Hz"]
     assert [ln.get_linestyle() for ln in ax.lines] == ["-", ":"]
+    fig = Figure()
+    axes = RR.plot_rate_panels(fig, (v,), (("x_end", "x at the end", "x_end"),
+                                           ("peak", "peak", "peak")), lambda w: "k", label,
+                               {"x_end": 0.5, "peak": math.nan}, "reference", {"x_end": 0.5},
+                               cols=1)
+    assert len(axes) == 2 and axes[0].get_ylabel() == "x at the end"
+    assert axes[1].get_xlabel() == "control rate f_c (Hz)" and axes[0].get_xlabel() == ""
+    # x_end shifted by 0.5 with its reference at 0 (dashed); no reference drawn for NaN
+    assert axes[0].lines[-1].get_label() == "reference" and axes[0].lines[-1].get_ydata()[0] == 0
+    assert all(ln.get_label() != "reference" for ln in axes[1].lines)
 
 
 def test_replay_windows_of_two_toy_runs():

@@ -67,7 +67,8 @@ def _result(three_level, agree=True):
     rows = tuple(RS.RateRow(f, _metrics()) for f in spec.rates)
     v = RS.Variant("zoh", 0.0, 0.0, rows, (), 100.0, (None, 100.0),
                   tuple((f, agree, {}) for f in spec.rates), three_level=three_level)
-    return S.SampledResult(spec, 0.1, 1.0, RS.RateRow(math.nan, _metrics()), 0.005, (v,))
+    return S.SampledResult(spec, RS.RateRow(math.nan, _metrics()), 0.005, (v,),
+                           lambda_opt=0.1, u_peak=1.0)
 
 
 def test_a_non_converged_mesh_metric_makes_the_mesh_claim_inconclusive():
@@ -113,8 +114,10 @@ def test_the_claimed_rate_metrics_of_a_design():
         ("zoh", 20.0, "braking_ok"), ("zoh_q_tau", 50.0, "traction_ok"),
         ("zoh_q_tau", 100.0, "evs_max_tracking"), ("zoh_q_tau", 100.0, "ok"),
         ("zoh_q_tau", 1000.0, "stop_distance"))
-    assert S.scenarios_of("traction_ok") == (0,) and S.scenarios_of("stop_distance") == (1,)
-    assert S.scenarios_of("ok") == (0, 1) and S.scenarios_of("u_max_over_peak") == (0, 1)
+    decl = S.declaration(None)         # the context is used only when a row is computed
+    assert decl.scenarios_of("traction_ok") == (0,)
+    assert decl.scenarios_of("stop_distance") == (1,)
+    assert decl.scenarios_of("ok") == (0, 1) and decl.scenarios_of("u_max_over_peak") == (0, 1)
 
 
 def test_a_partial_row_is_the_rate_row_of_its_scenarios():
@@ -127,10 +130,14 @@ def test_a_partial_row_is_the_rate_row_of_its_scenarios():
     ctx = sampled_context(design.spec, design.spec.K_table)
     kw = dict(dt_p=1e-3, predictor_step=1e-3, q=8.0, tau=0.002)
     full = S.rate_row(ctx, 100.0, **kw).metrics
-    brake = S.partial_row(ctx, 100.0, (1,), **kw).metrics
+
+    def part(scenarios):
+        return RS.partial_row(S.runs_of(ctx, 1e-3), S.declaration(ctx), 100.0, scenarios,
+                              8.0, 0.002, 1e-3).metrics
+    brake = part((1,))
     assert set(brake) == set(S.BRAKING_METRICS) | {"braking_diverged"}
     assert {k: repr(v) for k, v in brake.items()} == {k: repr(full[k]) for k in brake}
-    both = S.partial_row(ctx, 100.0, (0, 1), **kw).metrics
+    both = part((0, 1))
     assert {k: repr(v) for k, v in both.items()} == {k: repr(full[k]) for k in both}
     assert set(both) == set(full)
 

@@ -41,12 +41,14 @@ from dataclasses import dataclass, field
 from typing import Callable, Mapping
 
 from .refinement import guarded_check
+from ..jsonable import json_method
 from ..sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
 
 __all__ = ["RateMetrics", "Runs", "RateRow", "Variant", "ThreeLevel", "three_level_check",
            "rate_row", "partial_row", "sweep_variant", "claimed_rate_metrics", "variants",
            "read_rates", "read_inputs", "quantity_names", "quantities", "quantity_value",
-           "SweepTable", "read_table", "sweep", "sweep_quantity_names", "sweep_quantities"]
+           "SweepTable", "read_table", "sweep", "sweep_quantity_names", "sweep_quantities",
+           "Trace", "SweepResult"]
 
 
 def variants(q: float, tau: float) -> tuple:
@@ -108,6 +110,17 @@ def read_table(t, unit: str, *, plant_step_hi: float) -> dict:
     return dict(rates=rates, plant_step=step, bisect=t.number(
         "bisect", integer=True, default=4, lo=0, hi=12, what="integer"),
         **dict(zip(("quantisation", "measurement_delay"), read_inputs(t, unit))))
+
+
+@dataclass(frozen=True)
+class Trace:
+    """A time trace of a run for a figure: the variant's name (or a
+    reference's), the rate, the times and the values ``y`` (arrays)."""
+
+    variant: str
+    rate: float
+    t: object
+    y: object
 
 
 @dataclass(frozen=True)
@@ -371,6 +384,32 @@ def sweep(runs: Runs, decl: RateMetrics, table: SweepTable) -> tuple:
     return tuple(sweep_variant(runs, decl, table.rates, table.plant_step, name, q, tau,
                                bisect=table.bisect, claimed=table.three_level)
                  for name, q, tau in table.variants())
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """A sweep as a section shows it: its table ``spec``
+    (:class:`SweepTable`), the ``reference`` row (the controller not
+    sampled, say) at step ``reference_step``, the ``variants``
+    (:func:`sweep`), the windows replayed against Radau (``checks``,
+    :class:`workbench.features.mesh_replay.WindowCheck`) and the figure's
+    ``traces`` (:class:`Trace`). A system's own result subclasses it."""
+
+    spec: SweepTable
+    reference: RateRow
+    reference_step: float
+    variants: tuple
+    checks: tuple = ()
+    traces: tuple = ()
+
+    def variant(self, name: str) -> Variant:
+        return next(v for v in self.variants if v.name == name)
+
+    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"reference": "reference.metrics",
+                   "variants": lambda r: {v.name: v.json() for v in r.variants},
+                   "checks": "checks"}
+    to_json = json_method
 
 
 def claimed_rate_metrics(prefix: str, variants, rates: tuple, names: tuple, max_rate: float,

@@ -14,7 +14,8 @@ from ..report.markdown import fmt, md_table
 from ..sim.convergence import P_MAX, P_MIN
 
 __all__ = ["bound", "variant_label", "variant_sources", "summary_lines", "rate_tables",
-           "mesh_table", "mesh_text", "three_level_text", "replay_table", "plot_rate_metric", "plot_traces"]
+           "mesh_table", "mesh_text", "three_level_text", "replay_table", "plot_rate_metric",
+           "plot_rate_panels", "plot_traces"]
 
 
 def variant_label(v, input_name: str, unit: str) -> str:
@@ -189,6 +190,23 @@ def plot_rate_metric(ax, variants, key: str, failed: str, color, label, *,
     if reference is not None and not math.isnan(reference):
         ax.axhline(reference - shift, color="k", ls="--", lw=0.8, label=reference_label)
     ax.set_xscale("log")
+
+
+def plot_rate_panels(fig, variants, panels, color, label, reference: dict,
+                     reference_label: str, shifts: dict | None = None, cols: int = 2):
+    """Panels of :func:`plot_rate_metric` on a shared rate axis, ``cols`` a
+    row: ``panels`` ((metric, y label, failed), ...); ``reference``: metric
+    -> the reference's value; ``shifts``: metric -> its shift. Returns the
+    axes (flat)."""
+    axes = fig.subplots(-(-len(panels) // cols), cols, sharex=True).ravel()
+    for ax, (key, ylabel, failed) in zip(axes, panels):
+        plot_rate_metric(ax, variants, key, failed, color, label,
+                         shift=(shifts or {}).get(key, 0.0), reference=reference[key],
+                         reference_label=reference_label)
+        ax.set_ylabel(ylabel)
+    for ax in axes[-cols:]:
+        ax.set_xlabel("control rate f_c (Hz)")
+    return axes
 
 
 def plot_traces(ax, traces, y: str, color, label, styles: dict) -> None:

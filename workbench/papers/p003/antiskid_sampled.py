@@ -53,10 +53,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from ...features import rate_sweep as RS
-from ...jsonable import json_method
 from .antiskid_sampled_check import RADAU_QUANTITIES, radau_checks, radau_quantities
 from .antiskid_sampled_kernel import OUT, Context, run_once
 
@@ -124,36 +121,14 @@ def claimed_rate_metrics(spec: SampledSpec, claims) -> tuple:
 
 
 @dataclass(frozen=True)
-class Trace:
-    """lambda / lambda_opt - 1 on the plant's mesh from the start of traction."""
+class SampledResult(RS.SweepResult):
+    """Everything the sampled section shows (:func:`run_sampled`): the
+    sweep (the reference is the emulation at dt/2, the checks the Radau
+    windows, the traces lambda / lambda_opt - 1 from the start of traction),
+    lambda_opt and the peak adhesion torque."""
 
-    variant: str              # a variant's name, or "emulation"
-    rate: float
-    t: np.ndarray
-    excess: np.ndarray
-
-
-@dataclass(frozen=True)
-class SampledResult:
-    """Everything the sampled section shows (:func:`run_sampled`)."""
-
-    spec: SampledSpec
-    lambda_opt: float
-    u_peak: float
-    emulation: RS.RateRow
-    emulation_dt: float
-    variants: tuple
-    radau: tuple = ()         # antiskid_sampled_check.RadauCheck
-    traces: tuple = ()        # Trace
-
-    def variant(self, name: str) -> RS.Variant:
-        return next(v for v in self.variants if v.name == name)
-
-    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
-    JSON_FIELDS = {"emulation": "emulation.metrics",
-                   "variants": lambda r: {v.name: v.json() for v in r.variants},
-                   "radau": "radau"}
-    to_json = json_method
+    lambda_opt: float = math.nan
+    u_peak: float = math.nan
 
 
 def rate_metrics(ctx: Context, trac: dict, brake: dict) -> dict:
@@ -202,19 +177,6 @@ def rate_row(ctx: Context, rate: float, *, dt_p: float, predictor_step: float,
                        tau, dt_p)
 
 
-def partial_row(ctx: Context, rate: float, scenarios: tuple, *, dt_p: float,
-                predictor_step: float, q: float = 0.0, tau: float = 0.0) -> RS.RateRow:
-    """The metrics of ``scenarios`` (0 traction, 1 braking) at one rate
-    (:func:`workbench.features.rate_sweep.partial_row`)."""
-    return RS.partial_row(runs_of(ctx, predictor_step), declaration(ctx), rate, scenarios,
-                          q, tau, dt_p)
-
-
-def scenarios_of(metric: str) -> tuple:
-    """The scenarios (0 traction, 1 braking) a rate metric is computed from."""
-    return NEEDS.get(metric, (0, 1))
-
-
 def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:
     """The sampled section of an ``antiskid-run`` design with ``[sampled]``
     (``ctx``: :func:`workbench.papers.p003.antiskid_run_spec.sampled_context`;
@@ -228,11 +190,11 @@ def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:
     runs = runs_of(ctx, spec.predictor_step)
     variants = RS.sweep(runs, decl, spec)
     recs = trace_records(ctx, spec, dt_e)
-    shown = tuple(Trace(name, f, rec[:, 0].copy(), rec[:, 2] / ctx.cs.lambda_opt - 1.0)
+    shown = tuple(RS.Trace(name, f, rec[:, 0].copy(), rec[:, 2] / ctx.cs.lambda_opt - 1.0)
                   for name, f, rec in recs)
     zoh = {f: rec for name, f, rec in recs if name == "zoh"}
-    return SampledResult(spec, ctx.cs.lambda_opt, ctx.u_peak, emu, dt_e, variants,
-                         radau_checks(ctx, spec, runs, zoh), shown)
+    return SampledResult(spec, emu, dt_e, variants, radau_checks(ctx, spec, runs, zoh), shown,
+                         lambda_opt=ctx.cs.lambda_opt, u_peak=ctx.u_peak)
 
 
 def trace_records(ctx: Context, spec: SampledSpec, dt_e: float) -> list:
@@ -261,5 +223,5 @@ def sampled_quantity_names(spec: SampledSpec) -> set[str]:
 def sampled_quantities(res: SampledResult) -> dict:
     """Values of :func:`sampled_quantity_names`."""
     return {**RS.sweep_quantities("sampled", res.variants, RATE_METRICS, "emulation",
-                                  res.emulation.metrics, GAP_METRICS, TO_EMULATION),
-            **radau_quantities(res.radau, res.lambda_opt)}
+                                  res.reference.metrics, GAP_METRICS, TO_EMULATION),
+            **radau_quantities(res.checks, res.lambda_opt)}

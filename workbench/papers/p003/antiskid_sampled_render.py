@@ -69,7 +69,7 @@ def sampled_section(res, rail: str) -> str:
             "time to v_d (s)", "traction", "t_brake → stop (s)", "stop distance (m)",
             "min λ, braking", "max e_vs (m/s)", "max |u| / T_adh", "braking"]
     tables = RR.rate_tables(res.variants, variant_label, head, _row, _row(
-        f"{EMULATION}, dt/2 = {fmt(res.emulation_dt)} s", res.emulation.metrics))
+        f"{EMULATION}, dt/2 = {fmt(res.reference_step)} s", res.reference.metrics))
     return (
         f"## {HEADING}\n\n"
         "The other sections run the laws as an *emulation*: the law is evaluated at every "
@@ -142,7 +142,7 @@ def _checks_text(res) -> str:
         f"`solve_ivp(method=\"Radau\")` (rtol {fmt(RTOL)}), restarted from its own state at "
         "every change of the torque, against the mesh at each of its points (the same "
         "lambdified model):\n\n"
-        + RR.replay_table(res.radau, ["f_c (Hz)", "window", "t (s)", "v (m/s)",
+        + RR.replay_table(res.checks, ["f_c (Hz)", "window", "t (s)", "v (m/s)",
                                       "torque pieces", "max |Δλ| / λ_opt", "max |Δv| / v"],
                           (lambda c: c.d_abs[1] / res.lambda_opt, lambda c: c.d_rel[0]))
         + "\n\nWhy not Radau for every run: a sampled run restarts the integration at every "
@@ -165,18 +165,14 @@ def trace_figure(res) -> Figure:
 
 
 def plot_sampled(fig, res):
-    axes = fig.subplots(2, 2, sharex=True).ravel()
-    keys = (("lam_max_over_opt", "max λ / λ_opt − 1, traction (symlog)", "traction"),
-            ("evs_max_tracking", "max e_vs (m/s), braking", "braking"),
-            ("braking_duration", "t_brake → stop (s)", "braking"),
-            ("stop_distance", "stop distance (m)", "braking"))
-    shift = {"lam_max_over_opt": 1.0}          # the top left panel shows the excess over 1
-    for ax, (key, label, which) in zip(axes, keys):
-        RR.plot_rate_metric(ax, res.variants, key, f"{which}_diverged",
-                            lambda v: _COLORS.get(v.name, "tab:green"), variant_label,
-                            shift=shift.get(key, 0.0), reference=res.emulation.metrics[key],
-                            reference_label=EMULATION)
-        ax.set_ylabel(label)
+    keys = (("lam_max_over_opt", "max λ / λ_opt − 1, traction (symlog)", "traction_diverged"),
+            ("evs_max_tracking", "max e_vs (m/s), braking", "braking_diverged"),
+            ("braking_duration", "t_brake → stop (s)", "braking_diverged"),
+            ("stop_distance", "stop distance (m)", "braking_diverged"))
+    # the top left panel shows the excess over 1
+    axes = RR.plot_rate_panels(fig, res.variants, keys,
+                               lambda v: _COLORS.get(v.name, "tab:green"), variant_label,
+                               res.reference.metrics, EMULATION, {"lam_max_over_opt": 1.0})
     m = res.spec.creep_margin
     axes[0].axhline(0.0, color="grey", lw=0.8, label="λ_opt")
     axes[0].axhline(m, color="dimgrey", ls=":", lw=1.0, label="requirement λ_opt (1 + margin)")
@@ -184,14 +180,12 @@ def plot_sampled(fig, res):
     axes[0].set_ylim(bottom=-m / 1000)
     axes[1].axhline(EVS_BOUND, color="dimgrey", ls=":", lw=1.0)
     axes[1].set_yscale("log")
-    for ax in axes[2:]:
-        ax.set_xlabel("control rate f_c (Hz)")
     axes[0].legend(fontsize=6, loc="lower left")
 
 
 def plot_traces(fig, res):
     ax = fig.add_subplot(111)
-    RR.plot_traces(ax, res.traces, "excess", lambda tr: _COLORS.get(tr.variant, "tab:green"),
+    RR.plot_traces(ax, res.traces, "y", lambda tr: _COLORS.get(tr.variant, "tab:green"),
                    lambda tr: EMULATION if tr.variant == "emulation" else
                    f"{variant_label(res.variant(tr.variant))}, {fmt(tr.rate)} Hz",
                    {100.0: "-", 1000.0: "--"})
