@@ -14,7 +14,7 @@ from ..report.markdown import fmt, md_table
 from ..sim.convergence import P_MAX, P_MIN
 
 __all__ = ["bound", "variant_label", "variant_sources", "summary_lines", "rate_tables",
-           "mesh_table", "mesh_text", "three_level_text", "replay_table", "plot_rate_metric",
+           "mesh_table", "mesh_text", "three_level_text", "replay_table", "replay_text", "plot_rate_metric",
            "plot_rate_panels", "plot_traces"]
 
 
@@ -168,6 +168,19 @@ def replay_table(checks, head: list, differences) -> str:
              f"{fmt(c.lo, 2)}–{fmt(c.hi, 2)}", str(c.pieces)] + [bound(d(c)) for d in differences]
             for c in checks]
     return md_table(head, rows, "lllr" + "r" * len(differences))
+
+
+def replay_text(table: str, *, input_name: str, receiver: str, samples: int, variant: str,
+                rtol: float, model: str) -> str:
+    """*Radau*: the words of the replay check
+    (:mod:`workbench.features.mesh_replay`) before its ``table``
+    (:func:`replay_table`): the ``input_name`` the ``receiver`` received in
+    a window of ``samples`` samples of ``variant``, ``rtol``, ``model``: the
+    right-hand side Radau integrates, in words."""
+    return (f"*Radau*: the {input_name} {receiver} received in a window of {samples} samples "
+            f"({variant}) replayed into scipy's `solve_ivp(method=\"Radau\")` (rtol "
+            f"{fmt(rtol)}), restarted from its own state at every change of the {input_name}, "
+            f"against the mesh at each of its points ({model}):\n\n" + table)
 
 
 def plot_rate_metric(ax, variants, key: str, failed: str, color, label, *,

@@ -35,16 +35,15 @@ The *emulation* row is the case's controller as the other sections run it
 (every step of dt/2, the stiff hold with its mismatch estimate, the plant
 stepped with the control step), in the same two scenarios.
 
-The sweep itself is general (:mod:`workbench.features.rate_sweep`: the
-table's grid and inputs, the variants, the grid, the lowest passing rate
-and its bisection bracket, the mesh check of
-every grid rate up to :data:`MESH_CHECK_MAX_HZ` at ``plant_step`` / 2 within
-:data:`MESH_ATOL`, the three levels plant_step, /2, /4 of every rate metric a
-claim compares, every run made once). What stays here is paper 003's: the
-``[sampled]`` table, the kernel as the sweep's ``run`` callback
-(:func:`runs_of`), the metrics of a rate and their tolerances
-(:func:`rate_metrics`, :func:`declaration`), the emulation row, the traces of
-the figure, the quantity names, and the plant's mesh against scipy's Radau
+The sweep is general (:mod:`workbench.features.rate_sweep`: the table's
+general keys, the variants, the grid, the lowest passing rate and its
+bisection bracket, the mesh check at ``plant_step`` / 2 up to
+:data:`MESH_CHECK_MAX_HZ` within :data:`MESH_ATOL`, the three levels of every
+claimed rate metric, the result and its quantities, every run made once).
+What stays here is paper 003's: the case, margin and predictor keys, the
+kernel as the sweep's ``run`` callback (:func:`runs_of`), the metrics of a
+rate and their tolerances (:func:`rate_metrics`, :func:`declaration`), the
+emulation as the reference, the traces' records, and the Radau windows
 (:mod:`.antiskid_sampled_check`).
 """
 from __future__ import annotations

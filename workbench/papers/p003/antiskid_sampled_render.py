@@ -2,11 +2,11 @@
 (:mod:`workbench.papers.p003.antiskid_sampled`; pure rendering).
 
 The tables, the variants' words, the summary of the lowest rates, the mesh
-checks' text and the figure panels are general
-(:mod:`workbench.features.rate_sweep_render`); what stays here is paper
-003's wording: the cells of a rate (creep ratio, stop, e_vs), why a rate
-fails (traction or braking), the section's prose, the Radau table and the
-two figures' layout."""
+checks' text, the Radau table and its words and the figure panels are
+general (:mod:`workbench.features.rate_sweep_render`); what stays here is
+paper 003's wording: the cells of a rate (creep ratio, stop, e_vs), why a
+rate fails (traction or braking), the section's prose, the Radau table's
+headings and the two figures' layout."""
 from __future__ import annotations
 
 import math
@@ -137,14 +137,12 @@ def _checks_text(res) -> str:
         + RR.mesh_text(res.variants, variant_label, MESH_ATOL, max_rate=MESH_CHECK_MAX_HZ,
                        step=sp.plant_step)
         + "\n\n" + three_level_text(res)
-        + "\n\n*Radau*: the torque the wheel received in a window of "
-        f"{WINDOW_SAMPLES} samples (ZOH variant) replayed into scipy's "
-        f"`solve_ivp(method=\"Radau\")` (rtol {fmt(RTOL)}), restarted from its own state at "
-        "every change of the torque, against the mesh at each of its points (the same "
-        "lambdified model):\n\n"
-        + RR.replay_table(res.checks, ["f_c (Hz)", "window", "t (s)", "v (m/s)",
-                                      "torque pieces", "max |Δλ| / λ_opt", "max |Δv| / v"],
-                          (lambda c: c.d_abs[1] / res.lambda_opt, lambda c: c.d_rel[0]))
+        + "\n\n" + RR.replay_text(RR.replay_table(
+            res.checks, ["f_c (Hz)", "window", "t (s)", "v (m/s)", "torque pieces",
+                         "max |Δλ| / λ_opt", "max |Δv| / v"],
+            (lambda c: c.d_abs[1] / res.lambda_opt, lambda c: c.d_rel[0])),
+            input_name="torque", receiver="the wheel", samples=WINDOW_SAMPLES,
+            variant="ZOH variant", rtol=RTOL, model="the same lambdified model")
         + "\n\nWhy not Radau for every run: a sampled run restarts the integration at every "
         "sample and every arriving command (10 000 restarts per simulated second at 5 kHz), "
         "each with a creep-ratio transient of time constant ~v/4000 s to resolve; scipy's "
