@@ -156,8 +156,8 @@ def declaration(ctx: Context) -> RS.RateMetrics:
     a scenario not run counts as NaN outputs)."""
     nan = dict.fromkeys(OUT, math.nan)
     return RS.RateMetrics(RATE_METRICS, (0, 1),
-                       lambda got: rate_metrics(ctx, got[0] or nan, got[1] or nan), NEEDS,
-                       MESH_ATOL, MESH_CHECK_MAX_HZ)
+                          lambda got: rate_metrics(ctx, got[0] or nan, got[1] or nan), NEEDS,
+                          MESH_ATOL, MESH_CHECK_MAX_HZ)
 
 
 def runs_of(ctx: Context, predictor_step: float, emulation: bool = False) -> RS.Runs:
@@ -180,7 +180,7 @@ def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:
     """The sampled section of an ``antiskid-run`` design with ``[sampled]``
     (``ctx``: :func:`workbench.papers.p003.antiskid_run_spec.sampled_context`;
     ``dt``: the design's step, the emulation runs at dt/2): the emulation
-    row, every variant (:func:`workbench.features.rate_sweep.sweep_variant`),
+    row, every variant (:func:`workbench.features.rate_sweep.sweep`),
     the traces of the figure, the Radau check (on the grid's runs and the
     traces' records)."""
     dt_e = dt / 2
