@@ -254,6 +254,7 @@ def test_replay_windows_of_two_toy_runs():
     table = replay_table([w.check(1.0) for w in out], ["run", "window", "t", "x", "pieces",
                                                        "max |dx|"], (lambda c: c.d_abs[0],))
     assert table.count("\n") == 4 and "| 1 | a early | 0.1–0.5 |" in table
+    assert table.splitlines()[1] == "| :--- | :--- | :--- | ---: | ---: | ---: |"
     from workbench.features.rate_sweep_render import replay_text
     text = replay_text(table, input_name="voltage", receiver="the coil", samples=4,
                        variant="exact", rtol=1e-10, model="x' = -x + u")

@@ -167,7 +167,7 @@ def replay_table(checks, head: list, differences) -> str:
     rows = [[fmt(c.key), c.name, f"{fmt(c.t0, 5)}–{fmt(c.t1, 5)}",
              f"{fmt(c.lo, 2)}–{fmt(c.hi, 2)}", str(c.pieces)] + [bound(d(c)) for d in differences]
             for c in checks]
-    return md_table(head, rows, "lllr" + "r" * len(differences))
+    return md_table(head, rows, "lllrr" + "r" * len(differences))
 
 
 def replay_text(table: str, *, input_name: str, receiver: str, samples: int, variant: str,
