@@ -106,7 +106,7 @@ def cruise() -> None:
     for label, r, sim in (
             ("predictor (exact prediction: delay-free sampled loop)", c.predictor,
              "25 Hz (ZOH; bisected 23 fails / 25 meets)"),
-            (f"no predictor, delay {c.h_m:g} + {c.measurement_delay:g} s", c.delayed,
+            (f"no predictor, delay {c.h:g} + {c.measurement_delay:g} s", c.delayed,
              "55 Hz (ZOH, 8 N m quantisation, 2 ms measurement delay; 52 fails / 55 meets)")):
         cap = " (search cap)" if r.at_cap else ""
         rate = 1.0 / r.T_certified

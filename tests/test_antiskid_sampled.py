@@ -13,7 +13,8 @@ from workbench.cli import main
 from workbench.design import load_design
 from workbench.papers.p003 import antiskid_sampled as S
 from workbench.papers.p003.antiskid_run_spec import sampled_context
-from workbench.papers.p003.antiskid_sampled_check import replay
+from workbench.features.mesh_replay import replay, window
+from workbench.papers.p003.antiskid_sampled_check import ATOL, RTOL, plant_rhs
 
 pytest.importorskip("numba")
 
@@ -101,11 +102,11 @@ def test_fast_sampling_tends_to_the_emulation(ctx):
 
 def test_radau_replay_agrees_and_sees_a_tampered_record(ctx):
     _, (rec, _) = _traction(ctx, 100.0, ctx.h, ctx.h + 0.05)
-    dl, dv, pieces = replay(ctx.plant, rec)
+    (_, dl), (dv, _), pieces = replay(plant_rhs(ctx.plant), rec, RTOL, ATOL)
     assert pieces >= 4 and dl <= 1e-5 * ctx.cs.lambda_opt and dv <= 1e-4
     bad = rec.copy()
     bad[len(bad) // 2:, 2] += 1e-4        # the creep ratio moved by hand halfway
-    assert replay(ctx.plant, bad)[0] >= 0.9e-4
+    assert replay(plant_rhs(ctx.plant), bad, RTOL, ATOL)[0][1] >= 0.9e-4
 
 
 def test_the_braking_entry_sets_the_lowest_dry_rate(ctx):
@@ -142,7 +143,6 @@ def test_a_memoised_run_and_a_cut_record_are_those_of_separate_runs(ctx):
     check's windows is the grid's, the outputs of its own call; a window cut
     from a longer record (the figure's trace, or one run over both braking
     windows) holds the rows of a run recording that window alone."""
-    from workbench.papers.p003.antiskid_sampled_check import _window
     from workbench.papers.p003.antiskid_sampled_kernel import run_once
     runs = S.runs_of(ctx, 1e-3)
     kept = runs(100.0, 1, 0.0, 0.0, 2e-4)
@@ -154,4 +154,4 @@ def test_a_memoised_run_and_a_cut_record_are_those_of_separate_runs(ctx):
     long = run_once(ctx, 100.0, 0, record=(0.0, 0.5, 20000), t_cap=0.5, **kw)[1][0]
     t0, t1 = ctx.h - 1e-4, ctx.h + 0.05 - 1e-4
     alone = run_once(ctx, 100.0, 0, record=(t0, t1, 2000), **kw)[1][0]
-    assert len(alone) > 100 and np.array_equal(_window(long, t0, t1), alone)
+    assert len(alone) > 100 and np.array_equal(window(long, t0, t1), alone)

@@ -8,6 +8,7 @@ for a = 10, k = 30 it is stable for T < ln 2 / 10, rates above
 10 / ln 2 = 14.43 Hz."""
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -202,11 +203,20 @@ def test_the_words_of_a_toy_sweep():
     matplotlib.use("Agg")
     from matplotlib.figure import Figure
     ax = Figure().add_subplot(111)
-    traces = [SimpleNamespace(variant="p", rate=f, t=np.arange(3.0), x=np.ones(3) * f)
-              for f in (20.0, 50.0)]
-    RR.plot_traces(ax, traces, "x", lambda tr: "k", lambda tr: f"{tr.rate:g} Hz", {20.0: "-"})
+    traces = [RS.Trace("p", f, np.arange(3.0), np.ones(3) * f) for f in (20.0, 50.0)]
+    RR.plot_traces(ax, traces, "y", lambda tr: "k", lambda tr: f"{tr.rate:g} Hz", {20.0: "-"})
     assert [ln.get_label() for ln in ax.lines] == ["20 Hz", "50 Hz"]
     assert [ln.get_linestyle() for ln in ax.lines] == ["-", ":"]
+    fig = Figure()
+    axes = RR.plot_rate_panels(fig, (v,), (("x_end", "x at the end", "x_end"),
+                                           ("peak", "peak", "peak")), lambda w: "k", label,
+                               {"x_end": 0.5, "peak": math.nan}, "reference", {"x_end": 0.5},
+                               cols=1)
+    assert len(axes) == 2 and axes[0].get_ylabel() == "x at the end"
+    assert axes[1].get_xlabel() == "control rate f_c (Hz)" and axes[0].get_xlabel() == ""
+    # x_end shifted by 0.5 with its reference at 0 (dashed); no reference drawn for NaN
+    assert axes[0].lines[-1].get_label() == "reference" and axes[0].lines[-1].get_ydata()[0] == 0
+    assert all(ln.get_label() != "reference" for ln in axes[1].lines)
 
 
 def test_replay_windows_of_two_toy_runs():
@@ -235,6 +245,22 @@ def test_replay_windows_of_two_toy_runs():
     assert [w.name for w in out] == ["a early", "b", "a late"]
     assert [w.pieces for w in out] == [1, 2, 2]
     assert all(w.d_abs[0] <= 1e-8 for w in out) and out[0].rec[0, 0] >= 0.1
+    # a window in numbers, and its table (the general rendering)
+    from workbench.features.rate_sweep_render import replay_table
+    c = out[1].check("run b")
+    assert (c.key, c.name, c.points, c.pieces) == ("run b", "b", len(out[1].rec), 2)
+    assert 0.9 <= c.t0 < c.t1 <= 1.3 and c.lo == out[1].rec[:, 1].min() < c.hi
+    assert c.d_abs == out[1].d_abs and c.d_rel == out[1].d_rel
+    table = replay_table([w.check(1.0) for w in out], ["run", "window", "t", "x", "pieces",
+                                                       "max |dx|"], (lambda c: c.d_abs[0],))
+    assert table.count("\n") == 4 and "| 1 | a early | 0.1–0.5 |" in table
+    assert table.splitlines()[1] == "| :--- | :--- | :--- | ---: | ---: | ---: |"
+    from workbench.features.rate_sweep_render import replay_text
+    text = replay_text(table, input_name="voltage", receiver="the coil", samples=4,
+                       variant="exact", rtol=1e-10, model="x' = -x + u")
+    assert text.startswith("*Radau*: the voltage the coil received in a window of 4 samples "
+                           "(exact) replayed") and text.endswith(table)
+    assert "(rtol 1e-10)" in text and "every change of the voltage" in text
 
 
 def test_a_sweep_table_is_read_and_checked():
@@ -248,3 +274,24 @@ def test_a_sweep_table_is_read_and_checked():
     assert RS.variants(q.value, 0.0)[1] == ("zoh_q_tau", 0.5, 0.0)
     with pytest.raises(DesignError, match="sampled.rates_hz"):
         RS.read_rates(Reader("toy.toml", {"rates_hz": [10.0, 5.0]}, "sampled"))
+    # the whole general table, and a sweep of its variants on the toy loop
+    t = Reader("toy.toml", {"rates_hz": [5.0, 20.0, 100.0], "plant_step": 1e-3,
+                            "measurement_delay": {"value": 0.0, "unit": "s", "source": "-"},
+                            "quantisation": {"value": 40.0, "unit": "V", "source": "DAC"}},
+               "sampled")
+    table = RS.SweepTable(**RS.read_table(t, "V", plant_step_hi=1e-2))
+    t.finish()
+    assert (table.rates, table.plant_step, table.bisect) == ((5.0, 20.0, 100.0), 1e-3, 4)
+    assert [v[0] for v in table.variants()] == ["zoh", "zoh_q_tau"]
+    with pytest.raises(DesignError, match="sampled.plant_step"):
+        RS.read_table(Reader("toy.toml", {"rates_hz": [5.0], "plant_step": 0.5}, "sampled"),
+                      "V", plant_step_hi=1e-2)
+    runs, _ = _counted()
+    out = RS.sweep(runs, DECL, dataclasses.replace(table, bisect=0))
+    assert [v.name for v in out] == ["zoh", "zoh_q_tau"] and out[0].min_rate == 20.0
+    assert out[1].q == 40.0 and out[1].row(100.0).metrics != out[0].row(100.0).metrics
+    ref = {"x_end": 0.0, "ok": "yes"}
+    q = RS.sweep_quantities("toy", out, ("x_end", "ok"), "reference", ref, ("x_end",))
+    assert set(q) == RS.sweep_quantity_names("toy", table, ("x_end", "ok"), "reference",
+                                             ("x_end",))
+    assert q["toy.reference.ok"] == "yes" and q["toy.zoh_q_tau.min_rate"] == out[1].min_rate

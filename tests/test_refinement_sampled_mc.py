@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from workbench.claims import Claim, ClaimResult, Verdict, check_claim
+from workbench.features import rate_sweep as RS
 from workbench.papers.p003 import antiskid_sampled as S
 from workbench.features.montecarlo_render import refined_runs_text
 from workbench.features.refinement import _own_row, share_claim_levels, share_value
@@ -34,21 +35,21 @@ def _claim(cid, quantity, compare, value, tol=0.0, expect="pass"):
 
 def test_three_level_check_of_a_rate_metric():
     tol = S.MESH_ATOL["evs_max_tracking"]
-    ok = S.three_level_check("zoh_q_tau", 100.0, "evs_max_tracking", EVS_100, tol)
+    ok = RS.three_level_check("zoh_q_tau", 100.0, "evs_max_tracking", EVS_100, tol)
     assert ok.converged and ok.estimate < 1e-5 and ok.tolerance == S.MESH_ATOL[
         "evs_max_tracking"] and ok.reason() == ""
-    bad = S.three_level_check("zoh_q_tau", 200.0, "evs_max_tracking", EVS_200, tol)
+    bad = RS.three_level_check("zoh_q_tau", 200.0, "evs_max_tracking", EVS_200, tol)
     # every difference is below the two-level screen's 2e-4; the guarded
     # estimate (sign change: the larger difference at order 0.5) is not
     assert max(abs(a - b) for a, b in zip(EVS_200, EVS_200[1:])) < 2e-4
     assert bad.outcome == INCONCLUSIVE and bad.estimate > 2e-4
     assert bad.reason().startswith("not converged: zoh_q_tau 200 Hz evs_max_tracking")
-    word = S.three_level_check("zoh", 20.0, "braking_ok", ("no", "no", "yes"))
+    word = RS.three_level_check("zoh", 20.0, "braking_ok", ("no", "no", "yes"))
     assert word.outcome == NOT_CONVERGED and word.tolerance is None
-    assert S.three_level_check("zoh", 20.0, "braking_ok", ("no",) * 3).converged
+    assert RS.three_level_check("zoh", 20.0, "braking_ok", ("no",) * 3).converged
     nan = math.nan
-    assert S.three_level_check("zoh", 20.0, "stop_distance", (nan,) * 3).converged
-    part = S.three_level_check("zoh", 20.0, "stop_distance", (nan, 1.0, 1.0))
+    assert RS.three_level_check("zoh", 20.0, "stop_distance", (nan,) * 3).converged
+    part = RS.three_level_check("zoh", 20.0, "stop_distance", (nan, 1.0, 1.0))
     assert part.outcome == INCONCLUSIVE and "some levels" in part.note
 
 
@@ -61,11 +62,13 @@ def _metrics(**over):
 
 
 def _result(three_level, agree=True):
-    spec = S.SampledSpec("compensated", (100.0, 200.0), 1e-3, 1e-4, 1e-3, 0, None, None)
-    rows = tuple(S.RateRow(f, _metrics()) for f in spec.rates)
-    v = S.Variant("zoh", 0.0, 0.0, rows, (), 100.0, (None, 100.0),
+    spec = S.SampledSpec((100.0, 200.0), 1e-4, 0, case="compensated", creep_margin=1e-3,
+                         predictor_step=1e-3)
+    rows = tuple(RS.RateRow(f, _metrics()) for f in spec.rates)
+    v = RS.Variant("zoh", 0.0, 0.0, rows, (), 100.0, (None, 100.0),
                   tuple((f, agree, {}) for f in spec.rates), three_level=three_level)
-    return S.SampledResult(spec, 0.1, 1.0, S.RateRow(math.nan, _metrics()), 0.005, (v,))
+    return S.SampledResult(spec, RS.RateRow(math.nan, _metrics()), 0.005, (v,),
+                           lambda_opt=0.1, u_peak=1.0)
 
 
 def test_a_non_converged_mesh_metric_makes_the_mesh_claim_inconclusive():
@@ -75,11 +78,11 @@ def test_a_non_converged_mesh_metric_makes_the_mesh_claim_inconclusive():
     from workbench.papers.p003.antiskid_sampled_render import three_level_text
     claim = _claim("mesh", "sampled.zoh.mesh_converged", "==", "yes")
     tol = S.MESH_ATOL["evs_max_tracking"]
-    good = (S.three_level_check("zoh", 100.0, "evs_max_tracking", EVS_100, tol),)
+    good = (RS.three_level_check("zoh", 100.0, "evs_max_tracking", EVS_100, tol),)
     q = S.sampled_quantities(_result(good))
     assert q["sampled.zoh.mesh_converged"] == "yes"
     assert check_claim(claim, q["sampled.zoh.mesh_converged"]).verdict is Verdict.PASS
-    bad = good + (S.three_level_check("zoh", 200.0, "evs_max_tracking", EVS_200, tol),)
+    bad = good + (RS.three_level_check("zoh", 200.0, "evs_max_tracking", EVS_200, tol),)
     res = _result(bad)
     q = S.sampled_quantities(res)
     assert q["sampled.zoh.mesh_converged"] is None
@@ -92,8 +95,8 @@ def test_a_non_converged_mesh_metric_makes_the_mesh_claim_inconclusive():
 
 
 def test_the_claimed_rate_metrics_of_a_design():
-    spec = S.SampledSpec("c", (20.0, 100.0, 1000.0, 5000.0), 1e-3, 1e-4, 1e-3, 0,
-                         None, None)
+    spec = S.SampledSpec((20.0, 100.0, 1000.0, 5000.0), 1e-4, 0, case="c", creep_margin=1e-3,
+                         predictor_step=1e-3)
     raw = [{"quantity": "sampled.zoh.rate[100].evs_max_tracking"},
            {"quantity": "sampled.zoh.rate[1000].stop_distance_minus_emulation"},
            {"quantity": "sampled.zoh.rate[5000].lam_max_over_opt"},      # above 1 kHz
@@ -111,8 +114,10 @@ def test_the_claimed_rate_metrics_of_a_design():
         ("zoh", 20.0, "braking_ok"), ("zoh_q_tau", 50.0, "traction_ok"),
         ("zoh_q_tau", 100.0, "evs_max_tracking"), ("zoh_q_tau", 100.0, "ok"),
         ("zoh_q_tau", 1000.0, "stop_distance"))
-    assert S.scenarios_of("traction_ok") == (0,) and S.scenarios_of("stop_distance") == (1,)
-    assert S.scenarios_of("ok") == (0, 1) and S.scenarios_of("u_max_over_peak") == (0, 1)
+    decl = S.declaration(None)         # the context is used only when a row is computed
+    assert decl.scenarios_of("traction_ok") == (0,)
+    assert decl.scenarios_of("stop_distance") == (1,)
+    assert decl.scenarios_of("ok") == (0, 1) and decl.scenarios_of("u_max_over_peak") == (0, 1)
 
 
 def test_a_partial_row_is_the_rate_row_of_its_scenarios():
@@ -125,10 +130,14 @@ def test_a_partial_row_is_the_rate_row_of_its_scenarios():
     ctx = sampled_context(design.spec, design.spec.K_table)
     kw = dict(dt_p=1e-3, predictor_step=1e-3, q=8.0, tau=0.002)
     full = S.rate_row(ctx, 100.0, **kw).metrics
-    brake = S.partial_row(ctx, 100.0, (1,), **kw).metrics
+
+    def part(scenarios):
+        return RS.partial_row(S.runs_of(ctx, 1e-3), S.declaration(ctx), 100.0, scenarios,
+                              8.0, 0.002, 1e-3).metrics
+    brake = part((1,))
     assert set(brake) == set(S.BRAKING_METRICS) | {"braking_diverged"}
     assert {k: repr(v) for k, v in brake.items()} == {k: repr(full[k]) for k in brake}
-    both = S.partial_row(ctx, 100.0, (0, 1), **kw).metrics
+    both = part((0, 1))
     assert {k: repr(v) for k, v in both.items()} == {k: repr(full[k]) for k in both}
     assert set(both) == set(full)
 

@@ -161,6 +161,20 @@ def test_bad_input_is_one_clear_error(kw, match):
         implementation(A0, K0, B=B0, **kw)
 
 
+def test_predictor_sampling_of_the_standard_example():
+    """The general loop with a known loop delay (:func:`predictor_sampling`) on
+    Zhang, Branicky & Phillips' example: the predictor gives the delay-free
+    bound, without it the delay costs sampling interval."""
+    from workbench.features.sampled import predictor_sampling
+    c = predictor_sampling(A0, B0, K0.ravel(), 0.1, 0.02)
+    assert c.K.shape == (1, 2) and (c.h, c.measurement_delay) == (0.1, 0.02)
+    free = implementation(A0, K0, B=B0)
+    assert c.predictor.T_certified == free.T_certified
+    late = implementation(A0, K0, B=B0, network_delay=(0.1, 0.12))
+    assert c.delayed.T_certified == late.T_certified < free.T_certified
+    assert c.rate_delayed == 1.0 / late.T_certified
+
+
 def test_cruise_loop_003_certified_rate():
     """Paper 003's cruise linearisation with the Table 3 gain: certified without a
     predictor for a 43.3 ms + 2 ms delay at a rate far below the simulated 25 Hz."""

@@ -18,7 +18,7 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["replay", "window", "WindowReplay", "replay_windows"]
+__all__ = ["replay", "window", "WindowReplay", "WindowCheck", "replay_windows"]
 
 
 @dataclass(frozen=True)
@@ -31,6 +31,33 @@ class WindowReplay:
     d_abs: tuple
     d_rel: tuple
     pieces: int
+
+    def check(self, key, span: int = 0) -> "WindowCheck":
+        """The window in numbers (:class:`WindowCheck`), ``key`` the run's
+        (a rate, say), the range of state ``span`` (0: the first)."""
+        rec, x = self.rec, self.rec[:, 1 + span]
+        return WindowCheck(key, self.name, float(rec[0, 0]), float(rec[-1, 0]),
+                           float(x.min()), float(x.max()), self.pieces, len(rec), self.d_abs,
+                           self.d_rel)
+
+
+@dataclass(frozen=True)
+class WindowCheck:
+    """A replayed window without its record: the run's ``key``, the window's
+    name, its first and last times, the range [lo, hi] of one state over it,
+    the input pieces and mesh points replayed, and per state the largest
+    absolute and relative differences (:meth:`WindowReplay.check`)."""
+
+    key: object
+    name: str
+    t0: float
+    t1: float
+    lo: float
+    hi: float
+    pieces: int
+    points: int
+    d_abs: tuple
+    d_rel: tuple
 
 
 def window(rec: np.ndarray, t0: float, t1: float) -> np.ndarray:

@@ -41,11 +41,14 @@ from dataclasses import dataclass, field
 from typing import Callable, Mapping
 
 from .refinement import guarded_check
+from ..jsonable import json_method
 from ..sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
 
 __all__ = ["RateMetrics", "Runs", "RateRow", "Variant", "ThreeLevel", "three_level_check",
            "rate_row", "partial_row", "sweep_variant", "claimed_rate_metrics", "variants",
-           "read_rates", "read_inputs", "quantity_names", "quantities", "quantity_value"]
+           "read_rates", "read_inputs", "quantity_names", "quantities", "quantity_value",
+           "SweepTable", "read_table", "sweep", "sweep_quantity_names", "sweep_quantities",
+           "Trace", "SweepResult"]
 
 
 def variants(q: float, tau: float) -> tuple:
@@ -72,6 +75,52 @@ def read_inputs(t, unit: str) -> tuple:
     give the variants (:func:`variants`)."""
     return (t.quantity("quantisation", unit, positive=True, default=None),
             t.quantity("measurement_delay", "s", nonneg=True, hi=0.5, default=None))
+
+
+@dataclass(frozen=True)
+class SweepTable:
+    """The general keys of a design's rate-sweep table (:func:`read_table`):
+    the grid ``rates`` (Hz), the largest plant sub-step ``plant_step`` (s),
+    the ``bisect`` steps, the optional ``quantisation`` and
+    ``measurement_delay`` (:class:`workbench.reader.Quantity`) and
+    ``three_level``, the ((variant, rate, metric), ...) the design's claims
+    compare (:func:`claimed_rate_metrics`). A system's own table subclasses it."""
+
+    rates: tuple
+    plant_step: float
+    bisect: int
+    quantisation: object = None
+    measurement_delay: object = None
+    three_level: tuple = ()
+
+    def variants(self) -> tuple:
+        """The variants of the table's inputs (:func:`variants`)."""
+        q = 0.0 if self.quantisation is None else self.quantisation.value
+        tau = 0.0 if self.measurement_delay is None else self.measurement_delay.value
+        return variants(q, tau)
+
+
+def read_table(t, unit: str, *, plant_step_hi: float) -> dict:
+    """The :class:`SweepTable` keys of a design table ``t`` as keyword
+    arguments (``three_level`` not included): ``rates_hz``, ``plant_step``
+    (s, positive, at most ``plant_step_hi``), ``bisect`` (default 4, at most
+    12), the inputs (:func:`read_inputs`, the command in ``unit``)."""
+    rates = read_rates(t)
+    step = t.number("plant_step", positive=True, hi=plant_step_hi, what="number (s)")
+    return dict(rates=rates, plant_step=step, bisect=t.number(
+        "bisect", integer=True, default=4, lo=0, hi=12, what="integer"),
+        **dict(zip(("quantisation", "measurement_delay"), read_inputs(t, unit))))
+
+
+@dataclass(frozen=True)
+class Trace:
+    """A time trace of a run for a figure: the variant's name (or a
+    reference's), the rate, the times and the values ``y`` (arrays)."""
+
+    variant: str
+    rate: float
+    t: object
+    y: object
 
 
 @dataclass(frozen=True)
@@ -330,6 +379,39 @@ def sweep_variant(runs: Runs, decl: RateMetrics, rates: tuple, step: float, name
     return Variant(name, q, tau, rows, probes, min_rate, bracket, mesh, fines, checks, quarter)
 
 
+def sweep(runs: Runs, decl: RateMetrics, table: SweepTable) -> tuple:
+    """Every variant of ``table`` over its grid (:func:`sweep_variant`)."""
+    return tuple(sweep_variant(runs, decl, table.rates, table.plant_step, name, q, tau,
+                               bisect=table.bisect, claimed=table.three_level)
+                 for name, q, tau in table.variants())
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """A sweep as a section shows it: its table ``spec``
+    (:class:`SweepTable`), the ``reference`` row (the controller not
+    sampled, say) at step ``reference_step``, the ``variants``
+    (:func:`sweep`), the windows replayed against Radau (``checks``,
+    :class:`workbench.features.mesh_replay.WindowCheck`) and the figure's
+    ``traces`` (:class:`Trace`). A system's own result subclasses it."""
+
+    spec: SweepTable
+    reference: RateRow
+    reference_step: float
+    variants: tuple
+    checks: tuple = ()
+    traces: tuple = ()
+
+    def variant(self, name: str) -> Variant:
+        return next(v for v in self.variants if v.name == name)
+
+    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
+    JSON_FIELDS = {"reference": "reference.metrics",
+                   "variants": lambda r: {v.name: v.json() for v in r.variants},
+                   "checks": "checks"}
+    to_json = json_method
+
+
 def claimed_rate_metrics(prefix: str, variants, rates: tuple, names: tuple, max_rate: float,
                          claims, alias: Mapping[str, str] | None = None) -> tuple:
     """((variant, rate, metric), ...), sorted: the rate metrics that the
@@ -388,4 +470,25 @@ def quantities(prefix: str, v: Variant, metrics: tuple, reference: str = "",
         q.update({f"{b}.rate[{r.rate:g}].{m}": quantity_value(r.metrics[m]) for m in metrics})
         for d, m in (differences or {}).items():
             q[f"{b}.rate[{r.rate:g}].{d}"] = quantity_value(r.metrics[m] - ref[m])
+    return q
+
+
+def sweep_quantity_names(prefix: str, table: SweepTable, metrics: tuple, reference: str,
+                         gaps: tuple = (), differences=()) -> set[str]:
+    """The quantities of a sweep (:func:`sweep_quantities`)."""
+    names = {f"{prefix}.{reference}.{m}" for m in metrics}
+    for name, _, _ in table.variants():
+        names |= quantity_names(prefix, name, table.rates, metrics, reference, gaps,
+                                differences)
+    return names
+
+
+def sweep_quantities(prefix: str, variants_: tuple, metrics: tuple, reference: str,
+                     ref: dict, gaps: tuple = (), differences=None) -> dict:
+    """The quantities of a sweep: ``<prefix>.<reference>.<m>`` of the
+    reference's metrics ``ref``, then those of every variant
+    (:func:`quantities`)."""
+    q = {f"{prefix}.{reference}.{m}": quantity_value(ref[m]) for m in metrics}
+    for v in variants_:
+        q.update(quantities(prefix, v, metrics, reference, ref, gaps, differences))
     return q

@@ -14,7 +14,8 @@ from ..report.markdown import fmt, md_table
 from ..sim.convergence import P_MAX, P_MIN
 
 __all__ = ["bound", "variant_label", "variant_sources", "summary_lines", "rate_tables",
-           "mesh_table", "mesh_text", "three_level_text", "plot_rate_metric", "plot_traces"]
+           "mesh_table", "mesh_text", "three_level_text", "replay_table", "replay_text", "plot_rate_metric",
+           "plot_rate_panels", "plot_traces"]
 
 
 def variant_label(v, input_name: str, unit: str) -> str:
@@ -157,6 +158,31 @@ def three_level_text(variants, label, *, max_rate: float, step: float, scenarios
          "outcome"], rows, "lrlrrrrrl")
 
 
+def replay_table(checks, head: list, differences) -> str:
+    """The windows replayed against Radau
+    (:class:`workbench.features.mesh_replay.WindowCheck`): per window its
+    key, name, times, state range and input pieces, then each of
+    ``differences`` (check -> a difference, printed by :func:`bound`);
+    ``head``: the headings of these columns."""
+    rows = [[fmt(c.key), c.name, f"{fmt(c.t0, 5)}–{fmt(c.t1, 5)}",
+             f"{fmt(c.lo, 2)}–{fmt(c.hi, 2)}", str(c.pieces)] + [bound(d(c)) for d in differences]
+            for c in checks]
+    return md_table(head, rows, "lllrr" + "r" * len(differences))
+
+
+def replay_text(table: str, *, input_name: str, receiver: str, samples: int, variant: str,
+                rtol: float, model: str) -> str:
+    """*Radau*: the words of the replay check
+    (:mod:`workbench.features.mesh_replay`) before its ``table``
+    (:func:`replay_table`): the ``input_name`` the ``receiver`` received in
+    a window of ``samples`` samples of ``variant``, ``rtol``, ``model``: the
+    right-hand side Radau integrates, in words."""
+    return (f"*Radau*: the {input_name} {receiver} received in a window of {samples} samples "
+            f"({variant}) replayed into scipy's `solve_ivp(method=\"Radau\")` (rtol "
+            f"{fmt(rtol)}), restarted from its own state at every change of the {input_name}, "
+            f"against the mesh at each of its points ({model}):\n\n" + table)
+
+
 def plot_rate_metric(ax, variants, key: str, failed: str, color, label, *,
                      shift: float = 0.0, reference: float | None = None,
                      reference_label: str = "") -> None:
@@ -177,6 +203,23 @@ def plot_rate_metric(ax, variants, key: str, failed: str, color, label, *,
     if reference is not None and not math.isnan(reference):
         ax.axhline(reference - shift, color="k", ls="--", lw=0.8, label=reference_label)
     ax.set_xscale("log")
+
+
+def plot_rate_panels(fig, variants, panels, color, label, reference: dict,
+                     reference_label: str, shifts: dict | None = None, cols: int = 2):
+    """Panels of :func:`plot_rate_metric` on a shared rate axis, ``cols`` a
+    row: ``panels`` ((metric, y label, failed), ...); ``reference``: metric
+    -> the reference's value; ``shifts``: metric -> its shift. Returns the
+    axes (flat)."""
+    axes = fig.subplots(-(-len(panels) // cols), cols, sharex=True).ravel()
+    for ax, (key, ylabel, failed) in zip(axes, panels):
+        plot_rate_metric(ax, variants, key, failed, color, label,
+                         shift=(shifts or {}).get(key, 0.0), reference=reference[key],
+                         reference_label=reference_label)
+        ax.set_ylabel(ylabel)
+    for ax in axes[-cols:]:
+        ax.set_xlabel("control rate f_c (Hz)")
+    return axes
 
 
 def plot_traces(ax, traces, y: str, color, label, styles: dict) -> None:

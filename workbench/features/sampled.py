@@ -21,6 +21,12 @@ Design table (optional; absent: no implementation section)::
 Claimable quantities: ``implementation.T_certified``, ``.T_exact`` (first
 unstable constant period at the total delays' ends), ``.ratio``,
 ``.outcome``, ``.rate_certified`` (1 / T_certified, Hz).
+
+:func:`predictor_sampling`: a loop whose commands reach the plant a known
+loop delay late, certified with a predictor covering it (a delay-free
+sampled loop) and without (the delay, plus a measurement delay, as a
+network delay). Test on a system of no paper:
+``tests/test_sampled_implementation.py``.
 This module's top level stays light (the design reader imports it).
 """
 from __future__ import annotations
@@ -30,7 +36,7 @@ from dataclasses import dataclass
 
 __all__ = ["ImplementationSettings", "load_implementation_settings", "run_implementation",
            "implementation_quantity_names", "implementation_quantities",
-           "render_implementation_section"]
+           "render_implementation_section", "PredictorSampling", "predictor_sampling"]
 
 #: Grid of the (T, tau) stability map of the figure, and the largest input queue drawn.
 MAP_T, MAP_TAU, MAP_QUEUE = 48, 36, 120
@@ -166,6 +172,43 @@ def render_implementation_section(spec, di: DesignImplementation) -> tuple[str, 
     fig = Figure("implementation", "Exact periodic stability over (T, delay) and the "
                  "certified region.", lambda f, d=di: _plot(f, d), (6.4, 4.4))
     return text, (fig,)
+
+
+@dataclass(frozen=True)
+class PredictorSampling:
+    """Certified sampling of u = K x(t_k), held (ZOH), with and without a
+    predictor over the loop delay ``h`` (:func:`predictor_sampling`)."""
+
+    K: object
+    h: float
+    measurement_delay: float
+    predictor: object          # ImplementationResult, delay-free
+    delayed: object            # ImplementationResult, network delay [h, h + measurement_delay]
+
+    @property
+    def rate_delayed(self) -> float:
+        """Certified lowest control rate without a predictor (Hz)."""
+        return 1.0 / self.delayed.T_certified
+
+
+def predictor_sampling(A, B, K, h: float, measurement_delay: float) -> PredictorSampling:
+    """Certified lowest control rates of the loop x' = A x + B u, u = K x(t_k)
+    held, whose commands reach the plant ``h`` s after the sample.
+
+    **With the predictor** (exact prediction over the loop delay): the plant
+    sees K x(s_k) from s_k on, a delay-free sampled loop, certified for every
+    interval sequence by :mod:`workbench.lmi.sampled`. **Without a
+    predictor**: the command arrives ``h`` plus ``measurement_delay`` late,
+    certified by the input-delay approach (:func:`workbench.digital.implementation`
+    with that network delay).
+    """
+    import numpy as np
+
+    from ..digital import implementation
+    A, B = np.asarray(A, float), np.asarray(B, float)
+    K = np.asarray(K, float).reshape(B.shape[1], -1)
+    return PredictorSampling(K, h, measurement_delay, implementation(A, K, B=B),
+                             implementation(A, K, B=B, network_delay=(h, h + measurement_delay)))
 
 
 def _plot(fig, di: DesignImplementation) -> None:

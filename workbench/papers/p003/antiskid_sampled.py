@@ -35,16 +35,15 @@ The *emulation* row is the case's controller as the other sections run it
 (every step of dt/2, the stiff hold with its mismatch estimate, the plant
 stepped with the control step), in the same two scenarios.
 
-The sweep itself is general (:mod:`workbench.features.rate_sweep`: the
-table's grid and inputs, the variants, the grid, the lowest passing rate
-and its bisection bracket, the mesh check of
-every grid rate up to :data:`MESH_CHECK_MAX_HZ` at ``plant_step`` / 2 within
-:data:`MESH_ATOL`, the three levels plant_step, /2, /4 of every rate metric a
-claim compares, every run made once). What stays here is paper 003's: the
-``[sampled]`` table, the kernel as the sweep's ``run`` callback
-(:func:`runs_of`), the metrics of a rate and their tolerances
-(:func:`rate_metrics`, :func:`declaration`), the emulation row, the traces of
-the figure, the quantity names, and the plant's mesh against scipy's Radau
+The sweep is general (:mod:`workbench.features.rate_sweep`: the table's
+general keys, the variants, the grid, the lowest passing rate and its
+bisection bracket, the mesh check at ``plant_step`` / 2 up to
+:data:`MESH_CHECK_MAX_HZ` within :data:`MESH_ATOL`, the three levels of every
+claimed rate metric, the result and its quantities, every run made once).
+What stays here is paper 003's: the case, margin and predictor keys, the
+kernel as the sweep's ``run`` callback (:func:`runs_of`), the metrics of a
+rate and their tolerances (:func:`rate_metrics`, :func:`declaration`), the
+emulation as the reference, the traces' records, and the Radau windows
 (:mod:`.antiskid_sampled_check`).
 """
 from __future__ import annotations
@@ -53,13 +52,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from ...features import rate_sweep as RS
-from ...features.rate_sweep import (RateMetrics, RateRow, Runs, ThreeLevel,  # noqa: F401
-                                       Variant, three_level_check)
-from ...jsonable import json_method
-from ...reader import Quantity
 from .antiskid_sampled_check import RADAU_QUANTITIES, radau_checks, radau_quantities
 from .antiskid_sampled_kernel import OUT, Context, run_once
 
@@ -90,27 +83,14 @@ TO_EMULATION = {"stop_time_minus_emulation": "braking_duration",
 
 
 @dataclass(frozen=True)
-class SampledSpec:
-    """The design's ``[sampled]`` table (module docstring)."""
+class SampledSpec(RS.SweepTable):
+    """The design's ``[sampled]`` table (module docstring): the general keys
+    (:class:`workbench.features.rate_sweep.SweepTable`), the case, the
+    traction requirement's margin and the predictor's step."""
 
-    case: str
-    rates: tuple
-    creep_margin: float
-    plant_step: float
-    predictor_step: float
-    bisect: int
-    quantisation: Quantity | None
-    measurement_delay: Quantity | None
-    #: ((variant, rate, metric), ...): the rate metrics the design's claims
-    #: compare, checked at three levels of plant_step (:func:`claimed_rate_metrics`).
-    three_level: tuple = ()
-
-    def variants(self) -> tuple:
-        """((name, q in N m, tau in s), ...): ``zoh``, and ``zoh_q_tau`` when
-        the design gives a quantisation or a measurement delay."""
-        q = 0.0 if self.quantisation is None else self.quantisation.value
-        tau = 0.0 if self.measurement_delay is None else self.measurement_delay.value
-        return RS.variants(q, tau)
+    case: str = ""
+    creep_margin: float = 0.0
+    predictor_step: float = 0.0
 
 
 def load_sampled(root, case_names) -> SampledSpec | None:
@@ -120,13 +100,10 @@ def load_sampled(root, case_names) -> SampledSpec | None:
         return None
     t = root.table("sampled")
     case = t.string("case", choices=tuple(case_names))
-    rates = RS.read_rates(t)
-    out = SampledSpec(
-        case, rates, t.number("creep_margin", nonneg=True, hi=0.1),
-        t.number("plant_step", positive=True, hi=1e-3, what="number (s)"),
-        t.number("predictor_step", positive=True, hi=0.1, what="number (s)"),
-        t.number("bisect", integer=True, default=4, lo=0, hi=12, what="integer"),
-        *RS.read_inputs(t, "N m"))
+    out = SampledSpec(case=case, creep_margin=t.number("creep_margin", nonneg=True, hi=0.1),
+                      predictor_step=t.number("predictor_step", positive=True, hi=0.1,
+                                              what="number (s)"),
+                      **RS.read_table(t, "N m", plant_step_hi=1e-3))
     t.finish()
     return dataclasses.replace(out, three_level=claimed_rate_metrics(
         out, root.data.get("claims", [])))
@@ -143,36 +120,14 @@ def claimed_rate_metrics(spec: SampledSpec, claims) -> tuple:
 
 
 @dataclass(frozen=True)
-class Trace:
-    """lambda / lambda_opt - 1 on the plant's mesh from the start of traction."""
+class SampledResult(RS.SweepResult):
+    """Everything the sampled section shows (:func:`run_sampled`): the
+    sweep (the reference is the emulation at dt/2, the checks the Radau
+    windows, the traces lambda / lambda_opt - 1 from the start of traction),
+    lambda_opt and the peak adhesion torque."""
 
-    variant: str              # a variant's name, or "emulation"
-    rate: float
-    t: np.ndarray
-    excess: np.ndarray
-
-
-@dataclass(frozen=True)
-class SampledResult:
-    """Everything the sampled section shows (:func:`run_sampled`)."""
-
-    spec: SampledSpec
-    lambda_opt: float
-    u_peak: float
-    emulation: RateRow
-    emulation_dt: float
-    variants: tuple
-    radau: tuple = ()         # antiskid_sampled_check.RadauCheck
-    traces: tuple = ()        # Trace
-
-    def variant(self, name: str) -> Variant:
-        return next(v for v in self.variants if v.name == name)
-
-    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
-    JSON_FIELDS = {"emulation": "emulation.metrics",
-                   "variants": lambda r: {v.name: v.json() for v in r.variants},
-                   "radau": "radau"}
-    to_json = json_method
+    lambda_opt: float = math.nan
+    u_peak: float = math.nan
 
 
 def rate_metrics(ctx: Context, trac: dict, brake: dict) -> dict:
@@ -195,65 +150,50 @@ def rate_metrics(ctx: Context, trac: dict, brake: dict) -> dict:
             "traction_diverged": trac["t_diverged"], "braking_diverged": brake["t_diverged"]}
 
 
-def declaration(ctx: Context) -> RateMetrics:
+def declaration(ctx: Context) -> RS.RateMetrics:
     """The metric declarations of the sampled section: :data:`RATE_METRICS`
     of a rate from its traction (0) and braking (1) runs (:func:`rate_metrics`;
     a scenario not run counts as NaN outputs)."""
     nan = dict.fromkeys(OUT, math.nan)
-    return RateMetrics(RATE_METRICS, (0, 1),
-                       lambda got: rate_metrics(ctx, got[0] or nan, got[1] or nan), NEEDS,
-                       MESH_ATOL, MESH_CHECK_MAX_HZ)
+    return RS.RateMetrics(RATE_METRICS, (0, 1),
+                          lambda got: rate_metrics(ctx, got[0] or nan, got[1] or nan), NEEDS,
+                          MESH_ATOL, MESH_CHECK_MAX_HZ)
 
 
-def runs_of(ctx: Context, predictor_step: float, emulation: bool = False) -> Runs:
+def runs_of(ctx: Context, predictor_step: float, emulation: bool = False) -> RS.Runs:
     """The memo of the kernel's runs (:func:`.antiskid_sampled_kernel.run_once`,
     its outputs) of the sampled controller (``emulation``: of the case's own
     controller, every step)."""
-    return Runs(lambda rate, s, q, tau, step: run_once(
+    return RS.Runs(lambda rate, s, q, tau, step: run_once(
         ctx, rate, s, q=q, tau=tau, dt_p=step, predictor_step=predictor_step,
         emulation=emulation)[0])
 
 
 def rate_row(ctx: Context, rate: float, *, dt_p: float, predictor_step: float,
-             q: float = 0.0, tau: float = 0.0, emulation: bool = False) -> RateRow:
+             q: float = 0.0, tau: float = 0.0, emulation: bool = False) -> RS.RateRow:
     """Both scenarios at one rate, run now (the study's runs: :func:`run_sampled`)."""
     return RS.rate_row(runs_of(ctx, predictor_step, emulation), declaration(ctx), rate, q,
                        tau, dt_p)
-
-
-def partial_row(ctx: Context, rate: float, scenarios: tuple, *, dt_p: float,
-                predictor_step: float, q: float = 0.0, tau: float = 0.0) -> RateRow:
-    """The metrics of ``scenarios`` (0 traction, 1 braking) at one rate
-    (:func:`workbench.features.rate_sweep.partial_row`)."""
-    return RS.partial_row(runs_of(ctx, predictor_step), declaration(ctx), rate, scenarios,
-                          q, tau, dt_p)
-
-
-def scenarios_of(metric: str) -> tuple:
-    """The scenarios (0 traction, 1 braking) a rate metric is computed from."""
-    return NEEDS.get(metric, (0, 1))
 
 
 def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:
     """The sampled section of an ``antiskid-run`` design with ``[sampled]``
     (``ctx``: :func:`workbench.papers.p003.antiskid_run_spec.sampled_context`;
     ``dt``: the design's step, the emulation runs at dt/2): the emulation
-    row, every variant (:func:`workbench.features.rate_sweep.sweep_variant`),
+    row, every variant (:func:`workbench.features.rate_sweep.sweep`),
     the traces of the figure, the Radau check (on the grid's runs and the
     traces' records)."""
     dt_e = dt / 2
     decl = declaration(ctx)
     emu = RS.rate_row(runs_of(ctx, 0.0, emulation=True), decl, 1.0 / dt_e, 0.0, 0.0, dt_e)
     runs = runs_of(ctx, spec.predictor_step)
-    variants = tuple(RS.sweep_variant(runs, decl, spec.rates, spec.plant_step, name, q, tau,
-                                      bisect=spec.bisect, claimed=spec.three_level)
-                     for name, q, tau in spec.variants())
+    variants = RS.sweep(runs, decl, spec)
     recs = trace_records(ctx, spec, dt_e)
-    shown = tuple(Trace(name, f, rec[:, 0].copy(), rec[:, 2] / ctx.cs.lambda_opt - 1.0)
+    shown = tuple(RS.Trace(name, f, rec[:, 0].copy(), rec[:, 2] / ctx.cs.lambda_opt - 1.0)
                   for name, f, rec in recs)
     zoh = {f: rec for name, f, rec in recs if name == "zoh"}
-    return SampledResult(spec, ctx.cs.lambda_opt, ctx.u_peak, emu, dt_e, variants,
-                         radau_checks(ctx, spec, runs, zoh), shown)
+    return SampledResult(spec, emu, dt_e, variants, radau_checks(ctx, spec, runs, zoh), shown,
+                         lambda_opt=ctx.cs.lambda_opt, u_peak=ctx.u_peak)
 
 
 def trace_records(ctx: Context, spec: SampledSpec, dt_e: float) -> list:
@@ -275,19 +215,12 @@ def trace_records(ctx: Context, spec: SampledSpec, dt_e: float) -> list:
 
 def sampled_quantity_names(spec: SampledSpec) -> set[str]:
     """The ``sampled.*`` quantities a design with ``[sampled]`` has."""
-    names = {f"sampled.emulation.{m}" for m in RATE_METRICS} | set(RADAU_QUANTITIES)
-    for name, _, _ in spec.variants():
-        names |= RS.quantity_names("sampled", name, spec.rates, RATE_METRICS, "emulation",
-                                   GAP_METRICS, TO_EMULATION)
-    return names
+    return RS.sweep_quantity_names("sampled", spec, RATE_METRICS, "emulation", GAP_METRICS,
+                                   TO_EMULATION) | set(RADAU_QUANTITIES)
 
 
 def sampled_quantities(res: SampledResult) -> dict:
     """Values of :func:`sampled_quantity_names`."""
-    emu = res.emulation.metrics
-    q = {f"sampled.emulation.{m}": RS.quantity_value(emu[m]) for m in RATE_METRICS}
-    q.update(radau_quantities(res.radau, res.lambda_opt))
-    for v in res.variants:
-        q.update(RS.quantities("sampled", v, RATE_METRICS, "emulation", emu, GAP_METRICS,
-                               TO_EMULATION))
-    return q
+    return {**RS.sweep_quantities("sampled", res.variants, RATE_METRICS, "emulation",
+                                  res.reference.metrics, GAP_METRICS, TO_EMULATION),
+            **radau_quantities(res.checks, res.lambda_opt)}

@@ -23,11 +23,8 @@ of the ``zoh`` variant.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
-import numpy as np
-
-from ...features.mesh_replay import replay as mesh_replay, replay_windows, window as _window
+from ...features.mesh_replay import replay_windows
 from ...sim.wheel_slip import model_functions
 from .antiskid_sampled_kernel import run_once
 
@@ -44,44 +41,23 @@ RADAU_QUANTITIES = ("sampled.radau.max_dlam_over_opt", "sampled.radau.max_dv_rel
                     "sampled.radau.windows")
 
 
-@dataclass(frozen=True)
-class RadauCheck:
-    """One window: times (s), speed range (m/s), torque pieces replayed, and
-    the largest |lambda_mesh - lambda_Radau| and |v_mesh - v_Radau| / v over
-    its mesh points."""
-
-    rate: float
-    window: str
-    t0: float
-    t1: float
-    v_lo: float
-    v_hi: float
-    pieces: int
-    points: int
-    max_dlam: float
-    max_dv_rel: float
-
-
-def _rhs(p, u):
+def plant_rhs(p):
+    """``rhs(u)`` -> ``f(t, (v, lambda))`` of the plant with parameters ``p``
+    under the constant torque u (for :func:`workbench.features.mesh_replay.replay`)."""
     fns = model_functions("math")
 
-    def f(t, x):
-        v, lam = x
-        y = fns["traction" if lam >= 0 else "braking"](max(v, 1e-3), lam, *p)
-        return (y[0], y[1] + y[2] * u)
-    return f
-
-
-def replay(p, rec: np.ndarray) -> tuple[float, float, int]:
-    """(max |d lambda|, max |d v| / v, pieces) of the mesh record ``rec``
-    (rows t, v, lambda, torque over the sub-step ending at t) against Radau
-    from its first row (:func:`workbench.features.mesh_replay.replay`)."""
-    (_, dl), (dv, _), pieces = mesh_replay(lambda u: _rhs(p, u), rec, RTOL, ATOL)
-    return dl, dv, pieces
+    def rhs(u):
+        def f(t, x):
+            v, lam = x
+            y = fns["traction" if lam >= 0 else "braking"](max(v, 1e-3), lam, *p)
+            return (y[0], y[1] + y[2] * u)
+        return f
+    return rhs
 
 
 def radau_checks(ctx, spec, runs=None, traction: dict | None = None) -> tuple:
-    """:class:`RadauCheck` of every window at every rate of
+    """:class:`workbench.features.mesh_replay.WindowCheck` (key: the rate;
+    range: of v) of every window at every rate of
     :data:`RADAU_RATES_HZ` in the design's grid (``zoh``, unquantised).
 
     ``runs``: the section's :class:`workbench.features.rate_sweep.Runs` (the
@@ -113,11 +89,8 @@ def radau_checks(ctx, spec, runs=None, traction: dict | None = None) -> tuple:
                 return have
             cap = int((b - a) / spec.plant_step * 1.5) + 4 * int((b - a) * rate) + 16
             return run_once(ctx, rate, scen, record=(a, b, cap), **kw)[1][0]
-        for w in replay_windows(lambda u: _rhs(ctx.plant, u), wins, record, RTOL, ATOL):
-            rec = w.rec
-            out.append(RadauCheck(rate, w.name, float(rec[0, 0]), float(rec[-1, 0]),
-                                  float(rec[:, 1].min()), float(rec[:, 1].max()), w.pieces,
-                                  len(rec), w.d_abs[1], w.d_rel[0]))
+        out += [w.check(rate) for w in replay_windows(plant_rhs(ctx.plant), wins, record,
+                                                         RTOL, ATOL)]
     return tuple(out)
 
 
@@ -125,6 +98,6 @@ def radau_quantities(checks, lambda_opt: float) -> dict:
     """The :data:`RADAU_QUANTITIES` (None without a check)."""
     if not checks:
         return dict.fromkeys(RADAU_QUANTITIES)
-    return {"sampled.radau.max_dlam_over_opt": max(c.max_dlam for c in checks) / lambda_opt,
-            "sampled.radau.max_dv_rel": max(c.max_dv_rel for c in checks),
+    return {"sampled.radau.max_dlam_over_opt": max(c.d_abs[1] for c in checks) / lambda_opt,
+            "sampled.radau.max_dv_rel": max(c.d_rel[0] for c in checks),
             "sampled.radau.windows": len(checks)}

@@ -2,19 +2,18 @@
 (:mod:`workbench.papers.p003.antiskid_sampled`; pure rendering).
 
 The tables, the variants' words, the summary of the lowest rates, the mesh
-checks' text and the figure panels are general
-(:mod:`workbench.features.rate_sweep_render`); what stays here is paper
-003's wording: the cells of a rate (creep ratio, stop, e_vs), why a rate
-fails (traction or braking), the section's prose, the Radau table and the
-two figures' layout."""
+checks' text, the Radau table and its words and the figure panels are
+general (:mod:`workbench.features.rate_sweep_render`); what stays here is
+paper 003's wording: the cells of a rate (creep ratio, stop, e_vs), why a
+rate fails (traction or braking), the section's prose, the Radau table's
+headings and the two figures' layout."""
 from __future__ import annotations
 
 import math
 
 from ...features import rate_sweep_render as RR
-from ...features.rate_sweep_render import bound
 from ...printed_grid import printed_digits
-from ...report.markdown import Figure, fmt, md_table
+from ...report.markdown import Figure, fmt
 from .antiskid_sampled import MESH_ATOL, MESH_CHECK_MAX_HZ, TRACE_SECONDS
 from .antiskid_sampled_check import RTOL, WINDOW_SAMPLES
 from .antiskid_sampled_kernel import BRAKING_LEAD, EVS_SETTLE, TRACTION_TAIL
@@ -70,7 +69,7 @@ def sampled_section(res, rail: str) -> str:
             "time to v_d (s)", "traction", "t_brake → stop (s)", "stop distance (m)",
             "min λ, braking", "max e_vs (m/s)", "max |u| / T_adh", "braking"]
     tables = RR.rate_tables(res.variants, variant_label, head, _row, _row(
-        f"{EMULATION}, dt/2 = {fmt(res.emulation_dt)} s", res.emulation.metrics))
+        f"{EMULATION}, dt/2 = {fmt(res.reference_step)} s", res.reference.metrics))
     return (
         f"## {HEADING}\n\n"
         "The other sections run the laws as an *emulation*: the law is evaluated at every "
@@ -133,21 +132,17 @@ def three_level_text(res) -> str:
 
 def _checks_text(res) -> str:
     sp = res.spec
-    radau = [[fmt(c.rate), c.window, f"{fmt(c.t0, 5)}–{fmt(c.t1, 5)}",
-              f"{fmt(c.v_lo, 2)}–{fmt(c.v_hi, 2)}", str(c.pieces),
-              bound(c.max_dlam / res.lambda_opt), bound(c.max_dv_rel)] for c in res.radau]
     return (
         "**Checks of the plant's integration.** "
         + RR.mesh_text(res.variants, variant_label, MESH_ATOL, max_rate=MESH_CHECK_MAX_HZ,
                        step=sp.plant_step)
         + "\n\n" + three_level_text(res)
-        + "\n\n*Radau*: the torque the wheel received in a window of "
-        f"{WINDOW_SAMPLES} samples (ZOH variant) replayed into scipy's "
-        f"`solve_ivp(method=\"Radau\")` (rtol {fmt(RTOL)}), restarted from its own state at "
-        "every change of the torque, against the mesh at each of its points (the same "
-        "lambdified model):\n\n"
-        + md_table(["f_c (Hz)", "window", "t (s)", "v (m/s)", "torque pieces",
-                    "max |Δλ| / λ_opt", "max |Δv| / v"], radau, "lllrrrr")
+        + "\n\n" + RR.replay_text(RR.replay_table(
+            res.checks, ["f_c (Hz)", "window", "t (s)", "v (m/s)", "torque pieces",
+                         "max |Δλ| / λ_opt", "max |Δv| / v"],
+            (lambda c: c.d_abs[1] / res.lambda_opt, lambda c: c.d_rel[0])),
+            input_name="torque", receiver="the wheel", samples=WINDOW_SAMPLES,
+            variant="ZOH variant", rtol=RTOL, model="the same lambdified model")
         + "\n\nWhy not Radau for every run: a sampled run restarts the integration at every "
         "sample and every arriving command (10 000 restarts per simulated second at 5 kHz), "
         "each with a creep-ratio transient of time constant ~v/4000 s to resolve; scipy's "
@@ -168,18 +163,14 @@ def trace_figure(res) -> Figure:
 
 
 def plot_sampled(fig, res):
-    axes = fig.subplots(2, 2, sharex=True).ravel()
-    keys = (("lam_max_over_opt", "max λ / λ_opt − 1, traction (symlog)", "traction"),
-            ("evs_max_tracking", "max e_vs (m/s), braking", "braking"),
-            ("braking_duration", "t_brake → stop (s)", "braking"),
-            ("stop_distance", "stop distance (m)", "braking"))
-    shift = {"lam_max_over_opt": 1.0}          # the top left panel shows the excess over 1
-    for ax, (key, label, which) in zip(axes, keys):
-        RR.plot_rate_metric(ax, res.variants, key, f"{which}_diverged",
-                            lambda v: _COLORS.get(v.name, "tab:green"), variant_label,
-                            shift=shift.get(key, 0.0), reference=res.emulation.metrics[key],
-                            reference_label=EMULATION)
-        ax.set_ylabel(label)
+    keys = (("lam_max_over_opt", "max λ / λ_opt − 1, traction (symlog)", "traction_diverged"),
+            ("evs_max_tracking", "max e_vs (m/s), braking", "braking_diverged"),
+            ("braking_duration", "t_brake → stop (s)", "braking_diverged"),
+            ("stop_distance", "stop distance (m)", "braking_diverged"))
+    # the top left panel shows the excess over 1
+    axes = RR.plot_rate_panels(fig, res.variants, keys,
+                               lambda v: _COLORS.get(v.name, "tab:green"), variant_label,
+                               res.reference.metrics, EMULATION, {"lam_max_over_opt": 1.0})
     m = res.spec.creep_margin
     axes[0].axhline(0.0, color="grey", lw=0.8, label="λ_opt")
     axes[0].axhline(m, color="dimgrey", ls=":", lw=1.0, label="requirement λ_opt (1 + margin)")
@@ -187,14 +178,12 @@ def plot_sampled(fig, res):
     axes[0].set_ylim(bottom=-m / 1000)
     axes[1].axhline(EVS_BOUND, color="dimgrey", ls=":", lw=1.0)
     axes[1].set_yscale("log")
-    for ax in axes[2:]:
-        ax.set_xlabel("control rate f_c (Hz)")
     axes[0].legend(fontsize=6, loc="lower left")
 
 
 def plot_traces(fig, res):
     ax = fig.add_subplot(111)
-    RR.plot_traces(ax, res.traces, "excess", lambda tr: _COLORS.get(tr.variant, "tab:green"),
+    RR.plot_traces(ax, res.traces, "y", lambda tr: _COLORS.get(tr.variant, "tab:green"),
                    lambda tr: EMULATION if tr.variant == "emulation" else
                    f"{variant_label(res.variant(tr.variant))}, {fmt(tr.rate)} Hz",
                    {100.0: "-", 1000.0: "--"})
