@@ -14,7 +14,7 @@ from workbench.cli import main
 from workbench.design import load_design
 from workbench.kinds import REGISTRY
 from workbench.kinds.stop_accuracy.pipeline import Factor, apply_factors, group_statistics
-from workbench.kinds.stop_accuracy.run import run
+from workbench.kinds.stop_accuracy.run import run, stopping_points
 
 ROOT = Path(__file__).resolve().parent.parent
 ATO = ROOT / "designs" / "stop-accuracy-004-ato.toml"
@@ -50,15 +50,14 @@ def test_ato_open_reproduces_closed_loop_brake():
     ATO open-loop stop errors draw by draw, bit for bit (10 draws, 50 km/h;
     all 200 draws at both speeds are equal too, 166/200 and 164/200 within
     0.3 m, as reports/closed-loop-brake-004.md prints)."""
-    from workbench.papers.p004.closed_loop_brake import stopping_point, view
     from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
     d = load_design(ATO)
     spec = _small(d.spec, samples=10, speeds=(50.0,))
     res = run(spec)
-    p4 = view(load_design(ROOT / "designs" / "closed-loop-brake-004.toml").spec)
+    p4 = load_design(ROOT / "designs" / "closed-loop-brake-004.toml").spec
     p4 = dataclasses.replace(p4, speeds_kmh=(50.0,),
                              montecarlo=dataclasses.replace(p4.montecarlo, samples=10))
-    D = stopping_point(p4, 50 / 3.6)
+    D = stopping_points(p4)[50.0]
     assert res.distance[50.0] == D
     ref = run_montecarlo(p4, {50.0: D})[50.0, "ato-open"]
     got = res.mc[50.0, "ato_open"]

@@ -15,7 +15,7 @@ import pytest
 from workbench.cli import main
 from workbench.design import load_design
 from workbench.kinds.stop_accuracy.decel_loop import axle_speeds
-from workbench.kinds.stop_accuracy.run import run
+from workbench.kinds.stop_accuracy.run import run, stopping_points
 
 ROOT = Path(__file__).resolve().parent.parent
 CLOSED = ROOT / "designs" / "stop-accuracy-004-closed.toml"
@@ -31,16 +31,16 @@ CORNERS = {"force_error": (0.0, 0.15), "gradient": (-30.0, 0.0), "friction": (1.
 def both():
     """The kind's run and the study's, on 4 Monte Carlo draws and a 2 x 2 x 2
     grid from 50 km/h."""
-    from workbench.papers.p004.closed_loop_brake import run_grid, stopping_point, view
+    from workbench.papers.p004.closed_loop_brake import run_grid
     from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
     spec = load_design(CLOSED).spec
     spec = dataclasses.replace(spec, speeds_kmh=(50.0,), convergence=False,
                                montecarlo=dataclasses.replace(spec.montecarlo, samples=4),
                                grid=tuple((k, CORNERS[k]) for k, _ in spec.grid))
-    p4 = view(load_design(P004).spec)
-    p4 = dataclasses.replace(p4, speeds_kmh=(50.0,), **CORNERS,
+    p4 = load_design(P004).spec
+    p4 = dataclasses.replace(p4, speeds_kmh=(50.0,), grid=tuple((k, CORNERS[k]) for k, _ in p4.grid),
                              montecarlo=dataclasses.replace(p4.montecarlo, samples=4))
-    D = stopping_point(p4, 50 / 3.6)
+    D = stopping_points(p4)[50.0]
     return run(spec), run_grid(p4, montecarlo=False), run_montecarlo(p4, {50.0: D}), D
 
 

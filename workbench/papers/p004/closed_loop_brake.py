@@ -29,22 +29,24 @@ its claims name and the report's wording. The modes:
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ...features.quantities import Declared, names, units, values
-from ...kinds.stop_accuracy.pipeline import open_loop_distance
 from ...kinds.stop_accuracy.quantities import mc_family
 from ...kinds.stop_accuracy.run import speed_key
 from ...reader import Reader
 from ...tuning.pid import Damping, damping, deceleration_loop
-from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, FAULTS, FULL, MC_MODES,
-                                    run_horizon_sweep, run_montecarlo, simulate_brake)
-from .closed_loop_brake_spec import Paper004, Spec004, compute_worked, load, view
+from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, ELECTRIC_LOSS, FAULT_NAMES, FULL,
+                                    MC_MODES, run_curves, run_horizon_sweep, run_montecarlo)
+from .closed_loop_brake_spec import Paper004, compute_worked, load, loop_values
 
-__all__ = ["ANALYSIS", "Result004", "Run", "Spec004", "compute_worked", "decel_damping",
-           "run_grid", "stopping_point", "TABLE", "view"]
+__all__ = ["ANALYSIS", "NOMINAL", "Result004", "Run", "compute_worked", "decel_damping",
+           "run_grid", "TABLE"]
+
+#: the nominal corner (force error, gradient permille, friction factor)
+NOMINAL = (0.0, 0.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -88,69 +90,51 @@ class Result004:
         return float(max(errs)) if errs and all(np.isfinite(errs)) else float("nan")
 
 
-def _cases(spec: Spec004) -> list[Run]:
-    runs = []
+def run_grid(spec, *, montecarlo: bool = True) -> Result004:
+    """The error grid, the sensor faults and the electric-brake loss (the
+    kind's general run, without its Monte Carlo); with ``montecarlo`` also the
+    Monte Carlo of :data:`MC_MODES` and the horizon sweep."""
+    from ...kinds.stop_accuracy.quantities import feasible
+    from ...kinds.stop_accuracy.run import run
+    res = run(replace(spec, montecarlo=None, convergence=False))
+    keys = [k for k, _ in spec.grid]
+    corners = [dict(zip(keys, c)) for c in itertools.product(*(v for _, v in spec.grid))]
+    corners = [(c["force_error"], c["gradient"], c["friction"]) for c in corners]
+    runs, errors, feas = [], [], []
     for s in spec.speeds_kmh:
-        for fe, gr, fr in itertools.product(spec.force_error, spec.gradient, spec.friction):
-            runs.append(Run(s, "open", "analogue", fe, gr, fr, "healthy", True))
-            runs.append(Run(s, FULL, "analogue", fe, gr, fr, "healthy", True))
-            runs.append(Run(s, "ato-open", "analogue", fe, gr, fr, "healthy", True))
-            for ch in CHANNELS:
-                runs.append(Run(s, "closed", ch, fe, gr, fr, "healthy", True))
-        for f in FAULTS:
-            if f != "healthy":
-                runs.append(Run(s, "closed", "analogue", 0.0, 0.0, 1.0, f, True))
-        for mode in ("ato-open", "closed"):
-            runs.append(Run(s, mode, "analogue", 0.0, 0.0, 1.0, "healthy", False))
-    return runs
+        ok = feasible(res, s)
+        for k, corner in enumerate(corners):
+            for (m, ch), name in CONTROLLERS.items():
+                if m != FULL:
+                    runs.append(Run(s, m, ch, *corner, "healthy", True))
+                    errors.append(res.grid[s, name][k])
+                    feas.append(ok[k])
+        ok = ok[corners.index(NOMINAL)] if NOMINAL in corners else True
+        for f, label in FAULT_NAMES.items():
+            runs.append(Run(s, "closed", "analogue", *NOMINAL, label, True))
+            errors.append(res.faults[s, CONTROLLERS["closed", "analogue"], f])
+            feas.append(ok)
+        for m in ("ato-open", "closed"):
+            runs.append(Run(s, m, "analogue", *NOMINAL, "healthy", False))
+            errors.append(res.faults[s, CONTROLLERS[m, "analogue"], ELECTRIC_LOSS])
+            feas.append(ok)
+    fe = sorted({min(c[0] for c in corners), 0.0} & {c[0] for c in corners if c[1:] == (0.0, 1.0)})
+    curves = tuple((Run(spec.speeds_kmh[0], m, ch, f, 0.0, 1.0, "healthy", True), dx, v)
+                   for m, ch, f, dx, v in run_curves(spec, res.distance, fe))
+    return Result004(compute_worked(spec.paper.worked), res.distance, tuple(runs),
+                     tuple(errors), spec.tolerance, tuple(feas), curves,
+                     run_montecarlo(spec, res.distance) if montecarlo else None,
+                     decel_damping(spec),
+                     run_horizon_sweep(spec, res.distance) if montecarlo else (), spec)
 
 
-def stopping_point(spec: Spec004, v0: float) -> float:
-    """Nominal open-loop stopping distance of the single command (m)."""
-    return open_loop_distance({k: q.value for k, q in spec.params.items()}, spec.a_target, v0,
-                              dt=spec.dt, dt_ctrl=spec.dt_ctrl)
-
-
-def run_grid(spec: Spec004, *, montecarlo: bool = True) -> Result004:
-    """The error grid, the sensor faults, the electric-brake loss; with
-    ``montecarlo`` also the Monte Carlo and the horizon sweep."""
-    runs = _cases(spec)
-    n = len(runs)
-    D = {s: stopping_point(spec, s / 3.6) for s in spec.speeds_kmh}
-    arr = lambda f: np.array([f(r) for r in runs], float)
-    base = {k: q.value for k, q in spec.params.items()}
-    dist = arr(lambda r: D[r.speed_kmh])
-    tr = simulate_brake(
-        spec, v0=arr(lambda r: r.speed_kmh / 3.6), dist=dist,
-        controller=np.array([list(CONTROLLERS).index((r.mode, r.channel)) for r in runs]),
-        states=np.array([list(FAULTS[r.fault]) for r in runs]),
-        overrides={"K1": base["K1"] * arr(lambda r: r.friction),
-                   "v_ho": np.where(arr(lambda r: r.electric) > 0, base["v_ho"], 1e3)},
-        theta=arr(lambda r: r.gradient), kappa=1 + arr(lambda r: r.force_error))
-    err = tr.x_stop - dist
-    full = {(r.speed_kmh, r.force_error, r.gradient, r.friction): e
-            for r, e in zip(runs, err) if r.mode == FULL}
-    feasible = [bool(full.get((r.speed_kmh, r.force_error, r.gradient, r.friction), -1.0)
-                     <= -spec.tolerance) for r in runs]
-    keep = [k for k, r in enumerate(runs) if r.mode != FULL]
-    corners = {(0.0, 0.0, 1.0), (min(spec.force_error), 0.0, 1.0)}
-    curves = tuple((r, tr.x[:, k] - dist[k], tr.v[:, k]) for k, r in enumerate(runs)
-                   if r.speed_kmh == spec.speeds_kmh[0] and r.fault == "healthy" and r.electric
-                   and (r.force_error, r.gradient, r.friction) in corners and r.mode != FULL)
-    return Result004(compute_worked(spec.worked), D, tuple(runs[k] for k in keep),
-                     tuple(float(err[k]) for k in keep), spec.tolerance,
-                     tuple(feasible[k] for k in keep), curves,
-                     run_montecarlo(spec, D) if montecarlo else None, decel_damping(spec),
-                     run_horizon_sweep(spec, D) if montecarlo else (), spec.kind)
-
-
-def decel_damping(spec: Spec004) -> Damping:
+def decel_damping(spec) -> Damping:
     """Damping of the linearised deceleration PID loop (electric stage, dead
     time T1 plus one control period: sample and hold, and the backward
     difference of the measured speed)."""
-    p = {k: q.value for k, q in spec.params.items()}
-    return damping(*deceleration_loop(spec.pid["kp"], spec.pid["ki"], P1=p["P1"], T2=p["T2"],
-                                      tau=spec.tau_filter), p["T1"] + spec.dt_ctrl)
+    p, loop = {k: q.value for k, q in spec.params.items()}, loop_values(spec)
+    return damping(*deceleration_loop(loop["kp"], loop["ki"], P1=p["P1"], T2=p["T2"],
+                                      tau=loop["tau_filter"]), p["T1"] + spec.dt_ctrl)
 
 
 def _speeds(spec, **more) -> list:
@@ -183,7 +167,7 @@ def _feasible_max(r, s, ch):
     return max(feas) if feas else None
 
 
-_FAULTS = tuple(f for f in FAULTS if f != "healthy")
+_FAULTS = tuple(FAULT_NAMES.values())
 _CH = {"ch": CHANNELS}
 
 #: The quantities paper 004's claims name, declared once.
@@ -244,7 +228,7 @@ class ClosedLoopBrake:
         return units(TABLE, spec)
 
     def run(self, spec) -> Result004:
-        return run_grid(view(spec))
+        return run_grid(spec)
 
     def quantities(self, res: Result004) -> dict:
         return values(TABLE, res.spec, res)

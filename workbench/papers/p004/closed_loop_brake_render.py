@@ -8,9 +8,9 @@ import sympy as sp
 
 from ...kinds.stop_accuracy.render import error_colours, moving, quantity_table
 from ...report.markdown import Figure, Rendered, fmt, md_table
-from .closed_loop_brake_spec import view, worked_formulas
+from .closed_loop_brake_spec import loop_values, worked_formulas
 from .closed_loop_brake_fair_render import fault_text, figures, monte_carlo, retune_section
-from .closed_loop_brake_run import CHANNELS, FAULTS, MODES
+from .closed_loop_brake_run import CHANNELS, MODES, faults
 
 MODE_TEXT = {"open": "open loop, single command",
              "ato-open": "open loop + ATO re-commands (a_req sent as the brake demand: no "
@@ -37,24 +37,25 @@ def _worked_section(res, spec) -> str:
 
 
 def render(design, res) -> Rendered:
-    spec = view(design.spec)
+    spec, loop = design.spec, loop_values(design.spec)
+    grid = dict(spec.grid)
     sections = [
         "## Problem\n\nPaper 004 argues qualitatively that closing the loop on the measured "
         "deceleration cancels force errors, gradient and friction scatter; it gives no "
         "dynamics, gains or simulations. Here the brake is paper 000's electro-pneumatic "
         f"model (parameters below), the train brakes from {', '.join(fmt(s) for s in spec.speeds_kmh)} "
         f"km/h to a stopping point D = the nominal open-loop stopping distance of the single "
-        f"command {fmt(spec.a_target)} m/s² (D = "
+        f"command {fmt(spec.command)} m/s² (D = "
         + ", ".join(f"{fmt(d, 5)} m" for d in res.distance.values())
         + "), over the grid force error "
-        f"{list(spec.force_error)} × gradient {list(spec.gradient)} ‰ × air-brake friction "
-        f"factor {list(spec.friction)}. Modes: " + "; ".join(f"**{m}** = {MODE_TEXT[m]}" for m in MODES)
+        f"{list(grid['force_error'])} × gradient {list(grid['gradient'])} ‰ × air-brake "
+        f"friction factor {list(grid['friction'])}. Modes: " + "; ".join(f"**{m}** = {MODE_TEXT[m]}" for m in MODES)
         + ". The ATO's required deceleration is a_req = v_p² / (2 d_p) at the state predicted "
-        f"{fmt(spec.t_predict)} s ahead; the closed loop measures the deceleration from the "
+        f"{fmt(spec.constants['t_p'].value)} s ahead; the closed loop measures the deceleration from the "
         "maximum of four axle speeds (filtered derivative), uses the incremental fuzzy "
-        f"controller when |a_req − a_meas| > {fmt(spec.e_switch)} m/s² and PID below, and "
+        f"controller when |a_req − a_meas| > {fmt(loop['e_switch'])} m/s² and PID below, and "
         "falls back to the ATO open loop when all four axles are failed or sliding. The "
-        f"3-bit channel sends round(7 c / {fmt(spec.c_full)}) levels.\n\n"
+        f"3-bit channel sends round(7 c / {fmt(spec.c_max)}) levels.\n\n"
         + quantity_table("parameter", spec.params, 5),
         _worked_section(res, spec),
         retune_section(spec, res),
@@ -83,12 +84,12 @@ def render(design, res) -> Rendered:
         + _corner_details(res))
     frows = []
     for s in res.distance:
-        for f in FAULTS:
+        for f, axles in faults(spec).items():
             sel = res.select(speed_kmh=s, fault=f, mode="closed", channel="analogue",
                              force_error=0.0, gradient=0.0, friction=1.0, electric=True)
-            frows.append([fmt(s), f, FAULTS[f], fmt(sel[0][1], 3) if sel else "—",
-                          "fallback (ATO open loop)" if all(c in "sf" for c in FAULTS[f])
-                          else "closed, fault undetected" if set(FAULTS[f]) & set("hz")
+            frows.append([fmt(s), f, axles, fmt(sel[0][1], 3) if sel else "—",
+                          "fallback (ATO open loop)" if all(c in "sf" for c in axles)
+                          else "closed, fault undetected" if set(axles) & set("hz")
                           else "closed"])
         for m in ("ato-open", "closed"):
             sel = res.select(speed_kmh=s, mode=m, electric=False)
@@ -146,16 +147,17 @@ def _corner_details(res) -> str:
 
 def _plot_grid(fig, res, spec):
     cmap, norm = error_colours(res.tolerance)
+    grid = dict(spec.grid)
     speeds = list(res.distance)
-    nf = len(spec.friction)
+    nf = len(grid["friction"])
     gs = fig.add_gridspec(len(speeds), nf + 1, width_ratios=[1.0] * nf + [0.06])
     for i, s in enumerate(speeds):
-        for j, fr in enumerate(spec.friction):
+        for j, fr in enumerate(grid["friction"]):
             ax = fig.add_subplot(gs[i, j])
-            M = np.full((len(spec.force_error), len(spec.gradient)), np.nan)
+            M = np.full((len(grid["force_error"]), len(grid["gradient"])), np.nan)
             feas = np.ones(M.shape, bool)
-            for a, fe in enumerate(spec.force_error):
-                for b, gr in enumerate(spec.gradient):
+            for a, fe in enumerate(grid["force_error"]):
+                for b, gr in enumerate(grid["gradient"]):
                     sel = res.select(speed_kmh=s, mode="closed", channel="analogue", fault="healthy",
                                      electric=True, force_error=fe, gradient=gr, friction=fr)
                     M[a, b] = sel[0][1]
@@ -166,10 +168,10 @@ def _plot_grid(fig, res, spec):
                     ax.text(b, a, fmt(M[a, b], 2) + ("" if feas[a, b] else "\ninfeasible"),
                             ha="center", va="center", fontsize=7,
                             color="w" if abs(M[a, b]) > 2 * res.tolerance else "k")
-            ax.set_xticks(range(len(spec.gradient)))
-            ax.set_xticklabels([fmt(g) for g in spec.gradient])
-            ax.set_yticks(range(len(spec.force_error)))
-            ax.set_yticklabels([fmt(100 * f) for f in spec.force_error])
+            ax.set_xticks(range(len(grid["gradient"])))
+            ax.set_xticklabels([fmt(g) for g in grid["gradient"]])
+            ax.set_yticks(range(len(grid["force_error"])))
+            ax.set_yticklabels([fmt(100 * f) for f in grid["force_error"]])
             ax.grid(False)
             ax.set_title(f"{fmt(s)} km/h, friction ×{fmt(fr)}", fontsize=8)
             if i == len(speeds) - 1:
