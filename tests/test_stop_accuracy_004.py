@@ -48,25 +48,18 @@ def test_closed_loop_reproduces_closed_loop_brake_bit_for_bit(both):
     res, grid, mc, D = both
     assert res.distance[50.0] == D
     for name, channel in (("closed", "analogue"), ("closed_3bit", "3bit")):
-        ref = [e for _, e in grid.select(mode="closed", channel=channel, fault="healthy",
-                                         electric=True)]
-        assert res.grid[50.0, name] == tuple(ref)                   # corner by corner
+        assert res.grid[50.0, name] == grid.grid(50.0, "closed", channel)   # corner by corner
     from workbench.kinds.stop_accuracy.quantities import feasible
-    sel = [k for k, r in enumerate(grid.runs) if r.mode == "closed" and r.channel == "analogue"
-           and r.fault == "healthy" and r.electric]
-    assert feasible(res, 50.0) == [grid.feasible[k] for k in sel]    # [grid] feasible_with
-    assert 0 < sum(feasible(res, 50.0)) < len(sel)
+    assert feasible(res, 50.0) == grid.feasible(50.0)            # [grid] feasible_with
+    assert 0 < sum(feasible(res, 50.0)) < len(grid.corners())
     ref = mc[50.0, "closed"]
     np.testing.assert_array_equal(res.mc[50.0, "closed"].errors, ref.errors)   # draw by draw
-    nominal = dict(speed_kmh=50.0, mode="closed", channel="analogue", force_error=0.0,
-                   gradient=0.0, friction=1.0)
     for ours, theirs in FAULT_NAMES.items():
-        assert res.faults[50.0, "closed", ours] == grid.select(fault=theirs, **nominal)[0][1]
-    assert res.faults[50.0, "closed", "electric_loss"] == grid.select(
-        fault="healthy", electric=False, **nominal)[0][1]
-    # nominal corner: not on the reduced grid, on the study's healthy run
-    assert res.nominal[50.0, "closed"] == grid.select(fault="healthy", electric=True,
-                                                      **nominal)[0][1]
+        assert res.faults[50.0, "closed", ours] == grid.stop(50.0, fault=theirs)
+    assert res.faults[50.0, "closed", "electric_loss"] == grid.stop(50.0, fault="electric_loss")
+    # the nominal run is the grid's nominal corner, which the study's report printed
+    assert res.nominal[50.0, "closed"] == grid.stop(50.0) == res.grid[50.0, "closed"][
+        grid.corners().index((0.0, 0.0, 1.0))]
 
 
 def test_fallback_and_masking(both):

@@ -6,10 +6,13 @@ The design is a configuration of the general kind
 (:mod:`workbench.kinds.stop_accuracy`): the modes are its controllers (the
 ATO law an expression, the command generator its named module
 ``deceleration_loop``), the grid its ``[grid]``, the Monte Carlo its
-``[montecarlo]``, every run its simulation (:mod:`.closed_loop_brake_run`).
+``[montecarlo]``, the sensor faults and the electric-brake loss its
+``[[faults]]``; the grid, the faults and the nominal stops are the kind's
+general run (:func:`workbench.kinds.stop_accuracy.run.run`, kept whole in
+:attr:`Result004.kind`), the rest its batches (:mod:`.closed_loop_brake_run`).
 What stays here is paper 004's: the worked numbers of section 1.3 (sympy
-expressions written here once, ``[worked]``), the runs of its report and
-their names (``open``, ``ato-open``, ``closed``; channels ``analogue`` and
+expressions written here once, ``[worked]``), the names of its report's
+runs (``open``, ``ato-open``, ``closed``; channels ``analogue`` and
 ``3bit``; the axle-sensor cases of section 2.7 and the electric-brake loss at
 the nominal corner; the ATO-horizon sweep of ``[retuning]``), the quantities
 its claims name and the report's wording. The modes:
@@ -29,103 +32,95 @@ its claims name and the report's wording. The modes:
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass, replace
 
-import numpy as np
-
 from ...features.quantities import Declared, names, units, values
-from ...kinds.stop_accuracy.quantities import mc_family
-from ...kinds.stop_accuracy.run import speed_key
+from ...kinds.stop_accuracy.quantities import feasible, mc_family
+from ...kinds.stop_accuracy.run import run, speed_key
 from ...reader import Reader
 from ...tuning.pid import Damping, damping, deceleration_loop
-from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, ELECTRIC_LOSS, FAULT_NAMES, FULL,
-                                    MC_MODES, run_curves, run_horizon_sweep, run_montecarlo)
+from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, ELECTRIC_LOSS, FAULT_NAMES, MC_MODES,
+                                    run_curves, run_horizon_sweep, run_montecarlo)
 from .closed_loop_brake_spec import Paper004, compute_worked, load, loop_values
 
-__all__ = ["ANALYSIS", "NOMINAL", "Result004", "Run", "compute_worked", "decel_damping",
+__all__ = ["ANALYSIS", "NOMINAL", "Result004", "compute_worked", "corners", "decel_damping",
            "run_grid", "TABLE"]
 
 #: the nominal corner (force error, gradient permille, friction factor)
 NOMINAL = (0.0, 0.0, 1.0)
+#: a sensor fault's name in the report -> the design's fault
+_FAULT_KEYS = {v: k for k, v in FAULT_NAMES.items()}
 
 
-@dataclass(frozen=True)
-class Run:
-    """One simulated case."""
-
-    speed_kmh: float
-    mode: str
-    channel: str
-    force_error: float
-    gradient: float
-    friction: float
-    fault: str
-    electric: bool
+def corners(spec) -> list:
+    """(force error, gradient, friction) of every grid corner, in the grid's order."""
+    keys = [k for k, _ in spec.grid]
+    return [tuple(c[keys.index(k)] for k in ("force_error", "gradient", "friction"))
+            for c in itertools.product(*(v for _, v in spec.grid))]
 
 
 @dataclass(frozen=True)
 class Result004:
+    """The kind's general run and what paper 004's report adds to it."""
+
+    kind: object            # StopAccuracyResult: grid per (speed, controller), faults, nominal
     worked: dict
-    distance: dict          # speed -> stopping point D (m)
-    runs: tuple             # Run
-    errors: tuple           # stop error (m) per run (nan: no stop)
-    tolerance: float        # m, platform-door tolerance
-    feasible: tuple         # per run: full service can hold a_target on that corner
-    curves: tuple = ()      # (Run, position - D (m), speed (m/s)) of the curve corners
+    curves: tuple = ()      # (mode, channel, force error, position - D (m), speed (m/s))
     mc: dict | None = None  # (speed km/h, mode) -> StopStatistics of the Monte Carlo
     damping: Damping | None = None   # of the linearised deceleration PID loop
     sweep: tuple = ()       # (ATO horizon s, speed km/h, nominal closed-loop stop error m)
-    spec: object = None     # the design's StopAccuracySpec
 
-    def failing(self, **kw) -> list[tuple[Run, float]]:
-        """Runs (with errors) outside the tolerance among those selected."""
-        return [(r, e) for r, e in self.select(**kw) if not abs(e) <= self.tolerance]
+    @property
+    def spec(self):
+        return self.kind.spec
 
-    def select(self, **kw) -> list[tuple[Run, float]]:
-        return [(r, e) for r, e in zip(self.runs, self.errors)
-                if all(getattr(r, k) == v for k, v in kw.items())]
+    @property
+    def distance(self) -> dict:
+        return self.kind.distance
 
-    def max_abs(self, **kw) -> float:
-        errs = [abs(e) for _, e in self.select(**kw)]
-        return float(max(errs)) if errs and all(np.isfinite(errs)) else float("nan")
+    @property
+    def tolerance(self) -> float:
+        return self.kind.spec.tolerance
+
+    def corners(self) -> list:
+        return corners(self.spec)
+
+    def grid(self, s, mode: str, channel: str = "analogue") -> tuple:
+        """Stop errors (m) of a mode at every grid corner (healthy sensors)."""
+        return self.kind.grid[s, CONTROLLERS[mode, channel]]
+
+    def max_abs(self, s, mode: str, channel: str = "analogue") -> float:
+        """Largest |stop error| (m) of a mode over the grid; nan if a run did not stop."""
+        e = [abs(x) for x in self.grid(s, mode, channel)]
+        return float(max(e)) if e and all(math.isfinite(x) for x in e) else math.nan
+
+    def feasible(self, s) -> list:
+        """Per grid corner: full service from the first instant stops short of D."""
+        return feasible(self.kind, s)
+
+    def stop(self, s, mode: str = "closed", channel: str = "analogue",
+             fault: str = "healthy") -> float:
+        """Stop error (m) at the nominal corner: healthy, under a sensor fault
+        (its report name) or a fault of the design (``electric_loss``)."""
+        c = CONTROLLERS[mode, channel]
+        if fault == "healthy":
+            return self.kind.nominal[s, c]
+        return self.kind.faults[s, c, _FAULT_KEYS.get(fault, fault)]
 
 
 def run_grid(spec, *, montecarlo: bool = True) -> Result004:
-    """The error grid, the sensor faults and the electric-brake loss (the
-    kind's general run, without its Monte Carlo); with ``montecarlo`` also the
+    """The kind's general run (error grid, sensor faults, electric-brake loss,
+    without its Monte Carlo) and the curves; with ``montecarlo`` also the
     Monte Carlo of :data:`MC_MODES` and the horizon sweep."""
-    from ...kinds.stop_accuracy.quantities import feasible
-    from ...kinds.stop_accuracy.run import run
     res = run(replace(spec, montecarlo=None, convergence=False))
-    keys = [k for k, _ in spec.grid]
-    corners = [dict(zip(keys, c)) for c in itertools.product(*(v for _, v in spec.grid))]
-    corners = [(c["force_error"], c["gradient"], c["friction"]) for c in corners]
-    runs, errors, feas = [], [], []
-    for s in spec.speeds_kmh:
-        ok = feasible(res, s)
-        for k, corner in enumerate(corners):
-            for (m, ch), name in CONTROLLERS.items():
-                if m != FULL:
-                    runs.append(Run(s, m, ch, *corner, "healthy", True))
-                    errors.append(res.grid[s, name][k])
-                    feas.append(ok[k])
-        ok = ok[corners.index(NOMINAL)] if NOMINAL in corners else True
-        for f, label in FAULT_NAMES.items():
-            runs.append(Run(s, "closed", "analogue", *NOMINAL, label, True))
-            errors.append(res.faults[s, CONTROLLERS["closed", "analogue"], f])
-            feas.append(ok)
-        for m in ("ato-open", "closed"):
-            runs.append(Run(s, m, "analogue", *NOMINAL, "healthy", False))
-            errors.append(res.faults[s, CONTROLLERS[m, "analogue"], ELECTRIC_LOSS])
-            feas.append(ok)
-    fe = sorted({min(c[0] for c in corners), 0.0} & {c[0] for c in corners if c[1:] == (0.0, 1.0)})
-    curves = tuple((Run(spec.speeds_kmh[0], m, ch, f, 0.0, 1.0, "healthy", True), dx, v)
-                   for m, ch, f, dx, v in run_curves(spec, res.distance, fe))
-    return Result004(compute_worked(spec.paper.worked), res.distance, tuple(runs),
-                     tuple(errors), spec.tolerance, tuple(feas), curves,
+    cs = corners(spec)
+    fe = sorted({min(c[0] for c in cs), 0.0} & {c[0] for c in cs if c[1:] == NOMINAL[1:]})
+    return Result004(res, compute_worked(spec.paper.worked),
+                     tuple(run_curves(spec, res.distance, fe)),
                      run_montecarlo(spec, res.distance) if montecarlo else None,
                      decel_damping(spec),
-                     run_horizon_sweep(spec, res.distance) if montecarlo else (), spec)
+                     run_horizon_sweep(spec, res.distance) if montecarlo else ())
 
 
 def decel_damping(spec) -> Damping:
@@ -145,26 +140,14 @@ def _speeds(spec, **more) -> list:
     return out
 
 
-#: The error grid of one mode and channel at a speed (healthy sensors, electric brake on).
-def _grid(r, s, m, ch="analogue") -> dict:
-    return dict(speed_kmh=s, mode=m, channel=ch, fault="healthy", electric=True)
-
-
-def _nominal(r, s, **kw) -> float:
-    """Stop error (m) at the nominal corner (closed loop, analogue, healthy unless ``kw``)."""
-    return r.select(**{**dict(speed_kmh=s, mode="closed", channel="analogue", force_error=0.0,
-                              gradient=0.0, friction=1.0, electric=True, fault="healthy"),
-                       **kw})[0][1]
-
-
-def _feasible_abs(r, s, ch) -> list:
-    return [abs(e) for x, e in r.select(**_grid(r, s, "closed", ch))
-            if r.feasible[r.runs.index(x)]]
+def _failing(r, s, ch) -> list:
+    """Per grid corner: the closed loop's stop is outside the tolerance."""
+    return [not abs(x) <= r.tolerance for x in r.grid(s, "closed", ch)]
 
 
 def _feasible_max(r, s, ch):
-    feas = _feasible_abs(r, s, ch)
-    return max(feas) if feas else None
+    e = [abs(x) for x, ok in zip(r.grid(s, "closed", ch), r.feasible(s)) if ok]
+    return max(e) if e else None
 
 
 _FAULTS = tuple(FAULT_NAMES.values())
@@ -175,37 +158,37 @@ TABLE = (
     Declared("worked.{k}", "{u}", lambda r, k, u: r.worked[k], over=lambda spec: [
         {"k": k, "u": "%" if k.startswith("share") else "m/s^2" if k.startswith("a2") else "m"}
         for k in compute_worked(spec.paper.worked)]),
-    *(Declared("{b}.%s.max_abs_m" % m, "m", lambda r, b, s, m=m: r.max_abs(**_grid(r, s, m)),
+    *(Declared("{b}.%s.max_abs_m" % m, "m", lambda r, b, s, m=m: r.max_abs(s, m),
                over=_speeds) for m in ("open", "ato-open")),
     Declared("{b}.closed.{ch}.max_abs_m", "m",
-             lambda r, b, s, ch: r.max_abs(**_grid(r, s, "closed", ch)),
+             lambda r, b, s, ch: r.max_abs(s, "closed", ch),
              over=lambda spec: _speeds(spec, **_CH)),
     Declared("{b}.closed.{ch}.failing_corners", "1",
-             lambda r, b, s, ch: float(len(r.failing(**_grid(r, s, "closed", ch)))),
+             lambda r, b, s, ch: float(sum(_failing(r, s, ch))),
              over=lambda spec: _speeds(spec, **_CH)),
     Declared("{b}.closed.{ch}.failing_feasible_corners", "1", lambda r, b, s, ch: float(sum(
-        r.feasible[r.runs.index(x)] for x, _ in r.failing(**_grid(r, s, "closed", ch)))),
+        f and ok for f, ok in zip(_failing(r, s, ch), r.feasible(s)))),
              over=lambda spec: _speeds(spec, **_CH)),
     Declared("{b}.closed.{ch}.feasible_max_abs_m", "m",
              lambda r, b, s, ch: _feasible_max(r, s, ch), over=lambda spec: _speeds(spec, **_CH)),
     Declared("{b}.closed.3bit_minus_analogue_m", "m",
              lambda r, b, s: _feasible_max(r, s, "3bit") - _feasible_max(r, s, "analogue"),
              over=_speeds),
-    Declared("{b}.fault[{f}].abs_m", "m", lambda r, b, s, f: r.max_abs(speed_kmh=s, fault=f),
+    Declared("{b}.fault[{f}].abs_m", "m", lambda r, b, s, f: abs(r.stop(s, fault=f)),
              over=lambda spec: _speeds(spec, f=_FAULTS)),
-    Declared("{b}.fault[{f}].error_m", "m", lambda r, b, s, f: _nominal(r, s, fault=f),
+    Declared("{b}.fault[{f}].error_m", "m", lambda r, b, s, f: r.stop(s, fault=f),
              over=lambda spec: _speeds(spec, f=_FAULTS)),
     Declared("{b}.fault[{f}].change_vs_healthy_m", "m",
-             lambda r, b, s, f: abs(_nominal(r, s, fault=f) - _nominal(r, s)),
+             lambda r, b, s, f: abs(r.stop(s, fault=f) - r.stop(s)),
              over=lambda spec: _speeds(spec, f=_FAULTS)),
-    Declared("{b}.nominal.closed.analogue.abs_m", "m", lambda r, b, s: abs(_nominal(r, s)),
+    Declared("{b}.nominal.closed.analogue.abs_m", "m", lambda r, b, s: abs(r.stop(s)),
              over=_speeds),
     Declared("{b}.nominal.closed.3bit.abs_m", "m",
-             lambda r, b, s: abs(_nominal(r, s, channel="3bit")), over=_speeds),
+             lambda r, b, s: abs(r.stop(s, channel="3bit")), over=_speeds),
     Declared("{b}.nominal.ato-open.abs_m", "m",
-             lambda r, b, s: abs(_nominal(r, s, mode="ato-open")), over=_speeds),
+             lambda r, b, s: abs(r.stop(s, mode="ato-open")), over=_speeds),
     Declared("{b}.electric_loss.{m}.abs_m", "m",
-             lambda r, b, s, m: r.max_abs(speed_kmh=s, mode=m, electric=False),
+             lambda r, b, s, m: abs(r.stop(s, mode=m, fault=ELECTRIC_LOSS)),
              over=lambda spec: _speeds(spec, m=("closed", "ato-open"))),
     mc_family("{b}.mc.{m}", lambda spec: _speeds(spec, m=MC_MODES),
               lambda r, b, s, m: r.mc[s, m]),

@@ -16,13 +16,8 @@ MODE_LABEL = {"ato-open": "ATO open loop", "closed": "closed loop (analogue)"}
 def retune_section(spec, res) -> str:
     """``## Retuned closed loop``: the horizon, the PID's damping, the nominal corner."""
     p, loop = {k: q.value for k, q in spec.params.items()}, loop_values(spec)
-    nominal = dict(mode="closed", force_error=0.0, gradient=0.0, friction=1.0, fault="healthy",
-                   electric=True)
-    rows = []
-    for s in res.distance:
-        pick = lambda **kw: res.select(speed_kmh=s, **{**nominal, **kw})[0][1]
-        rows.append([fmt(s), fmt(pick(channel="analogue"), 3), fmt(pick(channel="3bit"), 3),
-                     fmt(pick(mode="ato-open", channel="analogue"), 3)])
+    rows = [[fmt(s), fmt(res.stop(s), 3), fmt(res.stop(s, channel="3bit"), 3),
+             fmt(res.stop(s, "ato-open"), 3)] for s in res.distance]
     d = res.damping
     return (
         "## Retuned closed loop (nominal corner)\n\n"
@@ -100,9 +95,7 @@ def _plot_faults(fig, res):
     speeds = list(res.distance)
     y = np.arange(len(cases))
     for k, s in enumerate(speeds):
-        err = [res.select(speed_kmh=s, fault=f, mode="closed", channel="analogue",
-                          force_error=0.0, gradient=0.0, friction=1.0, electric=True)[0][1]
-               for f in cases]
+        err = [res.stop(s, fault=f) for f in cases]
         ax.barh(y + (k - (len(speeds) - 1) / 2) * 0.35, err, height=0.35, color=f"C{k}",
                 label=f"{fmt(s)} km/h")
     ax.set_xscale("symlog", linthresh=0.3)

@@ -10,7 +10,7 @@ from ...kinds.stop_accuracy.render import error_colours, moving, quantity_table
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .closed_loop_brake_spec import loop_values, worked_formulas
 from .closed_loop_brake_fair_render import fault_text, figures, monte_carlo, retune_section
-from .closed_loop_brake_run import CHANNELS, MODES, faults
+from .closed_loop_brake_run import CHANNELS, ELECTRIC_LOSS, MODES, faults
 
 MODE_TEXT = {"open": "open loop, single command",
              "ato-open": "open loop + ATO re-commands (a_req sent as the brake demand: no "
@@ -62,17 +62,14 @@ def render(design, res) -> Rendered:
     ]
     rows = []
     for s in res.distance:
-        grid = dict(speed_kmh=s, fault="healthy", electric=True)
         for m in MODES:
             for ch in (CHANNELS if m == "closed" else ("analogue",)):
-                sel = res.select(mode=m, channel=ch, **grid)
-                fail = res.failing(mode=m, channel=ch, **grid)
-                ff = [r for r, _ in fail if res.feasible[res.runs.index(r)]]
-                rows.append([fmt(s), m, ch, fmt(res.max_abs(mode=m, channel=ch, **grid), 3),
-                             f"{len(fail)} / {len(sel)}", len(ff)])
-    n_inf = sum(not f for r, f in zip(res.runs, res.feasible)
-                if r.mode == "closed" and r.channel == "analogue" and r.fault == "healthy"
-                and r.electric) // max(len(res.distance), 1)
+                fail = [not abs(e) <= res.tolerance for e in res.grid(s, m, ch)]
+                rows.append([fmt(s), m, ch, fmt(res.max_abs(s, m, ch), 3),
+                             f"{sum(fail)} / {len(fail)}",
+                             sum(f and ok for f, ok in zip(fail, res.feasible(s)))])
+    n_inf = sum(not ok for s in res.distance for ok in res.feasible(s)) // max(
+        len(res.distance), 1)
     sections.append(
         f"## Error grid: stop error against the ±{fmt(res.tolerance)} m window\n\n"
         + md_table(["km/h", "mode", "channel", "max |error| (m)", "corners outside ±"
@@ -85,15 +82,13 @@ def render(design, res) -> Rendered:
     frows = []
     for s in res.distance:
         for f, axles in faults(spec).items():
-            sel = res.select(speed_kmh=s, fault=f, mode="closed", channel="analogue",
-                             force_error=0.0, gradient=0.0, friction=1.0, electric=True)
-            frows.append([fmt(s), f, axles, fmt(sel[0][1], 3) if sel else "—",
+            frows.append([fmt(s), f, axles, fmt(res.stop(s, fault=f), 3),
                           "fallback (ATO open loop)" if all(c in "sf" for c in axles)
                           else "closed, fault undetected" if set(axles) & set("hz")
                           else "closed"])
         for m in ("ato-open", "closed"):
-            sel = res.select(speed_kmh=s, mode=m, electric=False)
-            frows.append([fmt(s), f"electric brake lost ({m})", "oooo", fmt(sel[0][1], 3), m])
+            frows.append([fmt(s), f"electric brake lost ({m})", "oooo",
+                          fmt(res.stop(s, m, fault=ELECTRIC_LOSS), 3), m])
     sections.append(
         "## Sensor faults and electric-brake loss (nominal corner)\n\n"
         + md_table(["km/h", "case", "axles", "stop error (m)", "loop"], frows, "rllrl")
@@ -112,12 +107,12 @@ def render(design, res) -> Rendered:
 
 
 def _plot_curves(fig, res):
-    corners = sorted({r.force_error for r, _, _ in res.curves}, reverse=True)
+    corners = sorted({c[2] for c in res.curves}, reverse=True)
     for i, fe in enumerate(corners):
         ax = fig.add_subplot(1, len(corners), i + 1)
-        for k, (r, dx, v) in enumerate(c for c in res.curves if c[0].force_error == fe):
+        for k, (m, ch, _, dx, v) in enumerate(c for c in res.curves if c[2] == fe):
             keep = moving(v)
-            ax.plot(dx[keep], 3.6 * v[keep], color=f"C{k}", label=f"{r.mode} ({r.channel})")
+            ax.plot(dx[keep], 3.6 * v[keep], color=f"C{k}", label=f"{m} ({ch})")
         ax.axvline(0, color="k", lw=0.6)
         ax.set_xlabel("position − D (m)")
         ax.set_ylabel("speed (km/h)")
@@ -127,18 +122,14 @@ def _plot_curves(fig, res):
 
 def _corner_details(res) -> str:
     rows = []
+    cs = res.corners()
     for s in res.distance:
-        sel = {(r.force_error, r.gradient, r.friction, r.mode, r.channel): e
-               for r, e in res.select(speed_kmh=s, fault="healthy", electric=True)}
-        corners = sorted({k[:3] for k in sel})
-        for c in corners:
-            feas = next(f for r, f in zip(res.runs, res.feasible)
-                        if r.speed_kmh == s and (r.force_error, r.gradient, r.friction) == c)
-            rows.append([fmt(s), fmt(100 * c[0]), fmt(c[1]), fmt(c[2]), "yes" if feas else "no",
-                         fmt(sel[c + ("open", "analogue")], 3),
-                         fmt(sel[c + ("ato-open", "analogue")], 3),
-                         fmt(sel[c + ("closed", "analogue")], 3),
-                         fmt(sel[c + ("closed", "3bit")], 3)])
+        ok = res.feasible(s)
+        for k in sorted(range(len(cs)), key=cs.__getitem__):
+            rows.append([fmt(s), fmt(100 * cs[k][0]), fmt(cs[k][1]), fmt(cs[k][2]),
+                         "yes" if ok[k] else "no"] + [fmt(res.grid(s, m, ch)[k], 3) for m, ch in (
+                             ("open", "analogue"), ("ato-open", "analogue"),
+                             ("closed", "analogue"), ("closed", "3bit"))])
     return ("<details><summary>Every corner (stop error, m; + = overshoot)</summary>\n\n"
             + md_table(["km/h", "force error %", "gradient ‰", "friction", "feasible", "open",
                         "ATO open", "closed analogue", "closed 3-bit"], rows, "rrrrlrrrr")
@@ -149,19 +140,18 @@ def _plot_grid(fig, res, spec):
     cmap, norm = error_colours(res.tolerance)
     grid = dict(spec.grid)
     speeds = list(res.distance)
-    nf = len(grid["friction"])
+    nf, cs = len(grid["friction"]), res.corners()
     gs = fig.add_gridspec(len(speeds), nf + 1, width_ratios=[1.0] * nf + [0.06])
     for i, s in enumerate(speeds):
+        errors, ok = res.grid(s, "closed"), res.feasible(s)
         for j, fr in enumerate(grid["friction"]):
             ax = fig.add_subplot(gs[i, j])
             M = np.full((len(grid["force_error"]), len(grid["gradient"])), np.nan)
             feas = np.ones(M.shape, bool)
             for a, fe in enumerate(grid["force_error"]):
                 for b, gr in enumerate(grid["gradient"]):
-                    sel = res.select(speed_kmh=s, mode="closed", channel="analogue", fault="healthy",
-                                     electric=True, force_error=fe, gradient=gr, friction=fr)
-                    M[a, b] = sel[0][1]
-                    feas[a, b] = res.feasible[res.runs.index(sel[0][0])]
+                    k = cs.index((fe, gr, fr))
+                    M[a, b], feas[a, b] = errors[k], ok[k]
             im = ax.imshow(np.abs(M), cmap=cmap, norm=norm, origin="lower", aspect="auto")
             for a in range(M.shape[0]):
                 for b in range(M.shape[1]):
