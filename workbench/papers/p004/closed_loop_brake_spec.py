@@ -12,6 +12,7 @@ from functools import lru_cache
 
 import sympy as sp
 
+from ...kinds.stop_accuracy.needs import require
 from ...reader import Quantity, Reader
 from .closed_loop_brake_run import ELECTRIC_LOSS, FAULT_NAMES
 
@@ -51,27 +52,17 @@ class Paper004:
     t_predict_sweep: tuple
 
 
-#: The controllers, grid factors and constants the analysis reads from the design.
+#: The controllers the analysis runs by name.
 NEEDS = ("open", "ato_open", "closed", "closed_3bit", "full_service")
 
 
 def load(root: Reader, spec) -> Paper004:
     """Check that ``spec`` has what the report's runs need and read ``[worked]``
     and ``[retuning]``."""
-    names = [c.name for c in spec.controllers]
-    grid = dict(spec.grid)
-    if (names[:len(NEEDS)] != list(NEEDS) or any(spec.controllers[names.index(k)].loop is None
-                                                for k in ("closed", "closed_3bit"))
-            or set(grid) != {"force_error", "gradient", "friction"} or spec.command is None
-            or spec.grid_feasible != "full_service"
-            or not {f.name for f in spec.faults} >= {*FAULT_NAMES, ELECTRIC_LOSS}
-            or spec.montecarlo is None or "t_p" not in spec.constants
-            or "d_min" not in spec.constants):
-        raise root.fail("analysis.module", "p004.closed_loop_brake", "a design with the "
-                        "controllers " + ", ".join(NEEDS) + " (closed and closed_3bit with a "
-                        "deceleration_loop), a [grid] of force_error, gradient and friction "
-                        "feasible_with full_service, the [[faults]] " + ", ".join(
-                            [*FAULT_NAMES, ELECTRIC_LOSS]) + ", a [target] command, [montecarlo] and the constants t_p and d_min")
+    require(root, spec, "p004.closed_loop_brake", controllers=NEEDS,
+            loops=("closed", "closed_3bit"), grid=("force_error", "gradient", "friction"),
+            feasible_with="full_service", faults=(*FAULT_NAMES, ELECTRIC_LOSS),
+            constants=("t_p", "d_min"), tables=("command", "montecarlo"))
     w = root.table("worked")
     shares = []
     for s in w.tables("shares"):
