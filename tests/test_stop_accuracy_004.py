@@ -38,7 +38,8 @@ def both():
                                montecarlo=dataclasses.replace(spec.montecarlo, samples=4),
                                grid=tuple((k, CORNERS[k]) for k, _ in spec.grid))
     p4 = load_design(P004).spec
-    p4 = dataclasses.replace(p4, speeds_kmh=(50.0,), grid=tuple((k, CORNERS[k]) for k, _ in p4.grid),
+    p4 = dataclasses.replace(p4, speeds_kmh=(50.0,),
+                             grid=tuple((k, CORNERS[k]) for k, _ in p4.grid),
                              montecarlo=dataclasses.replace(p4.montecarlo, samples=4))
     D = stopping_points(p4)[50.0]
     return run(spec), run_grid(p4, montecarlo=False), run_montecarlo(p4, {50.0: D}), D

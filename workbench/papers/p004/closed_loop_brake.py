@@ -34,6 +34,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 from ...features.quantities import Declared, names, units, values
 from ...kinds.stop_accuracy.quantities import feasible, mc_family
@@ -90,6 +91,13 @@ class Result004:
         """Stop errors (m) of a mode at every grid corner (healthy sensors)."""
         return self.kind.grid[s, CONTROLLERS[mode, channel]]
 
+    @cached_property
+    def kind_values(self) -> dict:
+        """The kind's quantities of :attr:`kind`
+        (:mod:`workbench.kinds.stop_accuracy.quantities`)."""
+        from ...kinds.stop_accuracy.quantities import TABLE as KIND
+        return values(KIND, self.spec, self.kind)
+
     def max_abs(self, s, mode: str, channel: str = "analogue") -> float:
         """Largest |stop error| (m) of a mode over the grid; nan if a run did not stop."""
         e = [abs(x) for x in self.grid(s, mode, channel)]
@@ -132,68 +140,56 @@ def decel_damping(spec) -> Damping:
                                       tau=loop["tau_filter"]), p["T1"] + spec.dt_ctrl)
 
 
-def _speeds(spec, **more) -> list:
-    """Per speed ``s`` (km/h): ``{"b": "v<s>", "s": s}``, times the members ``more``."""
-    out = [{"b": speed_key(s), "s": s} for s in spec.speeds_kmh]
-    for k, vals in more.items():
-        out = [x | {k: v} for x in out for v in vals]
-    return out
+def _speeds(*members):
+    """``over`` of a family: per speed ``s`` (km/h) ``{"b": "v<s>", "s": s}``,
+    times each member (a dict) of ``members``."""
+    return lambda spec: [{"b": speed_key(s), "s": s} | x for s in spec.speeds_kmh
+                         for x in (members or ({},))]
 
 
-def _failing(r, s, ch) -> list:
-    """Per grid corner: the closed loop's stop is outside the tolerance."""
-    return [not abs(x) <= r.tolerance for x in r.grid(s, "closed", ch)]
+def _kind(name: str, f=lambda x: x):
+    """Read ``f`` of the kind's quantity ``name`` (a template over the index)."""
+    return lambda r, **ix: None if (x := r.kind_values[name.format(**ix)]) is None else f(x)
 
 
-def _feasible_max(r, s, ch):
-    e = [abs(x) for x, ok in zip(r.grid(s, "closed", ch), r.feasible(s)) if ok]
-    return max(e) if e else None
+#: the report's names -> the design's controllers
+_MODES = [{"m": m, "c": CONTROLLERS[m, "analogue"]} for m in ("open", "ato-open")]
+_CH = [{"ch": ch, "c": CONTROLLERS["closed", ch]} for ch in CHANNELS]
+_FAULTS = [{"f": v, "k": k} for k, v in FAULT_NAMES.items()]
+_CLOSED = CONTROLLERS["closed", "analogue"]
 
-
-_FAULTS = tuple(FAULT_NAMES.values())
-_CH = {"ch": CHANNELS}
-
-#: The quantities paper 004's claims name, declared once.
+#: The quantities paper 004's claims name, declared once: the grid's, the faults' and the
+#: nominal stops' are the kind's quantities (:mod:`workbench.kinds.stop_accuracy.quantities`)
+#: under the report's names.
 TABLE = (
     Declared("worked.{k}", "{u}", lambda r, k, u: r.worked[k], over=lambda spec: [
         {"k": k, "u": "%" if k.startswith("share") else "m/s^2" if k.startswith("a2") else "m"}
         for k in compute_worked(spec.paper.worked)]),
-    *(Declared("{b}.%s.max_abs_m" % m, "m", lambda r, b, s, m=m: r.max_abs(s, m),
-               over=_speeds) for m in ("open", "ato-open")),
-    Declared("{b}.closed.{ch}.max_abs_m", "m",
-             lambda r, b, s, ch: r.max_abs(s, "closed", ch),
-             over=lambda spec: _speeds(spec, **_CH)),
-    Declared("{b}.closed.{ch}.failing_corners", "1",
-             lambda r, b, s, ch: float(sum(_failing(r, s, ch))),
-             over=lambda spec: _speeds(spec, **_CH)),
-    Declared("{b}.closed.{ch}.failing_feasible_corners", "1", lambda r, b, s, ch: float(sum(
-        f and ok for f, ok in zip(_failing(r, s, ch), r.feasible(s)))),
-             over=lambda spec: _speeds(spec, **_CH)),
-    Declared("{b}.closed.{ch}.feasible_max_abs_m", "m",
-             lambda r, b, s, ch: _feasible_max(r, s, ch), over=lambda spec: _speeds(spec, **_CH)),
-    Declared("{b}.closed.3bit_minus_analogue_m", "m",
-             lambda r, b, s: _feasible_max(r, s, "3bit") - _feasible_max(r, s, "analogue"),
-             over=_speeds),
-    Declared("{b}.fault[{f}].abs_m", "m", lambda r, b, s, f: abs(r.stop(s, fault=f)),
-             over=lambda spec: _speeds(spec, f=_FAULTS)),
-    Declared("{b}.fault[{f}].error_m", "m", lambda r, b, s, f: r.stop(s, fault=f),
-             over=lambda spec: _speeds(spec, f=_FAULTS)),
+    Declared("{b}.{m}.max_abs_m", "m", _kind("{b}.{c}.grid.max_abs_m"), over=_speeds(*_MODES)),
+    *(Declared("{b}.closed.{ch}.%s" % name, unit, _kind("{b}.{c}.grid.%s" % name),
+               over=_speeds(*_CH))
+      for name, unit in (("max_abs_m", "m"), ("failing_corners", "1"),
+                         ("failing_feasible_corners", "1"), ("feasible_max_abs_m", "m"))),
+    Declared("{b}.closed.3bit_minus_analogue_m", "m", lambda r, b, s: None if None in (
+        x := [r.kind_values[f"{b}.{c['c']}.grid.feasible_max_abs_m"] for c in _CH]) else
+        x[1] - x[0], over=_speeds()),
+    Declared("{b}.fault[{f}].abs_m", "m", _kind("{b}.%s.fault[{k}].error_m" % _CLOSED, abs),
+             over=_speeds(*_FAULTS)),
+    Declared("{b}.fault[{f}].error_m", "m", _kind("{b}.%s.fault[{k}].error_m" % _CLOSED),
+             over=_speeds(*_FAULTS)),
     Declared("{b}.fault[{f}].change_vs_healthy_m", "m",
-             lambda r, b, s, f: abs(r.stop(s, fault=f) - r.stop(s)),
-             over=lambda spec: _speeds(spec, f=_FAULTS)),
-    Declared("{b}.nominal.closed.analogue.abs_m", "m", lambda r, b, s: abs(r.stop(s)),
-             over=_speeds),
-    Declared("{b}.nominal.closed.3bit.abs_m", "m",
-             lambda r, b, s: abs(r.stop(s, channel="3bit")), over=_speeds),
-    Declared("{b}.nominal.ato-open.abs_m", "m",
-             lambda r, b, s: abs(r.stop(s, mode="ato-open")), over=_speeds),
+             _kind("{b}.%s.fault[{k}].change_m" % _CLOSED), over=_speeds(*_FAULTS)),
+    Declared("{b}.nominal.closed.{ch}.abs_m", "m", _kind("{b}.{c}.nominal_m", abs),
+             over=_speeds(*_CH)),
+    Declared("{b}.nominal.ato-open.abs_m", "m", _kind("{b}.%s.nominal_m" % _MODES[1]["c"], abs),
+             over=_speeds()),
     Declared("{b}.electric_loss.{m}.abs_m", "m",
-             lambda r, b, s, m: abs(r.stop(s, mode=m, fault=ELECTRIC_LOSS)),
-             over=lambda spec: _speeds(spec, m=("closed", "ato-open"))),
-    mc_family("{b}.mc.{m}", lambda spec: _speeds(spec, m=MC_MODES),
+             _kind("{b}.{c}.fault[%s].error_m" % ELECTRIC_LOSS, abs), over=_speeds(
+                 *({"m": m, "c": CONTROLLERS[m, "analogue"]} for m in ("closed", "ato-open")))),
+    mc_family("{b}.mc.{m}", _speeds(*({"m": m} for m in MC_MODES)),
               lambda r, b, s, m: r.mc[s, m]),
     Declared("{b}.mc.closed_minus_ato-open_p", "1",
-             lambda r, b, s: r.mc[s, "closed"].p - r.mc[s, "ato-open"].p, over=_speeds),
+             lambda r, b, s: r.mc[s, "closed"].p - r.mc[s, "ato-open"].p, over=_speeds()),
     Declared("pid.damping_zeta", "1", lambda r: r.damping.zeta),
 )
 

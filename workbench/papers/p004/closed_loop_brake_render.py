@@ -49,10 +49,11 @@ def render(design, res) -> Rendered:
         + ", ".join(f"{fmt(d, 5)} m" for d in res.distance.values())
         + "), over the grid force error "
         f"{list(grid['force_error'])} × gradient {list(grid['gradient'])} ‰ × air-brake "
-        f"friction factor {list(grid['friction'])}. Modes: " + "; ".join(f"**{m}** = {MODE_TEXT[m]}" for m in MODES)
+        f"friction factor {list(grid['friction'])}. Modes: "
+        + "; ".join(f"**{m}** = {MODE_TEXT[m]}" for m in MODES)
         + ". The ATO's required deceleration is a_req = v_p² / (2 d_p) at the state predicted "
-        f"{fmt(spec.constants['t_p'].value)} s ahead; the closed loop measures the deceleration from the "
-        "maximum of four axle speeds (filtered derivative), uses the incremental fuzzy "
+        f"{fmt(spec.constants['t_p'].value)} s ahead; the closed loop measures the deceleration "
+        "from the maximum of four axle speeds (filtered derivative), uses the incremental fuzzy "
         f"controller when |a_req − a_meas| > {fmt(loop['e_switch'])} m/s² and PID below, and "
         "falls back to the ATO open loop when all four axles are failed or sliding. The "
         f"3-bit channel sends round(7 c / {fmt(spec.c_max)}) levels.\n\n"
