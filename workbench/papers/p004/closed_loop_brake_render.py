@@ -3,10 +3,10 @@
 "p004.closed_loop_brake"``): pure rendering, in the paper's wording."""
 from __future__ import annotations
 
-import numpy as np
 import sympy as sp
 
-from ...kinds.stop_accuracy.render import error_colours, moving, quantity_table
+from ...kinds.stop_accuracy.grid_map import GridAxis, plot_grid_map
+from ...kinds.stop_accuracy.render import moving, quantity_table
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .closed_loop_brake_spec import loop_values, worked_formulas
 from .closed_loop_brake_fair_render import fault_text, figures, monte_carlo, retune_section
@@ -138,38 +138,18 @@ def _corner_details(res) -> str:
 
 
 def _plot_grid(fig, res, spec):
-    cmap, norm = error_colours(res.tolerance)
-    grid = dict(spec.grid)
-    speeds = list(res.distance)
-    nf, cs = len(grid["friction"]), res.corners()
-    gs = fig.add_gridspec(len(speeds), nf + 1, width_ratios=[1.0] * nf + [0.06])
-    for i, s in enumerate(speeds):
-        errors, ok = res.grid(s, "closed"), res.feasible(s)
-        for j, fr in enumerate(grid["friction"]):
-            ax = fig.add_subplot(gs[i, j])
-            M = np.full((len(grid["force_error"]), len(grid["gradient"])), np.nan)
-            feas = np.ones(M.shape, bool)
-            for a, fe in enumerate(grid["force_error"]):
-                for b, gr in enumerate(grid["gradient"]):
-                    k = cs.index((fe, gr, fr))
-                    M[a, b], feas[a, b] = errors[k], ok[k]
-            im = ax.imshow(np.abs(M), cmap=cmap, norm=norm, origin="lower", aspect="auto")
-            for a in range(M.shape[0]):
-                for b in range(M.shape[1]):
-                    ax.text(b, a, fmt(M[a, b], 2) + ("" if feas[a, b] else "\ninfeasible"),
-                            ha="center", va="center", fontsize=7,
-                            color="w" if abs(M[a, b]) > 2 * res.tolerance else "k")
-            ax.set_xticks(range(len(grid["gradient"])))
-            ax.set_xticklabels([fmt(g) for g in grid["gradient"]])
-            ax.set_yticks(range(len(grid["force_error"])))
-            ax.set_yticklabels([fmt(100 * f) for f in grid["force_error"]])
-            ax.grid(False)
-            ax.set_title(f"{fmt(s)} km/h, friction ×{fmt(fr)}", fontsize=8)
-            if i == len(speeds) - 1:
-                ax.set_xlabel("gradient (‰, + uphill)")
-            if j == 0:
-                ax.set_ylabel("force error (%)")
-    fig.suptitle(f"closed-loop stop error (m); green: within ±{fmt(res.tolerance)} m, "
-                 f"orange to red: beyond it, dark red: ≥ {fmt(3 * res.tolerance)} m")
-    fig.colorbar(im, cax=fig.add_subplot(gs[:, nf]), extend="max",
-                 label=f"|stop error| (m); tolerance {fmt(res.tolerance)} m")
+    grid, cs = dict(spec.grid), res.corners()
+
+    def cell(s, fe, gr, fr):
+        k = cs.index((fe, gr, fr))
+        return res.grid(s, "closed")[k], res.feasible(s)[k]
+
+    tol = res.tolerance
+    plot_grid_map(
+        fig, list(res.distance), GridAxis(grid["force_error"], "force error (%)",
+                                          lambda f: fmt(100 * f)),
+        GridAxis(grid["gradient"], "gradient (‰, + uphill)"), GridAxis(grid["friction"]), cell,
+        tol, title=lambda s, fr: f"{fmt(s)} km/h, friction ×{fmt(fr)}",
+        suptitle=f"closed-loop stop error (m); green: within ±{fmt(tol)} m, orange to red: "
+        f"beyond it, dark red: ≥ {fmt(3 * tol)} m",
+        colorbar=f"|stop error| (m); tolerance {fmt(tol)} m")
