@@ -3,9 +3,7 @@ faults and Monte Carlo (pure rendering of a
 :class:`~workbench.papers.p004.closed_loop_brake.Result004`)."""
 from __future__ import annotations
 
-import numpy as np
-
-from ...kinds.stop_accuracy.render import mc_section, plot_mc_panels
+from ...kinds.stop_accuracy.render import mc_section, plot_case_bars, plot_mc_panels
 from ...report.markdown import Figure, fmt, md_table
 from .closed_loop_brake_run import MC_MODES, faults
 from .closed_loop_brake_spec import loop_values
@@ -89,22 +87,10 @@ def _plot_sweep(fig, res, spec):
 
 
 def _plot_faults(fig, res):
-    ax = fig.add_subplot(111)
     axles = faults(res.spec)
-    cases = list(axles)
-    speeds = list(res.distance)
-    y = np.arange(len(cases))
-    for k, s in enumerate(speeds):
-        err = [res.stop(s, fault=f) for f in cases]
-        ax.barh(y + (k - (len(speeds) - 1) / 2) * 0.35, err, height=0.35, color=f"C{k}",
-                label=f"{fmt(s)} km/h")
-    ax.set_xscale("symlog", linthresh=0.3)
-    ax.axvspan(-res.tolerance, res.tolerance, color="0.9", zorder=0)
-    ax.set_yticks(y)
-    ax.set_yticklabels([f"{c} ({axles[c]})" for c in cases], fontsize=8)
-    ax.invert_yaxis()
-    ax.set_xlabel(f"stop error (m, + overshoot; grey: ±{fmt(res.tolerance)} m)")
-    ax.legend(fontsize=8)
+    plot_case_bars(fig.add_subplot(111), [f"{c} ({a})" for c, a in axles.items()],
+                   [(f"{fmt(s)} km/h", [res.stop(s, fault=f) for f in axles])
+                    for s in res.distance], res.tolerance, linthresh=0.3)
 
 
 def _plot_mc(fig, res):

@@ -1,7 +1,8 @@
-"""The error-grid map of :mod:`workbench.kinds.stop_accuracy.grid_map` on a
-toy grid (no design): a panel per speed and third-factor value plus the
-colour bar, every cell's signed error printed, infeasible cells marked,
-large errors in white."""
+"""The general figures of the stop-accuracy kind on toy data (no design): the
+error-grid map (:mod:`workbench.kinds.stop_accuracy.grid_map`: a panel per
+speed and third-factor value plus the colour bar, every cell's signed error
+printed, infeasible cells marked, large errors in white) and the bars of the
+stop error per case (:func:`workbench.kinds.stop_accuracy.render.plot_case_bars`)."""
 from __future__ import annotations
 
 import matplotlib
@@ -10,6 +11,7 @@ matplotlib.use("Agg")
 from matplotlib.figure import Figure  # noqa: E402
 
 from workbench.kinds.stop_accuracy.grid_map import GridAxis, plot_grid_map  # noqa: E402
+from workbench.kinds.stop_accuracy.render import plot_case_bars  # noqa: E402
 
 
 def test_toy_grid_map():
@@ -29,3 +31,16 @@ def test_toy_grid_map():
     assert ax.get_title() == "1.0 1.0" and fig.axes[2].get_xlabel() == "col"
     assert fig.axes[0].get_ylabel() == "row" and ax.get_ylabel() == ""
     assert [t.get_text() for t in fig.axes[3].texts][0] == "-1.1"       # speed -1, panel 1.0
+
+
+def test_toy_case_bars():
+    ax = Figure().add_subplot(111)
+    plot_case_bars(ax, ["a", "b", "c"], [("one", [0.1, -2.0, 30.0]), ("two", [0.0, 1.0, -5.0])],
+                   0.3, linthresh=0.3)
+    bars = ax.patches[:6]
+    assert [b.get_width() for b in bars] == [0.1, -2.0, 30.0, 0.0, 1.0, -5.0]
+    assert [round(b.get_y() + b.get_height() / 2, 3) for b in bars] == [
+        -0.175, 0.825, 1.825, 0.175, 1.175, 2.175]                 # side by side per case
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["a", "b", "c"]
+    assert ax.get_xscale() == "symlog" and ax.yaxis_inverted()
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["one", "two"]
