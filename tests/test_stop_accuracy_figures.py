@@ -1,8 +1,10 @@
 """The general figures of the stop-accuracy kind on toy data (no design): the
 error-grid map (:mod:`workbench.kinds.stop_accuracy.grid_map`: a panel per
 speed and third-factor value plus the colour bar, every cell's signed error
-printed, infeasible cells marked, large errors in white) and the bars of the
-stop error per case (:func:`workbench.kinds.stop_accuracy.render.plot_case_bars`)."""
+printed, infeasible cells marked, large errors in white), the bars of the
+stop error per case (:func:`workbench.kinds.stop_accuracy.render.plot_case_bars`)
+and the speed-distance curves up to standstill
+(:func:`workbench.kinds.stop_accuracy.render.plot_speed_distance`)."""
 from __future__ import annotations
 
 import matplotlib
@@ -11,7 +13,10 @@ matplotlib.use("Agg")
 from matplotlib.figure import Figure  # noqa: E402
 
 from workbench.kinds.stop_accuracy.grid_map import GridAxis, plot_grid_map  # noqa: E402
-from workbench.kinds.stop_accuracy.render import plot_case_bars  # noqa: E402
+import numpy as np  # noqa: E402
+
+from workbench.kinds.stop_accuracy.render import (plot_case_bars,  # noqa: E402
+                                                  plot_speed_distance)
 
 
 def test_toy_grid_map():
@@ -44,3 +49,16 @@ def test_toy_case_bars():
     assert [t.get_text() for t in ax.get_yticklabels()] == ["a", "b", "c"]
     assert ax.get_xscale() == "symlog" and ax.yaxis_inverted()
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["one", "two"]
+
+
+def test_toy_speed_distance_stops_at_standstill():
+    fig = Figure()
+    dx = np.array([-10.0, -5.0, -1.0, 0.5, 0.5])
+    v = np.array([5.0, 3.0, 1.0, 0.0, 0.0])                    # m/s, stands still from the 4th
+    plot_speed_distance(fig, [("A", [("x", dx, v), ("y", dx - 1, v)]), ("B", [("z", dx, v)])])
+    a, b = fig.axes
+    line = a.get_lines()[0]
+    assert list(line.get_xdata()) == [-10.0, -5.0, -1.0]        # up to the first standstill
+    assert list(line.get_ydata()) == [18.0, 10.8, 3.6]          # km/h
+    assert [t.get_text() for t in a.get_legend().get_texts()] == ["x", "y"]
+    assert (a.get_title(), b.get_title()) == ("A", "B") and len(b.get_lines()) == 2  # + D line

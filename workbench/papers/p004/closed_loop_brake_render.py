@@ -6,7 +6,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ...kinds.stop_accuracy.grid_map import GridAxis, plot_grid_map
-from ...kinds.stop_accuracy.render import moving, quantity_table
+from ...kinds.stop_accuracy.render import plot_speed_distance, quantity_table
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .closed_loop_brake_spec import loop_values, worked_formulas
 from .closed_loop_brake_fair_render import fault_text, figures, monte_carlo, retune_section
@@ -108,17 +108,9 @@ def render(design, res) -> Rendered:
 
 
 def _plot_curves(fig, res):
-    corners = sorted({c[2] for c in res.curves}, reverse=True)
-    for i, fe in enumerate(corners):
-        ax = fig.add_subplot(1, len(corners), i + 1)
-        for k, (m, ch, _, dx, v) in enumerate(c for c in res.curves if c[2] == fe):
-            keep = moving(v)
-            ax.plot(dx[keep], 3.6 * v[keep], color=f"C{k}", label=f"{m} ({ch})")
-        ax.axvline(0, color="k", lw=0.6)
-        ax.set_xlabel("position − D (m)")
-        ax.set_ylabel("speed (km/h)")
-        ax.set_title(f"force error {fmt(100 * fe)} %", fontsize=9)
-        ax.legend(fontsize=7)
+    plot_speed_distance(fig, [(f"force error {fmt(100 * fe)} %", [
+        (f"{m} ({ch})", dx, v) for m, ch, f, dx, v in res.curves if f == fe])
+        for fe in sorted({c[2] for c in res.curves}, reverse=True)])
 
 
 def _corner_details(res) -> str:
