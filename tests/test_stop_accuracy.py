@@ -293,3 +293,17 @@ def test_every_paper_quantity_has_a_unit(name):
         assert (got["worked.d1"], got["worked.a2"], got["worked.share[15permille,1]"]) == (
             "m", "m/s^2", "%")
     assert any(u == "m" for u in got.values()) and any(u == "1" for u in got.values())
+
+
+def test_constant_sweep_through_the_design_value_is_the_nominal_stop():
+    """A constant swept through its design value gives the nominal stop bit for
+    bit, another value another stop (the general synthetic design)."""
+    from workbench.kinds.stop_accuracy.run import constant_sweep
+    spec = dataclasses.replace(load_design(SYNTH).spec, montecarlo=None, convergence=False)
+    res = run(spec)
+    k = spec.constants["k_v"].value
+    got = constant_sweep(spec, "profile", "k_v", [k, 2 * k], res.distance)
+    assert list(got) == [(x, s) for s in spec.speeds_kmh for x in (k, 2 * k)]
+    for s in spec.speeds_kmh:
+        assert got[k, s] == res.nominal[s, "profile"]
+        assert got[2 * k, s] != got[k, s]

@@ -71,19 +71,13 @@ def run_montecarlo(spec, distance: dict) -> dict:
 
 def run_horizon_sweep(spec, distance: dict) -> tuple:
     """Stop error (m) of the closed loop (analogue) at the nominal corner for
-    each ATO prediction horizon of ``[retuning] t_predict_sweep`` (the
-    constant ``t_p`` per run): ((t_predict, speed km/h, error), ...)."""
-    from ...kinds.stop_accuracy.run import compile_laws, simulate_runs
-    from ...sim.stopping import batch_params
-    cases = [(tp, s) for s in spec.speeds_kmh for tp in spec.paper.t_predict_sweep]
-    n = len(cases)
-    D = np.array([distance[s] for _, s in cases])
-    tr, _ = simulate_runs(spec, compile_laws(spec), spec.dt, batch_params(spec.base(), n, {}),
-                          np.full(n, _index(spec, "closed")), D, x0=0.0,
-                          v0=np.array([s / 3.6 for _, s in cases]), ratio=1.0,
-                          theta=np.zeros(n), kappa=np.ones(n), dt_rec=0.5,
-                          constants={"t_p": np.array([tp for tp, _ in cases])})
-    return tuple((tp, s, float(x - d)) for (tp, s), x, d in zip(cases, tr.x_stop, D))
+    each ATO prediction horizon (the constant ``t_p``) of ``[retuning]
+    t_predict_sweep`` (:func:`~workbench.kinds.stop_accuracy.run.constant_sweep`):
+    ((t_predict, speed km/h, error), ...)."""
+    from ...kinds.stop_accuracy.run import constant_sweep
+    return tuple((tp, s, e) for (tp, s), e in constant_sweep(
+        spec, CONTROLLERS["closed", "analogue"], "t_p", spec.paper.t_predict_sweep, distance,
+        dt_rec=0.5).items())
 
 
 __all__ = ["CHANNELS", "CONTROLLERS", "ELECTRIC_LOSS", "FAULT_NAMES", "FULL", "MC_MODES", "MODES",
