@@ -1,9 +1,9 @@
 """Paper 004's closed loop as a ``stop-accuracy`` configuration
 (designs/stop-accuracy-004-closed.toml, the named module ``deceleration_loop``):
 its stop errors equal those of designs/closed-loop-brake-004.toml (the same kind
-with paper 004's ``[analysis]`` module and its own run lists) draw by draw,
-corner by corner and fault by fault, bit for bit; bad module input exits 2 in
-one line."""
+with paper 004's ``[analysis]`` module, its report read from the kind's run)
+draw by draw, corner by corner and fault by fault, bit for bit; bad module
+input exits 2 in one line."""
 from __future__ import annotations
 
 import dataclasses
