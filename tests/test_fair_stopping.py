@@ -171,39 +171,36 @@ def test_predictor_loop_dead_time(spec000):
 # -- 004: retuned nominal corner, sensor faults, Monte Carlo determinism ----------------------
 @pytest.fixture(scope="module")
 def res004():
-    from workbench.papers.p004.closed_loop_brake import run_grid, view
-    spec = view(load_design(D004).spec)
-    nominal = replace(spec, force_error=(0.0,), gradient=(0.0,), friction=(1.0,))
+    from workbench.papers.p004.closed_loop_brake import NOMINAL, run_grid
+    spec = load_design(D004).spec
+    corner = dict(zip(("force_error", "gradient", "friction"), NOMINAL))
+    nominal = replace(spec, grid=tuple((k, (corner[k],)) for k, _ in spec.grid))
     return spec, run_grid(nominal, montecarlo=False)
 
 
 def test_004_horizon_is_dead_time_plus_lag(res004):
     spec, _ = res004
-    assert spec.t_predict == pytest.approx(spec.params["T1"].value + spec.params["T2"].value,
+    assert spec.constants["t_p"].value == pytest.approx(spec.params["T1"].value + spec.params["T2"].value,
                                            abs=0.005)
 
 
 @pytest.mark.parametrize("speed", [50.0, 80.0])
 def test_004_retuned_nominal_corner_within_0_3_m(res004, speed):
     spec, res = res004
-    e = res.select(speed_kmh=speed, mode="closed", channel="analogue", fault="healthy",
-                   electric=True)[0][1]
-    assert abs(e) <= spec.tolerance
+    assert abs(res.stop(speed)) <= spec.tolerance
 
 
 def test_004_sensor_reading_high_wins_max_of_4_and_stuck_one_defeats_it(res004):
     _, res = res004
-    pick = lambda f: res.select(speed_kmh=50.0, mode="closed", channel="analogue", fault=f,
-                                electric=True)[0][1]
+    pick = lambda f: res.stop(50.0, fault=f)
     healthy, high, stuck = pick("healthy"), pick("1 reading high"), pick("1 stuck")
     assert high != healthy and abs(high - healthy) < 0.05
     assert stuck < -10.0                      # full service from a frozen speed: far short
 
 
 def test_004_montecarlo_is_seeded():
-    from workbench.papers.p004.closed_loop_brake import view
     from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
-    spec = view(load_design(D004).spec)
+    spec = load_design(D004).spec
     spec = replace(spec, speeds_kmh=(50.0,), montecarlo=MonteCarloSpec(
         6, spec.montecarlo.seed, spec.montecarlo.distributions))
     a, b = run_montecarlo(spec, {50.0: 152.74}), run_montecarlo(spec, {50.0: 152.74})

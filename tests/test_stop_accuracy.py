@@ -14,7 +14,7 @@ from workbench.cli import main
 from workbench.design import load_design
 from workbench.kinds import REGISTRY
 from workbench.kinds.stop_accuracy.pipeline import Factor, apply_factors, group_statistics
-from workbench.kinds.stop_accuracy.run import run
+from workbench.kinds.stop_accuracy.run import run, stopping_points
 
 ROOT = Path(__file__).resolve().parent.parent
 ATO = ROOT / "designs" / "stop-accuracy-004-ato.toml"
@@ -50,15 +50,14 @@ def test_ato_open_reproduces_closed_loop_brake():
     ATO open-loop stop errors draw by draw, bit for bit (10 draws, 50 km/h;
     all 200 draws at both speeds are equal too, 166/200 and 164/200 within
     0.3 m, as reports/closed-loop-brake-004.md prints)."""
-    from workbench.papers.p004.closed_loop_brake import stopping_point, view
     from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
     d = load_design(ATO)
     spec = _small(d.spec, samples=10, speeds=(50.0,))
     res = run(spec)
-    p4 = view(load_design(ROOT / "designs" / "closed-loop-brake-004.toml").spec)
+    p4 = load_design(ROOT / "designs" / "closed-loop-brake-004.toml").spec
     p4 = dataclasses.replace(p4, speeds_kmh=(50.0,),
                              montecarlo=dataclasses.replace(p4.montecarlo, samples=10))
-    D = stopping_point(p4, 50 / 3.6)
+    D = stopping_points(p4)[50.0]
     assert res.distance[50.0] == D
     ref = run_montecarlo(p4, {50.0: D})[50.0, "ato-open"]
     got = res.mc[50.0, "ato_open"]
@@ -294,3 +293,17 @@ def test_every_paper_quantity_has_a_unit(name):
         assert (got["worked.d1"], got["worked.a2"], got["worked.share[15permille,1]"]) == (
             "m", "m/s^2", "%")
     assert any(u == "m" for u in got.values()) and any(u == "1" for u in got.values())
+
+
+def test_constant_sweep_through_the_design_value_is_the_nominal_stop():
+    """A constant swept through its design value gives the nominal stop bit for
+    bit, another value another stop (the general synthetic design)."""
+    from workbench.kinds.stop_accuracy.run import constant_sweep
+    spec = dataclasses.replace(load_design(SYNTH).spec, montecarlo=None, convergence=False)
+    res = run(spec)
+    k = spec.constants["k_v"].value
+    got = constant_sweep(spec, "profile", "k_v", [k, 2 * k], res.distance)
+    assert list(got) == [(x, s) for s in spec.speeds_kmh for x in (k, 2 * k)]
+    for s in spec.speeds_kmh:
+        assert got[k, s] == res.nominal[s, "profile"]
+        assert got[2 * k, s] != got[k, s]

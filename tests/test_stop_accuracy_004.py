@@ -1,9 +1,9 @@
 """Paper 004's closed loop as a ``stop-accuracy`` configuration
 (designs/stop-accuracy-004-closed.toml, the named module ``deceleration_loop``):
 its stop errors equal those of designs/closed-loop-brake-004.toml (the same kind
-with paper 004's ``[analysis]`` module and its own run lists) draw by draw,
-corner by corner and fault by fault, bit for bit; bad module input exits 2 in
-one line."""
+with paper 004's ``[analysis]`` module, its report read from the kind's run)
+draw by draw, corner by corner and fault by fault, bit for bit; bad module
+input exits 2 in one line."""
 from __future__ import annotations
 
 import dataclasses
@@ -15,7 +15,7 @@ import pytest
 from workbench.cli import main
 from workbench.design import load_design
 from workbench.kinds.stop_accuracy.decel_loop import axle_speeds
-from workbench.kinds.stop_accuracy.run import run
+from workbench.kinds.stop_accuracy.run import run, stopping_points
 
 ROOT = Path(__file__).resolve().parent.parent
 CLOSED = ROOT / "designs" / "stop-accuracy-004-closed.toml"
@@ -31,16 +31,17 @@ CORNERS = {"force_error": (0.0, 0.15), "gradient": (-30.0, 0.0), "friction": (1.
 def both():
     """The kind's run and the study's, on 4 Monte Carlo draws and a 2 x 2 x 2
     grid from 50 km/h."""
-    from workbench.papers.p004.closed_loop_brake import run_grid, stopping_point, view
+    from workbench.papers.p004.closed_loop_brake import run_grid
     from workbench.papers.p004.closed_loop_brake_run import run_montecarlo
     spec = load_design(CLOSED).spec
     spec = dataclasses.replace(spec, speeds_kmh=(50.0,), convergence=False,
                                montecarlo=dataclasses.replace(spec.montecarlo, samples=4),
                                grid=tuple((k, CORNERS[k]) for k, _ in spec.grid))
-    p4 = view(load_design(P004).spec)
-    p4 = dataclasses.replace(p4, speeds_kmh=(50.0,), **CORNERS,
+    p4 = load_design(P004).spec
+    p4 = dataclasses.replace(p4, speeds_kmh=(50.0,),
+                             grid=tuple((k, CORNERS[k]) for k, _ in p4.grid),
                              montecarlo=dataclasses.replace(p4.montecarlo, samples=4))
-    D = stopping_point(p4, 50 / 3.6)
+    D = stopping_points(p4)[50.0]
     return run(spec), run_grid(p4, montecarlo=False), run_montecarlo(p4, {50.0: D}), D
 
 
@@ -48,25 +49,18 @@ def test_closed_loop_reproduces_closed_loop_brake_bit_for_bit(both):
     res, grid, mc, D = both
     assert res.distance[50.0] == D
     for name, channel in (("closed", "analogue"), ("closed_3bit", "3bit")):
-        ref = [e for _, e in grid.select(mode="closed", channel=channel, fault="healthy",
-                                         electric=True)]
-        assert res.grid[50.0, name] == tuple(ref)                   # corner by corner
+        assert res.grid[50.0, name] == grid.grid(50.0, "closed", channel)   # corner by corner
     from workbench.kinds.stop_accuracy.quantities import feasible
-    sel = [k for k, r in enumerate(grid.runs) if r.mode == "closed" and r.channel == "analogue"
-           and r.fault == "healthy" and r.electric]
-    assert feasible(res, 50.0) == [grid.feasible[k] for k in sel]    # [grid] feasible_with
-    assert 0 < sum(feasible(res, 50.0)) < len(sel)
+    assert feasible(res, 50.0) == grid.feasible(50.0)            # [grid] feasible_with
+    assert 0 < sum(feasible(res, 50.0)) < len(grid.corners())
     ref = mc[50.0, "closed"]
     np.testing.assert_array_equal(res.mc[50.0, "closed"].errors, ref.errors)   # draw by draw
-    nominal = dict(speed_kmh=50.0, mode="closed", channel="analogue", force_error=0.0,
-                   gradient=0.0, friction=1.0)
     for ours, theirs in FAULT_NAMES.items():
-        assert res.faults[50.0, "closed", ours] == grid.select(fault=theirs, **nominal)[0][1]
-    assert res.faults[50.0, "closed", "electric_loss"] == grid.select(
-        fault="healthy", electric=False, **nominal)[0][1]
-    # nominal corner: not on the reduced grid, on the study's healthy run
-    assert res.nominal[50.0, "closed"] == grid.select(fault="healthy", electric=True,
-                                                      **nominal)[0][1]
+        assert res.faults[50.0, "closed", ours] == grid.stop(50.0, fault=theirs)
+    assert res.faults[50.0, "closed", "electric_loss"] == grid.stop(50.0, fault="electric_loss")
+    # the nominal run is the grid's nominal corner, which the study's report printed
+    assert res.nominal[50.0, "closed"] == grid.stop(50.0) == res.grid[50.0, "closed"][
+        grid.corners().index((0.0, 0.0, 1.0))]
 
 
 def test_fallback_and_masking(both):

@@ -9,7 +9,7 @@ from __future__ import annotations
 from ...report.markdown import Rendered, fmt, md_table
 
 __all__ = ["distribution_table", "error_colours", "mc_cells", "mc_section", "moving",
-           "plot_ecdf", "plot_mc_panels", "quantity_table", "render", "tolerance_lines"]
+           "plot_case_bars", "plot_ecdf", "plot_mc_panels", "plot_speed_distance", "quantity_table", "render", "tolerance_lines"]
 
 
 def _mm(x) -> str:
@@ -310,6 +310,48 @@ def plot_mc_panels(fig, panels, tol: float, *, unit: str = "m", scale: float = 1
         ax.set_title(title, fontsize=9)
         ax.legend(fontsize=7, loc="upper left")
     first.set_ylabel("fraction of stops ≤ error")
+
+
+def plot_speed_distance(fig, panels) -> None:
+    """Speed (km/h) against position relative to the stopping point (m), each
+    curve up to its first standstill (:func:`moving`), a panel per
+    ``(title, [(label, position - D (m), speed (m/s)), ...])`` of ``panels``."""
+    for i, (title, curves) in enumerate(panels):
+        ax = fig.add_subplot(1, len(panels), i + 1)
+        for k, (label, dx, v) in enumerate(curves):
+            keep = moving(v)
+            ax.plot(dx[keep], 3.6 * v[keep], color=f"C{k}", label=label)
+        ax.axvline(0, color="k", lw=0.6)
+        ax.set_xlabel("position − D (m)")
+        ax.set_ylabel("speed (km/h)")
+        ax.set_title(title, fontsize=9)
+        ax.legend(fontsize=7)
+
+
+def plot_case_bars(ax, cases, series, tol: float, *, linthresh: float) -> None:
+    """Horizontal bars of the stop error (m) per case, one bar per series
+    (e.g. per speed) side by side, on a symlog axis (linear within
+    ``linthresh``), the tolerance band ``tol`` grey.
+
+    Parameters
+    ----------
+    cases : sequence of str
+        The cases' labels, top to bottom.
+    series : sequence of (label, errors)
+        Per series its legend label and its error of each case.
+    """
+    import numpy as np
+    y = np.arange(len(cases))
+    for k, (label, errors) in enumerate(series):
+        ax.barh(y + (k - (len(series) - 1) / 2) * 0.35, errors, height=0.35, color=f"C{k}",
+                label=label)
+    ax.set_xscale("symlog", linthresh=linthresh)
+    ax.axvspan(-tol, tol, color="0.9", zorder=0)
+    ax.set_yticks(y)
+    ax.set_yticklabels(list(cases), fontsize=8)
+    ax.invert_yaxis()
+    ax.set_xlabel(f"stop error (m, + overshoot; grey: ±{fmt(tol)} m)")
+    ax.legend(fontsize=8)
 
 
 def error_colours(tol: float):

@@ -31,7 +31,7 @@ import numpy as np
 from ...jsonable import json_method
 from .pipeline import LAW_NAMES, apply_factors, group_statistics, open_loop_distance
 
-__all__ = ["StopAccuracyResult", "compile_laws", "montecarlo_draws", "montecarlo_statistics",
+__all__ = ["StopAccuracyResult", "compile_laws", "constant_sweep", "montecarlo_draws", "montecarlo_statistics",
            "run", "run_sections", "section_runs", "section_statistics", "simulate_cases",
            "simulate_runs", "stopping_points", "speed_key"]
 
@@ -110,9 +110,10 @@ def _simulate(spec, laws, dt, cases, draws=None, record=False):
     return tr.x_stop - D, traces
 
 
-def simulate_cases(spec, laws, dt, cases, draws=None, dt_rec=None):
+def simulate_cases(spec, laws, dt, cases, draws=None, dt_rec=None, constants=None):
     """Simulate ``cases`` [(speed km/h, controller index, fault or None, D m)],
     each repeated over the Monte Carlo ``draws`` (factor -> array) when given,
+    with ``constants`` (name -> array over the runs) in place of the design's,
     recorded every ``dt_rec`` (default dt_ctrl), in one batch (every operation
     is elementwise over runs: a run's result does not depend on the others in
     its batch).
@@ -152,7 +153,7 @@ def simulate_cases(spec, laws, dt, cases, draws=None, dt_rec=None):
         axles = np.repeat([list(c[2].axles if c[2] is not None and c[2].axles else "o" * k)
                            for c in cases], N, axis=0)
     tr, _ = simulate_runs(spec, laws, dt, p, ctl, D, x0=x0, v0=v0, ratio=ratio, theta=theta,
-                          kappa=kappa, axles=axles, dt_rec=dt_rec)
+                          kappa=kappa, axles=axles, dt_rec=dt_rec, constants=constants)
     return tr, D
 
 
@@ -251,6 +252,25 @@ def stopping_points(spec) -> dict:
     return {s: spec.distance if spec.distance is not None else
             open_loop_distance(base, spec.command, s / 3.6, dt=spec.dt, dt_ctrl=spec.dt_ctrl)
             for s in spec.speeds_kmh}
+
+
+def constant_sweep(spec, controller: str, name: str, values, distance: dict,
+                   dt_rec=None) -> dict:
+    """Stop error (m) of ``controller`` on the nominal plant from every speed
+    for each of ``values`` of the constant ``name``, in one batch
+    (:func:`simulate_cases`): {(value, speed km/h): error}, speed by speed.
+
+    Parameters
+    ----------
+    distance : dict
+        speed (km/h) -> the stopping point D (m) (:func:`stopping_points`).
+    """
+    ctl = [c.name for c in spec.controllers].index(controller)
+    keys = [(x, s) for s in spec.speeds_kmh for x in values]
+    tr, D = simulate_cases(spec, compile_laws(spec), spec.dt,
+                           [(s, ctl, None, distance[s]) for _, s in keys], dt_rec=dt_rec,
+                           constants={name: np.array([x for x, _ in keys], float)})
+    return {k: float(e) for k, e in zip(keys, tr.x_stop - D)}
 
 
 def montecarlo_draws(spec, mc) -> dict:

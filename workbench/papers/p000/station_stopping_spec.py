@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ...kinds.stop_accuracy.needs import require
+
 #: Paper name -> (the design's controller, label in the report). The first
 #: four are the controllers of the per-section tables: paper 000's three, then
 #: SMARC with the discontinuous sgn of eq 22 as printed (no boundary layer), to
@@ -102,17 +104,9 @@ def factor(spec, name: str):
 def load(root, spec) -> Line5:
     """Check that ``spec`` has the controllers the paper's rows name (with a
     [reference], [[sections]] and [montecarlo]) and read ``[[published]]``."""
-    names = {c.name for c in spec.controllers}
-    missing = [v for v, _ in VARIANTS.values() if v not in names]
-    if missing or spec.reference is None or spec.sections is None or spec.montecarlo is None:
-        raise root.fail("analysis.module", "p000.station_stopping", "a design with [reference], "
-                        "[[sections]], [montecarlo] and the controllers " + ", ".join(
-                            v for v, _ in VARIANTS.values()) + (
-                            f" (missing: {', '.join(missing)})" if missing else ""))
-    if any(controller(spec, k).pid is None for k in DAMPING) or "zeta_min" not in spec.constants:
-        raise root.fail("constants", sorted(spec.constants), "a constant zeta_min and the "
-                        "named module pid in the controllers " + ", ".join(
-                            VARIANTS[k][0] for k in DAMPING))
+    require(root, spec, "p000.station_stopping", controllers=[v for v, _ in VARIANTS.values()],
+            pids=[VARIANTS[k][0] for k in DAMPING], constants=("zeta_min",),
+            tables=("reference", "sections", "montecarlo"))
     zeta = spec.constants["zeta_min"].value
     if not 0 < zeta <= 1:
         raise root.fail("constants.zeta_min", zeta, "a damping ratio in (0, 1]")

@@ -6,10 +6,13 @@ The design is a configuration of the general kind
 (:mod:`workbench.kinds.stop_accuracy`): the modes are its controllers (the
 ATO law an expression, the command generator its named module
 ``deceleration_loop``), the grid its ``[grid]``, the Monte Carlo its
-``[montecarlo]``, every run its simulation (:mod:`.closed_loop_brake_run`).
+``[montecarlo]``, the sensor faults and the electric-brake loss its
+``[[faults]]``; the grid, the faults and the nominal stops are the kind's
+general run (:func:`workbench.kinds.stop_accuracy.run.run`, kept whole in
+:attr:`Result004.kind`), the rest its batches (:mod:`.closed_loop_brake_run`).
 What stays here is paper 004's: the worked numbers of section 1.3 (sympy
-expressions written here once, ``[worked]``), the runs of its report and
-their names (``open``, ``ato-open``, ``closed``; channels ``analogue`` and
+expressions written here once, ``[worked]``), the names of its report's
+runs (``open``, ``ato-open``, ``closed``; channels ``analogue`` and
 ``3bit``; the axle-sensor cases of section 2.7 and the electric-brake loss at
 the nominal corner; the ATO-horizon sweep of ``[retuning]``), the quantities
 its claims name and the report's wording. The modes:
@@ -29,204 +32,164 @@ its claims name and the report's wording. The modes:
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
-
-import numpy as np
+import math
+from dataclasses import dataclass, replace
+from functools import cached_property
 
 from ...features.quantities import Declared, names, units, values
-from ...kinds.stop_accuracy.pipeline import open_loop_distance
-from ...kinds.stop_accuracy.quantities import mc_family
-from ...kinds.stop_accuracy.run import speed_key
+from ...kinds.stop_accuracy.quantities import feasible, mc_family
+from ...kinds.stop_accuracy.run import run, speed_key
 from ...reader import Reader
 from ...tuning.pid import Damping, damping, deceleration_loop
-from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, FAULTS, FULL, MC_MODES,
-                                    run_horizon_sweep, run_montecarlo, simulate_brake)
-from .closed_loop_brake_spec import Paper004, Spec004, compute_worked, load, view
+from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, ELECTRIC_LOSS, FAULT_NAMES, MC_MODES,
+                                    run_curves, run_horizon_sweep, run_montecarlo)
+from .closed_loop_brake_spec import Paper004, compute_worked, load, loop_values
 
-__all__ = ["ANALYSIS", "Result004", "Run", "Spec004", "compute_worked", "decel_damping",
-           "run_grid", "stopping_point", "TABLE", "view"]
+__all__ = ["ANALYSIS", "NOMINAL", "Result004", "compute_worked", "corners", "decel_damping",
+           "run_grid", "TABLE"]
+
+#: the nominal corner (force error, gradient permille, friction factor)
+NOMINAL = (0.0, 0.0, 1.0)
+#: a sensor fault's name in the report -> the design's fault
+_FAULT_KEYS = {v: k for k, v in FAULT_NAMES.items()}
 
 
-@dataclass(frozen=True)
-class Run:
-    """One simulated case."""
-
-    speed_kmh: float
-    mode: str
-    channel: str
-    force_error: float
-    gradient: float
-    friction: float
-    fault: str
-    electric: bool
+def corners(spec) -> list:
+    """(force error, gradient, friction) of every grid corner, in the grid's order."""
+    keys = [k for k, _ in spec.grid]
+    return [tuple(c[keys.index(k)] for k in ("force_error", "gradient", "friction"))
+            for c in itertools.product(*(v for _, v in spec.grid))]
 
 
 @dataclass(frozen=True)
 class Result004:
+    """The kind's general run and what paper 004's report adds to it."""
+
+    kind: object            # StopAccuracyResult: grid per (speed, controller), faults, nominal
     worked: dict
-    distance: dict          # speed -> stopping point D (m)
-    runs: tuple             # Run
-    errors: tuple           # stop error (m) per run (nan: no stop)
-    tolerance: float        # m, platform-door tolerance
-    feasible: tuple         # per run: full service can hold a_target on that corner
-    curves: tuple = ()      # (Run, position - D (m), speed (m/s)) of the curve corners
+    curves: tuple = ()      # (mode, channel, force error, position - D (m), speed (m/s))
     mc: dict | None = None  # (speed km/h, mode) -> StopStatistics of the Monte Carlo
     damping: Damping | None = None   # of the linearised deceleration PID loop
     sweep: tuple = ()       # (ATO horizon s, speed km/h, nominal closed-loop stop error m)
-    spec: object = None     # the design's StopAccuracySpec
 
-    def failing(self, **kw) -> list[tuple[Run, float]]:
-        """Runs (with errors) outside the tolerance among those selected."""
-        return [(r, e) for r, e in self.select(**kw) if not abs(e) <= self.tolerance]
+    @property
+    def spec(self):
+        return self.kind.spec
 
-    def select(self, **kw) -> list[tuple[Run, float]]:
-        return [(r, e) for r, e in zip(self.runs, self.errors)
-                if all(getattr(r, k) == v for k, v in kw.items())]
+    @property
+    def distance(self) -> dict:
+        return self.kind.distance
 
-    def max_abs(self, **kw) -> float:
-        errs = [abs(e) for _, e in self.select(**kw)]
-        return float(max(errs)) if errs and all(np.isfinite(errs)) else float("nan")
+    @property
+    def tolerance(self) -> float:
+        return self.kind.spec.tolerance
 
+    def corners(self) -> list:
+        return corners(self.spec)
 
-def _cases(spec: Spec004) -> list[Run]:
-    runs = []
-    for s in spec.speeds_kmh:
-        for fe, gr, fr in itertools.product(spec.force_error, spec.gradient, spec.friction):
-            runs.append(Run(s, "open", "analogue", fe, gr, fr, "healthy", True))
-            runs.append(Run(s, FULL, "analogue", fe, gr, fr, "healthy", True))
-            runs.append(Run(s, "ato-open", "analogue", fe, gr, fr, "healthy", True))
-            for ch in CHANNELS:
-                runs.append(Run(s, "closed", ch, fe, gr, fr, "healthy", True))
-        for f in FAULTS:
-            if f != "healthy":
-                runs.append(Run(s, "closed", "analogue", 0.0, 0.0, 1.0, f, True))
-        for mode in ("ato-open", "closed"):
-            runs.append(Run(s, mode, "analogue", 0.0, 0.0, 1.0, "healthy", False))
-    return runs
+    def grid(self, s, mode: str, channel: str = "analogue") -> tuple:
+        """Stop errors (m) of a mode at every grid corner (healthy sensors)."""
+        return self.kind.grid[s, CONTROLLERS[mode, channel]]
 
+    @cached_property
+    def kind_values(self) -> dict:
+        """The kind's quantities of :attr:`kind`
+        (:mod:`workbench.kinds.stop_accuracy.quantities`)."""
+        from ...kinds.stop_accuracy.quantities import TABLE as KIND
+        return values(KIND, self.spec, self.kind)
 
-def stopping_point(spec: Spec004, v0: float) -> float:
-    """Nominal open-loop stopping distance of the single command (m)."""
-    return open_loop_distance({k: q.value for k, q in spec.params.items()}, spec.a_target, v0,
-                              dt=spec.dt, dt_ctrl=spec.dt_ctrl)
+    def max_abs(self, s, mode: str, channel: str = "analogue") -> float:
+        """Largest |stop error| (m) of a mode over the grid; nan if a run did not stop."""
+        e = [abs(x) for x in self.grid(s, mode, channel)]
+        return float(max(e)) if e and all(math.isfinite(x) for x in e) else math.nan
 
+    def feasible(self, s) -> list:
+        """Per grid corner: full service from the first instant stops short of D."""
+        return feasible(self.kind, s)
 
-def run_grid(spec: Spec004, *, montecarlo: bool = True) -> Result004:
-    """The error grid, the sensor faults, the electric-brake loss; with
-    ``montecarlo`` also the Monte Carlo and the horizon sweep."""
-    runs = _cases(spec)
-    n = len(runs)
-    D = {s: stopping_point(spec, s / 3.6) for s in spec.speeds_kmh}
-    arr = lambda f: np.array([f(r) for r in runs], float)
-    base = {k: q.value for k, q in spec.params.items()}
-    dist = arr(lambda r: D[r.speed_kmh])
-    tr = simulate_brake(
-        spec, v0=arr(lambda r: r.speed_kmh / 3.6), dist=dist,
-        controller=np.array([list(CONTROLLERS).index((r.mode, r.channel)) for r in runs]),
-        states=np.array([list(FAULTS[r.fault]) for r in runs]),
-        overrides={"K1": base["K1"] * arr(lambda r: r.friction),
-                   "v_ho": np.where(arr(lambda r: r.electric) > 0, base["v_ho"], 1e3)},
-        theta=arr(lambda r: r.gradient), kappa=1 + arr(lambda r: r.force_error))
-    err = tr.x_stop - dist
-    full = {(r.speed_kmh, r.force_error, r.gradient, r.friction): e
-            for r, e in zip(runs, err) if r.mode == FULL}
-    feasible = [bool(full.get((r.speed_kmh, r.force_error, r.gradient, r.friction), -1.0)
-                     <= -spec.tolerance) for r in runs]
-    keep = [k for k, r in enumerate(runs) if r.mode != FULL]
-    corners = {(0.0, 0.0, 1.0), (min(spec.force_error), 0.0, 1.0)}
-    curves = tuple((r, tr.x[:, k] - dist[k], tr.v[:, k]) for k, r in enumerate(runs)
-                   if r.speed_kmh == spec.speeds_kmh[0] and r.fault == "healthy" and r.electric
-                   and (r.force_error, r.gradient, r.friction) in corners and r.mode != FULL)
-    return Result004(compute_worked(spec.worked), D, tuple(runs[k] for k in keep),
-                     tuple(float(err[k]) for k in keep), spec.tolerance,
-                     tuple(feasible[k] for k in keep), curves,
-                     run_montecarlo(spec, D) if montecarlo else None, decel_damping(spec),
-                     run_horizon_sweep(spec, D) if montecarlo else (), spec.kind)
+    def stop(self, s, mode: str = "closed", channel: str = "analogue",
+             fault: str = "healthy") -> float:
+        """Stop error (m) at the nominal corner: healthy, under a sensor fault
+        (its report name) or a fault of the design (``electric_loss``)."""
+        c = CONTROLLERS[mode, channel]
+        if fault == "healthy":
+            return self.kind.nominal[s, c]
+        return self.kind.faults[s, c, _FAULT_KEYS.get(fault, fault)]
 
 
-def decel_damping(spec: Spec004) -> Damping:
+def run_grid(spec, *, montecarlo: bool = True) -> Result004:
+    """The kind's general run (error grid, sensor faults, electric-brake loss,
+    without its Monte Carlo) and the curves; with ``montecarlo`` also the
+    Monte Carlo of :data:`MC_MODES` and the horizon sweep."""
+    res = run(replace(spec, montecarlo=None, convergence=False))
+    cs = corners(spec)
+    fe = sorted({min(c[0] for c in cs), 0.0} & {c[0] for c in cs if c[1:] == NOMINAL[1:]})
+    return Result004(res, compute_worked(spec.paper.worked),
+                     tuple(run_curves(spec, res.distance, fe)),
+                     run_montecarlo(spec, res.distance) if montecarlo else None,
+                     decel_damping(spec),
+                     run_horizon_sweep(spec, res.distance) if montecarlo else ())
+
+
+def decel_damping(spec) -> Damping:
     """Damping of the linearised deceleration PID loop (electric stage, dead
     time T1 plus one control period: sample and hold, and the backward
     difference of the measured speed)."""
-    p = {k: q.value for k, q in spec.params.items()}
-    return damping(*deceleration_loop(spec.pid["kp"], spec.pid["ki"], P1=p["P1"], T2=p["T2"],
-                                      tau=spec.tau_filter), p["T1"] + spec.dt_ctrl)
+    p, loop = {k: q.value for k, q in spec.params.items()}, loop_values(spec)
+    return damping(*deceleration_loop(loop["kp"], loop["ki"], P1=p["P1"], T2=p["T2"],
+                                      tau=loop["tau_filter"]), p["T1"] + spec.dt_ctrl)
 
 
-def _speeds(spec, **more) -> list:
-    """Per speed ``s`` (km/h): ``{"b": "v<s>", "s": s}``, times the members ``more``."""
-    out = [{"b": speed_key(s), "s": s} for s in spec.speeds_kmh]
-    for k, vals in more.items():
-        out = [x | {k: v} for x in out for v in vals]
-    return out
+def _speeds(*members):
+    """``over`` of a family: per speed ``s`` (km/h) ``{"b": "v<s>", "s": s}``,
+    times each member (a dict) of ``members``."""
+    return lambda spec: [{"b": speed_key(s), "s": s} | x for s in spec.speeds_kmh
+                         for x in (members or ({},))]
 
 
-#: The error grid of one mode and channel at a speed (healthy sensors, electric brake on).
-def _grid(r, s, m, ch="analogue") -> dict:
-    return dict(speed_kmh=s, mode=m, channel=ch, fault="healthy", electric=True)
+def _kind(name: str, f=lambda x: x):
+    """Read ``f`` of the kind's quantity ``name`` (a template over the index)."""
+    return lambda r, **ix: None if (x := r.kind_values[name.format(**ix)]) is None else f(x)
 
 
-def _nominal(r, s, **kw) -> float:
-    """Stop error (m) at the nominal corner (closed loop, analogue, healthy unless ``kw``)."""
-    return r.select(**{**dict(speed_kmh=s, mode="closed", channel="analogue", force_error=0.0,
-                              gradient=0.0, friction=1.0, electric=True, fault="healthy"),
-                       **kw})[0][1]
+#: the report's names -> the design's controllers
+_MODES = [{"m": m, "c": CONTROLLERS[m, "analogue"]} for m in ("open", "ato-open")]
+_CH = [{"ch": ch, "c": CONTROLLERS["closed", ch]} for ch in CHANNELS]
+_FAULTS = [{"f": v, "k": k} for k, v in FAULT_NAMES.items()]
+_CLOSED = CONTROLLERS["closed", "analogue"]
 
-
-def _feasible_abs(r, s, ch) -> list:
-    return [abs(e) for x, e in r.select(**_grid(r, s, "closed", ch))
-            if r.feasible[r.runs.index(x)]]
-
-
-def _feasible_max(r, s, ch):
-    feas = _feasible_abs(r, s, ch)
-    return max(feas) if feas else None
-
-
-_FAULTS = tuple(f for f in FAULTS if f != "healthy")
-_CH = {"ch": CHANNELS}
-
-#: The quantities paper 004's claims name, declared once.
+#: The quantities paper 004's claims name, declared once: the grid's, the faults' and the
+#: nominal stops' are the kind's quantities (:mod:`workbench.kinds.stop_accuracy.quantities`)
+#: under the report's names.
 TABLE = (
     Declared("worked.{k}", "{u}", lambda r, k, u: r.worked[k], over=lambda spec: [
         {"k": k, "u": "%" if k.startswith("share") else "m/s^2" if k.startswith("a2") else "m"}
         for k in compute_worked(spec.paper.worked)]),
-    *(Declared("{b}.%s.max_abs_m" % m, "m", lambda r, b, s, m=m: r.max_abs(**_grid(r, s, m)),
-               over=_speeds) for m in ("open", "ato-open")),
-    Declared("{b}.closed.{ch}.max_abs_m", "m",
-             lambda r, b, s, ch: r.max_abs(**_grid(r, s, "closed", ch)),
-             over=lambda spec: _speeds(spec, **_CH)),
-    Declared("{b}.closed.{ch}.failing_corners", "1",
-             lambda r, b, s, ch: float(len(r.failing(**_grid(r, s, "closed", ch)))),
-             over=lambda spec: _speeds(spec, **_CH)),
-    Declared("{b}.closed.{ch}.failing_feasible_corners", "1", lambda r, b, s, ch: float(sum(
-        r.feasible[r.runs.index(x)] for x, _ in r.failing(**_grid(r, s, "closed", ch)))),
-             over=lambda spec: _speeds(spec, **_CH)),
-    Declared("{b}.closed.{ch}.feasible_max_abs_m", "m",
-             lambda r, b, s, ch: _feasible_max(r, s, ch), over=lambda spec: _speeds(spec, **_CH)),
-    Declared("{b}.closed.3bit_minus_analogue_m", "m",
-             lambda r, b, s: _feasible_max(r, s, "3bit") - _feasible_max(r, s, "analogue"),
-             over=_speeds),
-    Declared("{b}.fault[{f}].abs_m", "m", lambda r, b, s, f: r.max_abs(speed_kmh=s, fault=f),
-             over=lambda spec: _speeds(spec, f=_FAULTS)),
-    Declared("{b}.fault[{f}].error_m", "m", lambda r, b, s, f: _nominal(r, s, fault=f),
-             over=lambda spec: _speeds(spec, f=_FAULTS)),
+    Declared("{b}.{m}.max_abs_m", "m", _kind("{b}.{c}.grid.max_abs_m"), over=_speeds(*_MODES)),
+    *(Declared("{b}.closed.{ch}.%s" % name, unit, _kind("{b}.{c}.grid.%s" % name),
+               over=_speeds(*_CH))
+      for name, unit in (("max_abs_m", "m"), ("failing_corners", "1"),
+                         ("failing_feasible_corners", "1"), ("feasible_max_abs_m", "m"))),
+    Declared("{b}.closed.3bit_minus_analogue_m", "m", lambda r, b, s: None if None in (
+        x := [r.kind_values[f"{b}.{c['c']}.grid.feasible_max_abs_m"] for c in _CH]) else
+        x[1] - x[0], over=_speeds()),
+    Declared("{b}.fault[{f}].abs_m", "m", _kind("{b}.%s.fault[{k}].error_m" % _CLOSED, abs),
+             over=_speeds(*_FAULTS)),
+    Declared("{b}.fault[{f}].error_m", "m", _kind("{b}.%s.fault[{k}].error_m" % _CLOSED),
+             over=_speeds(*_FAULTS)),
     Declared("{b}.fault[{f}].change_vs_healthy_m", "m",
-             lambda r, b, s, f: abs(_nominal(r, s, fault=f) - _nominal(r, s)),
-             over=lambda spec: _speeds(spec, f=_FAULTS)),
-    Declared("{b}.nominal.closed.analogue.abs_m", "m", lambda r, b, s: abs(_nominal(r, s)),
-             over=_speeds),
-    Declared("{b}.nominal.closed.3bit.abs_m", "m",
-             lambda r, b, s: abs(_nominal(r, s, channel="3bit")), over=_speeds),
-    Declared("{b}.nominal.ato-open.abs_m", "m",
-             lambda r, b, s: abs(_nominal(r, s, mode="ato-open")), over=_speeds),
+             _kind("{b}.%s.fault[{k}].change_m" % _CLOSED), over=_speeds(*_FAULTS)),
+    Declared("{b}.nominal.closed.{ch}.abs_m", "m", _kind("{b}.{c}.nominal_m", abs),
+             over=_speeds(*_CH)),
+    Declared("{b}.nominal.ato-open.abs_m", "m", _kind("{b}.%s.nominal_m" % _MODES[1]["c"], abs),
+             over=_speeds()),
     Declared("{b}.electric_loss.{m}.abs_m", "m",
-             lambda r, b, s, m: r.max_abs(speed_kmh=s, mode=m, electric=False),
-             over=lambda spec: _speeds(spec, m=("closed", "ato-open"))),
-    mc_family("{b}.mc.{m}", lambda spec: _speeds(spec, m=MC_MODES),
+             _kind("{b}.{c}.fault[%s].error_m" % ELECTRIC_LOSS, abs), over=_speeds(
+                 *({"m": m, "c": CONTROLLERS[m, "analogue"]} for m in ("closed", "ato-open")))),
+    mc_family("{b}.mc.{m}", _speeds(*({"m": m} for m in MC_MODES)),
               lambda r, b, s, m: r.mc[s, m]),
     Declared("{b}.mc.closed_minus_ato-open_p", "1",
-             lambda r, b, s: r.mc[s, "closed"].p - r.mc[s, "ato-open"].p, over=_speeds),
+             lambda r, b, s: r.mc[s, "closed"].p - r.mc[s, "ato-open"].p, over=_speeds()),
     Declared("pid.damping_zeta", "1", lambda r: r.damping.zeta),
 )
 
@@ -244,7 +207,7 @@ class ClosedLoopBrake:
         return units(TABLE, spec)
 
     def run(self, spec) -> Result004:
-        return run_grid(view(spec))
+        return run_grid(spec)
 
     def quantities(self, res: Result004) -> dict:
         return values(TABLE, res.spec, res)

@@ -3,34 +3,28 @@ faults and Monte Carlo (pure rendering of a
 :class:`~workbench.papers.p004.closed_loop_brake.Result004`)."""
 from __future__ import annotations
 
-import numpy as np
-
-from ...kinds.stop_accuracy.render import mc_section, plot_mc_panels
+from ...kinds.stop_accuracy.render import mc_section, plot_case_bars, plot_mc_panels
 from ...report.markdown import Figure, fmt, md_table
-from .closed_loop_brake_run import FAULTS, MC_MODES
+from .closed_loop_brake_run import MC_MODES, faults
+from .closed_loop_brake_spec import loop_values
 
 MODE_LABEL = {"ato-open": "ATO open loop", "closed": "closed loop (analogue)"}
 
 
 def retune_section(spec, res) -> str:
     """``## Retuned closed loop``: the horizon, the PID's damping, the nominal corner."""
-    p = {k: q.value for k, q in spec.params.items()}
-    nominal = dict(mode="closed", force_error=0.0, gradient=0.0, friction=1.0, fault="healthy",
-                   electric=True)
-    rows = []
-    for s in res.distance:
-        pick = lambda **kw: res.select(speed_kmh=s, **{**nominal, **kw})[0][1]
-        rows.append([fmt(s), fmt(pick(channel="analogue"), 3), fmt(pick(channel="3bit"), 3),
-                     fmt(pick(mode="ato-open", channel="analogue"), 3)])
+    p, loop = {k: q.value for k, q in spec.params.items()}, loop_values(spec)
+    rows = [[fmt(s), fmt(res.stop(s), 3), fmt(res.stop(s, channel="3bit"), 3),
+             fmt(res.stop(s, "ato-open"), 3)] for s in res.distance]
     d = res.damping
     return (
         "## Retuned closed loop (nominal corner)\n\n"
         f"The ATO evaluates a_req = v_p² / (2 d_p) at the state predicted t_predict = "
-        f"{fmt(spec.t_predict, 3)} s ahead: the brake's dead time plus lag, T1 + T2 = "
+        f"{fmt(spec.constants['t_p'].value, 3)} s ahead: the brake's dead time plus lag, T1 + T2 = "
         f"{fmt(p['T1'] + p['T2'], 3)} s, the delay with which a dead time and a first-order lag "
         "follow a ramp. Before, 0.5 s: less than the dead time alone, so the loop reacted to the "
         "end of the stop only once it could no longer change it. The deceleration PID (kp "
-        f"{fmt(spec.pid['kp'])}, ki {fmt(spec.pid['ki'])}) is kept: on its linearised loop "
+        f"{fmt(loop['kp'])}, ki {fmt(loop['ki'])}) is kept: on its linearised loop "
         "(electric stage, dead time T1 plus one control period, the measurement filter; "
         "`workbench/studies/pid_tuning.py`) its dominant roots have damping ratio "
         f"{fmt(d.zeta, 2)} (decay rate {fmt(-d.alpha, 2)} 1/s), the criterion of paper 000's "
@@ -47,9 +41,10 @@ def retune_section(spec, res) -> str:
 
 
 def fault_text(spec) -> str:
+    loop = loop_values(spec)
     return ("Axle states: o = healthy, s = sliding (reads "
-            f"{fmt(100 * spec.slide)} % low), f = failed (reads 0), h = reads high (× "
-            f"{fmt(spec.high_ratio)}, e.g. a wheel diameter set too large), z = stuck at its "
+            f"{fmt(100 * loop['slide_ratio'])} % low), f = failed (reads 0), h = reads high (× "
+            f"{fmt(loop['high_ratio'])}, e.g. a wheel diameter set too large), z = stuck at its "
             "reading when braking starts. Train speed = max of the four; the command generator "
             "detects s and f (all four: fallback to the ATO open loop), not h or z. The ATO's "
             "own position and speed are not from these sensors. A sensor reading high or stuck "
@@ -62,7 +57,7 @@ def fault_text(spec) -> str:
 def monte_carlo(spec, res) -> str:
     """``## Monte Carlo``: both modes at both speeds over the same draws."""
     return mc_section(
-        spec.kind, "##", "), the same draws for both modes and both speeds, analogue channel, "
+        spec, "##", "), the same draws for both modes and both speeds, analogue channel, "
         "healthy sensors; the stopping point D is the nominal one of each speed.",
         [((fmt(s), MODE_LABEL[m]), st) for (s, m), st in res.mc.items()], heads=("km/h", "mode"),
         align="rl", unit="m", error=lambda x: fmt(x, 3), alt="Monte Carlo")
@@ -84,7 +79,7 @@ def _plot_sweep(fig, res, spec):
         pts = sorted((tp, e) for tp, sp_, e in res.sweep if sp_ == s)
         ax.plot([a for a, _ in pts], [b for _, b in pts], "o-", color=f"C{k}",
                 label=f"{fmt(s)} km/h")
-    ax.axvline(spec.t_predict, color="k", lw=0.8, ls=":", label="chosen: T1 + T2")
+    ax.axvline(spec.constants['t_p'].value, color="k", lw=0.8, ls=":", label="chosen: T1 + T2")
     ax.axhspan(-res.tolerance, res.tolerance, color="0.9", zorder=0, label=f"±{fmt(res.tolerance)} m")
     ax.set_xlabel("ATO prediction horizon t_predict (s)")
     ax.set_ylabel("stop error (m, + overshoot)")
@@ -92,23 +87,10 @@ def _plot_sweep(fig, res, spec):
 
 
 def _plot_faults(fig, res):
-    ax = fig.add_subplot(111)
-    cases = list(FAULTS)
-    speeds = list(res.distance)
-    y = np.arange(len(cases))
-    for k, s in enumerate(speeds):
-        err = [res.select(speed_kmh=s, fault=f, mode="closed", channel="analogue",
-                          force_error=0.0, gradient=0.0, friction=1.0, electric=True)[0][1]
-               for f in cases]
-        ax.barh(y + (k - (len(speeds) - 1) / 2) * 0.35, err, height=0.35, color=f"C{k}",
-                label=f"{fmt(s)} km/h")
-    ax.set_xscale("symlog", linthresh=0.3)
-    ax.axvspan(-res.tolerance, res.tolerance, color="0.9", zorder=0)
-    ax.set_yticks(y)
-    ax.set_yticklabels([f"{c} ({FAULTS[c]})" for c in cases], fontsize=8)
-    ax.invert_yaxis()
-    ax.set_xlabel(f"stop error (m, + overshoot; grey: ±{fmt(res.tolerance)} m)")
-    ax.legend(fontsize=8)
+    axles = faults(res.spec)
+    plot_case_bars(fig.add_subplot(111), [f"{c} ({a})" for c, a in axles.items()],
+                   [(f"{fmt(s)} km/h", [res.stop(s, fault=f) for f in axles])
+                    for s in res.distance], res.tolerance, linthresh=0.3)
 
 
 def _plot_mc(fig, res):

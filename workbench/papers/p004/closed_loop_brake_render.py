@@ -3,14 +3,14 @@
 "p004.closed_loop_brake"``): pure rendering, in the paper's wording."""
 from __future__ import annotations
 
-import numpy as np
 import sympy as sp
 
-from ...kinds.stop_accuracy.render import error_colours, moving, quantity_table
+from ...kinds.stop_accuracy.grid_map import GridAxis, plot_grid_map
+from ...kinds.stop_accuracy.render import plot_speed_distance, quantity_table
 from ...report.markdown import Figure, Rendered, fmt, md_table
-from .closed_loop_brake_spec import view, worked_formulas
+from .closed_loop_brake_spec import loop_values, worked_formulas
 from .closed_loop_brake_fair_render import fault_text, figures, monte_carlo, retune_section
-from .closed_loop_brake_run import CHANNELS, FAULTS, MODES
+from .closed_loop_brake_run import CHANNELS, ELECTRIC_LOSS, MODES, faults
 
 MODE_TEXT = {"open": "open loop, single command",
              "ato-open": "open loop + ATO re-commands (a_req sent as the brake demand: no "
@@ -37,41 +37,40 @@ def _worked_section(res, spec) -> str:
 
 
 def render(design, res) -> Rendered:
-    spec = view(design.spec)
+    spec, loop = design.spec, loop_values(design.spec)
+    grid = dict(spec.grid)
     sections = [
         "## Problem\n\nPaper 004 argues qualitatively that closing the loop on the measured "
         "deceleration cancels force errors, gradient and friction scatter; it gives no "
         "dynamics, gains or simulations. Here the brake is paper 000's electro-pneumatic "
         f"model (parameters below), the train brakes from {', '.join(fmt(s) for s in spec.speeds_kmh)} "
         f"km/h to a stopping point D = the nominal open-loop stopping distance of the single "
-        f"command {fmt(spec.a_target)} m/s² (D = "
+        f"command {fmt(spec.command)} m/s² (D = "
         + ", ".join(f"{fmt(d, 5)} m" for d in res.distance.values())
         + "), over the grid force error "
-        f"{list(spec.force_error)} × gradient {list(spec.gradient)} ‰ × air-brake friction "
-        f"factor {list(spec.friction)}. Modes: " + "; ".join(f"**{m}** = {MODE_TEXT[m]}" for m in MODES)
+        f"{list(grid['force_error'])} × gradient {list(grid['gradient'])} ‰ × air-brake "
+        f"friction factor {list(grid['friction'])}. Modes: "
+        + "; ".join(f"**{m}** = {MODE_TEXT[m]}" for m in MODES)
         + ". The ATO's required deceleration is a_req = v_p² / (2 d_p) at the state predicted "
-        f"{fmt(spec.t_predict)} s ahead; the closed loop measures the deceleration from the "
-        "maximum of four axle speeds (filtered derivative), uses the incremental fuzzy "
-        f"controller when |a_req − a_meas| > {fmt(spec.e_switch)} m/s² and PID below, and "
+        f"{fmt(spec.constants['t_p'].value)} s ahead; the closed loop measures the deceleration "
+        "from the maximum of four axle speeds (filtered derivative), uses the incremental fuzzy "
+        f"controller when |a_req − a_meas| > {fmt(loop['e_switch'])} m/s² and PID below, and "
         "falls back to the ATO open loop when all four axles are failed or sliding. The "
-        f"3-bit channel sends round(7 c / {fmt(spec.c_full)}) levels.\n\n"
+        f"3-bit channel sends round(7 c / {fmt(spec.c_max)}) levels.\n\n"
         + quantity_table("parameter", spec.params, 5),
         _worked_section(res, spec),
         retune_section(spec, res),
     ]
     rows = []
     for s in res.distance:
-        grid = dict(speed_kmh=s, fault="healthy", electric=True)
         for m in MODES:
             for ch in (CHANNELS if m == "closed" else ("analogue",)):
-                sel = res.select(mode=m, channel=ch, **grid)
-                fail = res.failing(mode=m, channel=ch, **grid)
-                ff = [r for r, _ in fail if res.feasible[res.runs.index(r)]]
-                rows.append([fmt(s), m, ch, fmt(res.max_abs(mode=m, channel=ch, **grid), 3),
-                             f"{len(fail)} / {len(sel)}", len(ff)])
-    n_inf = sum(not f for r, f in zip(res.runs, res.feasible)
-                if r.mode == "closed" and r.channel == "analogue" and r.fault == "healthy"
-                and r.electric) // max(len(res.distance), 1)
+                fail = [not abs(e) <= res.tolerance for e in res.grid(s, m, ch)]
+                rows.append([fmt(s), m, ch, fmt(res.max_abs(s, m, ch), 3),
+                             f"{sum(fail)} / {len(fail)}",
+                             sum(f and ok for f, ok in zip(fail, res.feasible(s)))])
+    n_inf = sum(not ok for s in res.distance for ok in res.feasible(s)) // max(
+        len(res.distance), 1)
     sections.append(
         f"## Error grid: stop error against the ±{fmt(res.tolerance)} m window\n\n"
         + md_table(["km/h", "mode", "channel", "max |error| (m)", "corners outside ±"
@@ -83,16 +82,14 @@ def render(design, res) -> Rendered:
         + _corner_details(res))
     frows = []
     for s in res.distance:
-        for f in FAULTS:
-            sel = res.select(speed_kmh=s, fault=f, mode="closed", channel="analogue",
-                             force_error=0.0, gradient=0.0, friction=1.0, electric=True)
-            frows.append([fmt(s), f, FAULTS[f], fmt(sel[0][1], 3) if sel else "—",
-                          "fallback (ATO open loop)" if all(c in "sf" for c in FAULTS[f])
-                          else "closed, fault undetected" if set(FAULTS[f]) & set("hz")
+        for f, axles in faults(spec).items():
+            frows.append([fmt(s), f, axles, fmt(res.stop(s, fault=f), 3),
+                          "fallback (ATO open loop)" if all(c in "sf" for c in axles)
+                          else "closed, fault undetected" if set(axles) & set("hz")
                           else "closed"])
         for m in ("ato-open", "closed"):
-            sel = res.select(speed_kmh=s, mode=m, electric=False)
-            frows.append([fmt(s), f"electric brake lost ({m})", "oooo", fmt(sel[0][1], 3), m])
+            frows.append([fmt(s), f"electric brake lost ({m})", "oooo",
+                          fmt(res.stop(s, m, fault=ELECTRIC_LOSS), 3), m])
     sections.append(
         "## Sensor faults and electric-brake loss (nominal corner)\n\n"
         + md_table(["km/h", "case", "axles", "stop error (m)", "loop"], frows, "rllrl")
@@ -111,33 +108,21 @@ def render(design, res) -> Rendered:
 
 
 def _plot_curves(fig, res):
-    corners = sorted({r.force_error for r, _, _ in res.curves}, reverse=True)
-    for i, fe in enumerate(corners):
-        ax = fig.add_subplot(1, len(corners), i + 1)
-        for k, (r, dx, v) in enumerate(c for c in res.curves if c[0].force_error == fe):
-            keep = moving(v)
-            ax.plot(dx[keep], 3.6 * v[keep], color=f"C{k}", label=f"{r.mode} ({r.channel})")
-        ax.axvline(0, color="k", lw=0.6)
-        ax.set_xlabel("position − D (m)")
-        ax.set_ylabel("speed (km/h)")
-        ax.set_title(f"force error {fmt(100 * fe)} %", fontsize=9)
-        ax.legend(fontsize=7)
+    plot_speed_distance(fig, [(f"force error {fmt(100 * fe)} %", [
+        (f"{m} ({ch})", dx, v) for m, ch, f, dx, v in res.curves if f == fe])
+        for fe in sorted({c[2] for c in res.curves}, reverse=True)])
 
 
 def _corner_details(res) -> str:
     rows = []
+    cs = res.corners()
     for s in res.distance:
-        sel = {(r.force_error, r.gradient, r.friction, r.mode, r.channel): e
-               for r, e in res.select(speed_kmh=s, fault="healthy", electric=True)}
-        corners = sorted({k[:3] for k in sel})
-        for c in corners:
-            feas = next(f for r, f in zip(res.runs, res.feasible)
-                        if r.speed_kmh == s and (r.force_error, r.gradient, r.friction) == c)
-            rows.append([fmt(s), fmt(100 * c[0]), fmt(c[1]), fmt(c[2]), "yes" if feas else "no",
-                         fmt(sel[c + ("open", "analogue")], 3),
-                         fmt(sel[c + ("ato-open", "analogue")], 3),
-                         fmt(sel[c + ("closed", "analogue")], 3),
-                         fmt(sel[c + ("closed", "3bit")], 3)])
+        ok = res.feasible(s)
+        for k in sorted(range(len(cs)), key=cs.__getitem__):
+            rows.append([fmt(s), fmt(100 * cs[k][0]), fmt(cs[k][1]), fmt(cs[k][2]),
+                         "yes" if ok[k] else "no"] + [fmt(res.grid(s, m, ch)[k], 3) for m, ch in (
+                             ("open", "analogue"), ("ato-open", "analogue"),
+                             ("closed", "analogue"), ("closed", "3bit"))])
     return ("<details><summary>Every corner (stop error, m; + = overshoot)</summary>\n\n"
             + md_table(["km/h", "force error %", "gradient ‰", "friction", "feasible", "open",
                         "ATO open", "closed analogue", "closed 3-bit"], rows, "rrrrlrrrr")
@@ -145,38 +130,18 @@ def _corner_details(res) -> str:
 
 
 def _plot_grid(fig, res, spec):
-    cmap, norm = error_colours(res.tolerance)
-    speeds = list(res.distance)
-    nf = len(spec.friction)
-    gs = fig.add_gridspec(len(speeds), nf + 1, width_ratios=[1.0] * nf + [0.06])
-    for i, s in enumerate(speeds):
-        for j, fr in enumerate(spec.friction):
-            ax = fig.add_subplot(gs[i, j])
-            M = np.full((len(spec.force_error), len(spec.gradient)), np.nan)
-            feas = np.ones(M.shape, bool)
-            for a, fe in enumerate(spec.force_error):
-                for b, gr in enumerate(spec.gradient):
-                    sel = res.select(speed_kmh=s, mode="closed", channel="analogue", fault="healthy",
-                                     electric=True, force_error=fe, gradient=gr, friction=fr)
-                    M[a, b] = sel[0][1]
-                    feas[a, b] = res.feasible[res.runs.index(sel[0][0])]
-            im = ax.imshow(np.abs(M), cmap=cmap, norm=norm, origin="lower", aspect="auto")
-            for a in range(M.shape[0]):
-                for b in range(M.shape[1]):
-                    ax.text(b, a, fmt(M[a, b], 2) + ("" if feas[a, b] else "\ninfeasible"),
-                            ha="center", va="center", fontsize=7,
-                            color="w" if abs(M[a, b]) > 2 * res.tolerance else "k")
-            ax.set_xticks(range(len(spec.gradient)))
-            ax.set_xticklabels([fmt(g) for g in spec.gradient])
-            ax.set_yticks(range(len(spec.force_error)))
-            ax.set_yticklabels([fmt(100 * f) for f in spec.force_error])
-            ax.grid(False)
-            ax.set_title(f"{fmt(s)} km/h, friction ×{fmt(fr)}", fontsize=8)
-            if i == len(speeds) - 1:
-                ax.set_xlabel("gradient (‰, + uphill)")
-            if j == 0:
-                ax.set_ylabel("force error (%)")
-    fig.suptitle(f"closed-loop stop error (m); green: within ±{fmt(res.tolerance)} m, "
-                 f"orange to red: beyond it, dark red: ≥ {fmt(3 * res.tolerance)} m")
-    fig.colorbar(im, cax=fig.add_subplot(gs[:, nf]), extend="max",
-                 label=f"|stop error| (m); tolerance {fmt(res.tolerance)} m")
+    grid, cs = dict(spec.grid), res.corners()
+
+    def cell(s, fe, gr, fr):
+        k = cs.index((fe, gr, fr))
+        return res.grid(s, "closed")[k], res.feasible(s)[k]
+
+    tol = res.tolerance
+    plot_grid_map(
+        fig, list(res.distance), GridAxis(grid["force_error"], "force error (%)",
+                                          lambda f: fmt(100 * f)),
+        GridAxis(grid["gradient"], "gradient (‰, + uphill)"), GridAxis(grid["friction"]), cell,
+        tol, title=lambda s, fr: f"{fmt(s)} km/h, friction ×{fmt(fr)}",
+        suptitle=f"closed-loop stop error (m); green: within ±{fmt(tol)} m, orange to red: "
+        f"beyond it, dark red: ≥ {fmt(3 * tol)} m",
+        colorbar=f"|stop error| (m); tolerance {fmt(tol)} m")

@@ -1,10 +1,9 @@
-"""Paper 004's own tables and its view of designs/closed-loop-brake-004.toml.
+"""Paper 004's own tables of designs/closed-loop-brake-004.toml and its check of the design.
 
 ``[worked]`` (the inputs of section 1.3's worked numbers, computed from
 sympy expressions written here once) and ``[retuning] t_predict_sweep`` are
-paper 004's; :func:`view` gives the design's ``stop-accuracy`` spec in the
-names of the report (a_target, the grid's force error, gradient and
-friction, the command generator's gains).
+paper 004's; :func:`load` checks that the design has the controllers,
+grid, faults and constants the report's runs name.
 """
 from __future__ import annotations
 
@@ -13,10 +12,11 @@ from functools import lru_cache
 
 import sympy as sp
 
-from ...controllers.fuzzy import FuzzyIncrement
+from ...kinds.stop_accuracy.needs import require
 from ...reader import Quantity, Reader
+from .closed_loop_brake_run import ELECTRIC_LOSS, FAULT_NAMES
 
-__all__ = ["NEEDS", "Paper004", "Spec004", "Worked", "compute_worked", "load", "view",
+__all__ = ["NEEDS", "Paper004", "Worked", "compute_worked", "load", "loop_values",
            "worked_formulas"]
 
 
@@ -52,53 +52,17 @@ class Paper004:
     t_predict_sweep: tuple
 
 
-@dataclass(frozen=True)
-class Spec004:
-    """The paper's view of the design: its ``stop-accuracy`` spec (``kind``)
-    in the names of the report (:func:`view`)."""
-
-    params: dict
-    worked: Worked
-    speeds_kmh: tuple
-    a_target: float
-    c_full: float
-    force_error: tuple
-    gradient: tuple
-    friction: tuple
-    tolerance: float
-    fuzzy: FuzzyIncrement
-    e_switch: float
-    pid: dict
-    tau_filter: float
-    slide: float
-    d_min: float
-    t_predict: float
-    dt: float
-    dt_ctrl: float
-    high_ratio: float
-    montecarlo: object                        # MonteCarloSpec
-    t_predict_sweep: tuple                    # ATO horizons (s) of the retuning sweep
-    kind: object                              # the StopAccuracySpec
-
-
-#: The controllers, grid factors and constants the analysis reads from the design.
+#: The controllers the analysis runs by name.
 NEEDS = ("open", "ato_open", "closed", "closed_3bit", "full_service")
 
 
 def load(root: Reader, spec) -> Paper004:
     """Check that ``spec`` has what the report's runs need and read ``[worked]``
     and ``[retuning]``."""
-    names = [c.name for c in spec.controllers]
-    grid = dict(spec.grid)
-    if (names[:len(NEEDS)] != list(NEEDS) or any(spec.controllers[names.index(k)].loop is None
-                                                for k in ("closed", "closed_3bit"))
-            or set(grid) != {"force_error", "gradient", "friction"} or spec.command is None
-            or spec.montecarlo is None or "t_p" not in spec.constants
-            or "d_min" not in spec.constants):
-        raise root.fail("analysis.module", "p004.closed_loop_brake", "a design with the "
-                        "controllers " + ", ".join(NEEDS) + " (closed and closed_3bit with a "
-                        "deceleration_loop), a [grid] of force_error, gradient and friction, a "
-                        "[target] command, [montecarlo] and the constants t_p and d_min")
+    require(root, spec, "p004.closed_loop_brake", controllers=NEEDS,
+            loops=("closed", "closed_3bit"), grid=("force_error", "gradient", "friction"),
+            feasible_with="full_service", faults=(*FAULT_NAMES, ELECTRIC_LOSS),
+            constants=("t_p", "d_min"), tables=("command", "montecarlo"))
     w = root.table("worked")
     shares = []
     for s in w.tables("shares"):
@@ -119,18 +83,9 @@ def load(root: Reader, spec) -> Paper004:
     return Paper004(worked, tuple(sweep))
 
 
-def view(spec) -> Spec004:
-    """The paper's view of the ``stop-accuracy`` spec ``spec`` (its values, at
-    its step ``dt``: a refined spec gives a refined view)."""
-    loop = spec.controllers[NEEDS.index("closed")].loop.values(spec.constants)
-    grid, const = dict(spec.grid), spec.constants
-    return Spec004(spec.params, spec.paper.worked, spec.speeds_kmh, spec.command, spec.c_max,
-                   grid["force_error"], grid["gradient"], grid["friction"], spec.tolerance,
-                   FuzzyIncrement(loop["e_scale"], loop["de_scale"], loop["du_scale"]),
-                   loop["e_switch"], {k: loop[k] for k in ("kp", "ki", "kd")},
-                   loop["tau_filter"], loop["slide_ratio"], const["d_min"].value,
-                   const["t_p"].value, spec.dt, spec.dt_ctrl, loop["high_ratio"],
-                   spec.montecarlo, spec.paper.t_predict_sweep, spec)
+def loop_values(spec) -> dict:
+    """The closed loop's command-generator values (gains, scales, sensor ratios)."""
+    return spec.controllers[NEEDS.index("closed")].loop.values(spec.constants)
 
 
 def compute_worked(w: Worked) -> dict:

@@ -1,0 +1,64 @@
+"""The general figures of the stop-accuracy kind on toy data (no design): the
+error-grid map (:mod:`workbench.kinds.stop_accuracy.grid_map`: a panel per
+speed and third-factor value plus the colour bar, every cell's signed error
+printed, infeasible cells marked, large errors in white), the bars of the
+stop error per case (:func:`workbench.kinds.stop_accuracy.render.plot_case_bars`)
+and the speed-distance curves up to standstill
+(:func:`workbench.kinds.stop_accuracy.render.plot_speed_distance`)."""
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+from matplotlib.figure import Figure  # noqa: E402
+
+from workbench.kinds.stop_accuracy.grid_map import GridAxis, plot_grid_map  # noqa: E402
+import numpy as np  # noqa: E402
+
+from workbench.kinds.stop_accuracy.render import (plot_case_bars,  # noqa: E402
+                                                  plot_speed_distance)
+
+
+def test_toy_grid_map():
+    fig = Figure()
+    # error = row + column + panel value; infeasible where the row value is 2
+    cell = lambda s, r, c, p: (s * (r + c + p), r != 2)
+    plot_grid_map(fig, [1.0, -1.0], GridAxis((0, 2), "row"), GridAxis((0.1, 0.2, 0.3), "col"),
+                  GridAxis((0.0, 1.0)), cell, 0.5, title=lambda s, p: f"{s} {p}",
+                  suptitle="toy", colorbar="|e|")
+    assert len(fig.axes) == 2 * 2 + 1                                  # 4 panels + colour bar
+    ax = fig.axes[1]                                                   # speed 1, panel 1.0
+    texts = {t.get_text(): t.get_color() for t in ax.texts}
+    assert set(texts) == {"1.1", "1.2", "1.3", "3.1\ninfeasible", "3.2\ninfeasible",
+                          "3.3\ninfeasible"}
+    assert texts["1.1"] == "w" and texts["3.1\ninfeasible"] == "w"     # |e| > 2 tol = 1
+    assert fig.axes[0].texts[0].get_text() == "0.1" and fig.axes[0].texts[0].get_color() == "k"
+    assert ax.get_title() == "1.0 1.0" and fig.axes[2].get_xlabel() == "col"
+    assert fig.axes[0].get_ylabel() == "row" and ax.get_ylabel() == ""
+    assert [t.get_text() for t in fig.axes[3].texts][0] == "-1.1"       # speed -1, panel 1.0
+
+
+def test_toy_case_bars():
+    ax = Figure().add_subplot(111)
+    plot_case_bars(ax, ["a", "b", "c"], [("one", [0.1, -2.0, 30.0]), ("two", [0.0, 1.0, -5.0])],
+                   0.3, linthresh=0.3)
+    bars = ax.patches[:6]
+    assert [b.get_width() for b in bars] == [0.1, -2.0, 30.0, 0.0, 1.0, -5.0]
+    assert [round(b.get_y() + b.get_height() / 2, 3) for b in bars] == [
+        -0.175, 0.825, 1.825, 0.175, 1.175, 2.175]                 # side by side per case
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["a", "b", "c"]
+    assert ax.get_xscale() == "symlog" and ax.yaxis_inverted()
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["one", "two"]
+
+
+def test_toy_speed_distance_stops_at_standstill():
+    fig = Figure()
+    dx = np.array([-10.0, -5.0, -1.0, 0.5, 0.5])
+    v = np.array([5.0, 3.0, 1.0, 0.0, 0.0])                    # m/s, stands still from the 4th
+    plot_speed_distance(fig, [("A", [("x", dx, v), ("y", dx - 1, v)]), ("B", [("z", dx, v)])])
+    a, b = fig.axes
+    line = a.get_lines()[0]
+    assert list(line.get_xdata()) == [-10.0, -5.0, -1.0]        # up to the first standstill
+    assert list(line.get_ydata()) == [18.0, 10.8, 3.6]          # km/h
+    assert [t.get_text() for t in a.get_legend().get_texts()] == ["x", "y"]
+    assert (a.get_title(), b.get_title()) == ("A", "B") and len(b.get_lines()) == 2  # + D line
