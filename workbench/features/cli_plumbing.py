@@ -1,9 +1,15 @@
-"""Plumbing of the ``workbench simulate`` and ``workbench sweep`` commands that
-every simulating kind shares (issue 35): picking the ``--case``, the trajectory
-CSV of a recorded :class:`~workbench.sim.delay.SimResult`, the checks of the
-sweep's flags, and the translation of a sweep's failures (an unreachable Dask
-scheduler, an ``--out`` folder that cannot be written) into one clear
+"""Plumbing of the ``workbench simulate`` and ``workbench sweep`` commands
+(issue 35): picking the ``--case``, the trajectory CSV of a recorded
+:class:`~workbench.sim.delay.SimResult`, the checks of the sweep's flags, and
+the translation of a sweep's failures (an unreachable Dask scheduler, an
+``--out`` folder that cannot be written) into one clear
 :class:`~workbench.errors.DesignError` each (exit 2, no traceback).
+
+Who uses what today: ``switched-run`` uses :func:`pick_case`; the
+``antiskid-run`` commands use all of it (the only sweep with ``--scheduler``).
+The ``delay-feedback`` and ``switched-run`` CSVs keep their own format
+(``repr`` floats, :func:`workbench.kinds.delay_feedback.cli.csv_text`), which
+their users' files already read; :func:`trajectory_csv` prints nine digits.
 """
 from __future__ import annotations
 
