@@ -50,3 +50,22 @@ def test_load_linear_check_reads_and_rejects():
                                                "far_delays": [1.0], "periods": 20.0}})
     with pytest.raises(DesignError, match="linear_check.factors"):
         load_linear_check(bad)
+
+
+@pytest.mark.parametrize("k", [1.0, 1.0 - 1e-13])
+def test_marginal_gain_runs_a_bounded_window(k, monkeypatch):
+    """A + B K with abscissa 0 (or 1e-13) asked for a window 3 / 0: it is cut to max_steps."""
+    import workbench.sim.delay as delay
+    seen = []
+    real = delay.simulate_linear_dde
+
+    def spy(A_, BK, h, x0, t_end, dt):
+        seen.append(t_end / dt)
+        return real(A_, BK, h, x0, t_end, dt)
+
+    monkeypatch.setattr(delay, "simulate_linear_dde", spy)
+    spec = LinearCheckSpec((0.0, -0.5), (0.9,), (1.0,), 10.0)
+    A0 = np.diag([-1.0, -1.0 - k])        # A + B K = diag(-1, -1 - k + k) -> abscissa ~0
+    lc = linear_delay_check(spec, A0, B, (0.0, k), np.array([1.0, 1.0]), max_steps=3000)
+    assert len(lc.ratios) == 1 and math.isfinite(lc.ratios[0][1])
+    assert seen and max(seen) <= 3000 * (1 + 1e-9)

@@ -33,11 +33,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["LinearCheckSpec", "LinearDelayCheck", "TEST_PROBLEM", "linear_delay_check",
-           "load_linear_check"]
+__all__ = ["LinearCheckSpec", "LinearDelayCheck", "MAX_STEPS", "TEST_PROBLEM",
+           "linear_delay_check", "load_linear_check"]
 
 #: (a, h, t_end) of the step-halving check x' = -a x(t - h), x = 1 on [-h, 0], over t_end s.
 TEST_PROBLEM = (1.0, 0.7, 10.0)
+#: Most steps of one far-delay run of the design's gain (three windows).
+MAX_STEPS = 2_000_000
 #: Steps (s) of the step-halving check.
 HALVING_STEPS = (0.1, 0.05, 0.025, 0.0125)
 
@@ -86,7 +88,8 @@ class LinearDelayCheck:
     halving: tuple = ()
 
 
-def linear_delay_check(spec: LinearCheckSpec, A, B, K, x0) -> LinearDelayCheck:
+def linear_delay_check(spec: LinearCheckSpec, A, B, K, x0,
+                       max_steps: int = MAX_STEPS) -> LinearDelayCheck:
     """Simulate x' = A x + B K x(t - h) from the constant history ``x0``.
 
     Parameters
@@ -97,13 +100,17 @@ def linear_delay_check(spec: LinearCheckSpec, A, B, K, x0) -> LinearDelayCheck:
     K : (n,) sequence
         The design's gain (one input row).
     x0 : (n,) array_like
+    max_steps : int, optional
+        Most steps of one far-delay run of ``K`` (default :data:`MAX_STEPS`).
 
     Returns
     -------
     LinearDelayCheck
         The ``K_finite`` runs last ``spec.periods`` crossing periods 2 pi / omega*
         (step min(period, h) / 50); the ``K`` runs three windows of
-        max(10 h, 3 / |abscissa of A + B K|) (step min(h, 1 / spectral radius of A) / 5).
+        max(10 h, 3 / |abscissa of A + B K|) (step min(h, 1 / spectral radius of A) / 5),
+        the window cut to ``max_steps`` / 3 steps (a gain whose abscissa is
+        0 or nearly 0 would otherwise ask for an unbounded run).
     """
     from ..margins import delay_margin_eig
     from ..sim.delay import envelope_ratio, simulate_linear_dde, step_halving
@@ -124,8 +131,9 @@ def linear_delay_check(spec: LinearCheckSpec, A, B, K, x0) -> LinearDelayCheck:
     rate = max(abs(np.linalg.eigvals(A)).max(), 1.0)
     slow = abs(np.max(np.linalg.eigvals(A + BK).real))
     for h in spec.far_delays:
-        window = max(10 * h, 3 / slow)
-        r = simulate_linear_dde(A, BK, h, x0, 3 * window, min(h, 1 / rate) / 5)
+        step = min(h, 1 / rate) / 5
+        window = min(max(10 * h, 3 / slow if slow > 0 else math.inf), max_steps * step / 3)
+        r = simulate_linear_dde(A, BK, h, x0, 3 * window, step)
         ratios.append((h, envelope_ratio(r, window)))
     return LinearDelayCheck(A, B, tuple(K), tuple(spec.finite_gain), fin, tuple(ratios_f),
                             margin, tuple(ratios), tuple(runs),

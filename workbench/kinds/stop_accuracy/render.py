@@ -360,8 +360,8 @@ def error_colours(tol: float):
     cell can look green), and its norm (bounds 0, tol/2, tol, 1.5 tol, 2 tol,
     3 tol; darker above): ``(cmap, norm)`` for ``imshow``."""
     from matplotlib.colors import BoundaryNorm, ListedColormap
-    cmap = ListedColormap(["#1a9850", "#a6d96a", "#fdae61", "#f46d43", "#d73027"])
-    cmap.set_over("#67001f")
+    cmap = ListedColormap(["#1a9850", "#a6d96a", "#fdae61", "#f46d43",
+                           "#d73027"]).with_extremes(over="#67001f")
     bounds = [0.0, tol / 2, tol, 1.5 * tol, 2 * tol, 3 * tol]
     return cmap, BoundaryNorm(bounds, cmap.N)
 
