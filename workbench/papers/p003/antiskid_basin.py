@@ -59,7 +59,6 @@ from ...features.basin_points import GainSweep
 from ...features.basin_trajectory import limit_event
 from ...memo import shared
 from ...plants.adhesion import NumericAdhesion, adhesion_model
-from ...roa.check import BasinCheck
 from ...symbolic.linearise import linearise_cruise
 
 #: Weights w of the fast (creep-ratio) mode against the slow (speed) mode

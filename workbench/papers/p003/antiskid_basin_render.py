@@ -18,25 +18,15 @@ from ...roa.render import render_basin_markdown
 from .antiskid_basin import LAM_DIVERGED
 
 
-def render_basin_result(res, *, rail: str) -> str:
-    """Section of a :class:`~workbench.papers.p003.antiskid_basin_run.BasinResult`."""
-    text = render_basin_section(res.basin, res.sweep, rail=rail,
-                                compare_source=res.compare_source, brake=res.brake)
-    if res.mass_factor != 1.0:
-        text += (f"\nThe plant of this design has {fmt(res.mass_factor, 3)} x the nominal mass; "
-                 "the basin is that of the controller's nominal model (the switch states are "
-                 "this design's simulated ones).\n")
-    return text
-
-
 #: Heading of the basin section (findings on switch and basin quantities link here).
 HEADING = ("Regions of attraction: does each switch land in the basin of the law that "
            "takes over?")
 
 
-def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—",
-                         brake=()) -> str:
-    """The report section: loop, certified bracket, switch verdicts, k2 rule."""
+def render_basin_result(res, *, rail: str) -> str:
+    """Section of a :class:`~workbench.papers.p003.antiskid_basin_run.BasinResult`:
+    loop, certified bracket, switch verdicts, k2 rule."""
+    basin = res.basin
     K = "[" + ", ".join(fmt(k, 4) for k in basin.K) + "]"
     head = (
         f"## {HEADING}\n\n"
@@ -57,8 +47,12 @@ def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—"
             "converges from it. REFUTED: its level holds a point with V' >= 0, so this V "
             "cannot certify it; the last column says what the delay-free trajectory does "
             f"(\"diverges\": |lambda| reaches {fmt(LAM_DIVERGED)}, the wheel spins).\n")
-    return (head + body + sw + brake_text(brake)
-            + (_k2_text(sweep, compare_source) if sweep is not None else ""))
+    text = head + body + sw + brake_text(res.brake) + _k2_text(res.sweep, res.compare_source)
+    if res.mass_factor != 1.0:
+        text += (f"\nThe plant of this design has {fmt(res.mass_factor, 3)} x the nominal mass; "
+                 "the basin is that of the controller's nominal model (the switch states are "
+                 "this design's simulated ones).\n")
+    return text
 
 
 def brake_text(brake) -> str:

@@ -45,7 +45,7 @@ class BasinResult:
     sweep: GainSweep
     compare_source: str
     mass_factor: float
-    brake: tuple = ()          # antiskid_basin_brake.BrakeSwitch per case that braked
+    brake: tuple = ()          # FrozenSwitch (antiskid_basin_brake) per case that braked
 
 
 def load_basin_settings(root) -> GainSweepSettings | None:
