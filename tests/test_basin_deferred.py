@@ -106,10 +106,10 @@ def test_falsified_top_is_the_estimates_falsifier(deferred):
 def test_switch_verdict_equals_the_eager_path(switch, k2, monkeypatch):
     """Every certificate computed (the path before issue 36) gives the same
     verdict, weight and fate as the deferred one (> 20 s: slow tier)."""
-    pt = (70.0, switch[1] + AB.cruise_loop(VALS, 70.0)[1])
-    fast = AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt)
+    loop = AB.cruise_loop(VALS, 70.0)[0]
+    fast = loop.judge((K[0], k2), switch, AB.T_JUDGE)
     monkeypatch.setenv(SEL.EAGER_ENV, "1")
-    assert AB.switch_in_basin(DRY, 70.0, (K[0], k2), pt) == fast
+    assert loop.judge((K[0], k2), switch, AB.T_JUDGE) == fast
 
 
 def test_k2_sweep_is_shared_through_the_run_folder(tmp_path, monkeypatch):
@@ -117,20 +117,20 @@ def test_k2_sweep_is_shared_through_the_run_folder(tmp_path, monkeypatch):
     nominal model and so the k2 sweep: a second process of the same run reads
     it from the run folder (here: the same key, the in-process cache bypassed)."""
     from workbench import memo
-    from workbench.papers.p003 import antiskid_basin_k2 as K2
+    from workbench.features.basin_points import GainSweep
     calls = []
 
     def fake(*key):
         calls.append(key)
-        return K2.K2Sweep(key[3], (key[2], 0.0), 1, (), (), None, min(key[4]), False)
+        return GainSweep(key[3], (key[2], 0.0), 1, (), (), None, min(key[4]), False)
 
     monkeypatch.setenv(memo.CACHE_ENV, str(tmp_path))
-    monkeypatch.setattr(K2, "_sweep", fake)
+    monkeypatch.setattr(AB, "_k2_sweep", fake)
     args = dict(grid=[0.0, 2.0], compare=[("row", (K[0], 10.5))], bisect=2, seed=0)
-    a = K2.safe_k2_range(DRY, 70.0, K[0], (70.0, 0.1), **args)
-    b = K2.safe_k2_range(dict(reversed(list(DRY.items()))), 70, K[0], (70.0, 0.1), **args)
+    a = AB.safe_k2_range(DRY, 70.0, K[0], (70.0, 0.1), **args)
+    b = AB.safe_k2_range(dict(reversed(list(DRY.items()))), 70, K[0], (70.0, 0.1), **args)
     assert a == b and len(calls) == 1 and len(list(tmp_path.glob("*.pickle"))) == 1
-    K2.safe_k2_range(DRY, 70.0, K[0], (70.0, 0.1), **dict(args, seed=1))
+    AB.safe_k2_range(DRY, 70.0, K[0], (70.0, 0.1), **dict(args, seed=1))
     assert len(calls) == 2                               # another key: computed
 
 
@@ -162,7 +162,7 @@ def test_cruise_basin_coarse_pass_equals_every_cover(monkeypatch):
     monkeypatch.setenv(SEL.EAGER_ENV, "1")
     eager = AB.cruise_basin(DRY, 70.0, K, pts, n_traj=2)
     assert n_fast < len(calls) - n_fast == len(AB.W_GRID)
-    assert (fast.q, fast.check, fast.K, fast.lambda_d) == (eager.q, eager.check, eager.K,
+    assert (fast.w, fast.check, fast.K, fast.lambda_d) == (eager.w, eager.check, eager.K,
                                                            eager.lambda_d)
     for a, b in zip(fast.trajectories, eager.trajectories, strict=True):
         assert (a.x0, a.fate) == (b.x0, b.fate) and np.array_equal(a.path, b.path)

@@ -144,3 +144,32 @@ def test_point_quantities_of_a_toy_check():
     assert set(q) == point_quantity_names(["in", "out"], "toy[{label}]", ("in_basin", "fate"))
     lv = level_quantities(chk.estimate)
     assert 0 < lv["basin.c_certified"] <= lv["basin.c_refuted"] <= 0.5 * 1.0 + 1e-9
+
+
+def test_frozen_switch_of_a_toy_tracking_loop_and_its_text():
+    """x' = -(x - r(t)), r(t) = 0.5 + 0.1 sin t, switched on at x = 0.2: frozen at
+    r(0) the state moves to x* = 0.5 (CERTIFIED), the time-varying loop tracks;
+    x' = 1 + x^2 has no equilibrium ahead (REFUTED: the rate and the time)."""
+    import math
+    from workbench.features.basin_scalar import FrozenSwitch, scalar_verdict
+    from workbench.features.basin_scalar_render import scalar_verdict_text
+    from workbench.features.basin_trajectory import limit_event, time_varying_fate
+    ref = lambda t: 0.5 + 0.1 * math.sin(t)                          # noqa: E731
+    fate = time_varying_fate(lambda t, x: [-(x - ref(t))], (0.2,), 0.0, 20.0,
+                             lambda t, x: abs(x[0] - ref(t)) < 0.1, events=[limit_event(0, 2.0)])
+    sw = FrozenSwitch("on", (0.2,), ref(0.0), scalar_verdict(-(Z - ref(0.0)), Z, 0.2, -2.0, 2.0),
+                      *fate)
+    assert (sw.outcome, sw.fate, sw.t_fate) == (Outcome.CERTIFIED, "tracks", None)
+    assert sw.verdict.star == pytest.approx(sw.reference)
+    assert scalar_verdict_text(sw.verdict, 0.2, 2.0, name="z").startswith("equilibrium z* = 0.5 (")
+    none = scalar_verdict(1 + Z**2, Z, 0.0, -2.0, 2.0)
+    text = scalar_verdict_text(none, 0.0, 2.0, name="z")
+    # |z'| >= 1 proven (rounded down), so z = 2 within 2 / 1 s (rounded up)
+    assert text.startswith("no equilibrium from the state up to z = 2: |z'| >= ")
+    rate = float(text.split(">= ")[1].split(" ")[0])
+    assert rate <= none.rate and float(text.split("within ")[1].split(" ")[0]) >= 2.0 / none.rate
+    down = scalar_verdict(-1 - Z**2, Z, 0.5, -2.0, 2.0)
+    text = scalar_verdict_text(down, 0.5, 2.0, name="z")
+    # from 0.5 down to -2: a distance of 2.5
+    assert "down to z = −2" in text
+    assert float(text.split("within ")[1].split(" ")[0]) >= 2.5 / down.rate

@@ -182,9 +182,10 @@ def test_gain_loop_on_a_toy_system():
     assert np.allclose(A_cl, [[0.0, 1.0], [-2.0, -3.0]])
     assert sp.simplify(J[1][0] - (-2.0 + 3 * loop.states[0] ** 2)) == 0
     assert loop.numeric(K)(1.0, 0.5) == [0.5, -2.0 - 1.5 + 1.0]
-    w, chk, trajs = loop.basin(K, [("near", (0.2, 0.0)), ("far", (3.0, 0.0))], n_traj=3,
-                               T=20.0, scale=(1, 1), pad=(0, 0), default=(1, 1))
-    assert w in loop.candidates and chk.loop == "toy Duffing"
+    res = loop.basin(K, [("near", (0.2, 0.0)), ("far", (3.0, 0.0))], n_traj=3,
+                     T=20.0, scale=(1, 1), pad=(0, 0), default=(1, 1))
+    chk, trajs = res.check, res.trajectories
+    assert res.w in loop.candidates and chk.loop == "toy Duffing" and res.K == K
     assert [p.verdict.outcome for p in chk.points] == [Outcome.CERTIFIED, Outcome.REFUTED]
     assert [t.fate for t in trajs[:2]] == ["converges", "diverges"] and len(trajs) == 5
     near, far = loop.judge(K, (0.2, 0.0), 20.0), loop.judge(K, (3.0, 0.0), 20.0)
@@ -196,3 +197,18 @@ def test_gain_loop_on_a_toy_system():
     # k1 > 0: no Hurwitz linearisation, hence no basin
     assert loop.basin((1.0, -3.0), [("near", (0.2, 0.0))], n_traj=0, T=1.0, scale=(1, 1),
                       pad=(0, 0), default=(1, 1)) is None
+
+
+def test_gain_loop_sweep_on_a_toy_system():
+    """k2 of the toy Duffing loop swept at k1 = -2: certified for k2 well below 0,
+    no basin from k2 = 0 on (A + B K not Hurwitz), the edge bisected in between."""
+    loop = _duffing()
+    sw = loop.sweep((-2.0, 0.0), (0.3, 0.0), 1, [1.0, -3.0, 0.0], 20.0, point=(1.3, 0.0),
+                    compare=[("far", (-2.0, -3.0))], bisect=3)
+    assert sw.point == (1.3, 0.0) and sw.gain == (-2.0, 0.0) and sw.grid_min == -3.0
+    assert [r.gain[1] for r in sw.rows] == sorted(r.gain[1] for r in sw.rows)
+    assert len(sw.rows) == 3 + 3 and sw.edge is not None and -3.0 <= sw.edge[0] < sw.edge[1] <= 0
+    by = {r.gain[1]: r.verdict for r in sw.rows}
+    assert by[-3.0].outcome is Outcome.CERTIFIED and by[-3.0].fate == "converges"
+    assert by[0.0].outcome is Outcome.REFUTED and not by[0.0].hurwitz
+    assert sw.compared[0].source == "far" and sw.compared[0].verdict == by[-3.0]

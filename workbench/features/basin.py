@@ -175,7 +175,7 @@ def closed_loop(model, values: dict, op, K):
 
 
 def delay_feedback_basin(model, values: dict, op, K, *, points=(), c_search: float | None = None,
-                         domain: tuple | None = None, weights=None, seed: int = 0):
+                         domain: tuple | None = None, seed: int = 0):
     """Certified basin of the delay-free loop of a delay-feedback design
     (:class:`workbench.roa.check.BasinCheck`).
 
@@ -191,13 +191,12 @@ def delay_feedback_basin(model, values: dict, op, K, *, points=(), c_search: flo
         Gain, u = u* + K (x - x*).
     points : sequence of (label, state)
         States to judge (absolute coordinates).
-    c_search, domain, weights, seed
-        As :func:`workbench.roa.check.check_basin` (``weights``: modal P;
-        default: the Lyapunov equation with Q = I).
+    c_search, domain, seed
+        As :func:`workbench.roa.check.check_basin` (P: the Lyapunov equation with Q = I).
     """
     from ..roa.check import check_basin
     fcl, states, A_cl = closed_loop(model, values, op, K)
-    return check_basin(fcl, states, op.x, A_cl=A_cl, weights=weights, points=points,
+    return check_basin(fcl, states, op.x, A_cl=A_cl, points=points,
                        c_search=c_search, domain=domain, names=model.spec.state_names,
                        loop=LOOP, seed=seed)
 

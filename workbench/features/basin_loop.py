@@ -22,7 +22,8 @@ import sympy as sp
 from ..plants.lambdify_cache import lambdify
 from ..roa import BasinProblem, estimate_basin, modal_P
 from ..roa.check import search_level
-from .basin_points import PointVerdict, check_points, point_in_basin, sampled_starts
+from .basin_points import (GainSweep, PointVerdict, check_points, point_in_basin, sampled_starts,
+                           sweep_gain_entry)
 from .basin_trajectory import Trajectory, trajectory
 
 
@@ -49,6 +50,28 @@ def modal_problem(f, states, x_eq, A_cl, weights, *, derivs=None, names=None, po
     P = modal_P(A_cl, weights)
     prob = BasinProblem(f, states, x_eq, P, P_source=P_source, names=names, derivatives=derivs)
     return prob, search_level(prob, points, domain, c_search)
+
+
+@dataclass(frozen=True)
+class GainBasin:
+    """Result of :meth:`GainLoop.basin` (no rendering).
+
+    Attributes
+    ----------
+    K : tuple of float
+        The gain.
+    w : object
+        The candidate chosen (e.g. the weight of a fast mode in a modal P).
+    check : workbench.roa.check.BasinCheck
+        Its estimate and the verdict of each judged state.
+    trajectories : tuple of Trajectory
+        From the judged states, then from the sampled starts.
+    """
+
+    K: tuple
+    w: object
+    check: object
+    trajectories: tuple
 
 
 @dataclass(frozen=True, eq=False)
@@ -140,6 +163,17 @@ class GainLoop:
                               self.numeric(K), T, events=self.events, escape=self.escape,
                               max_step=self.max_step, seed=seed)
 
+    def sweep(self, K, x, index: int, grid, T: float, *, point=None, compare=(), bisect: int = 4,
+              seed: int = 0) -> GainSweep:
+        """Entry ``index`` of the gain ``K`` over ``grid``, the state ``x`` judged by
+        :meth:`judge` over [0, T] at each gain, the edge of the certified range
+        bisected, and the labelled gains ``compare`` judged the same way
+        (:func:`~.basin_points.sweep_gain_entry`; ``point``: the state as the
+        result records it, default ``x``, e.g. in the design's own coordinates)."""
+        return sweep_gain_entry(lambda G: self.judge(G, x, T, seed=seed),
+                                x if point is None else point, K, index, grid, compare=compare,
+                                bisect=bisect)
+
     def trajectory(self, fn, x0, T: float, inside, *, path_dt=None) -> Trajectory:
         """One trajectory of x' = fn(*x) from x0 and its fate, escaping by the
         loop's events (:func:`~.basin_trajectory.trajectory`)."""
@@ -147,9 +181,9 @@ class GainLoop:
                           max_step=self.max_step, path_dt=path_dt)
 
     def basin(self, K, points, *, n_traj: int, T: float, scale, pad, default, seed: int = 0,
-              path_dt=None):
-        """(candidate, BasinCheck, trajectories) of the best candidate for the
-        labelled ``points`` (:meth:`check`; None: no Hurwitz loop), with the
+              path_dt=None) -> GainBasin | None:
+        """The :class:`GainBasin` of the best candidate for the labelled
+        ``points`` (:meth:`check`; None: no Hurwitz loop), with the
         trajectories from the points and from ``n_traj`` seeded starts around them
         (:func:`~.basin_points.sampled_starts` with ``scale``, ``pad``, ``default``)
         over [0, T], "converges" once in the certified level set."""
@@ -161,5 +195,5 @@ class GainLoop:
                                 default=default)
         fn, c = self.numeric(K), check.estimate.c_certified
         inside = lambda p: prob.V(p) <= c
-        return w, check, tuple(self.trajectory(fn, x0, T, inside, path_dt=path_dt)
-                               for x0 in starts)
+        return GainBasin(tuple(float(k) for k in K), w, check, tuple(
+            self.trajectory(fn, x0, T, inside, path_dt=path_dt) for x0 in starts))

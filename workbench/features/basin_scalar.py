@@ -14,6 +14,13 @@ the direction of g; so, from the state x_s:
   the state's verdict; a state beyond the certified level that is proven to
   move towards it (sign of g on the way) is CERTIFIED too;
 * otherwise INCONCLUSIVE.
+
+:class:`FrozenSwitch` holds such a verdict for a state where a law whose
+reference varies in time takes over: the verdict of the loop frozen at the
+switch instant (reference held, the fast state alone moving), and the fate of
+the time-varying loop from the same state
+(:func:`~workbench.features.basin_trajectory.time_varying_fate`), which drops
+the frozen assumptions. Rendering: :mod:`.basin_scalar_render`.
 """
 from __future__ import annotations
 
@@ -138,3 +145,35 @@ def scalar_verdict(g, x, x_s: float, lo: float, hi: float, *, name: str = "x",
             return ScalarVerdict(Outcome.CERTIFIED, "monotone approach, level set", d, star, m,
                                  level)
     return ScalarVerdict(pv.outcome, "level set", d, star, None, level)
+
+
+@dataclass(frozen=True)
+class FrozenSwitch:
+    """A switch state judged on the loop frozen at the switch instant, and the
+    fate of the time-varying loop from it (module docstring).
+
+    Attributes
+    ----------
+    label : str
+    x : tuple of float
+        The full state at the switch.
+    reference : float
+        The reference at the switch instant, held in the frozen loop.
+    verdict : ScalarVerdict
+        Of the frozen one-state loop (:func:`scalar_verdict`).
+    fate : str
+        Of the time-varying loop: the escape word, the settled word or "undecided".
+    t_fate : float or None
+        When it escaped (time after the switch).
+    """
+
+    label: str
+    x: tuple
+    reference: float
+    verdict: ScalarVerdict
+    fate: str
+    t_fate: float | None
+
+    @property
+    def outcome(self) -> Outcome:
+        return self.verdict.outcome

@@ -16,7 +16,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from .basin import BasinEstimate, LevelVerdict, estimate_basin
-from .lyapunov import lyapunov_P, modal_P
+from .lyapunov import lyapunov_P
 from .problem import BasinProblem
 
 
@@ -91,7 +91,7 @@ def search_level(prob: BasinProblem, points, domain: tuple | None = None,
 
 
 def check_basin(f: Sequence[sp.Expr], states: Sequence[sp.Symbol], x_eq: Sequence[float], *,
-                A_cl=None, P=None, Q=None, weights=None, points: Sequence[tuple[str, Sequence[float]]] = (),
+                A_cl, points: Sequence[tuple[str, Sequence[float]]] = (),
                 c_search: float | None = None, domain: tuple | None = None,
                 names: Sequence[str] | None = None, loop: str = "delay-free closed loop",
                 seed: int = 0, min_width: float = 2.0**-12) -> BasinCheck:
@@ -102,16 +102,9 @@ def check_basin(f: Sequence[sp.Expr], states: Sequence[sp.Symbol], x_eq: Sequenc
     f, states, x_eq
         Delay-free closed-loop vector field (sympy, in ``states`` only) and
         its equilibrium.
-    A_cl : (n, n) array_like, optional
-        Linearisation A + B K; P from A_cl' P + P A_cl = -Q when ``P`` is not given.
-    P : (n, n) array_like, optional
-        The certificate's P (takes precedence).
-    Q : (n, n) array_like, optional
-        Weight of the Lyapunov equation (identity by default).
-    weights : sequence of float, optional
-        With ``A_cl``: P = :func:`~workbench.roa.lyapunov.modal_P` (A_cl,
-        weights) instead of the Lyapunov equation (better when the loop has
-        slow and fast modes).
+    A_cl : (n, n) array_like
+        Linearisation A + B K; P from A_cl' P + P A_cl = -I (a modal P, for a
+        loop with slow and fast modes: :class:`workbench.features.basin_loop.GainLoop`).
     points : sequence of (label, state)
         States to judge (e.g. the states at the phase switches).
     c_search : float, optional
@@ -134,15 +127,7 @@ def check_basin(f: Sequence[sp.Expr], states: Sequence[sp.Symbol], x_eq: Sequenc
     ModelError
         When no P can be formed (A_cl not Hurwitz), or no search level is known.
     """
-    if P is not None:
-        Pm, src = np.asarray(P, float), "certificate"
-    elif A_cl is not None and weights is not None:
-        Pm, src = modal_P(A_cl, weights), "modal"
-    elif A_cl is not None:
-        Pm, src = lyapunov_P(A_cl, Q), "lyapunov"
-    else:
-        raise ModelError("check_basin needs A_cl (for a Lyapunov equation) or P")
-    prob = BasinProblem(f, states, x_eq, Pm, P_source=src, names=names)
+    prob = BasinProblem(f, states, x_eq, lyapunov_P(A_cl), P_source="lyapunov", names=names)
     c_search = search_level(prob, [x for _, x in points], domain, c_search)
     est: BasinEstimate = estimate_basin(prob, c_search, seed=seed, min_width=min_width)
     checks = tuple(PointCheck(label, tuple(float(v) for v in x), est.point_verdict(x))

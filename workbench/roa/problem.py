@@ -305,17 +305,6 @@ class BasinProblem:
         fn = sp.lambdify(self.states, self.vdot_grad, "numpy", cse=True)
         return lambda x: np.array(fn(*np.asarray(x, float)), float)
 
-    @cached_property
-    def f_numeric(self):
-        """(x: (N, n)) -> f(x) as (N, n), floats (trajectory sampling)."""
-        fn = sp.lambdify(self.states, list(self.f), "numpy", cse=True)
-
-        def run(X):
-            X = np.atleast_2d(np.asarray(X, float))
-            out = fn(*X.T)
-            return np.stack([np.broadcast_to(np.asarray(o, float), (X.shape[0],)) for o in out], 1)
-        return run
-
     def V(self, X) -> np.ndarray:
         """V at points (N, n), floats."""
         E = np.atleast_2d(np.asarray(X, float)) - self.x_eq
@@ -325,10 +314,6 @@ class BasinProblem:
     @cached_property
     def vdot_interval(self) -> IntervalFunction:
         return IntervalFunction([self.vdot], self.states)
-
-    @cached_property
-    def f_interval(self) -> IntervalFunction:
-        return IntervalFunction(list(self.f), self.states)
 
     def V_interval(self, lo: np.ndarray, hi: np.ndarray) -> Interval:
         """Enclosure of V on the boxes lo <= x <= hi ((N, n) arrays)."""

@@ -20,14 +20,23 @@ Results:
   [1, w] on the slow speed mode and the fast creep mode, w from a small grid
   chosen to certify the switch states: P_source "optimised"), the verdict
   for the switch states, sampled delay-free trajectories (figure);
-* :func:`switch_in_basin` -- the best verdict over the weight grid for one
-  switch state and gain (used by :func:`~.antiskid_basin_k2.safe_k2_range`).
+* :func:`safe_k2_range` -- a certified switching rule for eq (75): the gains
+  k2 (k1 kept) for which the printed switch state (v_d, lambda_opt) is
+  CERTIFIED (the best verdict over the weight grid, w: the deciding weight),
+  the edge between the largest certified grid value and the next bisected,
+  and gains given for comparison (003's Table 3 rows, with their own k1)
+  judged the same way. The rule is *sufficient*: a state outside every
+  certified level set may still converge; the "fate" says what the delay-free
+  trajectory from it does within :data:`T_JUDGE` ("diverges": lambda reaches
+  0.9, the wheel spins; "undecided": neither that nor a certified level set).
 
 Only the closed loop (law (61) at v_d on the adhesion plant, its domain and
-the |lambda| = 0.9 divergence event) and the weight grid are paper 003's and
-stay here: a :class:`workbench.features.basin_loop.GainLoop`, whose general
-methods give the modal problems, the switch states' verdicts, the best verdict
-over the grid, the sampled starts and the trajectories' fates; the figure is
+the |lambda| = 0.9 divergence event), the weight grid and the k2
+parameterisation are paper 003's and stay here: a
+:class:`workbench.features.basin_loop.GainLoop`, whose general methods give
+the modal problems, the switch states' verdicts, the best verdict over the
+grid, the sampled starts, the trajectories' fates and the gain sweep
+(:meth:`~workbench.features.basin_loop.GainLoop.sweep`); the figure is
 :mod:`workbench.features.basin_plot`'s.
 
 References
@@ -45,11 +54,11 @@ import sympy as sp
 
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import ModelError
-from ...features.basin_loop import GainLoop
-from ...features.basin_points import PointVerdict
-from ...features.basin_trajectory import integrate, limit_event
+from ...features.basin_loop import GainBasin, GainLoop
+from ...features.basin_points import GainSweep
+from ...features.basin_trajectory import limit_event
+from ...memo import shared
 from ...plants.adhesion import NumericAdhesion, adhesion_model
-from ...roa.check import BasinCheck
 from ...symbolic.linearise import linearise_cruise
 
 #: Weights w of the fast (creep-ratio) mode against the slow (speed) mode
@@ -64,28 +73,16 @@ LOOP = ("adhesion plant (eq 12 / eq 15) under the cruise law (61), delay-free: t
 
 
 @dataclass(frozen=True)
-class CruiseBasin:
-    """Basin of the cruise law for one design (no rendering).
+class CruiseBasin(GainBasin):
+    """Basin of the cruise law for one design (no rendering): the
+    :class:`~workbench.features.basin_loop.GainBasin` in the error coordinates
+    (``w``: the weight of the fast mode in P = modal_P(A + B K, [1, w]);
+    ``trajectories``: from each switch state, then from the seeded grid) and
+    the cruise point (m/s, creep ratios)."""
 
-    Attributes
-    ----------
-    check : BasinCheck
-        Estimate and the verdict for each switch state (error coordinates).
-    K : tuple
-    q : float
-        Weight w of the fast mode in P = modal_P(A + B K, [1, w]).
-    lambda_d, lambda_opt, v_d : float
-    trajectories : tuple of Trajectory
-        Sampled trajectories (seeded grid) and one from each switch state.
-    """
-
-    check: BasinCheck
-    K: tuple
-    q: float
     v_d: float
     lambda_d: float
     lambda_opt: float
-    trajectories: tuple
 
 
 #: |lambda| at which a delay-free trajectory has diverged (the runs' own test).
@@ -95,6 +92,8 @@ LAM_DIVERGED = ControllerSettings.lam_diverged
 #: fate (issue 36 item 5: a failing trajectory's accepted steps bunch up where
 #: it diverges and move by ~1e-7 s under a 3-ulp change of the start).
 PATH_DT = 0.01
+#: Horizon (s) of the delay-free trajectory from a switch state judged for a gain.
+T_JUDGE = 10.0
 
 
 @lru_cache(maxsize=8)
@@ -163,26 +162,49 @@ def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
                       default=(2, 0.1), seed=seed, path_dt=PATH_DT)
     if best is None:
         raise ModelError(f"cruise loop with K = {tuple(K)} has no Hurwitz linearisation")
-    q, check, trajs = best
-    return CruiseBasin(check, tuple(float(k) for k in K), q, v_d, lam_d, lam_opt, trajs)
+    return CruiseBasin(best.K, best.w, best.check, best.trajectories, v_d, lam_d, lam_opt)
 
 
-def delay_free(fn, x0, lam_d: float, T: float):
-    """The delay-free loop x' = fn(x) from x0 over [0, T] (max step 0.05 s,
-    dense output), stopped when |lambda| reaches 0.9 (the solver's own steps:
-    tests/test_basin_perturb.py)."""
-    return integrate(fn, x0, T, events=[limit_event(1, LAM_DIVERGED, lam_d)], max_step=0.05,
-                     dense=True)
+@lru_cache(maxsize=8)
+def _k2_sweep(values: tuple, v_d: float, k1: float, point: tuple, grid: tuple, compare: tuple,
+              bisect: int, seed: int) -> GainSweep:
+    loop, lam_d, _ = cruise_loop(values, v_d)
+    return loop.sweep((k1, 0.0), (point[0] - v_d, point[1] - lam_d), 1, grid, T_JUDGE,
+                      point=point, compare=compare, bisect=bisect, seed=seed)
 
 
-def switch_in_basin(values: dict, v_d: float, K, point, *, seed: int = 0,
-                    t_sim: float = 10.0) -> PointVerdict:
-    """Is the switch state ``point`` (absolute (v, lambda)) inside a certified
-    basin of law (61) with gain K? Best verdict over :data:`W_GRID` (w: the
-    deciding weight), and the fate of the delay-free trajectory from it
-    ("diverges": lambda reaches 0.9, the wheel spins; "undecided": neither
-    that nor a certified level set within 10 s)
-    (:meth:`workbench.features.basin_loop.GainLoop.judge`)."""
-    loop, lam_d, _ = cruise_loop(_values(values), v_d)
-    return loop.judge(tuple(K), (float(point[0]) - v_d, float(point[1]) - lam_d), t_sim,
-                      seed=seed)
+def safe_k2_range(values: dict, v_d: float, k1: float, point, *, grid, compare=(),
+                  bisect: int = 4, seed: int = 0) -> GainSweep:
+    """Cruise gains k2 (k1 kept) for which ``point`` lies in a certified basin
+    (module docstring; :meth:`workbench.features.basin_loop.GainLoop.sweep`).
+
+    Parameters
+    ----------
+    values : dict
+        Nominal plant constants (SI) the controller is built on.
+    v_d : float
+        Cruise speed (m/s).
+    k1 : float
+        First gain entry, kept along the sweep.
+    point : (v, lambda)
+        Switch state (absolute), e.g. (v_d, lambda_opt) for eq (75) as printed.
+    grid : sequence of float
+        k2 values judged.
+    compare : sequence of (label, (k1, k2))
+        Gains judged for comparison (e.g. 003 Table 3).
+    bisect : int
+        Bisection steps on the edge of the certified range.
+    seed : int
+        Seed of the falsifier.
+
+    Returns
+    -------
+    GainSweep
+        Of k2 (entry 1) with k1 = ``gain[0]`` kept; ``grid_min`` the smallest k2 of the grid.
+    """
+    cmp_ = tuple((str(lab), (float(g[0]), float(g[1]))) for lab, g in compare)
+    key = (_values(values), float(v_d), float(k1), tuple(float(p) for p in point),
+           tuple(float(g) for g in grid), cmp_, int(bisect), int(seed))
+    # the designs that differ only in the plant's mass share the controller's
+    # nominal model, hence this sweep: computed once per run (run folder)
+    return shared("antiskid_basin.k2_sweep", key, lambda: _k2_sweep(*key))

@@ -15,7 +15,8 @@ The frozen loop is one-dimensional: lambda' = g(lambda), the traction form
 for lambda >= 0 and the braking form below (as the plant), under law (69),
 which is computed on the braking form (eq 16) whatever the sign of lambda.
 Its verdict on [-0.9, 0.9] (|lambda| = 0.9: spin or lock) is the general
-one-state verdict, :func:`workbench.features.basin_scalar.scalar_verdict`:
+one-state verdict, :func:`workbench.features.basin_scalar.scalar_verdict`
+(the result: a :class:`workbench.features.basin_scalar.FrozenSwitch`):
 REFUTED when no equilibrium lies between the switch state and the end it
 moves to (the sign of g proven), the level-set certificate of the nearest
 stable equilibrium otherwise. Only the frozen loop (law (69) on the adhesion
@@ -34,15 +35,13 @@ References
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import lru_cache
 
 import sympy as sp
 
-from ...features.basin_scalar import ScalarVerdict, scalar_verdict
+from ...features.basin_scalar import FrozenSwitch, scalar_verdict
 from ...features.basin_trajectory import limit_event
 from ...features.basin_trajectory import time_varying_fate as fate_from
-from ...outcome import Outcome
 from ...plants.adhesion import adhesion_model
 from ...plants.lambdify_cache import lambdify
 from ...sim.wheel_slip import ScalarOps, wheel_speed
@@ -55,41 +54,6 @@ T_FATE = 5.0
 FATE_RTOL = 1e-8
 #: |v lambda - v_s*| (m/s) under which the loop "tracks" at T_FATE.
 TRACK_TOL = 0.01
-
-
-@dataclass(frozen=True)
-class BrakeSwitch:
-    """Verdict for the state where law (69) takes over.
-
-    Attributes
-    ----------
-    label : str
-    v, lam : float
-        The state at t_brake.
-    vs_frozen : float
-        v_s*(t_brake) (m/s), frozen.
-    verdict : ScalarVerdict
-        Of the frozen loop on [-0.9, 0.9] (``star``: its equilibrium the state
-        moves to; ``rate``: proven lower bound of |lambda'| on the way, 1/s).
-    fate : str
-        Time-varying delay-free loop: "diverges" (|lambda| reaches 0.9 or a step
-        fails), "tracks" (lambda < 0 and |v lambda - v_s*| < 0.01 m/s at T_FATE),
-        "undecided".
-    t_fate : float or None
-        When it diverged (s after t_brake).
-    """
-
-    label: str
-    v: float
-    lam: float
-    vs_frozen: float
-    verdict: ScalarVerdict
-    fate: str
-    t_fate: float | None
-
-    @property
-    def outcome(self) -> Outcome:
-        return self.verdict.outcome
 
 
 @lru_cache(maxsize=4)
@@ -114,8 +78,14 @@ def frozen_loop(values: dict, v: float, vs: float, k_de: float):
 
 
 def brake_switch(values: dict, label: str, point, *, profile, k_de: float,
-                 t: float | None = None, seed: int = 0) -> BrakeSwitch:
-    """Verdict for the switch state ``point`` = (v, lambda) (module docstring).
+                 t: float | None = None, seed: int = 0) -> FrozenSwitch:
+    """Verdict for the switch state ``point`` = (v, lambda) (module docstring):
+    the reference is v_s*(t) frozen, the verdict that of the frozen loop on
+    [-0.9, 0.9] (``star``: its equilibrium the state moves to; ``rate``: proven
+    lower bound of |lambda'| on the way, 1/s), the fate that of the time-varying
+    loop: "diverges" (|lambda| reaches 0.9 or a step fails, ``t_fate``: when,
+    s after t_brake), "tracks" (lambda < 0 and |v lambda - v_s*| < 0.01 m/s at
+    T_FATE), "undecided".
 
     Parameters
     ----------
@@ -141,12 +111,12 @@ def brake_switch(values: dict, label: str, point, *, profile, k_de: float,
     g, lam = frozen_loop(values, v, vs, k_de)
     fate, t_fate = time_varying_fate(values, (v, lam_s), profile, k_de)
     sv = scalar_verdict(g, lam, lam_s, -LAM_LIMIT, LAM_LIMIT, name="lambda", seed=seed)
-    return BrakeSwitch(label, v, lam_s, vs, sv, fate, t_fate)
+    return FrozenSwitch(label, (v, lam_s), vs, sv, fate, t_fate)
 
 
 def time_varying_fate(values: dict, x0, profile, k_de: float) -> tuple[str, float | None]:
     """Fate of the time-varying delay-free loop from x0 = (v, lambda) at t_brake
-    (class :class:`BrakeSwitch`, ``fate``), and when it diverged."""
+    (:func:`brake_switch`), and when it diverged."""
     (y1, y2, y3), (z1, z2, z3), vs_, lam = _forms(tuple(sorted(values.items())))
     fns = [lambdify((vs_, lam), e, "math") for e in (y1, y2, y3, z1, z2, z3)]
     Y1, Y2, Y3, Z1, Z2, Z3 = fns

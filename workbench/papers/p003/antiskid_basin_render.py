@@ -1,6 +1,6 @@
 """Markdown and figure of the cruise-basin check (pure rendering of
 :class:`~workbench.papers.p003.antiskid_basin.CruiseBasin` and
-:class:`~workbench.papers.p003.antiskid_basin_k2.K2Sweep`).
+:class:`~workbench.features.basin_points.GainSweep`).
 
 Paper 003's wording (laws (61), (69), eqs (75)-(76), the k2 rule) and the
 cruise figure's look stay here; the figure itself is the general
@@ -12,21 +12,10 @@ from __future__ import annotations
 from ...features.basin_plot import BasinPlotStyle
 from ...features.basin_plot import plot_basin as draw_basin
 from ...features.basin_points_render import gain_edge_text, gain_sweep_table, points_table
-from ...printed_grid import directed
+from ...features.basin_scalar_render import scalar_verdict_text
 from ...report.markdown import fmt, md_table
-from ...roa.render import fmt_level, render_basin_markdown
+from ...roa.render import render_basin_markdown
 from .antiskid_basin import LAM_DIVERGED
-
-
-def render_basin_result(res, *, rail: str) -> str:
-    """Section of a :class:`~workbench.papers.p003.antiskid_basin_run.BasinResult`."""
-    text = render_basin_section(res.basin, res.sweep, rail=rail,
-                                compare_source=res.compare_source, brake=res.brake)
-    if res.mass_factor != 1.0:
-        text += (f"\nThe plant of this design has {fmt(res.mass_factor, 3)} x the nominal mass; "
-                 "the basin is that of the controller's nominal model (the switch states are "
-                 "this design's simulated ones).\n")
-    return text
 
 
 #: Heading of the basin section (findings on switch and basin quantities link here).
@@ -34,9 +23,10 @@ HEADING = ("Regions of attraction: does each switch land in the basin of the law
            "takes over?")
 
 
-def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—",
-                         brake=()) -> str:
-    """The report section: loop, certified bracket, switch verdicts, k2 rule."""
+def render_basin_result(res, *, rail: str) -> str:
+    """Section of a :class:`~workbench.papers.p003.antiskid_basin_run.BasinResult`:
+    loop, certified bracket, switch verdicts, k2 rule."""
+    basin = res.basin
     K = "[" + ", ".join(fmt(k, 4) for k in basin.K) + "]"
     head = (
         f"## {HEADING}\n\n"
@@ -47,7 +37,7 @@ def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—"
         "real loop keeps the delayed term B K E(t - h); that term's local stability is what "
         "the LMI certificate (Theorem 1) proves. A switch is safe when both hold. "
         "V = E' P E with P = S^-T diag(1, w) S^-1 in the modal coordinates of A + B K "
-        f"(w = {fmt(basin.q)}: the grid value that certifies the switch states best).\n\n")
+        f"(w = {fmt(basin.w)}: the grid value that certifies the switch states best).\n\n")
     body = render_basin_markdown(basin.check, heading="### Certified level set")
     sw = ("\n### Switch states (acceleration → cruise)\n\n"
           + points_table(basin.check, [tr.fate for tr in basin.trajectories],
@@ -57,36 +47,26 @@ def render_basin_section(basin, sweep, *, rail: str, compare_source: str = "—"
             "converges from it. REFUTED: its level holds a point with V' >= 0, so this V "
             "cannot certify it; the last column says what the delay-free trajectory does "
             f"(\"diverges\": |lambda| reaches {fmt(LAM_DIVERGED)}, the wheel spins).\n")
-    return (head + body + sw + brake_text(brake)
-            + (_k2_text(sweep, compare_source) if sweep is not None else ""))
-
-
-def _directed(x: float, up: bool) -> str:
-    """x rounded up or down to 2 significant digits (a proven bound's direction)."""
-    return fmt(directed(x, up=up, sig=2), 2)
+    text = head + body + sw + brake_text(res.brake) + _k2_text(res.sweep, res.compare_source)
+    if res.mass_factor != 1.0:
+        text += (f"\nThe plant of this design has {fmt(res.mass_factor, 3)} x the nominal mass; "
+                 "the basin is that of the controller's nominal model (the switch states are "
+                 "this design's simulated ones).\n")
+    return text
 
 
 def brake_text(brake) -> str:
-    """Subsection of the cruise -> braking switch (:mod:`.antiskid_basin_brake`)."""
+    """Subsection of the cruise -> braking switch (:mod:`.antiskid_basin_brake`;
+    the frozen loop's verdict in words:
+    :func:`workbench.features.basin_scalar_render.scalar_verdict_text`)."""
     from .antiskid_basin_brake import FATE_RTOL, LAM_LIMIT, T_FATE, TRACK_TOL
     rows = []
     for b in brake:
-        sv = b.verdict
-        if sv.why == "no equilibrium":
-            up = sv.direction > 0
-            frozen = (f"no equilibrium from the state {'up to' if up else 'down to'} lambda = "
-                      f"{'' if up else '−'}{fmt(LAM_LIMIT)}: |lambda'| >= "
-                      f"{_directed(sv.rate, False)} 1/s proven, so it gets there within "
-                      f"{_directed((LAM_LIMIT - abs(b.lam)) / sv.rate, True)} s")
-        elif sv.star is not None:
-            frozen = (f"equilibrium lambda* = {fmt(sv.star, 4)} ({sv.why}"
-                      + (f"; V = {fmt_level(sv.level[0], 'up')}, c_certified = "
-                         f"{fmt_level(sv.level[1])}" if sv.level else "") + ")")
-        else:
-            frozen = sv.why.replace("sign not", "sign of lambda' not")
+        v, lam = b.x
+        frozen = scalar_verdict_text(b.verdict, lam, LAM_LIMIT, name="lambda")
         fate = (f"diverges: |lambda| = {fmt(LAM_LIMIT)} at t_brake + {fmt(b.t_fate, 2)} s"
                 if b.fate == "diverges" else b.fate)
-        rows.append([f"`{b.label}`", fmt(b.v, 4), fmt(b.lam, 4), fmt(b.vs_frozen, 4), frozen,
+        rows.append([f"`{b.label}`", fmt(v, 4), fmt(lam, 4), fmt(b.reference, 4), frozen,
                      b.outcome.name, fate])
     if not rows:
         return ("\n### Switch states (cruise → braking)\n\nNo case reached the braking "

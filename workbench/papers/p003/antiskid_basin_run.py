@@ -33,9 +33,8 @@ from dataclasses import dataclass
 
 from ...features.basin import (LEVEL_QUANTITIES, level_quantities, point_quantities,
                                 point_quantity_names)
-from ...features.basin_points import GainSweepSettings, load_gain_sweep
-from .antiskid_basin import CruiseBasin, cruise_basin
-from .antiskid_basin_k2 import K2Sweep, safe_k2_range
+from ...features.basin_points import GainSweep, GainSweepSettings, load_gain_sweep
+from .antiskid_basin import CruiseBasin, cruise_basin, safe_k2_range
 
 
 @dataclass(frozen=True)
@@ -43,10 +42,10 @@ class BasinResult:
     """Basin of the cruise law at the design's gain and the k2 rule."""
 
     basin: CruiseBasin
-    sweep: K2Sweep
+    sweep: GainSweep
     compare_source: str
     mass_factor: float
-    brake: tuple = ()          # antiskid_basin_brake.BrakeSwitch per case that braked
+    brake: tuple = ()          # FrozenSwitch (antiskid_basin_brake) per case that braked
 
 
 def load_basin_settings(root) -> GainSweepSettings | None:

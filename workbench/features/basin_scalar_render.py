@@ -1,0 +1,35 @@
+"""The verdict of a one-state loop in words (pure rendering of a
+:class:`~workbench.features.basin_scalar.ScalarVerdict`): a table cell saying
+why the state is, or is not, in a basin. Proven bounds are printed to 2
+significant digits, rounded in their safe direction (a rate down, a time up);
+the headings and the words around the cell are the caller's."""
+from __future__ import annotations
+
+from ..printed_grid import directed
+from ..report.markdown import fmt
+from ..roa.render import fmt_level
+
+
+def _directed(x: float, up: bool) -> str:
+    """x rounded up or down to 2 significant digits (a proven bound's direction)."""
+    return fmt(directed(x, up=up, sig=2), 2)
+
+
+def scalar_verdict_text(sv, x_s: float, limit: float, *, name: str = "x",
+                        rate_unit: str = "1/s") -> str:
+    """Why the state ``x_s`` of a one-state loop on [-limit, limit] (``name``: the
+    state's display name, ``rate_unit`` that of its rate; time in s) has the verdict ``sv``: no equilibrium up
+    to the end it moves to (the proven rate, and the time within which it gets
+    there), the equilibrium it moves to (with the level set's V and c_certified),
+    or why nothing is proven."""
+    if sv.why == "no equilibrium":
+        up = sv.direction > 0
+        return (f"no equilibrium from the state {'up to' if up else 'down to'} {name} = "
+                f"{'' if up else '−'}{fmt(limit)}: |{name}'| >= "
+                f"{_directed(sv.rate, False)} {rate_unit} proven, so it gets there within "
+                f"{_directed((limit - sv.direction * x_s) / sv.rate, True)} s")
+    if sv.star is not None:
+        return (f"equilibrium {name}* = {fmt(sv.star, 4)} ({sv.why}"
+                + (f"; V = {fmt_level(sv.level[0], 'up')}, c_certified = "
+                   f"{fmt_level(sv.level[1])}" if sv.level else "") + ")")
+    return sv.why.replace("sign not", f"sign of {name}' not")
