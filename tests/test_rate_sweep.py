@@ -263,6 +263,24 @@ def test_replay_windows_of_two_toy_runs():
     assert "(rtol 1e-10)" in text and "every change of the voltage" in text
 
 
+def test_windows_at_events_and_a_record_made_anyway():
+    """:func:`sample_windows` places windows at events (one not reached: NaN,
+    left out), shifted earlier; :func:`reusing` takes a record made anyway
+    only when it runs on past the window by the margin."""
+    from workbench.features.mesh_replay import reusing, sample_windows
+    wins = sample_windows(("start", "event", "never"), (0.5, 2.0, math.nan), ("a", "b", "b"),
+                          1.0, 0.25)
+    assert wins == (("start", 0.25, 1.25, "a"), ("event", 1.75, 2.75, "b"))
+    have = np.column_stack([np.linspace(0.0, 2.0, 5), np.zeros((5, 2))])
+    made = []
+    rec = reusing({"a": have, "b": None}, lambda run, a, b: made.append((run, a, b)) or run,
+                  margin=0.5)
+    assert rec("a", 0.25, 1.25) is have and made == []
+    assert rec("a", 0.25, 1.75) == "a" and rec("b", 1.75, 2.75) == "b"
+    assert rec("c", 0.0, 1.0) == "c" and made == [("a", 0.25, 1.75), ("b", 1.75, 2.75),
+                                                   ("c", 0.0, 1.0)]
+
+
 def test_a_sweep_table_is_read_and_checked():
     from workbench.errors import DesignError
     from workbench.reader import Reader
