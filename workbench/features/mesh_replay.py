@@ -21,7 +21,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 __all__ = ["replay", "window", "WindowReplay", "WindowCheck", "replay_windows", "sample_windows",
-           "reusing"]
+           "reusing", "largest"]
 
 
 @dataclass(frozen=True)
@@ -61,6 +61,13 @@ class WindowCheck:
     points: int
     d_abs: tuple
     d_rel: tuple
+
+
+def largest(checks) -> tuple:
+    """(abs, rel): per state, the largest absolute and relative differences
+    of the :class:`WindowCheck` ``checks`` (at least one)."""
+    return tuple(tuple(map(max, zip(*(getattr(c, k) for c in checks))))
+                 for k in ("d_abs", "d_rel"))
 
 
 def window(rec: np.ndarray, t0: float, t1: float) -> np.ndarray:

@@ -22,7 +22,7 @@ of the ``zoh`` variant.
 """
 from __future__ import annotations
 
-from ...features.mesh_replay import replay_windows, reusing, sample_windows
+from ...features.mesh_replay import largest, replay_windows, reusing, sample_windows
 from ...sim.wheel_slip import model_functions
 from .antiskid_sampled_kernel import run_once
 
@@ -88,9 +88,9 @@ def radau_checks(ctx, spec, runs, traction: dict) -> tuple:
 
 
 def radau_quantities(checks, lambda_opt: float) -> dict:
-    """The :data:`RADAU_QUANTITIES` (None without a check)."""
+    """The :data:`RADAU_QUANTITIES`: the largest difference of lambda over
+    lambda_opt, of v relative, the windows (None without a check)."""
     if not checks:
         return dict.fromkeys(RADAU_QUANTITIES)
-    return {"sampled.radau.max_dlam_over_opt": max(c.d_abs[1] for c in checks) / lambda_opt,
-            "sampled.radau.max_dv_rel": max(c.d_rel[0] for c in checks),
-            "sampled.radau.windows": len(checks)}
+    d_abs, d_rel = largest(checks)
+    return dict(zip(RADAU_QUANTITIES, (d_abs[1] / lambda_opt, d_rel[0], len(checks))))
