@@ -6,7 +6,9 @@ exponential-Euler sub-steps of at most ``plant_step``. Here the torque the
 wheel received in a window of a run (piecewise constant: the held,
 delayed commands) is replayed open loop into scipy's Radau and both
 trajectories are compared at every mesh point of the window (the general
-replay of windows of runs: :func:`workbench.features.mesh_replay.replay_windows`).
+replay of windows of runs: :func:`workbench.features.mesh_replay.replay_windows`,
+placed by :func:`~workbench.features.mesh_replay.sample_windows`, reusing the
+figure's records by :func:`~workbench.features.mesh_replay.reusing`).
 What stays here is paper 003's: where the windows are, the tolerances, the
 kernel's recording and the right-hand side. The right-hand
 side is the lambdified sympy model of :mod:`workbench.sim.wheel_slip` (the
