@@ -93,7 +93,9 @@ def main() -> None:
 def cruise() -> None:
     """Paper 003's cruise loop: certified lowest rate on the linearisation next to the
     simulated lowest rate of the nonlinear laws (issue 20, reports/antiskid-run-dry.md)."""
-    from workbench.papers.p003.antiskid_cruise_sampled import cruise_sampling
+    from workbench.design import load_design
+    from workbench.features.sampled import published_row_sampling
+    from workbench.papers.p003.antiskid_cruise import operating_point
     print("\nPaper 003 cruise loop, linearisation of designs/antiskid-cruise-dry.toml with the "
           "printed Table 3 gain (eps = 0.35):\n")
     print("| implementation | certified T_max (s) | certified lowest rate (Hz) | "
@@ -101,7 +103,9 @@ def cruise() -> None:
           "seconds |")
     print("| --- | --- | --- | --- | --- | --- |")
     t0 = time.perf_counter()
-    c = cruise_sampling("designs/antiskid-cruise-dry.toml")
+    spec = load_design("designs/antiskid-cruise-dry.toml").spec
+    lin = operating_point(spec)[3]
+    c = published_row_sampling(lin.A, lin.B, spec.published, 0.35, 0.002)
     sec = time.perf_counter() - t0
     for label, r, sim in (
             ("predictor (exact prediction: delay-free sampled loop)", c.predictor,

@@ -1,13 +1,13 @@
 """Comfort: the general feature :mod:`workbench.features.comfort` on toy
-speeds (issue 35), and the comfort and torque of an antiskid run (issue 19,
-item 5), on runs whose acceleration and jerk are known in closed form."""
+speeds and toy recorded runs with an input (issues 19 item 5 and 35), whose
+acceleration and jerk are known in closed form; no train model."""
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from workbench.features.comfort import ComfortLimits
-from workbench.papers.p003.antiskid_comfort import comfort_of, comfort_quantities
+from workbench.features.comfort import comfort_of, comfort_quantities
 from workbench.reader import Quantity
 
 SPEC = ComfortLimits(Quantity(1.0, "m/s^2", "test"), Quantity(0.75, "m/s^3", "test"),

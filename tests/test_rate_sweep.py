@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from workbench.features import rate_sweep as RS
+from workbench.features import rate_sweep_quantities as RQ
 from workbench.sim.convergence import CONVERGED
 
 A, K, T_END = 10.0, 30.0, 1.0
@@ -44,8 +45,7 @@ def toy_run(rate, scenario, q, tau, step):
 
 
 def combine(got):
-    nan = {"x_end": math.nan, "peak": math.nan}
-    s0, s1 = got[0] or nan, got[1] or nan
+    s0, s1 = got[0], got[1]            # a scenario not run: NaN outputs (DECL.outputs)
     ok0, ok1 = s0["x_end"] < 1.0, s1["peak"] < 10.0
     return {"x_end": s0["x_end"], "peak": s1["peak"], "decays": "yes" if ok0 else "no",
             "bounded": "yes" if ok1 else "no", "ok": "yes" if ok0 and ok1 else "no"}
@@ -53,7 +53,7 @@ def combine(got):
 
 DECL = RS.RateMetrics(("x_end", "peak", "decays", "bounded", "ok"), (0, 1), combine,
                       {"x_end": (0,), "decays": (0,), "peak": (1,), "bounded": (1,)},
-                      {"x_end": 1e-2}, mesh_max_rate=50.0)
+                      {"x_end": 1e-2}, mesh_max_rate=50.0, outputs=("x_end", "peak"))
 RATES = (5.0, 10.0, 20.0, 50.0, 100.0)
 
 
@@ -68,7 +68,7 @@ def _counted():
 
 def test_the_sweep_brackets_the_stability_boundary_of_a_toy_loop():
     runs, calls = _counted()
-    claimed = RS.claimed_rate_metrics(
+    claimed = RQ.claimed_rate_metrics(
         "toy", ["p"], RATES, DECL.names, DECL.mesh_max_rate,
         [{"quantity": "toy.p.rate[20].x_end"}, {"quantity": "toy.p.rate[100].x_end"},
          {"quantity": "toy.p.rate[50].decays"}, {"quantity": "toy.q.rate[20].x_end"}])
@@ -157,16 +157,16 @@ def test_quantities_of_a_toy_variant():
     runs, _ = _counted()
     v = RS.sweep_variant(runs, DECL, RATES, 1e-3, "p", 0.0, 0.0, bisect=0)
     ref = {"x_end": 0.0}
-    q = RS.quantities("toy", v, ("x_end", "ok"), "reference", ref, ("x_end",),
+    q = RQ.quantities("toy", v, ("x_end", "ok"), "reference", ref, ("x_end",),
                       {"x_end_minus_reference": "x_end"})
-    names = RS.quantity_names("toy", "p", RATES, ("x_end", "ok"), "reference", ("x_end",),
+    names = RQ.quantity_names("toy", "p", RATES, ("x_end", "ok"), "reference", ("x_end",),
                               {"x_end_minus_reference": "x_end"})
     assert set(q) == names
     assert q["toy.p.min_rate"] == 20.0 and q["toy.p.bracket_low"] == 10.0
     assert q["toy.p.rate[100].ok"] == "yes" and q["toy.p.mesh_converged"] is None
     assert q["toy.p.gap_to_reference.x_end"] == v.row(100.0).metrics["x_end"]
     assert q["toy.p.rate[20].x_end_minus_reference"] == q["toy.p.rate[20].x_end"]
-    assert RS.quantity_value(math.nan) is None and RS.quantity_value("no") == "no"
+    assert RQ.quantity_value(math.nan) is None and RQ.quantity_value("no") == "no"
 
 
 def test_the_words_of_a_toy_sweep():
@@ -263,6 +263,24 @@ def test_replay_windows_of_two_toy_runs():
     assert "(rtol 1e-10)" in text and "every change of the voltage" in text
 
 
+def test_windows_at_events_and_a_record_made_anyway():
+    """:func:`sample_windows` places windows at events (one not reached: NaN,
+    left out), shifted earlier; :func:`reusing` takes a record made anyway
+    only when it runs on past the window by the margin."""
+    from workbench.features.mesh_replay import reusing, sample_windows
+    wins = sample_windows(("start", "event", "never"), (0.5, 2.0, math.nan), ("a", "b", "b"),
+                          1.0, 0.25)
+    assert wins == (("start", 0.25, 1.25, "a"), ("event", 1.75, 2.75, "b"))
+    have = np.column_stack([np.linspace(0.0, 2.0, 5), np.zeros((5, 2))])
+    made = []
+    rec = reusing({"a": have, "b": None}, lambda run, a, b: made.append((run, a, b)) or run,
+                  margin=0.5)
+    assert rec("a", 0.25, 1.25) is have and made == []
+    assert rec("a", 0.25, 1.75) == "a" and rec("b", 1.75, 2.75) == "b"
+    assert rec("c", 0.0, 1.0) == "c" and made == [("a", 0.25, 1.75), ("b", 1.75, 2.75),
+                                                   ("c", 0.0, 1.0)]
+
+
 def test_a_sweep_table_is_read_and_checked():
     from workbench.errors import DesignError
     from workbench.reader import Reader
@@ -291,7 +309,16 @@ def test_a_sweep_table_is_read_and_checked():
     assert [v.name for v in out] == ["zoh", "zoh_q_tau"] and out[0].min_rate == 20.0
     assert out[1].q == 40.0 and out[1].row(100.0).metrics != out[0].row(100.0).metrics
     ref = {"x_end": 0.0, "ok": "yes"}
-    q = RS.sweep_quantities("toy", out, ("x_end", "ok"), "reference", ref, ("x_end",))
-    assert set(q) == RS.sweep_quantity_names("toy", table, ("x_end", "ok"), "reference",
+    q = RQ.sweep_quantities("toy", out, ("x_end", "ok"), "reference", ref, ("x_end",))
+    assert set(q) == RQ.sweep_quantity_names("toy", table, ("x_end", "ok"), "reference",
                                              ("x_end",))
     assert q["toy.reference.ok"] == "yes" and q["toy.zoh_q_tau.min_rate"] == out[1].min_rate
+    # the same through a Section, with a difference to the reference and the claims it reads
+    sec = RQ.Section("toy", ("x_end", "ok"), 50.0, "reference", ("x_end",), {"x_minus_ref": "x_end"})
+    res = RS.SweepResult(table, RS.RateRow(math.nan, ref), 1e-3, out)
+    got = sec.quantities(res)
+    assert set(got) == sec.quantity_names(table) and got["toy.zoh.rate[20].x_minus_ref"] == \
+        got["toy.zoh.rate[20].x_end"] == q["toy.zoh.rate[20].x_end"]
+    assert sec.claimed(table, [{"quantity": "toy.zoh.rate[20].x_minus_ref"},
+                               {"quantity": "toy.zoh_q_tau.rate[100].ok"}]) == (
+        ("zoh", 20.0, "x_end"),)                  # 100 Hz: above max_rate

@@ -105,10 +105,10 @@ def test_the_claimed_rate_metrics_of_a_design():
            {"quantity": "sampled.zoh.rate[x].ok"}, {"id": "no quantity"}, "not a table",
            {"quantity": "sampled.zoh.rate[20].braking_ok"},
            {"quantity": "sampled.zoh.rate[100].evs_max_tracking"}]
-    assert S.claimed_rate_metrics(spec, raw) == (
+    assert S.SECTION.claimed(spec, raw) == (
         ("zoh", 20.0, "braking_ok"), ("zoh", 100.0, "evs_max_tracking"),
         ("zoh", 1000.0, "stop_distance"))
-    assert S.claimed_rate_metrics(spec, "not a list") == ()
+    assert S.SECTION.claimed(spec, "not a list") == ()
     from workbench.design import load_design
     assert load_design(DRY).spec.sampled.three_level == (
         ("zoh", 20.0, "braking_ok"), ("zoh_q_tau", 50.0, "traction_ok"),

@@ -175,11 +175,32 @@ def test_predictor_sampling_of_the_standard_example():
     assert c.rate_delayed == 1.0 / late.T_certified
 
 
+def test_published_row_sampling_picks_the_row_of_eps():
+    """:func:`published_row_sampling` on the standard example: the printed
+    row's K and h_m are the loop's; an eps with no row is one clear error."""
+    from workbench.features.published_rows import Published
+    from workbench.features.sampled import predictor_sampling, published_row_sampling
+    rows = (Published(0.5, 0.3, (1.0, 1.0), "toy"), Published(0.2, 0.1, tuple(K0.ravel()), "toy"))
+    c = published_row_sampling(A0, B0, rows, 0.2, 0.02)
+    ref = predictor_sampling(A0, B0, K0.ravel(), 0.1, 0.02)
+    assert (c.h, c.measurement_delay) == (0.1, 0.02) and (c.K == ref.K).all()
+    assert c.delayed.T_certified == ref.delayed.T_certified
+    with pytest.raises(ValueError, match="eps = 0.3"):
+        published_row_sampling(A0, B0, rows, 0.3, 0.02)
+
+
 def test_cruise_loop_003_certified_rate():
-    """Paper 003's cruise linearisation with the Table 3 gain: certified without a
-    predictor for a 43.3 ms + 2 ms delay at a rate far below the simulated 25 Hz."""
-    from workbench.papers.p003.antiskid_cruise_sampled import cruise_sampling
-    c = cruise_sampling("designs/antiskid-cruise-dry.toml")
+    """Paper 003's cruise loop implemented digitally (issue 34): the cruise
+    linearisation closed with the Table 3 gain (eps = 0.35) is certified without a
+    predictor for a 43.3 ms + 2 ms delay at a rate far below the simulated 25 Hz
+    (the linearisation at cruise only: the simulated lowest rate of the run designs
+    also covers traction from rest and the entry into braking)."""
+    from workbench.design import load_design
+    from workbench.features.sampled import published_row_sampling
+    from workbench.papers.p003.antiskid_cruise import operating_point
+    spec = load_design("designs/antiskid-cruise-dry.toml").spec
+    lin = operating_point(spec)[3]
+    c = published_row_sampling(lin.A, lin.B, spec.published, 0.35, 0.002)
     assert c.delayed.outcome is Outcome.CERTIFIED and c.delayed.recheck_passed
     assert 0.1 < c.delayed.T_certified <= c.delayed.first_unstable
     assert c.rate_delayed < 25.0

@@ -25,10 +25,16 @@ Two ways to the same quantities:
 
 Both use :func:`rate` for the differences, :func:`peak_abs` for the peaks and
 count the samples above a limit times the step for the time above it.
+
+A recorded run with an input (:func:`comfort_of`: the speed one of its
+states) adds its largest |input| over a reference magnitude; a study that
+runs each case at a step, its half and its quarter reports the half's
+measures and whether the peaks converged (:func:`comfort_quantities`).
+Tests on toy runs, no model: ``tests/test_comfort.py``.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -37,7 +43,8 @@ from ..reader import Quantity, Reader
 __all__ = ["ComfortLimits", "Comfort", "RunningComfort", "load_comfort", "peaks_converged",
            "read_limits", "rate", "peak_abs",
            "time_above", "stretches", "acceleration_jerk", "comfort_of_speed", "rate_units",
-           "metric_units", "PEAKS", "TIMES"]
+           "metric_units", "PEAKS", "TIMES", "RunComfort", "comfort_of", "RUN_MEASURES",
+           "COMFORT_QUANTITIES", "comfort_quantities"]
 
 #: Peak quantities: name -> attribute of :class:`Comfort` (|a|, |jerk|).
 PEAKS = {"peak_abs_accel": "a_max_abs", "peak_abs_jerk": "jerk_max_abs"}
@@ -183,6 +190,31 @@ def comfort_of_speed(t: np.ndarray, v: np.ndarray, limits: ComfortLimits,
                    time_above(j, lim_j, step), stretches(t_j, j, lim_j))
 
 
+@dataclass(frozen=True)
+class RunComfort(Comfort):
+    """:class:`Comfort` of a recorded run's speed, and its input.
+
+    Attributes
+    ----------
+    u_max_over_peak : float
+        Largest |u| of the run's first input over a reference magnitude (the
+        most the actuator or the contact transmits, say).
+    """
+
+    u_max_over_peak: float
+
+
+def comfort_of(run, limits: ComfortLimits, u_peak: float, step: float,
+               speed: int = 0) -> RunComfort:
+    """:class:`RunComfort` of a recorded run (``run.t``, ``run.x[speed]`` the
+    speed, ``run.u[0]`` the input) on a uniform grid of ``step`` seconds
+    (:func:`comfort_of_speed`), the input over ``u_peak``."""
+    c = comfort_of_speed(run.t, run.x[speed], limits, step)
+    u = np.asarray(run.u[0], float)
+    return RunComfort(**{f.name: getattr(c, f.name) for f in fields(c)},
+                      u_max_over_peak=float(np.max(np.abs(u))) / u_peak)
+
+
 #: Relative tolerance of :func:`peaks_converged` (of the largest peak).
 COMFORT_RTOL = 0.01
 
@@ -196,6 +228,26 @@ def peaks_converged(levels, rtol: float = COMFORT_RTOL) -> str | None:
     keys = ("a_max_abs", "jerk_max_abs")
     vals = {k: tuple(getattr(x, k) for x in levels) for k in keys}
     return screen(vals, {k: rtol * max(abs(x) for x in vals[k]) for k in keys})[0]
+
+
+#: Per-case measures of a run (attributes of :class:`RunComfort`).
+RUN_MEASURES = ("a_max_abs", "jerk_max_abs", "time_above_a", "time_above_jerk",
+                "u_max_over_peak")
+#: Quantities per case (prefixed ``cases[NAME].``): :data:`RUN_MEASURES` and the convergence flag.
+COMFORT_QUANTITIES = RUN_MEASURES + ("comfort_converged",)
+
+
+def comfort_quantities(name: str, fine: RunComfort, coarse: RunComfort,
+                       quarter: RunComfort | None = None, rtol: float = COMFORT_RTOL) -> dict:
+    """The :data:`COMFORT_QUANTITIES` of case ``name`` run at a step
+    (``coarse``), its half (``fine``, the values reported) and its quarter.
+
+    ``comfort_converged``: the peaks of the three pass :func:`peaks_converged`:
+    "yes", else None (not determined, INCONCLUSIVE; also without a quarter
+    run: a two-level agreement is no convergence, issue 33 item 4)."""
+    b = f"cases[{name}]"
+    conv = None if quarter is None else peaks_converged((coarse, fine, quarter), rtol)
+    return {f"{b}.{k}": getattr(fine, k) for k in RUN_MEASURES} | {f"{b}.comfort_converged": conv}
 
 
 class RunningComfort:

@@ -9,16 +9,19 @@ A record is an array with rows (t, x_1, ..., x_n, u): the state at the end
 of a sub-step and the input held over the sub-step ending at t; its first
 row is the initial state. :func:`replay_windows` cuts windows out of the
 records of one or more runs (one record per run, spanning its windows) and
-replays each. Test on a system of no paper: ``tests/test_rate_sweep.py``.
+replays each; :func:`sample_windows` places windows of a given length at
+events of the runs, :func:`reusing` takes a record a run made anyway. Test on a system of no paper: ``tests/test_rate_sweep.py``.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Mapping
 
 import numpy as np
 
-__all__ = ["replay", "window", "WindowReplay", "WindowCheck", "replay_windows"]
+__all__ = ["replay", "window", "WindowReplay", "WindowCheck", "replay_windows", "sample_windows",
+           "reusing", "largest"]
 
 
 @dataclass(frozen=True)
@@ -60,11 +63,43 @@ class WindowCheck:
     d_rel: tuple
 
 
+def largest(checks) -> tuple:
+    """(abs, rel): per state, the largest absolute and relative differences
+    of the :class:`WindowCheck` ``checks`` (at least one)."""
+    return tuple(tuple(map(max, zip(*(getattr(c, k) for c in checks))))
+                 for k in ("d_abs", "d_rel"))
+
+
 def window(rec: np.ndarray, t0: float, t1: float) -> np.ndarray:
     """The rows of a mesh record with t0 <= t <= t1: what a run recording
     only that window records (when the mesh does not depend on where the
     record ends)."""
     return rec[(rec[:, 0] >= t0) & (rec[:, 0] <= t1)]
+
+
+def sample_windows(names, starts, runs, length: float, shift: float = 0.0) -> tuple:
+    """((name, t0 - shift, t0 + length - shift, run), ...): windows of
+    ``length`` s of run ``runs[i]`` from ``starts[i]`` (one per name; a start
+    of NaN, an event not reached, is left out), for :func:`replay_windows`.
+
+    ``shift``: every window starts and ends this much earlier. Half a mesh
+    step keeps a window whose ends fall on mesh points (sample times, say)
+    from holding those points or not by the last bit of its start."""
+    return tuple((name, t0 - shift, t0 + length - shift, run)
+                 for name, t0, run in zip(names, starts, runs) if not math.isnan(t0))
+
+
+def reusing(have: Mapping, record: Callable, margin: float = 0.0) -> Callable:
+    """A ``record`` callback for :func:`replay_windows` that takes a record
+    made already (``have``: run -> record or None) when it holds [a, b +
+    ``margin``] (the rows up to b no longer depend on where the run ended)
+    and calls ``record(run, a, b)`` otherwise."""
+    def rec(run, a, b):
+        got = have.get(run)
+        if got is not None and len(got) and got[0, 0] <= a and b + margin <= got[-1, 0]:
+            return got
+        return record(run, a, b)
+    return rec
 
 
 def replay_windows(rhs: Callable, windows, record: Callable, rtol: float, atol) -> tuple:

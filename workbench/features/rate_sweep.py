@@ -30,13 +30,15 @@ For one variant (q, tau) (:func:`sweep_variant`):
   screen's run) and ``step`` / 4 (only the scenarios the metric needs), with
   a Richardson estimate of its error (:func:`three_level_check`).
 
-Test on a system of no paper: ``tests/test_rate_sweep.py`` (a first-order
-loop with a sampled proportional law).
+The quantities of a sweep and the rate metrics its claims compare:
+:mod:`workbench.features.rate_sweep_quantities`. Test on a system of no
+paper: ``tests/test_rate_sweep.py`` (a first-order loop with a sampled
+proportional law).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
-import re
 from dataclasses import dataclass, field
 from typing import Callable, Mapping
 
@@ -45,10 +47,9 @@ from ..jsonable import json_method
 from ..sim.convergence import CONVERGED, INCONCLUSIVE, NOT_CONVERGED
 
 __all__ = ["RateMetrics", "Runs", "RateRow", "Variant", "ThreeLevel", "three_level_check",
-           "rate_row", "partial_row", "sweep_variant", "claimed_rate_metrics", "variants",
-           "read_rates", "read_inputs", "quantity_names", "quantities", "quantity_value",
-           "SweepTable", "read_table", "sweep", "sweep_quantity_names", "sweep_quantities",
-           "Trace", "SweepResult"]
+           "rate_row", "partial_row", "sweep_variant", "variants", "read_rates", "read_inputs",
+           "SweepTable", "read_table", "load_table", "sweep", "Trace", "trace_records",
+           "SweepResult"]
 
 
 def variants(q: float, tau: float) -> tuple:
@@ -84,7 +85,8 @@ class SweepTable:
     the ``bisect`` steps, the optional ``quantisation`` and
     ``measurement_delay`` (:class:`workbench.reader.Quantity`) and
     ``three_level``, the ((variant, rate, metric), ...) the design's claims
-    compare (:func:`claimed_rate_metrics`). A system's own table subclasses it."""
+    compare (:func:`workbench.features.rate_sweep_quantities.claimed_rate_metrics`).
+    A system's own table subclasses it."""
 
     rates: tuple
     plant_step: float
@@ -112,6 +114,32 @@ def read_table(t, unit: str, *, plant_step_hi: float) -> dict:
         **dict(zip(("quantisation", "measurement_delay"), read_inputs(t, unit))))
 
 
+def load_table(root, key: str, cls: type, unit: str, plant_step_hi: float, section,
+               own: Callable = dict) -> SweepTable | None:
+    """Table ``key`` of a design (its :class:`workbench.reader.Reader`
+    ``root``) as a ``cls`` (a :class:`SweepTable`), None when absent: the
+    system's own keys first (``own(t)`` -> keyword arguments), then the
+    general ones (:func:`read_table`), ``three_level`` the rate metrics the
+    design's claims compare (``section``: a
+    :class:`workbench.features.rate_sweep_quantities.Section`)."""
+    if not root.has(key):
+        return None
+    t = root.table(key)
+    out = cls(**own(t), **read_table(t, unit, plant_step_hi=plant_step_hi))
+    t.finish()
+    return dataclasses.replace(out, three_level=section.claimed(out, root.data.get("claims", [])))
+
+
+def trace_records(table: SweepTable, rates: tuple, record: Callable, reference: tuple) -> list:
+    """[(variant, rate, record), ...]: ``record(rate, q, tau)`` of every
+    variant of ``table`` at each of ``rates`` on its grid, then
+    ``record(rate, reference=True)`` of ``reference`` = (name, rate) (the
+    records a figure's :class:`Trace` are cut from)."""
+    out = [(name, f, record(f, q, tau)) for name, q, tau in table.variants()
+           for f in rates if f in table.rates]
+    return out + [(reference[0], reference[1], record(reference[1], reference=True))]
+
+
 @dataclass(frozen=True)
 class Trace:
     """A time trace of a run for a figure: the variant's name (or a
@@ -134,7 +162,8 @@ class RateMetrics:
     computed from (absent: every scenario); ``mesh_atol``: metric -> largest
     difference between ``step`` and ``step`` / 2 (the mesh check);
     ``mesh_max_rate``: the mesh and three-level checks cover grid rates up
-    to this (Hz)."""
+    to this (Hz); ``outputs``: the names of a run's outputs, given: a
+    scenario not run reaches ``combine`` as NaN outputs instead of None."""
 
     names: tuple
     scenarios: tuple
@@ -142,10 +171,16 @@ class RateMetrics:
     needs: Mapping[str, tuple] = field(default_factory=dict)
     mesh_atol: Mapping[str, float] = field(default_factory=dict)
     mesh_max_rate: float = math.inf
+    outputs: tuple = ()
 
     def scenarios_of(self, metric: str) -> tuple:
         """The scenarios ``metric`` is computed from."""
         return tuple(self.needs.get(metric, self.scenarios))
+
+    def metrics(self, got: dict) -> dict:
+        """``combine`` of {scenario: outputs or None (not run)}."""
+        nan = dict.fromkeys(self.outputs, math.nan) if self.outputs else None
+        return self.combine({s: nan if o is None else o for s, o in got.items()})
 
 
 class Runs:
@@ -289,7 +324,7 @@ class Variant:
 def rate_row(runs: Runs, decl: RateMetrics, rate: float, q: float, tau: float, step: float,
              probe: bool = False) -> RateRow:
     """Every scenario of ``decl`` at one rate."""
-    return RateRow(rate, decl.combine({s: runs(rate, s, q, tau, step)
+    return RateRow(rate, decl.metrics({s: runs(rate, s, q, tau, step)
                                        for s in decl.scenarios}), probe)
 
 
@@ -299,7 +334,7 @@ def partial_row(runs: Runs, decl: RateMetrics, rate: float, scenarios: tuple, q:
     alone, from the runs :func:`rate_row` makes (the same calls, the same
     numbers)."""
     got = {s: runs(rate, s, q, tau, step) if s in scenarios else None for s in decl.scenarios}
-    m = decl.combine(got)
+    m = decl.metrics(got)
     return RateRow(rate, {k: v for k, v in m.items()
                           if set(decl.scenarios_of(k)) <= set(scenarios)})
 
@@ -410,85 +445,3 @@ class SweepResult:
                    "variants": lambda r: {v.name: v.json() for v in r.variants},
                    "checks": "checks"}
     to_json = json_method
-
-
-def claimed_rate_metrics(prefix: str, variants, rates: tuple, names: tuple, max_rate: float,
-                         claims, alias: Mapping[str, str] | None = None) -> tuple:
-    """((variant, rate, metric), ...), sorted: the rate metrics that the
-    ``[[claims]]`` tables ``claims`` (raw TOML tables; a malformed one is
-    skipped here and reported by the claims' own validation) compare as
-    ``<prefix>.<variant>.rate[<f>].<metric>`` (``variants``: their names;
-    ``metric`` in ``names``), at a grid rate up to ``max_rate``; ``alias``: quantity -> the rate metric it moves
-    with (a difference to a reference, say)."""
-    pattern = re.compile(r"^" + re.escape(prefix) + r"\.([a-z_]+)\.rate\[([^\]]+)\]\.([a-z0-9_]+)$")
-    known, alias = set(variants), alias or {}
-    out = set()
-    for c in claims if isinstance(claims, list) else ():
-        m = pattern.match(str(c.get("quantity", ""))) if isinstance(c, dict) else None
-        if m is None or m[1] not in known:
-            continue
-        try:
-            rate = float(m[2])
-        except ValueError:
-            continue
-        metric = alias.get(m[3], m[3])
-        if rate in rates and rate <= max_rate and metric in names:
-            out.add((m[1], rate, metric))
-    return tuple(sorted(out))
-
-
-def quantity_value(x):
-    """A quantity value: None for NaN."""
-    return None if isinstance(x, float) and math.isnan(x) else x
-
-
-def quantity_names(prefix: str, name: str, rates: tuple, metrics: tuple,
-                   reference: str = "", gaps: tuple = (), differences=()) -> set[str]:
-    """The quantities of variant ``name`` (:func:`quantities`)."""
-    b = f"{prefix}.{name}"
-    return ({f"{b}.{k}" for k in ("min_rate", "bracket_low", "bracket_high", "mesh_converged")}
-            | {f"{b}.gap_to_{reference}.{m}" for m in gaps}
-            | {f"{b}.rate[{f:g}].{m}" for f in rates for m in tuple(metrics) + tuple(differences)})
-
-
-def quantities(prefix: str, v: Variant, metrics: tuple, reference: str = "",
-               ref: dict | None = None, gaps: tuple = (), differences=None) -> dict:
-    """The quantities of a variant: ``<prefix>.<name>.min_rate``,
-    ``.bracket_low``, ``.bracket_high``, ``.mesh_converged`` ("yes" or None),
-    ``.gap_to_<reference>.<m>`` (|top grid rate - ``ref``| of each metric of
-    ``gaps``), and per grid rate ``.rate[<f>].<m>`` of ``metrics`` and of
-    ``differences`` (name -> metric: the metric minus ``ref``'s); None for
-    NaN."""
-    b = f"{prefix}.{v.name}"
-    q = {f"{b}.min_rate": v.min_rate}
-    q[f"{b}.bracket_low"], q[f"{b}.bracket_high"] = v.bracket
-    q[f"{b}.mesh_converged"] = "yes" if v.mesh_converged else None
-    top = v.rows[-1].metrics
-    for m in gaps:
-        q[f"{b}.gap_to_{reference}.{m}"] = quantity_value(abs(top[m] - ref[m]))
-    for r in v.rows:
-        q.update({f"{b}.rate[{r.rate:g}].{m}": quantity_value(r.metrics[m]) for m in metrics})
-        for d, m in (differences or {}).items():
-            q[f"{b}.rate[{r.rate:g}].{d}"] = quantity_value(r.metrics[m] - ref[m])
-    return q
-
-
-def sweep_quantity_names(prefix: str, table: SweepTable, metrics: tuple, reference: str,
-                         gaps: tuple = (), differences=()) -> set[str]:
-    """The quantities of a sweep (:func:`sweep_quantities`)."""
-    names = {f"{prefix}.{reference}.{m}" for m in metrics}
-    for name, _, _ in table.variants():
-        names |= quantity_names(prefix, name, table.rates, metrics, reference, gaps,
-                                differences)
-    return names
-
-
-def sweep_quantities(prefix: str, variants_: tuple, metrics: tuple, reference: str,
-                     ref: dict, gaps: tuple = (), differences=None) -> dict:
-    """The quantities of a sweep: ``<prefix>.<reference>.<m>`` of the
-    reference's metrics ``ref``, then those of every variant
-    (:func:`quantities`)."""
-    q = {f"{prefix}.{reference}.{m}": quantity_value(ref[m]) for m in metrics}
-    for v in variants_:
-        q.update(quantities(prefix, v, metrics, reference, ref, gaps, differences))
-    return q

@@ -25,7 +25,8 @@ unstable constant period at the total delays' ends), ``.ratio``,
 :func:`predictor_sampling`: a loop whose commands reach the plant a known
 loop delay late, certified with a predictor covering it (a delay-free
 sampled loop) and without (the delay, plus a measurement delay, as a
-network delay). Test on a system of no paper:
+network delay); :func:`published_row_sampling`: the same with a printed
+row's gain and delay bound. Test on a system of no paper:
 ``tests/test_sampled_implementation.py``.
 This module's top level stays light (the design reader imports it).
 """
@@ -36,7 +37,7 @@ from dataclasses import dataclass
 
 __all__ = ["ImplementationSettings", "load_implementation_settings", "run_implementation",
            "implementation_quantity_names", "implementation_quantities",
-           "render_implementation_section", "PredictorSampling", "predictor_sampling"]
+           "render_implementation_section", "PredictorSampling", "predictor_sampling", "published_row_sampling"]
 
 #: Grid of the (T, tau) stability map of the figure, and the largest input queue drawn.
 MAP_T, MAP_TAU, MAP_QUEUE = 48, 36, 120
@@ -209,6 +210,18 @@ def predictor_sampling(A, B, K, h: float, measurement_delay: float) -> Predictor
     K = np.asarray(K, float).reshape(B.shape[1], -1)
     return PredictorSampling(K, h, measurement_delay, implementation(A, K, B=B),
                              implementation(A, K, B=B, network_delay=(h, h + measurement_delay)))
+
+
+def published_row_sampling(A, B, published, eps: float,
+                           measurement_delay: float) -> PredictorSampling:
+    """:func:`predictor_sampling` of the loop (A, B) closed with the printed
+    row ``eps`` of ``published``
+    (:class:`workbench.features.published_rows.Published`, its gain K and its
+    delay bound h_m as the loop delay); ValueError when no row has this eps."""
+    rows = [p for p in published if p.eps == eps]
+    if not rows:
+        raise ValueError(f"no printed row [[synthesis.published]] with eps = {eps:g}")
+    return predictor_sampling(A, B, rows[0].K, rows[0].h_m, measurement_delay)
 
 
 def _plot(fig, di: DesignImplementation) -> None:

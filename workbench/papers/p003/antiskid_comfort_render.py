@@ -1,5 +1,5 @@
 """Markdown and figures of an antiskid run's comfort and torque
-(:mod:`workbench.papers.p003.antiskid_comfort`; pure rendering).
+(:func:`workbench.features.comfort.comfort_of`; pure rendering).
 
 The comfort columns and the acceleration/jerk figure are the general
 :mod:`workbench.features.comfort_render`; what stays here is paper 003's:
@@ -15,7 +15,7 @@ from ...features.comfort_render import comfort_cells, comfort_headers
 from ...features.comfort_render import plot_comfort as plot_comfort_traces
 from ...report.markdown import Figure, fmt, md_table
 from ...sim.convergence import P_MIN
-from .antiskid_comfort import comfort_quantities
+from ...features.comfort import comfort_quantities
 from .antiskid_run import RECORD_DT
 from .antiskid_run_figures import color_of
 from .antiskid_run_spec import peak_adhesion_torque

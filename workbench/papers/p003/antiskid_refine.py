@@ -100,7 +100,7 @@ def _case_levels(spec, result, cache, name):
         q4 = case_metrics(m4, cs, spec.scenario["t_brake"])
         c4 = None
         if spec.comfort is not None:
-            from .antiskid_comfort import comfort_of
+            from ...features.comfort import comfort_of
             c4 = comfort_of(run4, spec.comfort, cs.u_range / spec.torque_range, rec)
     coarse = dataclasses.replace(cr, metrics=cr.metrics_coarse, switch=None,
                                  comfort=cr.comfort_coarse, quarter=None)

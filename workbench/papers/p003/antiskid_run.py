@@ -59,7 +59,7 @@ class CaseResult:
     converged: dict          # metric -> bool
     run: SimResult           # recorded at dt / 2
     switch: SwitchCheck | None
-    comfort: object = None         # antiskid_comfort.Comfort at dt / 2 (design with [comfort])
+    comfort: object = None         # features.comfort.RunComfort at dt / 2 (design with [comfort])
     comfort_coarse: object = None  # the same at dt
     #: The case at dt / 4 (:func:`quarter_cases`): (metrics, run, comfort), or None.
     quarter: tuple | None = None
@@ -272,7 +272,7 @@ class AntiskidRun:
             names |= {f"{b}.diverged", f"{b}.stopped", f"{b}.converged",
                       f"{b}.switch.abscissa", f"{b}.switch.margin", f"{b}.switch.dmu_dlam"}
             if spec.comfort is not None:
-                from .antiskid_comfort import COMFORT_QUANTITIES
+                from ...features.comfort import COMFORT_QUANTITIES
                 names |= {f"{b}.{k}" for k in COMFORT_QUANTITIES}
         if spec.montecarlo is not None:
             from .antiskid_halving import halving_quantity_names
@@ -362,7 +362,7 @@ class AntiskidRun:
                 sw = switch_check(cs, fine[f"v_at_{key}"], fine[f"lam_at_{key}"])
             comfort = (None, None)
             if spec.comfort is not None:
-                from .antiskid_comfort import comfort_of
+                from ...features.comfort import comfort_of
                 u_peak = cs.u_range / spec.torque_range
                 comfort = tuple(comfort_of(r, spec.comfort, u_peak, RECORD_DT)
                                 for r in (run2, run1) + ((q4[1],) if q4 else ()))
@@ -397,7 +397,7 @@ class AntiskidRun:
             q[f"{b}.switch.margin"] = None if sw is None else sw.margin.h
             q[f"{b}.switch.dmu_dlam"] = None if sw is None else sw.dmu_dlam
             if c.comfort is not None:
-                from .antiskid_comfort import comfort_quantities
+                from ...features.comfort import comfort_quantities
                 q.update(comfort_quantities(c.case.name, c.comfort, c.comfort_coarse,
                                             None if c.quarter is None else c.quarter[2]))
         if res.montecarlo is not None:

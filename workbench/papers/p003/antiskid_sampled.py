@@ -39,20 +39,21 @@ The sweep is general (:mod:`workbench.features.rate_sweep`: the table's
 general keys, the variants, the grid, the lowest passing rate and its
 bisection bracket, the mesh check at ``plant_step`` / 2 up to
 :data:`MESH_CHECK_MAX_HZ` within :data:`MESH_ATOL`, the three levels of every
-claimed rate metric, the result and its quantities, every run made once).
+claimed rate metric, the result, every run made once; its quantities and
+claimed rate metrics: :mod:`workbench.features.rate_sweep_quantities`).
 What stays here is paper 003's: the case, margin and predictor keys, the
 kernel as the sweep's ``run`` callback (:func:`runs_of`), the metrics of a
-rate and their tolerances (:func:`rate_metrics`, :func:`declaration`), the
-emulation as the reference, the traces' records, and the Radau windows
+rate and their tolerances (:func:`rate_metrics`, :func:`declaration`,
+:data:`SECTION`), the emulation as the reference, the traces' records, and the Radau windows
 (:mod:`.antiskid_sampled_check`).
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 
 from ...features import rate_sweep as RS
+from ...features import rate_sweep_quantities as RQ
 from .antiskid_sampled_check import RADAU_QUANTITIES, radau_checks, radau_quantities
 from .antiskid_sampled_kernel import OUT, Context, run_once
 
@@ -80,6 +81,10 @@ GAP_METRICS = ("lam_max_over_opt", "t_cruise", "braking_duration", "stop_distanc
 #: (the emulation does not depend on plant_step).
 TO_EMULATION = {"stop_time_minus_emulation": "braking_duration",
                 "stop_distance_minus_emulation": "stop_distance"}
+#: The section's quantities and the rate metrics its claims compare (a difference to the
+#: emulation counts as its rate metric).
+SECTION = RQ.Section("sampled", RATE_METRICS, MESH_CHECK_MAX_HZ, "emulation", GAP_METRICS,
+                     TO_EMULATION)
 
 
 @dataclass(frozen=True)
@@ -96,27 +101,10 @@ class SampledSpec(RS.SweepTable):
 def load_sampled(root, case_names) -> SampledSpec | None:
     """Read ``[sampled]`` from a run design (a :class:`workbench.reader.Reader`);
     None when absent."""
-    if not root.has("sampled"):
-        return None
-    t = root.table("sampled")
-    case = t.string("case", choices=tuple(case_names))
-    out = SampledSpec(case=case, creep_margin=t.number("creep_margin", nonneg=True, hi=0.1),
-                      predictor_step=t.number("predictor_step", positive=True, hi=0.1,
-                                              what="number (s)"),
-                      **RS.read_table(t, "N m", plant_step_hi=1e-3))
-    t.finish()
-    return dataclasses.replace(out, three_level=claimed_rate_metrics(
-        out, root.data.get("claims", [])))
-
-
-def claimed_rate_metrics(spec: SampledSpec, claims) -> tuple:
-    """((variant, rate, metric), ...), sorted: the rate metrics the
-    ``[[claims]]`` tables ``claims`` compare at a grid rate up to
-    :data:`MESH_CHECK_MAX_HZ` (a difference to the emulation counts as its
-    rate metric, :data:`TO_EMULATION`;
-    :func:`workbench.features.rate_sweep.claimed_rate_metrics`)."""
-    return RS.claimed_rate_metrics("sampled", [n for n, _, _ in spec.variants()], spec.rates,
-                                   RATE_METRICS, MESH_CHECK_MAX_HZ, claims, TO_EMULATION)
+    return RS.load_table(root, "sampled", SampledSpec, "N m", 1e-3, SECTION, lambda t: dict(
+        case=t.string("case", choices=tuple(case_names)),
+        creep_margin=t.number("creep_margin", nonneg=True, hi=0.1),
+        predictor_step=t.number("predictor_step", positive=True, hi=0.1, what="number (s)")))
 
 
 @dataclass(frozen=True)
@@ -154,10 +142,8 @@ def declaration(ctx: Context) -> RS.RateMetrics:
     """The metric declarations of the sampled section: :data:`RATE_METRICS`
     of a rate from its traction (0) and braking (1) runs (:func:`rate_metrics`;
     a scenario not run counts as NaN outputs)."""
-    nan = dict.fromkeys(OUT, math.nan)
-    return RS.RateMetrics(RATE_METRICS, (0, 1),
-                          lambda got: rate_metrics(ctx, got[0] or nan, got[1] or nan), NEEDS,
-                          MESH_ATOL, MESH_CHECK_MAX_HZ)
+    return RS.RateMetrics(RATE_METRICS, (0, 1), lambda got: rate_metrics(ctx, got[0], got[1]),
+                          NEEDS, MESH_ATOL, MESH_CHECK_MAX_HZ, OUT)
 
 
 def runs_of(ctx: Context, predictor_step: float, emulation: bool = False) -> RS.Runs:
@@ -199,28 +185,21 @@ def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:
 def trace_records(ctx: Context, spec: SampledSpec, dt_e: float) -> list:
     """[(variant, rate, mesh record), ...]: the first :data:`TRACE_SECONDS`
     of traction of each variant at :data:`TRACE_RATES_HZ` (grid rates only)
-    and of the emulation."""
-    runs = [(name, f, dict(q=q, tau=tau, dt_p=spec.plant_step,
-                           predictor_step=spec.predictor_step))
-            for name, q, tau in spec.variants() for f in TRACE_RATES_HZ if f in spec.rates]
-    runs.append(("emulation", 1.0 / dt_e, dict(dt_p=dt_e, emulation=True)))
-    out = []
-    for name, f, kw in runs:
+    and of the emulation (:func:`workbench.features.rate_sweep.trace_records`)."""
+    def record(f, q=0.0, tau=0.0, reference=False):
+        kw = (dict(dt_p=dt_e, emulation=True) if reference else dict(
+            q=q, tau=tau, dt_p=spec.plant_step, predictor_step=spec.predictor_step))
         cap = int(TRACE_SECONDS / min(kw["dt_p"], 1.0 / f)) * 3 + 16
-        _, (rec, _) = run_once(ctx, f, 0, record=(0.0, TRACE_SECONDS, cap),
-                               t_cap=TRACE_SECONDS, **kw)
-        out.append((name, f, rec))
-    return out
+        return run_once(ctx, f, 0, record=(0.0, TRACE_SECONDS, cap), t_cap=TRACE_SECONDS,
+                        **kw)[1][0]
+    return RS.trace_records(spec, TRACE_RATES_HZ, record, ("emulation", 1.0 / dt_e))
 
 
 def sampled_quantity_names(spec: SampledSpec) -> set[str]:
     """The ``sampled.*`` quantities a design with ``[sampled]`` has."""
-    return RS.sweep_quantity_names("sampled", spec, RATE_METRICS, "emulation", GAP_METRICS,
-                                   TO_EMULATION) | set(RADAU_QUANTITIES)
+    return SECTION.quantity_names(spec) | set(RADAU_QUANTITIES)
 
 
 def sampled_quantities(res: SampledResult) -> dict:
     """Values of :func:`sampled_quantity_names`."""
-    return {**RS.sweep_quantities("sampled", res.variants, RATE_METRICS, "emulation",
-                                  res.reference.metrics, GAP_METRICS, TO_EMULATION),
-            **radau_quantities(res.checks, res.lambda_opt)}
+    return {**SECTION.quantities(res), **radau_quantities(res.checks, res.lambda_opt)}

@@ -6,7 +6,9 @@ exponential-Euler sub-steps of at most ``plant_step``. Here the torque the
 wheel received in a window of a run (piecewise constant: the held,
 delayed commands) is replayed open loop into scipy's Radau and both
 trajectories are compared at every mesh point of the window (the general
-replay of windows of runs: :func:`workbench.features.mesh_replay.replay_windows`).
+replay of windows of runs: :func:`workbench.features.mesh_replay.replay_windows`,
+placed by :func:`~workbench.features.mesh_replay.sample_windows`, reusing the
+figure's records by :func:`~workbench.features.mesh_replay.reusing`).
 What stays here is paper 003's: where the windows are, the tolerances, the
 kernel's recording and the right-hand side. The right-hand
 side is the lambdified sympy model of :mod:`workbench.sim.wheel_slip` (the
@@ -22,9 +24,7 @@ of the ``zoh`` variant.
 """
 from __future__ import annotations
 
-import math
-
-from ...features.mesh_replay import replay_windows
+from ...features.mesh_replay import largest, replay_windows, reusing, sample_windows
 from ...sim.wheel_slip import model_functions
 from .antiskid_sampled_kernel import run_once
 
@@ -55,49 +55,44 @@ def plant_rhs(p):
     return rhs
 
 
-def radau_checks(ctx, spec, runs=None, traction: dict | None = None) -> tuple:
+def radau_checks(ctx, spec, runs, traction: dict) -> tuple:
     """:class:`workbench.features.mesh_replay.WindowCheck` (key: the rate;
     range: of v) of every window at every rate of
     :data:`RADAU_RATES_HZ` in the design's grid (``zoh``, unquantised).
 
     ``runs``: the section's :class:`workbench.features.rate_sweep.Runs` (the
-    grid's braking run locates the braking windows; made here when absent);
-    ``traction``: rate -> mesh record of the first seconds of the ``zoh``
-    traction run from t = 0 (the figure's traces), which holds the traction
-    window. Both braking windows come from one recorded run; the kernel's
-    mesh before the end of a record does not depend on where the run or the
-    record ends, so the windows are those of separate runs (issue 36)."""
+    grid's braking run locates the braking windows); ``traction``: rate ->
+    mesh record of the first seconds of the ``zoh`` traction run from t = 0
+    (the figure's traces), which holds the traction window. Both braking
+    windows come from one recorded run; the kernel's mesh before the end of a
+    record does not depend on where the run or the record ends, so the
+    windows are those of separate runs (issue 36)."""
     out = []
     for rate in (f for f in RADAU_RATES_HZ if f in spec.rates):
         kw = dict(dt_p=spec.plant_step, predictor_step=spec.predictor_step)
-        brake = (runs(rate, 1, 0.0, 0.0, spec.plant_step) if runs is not None
-                 else run_once(ctx, rate, 1, **kw)[0])
+        brake = runs(rate, 1, 0.0, 0.0, spec.plant_step)
         length = WINDOW_SAMPLES / rate
-        # the traction window starts and ends on sample times (h, h + 40 samples):
-        # whether those mesh points are recorded depended on the last bit of h, so
-        # every window starts and ends half a mesh step earlier (issue 36 item 5)
-        half = 0.5 * min(spec.plant_step, 1.0 / rate)
-        starts = (ctx.h, brake["t_omega3"] - length / 2, brake["t_stop"] - length)
-        wins = [(name, t0 - half, t0 + length - half, scen)
-                for name, t0, scen in zip(WINDOWS, starts, (0, 1, 1)) if not math.isnan(t0)]
-        have = (traction or {}).get(rate)
+        # the traction window starts and ends on sample times (h, h + 40 samples): every
+        # window starts and ends half a mesh step earlier (issue 36 item 5)
+        wins = sample_windows(WINDOWS, (ctx.h, brake["t_omega3"] - length / 2,
+                                        brake["t_stop"] - length), (0, 1, 1), length,
+                              0.5 * min(spec.plant_step, 1.0 / rate))
 
-        def record(scen, a, b, rate=rate, have=have, kw=kw):
-            # the stretch holding b ends by b + 1 / rate: before the record's run ended
-            if scen == 0 and have is not None and len(have) and have[0, 0] <= a and \
-                    b + 2 / rate <= have[-1, 0]:
-                return have
+        def record(scen, a, b, rate=rate, kw=kw):
             cap = int((b - a) / spec.plant_step * 1.5) + 4 * int((b - a) * rate) + 16
             return run_once(ctx, rate, scen, record=(a, b, cap), **kw)[1][0]
+        # the traces' record holds the traction window when it runs on past b + 2 samples
+        # (the stretch holding b ends by b + 1 / rate)
+        record = reusing({0: traction.get(rate)}, record, 2 / rate)
         out += [w.check(rate) for w in replay_windows(plant_rhs(ctx.plant), wins, record,
                                                          RTOL, ATOL)]
     return tuple(out)
 
 
 def radau_quantities(checks, lambda_opt: float) -> dict:
-    """The :data:`RADAU_QUANTITIES` (None without a check)."""
+    """The :data:`RADAU_QUANTITIES`: the largest difference of lambda over
+    lambda_opt, of v relative, the windows (None without a check)."""
     if not checks:
         return dict.fromkeys(RADAU_QUANTITIES)
-    return {"sampled.radau.max_dlam_over_opt": max(c.d_abs[1] for c in checks) / lambda_opt,
-            "sampled.radau.max_dv_rel": max(c.d_rel[0] for c in checks),
-            "sampled.radau.windows": len(checks)}
+    d_abs, d_rel = largest(checks)
+    return dict(zip(RADAU_QUANTITIES, (d_abs[1] / lambda_opt, d_rel[0], len(checks))))
