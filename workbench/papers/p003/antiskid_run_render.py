@@ -15,7 +15,7 @@ from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, Contr
 from ...features.linear_delay_check import TEST_PROBLEM as HALVING_PROBLEM
 from ...printed_grid import quantised
 from ...report.binned_fractions import binned_fraction_rows
-from ...features.montecarlo_render import DRAWS_TEXT, montecarlo_figures, rates_text
+from ...features.montecarlo_render import DRAWS_TEXT, rates_text
 from ...report.case_tables import CaseLevels, case_convergence_section, case_metric_table, case_rows
 from ...report.delay_cross_check import delay_cross_check, plot_envelopes
 from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
@@ -24,6 +24,7 @@ from ...sim.wheel_slip import MAX_DLAMBDA, MAX_HALVINGS
 from .antiskid_basin_render import HEADING as BASIN_HEADING
 from .antiskid_comfort_render import (HEADING, PATTERN, TORQUE_CAPTION, comfort_figure,
                                       comfort_section, torque_figure)
+from .antiskid_montecarlo_render import WORDS
 from .antiskid_run_figures import plot_adhesion, plot_creep, plot_evs, plot_speed
 
 _LABELS = {  # metric -> (label, unit, sig)
@@ -116,8 +117,7 @@ def render(design, res) -> Rendered:
         figs += (Figure("basin", "Certified basin of the cruise law (61), switch states.",
                         lambda fig, b=res.basin.basin: plot_basin(fig, b), (7.0, 5.0)),)
     if res.montecarlo is not None:
-        from .antiskid_montecarlo_render import draw_histograms, draw_outcomes
-        figs += montecarlo_figures(res.montecarlo, draw_histograms, draw_outcomes)
+        figs += WORDS.figures(res.montecarlo)
     sections.append(
         "## Figures\n\n"
         "![speed]({figdir}/speed.png)\n\nSpeed and wheel speed of every case (a case "
@@ -257,7 +257,6 @@ def _linear_section(res) -> str:
 
 
 def _montecarlo_section(design, mc, halving=None) -> str:
-    from .antiskid_montecarlo_render import halving_section, summary_tables
     ms = design.spec.montecarlo
     rng = lambda lo_hi, sig=3: f"[{fmt(lo_hi[0], sig)}, {fmt(lo_hi[1], sig)}]"
     rows = [["plant mass / nominal", rng(ms.mass)],
@@ -292,7 +291,7 @@ def _montecarlo_section(design, mc, halving=None) -> str:
         "transient at dt |J| ~ 40, is not resolved by the fixed step on mismatched plants "
         "(in the halving check dt/2 moved it by up to 13 s); whether a run stops is the "
         "`not stopped` row):\n\n"
-        + summary_tables(mc, 3) + "\n\n" + rates_text(mc.n) + "\n\nThe rates of the table "
+        + WORDS.tables(mc, 3) + "\n\n" + rates_text(mc.n) + "\n\nThe rates of the table "
         "with their intervals (the claims `mc-*-vs-full` and "
         "`mc-perturbations-raise-divergence` compare these intervals with full sweeps)."
         + "\n\nBy adhesion (s = 0 wet, s = 1 dry):\n\n"
@@ -300,7 +299,7 @@ def _montecarlo_section(design, mc, halving=None) -> str:
                    brows, "lrrr")
         + "\n\n" + DRAWS_TEXT
         + ("" if halving is None else "\n\n### Step-size check of the Monte Carlo runs\n\n"
-           + halving_section(halving, design.spec)))
+           + WORDS.halving(halving, ms.samples)))
 
 
 def _perturbation_rows(ms, rng) -> list[list[str]]:
