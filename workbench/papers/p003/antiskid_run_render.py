@@ -12,13 +12,13 @@ from __future__ import annotations
 import math
 
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
+from ...features.frozen_loop_render import frozen_loop_cells
 from ...features.linear_delay_check import TEST_PROBLEM as HALVING_PROBLEM
-from ...printed_grid import quantised
 from ...report.binned_fractions import binned_fraction_rows
 from ...features.montecarlo_render import DRAWS_TEXT, rates_text
 from ...report.case_tables import CaseLevels, case_convergence_section, case_metric_table, case_rows
 from ...report.delay_cross_check import delay_cross_check, plot_envelopes
-from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
+from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...sim.convergence import P_MIN
 from ...sim.wheel_slip import MAX_DLAMBDA, MAX_HALVINGS
 from .antiskid_basin_render import HEADING as BASIN_HEADING
@@ -161,21 +161,10 @@ def _results_section(res) -> str:
             "ended before).")
 
 
-#: A_loc is printed on the grid of 1e-5 of its largest entry's decade
-#: (:func:`workbench.printed_grid.quantised`): its central differences (step
-#: 1e-7 in lambda) carry a rounding error of about eps |f| / 1e-7 ~ 1e-9, so an
-#: entry of 2.6e-7 (d v'/d lambda) has no reproducible second digit (2.6e-7 as
-#: designed, 2.62e-7 with the inputs moved 3 ulp); on the grid it prints 0.
-A_DIGITS = 6
-
-
 def _switch_section(res, spec) -> str:
     def at_switch(sw):
-        m = sw.margin
-        mtxt = ("unstable at h = 0" if m.reason == "unstable-at-zero-delay" else
-                "∞ (delay-independent)" if math.isinf(m.h) else fmt(m.h, 3) + " s")
         return [fmt(sw.v, 4), fmt(sw.lam, 4), fmt(sw.dmu_dlam, 3),
-                f"${latex_matrix(quantised(sw.A_loc, A_DIGITS), 3)}$", fmt(sw.abscissa, 3), mtxt]
+                *frozen_loop_cells(sw.A_loc, sw.abscissa, sw.margin)]
 
     def at_brake(m):
         lb, dv = m["lam_at_brake"], m["t_diverged"]
