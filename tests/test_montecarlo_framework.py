@@ -280,6 +280,9 @@ def test_halving_check_of_a_toy_sweep(rtol):
                        draws=(("a", "rate a"),), batch_note=" (the toy's note)",
                        not_compared="; nothing left out")
     assert words.halving(hc, N) == md                  # the study's words as one table
+    sec = dataclasses.replace(words, outcomes={"grew": "grew", OK: "ok"}).section(
+        res, heading="Toy", intro="", draws=[], summary_note="", halving=hc, samples=N)
+    assert sec.endswith("\n\n### Step-size check of the Monte Carlo runs\n\n" + md)
     alt = dataclasses.replace(words, alternates={"a": ("x0", "x(0)", "")})
     assert alt.halving(hc, N) == halving_section(hc, ("x_end",), ("grew",), (("x0", "x(0)"),),
                                                  N, " (the toy's note)", "; nothing left out")
@@ -366,5 +369,10 @@ def test_sweep_words_render_a_toy_sweep():
     assert fig.axes[0].get_legend().get_texts()[0].get_text() == "x = 1"
     plt.close(fig)
     plt.close(ref)
+    md = words.section(res, heading="Toy sweep", intro="Draws:", draws=[["a", "[-0.5, 2]"]],
+                       summary_note="Summary:", notes=("A note.",))
+    assert md.startswith("## Toy sweep\n\nDraws:\n\n| parameter | range |")
+    assert md[md.index("Summary:"):] == ("Summary:\n\n" + words.tables(res, 3) + "\n\n"
+                                         + rates_text(N) + "\n\nA note.\n\n" + DRAWS_TEXT)
     assert [f.name for f in words.figures(res)] == ["montecarlo-histograms",
                                                     "montecarlo-rates", "montecarlo-outcomes"]

@@ -294,6 +294,21 @@ class SweepWords:
             res.metrics.get(self.shade[1], [np.nan] * res.n), float), self.shade[2])
         draw_outcome_scatter(fig, res.samples, tuple(panels), tuple(groups), res.n, shade)
 
+    def section(self, res, *, heading: str, intro: str, draws, summary_note: str,
+                notes=(), halving=None, samples: int | None = None, sig: int = 3) -> str:
+        """A report section of the sweep ``res``: ``## heading``, ``intro``,
+        the ``draws`` table (rows of parameter, range), ``summary_note`` over
+        :meth:`tables` (``sig`` digits), :func:`rates_text`, the study's
+        ``notes`` (paragraphs), the figures' text (:data:`DRAWS_TEXT`) and,
+        when given, the step-halving check ``halving`` (:meth:`halving`) of
+        a sweep of ``samples`` runs."""
+        parts = [f"## {heading}\n\n{intro}", md_table(["parameter", "range"], draws, "ll"),
+                 summary_note, self.tables(res, sig), rates_text(res.n), *notes, DRAWS_TEXT]
+        if halving is not None:
+            parts.append("### Step-size check of the Monte Carlo runs\n\n"
+                         + self.halving(halving, samples, sig))
+        return "\n\n".join(parts)
+
     def figures(self, res) -> tuple[Figure, ...]:
         """:func:`montecarlo_figures` of ``res``."""
         return montecarlo_figures(res, self.histograms, self.outcome_scatter)
