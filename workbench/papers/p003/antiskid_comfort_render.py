@@ -12,14 +12,13 @@ from __future__ import annotations
 import numpy as np
 
 from ...controllers.antiskid003_settings import PHASE_NAMES
-from ...features.comfort import COMFORT_RTOL
+from ...features.comfort import COMFORT_RTOL, peaks_converged
 from ...features.comfort_render import (comfort_cells, comfort_headers, phase_switches,
                                         windows_text)
 from ...features.comfort_render import plot_comfort as plot_comfort_traces
 from ...report.case_figures import plot_against_limits
 from ...report.markdown import Figure, fmt, md_table
 from ...sim.convergence import P_MIN
-from .antiskid_comfort import comfort_quantities
 from .antiskid_run import RECORD_DT
 from .antiskid_run_figures import color_of
 from .antiskid_run_spec import peak_adhesion_torque
@@ -54,14 +53,10 @@ def comfort_section(res, spec) -> str:
     """``## Passenger comfort and wheel torque``."""
     cf = spec.comfort
     u_peak = peak_adhesion_torque(spec)
-    rows = []
-    for c in res.cases:
-        m = c.comfort
-        agree = comfort_quantities(c.case.name, m, c.comfort_coarse,
-                                   None if c.quarter is None else c.quarter[2])[
-            f"cases[{c.case.name}].comfort_converged"]
-        agree = "—" if c.quarter is None else (agree or "**not converged**")
-        rows.append([f"`{c.case.name}`", *comfort_cells(m), fmt(m.u_max_over_peak, 3), agree])
+    rows = [[f"`{c.case.name}`", *comfort_cells(c.comfort), fmt(c.comfort.u_max_over_peak, 3),
+             "—" if c.quarter is None else    # the claim's verdict (antiskid_comfort)
+             peaks_converged((c.comfort_coarse, c.comfort, c.quarter[2])) or "**not converged**"]
+            for c in res.cases]
     done = [c for c in res.cases if np.isnan(c.metrics["t_diverged"])]
     where = "".join(f"\n\n`{c.case.name}`: |jerk| > {fmt(cf.jerk_max.value)} m/s³ at "
                     + (windows_text(c.comfort.jerk_windows, _switches(c, spec),
