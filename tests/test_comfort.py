@@ -191,3 +191,18 @@ def test_plot_against_limits_on_a_toy():
     assert [ln.get_label() for ln in lines[2:4]] == ["±1", "±2"]
     assert all(ln.get_label().startswith("_") for ln in lines[4:])   # unlabelled
     plt.close(fig)
+
+
+def test_converged_column_on_a_toy():
+    """features.comfort_render.converged_cell / _head / _text: a speed ramp
+    whose slope moves with the level (no paper's run)."""
+    from workbench.features.comfort import comfort_of_speed
+    from workbench.features.comfort_render import converged_cell, converged_head, converged_text
+    t = np.arange(0.0, 20.0 + 1e-9, 0.05)
+    ramp = lambda k: comfort_of_speed(t, np.where(t < 5, k * t, 5 * k), SPEC, 0.05)
+    assert converged_cell((ramp(0.84), ramp(0.8), ramp(0.798))) == "yes"
+    assert converged_cell((ramp(0.88), ramp(0.8), ramp(0.72))) == "**not converged**"
+    assert converged_cell(None) == "—"                      # no dt/4 run
+    assert converged_head() == "converged, dt to dt/4 (1 %)"
+    assert converged_text(0.02).startswith("Converged: the |a| and |jerk| peaks at dt, dt/2 "
+                                           "and dt/4 have a Richardson error estimate within 2 %")

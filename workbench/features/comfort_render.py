@@ -10,9 +10,11 @@ import math
 import numpy as np
 
 from ..report.markdown import fmt
+from ..sim.convergence import P_MIN
+from .comfort import COMFORT_RTOL, peaks_converged
 
-__all__ = ["comfort_headers", "comfort_cells", "phase_switches", "windows_text",
-           "plot_comfort"]
+__all__ = ["comfort_headers", "comfort_cells", "converged_head", "converged_cell",
+           "converged_text", "phase_switches", "windows_text", "plot_comfort"]
 
 
 def comfort_headers(limits, accel_unit: str = "m/s²", jerk_unit: str = "m/s³") -> list[str]:
@@ -26,6 +28,27 @@ def comfort_cells(c) -> list[str]:
     :func:`comfort_headers`."""
     return [fmt(c.a_max_abs, 3), fmt(c.time_above_a, 3), fmt(c.jerk_max_abs, 2),
             fmt(c.time_above_jerk, 2)]
+
+
+def converged_head(rtol: float = COMFORT_RTOL) -> str:
+    """Header of the column of :func:`converged_cell`."""
+    return f"converged, dt to dt/4 ({fmt(100 * rtol)} %)"
+
+
+def converged_cell(levels, rtol: float = COMFORT_RTOL) -> str:
+    """Whether the peaks of three :class:`~workbench.features.comfort.Comfort`
+    results (at dt, dt/2, dt/4) converged
+    (:func:`~workbench.features.comfort.peaks_converged`): "yes" or
+    "**not converged**"; "—" for ``levels`` None (no dt/4 run)."""
+    return "—" if levels is None else peaks_converged(levels, rtol) or "**not converged**"
+
+
+def converged_text(rtol: float = COMFORT_RTOL) -> str:
+    """What :func:`converged_cell` means, in words (a sentence without its end)."""
+    return ("Converged: the |a| and |jerk| peaks at dt, dt/2 and dt/4 have a Richardson "
+            f"error estimate within {fmt(100 * rtol)} % of the peak (levels whose "
+            f"differences change sign: the larger difference at order {fmt(P_MIN)}); — : no "
+            "dt/4 run")
 
 
 def phase_switches(t, phase, names, pinned=None) -> list[tuple[float, str]]:

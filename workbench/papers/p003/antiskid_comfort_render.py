@@ -12,13 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from ...controllers.antiskid003_settings import PHASE_NAMES
-from ...features.comfort import COMFORT_RTOL, peaks_converged
-from ...features.comfort_render import (comfort_cells, comfort_headers, phase_switches,
+from ...features.comfort_render import (comfort_cells, comfort_headers, converged_cell,
+                                        converged_head, converged_text, phase_switches,
                                         windows_text)
 from ...features.comfort_render import plot_comfort as plot_comfort_traces
 from ...report.case_figures import plot_against_limits
 from ...report.markdown import Figure, fmt, md_table
-from ...sim.convergence import P_MIN
 from .antiskid_run import RECORD_DT
 from .antiskid_run_figures import color_of
 from .antiskid_run_spec import peak_adhesion_torque
@@ -54,8 +53,8 @@ def comfort_section(res, spec) -> str:
     cf = spec.comfort
     u_peak = peak_adhesion_torque(spec)
     rows = [[f"`{c.case.name}`", *comfort_cells(c.comfort), fmt(c.comfort.u_max_over_peak, 3),
-             "—" if c.quarter is None else    # the claim's verdict (antiskid_comfort)
-             peaks_converged((c.comfort_coarse, c.comfort, c.quarter[2])) or "**not converged**"]
+             converged_cell(None if c.quarter is None else
+                            (c.comfort_coarse, c.comfort, c.quarter[2]))]
             for c in res.cases]
     done = [c for c in res.cases if np.isnan(c.metrics["t_diverged"])]
     where = "".join(f"\n\n`{c.case.name}`: |jerk| > {fmt(cf.jerk_max.value)} m/s³ at "
@@ -79,13 +78,9 @@ def comfort_section(res, spec) -> str:
         "model, the most the rail transmits in steady state (the paper gives no drive or "
         f"brake limit; the design's only torque bound, `torque_range` = "
         f"{fmt(spec.torque_range)} T_adh, is its divergence test).\n\n"
-        + md_table(["case", *comfort_headers(cf), "max |u| / T_adh",
-                    f"converged, dt to dt/4 ({fmt(100 * COMFORT_RTOL)} %)"],
+        + md_table(["case", *comfort_headers(cf), "max |u| / T_adh", converged_head()],
                    rows, "lrrrrrl")
-        + "\n\nConverged: the |a| and |jerk| peaks at dt, dt/2 and dt/4 have a Richardson "
-        f"error estimate within {fmt(100 * COMFORT_RTOL)} % of the peak (levels whose "
-        f"differences change sign: the larger difference at order {fmt(P_MIN)}); — : no dt/4 run "
-        "(no claim states the case's convergence)."
+        + "\n\n" + converged_text() + " (no claim states the case's convergence)."
         + where
         + "\n\n![comfort]({figdir}/comfort.png)\n\nAcceleration (top) and jerk (bottom) "
         "against time with the comfort limits (dashed); dotted: the phase switches of the "
