@@ -147,3 +147,62 @@ def test_general_peaks_converged_and_table_on_a_toy():
     assert peaks_converged((ramp(0.8), ramp(0.8), ramp(0.8))) == "yes"
     assert peaks_converged((ramp(0.84), ramp(0.8), ramp(0.798))) == "yes"
     assert peaks_converged((ramp(0.88), ramp(0.8), ramp(0.72))) is None
+
+
+def test_phase_switches_and_jerk_windows_text_on_a_toy():
+    """features.comfort_render on no paper's run: a three-phase toy record
+    (idle, run, stop), one switch due at a known time."""
+    from workbench.features.comfort_render import phase_switches, windows_text
+    names = ("idle", "run", "stop")
+    t = np.array([0.0, 1.0, 2.0, 3.0, 4.0])
+    phase = [0, 0, 1, 1, 2]
+    assert phase_switches(t, phase, names) == [(2.0, "idle → run"), (4.0, "run → stop")]
+    # the switch into "stop" was due at 3.9 s: given there, within the tolerance only
+    assert phase_switches(t, phase, names, (("stop",), 3.9, 0.2))[1] == (3.9, "run → stop")
+    assert phase_switches(t, phase, names, (("stop",), 3.5, 0.2))[1] == (4.0, "run → stop")
+    assert phase_switches(t, phase, names, (("stop",), np.nan, 0.2))[1] == (4.0, "run → stop")
+    # a switch within the group keeps its record time
+    assert phase_switches(t, [0, 0, 1, 1, 2], names, (("run", "stop"), 3.9, 0.2))[1][0] == 4.0
+    events = phase_switches(t, phase, names)
+    text = windows_text([(1.5, 1.6, 0.912), (10.0, 11.0, 2.0)], events, 0.5)
+    assert text == ("1.5-1.6 s (peak 0.91 m/s³; idle → run at 2 s); "
+                    "10-11 s (peak 2 m/s³; no phase switch within the window)")
+    assert windows_text([], events, 0.5) == ""
+
+
+def test_plot_against_limits_on_a_toy():
+    """report.case_figures.plot_against_limits: a line per trace, then each
+    limit at + and - its value (+ lines first, the label on + only)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from workbench.report.case_figures import Palette, plot_against_limits
+    t = np.linspace(0.0, 1.0, 11)
+    fig = plt.figure()
+    ax = fig.add_subplot(111)
+    plot_against_limits(ax, [("a", t, np.sin(t)), ("b", t, 3 * t)], Palette({"a": "tab:red"}),
+                        [(1.0, "--", "±1"), (2.0, ":", "±2")], lw=0.8)
+    lines = ax.get_lines()
+    assert [ln.get_label() for ln in lines[:2]] == ["a", "b"]
+    assert (lines[0].get_color(), lines[1].get_color()) == ("tab:red", "tab:green")
+    assert lines[0].get_linewidth() == 0.8
+    assert [ln.get_ydata()[0] for ln in lines[2:]] == [1.0, 2.0, -1.0, -2.0]
+    assert [ln.get_linestyle() for ln in lines[2:]] == ["--", ":", "--", ":"]
+    assert [ln.get_label() for ln in lines[2:4]] == ["±1", "±2"]
+    assert all(ln.get_label().startswith("_") for ln in lines[4:])   # unlabelled
+    plt.close(fig)
+
+
+def test_converged_column_on_a_toy():
+    """features.comfort_render.converged_cell / _head / _text: a speed ramp
+    whose slope moves with the level (no paper's run)."""
+    from workbench.features.comfort import comfort_of_speed
+    from workbench.features.comfort_render import converged_cell, converged_head, converged_text
+    t = np.arange(0.0, 20.0 + 1e-9, 0.05)
+    ramp = lambda k: comfort_of_speed(t, np.where(t < 5, k * t, 5 * k), SPEC, 0.05)
+    assert converged_cell((ramp(0.84), ramp(0.8), ramp(0.798))) == "yes"
+    assert converged_cell((ramp(0.88), ramp(0.8), ramp(0.72))) == "**not converged**"
+    assert converged_cell(None) == "—"                      # no dt/4 run
+    assert converged_head() == "converged, dt to dt/4 (1 %)"
+    assert converged_text(0.02).startswith("Converged: the |a| and |jerk| peaks at dt, dt/2 "
+                                           "and dt/4 have a Richardson error estimate within 2 %")

@@ -11,6 +11,7 @@ decay x' = -a x from x(0) = x0, exact solution (or explicit Euler at a step
 for the halving check), the rate ``a`` and ``x0`` drawn."""
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import ClassVar
 
@@ -30,7 +31,7 @@ from workbench.features.montecarlo_halving import (HalvingCheck, halving_quantit
 from workbench.features.montecarlo_render import (DRAWS_TEXT, draw_outcome_scatter,
                                                   halving_section, halving_tables,
                                                   montecarlo_figures, rates_text,
-                                                  summary_tables)
+                                                  summary_tables, SweepWords)
 from workbench.features.montecarlo_stats import (OK, RunsResult, finite_span, quantity_names,
                                                  summary_row)
 
@@ -275,6 +276,16 @@ def test_halving_check_of_a_toy_sweep(rtol):
     assert f"**{sum(hc.run_agree)} of {n} runs agree" in md and md.endswith(text)
     assert f"between k and k + {N - n} of the {N} runs" in md        # the refinement it covers
     assert "Refinement" not in halving_section(hc, ("x_end",), ("grew",), (), None)
+    words = SweepWords({}, {}, halving_metrics=("x_end",), halving_outcomes=("grew",),
+                       draws=(("a", "rate a"),), batch_note=" (the toy's note)",
+                       not_compared="; nothing left out")
+    assert words.halving(hc, N) == md                  # the study's words as one table
+    sec = dataclasses.replace(words, outcomes={"grew": "grew", OK: "ok"}).section(
+        res, heading="Toy", intro="", draws=[], summary_note="", halving=hc, samples=N)
+    assert sec.endswith("\n\n### Step-size check of the Monte Carlo runs\n\n" + md)
+    alt = dataclasses.replace(words, alternates={"a": ("x0", "x(0)", "")})
+    assert alt.halving(hc, N) == halving_section(hc, ("x_end",), ("grew",), (("x0", "x(0)"),),
+                                                 N, " (the toy's note)", "; nothing left out")
 
 
 def test_outcome_scatter_and_report_figures_of_a_toy_sweep():
@@ -306,3 +317,62 @@ def test_outcome_scatter_and_report_figures_of_a_toy_sweep():
     figs[1].draw(fig)                                              # the rates of the toy
     assert len(fig.axes[0].get_yticklabels()) == len(res.outcome_rates())
     plt.close(fig)
+
+
+def test_sweep_words_render_a_toy_sweep():
+    """SweepWords: the toy's words as one table drive the tables, the
+    histograms, the step-halving text and the outcome scatter (groups from
+    the flags, an alternate draw in place of another)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from workbench.features.montecarlo_render import SweepWords, draw_histograms
+    d = drawn_factors(SPEC, ORDER)
+    m = decay_chunk(d)
+    grew = np.asarray(m["grew"])
+    res = Decay({k: v.tolist() for k, v in d.items()}, {"x_end": m["x_end"].tolist()},
+                {"grew": grew.tolist(), "big": (np.asarray(d["x0"]) > 1.0).tolist()},
+                math.nan, 1)
+    words = SweepWords(
+        outcomes={"grew": "x grew", OK: "ok"}, units={"x_end": "-"},
+        marks={"x_end": (1.0, "x = 1")}, halving_metrics=("x_end",),
+        halving_outcomes=("grew",), draws=(("a", "rate a"), ("x0", "x(0)")),
+        batch_note=" (the toy's note)", not_compared="; nothing left out",
+        panels=(("a", "x0", "rate a", "x(0)"),),
+        groups=(("grew, big", ("grew", "big"), (), "tab:red", "x"),
+                ("grew, small", ("grew",), ("big",), "tab:orange", "x"),
+                ("decayed", (), ("grew",), "tab:blue", "o")),
+        shade=("decayed", "x_end", "x at T"),
+        alternates={"x0": ("x_start", "x start", "start of x")})
+    assert words.tables(res, 3) == summary_tables(res, 3, {"grew": "x grew", OK: "ok"})
+    assert "| x grew |" in words.tables(res, 3)
+    fig = plt.figure()
+    words.outcome_scatter(fig, res)
+    ax = fig.axes[0]
+    big = np.asarray(d["x0"]) > 1.0
+    counts = [int((grew & big).sum()), int((grew & ~big).sum()), int((~grew).sum())]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels == [f"{lab}: {k} of {N}" for lab, k in
+                      zip(("grew, big", "grew, small", "decayed"), counts) if k]
+    assert ax.get_ylabel() == "x(0)" and len(fig.axes) == 2      # decayed shaded by x_end
+    plt.close(fig)
+    fig = plt.figure()                                # the sweep has the alternate draw
+    alt = Decay({**res.samples, "x_start": res.samples["x0"]}, res.metrics, res.violations,
+                math.nan, 1)
+    words.outcome_scatter(fig, alt)
+    assert fig.axes[0].get_ylabel() == "start of x"
+    plt.close(fig)
+    fig, ref = plt.figure(), plt.figure()
+    words.histograms(fig, res)
+    draw_histograms(ref, res, {"x_end": "-"}, {"x_end": (1.0, "x = 1")})
+    assert fig.axes[0].get_xlabel() == ref.axes[0].get_xlabel() == "x_end (-)"
+    assert fig.axes[0].get_legend().get_texts()[0].get_text() == "x = 1"
+    plt.close(fig)
+    plt.close(ref)
+    md = words.section(res, heading="Toy sweep", intro="Draws:", draws=[["a", "[-0.5, 2]"]],
+                       summary_note="Summary:", notes=("A note.",))
+    assert md.startswith("## Toy sweep\n\nDraws:\n\n| parameter | range |")
+    assert md[md.index("Summary:"):] == ("Summary:\n\n" + words.tables(res, 3) + "\n\n"
+                                         + rates_text(N) + "\n\nA note.\n\n" + DRAWS_TEXT)
+    assert [f.name for f in words.figures(res)] == ["montecarlo-histograms",
+                                                    "montecarlo-rates", "montecarlo-outcomes"]

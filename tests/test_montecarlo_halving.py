@@ -16,8 +16,14 @@ from workbench.papers.p003.antiskid_halving import (HALVING_METRICS, HALVING_OUT
                                                     compare_steps, halving_quantities,
                                                     halving_quantity_names, start_halving)
 from workbench.papers.p003.antiskid_montecarlo import draw_samples, sweep
-from workbench.papers.p003.antiskid_montecarlo_render import halving_section
+from workbench.papers.p003.antiskid_montecarlo_render import WORDS
 from workbench.papers.p003.antiskid_run_spec import SweepSpec, gain_for
+
+
+def halving_section(hc, spec) -> str:
+    """The report's text of the check of the design's sweep."""
+    return WORDS.halving(hc, spec.montecarlo.samples)
+
 
 N = 4
 

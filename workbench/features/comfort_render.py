@@ -1,11 +1,20 @@
-"""Table columns and the acceleration/jerk figure of
-:mod:`workbench.features.comfort` (pure rendering; the study adds its own
-columns, wording and event markers)."""
+"""Table columns, the stretches above the jerk limit with the events near
+them, and the acceleration/jerk figure of :mod:`workbench.features.comfort`
+(pure rendering; the study adds its own columns, wording and event markers).
+Events of a phase-scheduled run are its phase switches
+(:func:`phase_switches`). Test on a toy: ``tests/test_comfort.py``."""
 from __future__ import annotations
 
-from ..report.markdown import fmt
+import math
 
-__all__ = ["comfort_headers", "comfort_cells", "plot_comfort"]
+import numpy as np
+
+from ..report.markdown import fmt
+from ..sim.convergence import P_MIN
+from .comfort import COMFORT_RTOL, peaks_converged
+
+__all__ = ["comfort_headers", "comfort_cells", "converged_head", "converged_cell",
+           "converged_text", "phase_switches", "windows_text", "plot_comfort"]
 
 
 def comfort_headers(limits, accel_unit: str = "m/s²", jerk_unit: str = "m/s³") -> list[str]:
@@ -19,6 +28,73 @@ def comfort_cells(c) -> list[str]:
     :func:`comfort_headers`."""
     return [fmt(c.a_max_abs, 3), fmt(c.time_above_a, 3), fmt(c.jerk_max_abs, 2),
             fmt(c.time_above_jerk, 2)]
+
+
+def converged_head(rtol: float = COMFORT_RTOL) -> str:
+    """Header of the column of :func:`converged_cell`."""
+    return f"converged, dt to dt/4 ({fmt(100 * rtol)} %)"
+
+
+def converged_cell(levels, rtol: float = COMFORT_RTOL) -> str:
+    """Whether the peaks of three :class:`~workbench.features.comfort.Comfort`
+    results (at dt, dt/2, dt/4) converged
+    (:func:`~workbench.features.comfort.peaks_converged`): "yes" or
+    "**not converged**"; "—" for ``levels`` None (no dt/4 run)."""
+    return "—" if levels is None else peaks_converged(levels, rtol) or "**not converged**"
+
+
+def converged_text(rtol: float = COMFORT_RTOL) -> str:
+    """What :func:`converged_cell` means, in words (a sentence without its end)."""
+    return ("Converged: the |a| and |jerk| peaks at dt, dt/2 and dt/4 have a Richardson "
+            f"error estimate within {fmt(100 * rtol)} % of the peak (levels whose "
+            f"differences change sign: the larger difference at order {fmt(P_MIN)}); — : no "
+            "dt/4 run")
+
+
+def phase_switches(t, phase, names, pinned=None) -> list[tuple[float, str]]:
+    """(time, "a → b") of each change of a recorded phase.
+
+    Parameters
+    ----------
+    t : array of float
+        Record times (s).
+    phase : array of int
+        The phase at each record time, an index into ``names``.
+    names : sequence of str
+        Phase names.
+    pinned : (group, t0, tol) or None
+        A switch from a phase outside ``group`` (phase names) into it, at a
+        record time within ``tol`` (s) of ``t0``, is given at ``t0``: a
+        switch due at a known time first shows at a record sample that can
+        depend on the last bit of the accumulated time. Not used when ``t0``
+        is not finite.
+    """
+    ph = np.asarray(phase)
+
+    def at(i):
+        if pinned is not None:
+            group, t0, tol = pinned
+            if (names[ph[i]] in group and names[ph[i - 1]] not in group
+                    and math.isfinite(t0) and abs(t[i] - t0) <= tol):
+                return t0
+        return float(t[i])
+
+    return [(float(at(i)), f"{names[ph[i - 1]]} → {names[ph[i]]}")
+            for i in np.flatnonzero(ph[1:] != ph[:-1]) + 1]
+
+
+def windows_text(windows, events, window: float, jerk_unit: str = "m/s³") -> str:
+    """The stretches (start, end, peak |jerk|) of ``windows`` (s; e.g.
+    :attr:`~workbench.features.comfort.Comfort.jerk_windows`), each with the
+    events (time, what) within ``window`` seconds of it."""
+    parts = []
+    for t0, t1, peak in windows:
+        near = [f"{what} at {fmt(ts, 4)} s" for ts, what in events
+                if t0 - window <= ts <= t1 + window]
+        parts.append(f"{fmt(t0, 4)}-{fmt(t1, 4)} s (peak {fmt(peak, 2)} {jerk_unit}; "
+                     + ("; ".join(near) if near else "no phase switch within the window")
+                     + ")")
+    return "; ".join(parts)
 
 
 def plot_comfort(fig, traces, limits, events=(), accel_unit: str = "m/s²",

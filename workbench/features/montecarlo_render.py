@@ -5,19 +5,21 @@ and the tables of a step-halving check of its runs
 (:class:`~workbench.features.montecarlo_halving.HalvingCheck`) with what it
 covers, the runs at their draws marked by outcome, and the figures of a sweep
 in a report. A study supplies only its words (outcome labels, units, marked
-values, draw labels, what its kernel guarantees).
+values, draw labels, what its kernel guarantees), as one table:
+:class:`SweepWords`.
 
 Used by the ``antiskid-run`` study (paper 003);
 ``tests/test_montecarlo_framework.py`` renders a toy sweep with it."""
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..report.markdown import Figure, fmt, md_table
 
-__all__ = ["DRAWS_TEXT", "draw_histograms", "draw_outcome_scatter", "draw_rates",
+__all__ = ["DRAWS_TEXT", "SweepWords", "draw_histograms", "draw_outcome_scatter", "draw_rates",
            "halving_section", "halving_tables", "montecarlo_figures", "rate_text",
            "rates_text", "refined_runs_text", "summary_tables"]
 
@@ -177,7 +179,7 @@ def draw_histograms(fig, res, units: dict, marks: dict | None = None) -> None:
     ``units``: metric -> unit (x label), ``marks``: metric -> (x, label) of a
     dashed reference line."""
     marks = marks or {}
-    axes = fig.subplots(1, len(res.SUMMARY))
+    axes = fig.subplots(1, len(res.SUMMARY), squeeze=False)[0]   # one metric: one axes
     for ax, k in zip(axes, res.SUMMARY):
         x = np.asarray(res.metrics[k], float)
         x = x[np.isfinite(x)]
@@ -203,3 +205,110 @@ def draw_rates(fig, res) -> None:
     ax.set_xlim(-2, 102)
     ax.set_xlabel(f"runs with the outcome (%) of {res.n}, Wilson 95 % interval")
     ax.grid(alpha=0.3)
+
+
+@dataclass(frozen=True)
+class SweepWords:
+    """A study's words for its sweep: all the tables and figures of this
+    module need that is not general (a table of labels, units and flags).
+
+    Attributes
+    ----------
+    outcomes : dict
+        Outcome -> its words (:func:`summary_tables`).
+    units : dict
+        Summary metric -> unit (:func:`draw_histograms`).
+    marks : dict
+        Metric -> (x, label) of a dashed line on its histogram.
+    halving_metrics, halving_outcomes : tuple of str
+        What the step-halving check compares (:func:`halving_section`).
+    draws : tuple
+        (draw, column label) of the runs that disagree in the check.
+    batch_note, not_compared : str
+        The words of :func:`halving_section`.
+    panels : tuple
+        (x draw, y draw, x label, y label) of each panel of the outcome
+        scatter (:func:`draw_outcome_scatter`).
+    groups : tuple
+        (label, flags set, flags not set, colour, marker) of each group of
+        runs in the scatter: the runs with every flag of the first tuple and
+        none of the second (flags of ``res.violations``).
+    shade : (group label, metric, colour-bar label) or None
+        The group coloured by a metric of its runs (NaN where missing).
+    alternates : dict
+        Draw -> (draw, column label, axis label) used in its place where the
+        sweep has that draw (a draw that replaces another).
+    """
+
+    outcomes: dict
+    units: dict
+    marks: dict = field(default_factory=dict)
+    halving_metrics: tuple = ()
+    halving_outcomes: tuple = ()
+    draws: tuple = ()
+    batch_note: str = ""
+    not_compared: str = ""
+    panels: tuple = ()
+    groups: tuple = ()
+    shade: tuple | None = None
+    alternates: dict = field(default_factory=dict)
+
+    def _draw(self, key: str, label: str, drawn, axis: bool) -> tuple[str, str]:
+        """(draw, label) of ``key``, or its alternate where ``drawn`` has it."""
+        alt = self.alternates.get(key)
+        return (alt[0], alt[2 if axis else 1]) if alt and alt[0] in drawn else (key, label)
+
+    def tables(self, res, sig: int) -> str:
+        """:func:`summary_tables` of ``res`` with :attr:`outcomes`."""
+        return summary_tables(res, sig, self.outcomes)
+
+    def histograms(self, fig, res) -> None:
+        """:func:`draw_histograms` of ``res`` with :attr:`units` and :attr:`marks`."""
+        draw_histograms(fig, res, self.units, self.marks)
+
+    def halving(self, hc, samples: int | None = None, sig: int = 3) -> str:
+        """:func:`halving_section` of the check ``hc`` of a sweep of
+        ``samples`` runs (None: not known)."""
+        labels = tuple(self._draw(d, lab, hc.draws, False) for d, lab in self.draws)
+        return halving_section(hc, self.halving_metrics, self.halving_outcomes, labels,
+                               samples, self.batch_note, self.not_compared, sig)
+
+    def outcome_scatter(self, fig, res) -> None:
+        """:func:`draw_outcome_scatter` of ``res`` with :attr:`panels`,
+        :attr:`groups` and :attr:`shade`."""
+        flag = lambda k: np.asarray(res.violations[k], bool)
+        groups = []
+        for label, on, off, colour, marker in self.groups:
+            sel = np.ones(res.n, bool)
+            for k in on:
+                sel = sel & flag(k)
+            for k in off:
+                sel = sel & ~flag(k)
+            groups.append((label, sel, colour, marker))
+        panels = []
+        for kx, ky, lx, ly in self.panels:
+            (kx, lx), (ky, ly) = (self._draw(kx, lx, res.samples, True),
+                                  self._draw(ky, ly, res.samples, True))
+            panels.append((kx, ky, lx, ly))
+        shade = None if self.shade is None else (self.shade[0], np.asarray(
+            res.metrics.get(self.shade[1], [np.nan] * res.n), float), self.shade[2])
+        draw_outcome_scatter(fig, res.samples, tuple(panels), tuple(groups), res.n, shade)
+
+    def section(self, res, *, heading: str, intro: str, draws, summary_note: str,
+                notes=(), halving=None, samples: int | None = None, sig: int = 3) -> str:
+        """A report section of the sweep ``res``: ``## heading``, ``intro``,
+        the ``draws`` table (rows of parameter, range), ``summary_note`` over
+        :meth:`tables` (``sig`` digits), :func:`rates_text`, the study's
+        ``notes`` (paragraphs), the figures' text (:data:`DRAWS_TEXT`) and,
+        when given, the step-halving check ``halving`` (:meth:`halving`) of
+        a sweep of ``samples`` runs."""
+        parts = [f"## {heading}\n\n{intro}", md_table(["parameter", "range"], draws, "ll"),
+                 summary_note, self.tables(res, sig), rates_text(res.n), *notes, DRAWS_TEXT]
+        if halving is not None:
+            parts.append("### Step-size check of the Monte Carlo runs\n\n"
+                         + self.halving(halving, samples, sig))
+        return "\n\n".join(parts)
+
+    def figures(self, res) -> tuple[Figure, ...]:
+        """:func:`montecarlo_figures` of ``res``."""
+        return montecarlo_figures(res, self.histograms, self.outcome_scatter)

@@ -56,6 +56,20 @@ def plot_phase_plane(ax, traces: Iterable[tuple], color_of, **style) -> None:
         ax.plot(x[-1], y[-1], "x", color=color_of(name), ms=6)
 
 
+def plot_against_limits(ax, traces: Iterable[tuple], color_of, limits: Iterable[tuple],
+                        **style) -> None:
+    """One line per trace (case name, t, y) in the case's colour, labelled
+    with the name, the data as given; then each of ``limits`` (value, line
+    style, legend label) as black lines at +value and -value (the label on
+    +value), all + lines first. ``style`` passes to the traces' ``ax.plot``."""
+    for name, t, y in traces:
+        ax.plot(t, y, color=color_of(name), label=name, **style)
+    limits = list(limits)
+    for s in (1, -1):
+        for value, ls, label in limits:
+            ax.axhline(s * value, color="k", ls=ls, lw=0.8, label=label if s > 0 else None)
+
+
 def time_window(t_event: float, before: float, width: float) -> tuple[float, float]:
     """An x range of ``width`` seconds from the whole second at or below
     ``t_event - before``: ends on a grid, not on the data."""

@@ -7,7 +7,8 @@ import numpy as np
 
 from ...features.comfort import TIMES
 from ...features.convergence import claim_table
-from ...report.case_tables import MISSING, fmt_finite
+from ...features.montecarlo_stats import finite_span
+from ...report.case_tables import fmt_finite
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...sim.convergence import P_MAX, P_MIN
 from .quantities import scenario_metrics
@@ -174,9 +175,8 @@ def _montecarlo(spec, res):
         units = scenario_metrics(spec, sc.name)
         rows = []
         for k, v in m.metrics.items():
-            ok = ~np.isnan(v)
-            rows.append([f"`{k}`", fmt(np.min(v[ok]), 4) if ok.any() else MISSING,
-                         fmt(np.max(v[ok]), 4) if ok.any() else MISSING, units[k]])
+            lo, hi = finite_span(v)          # None (printed —) when no run has it
+            rows.append([f"`{k}`", fmt(lo, 4), fmt(hi, 4), units[k]])
         bad = sorted({x for x in m.reasons if x not in ("until", "t_end")})[:3]
         parts.append(
             f"### Scenario `{sc.name}`\n\n{m.samples} runs: {int(m.metrics['completed'].sum())} "

@@ -1,70 +1,36 @@
-"""Rendering of the Monte Carlo sweep and its step-halving check (pure): the
-paper's words, units and figures; the tables (summary, outcome rates,
-step-halving), the text of the check, rates, histograms and the scatter of
-the runs are :mod:`workbench.features.montecarlo_render`. What stays here is
-paper 003's: the labels of the antiskid draws and outcomes, lambda_opt on
-the histogram of `lam_max_over_opt`, the time a run diverged as its
-colour."""
+"""The antiskid sweep's words for the general Monte Carlo rendering
+(:class:`workbench.features.montecarlo_render.SweepWords`: the summary,
+outcome-rate and step-halving tables, histograms and the scatter of the
+runs). What stays here is paper 003's: the labels of the antiskid draws and
+outcomes, lambda_opt on the histogram of `lam_max_over_opt`, the time a run
+diverged as its colour, the varying delay's period in place of the h draw."""
 from __future__ import annotations
 
-import numpy as np
-
-from ...features.montecarlo_halving import HalvingCheck
-from ...features.montecarlo_render import draw_histograms as general_histograms
-from ...features.montecarlo_render import draw_outcome_scatter
-from ...features.montecarlo_render import halving_section as general_halving_section
-from ...features.montecarlo_render import summary_tables as general_tables
+from ...features.montecarlo_render import SweepWords
 from .antiskid_halving import HALVING_METRICS, HALVING_OUTCOMES
-from .antiskid_montecarlo import SUMMARY_METRICS, VIOLATIONS, SweepResult
+from .antiskid_montecarlo import SUMMARY_METRICS, VIOLATIONS
 
+#: The antiskid sweep's tables and figures (``WORDS.tables(res, sig)`` is what
+#: ``workbench sweep`` prints and the report shows).
+WORDS = SweepWords(
+    outcomes={**VIOLATIONS, "ok": "ok: none of the above"},
+    units={k: "-" if k == "lam_max_over_opt" else "s" for k in SUMMARY_METRICS},
+    marks={"lam_max_over_opt": (1.0, "lambda_opt")},
+    halving_metrics=HALVING_METRICS, halving_outcomes=HALVING_OUTCOMES,
+    draws=(("mass", "mass factor"), ("adhesion", "adhesion s"), ("h", "h (s)"),
+           ("v0", "v(0) (m/s)")),
+    batch_note=" (each run of a batch follows its single-run trajectory, so a run's values "
+               "do not depend on its chunk)",
+    not_compared="; `lam_max_over_opt` is not compared for a run that diverged in traction "
+                 "at either step",
+    panels=(("adhesion", "h", "adhesion s (0 wet, 1 dry)", "true input delay h (s)"),
+            ("mass", "v0", "plant mass / nominal", "v(0) (m/s)")),
+    groups=(("stopped", (), ("diverged", "not_stopped"), "tab:blue", "o"),
+            ("diverged", ("diverged",), (), "tab:red", "x"),
+            ("not stopped, not diverged", ("not_stopped",), ("diverged",), "tab:gray", "s")),
+    shade=("diverged", "t_diverged", "diverged at t (s)"),
+    # with a varying delay h(t) the constant h draw is not used
+    alternates={"h": ("delay_period", "h(t) period (s)", "period of the varying delay h(t) (s)")})
 
-#: Column labels of the draws in :func:`halving_section`.
-_DRAW_LABELS = (("mass", "mass factor"), ("adhesion", "adhesion s"), ("h", "h (s)"),
-                ("v0", "v(0) (m/s)"))
-
-
-def halving_section(hc: HalvingCheck, spec=None, sig: int = 3) -> str:
-    """Markdown (no heading) of a :class:`HalvingCheck` of the antiskid
-    sweep (:func:`workbench.features.montecarlo_render.halving_section`).
-    ``spec``: the design's ``RunSpec``, for the size of the sweep (optional;
-    the tolerances are the check's own)."""
-    labels = tuple(("delay_period", "h(t) period (s)") if d == "h" and "delay_period" in hc.draws
-                   else (d, lab) for d, lab in _DRAW_LABELS)    # the h draw unused then
-    return general_halving_section(
-        hc, HALVING_METRICS, HALVING_OUTCOMES, labels,
-        None if spec is None or spec.montecarlo is None else spec.montecarlo.samples,
-        " (each run of a batch follows its single-run trajectory, so a run's values do not "
-        "depend on its chunk)",
-        "; `lam_max_over_opt` is not compared for a run that diverged in traction at either "
-        "step", sig)
-
-
-def draw_histograms(fig, res: SweepResult) -> None:
-    """Histograms of the summary metrics, lambda_opt marked (pure)."""
-    general_histograms(fig, res, {k: "-" if k == "lam_max_over_opt" else "s"
-                                  for k in SUMMARY_METRICS},
-                       {"lam_max_over_opt": (1.0, "lambda_opt")})
-
-
-def draw_outcomes(fig, res: SweepResult) -> None:
-    """Each run at its (adhesion s, true delay h) and (mass factor, v0),
-    marked by its outcome: stopped, diverged, or neither; a diverged run is
-    coloured by the time it diverged (pure;
-    :func:`workbench.features.montecarlo_render.draw_outcome_scatter`)."""
-    t_div = np.asarray(res.metrics.get("t_diverged", [np.nan] * res.n), float)
-    div = np.asarray(res.violations["diverged"], bool)
-    stuck = np.asarray(res.violations["not_stopped"], bool) & ~div
-    delay = (("delay_period", "period of the varying delay h(t) (s)")
-             if "delay_period" in res.samples else ("h", "true input delay h (s)"))
-    draw_outcome_scatter(
-        fig, res.samples, (("adhesion", delay[0], "adhesion s (0 wet, 1 dry)", delay[1]),
-                           ("mass", "v0", "plant mass / nominal", "v(0) (m/s)")),
-        (("stopped", ~div & ~stuck, "tab:blue", "o"), ("diverged", div, "tab:red", "x"),
-         ("not stopped, not diverged", stuck, "tab:gray", "s")),
-        res.n, ("diverged", t_div, "diverged at t (s)"))
-
-
-def summary_tables(res: SweepResult, sig: int) -> str:
-    """Markdown: the summary statistics and the violation fractions (``sig``
-    significant digits), as printed by ``workbench sweep`` and in reports."""
-    return general_tables(res, sig, {**VIOLATIONS, "ok": "ok: none of the above"})
+#: What ``workbench sweep`` prints and draws (:func:`.antiskid_run.sweep_command`).
+summary_tables, draw_histograms = WORDS.tables, WORDS.histograms

@@ -3,27 +3,29 @@
 The layout is general (:mod:`workbench.report.case_tables`: per-case metrics
 and convergence tables, rows per case; :mod:`workbench.report.delay_cross_check`:
 the linear cross-check of the LMI delay bound; :mod:`workbench.report.case_figures`;
+:mod:`workbench.features.frozen_loop_render`: the loop frozen at a phase switch;
 :mod:`workbench.features.montecarlo_render`: the Monte Carlo tables, figures and
-their text). What stays here is paper 003's: the wording of the scenario, of the phase
-switches of controller (75) and of the numerics, the metric labels, the
-creep-ratio and lambda_opt lines."""
+their text, with the sweep's words of :mod:`.antiskid_montecarlo_render`). What
+stays here is paper 003's and has no general counterpart: the wording of the
+scenario, of the phase switches of controller (75) and of the numerics, the
+metric labels, the creep-ratio and lambda_opt lines."""
 from __future__ import annotations
 
 import math
 
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
+from ...features.frozen_loop_render import frozen_loop_cells
 from ...features.linear_delay_check import TEST_PROBLEM as HALVING_PROBLEM
-from ...printed_grid import quantised
 from ...report.binned_fractions import binned_fraction_rows
-from ...features.montecarlo_render import DRAWS_TEXT, montecarlo_figures, rates_text
 from ...report.case_tables import CaseLevels, case_convergence_section, case_metric_table, case_rows
 from ...report.delay_cross_check import delay_cross_check, plot_envelopes
-from ...report.markdown import Figure, Rendered, fmt, latex_matrix, md_table
+from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...sim.convergence import P_MIN
 from ...sim.wheel_slip import MAX_DLAMBDA, MAX_HALVINGS
 from .antiskid_basin_render import HEADING as BASIN_HEADING
 from .antiskid_comfort_render import (HEADING, PATTERN, TORQUE_CAPTION, comfort_figure,
                                       comfort_section, torque_figure)
+from .antiskid_montecarlo_render import WORDS
 from .antiskid_run_figures import plot_adhesion, plot_creep, plot_evs, plot_speed
 
 _LABELS = {  # metric -> (label, unit, sig)
@@ -116,8 +118,7 @@ def render(design, res) -> Rendered:
         figs += (Figure("basin", "Certified basin of the cruise law (61), switch states.",
                         lambda fig, b=res.basin.basin: plot_basin(fig, b), (7.0, 5.0)),)
     if res.montecarlo is not None:
-        from .antiskid_montecarlo_render import draw_histograms, draw_outcomes
-        figs += montecarlo_figures(res.montecarlo, draw_histograms, draw_outcomes)
+        figs += WORDS.figures(res.montecarlo)
     sections.append(
         "## Figures\n\n"
         "![speed]({figdir}/speed.png)\n\nSpeed and wheel speed of every case (a case "
@@ -161,21 +162,10 @@ def _results_section(res) -> str:
             "ended before).")
 
 
-#: A_loc is printed on the grid of 1e-5 of its largest entry's decade
-#: (:func:`workbench.printed_grid.quantised`): its central differences (step
-#: 1e-7 in lambda) carry a rounding error of about eps |f| / 1e-7 ~ 1e-9, so an
-#: entry of 2.6e-7 (d v'/d lambda) has no reproducible second digit (2.6e-7 as
-#: designed, 2.62e-7 with the inputs moved 3 ulp); on the grid it prints 0.
-A_DIGITS = 6
-
-
 def _switch_section(res, spec) -> str:
     def at_switch(sw):
-        m = sw.margin
-        mtxt = ("unstable at h = 0" if m.reason == "unstable-at-zero-delay" else
-                "∞ (delay-independent)" if math.isinf(m.h) else fmt(m.h, 3) + " s")
         return [fmt(sw.v, 4), fmt(sw.lam, 4), fmt(sw.dmu_dlam, 3),
-                f"${latex_matrix(quantised(sw.A_loc, A_DIGITS), 3)}$", fmt(sw.abscissa, 3), mtxt]
+                *frozen_loop_cells(sw.A_loc, sw.abscissa, sw.margin)]
 
     def at_brake(m):
         lb, dv = m["lam_at_brake"], m["t_diverged"]
@@ -257,7 +247,6 @@ def _linear_section(res) -> str:
 
 
 def _montecarlo_section(design, mc, halving=None) -> str:
-    from .antiskid_montecarlo_render import halving_section, summary_tables
     ms = design.spec.montecarlo
     rng = lambda lo_hi, sig=3: f"[{fmt(lo_hi[0], sig)}, {fmt(lo_hi[1], sig)}]"
     rows = [["plant mass / nominal", rng(ms.mass)],
@@ -268,39 +257,35 @@ def _montecarlo_section(design, mc, halving=None) -> str:
             ["v(0) (m/s)", rng(ms.v0)]] + _perturbation_rows(ms, rng)
     brows = binned_fraction_rows(mc.samples["adhesion"], *ms.adhesion, 4,
                                  [mc.violations["diverged"], mc.violations["above_lambda_opt"]])
-    return (
-        "## Monte Carlo robustness (reduced sample)\n\n"
-        f"{mc.n} runs of case `{ms.case}` with seed {ms.seed} at dt = "
-        f"{fmt(ms.dt or design.spec.dt)} s (the `[montecarlo]` step): a reduced sample of the "
-        f"`workbench sweep designs/{design.name}.toml --samples N --seed {ms.seed}` study, "
-        f"with the same sampler (run i has the same draws for every N, so these are the first {mc.n} runs of "
-        "that study; each run of a batch follows its single-run trajectory). The claims "
-        "`mc-*-vs-full` compare "
-        "these fractions with the full 1000-run sweep. Draws, uniform and independent; the "
-        f"controller keeps the nominal {design.spec.rail}-rail model and the design's h"
-        + (":" if ms.perturb is None else ". Perturbations sampled as well (`[montecarlo]`; "
-           "each a function of (seed, run index) only, by the counter-based generator of "
-           "`workbench/sim/counter_rng.py`):") + "\n\n"
-        + md_table(["parameter", "range"], rows, "ll")
-        + "\n\nSummary statistics (3 significant digits; `lam_max_over_opt` is the max creep "
-        "ratio in traction over the sample's own lambda_opt, not given for a run that diverged "
-        "in traction (its max is where the divergence test fired); `omega3_after_brake` is "
-        "t_brake to omega <= 3 rad/s, the end of the creep-controlled braking (the paper's "
-        "'about 350 s'), finite for the runs that get there. The time to v <= v_stop is not "
-        "given per run: after omega <= 3 rad/s the train coasts on running resistance, "
-        "~46 s per m/s of speed left when the creep is released, and that release, a "
-        "transient at dt |J| ~ 40, is not resolved by the fixed step on mismatched plants "
-        "(in the halving check dt/2 moved it by up to 13 s); whether a run stops is the "
-        "`not stopped` row):\n\n"
-        + summary_tables(mc, 3) + "\n\n" + rates_text(mc.n) + "\n\nThe rates of the table "
-        "with their intervals (the claims `mc-*-vs-full` and "
-        "`mc-perturbations-raise-divergence` compare these intervals with full sweeps)."
-        + "\n\nBy adhesion (s = 0 wet, s = 1 dry):\n\n"
-        + md_table(["adhesion s", "runs", "fraction diverged", "fraction above lambda_opt"],
-                   brows, "lrrr")
-        + "\n\n" + DRAWS_TEXT
-        + ("" if halving is None else "\n\n### Step-size check of the Monte Carlo runs\n\n"
-           + halving_section(halving, design.spec)))
+    return WORDS.section(
+        mc, heading="Monte Carlo robustness (reduced sample)", intro=(
+            f"{mc.n} runs of case `{ms.case}` with seed {ms.seed} at dt = "
+            f"{fmt(ms.dt or design.spec.dt)} s (the `[montecarlo]` step): a reduced sample of the "
+            f"`workbench sweep designs/{design.name}.toml --samples N --seed {ms.seed}` study, "
+            f"with the same sampler (run i has the same draws for every N, so these are the first {mc.n} runs of "
+            "that study; each run of a batch follows its single-run trajectory). The claims "
+            "`mc-*-vs-full` compare "
+            "these fractions with the full 1000-run sweep. Draws, uniform and independent; the "
+            f"controller keeps the nominal {design.spec.rail}-rail model and the design's h"
+            + (":" if ms.perturb is None else ". Perturbations sampled as well (`[montecarlo]`; "
+               "each a function of (seed, run index) only, by the counter-based generator of "
+               "`workbench/sim/counter_rng.py`):")), draws=rows, summary_note=(
+            "Summary statistics (3 significant digits; `lam_max_over_opt` is the max creep "
+            "ratio in traction over the sample's own lambda_opt, not given for a run that diverged "
+            "in traction (its max is where the divergence test fired); `omega3_after_brake` is "
+            "t_brake to omega <= 3 rad/s, the end of the creep-controlled braking (the paper's "
+            "'about 350 s'), finite for the runs that get there. The time to v <= v_stop is not "
+            "given per run: after omega <= 3 rad/s the train coasts on running resistance, "
+            "~46 s per m/s of speed left when the creep is released, and that release, a "
+            "transient at dt |J| ~ 40, is not resolved by the fixed step on mismatched plants "
+            "(in the halving check dt/2 moved it by up to 13 s); whether a run stops is the "
+            "`not stopped` row):"),
+        notes=("The rates of the table with their intervals (the claims `mc-*-vs-full` and "
+               "`mc-perturbations-raise-divergence` compare these intervals with full sweeps).",
+               "By adhesion (s = 0 wet, s = 1 dry):\n\n"
+               + md_table(["adhesion s", "runs", "fraction diverged",
+                           "fraction above lambda_opt"], brows, "lrrr")),
+        halving=halving, samples=ms.samples)
 
 
 def _perturbation_rows(ms, rng) -> list[list[str]]:
