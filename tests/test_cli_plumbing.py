@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from workbench.errors import DesignError
-from workbench.features.cli_plumbing import (check_sweep_flags, pick_case, sweep_errors,
-                                             trajectory_csv)
+from workbench.features.cli_plumbing import (check_sweep_flags, pick_case, run_sweep,
+                                             sweep_errors, trajectory_csv)
 from workbench.sim.batch import SchedulerUnreachable
 from workbench.sim.delay import simulate_linear_dde
 
@@ -53,3 +53,32 @@ def test_sweep_errors_name_the_flag():
     with pytest.raises(ValueError):
         with sweep_errors("dir", None):
             raise ValueError("a bug")
+
+
+class _Pending:
+    """A toy streamed sweep: its result is the sum of the runs."""
+
+    def __init__(self, runs):
+        self.runs = runs
+
+    def result(self, progress):
+        return sum(self.runs), progress
+
+
+def test_run_sweep_in_memory_streamed_and_its_errors():
+    flags = dict(resume=False, scheduler=None, progress=True)
+    direct, streamed = lambda: (6, None), lambda: _Pending([1, 2, 3])
+    assert run_sweep(direct, streamed, out=None, **flags) == (6, None)
+    assert run_sweep(direct, streamed, out="dir", **flags) == (6, True)
+
+    def taken():
+        raise FileExistsError("dir holds another sweep")
+    with pytest.raises(DesignError, match="--out = 'dir'; expected a new folder or --resume"):
+        run_sweep(direct, taken, out="dir", **flags)
+    with pytest.raises(DesignError, match="--resume"):
+        run_sweep(direct, streamed, out=None, **{**flags, "resume": True})
+
+    def unreachable():
+        raise SchedulerUnreachable("nobody there")
+    with pytest.raises(DesignError, match="--scheduler = 'local'"):
+        run_sweep(unreachable, streamed, out=None, **{**flags, "scheduler": "local"})

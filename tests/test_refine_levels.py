@@ -181,7 +181,7 @@ def test_dry_stop_duration_levels_and_the_converged_instead():
     K = gain_for(spec)[0]
     lin = nominal_cruise(spec)[2]
     res = RunResult(0.0, 0.0, tuple(K), "", None, tuple(STUDY._cases(spec, K)),
-                    linear_check(spec, lin.A, lin.B, K), spec.dt)
+                    linear_check(spec, lin.A, lin.B, K), spec.dt, spec=spec)
     stop = next(c for c in design.claims if c.id == "stop-duration")
     assert stop.converged_instead == "cases[compensated].omega3_after_brake"
     omega3 = replace(stop, id="omega3", quantity=stop.converged_instead, value=50.0,

@@ -454,3 +454,11 @@ def test_comfort_limits_give_the_time_above_them(tmp_path, monkeypatch, capsys):
     line = _cli_error(write(tmp_path, COMFORT.replace("LIMITS", LIMITS.replace("m/s^3", "m/s^2"))),
                       capsys)
     assert "comfort.jerk_max.unit" in line and '"m/s^3"' in line, line
+
+
+def test_whole_steps_of_the_delay_and_the_control_period():
+    """A delay or period of 3 steps with decimal rounding is whole; a quarter
+    step off, or a value that rounds to 0 steps, is not."""
+    from workbench.kinds.switched_run import whole_steps
+    assert whole_steps(0.3, 0.1) and whole_steps(0.1, 0.1)
+    assert not whole_steps(0.25, 0.1) and not whole_steps(1e-300, 0.1)

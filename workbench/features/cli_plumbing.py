@@ -5,6 +5,10 @@ the translation of a sweep's failures (an unreachable Dask scheduler, an
 ``--out`` folder that cannot be written) into one clear
 :class:`~workbench.errors.DesignError` each (exit 2, no traceback).
 
+The driver of a sweep with ``--out`` / ``--resume`` / ``--scheduler``,
+:func:`run_sweep`, takes the study's two ways to run (in memory, or streamed
+to a folder) as callbacks and owns the flag checks and the failures.
+
 Who uses what today: ``switched-run`` uses :func:`pick_case`; the
 ``antiskid-run`` commands use all of it (the only sweep with ``--scheduler``).
 The ``delay-feedback`` and ``switched-run`` CSVs keep their own format
@@ -19,7 +23,8 @@ import numpy as np
 
 from ..errors import DesignError
 
-__all__ = ["check_scheduler", "check_sweep_flags", "pick_case", "sweep_errors", "trajectory_csv"]
+__all__ = ["check_scheduler", "check_sweep_flags", "pick_case", "run_sweep", "sweep_errors",
+           "trajectory_csv"]
 
 
 def pick_case(names, case: str | None) -> str:
@@ -77,3 +82,37 @@ def sweep_errors(out: str | None, scheduler: str | None):
             raise
         raise DesignError("<cli>", "--out", out, f"a folder the chunks can be written to "
                           f"({type(e).__name__}: {e})") from None
+
+
+def run_sweep(direct, streamed, *, out: str | None, resume: bool, scheduler: str | None,
+              progress: bool):
+    """The result of a sweep, ``--scheduler``, ``--out`` and ``--resume`` checked.
+
+    Parameters
+    ----------
+    direct : callable
+        ``direct() -> result``: the sweep held in memory (no ``--out``).
+    streamed : callable
+        ``streamed() -> pending``: the sweep written to the folder ``out`` as
+        it runs; ``pending.result(progress=...)`` waits for it. A
+        FileExistsError (a folder of another sweep, or without ``--resume``)
+        becomes a DesignError on ``--out``.
+    out, resume, scheduler : the flags
+    progress : bool
+        Show the streamed sweep's progress.
+
+    Returns
+    -------
+    The sweep's result; its failures are one DesignError each (:func:`sweep_errors`).
+    """
+    from .montecarlo_chunks import check_resume
+    check_scheduler(scheduler)
+    check_resume(out, resume)
+    with sweep_errors(out, scheduler):
+        if not out:
+            return direct()
+        try:
+            pending = streamed()
+        except FileExistsError as e:
+            raise DesignError("<cli>", "--out", out, f"a new folder or --resume ({e})") from None
+        return pending.result(progress=progress)

@@ -45,7 +45,7 @@ from ..delay_feedback import NAME_PATTERN as _NAME
 from ..delay_feedback import read_plant
 from ..delay_feedback.spec import PlantSpec
 
-__all__ = ["Phase", "Scenario", "SwitchedRunSpec", "STUDY", "MAX_STEPS"]
+__all__ = ["Phase", "Scenario", "SwitchedRunSpec", "STUDY", "MAX_STEPS", "whole_steps"]
 
 #: Most integration steps of one run (t_end / dt, at the finest level).
 MAX_STEPS = 2_000_000
@@ -164,11 +164,29 @@ def _phases(root: Reader, plant: PlantSpec, names: set[str]) -> tuple[Phase, ...
     return tuple(out)
 
 
-def _multiple(r: Reader, key: str, value: float, dt: float, what: str) -> None:
+def _keyed_numbers(t: Reader, allowed, expected: str, **kw) -> dict[str, float]:
+    """``{key = number, ...}`` of the table ``t``, each key one of ``allowed``
+    (else ``expected`` is the message); ``kw``: the bounds of
+    :meth:`~workbench.reader.Reader.number`."""
+    out = {}
+    for k in list(t.data):
+        if k not in allowed:
+            raise t.fail(k, t.data[k], expected)
+        out[k] = t.number(k, **kw)
+    t.finish()
+    return out
+
+
+def whole_steps(value: float, dt: float) -> bool:
+    """``value`` is a whole number (>= 1) of steps ``dt`` (to 1e-9 relative)."""
     k = value / dt
-    if not (round(k) >= 1 and abs(k - round(k)) <= 1e-9 * max(k, 1.0)):   # 1e-300 s: 0 steps
+    return round(k) >= 1 and abs(k - round(k)) <= 1e-9 * max(k, 1.0)   # 1e-300 s: 0 steps
+
+
+def _multiple(r: Reader, key: str, value: float, dt: float, what: str) -> None:
+    if not whole_steps(value, dt):
         raise r.fail(key, dt, f"a step of which {what} is a whole multiple (>= 1) "
-                     f"(found {k:.6g} steps)")
+                     f"(found {value / dt:.6g} steps)")
 
 
 def _scenarios(root: Reader, spec_plant: PlantSpec, phases, h: float, convergence: bool,
@@ -199,20 +217,10 @@ def _scenarios(root: Reader, spec_plant: PlantSpec, phases, h: float, convergenc
         if sampled is not None:
             _multiple(r, "dt", sampled.period, dt, f"the control period {sampled.period:g} s")
         phase = r.string("phase", choices=phase_names)
-        pt = r.table("parameters", default=None)
-        over = {}
-        for k in list(pt.data):
-            if k not in spec_plant.parameters:
-                raise pt.fail(k, pt.data[k], "a parameter of [parameters]")
-            over[k] = pt.number(k, lo=-1e15, hi=1e15)
-        pt.finish()
-        tt = r.table("target", default=None)
-        target = {}
-        for k in list(tt.data):
-            if k not in states:
-                raise tt.fail(k, tt.data[k], "a state: " + ", ".join(states))
-            target[k] = tt.number(k, lo=-1e12, hi=1e12)
-        tt.finish()
+        over = _keyed_numbers(r.table("parameters", default=None), spec_plant.parameters,
+                              "a parameter of [parameters]", lo=-1e15, hi=1e15)
+        target = _keyed_numbers(r.table("target", default=None), states,
+                                "a state: " + ", ".join(states), lo=-1e12, hi=1e12)
         rate = r.number("max_switch_rate", default=10.0, positive=True, hi=1e6,
                         what="number of switches per second")
         r.finish()
@@ -225,13 +233,9 @@ def _sampled(root: Reader, plant: PlantSpec) -> SampledSpec | None:
         return None
     t = root.table("sampled")
     period = t.number("period", positive=True, hi=1e3, what="control period (s)")
-    qt = t.table("quantisation", default=None)
-    q = {}
-    for k in list(qt.data):
-        if k not in plant.state_names:
-            raise qt.fail(k, qt.data[k], "a state: " + ", ".join(plant.state_names))
-        q[k] = qt.number(k, positive=True, hi=1e12, what="quantisation step")
-    qt.finish()
+    q = _keyed_numbers(t.table("quantisation", default=None), plant.state_names,
+                       "a state: " + ", ".join(plant.state_names), positive=True, hi=1e12,
+                       what="quantisation step")
     t.finish()
     return SampledSpec(period, q)
 

@@ -37,15 +37,14 @@ def _step(spec, sc, dt) -> float:
     """``--dt`` checked: a step of the scenario's horizon of which the delay
     and the control period are whole multiples (as the design's own)."""
     from ...errors import DesignError
-    from . import MAX_STEPS
+    from . import MAX_STEPS, whole_steps
     if dt is None:
         return sc.dt
     ok = isinstance(dt, float) and math.isfinite(dt) and 0 < dt <= sc.t_end / 10 \
         and sc.t_end / dt <= MAX_STEPS
     for what, v in (("the delay h", spec.h),
                     ("the control period", spec.sampled.period if spec.sampled else 0.0)):
-        k = v / dt if ok else 0.0
-        if ok and v and not abs(k - round(k)) <= 1e-9 * max(k, 1.0):
+        if ok and v and not whole_steps(v, dt):
             raise DesignError("<cli>", "--dt", dt, f"a step of which {what} {v:g} s is a "
                               "whole multiple")
     if not ok:

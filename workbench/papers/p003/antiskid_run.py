@@ -12,28 +12,38 @@ the Monte Carlo part is :mod:`workbench.papers.p003.antiskid_montecarlo` and
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import DesignError
 from ...features.cli_plumbing import pick_case, trajectory_csv
+from ...features.comfort import COMFORT_QUANTITIES, comfort_of, comfort_quantities
 from ...features.convergence import agree
 from ...features.frozen_loop import freeze
 from ...features.linear_delay_check import LinearDelayCheck, linear_delay_check
+from ...features.quantities import Declared, Group, names, values
 from ...jsonable import OMIT, json_method
 from ...margins import DelayMargin
 from ...reader import Reader
 from ...sim.delay import SimResult
-from ...sim.wheel_slip import PARAM_ORDER, model_functions
+from ...sim.wheel_slip import model_functions
+from .antiskid_basin_run import basin_quantities, basin_quantity_names, run_basin
+from .antiskid_halving import halving_quantities, halving_quantity_names, start_halving
+from .antiskid_montecarlo import (_dmu_traction, montecarlo_quantities,
+                                  montecarlo_quantity_names, start_streaming, start_sweep, sweep)
+from .antiskid_refine import (quarter_cases, refine_levels, three_level_metrics,
+                              unconverged_reason)
 from .antiskid_run_spec import (METRICS, Case, RunSpec, case_mesh, case_metrics,
                                 controller_settings, gain_for, load_run_spec, nominal_cruise,
-                                plant_values, run_settings)
+                                plant_values, run_settings, sampled_context)
+from .antiskid_sampled import run_sampled, sampled_quantities, sampled_quantity_names
 from .antiskid_scenario import simulate_antiskid
 
 #: Record step (s) of the runs (figures, comfort) at dt and dt / 2.
 RECORD_DT = 0.05
+
 
 @dataclass(frozen=True)
 class SwitchCheck:
@@ -83,6 +93,7 @@ class RunResult:
     halving: object = None      # antiskid_halving.HalvingCheck or None
     basin: object = None        # antiskid_basin_run.BasinResult or None
     sampled: object = None      # antiskid_sampled.SampledResult or None
+    spec: RunSpec | None = None  # the design's (the quantities expand from it)
 
     def case(self, name: str) -> CaseResult:
         return next(c for c in self.cases if c.case.name == name)
@@ -110,16 +121,8 @@ def switch_check(cs: ControllerSettings, v: float, lam: float) -> SwitchCheck:
     gain = rhs(np.array([v, lam]))[1]
     Ad = gain * np.array([[0.0], [1.0]]) @ np.array([cs.K])
     fl = freeze(lambda x: rhs(x)[0], (v, lam), (1e-4 * max(v, 1.0), 1e-7), Ad)
-    return SwitchCheck(v, lam, float(_dmu(cs.params)(lam)), fl.A, fl.abscissa, fl.margin)
-
-
-def _dmu(params):
-    import sympy as sp
-    from ...plants.adhesion import adhesion_model
-    mdl = adhesion_model()
-    vals = dict(zip(PARAM_ORDER, params))
-    from ...plants.lambdify_cache import lambdify
-    return lambdify(mdl.lam, mdl.substitute(sp.diff(mdl.mu_traction, mdl.lam), vals), "math")
+    return SwitchCheck(v, lam, float(_dmu_traction()(lam, *cs.params)), fl.A, fl.abscissa,
+                       fl.margin)
 
 
 def linear_check(spec: RunSpec, A, B, K) -> LinearDelayCheck:
@@ -191,37 +194,25 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     import json
     from pathlib import Path
 
-    from ...features.cli_plumbing import check_scheduler, check_sweep_flags, sweep_errors
-    from ...features.montecarlo_chunks import check_resume
+    from ...features.cli_plumbing import check_sweep_flags, run_sweep
     from ...report.markdown import Figure
-    from .antiskid_montecarlo import sweep
+    from .antiskid_kernel import KERNELS, compiled_available
     from .antiskid_montecarlo_render import draw_histograms, summary_tables
     check_sweep_flags(samples, workers)
     if design.spec.montecarlo is None:
         raise DesignError(design.path, "montecarlo", "<missing>",
                           "an antiskid-run design with a [montecarlo] table")
-    from .antiskid_kernel import KERNELS, compiled_available
     if kernel is not None and kernel not in KERNELS:
         raise DesignError("<cli>", "--kernel", kernel, " or ".join(KERNELS))
     if kernel == "compiled" and not compiled_available():
         raise DesignError("<cli>", "--kernel", kernel,
                           "numpy here: numba is not installed "
                           "(pip install 'traincontrol-workbench[fast]')")
-    check_scheduler(scheduler)
-    check_resume(out, resume)
-    with sweep_errors(out, scheduler):
-        if out:
-            from .antiskid_montecarlo import start_streaming
-            try:
-                pending = start_streaming(design, samples, seed, out, resume=resume,
-                                          workers=workers, kernel=kernel, scheduler=scheduler)
-            except FileExistsError as e:
-                raise DesignError("<cli>", "--out", out, f"a new folder or --resume ({e})") \
-                    from None
-            res = pending.result(progress=not as_json)
-        else:
-            res = sweep(design, samples, seed, workers=workers, kernel=kernel,
-                        progress=not as_json, scheduler=scheduler)
+    res = run_sweep(lambda: sweep(design, samples, seed, workers=workers, kernel=kernel,
+                                  progress=not as_json, scheduler=scheduler),
+                    lambda: start_streaming(design, samples, seed, out, resume=resume,
+                                            workers=workers, kernel=kernel, scheduler=scheduler),
+                    out=out, resume=resume, scheduler=scheduler, progress=not as_json)
     if figure:
         from ...report.figures import save_figure
         save_figure(Figure(Path(figure).stem, "Monte Carlo histograms",
@@ -240,6 +231,79 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     return 0
 
 
+def _num(x):
+    """A value, None when not determined (None or nan)."""
+    return None if x is None or (isinstance(x, float) and math.isnan(x)) else x
+
+
+def _cases(spec):
+    return [{"c": c.name} for c in spec.cases]
+
+
+def _case_metrics(spec):
+    return [{"c": c.name, "m": m, "unit": u} for c in spec.cases for m, u in METRICS.items()]
+
+
+def _factors(spec):
+    return [{"f": f"{f:g}", "fac": f} for f in spec.linear.factors]
+
+
+def _switch(r, c, field):
+    sw = r.case(c).switch
+    return None if sw is None else sw.margin.h if field == "margin" else getattr(sw, field)
+
+
+def _of(f, x) -> dict:
+    """``f(x)``, no quantity when the part ``x`` did not run (None)."""
+    return {} if x is None else f(x)
+
+
+def _comfort_values(r) -> dict:
+    return {k: v for c in r.cases if c.comfort is not None for k, v in comfort_quantities(
+        c.case.name, c.comfort, c.comfort_coarse, None if c.quarter is None else c.quarter[2]
+    ).items()}
+
+
+#: Every claimable quantity of an ``antiskid-run`` design (:mod:`workbench.features.quantities`).
+TABLE = (
+    Declared("operating_point.lambda_opt", "1", lambda r: r.lambda_opt),
+    Declared("operating_point.lambda_d", "1", lambda r: r.lambda_d),
+    Declared("gain.K1", "1/m", lambda r: r.K[0]),      # u~ (1/s) per speed error (m/s)
+    Declared("gain.K2", "1/s", lambda r: r.K[1]),      # per creep-ratio error
+    Declared("gain.h_certified", "s", lambda r: r.h_certified),
+    Declared("linear.finite.h_star", "s", lambda r: r.linear.finite_margin.h),
+    Declared("linear.paper.exact_margin", "s", lambda r: r.linear.margin.h),
+    Declared("linear.paper.max_envelope_ratio", "1",
+             lambda r: max(x for _, x in r.linear.ratios)),
+    Declared("linear.finite.ratio[{f}]", "1", lambda r, f, fac: next(
+        (x for g, _, x in r.linear.ratios_finite if g == fac), None), over=_factors),
+    Declared("cases[{c}].{m}", "{unit}", lambda r, c, m, unit: _num(r.case(c).metrics[m]),
+             over=_case_metrics),
+    Declared("cases[{c}].diverged", "", lambda r, c: "no" if math.isnan(
+        r.case(c).metrics["t_diverged"]) else "yes", over=_cases),
+    Declared("cases[{c}].stopped", "", lambda r, c: "yes" if math.isfinite(
+        r.case(c).metrics["braking_duration"]) else "no", over=_cases),
+    Declared("cases[{c}].converged", "", lambda r, c: None if r.case(c).quarter is None
+             or r.case(c).unconverged else "yes", over=_cases),
+    *(Declared(f"cases[{{c}}].switch.{f}", u, lambda r, c, f=f: _switch(r, c, f), over=_cases)
+      for f, u in (("abscissa", "1/s"), ("margin", "s"), ("dmu_dlam", "1"))),
+    Group(lambda spec: {f"cases[{c.name}].{k}" for c in spec.cases for k in COMFORT_QUANTITIES},
+          _comfort_values, present=lambda spec: spec.comfort is not None),
+    Group(lambda spec: montecarlo_quantity_names(),
+          lambda r: _of(montecarlo_quantities, r.montecarlo),
+          present=lambda spec: spec.montecarlo is not None),
+    Group(lambda spec: halving_quantity_names(), lambda r: _of(halving_quantities, r.halving),
+          present=lambda spec: spec.montecarlo is not None and bool(spec.montecarlo.halving)),
+    Group(lambda spec: basin_quantity_names([c.name for c in spec.cases], True),
+          lambda r: _of(lambda b: basin_quantities(b.basin, b.sweep, [c.case.name for c in
+                                                                         r.cases], b.brake),
+                        r.basin), present=lambda spec: spec.basin is not None),
+    Group(lambda spec: sampled_quantity_names(spec.sampled),
+          lambda r: _of(sampled_quantities, r.sampled),
+          present=lambda spec: spec.sampled is not None),
+)
+
+
 class AntiskidRun:
     kind = "antiskid-run"
     #: Findings' metrics refined three levels (issue 33, item 4) by :meth:`refine_levels`.
@@ -248,7 +312,6 @@ class AntiskidRun:
     def refine_levels(self, design, result, findings) -> dict:
         """The findings' metrics at three levels of their numerical parameter
         (:func:`workbench.papers.p003.antiskid_refine.refine_levels`)."""
-        from .antiskid_refine import refine_levels
         return refine_levels(design, result, findings, quantities=self.quantities,
                              record_dt=RECORD_DT)
 
@@ -262,31 +325,7 @@ class AntiskidRun:
         return load_run_spec(root)
 
     def quantity_names(self, spec: RunSpec) -> set[str]:
-        names = {"operating_point.lambda_opt", "operating_point.lambda_d", "gain.K1", "gain.K2",
-                 "gain.h_certified", "linear.finite.h_star", "linear.paper.exact_margin",
-                 "linear.paper.max_envelope_ratio"}
-        names |= {f"linear.finite.ratio[{f:g}]" for f in spec.linear.factors}
-        for c in spec.cases:
-            b = f"cases[{c.name}]"
-            names |= {f"{b}.{m}" for m in METRICS}
-            names |= {f"{b}.diverged", f"{b}.stopped", f"{b}.converged",
-                      f"{b}.switch.abscissa", f"{b}.switch.margin", f"{b}.switch.dmu_dlam"}
-            if spec.comfort is not None:
-                from ...features.comfort import COMFORT_QUANTITIES
-                names |= {f"{b}.{k}" for k in COMFORT_QUANTITIES}
-        if spec.montecarlo is not None:
-            from .antiskid_halving import halving_quantity_names
-            from .antiskid_montecarlo import montecarlo_quantity_names
-            names |= montecarlo_quantity_names()
-            if spec.montecarlo.halving:
-                names |= halving_quantity_names()
-        if spec.basin is not None:
-            from .antiskid_basin_run import basin_quantity_names
-            names |= basin_quantity_names([c.name for c in spec.cases], True)
-        if spec.sampled is not None:
-            from .antiskid_sampled import sampled_quantity_names
-            names |= sampled_quantity_names(spec.sampled)
-        return names
+        return names(TABLE, spec)
 
     def start(self, design):
         """Start the Monte Carlo part of :meth:`run` (its process pools) now,
@@ -295,8 +334,6 @@ class AntiskidRun:
         spec: RunSpec = design.spec
         if spec.montecarlo is None:
             return None
-        from .antiskid_halving import start_halving
-        from .antiskid_montecarlo import start_sweep
         K = gain_for(spec)[0]
         ms = spec.montecarlo
         pending = start_sweep(design, ms.samples, ms.seed, workers=ms.workers,
@@ -317,13 +354,10 @@ class AntiskidRun:
             started = self.start(design)
         pending, halving = started or (None, None)
         try:
-            from .antiskid_refine import quarter_cases
             cases = self._cases(spec, K, quarter_cases(design))
             lc = linear_check(spec, lin.A, lin.B, K)
             sampled = None
             if spec.sampled is not None:
-                from .antiskid_run_spec import sampled_context
-                from .antiskid_sampled import run_sampled
                 sampled = run_sampled(spec.sampled, sampled_context(spec, K), spec.dt)
         except BaseException:
             for p in (pending, halving):
@@ -332,13 +366,12 @@ class AntiskidRun:
             raise
         mc = None if pending is None else pending.result()
         hc = None if halving is None else halving.result()(mc)
-        from .antiskid_basin_run import run_basin
         bs = None if spec.basin is None else run_basin(
             spec.basin, plant_values(spec), spec.scenario["v_d"], K, nominal.lambda_opt(), cases,
             spec.mass_factor, profile=controller_settings(spec, K, spec.cases[0]).profile,
             k_de=spec.k_de)
         return RunResult(nominal.lambda_opt(), lam_d, tuple(K), how, h_cert, tuple(cases), lc,
-                         spec.dt, mc, hc, bs, sampled)
+                         spec.dt, mc, hc, bs, sampled, spec)
 
     def _cases(self, spec: RunSpec, K, quarter: frozenset = frozenset()) -> list[CaseResult]:
         cases = []
@@ -362,13 +395,11 @@ class AntiskidRun:
                 sw = switch_check(cs, fine[f"v_at_{key}"], fine[f"lam_at_{key}"])
             comfort = (None, None)
             if spec.comfort is not None:
-                from ...features.comfort import comfort_of
                 u_peak = cs.u_range / spec.torque_range
                 comfort = tuple(comfort_of(r, spec.comfort, u_peak, RECORD_DT)
                                 for r in (run2, run1) + ((q4[1],) if q4 else ()))
             bad, why = (), ""
             if q4 is not None:
-                from .antiskid_refine import three_level_metrics, unconverged_reason
                 conv, bad = three_level_metrics(spec, coarse, fine, q4[0])
                 why = unconverged_reason(spec, case.name, coarse, fine, q4[0], bad)
                 q4 = (q4[0], q4[1], comfort[2] if spec.comfort is not None else None)
@@ -377,43 +408,9 @@ class AntiskidRun:
         return cases
 
     def quantities(self, res: RunResult) -> dict:
-        nan2none = lambda x: None if x is None or (isinstance(x, float) and math.isnan(x)) else x
-        q = {"operating_point.lambda_opt": res.lambda_opt, "operating_point.lambda_d": res.lambda_d,
-             "gain.K1": res.K[0], "gain.K2": res.K[1], "gain.h_certified": res.h_certified,
-             "linear.finite.h_star": res.linear.finite_margin.h,
-             "linear.paper.exact_margin": res.linear.margin.h,
-             "linear.paper.max_envelope_ratio": max(r for _, r in res.linear.ratios)}
-        for fac, _, r in res.linear.ratios_finite:
-            q[f"linear.finite.ratio[{fac:g}]"] = r
-        for c in res.cases:
-            b = f"cases[{c.case.name}]"
-            for k in METRICS:
-                q[f"{b}.{k}"] = nan2none(c.metrics[k])
-            q[f"{b}.diverged"] = "no" if math.isnan(c.metrics["t_diverged"]) else "yes"
-            q[f"{b}.stopped"] = "yes" if math.isfinite(c.metrics["braking_duration"]) else "no"
-            q[f"{b}.converged"] = (None if c.quarter is None or c.unconverged else "yes")
-            sw = c.switch
-            q[f"{b}.switch.abscissa"] = None if sw is None else sw.abscissa
-            q[f"{b}.switch.margin"] = None if sw is None else sw.margin.h
-            q[f"{b}.switch.dmu_dlam"] = None if sw is None else sw.dmu_dlam
-            if c.comfort is not None:
-                from ...features.comfort import comfort_quantities
-                q.update(comfort_quantities(c.case.name, c.comfort, c.comfort_coarse,
-                                            None if c.quarter is None else c.quarter[2]))
-        if res.montecarlo is not None:
-            from .antiskid_halving import halving_quantities
-            from .antiskid_montecarlo import montecarlo_quantities
-            q.update(montecarlo_quantities(res.montecarlo))
-            if res.halving is not None:
-                q.update(halving_quantities(res.halving))
-        if res.basin is not None:
-            from .antiskid_basin_run import basin_quantities
-            q.update(basin_quantities(res.basin.basin, res.basin.sweep,
-                                      [c.case.name for c in res.cases], res.basin.brake))
-        if res.sampled is not None:
-            from .antiskid_sampled import sampled_quantities
-            q.update(sampled_quantities(res.sampled))
-        return q
+        """The values of :data:`TABLE` for the cases ``res`` holds (all of the
+        design's, or one: :func:`~workbench.papers.p003.antiskid_refine.refine_levels`)."""
+        return values(TABLE, replace(res.spec, cases=tuple(c.case for c in res.cases)), res)
 
 
 STUDY = AntiskidRun()
