@@ -2,9 +2,12 @@
 error-grid map (:mod:`workbench.kinds.stop_accuracy.grid_map`: a panel per
 speed and third-factor value plus the colour bar, every cell's signed error
 printed, infeasible cells marked, large errors in white), the bars of the
-stop error per case (:func:`workbench.kinds.stop_accuracy.render.plot_case_bars`)
-and the speed-distance curves up to standstill
-(:func:`workbench.kinds.stop_accuracy.render.plot_speed_distance`)."""
+stop error per case (:func:`workbench.kinds.stop_accuracy.render.plot_case_bars`),
+the speed-distance curves up to standstill
+(:func:`workbench.kinds.stop_accuracy.render.plot_speed_distance`), the sweep of a
+constant (:func:`~workbench.kinds.stop_accuracy.render.plot_constant_sweep`), the
+samples of stop errors (:mod:`workbench.kinds.stop_accuracy.error_samples`) and the
+``ANALYSIS`` object built from a toy table (:mod:`workbench.kinds.stop_accuracy.analysis`)."""
 from __future__ import annotations
 
 import matplotlib
@@ -62,3 +65,51 @@ def test_toy_speed_distance_stops_at_standstill():
     assert list(line.get_ydata()) == [18.0, 10.8, 3.6]          # km/h
     assert [t.get_text() for t in a.get_legend().get_texts()] == ["x", "y"]
     assert (a.get_title(), b.get_title()) == ("A", "B") and len(b.get_lines()) == 2  # + D line
+
+
+def test_toy_constant_sweep_one_line_per_speed():
+    from workbench.kinds.stop_accuracy.render import plot_constant_sweep
+    ax = Figure().add_subplot(111)
+    sweep = [(2.0, 50.0, 0.4), (1.0, 50.0, -0.1), (1.0, 80.0, 0.2), (2.0, 80.0, 0.9)]
+    plot_constant_sweep(ax, sweep, [50.0, 80.0], 0.3, chosen=1.5, chosen_label="chosen",
+                        xlabel="k (s)")
+    a, b = ax.get_lines()[:2]
+    assert list(a.get_xdata()) == [1.0, 2.0] and list(a.get_ydata()) == [-0.1, 0.4]  # sorted
+    assert list(b.get_ydata()) == [0.2, 0.9]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels == ["50 km/h", "80 km/h", "chosen", "±0.3 m"] and ax.get_xlabel() == "k (s)"
+
+
+def test_toy_error_samples():
+    from workbench.kinds.stop_accuracy.error_samples import (plot_abs_ecdf, plot_grouped_boxes,
+                                                             within_rows)
+    e = [-5.0, 1.0, 2.0, 40.0]
+    (row,) = within_rows([("toy", e)], 30.0)
+    assert row[:3] == ["toy", "3 / 4", "0.75"] and row[3].startswith("[")
+    assert row[4] == "34.7"                                          # 95th pct of |e|, 3 digits
+    ax = Figure().add_subplot(111)
+    plot_abs_ecdf(ax, [("a", e), ("b", [0.0])], 30.0, window_label="w", unit="cm", linthresh=1.0)
+    assert list(ax.get_lines()[0].get_xdata()) == [1.0, 2.0, 5.0, 40.0]     # |e|, sorted
+    assert ax.get_xscale() == "symlog" and ax.get_xlabel() == "|stop error| (cm)"
+    ax = Figure().add_subplot(111)
+    plot_grouped_boxes(ax, [("a", [[1.0, 2.0], [3.0, 4.0], [0.0, 1.0]]), ("b", [[0.0]] * 3)],
+                       xlabel="group", ylabel="e")
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["1", "2", "3"]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["a", "b"]
+    assert len(ax.patches) == 6                                    # a box per series and group
+
+
+def test_toy_analysis_object():
+    from types import SimpleNamespace
+
+    from workbench.features.quantities import Declared
+    from workbench.kinds.stop_accuracy.analysis import Analysis
+    table = (Declared("toy.{k}", "m", lambda r, k: r.x[k], over=lambda spec: [
+        {"k": k} for k in spec.keys]),)
+    a = Analysis(table, lambda root, spec: "read", lambda spec: SimpleNamespace(
+        spec=spec, x={k: len(k) for k in spec.keys}), lambda design, res: "rendered")
+    spec = SimpleNamespace(keys=("a", "bb"))
+    assert a.quantity_names(spec) == {"toy.a", "toy.bb"}
+    assert a.quantity_units(spec) == {"toy.a": "m", "toy.bb": "m"}
+    assert a.quantities(a.run(spec)) == {"toy.a": 1, "toy.bb": 2}
+    assert a.load(None, spec) == "read" and a.render(None, None) == "rendered"

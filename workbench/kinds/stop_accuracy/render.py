@@ -9,7 +9,7 @@ from __future__ import annotations
 from ...report.markdown import Rendered, fmt, md_table
 
 __all__ = ["distribution_table", "error_colours", "mc_cells", "mc_section", "moving",
-           "plot_case_bars", "plot_ecdf", "plot_mc_panels", "plot_speed_distance", "quantity_table", "render", "tolerance_lines"]
+           "plot_case_bars", "plot_constant_sweep", "plot_ecdf", "plot_mc_panels", "plot_speed_distance", "quantity_table", "render", "tolerance_lines"]
 
 
 def _mm(x) -> str:
@@ -351,6 +351,27 @@ def plot_case_bars(ax, cases, series, tol: float, *, linthresh: float) -> None:
     ax.set_yticklabels(list(cases), fontsize=8)
     ax.invert_yaxis()
     ax.set_xlabel(f"stop error (m, + overshoot; grey: ±{fmt(tol)} m)")
+    ax.legend(fontsize=8)
+
+
+def plot_constant_sweep(ax, sweep, speeds, tol: float, *, chosen: float, chosen_label: str,
+                        xlabel: str) -> None:
+    """The stop error (m) of :func:`.run.constant_sweep` against the constant's
+    value, a line per speed of ``speeds`` (km/h), the value ``chosen``
+    dotted, the tolerance band ``tol`` grey.
+
+    Parameters
+    ----------
+    sweep : iterable of (value, speed km/h, stop error m)
+    """
+    for k, s in enumerate(speeds):
+        pts = sorted((x, e) for x, sp, e in sweep if sp == s)
+        ax.plot([a for a, _ in pts], [b for _, b in pts], "o-", color=f"C{k}",
+                label=f"{fmt(s)} km/h")
+    ax.axvline(chosen, color="k", lw=0.8, ls=":", label=chosen_label)
+    ax.axhspan(-tol, tol, color="0.9", zorder=0, label=f"±{fmt(tol)} m")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("stop error (m, + overshoot)")
     ax.legend(fontsize=8)
 
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from ...features.montecarlo import within_rate
-from ...kinds.stop_accuracy.render import moving, plot_ecdf, quantity_table
+from ...kinds.stop_accuracy.error_samples import plot_abs_ecdf, plot_grouped_boxes, within_rows
+from ...kinds.stop_accuracy.render import moving, quantity_table
 from ...plants.brake000 import brake_model
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .station_stopping_fair_render import fair_section, figures
@@ -100,7 +100,7 @@ def render(design, res) -> Rendered:
         "the boundary layer changes little here (compare the two SMARC rows); the brake's "
         "delays and lags filter the rest before it reaches the jerk."
         + "\n\nShare of stops beyond the stopping point (overshoots): " + ", ".join(
-            f"{label(c)} {fmt(_overshoot_share(res, c, ns), 3)} %" for c in CONTROLLERS)
+            f"{label(c)} {fmt(_overshoot_share(res, c), 3)} %" for c in CONTROLLERS)
         + ": the errors are mostly a systematic overshoot, set by the air stage's delay and lag "
         "after the hand-over, not scatter."
         + f"\n\nFinal SMARC mass estimates theta_hat span [{fmt(res.theta_hat_final[0], 3)}, "
@@ -142,11 +142,7 @@ def _errors(res, c: str) -> list[float]:
 
 def _within_section(res) -> str:
     """P(|e| <= 30 cm) per controller over all sections, Wilson 95 % interval."""
-    rows = []
-    for c in CONTROLLERS:
-        k, n, p, lo, hi = within_rate(_errors(res, c), 100 * STOP_WINDOW_M)
-        rows.append([label(c), f"{k} / {n}", fmt(p, 3), f"[{fmt(lo, 3)}, {fmt(hi, 3)}]",
-                     fmt(float(np.percentile(np.abs(_errors(res, c)), 95)), 3)])
+    rows = within_rows(_series(res), 100 * STOP_WINDOW_M)
     w = fmt(STOP_WINDOW_M)
     return (f"**Stops within ±{w} m** (the usual platform-screen-door tolerance), over all "
             "sections and repeats, with the Wilson 95 % interval of the proportion:\n\n"
@@ -157,21 +153,19 @@ def _within_section(res) -> str:
             "the nominal row and the rows with known-delay compensation follow.")
 
 
+def _series(res) -> list:
+    """(label, every stop error over all sections (cm)) per controller."""
+    return [(label(c), _errors(res, c)) for c in CONTROLLERS]
+
+
 def _plot_cdf(fig, res):
-    ax = fig.add_subplot(111)
-    for k, c in enumerate(CONTROLLERS):
-        plot_ecdf(ax, np.abs(_errors(res, c)), color=f"C{k}", label=label(c))
-    ax.axvline(100 * STOP_WINDOW_M, color="k", ls="--", lw=0.8, label=f"{fmt(STOP_WINDOW_M)} m")
-    ax.set_xscale("symlog", linthresh=1.0)
-    ax.set_xlim(left=0.0)              # an |error| axis has no negative ticks
-    ax.set_xlabel("|stop error| (cm)")
-    ax.set_ylabel("fraction of stops")
-    ax.legend(fontsize=8)
+    plot_abs_ecdf(fig.add_subplot(111), _series(res), 100 * STOP_WINDOW_M,
+                  window_label=f"{fmt(STOP_WINDOW_M)} m", unit="cm", linthresh=1.0)
 
 
-def _overshoot_share(res, c: str, ns: int) -> float:
+def _overshoot_share(res, c: str) -> float:
     """Percentage of the stops of controller ``c`` beyond the stopping point."""
-    return 100 * float(np.mean([e > 0 for i in range(ns) for e in res.stats[c, i].errors]))
+    return 100 * float(np.mean([e > 0 for e in _errors(res, c)]))
 
 
 def _consistency(published) -> str:
@@ -187,24 +181,10 @@ def _consistency(published) -> str:
 
 
 def _plot_errors(fig, res):
-    ax = fig.add_subplot(111)
-    ns = len(res.sections)
-    for k, c in enumerate(CONTROLLERS):
-        data = [res.stats[c, i].errors for i in range(ns)]
-        pos = np.arange(ns) + 1 + (k - (len(CONTROLLERS) - 1) / 2) * 0.2
-        b = ax.boxplot(data, positions=pos, widths=0.17, patch_artist=True, showfliers=True,
-                       flierprops={"markersize": 2})
-        for patch in b["boxes"]:
-            patch.set_facecolor(f"C{k}")
-            patch.set_alpha(0.6)
-        ax.plot([], [], "s", color=f"C{k}", label=label(c))
-    ax.axhline(0, color="k", lw=0.6)
-    ax.set_xticks(np.arange(ns) + 1)
-    ax.set_xticklabels([str(i + 1) for i in range(ns)])
-    ax.set_xlabel("section (Table 3 order)")
-    ax.set_ylabel("stop error (cm, + overshoot)")
-    ax.legend(ncol=len(CONTROLLERS), loc="lower center", bbox_to_anchor=(0.5, 1.0),
-              fontsize=8, frameon=False)
+    plot_grouped_boxes(fig.add_subplot(111), [
+        (label(c), [res.stats[c, i].errors for i in range(len(res.sections))])
+        for c in CONTROLLERS], xlabel="section (Table 3 order)",
+        ylabel="stop error (cm, + overshoot)")
 
 
 def _plot_curves(fig, res):

@@ -36,14 +36,15 @@ import math
 from dataclasses import dataclass, replace
 from functools import cached_property
 
-from ...features.quantities import Declared, names, units, values
+from ...features.quantities import Declared, values
+from ...kinds.stop_accuracy.analysis import Analysis
 from ...kinds.stop_accuracy.quantities import feasible, mc_family
 from ...kinds.stop_accuracy.run import run, speed_key
-from ...reader import Reader
 from ...tuning.pid import Damping, damping, deceleration_loop
 from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, ELECTRIC_LOSS, FAULT_NAMES, MC_MODES,
                                     run_curves, run_horizon_sweep, run_montecarlo)
-from .closed_loop_brake_spec import Paper004, compute_worked, load, loop_values
+from .closed_loop_brake_render import render
+from .closed_loop_brake_spec import compute_worked, load, loop_values
 
 __all__ = ["ANALYSIS", "NOMINAL", "Result004", "compute_worked", "corners", "decel_damping",
            "run_grid", "TABLE"]
@@ -194,27 +195,5 @@ TABLE = (
 )
 
 
-class ClosedLoopBrake:
-    """The analysis of ``[analysis] module = "p004.closed_loop_brake"``."""
-
-    def load(self, root: Reader, spec) -> Paper004:
-        return load(root, spec)
-
-    def quantity_names(self, spec) -> set[str]:
-        return names(TABLE, spec)
-
-    def quantity_units(self, spec) -> dict[str, str]:
-        return units(TABLE, spec)
-
-    def run(self, spec) -> Result004:
-        return run_grid(spec)
-
-    def quantities(self, res: Result004) -> dict:
-        return values(TABLE, res.spec, res)
-
-    def render(self, design, res):
-        from .closed_loop_brake_render import render
-        return render(design, res)
-
-
-ANALYSIS = ClosedLoopBrake()
+#: the analysis of ``[analysis] module = "p004.closed_loop_brake"``
+ANALYSIS = Analysis(TABLE, load, run_grid, render)

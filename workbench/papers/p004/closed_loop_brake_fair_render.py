@@ -3,7 +3,8 @@ faults and Monte Carlo (pure rendering of a
 :class:`~workbench.papers.p004.closed_loop_brake.Result004`)."""
 from __future__ import annotations
 
-from ...kinds.stop_accuracy.render import mc_section, plot_case_bars, plot_mc_panels
+from ...kinds.stop_accuracy.render import (mc_section, plot_case_bars, plot_constant_sweep,
+                                           plot_mc_panels)
 from ...report.markdown import Figure, fmt, md_table
 from .closed_loop_brake_run import MC_MODES, faults
 from .closed_loop_brake_spec import loop_values
@@ -74,16 +75,9 @@ def figures(spec, res) -> tuple[Figure, ...]:
 
 
 def _plot_sweep(fig, res, spec):
-    ax = fig.add_subplot(111)
-    for k, s in enumerate(res.distance):
-        pts = sorted((tp, e) for tp, sp_, e in res.sweep if sp_ == s)
-        ax.plot([a for a, _ in pts], [b for _, b in pts], "o-", color=f"C{k}",
-                label=f"{fmt(s)} km/h")
-    ax.axvline(spec.constants['t_p'].value, color="k", lw=0.8, ls=":", label="chosen: T1 + T2")
-    ax.axhspan(-res.tolerance, res.tolerance, color="0.9", zorder=0, label=f"±{fmt(res.tolerance)} m")
-    ax.set_xlabel("ATO prediction horizon t_predict (s)")
-    ax.set_ylabel("stop error (m, + overshoot)")
-    ax.legend(fontsize=8)
+    plot_constant_sweep(fig.add_subplot(111), res.sweep, list(res.distance), res.tolerance,
+                        chosen=spec.constants["t_p"].value, chosen_label="chosen: T1 + T2",
+                        xlabel="ATO prediction horizon t_predict (s)")
 
 
 def _plot_faults(fig, res):
