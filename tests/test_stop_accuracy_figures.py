@@ -7,7 +7,11 @@ the speed-distance curves up to standstill
 (:func:`workbench.kinds.stop_accuracy.render.plot_speed_distance`), the sweep of a
 constant (:func:`~workbench.kinds.stop_accuracy.render.plot_constant_sweep`), the
 samples of stop errors (:mod:`workbench.kinds.stop_accuracy.error_samples`) and the
-``ANALYSIS`` object built from a toy table (:mod:`workbench.kinds.stop_accuracy.analysis`)."""
+``ANALYSIS`` object built from a toy table (:mod:`workbench.kinds.stop_accuracy.analysis`),
+the final approach and speed errors of recorded stops
+(:mod:`workbench.kinds.stop_accuracy.trace_figures`), the table rows of every grid corner
+(:func:`~workbench.kinds.stop_accuracy.render.corner_rows`), and the per-section tables of
+the repeats (:mod:`workbench.kinds.stop_accuracy.error_samples`)."""
 from __future__ import annotations
 
 import matplotlib
@@ -70,7 +74,7 @@ def test_toy_speed_distance_stops_at_standstill():
 def test_toy_constant_sweep_one_line_per_speed():
     from workbench.kinds.stop_accuracy.render import plot_constant_sweep
     ax = Figure().add_subplot(111)
-    sweep = [(2.0, 50.0, 0.4), (1.0, 50.0, -0.1), (1.0, 80.0, 0.2), (2.0, 80.0, 0.9)]
+    sweep = {(2.0, 50.0): 0.4, (1.0, 50.0): -0.1, (1.0, 80.0): 0.2, (2.0, 80.0): 0.9}
     plot_constant_sweep(ax, sweep, [50.0, 80.0], 0.3, chosen=1.5, chosen_label="chosen",
                         xlabel="k (s)")
     a, b = ax.get_lines()[:2]
@@ -113,3 +117,55 @@ def test_toy_analysis_object():
     assert a.quantity_units(spec) == {"toy.a": "m", "toy.bb": "m"}
     assert a.quantities(a.run(spec)) == {"toy.a": 1, "toy.bb": 2}
     assert a.load(None, spec) == "read" and a.render(None, None) == "rendered"
+
+
+def test_toy_trace_figures():
+    from workbench.kinds.stop_accuracy.render import cm
+    from workbench.kinds.stop_accuracy.trace_figures import (plot_final_approach,
+                                                             plot_speed_errors,
+                                                             plot_tracked_stops)
+    assert cm(0.1234) == "12.3" and cm(-0.0001) == "0.0"          # no negative zero
+    fig = Figure()
+    dx = np.array([-50.0, -30.0, -1.0, 0.2, 0.2])
+    v = np.array([8.0, 6.0, 1.0, 0.0, 0.0])
+    plot_final_approach(fig, [("A", [("a", dx, v, 0.2), ("b", dx - 0.5, v, -0.3)]),
+                              ("B", [("c", dx, v, 0.2)])], window=40)
+    a, b = fig.axes
+    assert list(a.get_lines()[0].get_xdata()) == [-30.0, -1.0]    # last 40 m, while moving
+    assert [t.get_text() for t in a.get_legend().get_texts()] == ["a", "b"]  # on the stop dots
+    assert list(a.get_lines()[1].get_xdata()) == [0.2] and b.get_ylabel() == ""
+    ax = Figure().add_subplot(111)
+    t = np.arange(5.0)
+    plot_speed_errors(ax, [("x", t, v, v - 0.01)])
+    assert list(ax.get_lines()[0].get_xdata()) == [0.0, 1.0, 2.0]
+    assert np.allclose(ax.get_lines()[0].get_ydata(), 1.0)             # cm/s
+    fig = Figure()
+    plot_tracked_stops(fig, [("x", t, dx, v, v - 0.02)], (dx, v), title="T")
+    a, b = fig.axes
+    assert [t.get_text() for t in a.get_legend().get_texts()] == ["x", "target"]
+    assert np.allclose(b.get_lines()[0].get_ydata(), 2.0) and b.get_title() == "T"
+
+
+def test_toy_corner_rows():
+    from types import SimpleNamespace
+
+    from workbench.kinds.stop_accuracy.render import corner_rows
+    spec = SimpleNamespace(grid=(("b", (2.0, 1.0)), ("a", (0.5,))), speeds_kmh=(50.0,),
+                           tolerance=0.3, grid_feasible="full")
+    res = SimpleNamespace(spec=spec, grid={(50.0, "full"): (-1.0, 0.1),     # corners (2,.5), (1,.5)
+                                           (50.0, "x"): (0.25, -0.125)})
+    rows = corner_rows(res, ("a", "b"), ["x"], (str, lambda b: f"b{b:g}"))
+    assert rows == [["50", "0.5", "b1", "no", "-0.125"], ["50", "0.5", "b2", "yes", "0.25"]]
+
+
+def test_toy_section_and_ride_tables():
+    from workbench.kinds.stop_accuracy.error_samples import ride_table, section_table
+    from workbench.kinds.stop_accuracy.sections import CellStats
+    cell = lambda m, j: CellStats(m, -m, 2 * m, m, j, 2 * j, 10.0 + m, 0.5, ())
+    series = [("A", [cell(1.0, 0.1), cell(3.0, 0.3)]), ("B", [cell(2.0, 0.2), cell(2.0, 0.4)])]
+    lines = section_table(series).splitlines()
+    assert lines[0].startswith("| # | A mean abs | A mean | A var | B mean abs |")
+    assert lines[2].startswith("| 1 | 1 | -1 | 2 | 2 |")
+    assert lines[-1].startswith("| all | **2** |  |  | **2** |")           # mean over sections
+    rows = ride_table(series, 12.0).splitlines()
+    assert rows[2] == "| A | 0.2 | 0.6 | 0.5 | 12 | 12 |"          # mean, max jerk; run time

@@ -1,9 +1,11 @@
 """Samples of stop errors (repeats, draws) per controller, rendered: the
 share within a stopping window with its Wilson 95 % interval, box plots per
-group (e.g. per section) and the distribution of |error| (pure rendering).
+group (e.g. per section), the distribution of |error|, and the tables of the
+per-section statistics of the repeats (pure rendering).
 
 Each takes ``series``, a sequence of ``(label, errors)`` (one per controller,
-errors in one unit, the window in the same), so a report passes its own
+errors in one unit, the window in the same) or ``(label, cells)`` (the
+:class:`~.sections.CellStats` of each section), so a report passes its own
 labels and unit.
 """
 from __future__ import annotations
@@ -11,10 +13,10 @@ from __future__ import annotations
 import numpy as np
 
 from ...features.montecarlo import within_rate
-from ...report.markdown import fmt
+from ...report.markdown import fmt, md_table
 from .render import plot_ecdf
 
-__all__ = ["plot_abs_ecdf", "plot_grouped_boxes", "within_rows"]
+__all__ = ["plot_abs_ecdf", "plot_grouped_boxes", "ride_table", "section_table", "within_rows"]
 
 
 def within_rows(series, window: float) -> list:
@@ -65,3 +67,30 @@ def plot_grouped_boxes(ax, series, *, xlabel: str, ylabel: str) -> None:
     ax.set_ylabel(ylabel)
     ax.legend(ncol=len(series), loc="lower center", bbox_to_anchor=(0.5, 1.0),
               fontsize=8, frameon=False)
+
+
+def section_table(series) -> str:
+    """Per section (a row each, numbered from 1) the mean |error|, signed mean
+    and variance of each ``(label, cells)`` of ``series``, and a last row with
+    each controller's mean over the sections of the mean |error| (bold)."""
+    rows = [[i + 1] + [fmt(x, 3) for _, cells in series
+                       for x in (cells[i].mean_abs, cells[i].mean, cells[i].var)]
+            for i in range(len(series[0][1]))]
+    rows.append(["all"] + sum(([f"**{fmt(float(np.mean([c.mean_abs for c in cells])), 3)}**",
+                                "", ""] for _, cells in series), []))
+    head = ["#"] + [f"{label} {h}" for label, _ in series for h in ("mean abs", "mean", "var")]
+    return md_table(head, rows, "r" * len(head))
+
+
+def ride_table(series, planned: float) -> str:
+    """Ride quality and time of each ``(label, cells)`` of ``series`` over the
+    sections: mean and largest |jerk|, mean command rate, mean run time, and
+    the ``planned`` braking time (s)."""
+    rows = [[label, fmt(np.mean([c.jerk_mean for c in cells]), 3),
+             fmt(np.max([c.jerk_max for c in cells]), 3),
+             fmt(np.mean([c.command_rate for c in cells]), 3),
+             fmt(np.mean([c.run_time for c in cells]), 4), fmt(planned, 4)]
+            for label, cells in series]
+    return md_table(["controller", "mean |jerk| (m/s³)", "max |jerk| (m/s³)",
+                     "mean |dc/dt| of the command (m/s³)", "mean run time (s)", "planned (s)"],
+                    rows, "lrrrrr")

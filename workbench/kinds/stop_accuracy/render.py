@@ -8,14 +8,22 @@ from __future__ import annotations
 
 from ...report.markdown import Rendered, fmt, md_table
 
-__all__ = ["distribution_table", "error_colours", "mc_cells", "mc_section", "moving",
-           "plot_case_bars", "plot_constant_sweep", "plot_ecdf", "plot_mc_panels", "plot_speed_distance", "quantity_table", "render", "tolerance_lines"]
+__all__ = ["cm", "corner_rows", "distribution_table", "error_colours", "mc_cells", "mc_section", "moving",
+           "plot_case_bars", "plot_constant_sweep", "plot_ecdf", "plot_mc_panels",
+           "plot_speed_distance", "quantity_table", "ranges_table", "render", "tolerance_lines"]
 
 
 def _mm(x) -> str:
     if x is None or x != x:
         return "no stop"
     return f"{x:+.3f}"
+
+
+def cm(x_m: float) -> str:
+    """Metres as centimetres to the millimetre (a stop error's meaningful
+    resolution); a negative zero is written 0.0."""
+    s = f"{100 * x_m:.1f}"
+    return "0.0" if s == "-0.0" else s
 
 
 def render(design, res) -> Rendered:
@@ -174,6 +182,22 @@ def _grid(spec, res) -> str:
                                                                               else "")))
 
 
+def corner_rows(res, order, controllers, ticks) -> list:
+    """Per speed and corner of ``[grid]`` (sorted by the factors' values in
+    ``order``, their names): the speed, each factor's value (written by the
+    function of ``ticks`` at its place), whether the corner is feasible
+    (``feasible_with``) and the stop error (m) of each of ``controllers``."""
+    from .quantities import feasible
+    from .run import grid_corners
+    cs, rows = grid_corners(res.spec, order), []
+    for s in res.spec.speeds_kmh:
+        ok = feasible(res, s)
+        rows += [[fmt(s)] + [w(x) for w, x in zip(ticks, cs[k])] + ["yes" if ok[k] else "no"]
+                 + [fmt(res.grid[s, c][k], 3) for c in controllers]
+                 for k in sorted(range(len(cs)), key=cs.__getitem__)]
+    return rows
+
+
 def _montecarlo(spec, res) -> str:
     m = spec.montecarlo
     dist = [[f"`{k}`", d.describe(), d.source] for k, d in m.distributions.items()]
@@ -249,6 +273,15 @@ def distribution_table(spec) -> str:
     rows = [[f"`{k}`", factor[k].what, d.describe(), factor[k].unit, d.source]
             for k, d in spec.montecarlo.distributions.items()]
     return md_table(["factor", "meaning", "distribution", "unit", "source"], rows, "lllll")
+
+
+def ranges_table(spec) -> str:
+    """The ``[repeats] ranges`` of ``spec`` (uniform draws of the repeats) with
+    each factor's meaning and unit (``[disturbances]``)."""
+    factor = {f.name: f for f in spec.factors}
+    rows = [[f"`{k}`", factor[k].what, f"[{fmt(lo)}, {fmt(hi)}]", factor[k].unit]
+            for k, lo, hi in spec.sections.ranges]
+    return md_table(["factor", "meaning", "range", "unit"], rows, "llll")
 
 
 def mc_cells(st, error) -> list:
@@ -362,10 +395,11 @@ def plot_constant_sweep(ax, sweep, speeds, tol: float, *, chosen: float, chosen_
 
     Parameters
     ----------
-    sweep : iterable of (value, speed km/h, stop error m)
+    sweep : dict
+        (value, speed km/h) -> stop error (m), as :func:`.run.constant_sweep`.
     """
     for k, s in enumerate(speeds):
-        pts = sorted((x, e) for x, sp, e in sweep if sp == s)
+        pts = sorted((x, e) for (x, sp), e in sweep.items() if sp == s)
         ax.plot([a for a, _ in pts], [b for _, b in pts], "o-", color=f"C{k}",
                 label=f"{fmt(s)} km/h")
     ax.axvline(chosen, color="k", lw=0.8, ls=":", label=chosen_label)

@@ -6,12 +6,14 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from ...kinds.stop_accuracy.error_samples import plot_abs_ecdf, plot_grouped_boxes, within_rows
-from ...kinds.stop_accuracy.render import moving, quantity_table
+from ...kinds.stop_accuracy.error_samples import (plot_abs_ecdf, plot_grouped_boxes, ride_table,
+                                                  section_table, within_rows)
+from ...kinds.stop_accuracy.render import quantity_table, ranges_table
+from ...kinds.stop_accuracy.trace_figures import plot_tracked_stops
 from ...plants.brake000 import brake_model
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .station_stopping_fair_render import fair_section, figures
-from .station_stopping_spec import CONTROLLERS, factor, gains, label, smarc_gains
+from .station_stopping_spec import CONTROLLERS, gains, label, smarc_gains
 
 
 #: Stop window of the accuracy table and figure (m): the usual platform-screen-door tolerance.
@@ -40,8 +42,6 @@ def model_section() -> str:
 
 def render(design, res) -> Rendered:
     spec = design.spec
-    urow = [[f"`{k}`", factor(spec, k).what, f"[{fmt(lo)}, {fmt(hi)}]", factor(spec, k).unit]
-            for k, lo, hi in spec.sections.ranges]
     srow = [[i + 1, s.name, fmt(s.length, 5), fmt(t, 4), s.source]
             for i, (s, t) in enumerate(zip(res.sections, res.planned_time))]
     g, pid, ref, rp = smarc_gains(spec), gains(spec, "pid"), spec.reference, spec.sections
@@ -54,7 +54,7 @@ def render(design, res) -> Rendered:
         "same uncertain plants.\n\n"
         + quantity_table("parameter", spec.params, 5)
         + "\n\nUncertainty (uniform, per repeat):\n\n"
-        + md_table(["factor", "meaning", "range", "unit"], urow, "llll")
+        + ranges_table(spec)
         + "\n\n" + md_table(["#", "section", "length (m)", "planned braking time (s)",
                              "source"], srow, "rlrrl")
         + "\n\nEvery section reaches v_max before braking, so the public data (lengths) do not "
@@ -69,32 +69,14 @@ def render(design, res) -> Rendered:
         f"{fmt(spec.dt_ctrl)} s, plant stepped at {fmt(spec.dt)} s.",
         model_section(),
     ]
-    ns = len(res.sections)
-    rows = []
-    for i in range(ns):
-        row = [i + 1]
-        for c in CONTROLLERS:
-            s = res.stats[c, i]
-            row += [fmt(s.mean_abs, 3), fmt(s.mean, 3), fmt(s.var, 3)]
-        rows.append(row)
-    rows.append(["all"] + sum(([f"**{fmt(res.overall(c), 3)}**", "", ""] for c in CONTROLLERS), []))
-    head = ["#"] + [f"{label(c)} {h}" for c in CONTROLLERS for h in ("mean abs", "mean", "var")]
-    qrow = []
-    for c in CONTROLLERS:
-        js = [res.stats[c, i].jerk_mean for i in range(ns)]
-        jm = [res.stats[c, i].jerk_max for i in range(ns)]
-        rt = [res.stats[c, i].run_time for i in range(ns)]
-        cr = [res.stats[c, i].command_rate for i in range(ns)]
-        qrow.append([label(c), fmt(np.mean(js), 3), fmt(np.max(jm), 3), fmt(np.mean(cr), 3),
-                     fmt(np.mean(rt), 4), fmt(np.mean(res.planned_time), 4)])
+    cells = [(label(c), [res.stats[c, i] for i in range(len(res.sections))])
+             for c in CONTROLLERS]
     sections.append(
         "## Stop accuracy (cf. Tables 3-4)\n\nStop error = stop position − stopping point "
         "(cm, + = overshoot), per section over the repeats: mean |error|, signed mean, "
-        "variance (cm²).\n\n" + md_table(head, rows, "r" * len(head))
+        "variance (cm²).\n\n" + section_table(cells)
         + "\n\nRide quality and time (braking phase, up to standstill):\n\n"
-        + md_table(["controller", "mean |jerk| (m/s³)", "max |jerk| (m/s³)",
-                    "mean |dc/dt| of the command (m/s³)", "mean run time (s)", "planned (s)"],
-                   qrow, "lrrrrr")
+        + ride_table(cells, np.mean(res.planned_time))
         + f"\n\nThe command rate measures chattering of the brake command. With the robust "
         f"gain eta = {fmt(g['eta'])} m/s² the switching term of eq 22 is small beside k_s z, so "
         "the boundary layer changes little here (compare the two SMARC rows); the brake's "
@@ -188,17 +170,6 @@ def _plot_errors(fig, res):
 
 
 def _plot_curves(fig, res):
-    ax1, ax2 = fig.add_subplot(121), fig.add_subplot(122)
-    for k, c in enumerate(CONTROLLERS):
-        t, dx, v, _, vd = res.example[c]
-        keep = moving(v)
-        ax1.plot(dx[keep], v[keep] * 3.6, color=f"C{k}", label=label(c))
-        ax2.plot(t[keep], (v[keep] - vd[keep]) * 100, color=f"C{k}", label=label(c))
-    t, _, _, xd, vd = res.example["pid"]
-    ax1.plot(xd, vd * 3.6, "k--", lw=0.8, label="target")
-    ax1.set_xlabel("position − stopping point (m)")
-    ax1.set_ylabel("speed (km/h)")
-    ax1.legend()
-    ax2.set_xlabel("time from braking start (s)")
-    ax2.set_ylabel("speed error (cm/s)")
-    ax2.set_title("speed error (cf. fig 8)")
+    _, _, _, xd, vd = res.example["pid"]
+    plot_tracked_stops(fig, [(label(c), *(res.example[c][j] for j in (0, 1, 2, 4)))
+                             for c in CONTROLLERS], (xd, vd), title="speed error (cf. fig 8)")

@@ -3,18 +3,18 @@ faults and Monte Carlo (pure rendering of a
 :class:`~workbench.papers.p004.closed_loop_brake.Result004`)."""
 from __future__ import annotations
 
+from ...kinds.stop_accuracy.loop_damping import loop_values
 from ...kinds.stop_accuracy.render import (mc_section, plot_case_bars, plot_constant_sweep,
                                            plot_mc_panels)
 from ...report.markdown import Figure, fmt, md_table
 from .closed_loop_brake_run import MC_MODES, faults
-from .closed_loop_brake_spec import loop_values
 
 MODE_LABEL = {"ato-open": "ATO open loop", "closed": "closed loop (analogue)"}
 
 
 def retune_section(spec, res) -> str:
     """``## Retuned closed loop``: the horizon, the PID's damping, the nominal corner."""
-    p, loop = {k: q.value for k, q in spec.params.items()}, loop_values(spec)
+    p, loop = {k: q.value for k, q in spec.params.items()}, loop_values(spec, "closed")
     rows = [[fmt(s), fmt(res.stop(s), 3), fmt(res.stop(s, channel="3bit"), 3),
              fmt(res.stop(s, "ato-open"), 3)] for s in res.distance]
     d = res.damping
@@ -42,7 +42,7 @@ def retune_section(spec, res) -> str:
 
 
 def fault_text(spec) -> str:
-    loop = loop_values(spec)
+    loop = loop_values(spec, "closed")
     return ("Axle states: o = healthy, s = sliding (reads "
             f"{fmt(100 * loop['slide_ratio'])} % low), f = failed (reads 0), h = reads high (× "
             f"{fmt(loop['high_ratio'])}, e.g. a wheel diameter set too large), z = stuck at its "
