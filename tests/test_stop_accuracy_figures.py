@@ -10,8 +10,10 @@ samples of stop errors (:mod:`workbench.kinds.stop_accuracy.error_samples`) and 
 ``ANALYSIS`` object built from a toy table (:mod:`workbench.kinds.stop_accuracy.analysis`),
 the final approach and speed errors of recorded stops
 (:mod:`workbench.kinds.stop_accuracy.trace_figures`), the table rows of every grid corner
-(:func:`~workbench.kinds.stop_accuracy.render.corner_rows`), and the per-section tables of
-the repeats (:mod:`workbench.kinds.stop_accuracy.error_samples`)."""
+(:func:`~workbench.kinds.stop_accuracy.render.corner_rows`), the per-section tables of
+the repeats (:mod:`workbench.kinds.stop_accuracy.error_samples`), the map cell of a result
+(:func:`~workbench.kinds.stop_accuracy.grid_map.result_cell`) and the Monte Carlo figure
+(:func:`~workbench.kinds.stop_accuracy.render.mc_figure`)."""
 from __future__ import annotations
 
 import matplotlib
@@ -146,7 +148,7 @@ def test_toy_trace_figures():
     assert np.allclose(b.get_lines()[0].get_ydata(), 2.0) and b.get_title() == "T"
 
 
-def test_toy_corner_rows():
+def test_toy_corner_rows_and_grid_cell():
     from types import SimpleNamespace
 
     from workbench.kinds.stop_accuracy.render import corner_rows
@@ -156,6 +158,18 @@ def test_toy_corner_rows():
                                            (50.0, "x"): (0.25, -0.125)})
     rows = corner_rows(res, ("a", "b"), ["x"], (str, lambda b: f"b{b:g}"))
     assert rows == [["50", "0.5", "b1", "no", "-0.125"], ["50", "0.5", "b2", "yes", "0.25"]]
+    from workbench.kinds.stop_accuracy.grid_map import result_cell
+    cell = result_cell(res, "x", ("a", "b"))
+    assert cell(50.0, 0.5, 1.0) == (-0.125, False) and cell(50.0, 0.5, 2.0) == (0.25, True)
+
+
+def test_toy_mc_figure():
+    from workbench.kinds.stop_accuracy.render import mc_figure
+    f = mc_figure("cap", [("A", [("a", [0.1, -0.2])])], 0.3, (4.0, 3.0), unit="cm", scale=100)
+    assert (f.name, f.caption, f.size) == ("mc-stop-errors", "cap", (4.0, 3.0))
+    fig = Figure()
+    f.draw(fig)
+    assert fig.axes[0].get_xlabel() == "stop error (cm, + overshoot)"
 
 
 def test_toy_section_and_ride_tables():

@@ -6,9 +6,9 @@ cannot reach that digit except on an exact tie.
 """
 from __future__ import annotations
 
-from ...report.markdown import Rendered, fmt, md_table
+from ...report.markdown import Figure, Rendered, fmt, md_table
 
-__all__ = ["cm", "corner_rows", "distribution_table", "error_colours", "mc_cells", "mc_section", "moving",
+__all__ = ["cm", "corner_rows", "distribution_table", "error_colours", "mc_cells", "mc_figure", "mc_section", "moving",
            "plot_case_bars", "plot_constant_sweep", "plot_ecdf", "plot_mc_panels",
            "plot_speed_distance", "quantity_table", "ranges_table", "render", "tolerance_lines"]
 
@@ -321,6 +321,14 @@ def mc_section(spec, level: str, intro: str, rows, *, heads, align: str, unit: s
                                       f"mean e ({unit})", "overshoots (%)"],
                        [list(k) + mc_cells(st, error) for k, st in rows], align + "rrrrrr")
             + f"\n\n![{alt}]({{figdir}}/mc-stop-errors.png)")
+
+
+def mc_figure(caption: str, panels, tol: float, size, **kw) -> Figure:
+    """The figure ``mc-stop-errors`` that :func:`mc_section` shows:
+    :func:`plot_mc_panels` of ``panels`` (``kw``: its ``unit``, ``scale``,
+    ``linthresh``), ``size`` in inches."""
+    return Figure("mc-stop-errors", caption, lambda fig: plot_mc_panels(fig, panels, tol, **kw),
+                  size=size)
 
 
 def plot_mc_panels(fig, panels, tol: float, *, unit: str = "m", scale: float = 1.0,

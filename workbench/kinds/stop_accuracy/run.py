@@ -33,8 +33,9 @@ from .pipeline import LAW_NAMES, apply_factors, group_statistics, open_loop_dist
 
 __all__ = ["StopAccuracyResult", "compile_laws", "constant_sweep", "controller_index",
            "controller_montecarlo", "factor_traces", "grid_corners", "montecarlo_draws",
-           "montecarlo_statistics", "run", "run_sections", "section_runs", "section_statistics", "simulate_cases",
-           "simulate_runs", "stopping_points", "speed_key"]
+           "montecarlo_statistics", "run", "run_sections", "section_example", "section_runs",
+           "section_statistics", "simulate_cases", "simulate_runs", "stopping_points",
+           "speed_key"]
 
 
 def speed_key(s: float) -> str:
@@ -366,6 +367,16 @@ def section_runs(spec, laws, dt: float):
     tr, track = simulate_runs(spec, laws, dt, batch_params(base, n, over), ci, D, x0=x0, v0=v0,
                               ratio=np.ones(n), theta=theta, kappa=kappa)
     return tr, track, {"controller": ci, "section": si, "repeat": ri, "D": D}
+
+
+def section_example(spec, tr, runs, name: str, section: int = 0) -> tuple:
+    """(t (s), position - D (m), v (m/s), x_d - D (m), v_d (m/s)) of the first
+    repeat of the controller ``name`` on the section ``section`` (index) of
+    :func:`section_runs` (its ``tr`` and ``runs``), with its target."""
+    ci, si, D = runs["controller"], runs["section"], runs["D"]
+    j = int(np.flatnonzero((ci == controller_index(spec, name)) & (si == section))[0])
+    xd, vd, _ = spec.reference.braking(D[j], tr.t)
+    return tr.t, tr.x[:, j] - D[j], tr.v[:, j], xd, vd
 
 
 def section_statistics(spec, tr, runs) -> dict:

@@ -4,7 +4,7 @@ Carlo (pure rendering of a
 :class:`~workbench.papers.p000.station_stopping_run.StopResult`)."""
 from __future__ import annotations
 
-from ...kinds.stop_accuracy.render import cm, mc_section, plot_mc_panels
+from ...kinds.stop_accuracy.render import cm, mc_figure, mc_section
 from ...kinds.stop_accuracy.trace_figures import plot_final_approach, plot_speed_errors
 from ...report.markdown import Figure, fmt, md_table
 from .station_stopping_run import loop_dead_time
@@ -126,8 +126,11 @@ def figures(res) -> tuple[Figure, ...]:
             Figure("final-approach", "Final approach on the nominal plant, as in paper 000 and "
                    "with known-delay compensation.",
                    lambda fig, res=res: _plot_final(fig, res), size=(8.0, 3.6)),
-            Figure("mc-stop-errors", "Monte Carlo stop errors per controller.",
-                   lambda fig, res=res: _plot_mc(fig, res), size=(8.0, 4.0)))
+            mc_figure("Monte Carlo stop errors per controller.", [
+                (title, [(label(c), res.mc[c].errors) for c in ctls]) for title, ctls in (
+                    ("as in paper 000", UNCOMPENSATED),
+                    ("with known-delay compensation", COMPENSATED + ("smarc-comp-nogain",)))],
+                res.tolerance, (8.0, 4.0), unit="cm", scale=100, linthresh=1.0))
 
 
 def _plot_pid(fig, res):
@@ -142,11 +145,3 @@ def _plot_final(fig, res):
         (f"{how}: stop {cm(res.nominal[c].error)} cm", res.nominal[c].dx, res.nominal[c].v,
          res.nominal[c].error) for how, c in (("as in paper", plain), ("compensated", comp))])
         for name, plain, comp in laws], window=40)
-
-
-def _plot_mc(fig, res):
-    groups = (("as in paper 000", UNCOMPENSATED),
-              ("with known-delay compensation", COMPENSATED + ("smarc-comp-nogain",)))
-    plot_mc_panels(fig, [(title, [(label(c), res.mc[c].errors) for c in ctls])
-                         for title, ctls in groups], res.tolerance, unit="cm", scale=100,
-                   linthresh=1.0)

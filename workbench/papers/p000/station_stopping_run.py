@@ -17,8 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...kinds.stop_accuracy.loop_damping import pid_damping, pid_dead_time
-from .station_stopping_spec import (ABLATION, CONTROLLERS, DAMPING, MC_CONTROLLERS, VARIANTS,
-                                    controller)
+from .station_stopping_spec import ABLATION, CONTROLLERS, DAMPING, MC_CONTROLLERS, VARIANTS
 
 #: Speed errors below this (m/s; 0.18 km/h, below a speedometer's resolution) do not
 #: count as a sign change (oscillation count).
@@ -81,17 +80,12 @@ def _sign_changes(err: np.ndarray) -> int:
 
 
 def _sections(spec, laws):
-    from ...kinds.stop_accuracy.run import section_runs, section_statistics
+    from ...kinds.stop_accuracy.run import section_example, section_runs, section_statistics
     tr, track, runs = section_runs(spec, laws, spec.dt)
     cells = section_statistics(spec, tr, runs)
     ns = len(spec.sections.sections)
     stats = {(k, s): cells[s, VARIANTS[k][0]] for s in range(ns) for k in CONTROLLERS}
-    D, ci, si = runs["D"], runs["controller"], runs["section"]
-    example = {}
-    for k in CONTROLLERS:
-        j = int(np.flatnonzero((ci == spec.controllers.index(controller(spec, k))) & (si == 0))[0])
-        xd, vd, _ = spec.reference.braking(D[j], tr.t)
-        example[k] = (tr.t, tr.x[:, j] - D[j], tr.v[:, j], xd, vd)
+    example = {k: section_example(spec, tr, runs, VARIANTS[k][0]) for k in CONTROLLERS}
     planned = tuple(spec.reference.braking(s.length, tr.t[:1])[2]
                     for s in spec.sections.sections)
     th = track.smarc[VARIANTS["smarc"][0]].theta_hat
@@ -101,11 +95,12 @@ def _sections(spec, laws):
 def run_station_stops(spec) -> StopResult:
     """The per-section repeats, the nominal row (every controller) and the
     Monte Carlo (:data:`MC_CONTROLLERS`) of the design ``spec``."""
-    from ...kinds.stop_accuracy.run import compile_laws, montecarlo_statistics, simulate_cases
+    from ...kinds.stop_accuracy.run import (compile_laws, controller_index, montecarlo_statistics,
+                                            simulate_cases)
     laws = compile_laws(spec)
     stats, example, planned, theta = _sections(spec, laws)
     (speed,), L = spec.speeds_kmh, spec.distance
-    index = {k: spec.controllers.index(controller(spec, k)) for k in VARIANTS}
+    index = {k: controller_index(spec, v) for k, (v, _) in VARIANTS.items()}
     nom = list(MC_CONTROLLERS + ABLATION)
     tr, D = simulate_cases(spec, laws, spec.dt, [(speed, index[k], None, L) for k in nom])
     _, vd, t_plan = spec.reference.braking(L, tr.t)

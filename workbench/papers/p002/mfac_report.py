@@ -11,13 +11,13 @@ __all__ = ["render"]
 
 import numpy as np
 
-from ...controllers.mfac import RESET_CONDITIONS, MFACGains, frozen_ppd_poles
+from ...controllers.mfac import RESET_CONDITIONS
 from ...features.reproducible import NUDGE, RTOL, count_text
 from ...plants.train002 import latex_equations
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...tuning.pareto import TIE_REL, dominated_share
 from ...kinds.tracking import figures as F
-from ...kinds.tracking.mfac import most_sensitive
+from ...kinds.tracking.mfac import frozen_integrator, most_sensitive
 from ...kinds.tracking import render_general as G
 from ...kinds.tracking.spec import OBJECTIVES
 
@@ -154,10 +154,7 @@ def _why(spec, res) -> str:
                     + [_pct(s.by_condition[k]) for k in (*RESET_CONDITIONS, "at_limit")]
                     + [_pct(s.saturated), _span(r.mfac.reset_rate[r.mfac.reproducible])])
     integ = res.readings[0]
-    g = integ.mfac.chosen_params()
-    gains = MFACGains(g["lam"], g["rho"], g["eta"], g["mu"], g["phi1"])
-    z = frozen_ppd_poles(gains, g["phi1"], spec.Ts)
-    G = g["rho"] * g["phi1"] / (g["lam"] + g["phi1"] ** 2)
+    G, z = frozen_integrator(integ.mfac, spec.Ts)
     # a real part below 1e-9 |z| is the rounding of 2 - G Ts = 0 (G Ts = 2): printed as 0
     re = [0.0 if abs(x.real) < 1e-9 * abs(x) else x.real for x in z[:2]]
     roots = (f"{fmt(re[0], 3)} ± {fmt(abs(z[0].imag), 2)} j" if abs(z[0].imag) > 1e-6

@@ -4,8 +4,8 @@ faults and Monte Carlo (pure rendering of a
 from __future__ import annotations
 
 from ...kinds.stop_accuracy.loop_damping import loop_values
-from ...kinds.stop_accuracy.render import (mc_section, plot_case_bars, plot_constant_sweep,
-                                           plot_mc_panels)
+from ...kinds.stop_accuracy.render import (mc_figure, mc_section, plot_case_bars,
+                                           plot_constant_sweep)
 from ...report.markdown import Figure, fmt, md_table
 from .closed_loop_brake_run import MC_MODES, faults
 
@@ -70,8 +70,9 @@ def figures(spec, res) -> tuple[Figure, ...]:
                    lambda fig, res=res, spec=spec: _plot_sweep(fig, res, spec), size=(6.4, 3.6)),
             Figure("sensor-faults", "Stop error per axle-sensor case, nominal corner.",
                    lambda fig, res=res: _plot_faults(fig, res), size=(7.0, 3.8)),
-            Figure("mc-stop-errors", "Monte Carlo stop errors per speed and mode.",
-                   lambda fig, res=res: _plot_mc(fig, res), size=(7.0, 3.8)))
+            mc_figure("Monte Carlo stop errors per speed and mode.", [
+                (f"{fmt(s)} km/h", [(MODE_LABEL[m], res.mc[s, m].errors) for m in MC_MODES])
+                for s in sorted({s for s, _ in res.mc})], res.tolerance, (7.0, 3.8)))
 
 
 def _plot_sweep(fig, res, spec):
@@ -85,9 +86,3 @@ def _plot_faults(fig, res):
     plot_case_bars(fig.add_subplot(111), [f"{c} ({a})" for c, a in axles.items()],
                    [(f"{fmt(s)} km/h", [res.stop(s, fault=f) for f in axles])
                     for s in res.distance], res.tolerance, linthresh=0.3)
-
-
-def _plot_mc(fig, res):
-    plot_mc_panels(fig, [(f"{fmt(s)} km/h", [(MODE_LABEL[m], res.mc[s, m].errors)
-                                             for m in MC_MODES])
-                         for s in sorted({s for s, _ in res.mc})], res.tolerance)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ...kinds.stop_accuracy.grid_map import GridAxis, plot_grid_map
+from ...kinds.stop_accuracy.grid_map import GridAxis, plot_grid_map, result_cell
 from ...kinds.stop_accuracy.loop_damping import loop_values
 from ...kinds.stop_accuracy.quantities import feasible
 from ...kinds.stop_accuracy.render import corner_rows, plot_speed_distance, quantity_table
@@ -127,17 +127,12 @@ def _corner_details(res) -> str:
 
 
 def _plot_grid(fig, res, spec):
-    grid, cs = dict(spec.grid), res.corners()
-
-    def cell(s, fe, gr, fr):
-        k = cs.index((fe, gr, fr))
-        return res.grid(s, "closed")[k], feasible(res.kind, s)[k]
-
-    tol = res.tolerance
+    grid, tol = dict(spec.grid), res.tolerance
     plot_grid_map(
         fig, list(res.distance), GridAxis(grid["force_error"], "force error (%)",
                                           lambda f: fmt(100 * f)),
-        GridAxis(grid["gradient"], "gradient (‰, + uphill)"), GridAxis(grid["friction"]), cell,
+        GridAxis(grid["gradient"], "gradient (‰, + uphill)"), GridAxis(grid["friction"]),
+        result_cell(res.kind, CONTROLLERS["closed", "analogue"], FACTORS),
         tol, title=lambda s, fr: f"{fmt(s)} km/h, friction ×{fmt(fr)}",
         suptitle=f"closed-loop stop error (m); green: within ±{fmt(tol)} m, orange to red: "
         f"beyond it, dark red: ≥ {fmt(3 * tol)} m",
