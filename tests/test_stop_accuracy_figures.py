@@ -12,8 +12,10 @@ the final approach and speed errors of recorded stops
 (:mod:`workbench.kinds.stop_accuracy.trace_figures`), the table rows of every grid corner
 (:func:`~workbench.kinds.stop_accuracy.render.corner_rows`), the per-section tables of
 the repeats (:mod:`workbench.kinds.stop_accuracy.error_samples`), the map cell of a result
-(:func:`~workbench.kinds.stop_accuracy.grid_map.result_cell`) and the Monte Carlo figure
-(:func:`~workbench.kinds.stop_accuracy.render.mc_figure`)."""
+(:func:`~workbench.kinds.stop_accuracy.grid_map.result_cell`), the Monte Carlo figure
+(:func:`~workbench.kinds.stop_accuracy.render.mc_figure`), and the tables of the sections and
+of the repeats' ranges (:func:`~workbench.kinds.stop_accuracy.render.sections_table`,
+:func:`~workbench.kinds.stop_accuracy.render.ranges_table`)."""
 from __future__ import annotations
 
 import matplotlib
@@ -183,3 +185,17 @@ def test_toy_section_and_ride_tables():
     assert lines[-1].startswith("| all | **2** |  |  | **2** |")           # mean over sections
     rows = ride_table(series, 12.0).splitlines()
     assert rows[2] == "| A | 0.2 | 0.6 | 0.5 | 12 | 12 |"          # mean, max jerk; run time
+
+
+def test_toy_sections_and_ranges_tables():
+    from types import SimpleNamespace
+
+    from workbench.kinds.stop_accuracy.render import ranges_table, sections_table
+    sec = lambda n, L: SimpleNamespace(name=n, length=L, source="toy")
+    spec = SimpleNamespace(
+        sections=SimpleNamespace(sections=(sec("A", 1000.0), sec("B", 1500.0)),
+                                 ranges=(("mass", 0.9, 1.1),)),
+        factors=(SimpleNamespace(name="mass", what="mass ratio", unit="1"),))
+    rows = sections_table(spec, (30.0, 31.5)).splitlines()
+    assert rows[2].startswith("| 1 | A | 1000 | 30 | toy |") and rows[3].startswith("| 2 | B |")
+    assert ranges_table(spec).splitlines()[2].startswith("| `mass` | mass ratio | [0.9, 1.1] | 1 |")

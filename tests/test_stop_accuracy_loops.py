@@ -1,7 +1,9 @@
 """Damping of a stop-accuracy design's linearised loops
 (:mod:`workbench.kinds.stop_accuracy.loop_damping`) on non-paper systems: the
-speed PID of the general synthetic design, and a toy controller with the
-module ``deceleration_loop`` (with and without the predictor's dead time)."""
+speed PID of the general synthetic design (with and without the predictor's
+dead time), a toy controller with the module ``deceleration_loop``, and the
+oscillation count of a recorded error
+(:func:`~workbench.kinds.stop_accuracy.loop_damping.sign_changes`)."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -47,3 +49,9 @@ def test_deceleration_loop_of_a_toy_controller():
     got = loop_damping(toy, "c")
     assert got == damping(*deceleration_loop(0.5, 0.4, P1=0.9, T2=0.5, tau=0.2), 0.3 + 0.1)
     assert got.alpha < 0 and 0 < got.zeta <= 1
+
+
+def test_sign_changes_ignore_the_deadband():
+    from workbench.kinds.stop_accuracy.loop_damping import sign_changes
+    assert sign_changes([1.0, 0.01, -1.0, -0.5, 0.2, 0.03, -0.01], 0.05) == 2
+    assert sign_changes([0.01, -0.02, 0.03], 0.05) == 0                  # all inside the band

@@ -10,13 +10,19 @@ period and the controller's named modules:
   (:func:`~workbench.tuning.pid.deceleration_loop`), dead time T1 plus one
   control period (sample and hold, and the backward difference of the
   measured speed), through the loop's measurement filter.
+
+Its time-domain check is :func:`sign_changes` of a recorded error (a ringing
+loop changes sign often).
 """
 from __future__ import annotations
+
+import numpy as np
 
 from ...tuning.pid import Damping, damping, deceleration_loop, speed_loop
 from .run import controller_index
 
-__all__ = ["loop_damping", "loop_values", "pid_damping", "pid_dead_time", "pid_gains"]
+__all__ = ["loop_damping", "loop_values", "pid_damping", "pid_dead_time", "pid_gains",
+           "sign_changes"]
 
 
 def _controller(spec, name: str):
@@ -49,7 +55,16 @@ def loop_values(spec, name: str) -> dict:
 
 
 def loop_damping(spec, name: str) -> Damping:
-    """:class:`~workbench.tuning.pid.Damping` of the deceleration loop of the controller ``name``."""
+    """:class:`~workbench.tuning.pid.Damping` of the deceleration loop of the
+    controller ``name``."""
     p, loop = {k: q.value for k, q in spec.params.items()}, loop_values(spec, name)
     return damping(*deceleration_loop(loop["kp"], loop["ki"], P1=p["P1"], T2=p["T2"],
                                       tau=loop["tau_filter"]), p["T1"] + spec.dt_ctrl)
+
+
+def sign_changes(err, deadband: float) -> int:
+    """Sign changes of a recorded error ``err``, samples with |error| below
+    ``deadband`` ignored: the oscillation count."""
+    s = np.sign(np.where(np.abs(err) < deadband, 0.0, err))
+    s = s[s != 0]
+    return int(np.sum(s[1:] != s[:-1]))

@@ -8,9 +8,10 @@ from __future__ import annotations
 
 from ...report.markdown import Figure, Rendered, fmt, md_table
 
-__all__ = ["cm", "corner_rows", "distribution_table", "error_colours", "mc_cells", "mc_figure", "mc_section", "moving",
-           "plot_case_bars", "plot_constant_sweep", "plot_ecdf", "plot_mc_panels",
-           "plot_speed_distance", "quantity_table", "ranges_table", "render", "tolerance_lines"]
+__all__ = ["cm", "corner_rows", "distribution_table", "error_colours", "mc_cells", "mc_figure",
+           "mc_section", "moving", "plot_case_bars", "plot_constant_sweep", "plot_ecdf",
+           "plot_mc_panels", "plot_speed_distance", "quantity_table", "ranges_table", "render",
+           "sections_table", "tolerance_lines"]
 
 
 def _mm(x) -> str:
@@ -282,6 +283,15 @@ def ranges_table(spec) -> str:
     rows = [[f"`{k}`", factor[k].what, f"[{fmt(lo)}, {fmt(hi)}]", factor[k].unit]
             for k, lo, hi in spec.sections.ranges]
     return md_table(["factor", "meaning", "range", "unit"], rows, "llll")
+
+
+def sections_table(spec, planned) -> str:
+    """The ``[[sections]]`` of ``spec`` (number, name, length, source) with the
+    ``planned`` braking time (s) of each."""
+    rows = [[i + 1, s.name, fmt(s.length, 5), fmt(t, 4), s.source]
+            for i, (s, t) in enumerate(zip(spec.sections.sections, planned))]
+    return md_table(["#", "section", "length (m)", "planned braking time (s)", "source"], rows,
+                    "rlrrl")
 
 
 def mc_cells(st, error) -> list:

@@ -8,7 +8,7 @@ import sympy as sp
 
 from ...kinds.stop_accuracy.error_samples import (plot_abs_ecdf, plot_grouped_boxes, ride_table,
                                                   section_table, within_rows)
-from ...kinds.stop_accuracy.render import quantity_table, ranges_table
+from ...kinds.stop_accuracy.render import quantity_table, ranges_table, sections_table
 from ...kinds.stop_accuracy.trace_figures import plot_tracked_stops
 from ...plants.brake000 import brake_model
 from ...report.markdown import Figure, Rendered, fmt, md_table
@@ -42,8 +42,6 @@ def model_section() -> str:
 
 def render(design, res) -> Rendered:
     spec = design.spec
-    srow = [[i + 1, s.name, fmt(s.length, 5), fmt(t, 4), s.source]
-            for i, (s, t) in enumerate(zip(res.sections, res.planned_time))]
     g, pid, ref, rp = smarc_gains(spec), gains(spec, "pid"), spec.reference, spec.sections
     sections = [
         "## Problem\n\nStation stops of paper 000 (section 3.2) on the seven Beijing Line 5 "
@@ -55,8 +53,7 @@ def render(design, res) -> Rendered:
         + quantity_table("parameter", spec.params, 5)
         + "\n\nUncertainty (uniform, per repeat):\n\n"
         + ranges_table(spec)
-        + "\n\n" + md_table(["#", "section", "length (m)", "planned braking time (s)",
-                             "source"], srow, "rlrrl")
+        + "\n\n" + sections_table(spec, res.planned_time)
         + "\n\nEvery section reaches v_max before braking, so the public data (lengths) do not "
         "distinguish the sections' braking phases: they differ here only by their random "
         "draws. Controllers: PID on the speed error with the target deceleration as "
@@ -71,6 +68,7 @@ def render(design, res) -> Rendered:
     ]
     cells = [(label(c), [res.stats[c, i] for i in range(len(res.sections))])
              for c in CONTROLLERS]
+    series = [(lab, [e for c in cs for e in c.errors]) for lab, cs in cells]   # all errors, cm
     sections.append(
         "## Stop accuracy (cf. Tables 3-4)\n\nStop error = stop position − stopping point "
         "(cm, + = overshoot), per section over the repeats: mean |error|, signed mean, "
@@ -82,14 +80,14 @@ def render(design, res) -> Rendered:
         "the boundary layer changes little here (compare the two SMARC rows); the brake's "
         "delays and lags filter the rest before it reaches the jerk."
         + "\n\nShare of stops beyond the stopping point (overshoots): " + ", ".join(
-            f"{label(c)} {fmt(_overshoot_share(res, c), 3)} %" for c in CONTROLLERS)
+            f"{lab} {fmt(100 * float(np.mean([e > 0 for e in es])), 3)} %" for lab, es in series)
         + ": the errors are mostly a systematic overshoot, set by the air stage's delay and lag "
         "after the hand-over, not scatter."
         + f"\n\nFinal SMARC mass estimates theta_hat span [{fmt(res.theta_hat_final[0], 3)}, "
         f"{fmt(res.theta_hat_final[1], 3)}] (per unit of the nominal mass; > 1 absorbs the "
         "brake's under-delivery, P1 and the air gain).\n\n"
         "![stop errors]({figdir}/stop-errors.png)\n\n![curves]({figdir}/stop-curves.png)"
-        + "\n\n" + _within_section(res))
+        + "\n\n" + _within_section(series))
     sections.append(fair_section(spec, res))
     if spec.paper.published:
         prow = []
@@ -109,22 +107,23 @@ def render(design, res) -> Rendered:
                         "SMARC var printed", "ours", "source"], prow, "rrrrrrrrrrrl")
             + _consistency(spec.paper.published))
     figs = (Figure("stop-errors", "Stop-error distribution per controller and section.",
-                   lambda fig, res=res: _plot_errors(fig, res), size=(7.0, 4.0)),
+                   lambda fig: plot_grouped_boxes(
+                       fig.add_subplot(111), [(lab, [c.errors for c in cs]) for lab, cs in cells],
+                       xlabel="section (Table 3 order)", ylabel="stop error (cm, + overshoot)"),
+                   size=(7.0, 4.0)),
             Figure("stop-curves", "Speed against distance to the stopping point, section 1.",
                    lambda fig, res=res: _plot_curves(fig, res), size=(7.0, 4.0)),
             Figure("stop-error-cdf", "Distribution of |stop error| per controller.",
-                   lambda fig, res=res: _plot_cdf(fig, res), size=(7.0, 4.0))) + figures(res)
+                   lambda fig: plot_abs_ecdf(fig.add_subplot(111), series, 100 * STOP_WINDOW_M,
+                                             window_label=f"{fmt(STOP_WINDOW_M)} m", unit="cm",
+                                             linthresh=1.0), size=(7.0, 4.0))) + figures(res)
     return Rendered(tuple(sections), figs)
 
 
-def _errors(res, c: str) -> list[float]:
-    """Every stop error of controller ``c`` over all sections (cm)."""
-    return [e for i in range(len(res.sections)) for e in res.stats[c, i].errors]
-
-
-def _within_section(res) -> str:
-    """P(|e| <= 30 cm) per controller over all sections, Wilson 95 % interval."""
-    rows = within_rows(_series(res), 100 * STOP_WINDOW_M)
+def _within_section(series) -> str:
+    """P(|e| <= 30 cm) per ``(label, every stop error (cm))`` of ``series``,
+    Wilson 95 % interval."""
+    rows = within_rows(series, 100 * STOP_WINDOW_M)
     w = fmt(STOP_WINDOW_M)
     return (f"**Stops within ±{w} m** (the usual platform-screen-door tolerance), over all "
             "sections and repeats, with the Wilson 95 % interval of the proportion:\n\n"
@@ -133,21 +132,6 @@ def _within_section(res) -> str:
             + "\n\n![stop error distribution]({figdir}/stop-error-cdf.png)\n\nThese are the paper "
             "rows over the repeats' uniform ranges; the Monte Carlo over continuous distributions, "
             "the nominal row and the rows with known-delay compensation follow.")
-
-
-def _series(res) -> list:
-    """(label, every stop error over all sections (cm)) per controller."""
-    return [(label(c), _errors(res, c)) for c in CONTROLLERS]
-
-
-def _plot_cdf(fig, res):
-    plot_abs_ecdf(fig.add_subplot(111), _series(res), 100 * STOP_WINDOW_M,
-                  window_label=f"{fmt(STOP_WINDOW_M)} m", unit="cm", linthresh=1.0)
-
-
-def _overshoot_share(res, c: str) -> float:
-    """Percentage of the stops of controller ``c`` beyond the stopping point."""
-    return 100 * float(np.mean([e > 0 for e in _errors(res, c)]))
 
 
 def _consistency(published) -> str:
@@ -160,13 +144,6 @@ def _consistency(published) -> str:
     return ("\n\n**The printed tables are not mutually consistent** if Table 3 is the mean "
             "|stop error| of Table 4's runs: |mean e| ≤ mean |e| always, but " + rows
             + ". Table 3 must come from other runs (or be another statistic).")
-
-
-def _plot_errors(fig, res):
-    plot_grouped_boxes(fig.add_subplot(111), [
-        (label(c), [res.stats[c, i].errors for i in range(len(res.sections))])
-        for c in CONTROLLERS], xlabel="section (Table 3 order)",
-        ylabel="stop error (cm, + overshoot)")
 
 
 def _plot_curves(fig, res):

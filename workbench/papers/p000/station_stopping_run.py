@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...kinds.stop_accuracy.loop_damping import pid_damping, pid_dead_time
+from ...kinds.stop_accuracy.loop_damping import pid_damping, pid_dead_time, sign_changes
 from .station_stopping_spec import ABLATION, CONTROLLERS, DAMPING, MC_CONTROLLERS, VARIANTS
 
 #: Speed errors below this (m/s; 0.18 km/h, below a speedometer's resolution) do not
@@ -73,12 +73,6 @@ def loop_dead_time(spec, name: str) -> float:
     return pid_dead_time(spec, VARIANTS[name][0])
 
 
-def _sign_changes(err: np.ndarray) -> int:
-    s = np.sign(np.where(np.abs(err) < SIGN_DEADBAND, 0.0, err))
-    s = s[s != 0]
-    return int(np.sum(s[1:] != s[:-1]))
-
-
 def _sections(spec, laws):
     from ...kinds.stop_accuracy.run import section_example, section_runs, section_statistics
     tr, track, runs = section_runs(spec, laws, spec.dt)
@@ -106,7 +100,7 @@ def run_station_stops(spec) -> StopResult:
     _, vd, t_plan = spec.reference.braking(L, tr.t)
     track = tr.t < 0.8 * t_plan
     nominal = {k: NominalRun(float(tr.x_stop[j] - D[j]), tr.t, tr.x[:, j] - D[j], tr.v[:, j], vd,
-                             _sign_changes((tr.v[:, j] - vd)[track]))
+                             sign_changes((tr.v[:, j] - vd)[track], SIGN_DEADBAND))
                for j, k in enumerate(nom)}
     mcs = montecarlo_statistics(spec, laws, [(speed, index[k], None, L) for k in MC_CONTROLLERS],
                                 MC_CONTROLLERS)
