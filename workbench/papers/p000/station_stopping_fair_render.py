@@ -122,7 +122,9 @@ def _mc_part(spec, res) -> str:
 def figures(res) -> tuple[Figure, ...]:
     return (Figure("pid-speed-error", "Speed error of the nominal stop: PID as in the paper rows "
                    "(rings), damped, damped + compensation.",
-                   lambda fig, res=res: _plot_pid(fig, res), size=(7.0, 3.6)),
+                   lambda fig: plot_speed_errors(fig.add_subplot(111), [
+                       (label(c), res.nominal[c].t, res.nominal[c].v, res.nominal[c].v_d)
+                       for c in DAMPING]), size=(7.0, 3.6)),
             Figure("final-approach", "Final approach on the nominal plant, as in paper 000 and "
                    "with known-delay compensation.",
                    lambda fig, res=res: _plot_final(fig, res), size=(8.0, 3.6)),
@@ -131,11 +133,6 @@ def figures(res) -> tuple[Figure, ...]:
                     ("as in paper 000", UNCOMPENSATED),
                     ("with known-delay compensation", COMPENSATED + ("smarc-comp-nogain",)))],
                 res.tolerance, (8.0, 4.0), unit="cm", scale=100, linthresh=1.0))
-
-
-def _plot_pid(fig, res):
-    plot_speed_errors(fig.add_subplot(111), [
-        (label(c), res.nominal[c].t, res.nominal[c].v, res.nominal[c].v_d) for c in DAMPING])
 
 
 def _plot_final(fig, res):

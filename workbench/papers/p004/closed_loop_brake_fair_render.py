@@ -65,24 +65,17 @@ def monte_carlo(spec, res) -> str:
 
 
 def figures(spec, res) -> tuple[Figure, ...]:
+    axles = faults(spec)
     return (Figure("horizon-sweep", "Closed-loop stop error at the nominal corner against the "
-                   "ATO's prediction horizon.",
-                   lambda fig, res=res, spec=spec: _plot_sweep(fig, res, spec), size=(6.4, 3.6)),
+                   "ATO's prediction horizon.", lambda fig: plot_constant_sweep(
+                       fig.add_subplot(111), res.sweep, list(res.distance), res.tolerance,
+                       chosen=spec.constants["t_p"].value, chosen_label="chosen: T1 + T2",
+                       xlabel="ATO prediction horizon t_predict (s)"), size=(6.4, 3.6)),
             Figure("sensor-faults", "Stop error per axle-sensor case, nominal corner.",
-                   lambda fig, res=res: _plot_faults(fig, res), size=(7.0, 3.8)),
+                   lambda fig: plot_case_bars(
+                       fig.add_subplot(111), [f"{c} ({a})" for c, a in axles.items()],
+                       [(f"{fmt(s)} km/h", [res.stop(s, fault=f) for f in axles])
+                        for s in res.distance], res.tolerance, linthresh=0.3), size=(7.0, 3.8)),
             mc_figure("Monte Carlo stop errors per speed and mode.", [
                 (f"{fmt(s)} km/h", [(MODE_LABEL[m], res.mc[s, m].errors) for m in MC_MODES])
                 for s in sorted({s for s, _ in res.mc})], res.tolerance, (7.0, 3.8)))
-
-
-def _plot_sweep(fig, res, spec):
-    plot_constant_sweep(fig.add_subplot(111), res.sweep, list(res.distance), res.tolerance,
-                        chosen=spec.constants["t_p"].value, chosen_label="chosen: T1 + T2",
-                        xlabel="ATO prediction horizon t_predict (s)")
-
-
-def _plot_faults(fig, res):
-    axles = faults(res.spec)
-    plot_case_bars(fig.add_subplot(111), [f"{c} ({a})" for c, a in axles.items()],
-                   [(f"{fmt(s)} km/h", [res.stop(s, fault=f) for f in axles])
-                    for s in res.distance], res.tolerance, linthresh=0.3)

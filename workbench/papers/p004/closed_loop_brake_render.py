@@ -102,18 +102,15 @@ def render(design, res) -> Rendered:
                     "\n\n![curves]({figdir}/speed-distance.png)")
     sections.append(monte_carlo(spec, res))
     figs = (Figure("speed-distance", "Speed against position relative to the stopping point.",
-                   lambda fig, res=res: _plot_curves(fig, res), size=(7.0, 4.0)),
+                   lambda fig: plot_speed_distance(fig, [(f"force error {fmt(100 * fe)} %", [
+                       (f"{m} ({ch})", dx, v) for m, ch, f, dx, v in res.curves if f == fe])
+                       for fe in sorted({c[2] for c in res.curves}, reverse=True)]),
+                   size=(7.0, 4.0)),
             Figure("error-grid", "Closed-loop stop error per grid corner (analogue channel), "
                    "with the open loop for contrast.",
                    lambda fig, res=res, spec=spec: _plot_grid(fig, res, spec), size=(8.0, 5.5)),
             ) + figures(spec, res)
     return Rendered(tuple(sections), figs)
-
-
-def _plot_curves(fig, res):
-    plot_speed_distance(fig, [(f"force error {fmt(100 * fe)} %", [
-        (f"{m} ({ch})", dx, v) for m, ch, f, dx, v in res.curves if f == fe])
-        for fe in sorted({c[2] for c in res.curves}, reverse=True)])
 
 
 def _corner_details(res) -> str:
