@@ -5,10 +5,14 @@ Every stop is the kind's (:mod:`workbench.kinds.stop_accuracy.run`): the
 per-section repeats (:func:`~workbench.kinds.stop_accuracy.run.section_runs`),
 the nominal plant and the Monte Carlo
 (:func:`~workbench.kinds.stop_accuracy.run.simulate_cases`, every case
-meeting the same draws). This module adds what is paper 000's: the nominal
-row's traces and speed-error sign changes, the example stops of section 1,
-the SMARC estimates of the repeats and the damping of the PIDs' linearised
-loops (:mod:`workbench.tuning.pid`).
+meeting the same draws), and so are the example stops of section 1
+(:func:`~workbench.kinds.stop_accuracy.run.section_example`), the damping of
+the PIDs' linearised loops and the sign changes of their speed errors
+(:mod:`workbench.kinds.stop_accuracy.loop_damping`). What stays here is
+paper 000's: which runs make its rows (the paper names of
+:mod:`.station_stopping_spec`), the nominal row's tracking window (the first
+80 % of the planned braking) and dead band (:data:`SIGN_DEADBAND`), and the
+result its report and claims read (:class:`StopResult`).
 """
 from __future__ import annotations
 

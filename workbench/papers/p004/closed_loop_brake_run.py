@@ -1,13 +1,15 @@
 """Paper 004's runs (designs/closed-loop-brake-004.toml) on the
 ``stop-accuracy`` kind's general run (:func:`workbench.kinds.stop_accuracy.run.run`):
 its error grid (``[grid]``, feasibility by ``feasible_with``), its axle-sensor
-faults and the electric-brake loss (``[[faults]]``), and its Monte Carlo
-(:func:`~workbench.kinds.stop_accuracy.run.montecarlo_statistics`).
+faults and the electric-brake loss (``[[faults]]``), its Monte Carlo
+(:func:`~workbench.kinds.stop_accuracy.run.controller_montecarlo`), the
+speed-distance curves (:func:`~workbench.kinds.stop_accuracy.run.factor_traces`)
+and the horizon sweep (:func:`~workbench.kinds.stop_accuracy.run.constant_sweep`).
 
 What stays here, and why: the names its report and claims use for the modes,
-channels and faults (``ato-open``, ``3bit``, "1 sliding"), the speed-distance
-curves of two grid corners and the ATO-horizon sweep of ``[retuning]`` (runs
-of paper 004's report that the kind does not make).
+channels and faults (``ato-open``, ``3bit``, "1 sliding"), and which runs its
+report makes: the curves of two grid corners, the Monte Carlo of two modes
+(recorded every 0.5 s) and the ATO-horizon sweep of ``[retuning]``.
 """
 from __future__ import annotations
 
@@ -41,7 +43,7 @@ def faults(spec) -> dict:
 def run_curves(spec, distance: dict, force_errors) -> list:
     """(mode, channel, force error, position - D (m), speed (m/s)) of every mode
     at the first speed and each of ``force_errors`` (gradient 0, friction x1),
-    recorded every 0.5 s (:func:`~workbench.kinds.stop_accuracy.run.simulate_cases`)."""
+    recorded every 0.5 s (:func:`~workbench.kinds.stop_accuracy.run.factor_traces`)."""
     from ...kinds.stop_accuracy.run import factor_traces
     s, modes = spec.speeds_kmh[0], [k for k in CONTROLLERS if k[0] != FULL]
     tr = factor_traces(spec, [CONTROLLERS[k] for k in modes], s, distance[s], "force_error",
@@ -53,7 +55,7 @@ def run_montecarlo(spec, distance: dict) -> dict:
     """Stop statistics per (speed km/h, mode) over the Monte Carlo draws
     (analogue channel, healthy sensors; every mode and speed meets the same
     draws), the kind's Monte Carlo batch
-    (:func:`~workbench.kinds.stop_accuracy.run.montecarlo_statistics`):
+    (:func:`~workbench.kinds.stop_accuracy.run.controller_montecarlo`):
     {(speed, mode): StopStatistics}."""
     from ...kinds.stop_accuracy.run import controller_montecarlo
     st = controller_montecarlo(spec, [CONTROLLERS[m, "analogue"] for m in MC_MODES], distance,
