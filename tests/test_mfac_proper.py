@@ -110,6 +110,18 @@ def test_frozen_loop_poles_reduce_to_the_integrator_case():
     assert np.max(np.abs(frozen_loop_poles(0.2, [0.5], [1.0, -0.5]))) < 1.0
 
 
+def test_frozen_integrator_at_a_tuning_s_chosen_point():
+    """The tracking kind's diagnosis of a chosen MFAC point (a toy tuning): G
+    and the integrator roots of :func:`frozen_ppd_poles`, on the unit circle."""
+    from types import SimpleNamespace
+
+    from workbench.kinds.tracking.mfac import frozen_integrator
+    p = {"eta": 1.0, "mu": 1.0, "rho": 0.5, "lam": 1e-3, "phi1": 0.02}
+    G, z = frozen_integrator(SimpleNamespace(chosen_params=lambda: p), 0.1)
+    assert G == pytest.approx(0.5 * 0.02 / (1e-3 + 0.02 ** 2))
+    assert np.allclose(np.abs(z), 1.0) and np.prod(z) == pytest.approx(1.0)    # 0 < G Ts < 4
+
+
 # -- the two readings: DC gain -------------------------------------------------------------
 FO = dict(f=1.3, e=0.2, delay=0.3, lag=0.65, g=9.81, u_min=-5.0, u_max=25.0)
 

@@ -51,7 +51,7 @@ def test_closed_loop_reproduces_closed_loop_brake_bit_for_bit(both):
     for name, channel in (("closed", "analogue"), ("closed_3bit", "3bit")):
         assert res.grid[50.0, name] == grid.grid(50.0, "closed", channel)   # corner by corner
     from workbench.kinds.stop_accuracy.quantities import feasible
-    assert feasible(res, 50.0) == grid.feasible(50.0)            # [grid] feasible_with
+    assert feasible(res, 50.0) == feasible(grid.kind, 50.0)      # [grid] feasible_with
     assert 0 < sum(feasible(res, 50.0)) < len(grid.corners())
     ref = mc[50.0, "closed"]
     np.testing.assert_array_equal(res.mc[50.0, "closed"].errors, ref.errors)   # draw by draw

@@ -176,11 +176,6 @@ RENDERER_CONSTANTS = {
         "the horizon before the retuning (a t_predict_sweep value)",
     ("papers/p004/closed_loop_brake_fair_render.py", "0.7"):
         "paper 000's damping criterion of its PID",
-    ("papers/p004/closed_loop_brake_fair_render.py", "0.9"): "a matplotlib grey level, not text",
-    ("papers/p000/station_stopping_fair_render.py", "0.0"):
-        "how a zero is printed, not a number in prose",
-    ("papers/p000/station_stopping_fair_render.py", "-0.0"):
-        "how a zero is printed, not a number in prose",
 }
 
 

@@ -14,7 +14,7 @@ import numpy as np
 from ...report.markdown import fmt
 from .render import error_colours
 
-__all__ = ["GridAxis", "plot_grid_map"]
+__all__ = ["GridAxis", "plot_grid_map", "result_cell"]
 
 
 @dataclass(frozen=True)
@@ -74,3 +74,17 @@ def plot_grid_map(fig, speeds, rows: GridAxis, cols: GridAxis, panels: GridAxis,
                 ax.set_ylabel(rows.label)
     fig.suptitle(suptitle)
     fig.colorbar(im, cax=fig.add_subplot(gs[:, n]), extend="max", label=colorbar)
+
+
+def result_cell(res, controller: str, order):
+    """The ``cell`` of :func:`plot_grid_map` of ``controller`` in a kind's
+    result ``res`` (its ``grid`` and ``feasible_with``), the map's factors
+    being the grid's factors in ``order`` (their names)."""
+    from .quantities import feasible
+    from .run import grid_corners
+    cs = grid_corners(res.spec, order)
+
+    def cell(s, *values):
+        k = cs.index(values)
+        return res.grid[s, controller][k], feasible(res, s)[k]
+    return cell

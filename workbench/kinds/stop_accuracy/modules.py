@@ -76,6 +76,14 @@ class Reference:
         x0, v0, _ = tc.at(tc.t_brake)
         return float(x0[0]), float(v0[0])
 
+    def braking(self, D: float, t):
+        """(x_d - D, v_d) of the target of a section of length D at the times
+        ``t`` (s) from its braking start, and its planned braking time (s)."""
+        one = self.curve(np.array([D]))
+        tb = one.t_brake[0]
+        xd, vd, _ = one.at(t + tb)
+        return xd - D, vd, float(one.t_final[0] - tb)
+
 
 @dataclass(frozen=True)
 class Compensation:

@@ -6,16 +6,25 @@ cannot reach that digit except on an exact tie.
 """
 from __future__ import annotations
 
-from ...report.markdown import Rendered, fmt, md_table
+from ...report.markdown import Figure, Rendered, fmt, md_table
 
-__all__ = ["distribution_table", "error_colours", "mc_cells", "mc_section", "moving",
-           "plot_case_bars", "plot_ecdf", "plot_mc_panels", "plot_speed_distance", "quantity_table", "render", "tolerance_lines"]
+__all__ = ["cm", "corner_rows", "distribution_table", "error_colours", "mc_cells", "mc_figure",
+           "mc_section", "moving", "plot_case_bars", "plot_constant_sweep", "plot_ecdf",
+           "plot_mc_panels", "plot_speed_distance", "quantity_table", "ranges_table", "render",
+           "sections_table", "tolerance_lines"]
 
 
 def _mm(x) -> str:
     if x is None or x != x:
         return "no stop"
     return f"{x:+.3f}"
+
+
+def cm(x_m: float) -> str:
+    """Metres as centimetres to the millimetre (a stop error's meaningful
+    resolution); a negative zero is written 0.0."""
+    s = f"{100 * x_m:.1f}"
+    return "0.0" if s == "-0.0" else s
 
 
 def render(design, res) -> Rendered:
@@ -174,6 +183,22 @@ def _grid(spec, res) -> str:
                                                                               else "")))
 
 
+def corner_rows(res, order, controllers, ticks) -> list:
+    """Per speed and corner of ``[grid]`` (sorted by the factors' values in
+    ``order``, their names): the speed, each factor's value (written by the
+    function of ``ticks`` at its place), whether the corner is feasible
+    (``feasible_with``) and the stop error (m) of each of ``controllers``."""
+    from .quantities import feasible
+    from .run import grid_corners
+    cs, rows = grid_corners(res.spec, order), []
+    for s in res.spec.speeds_kmh:
+        ok = feasible(res, s)
+        rows += [[fmt(s)] + [w(x) for w, x in zip(ticks, cs[k])] + ["yes" if ok[k] else "no"]
+                 + [fmt(res.grid[s, c][k], 3) for c in controllers]
+                 for k in sorted(range(len(cs)), key=cs.__getitem__)]
+    return rows
+
+
 def _montecarlo(spec, res) -> str:
     m = spec.montecarlo
     dist = [[f"`{k}`", d.describe(), d.source] for k, d in m.distributions.items()]
@@ -251,6 +276,24 @@ def distribution_table(spec) -> str:
     return md_table(["factor", "meaning", "distribution", "unit", "source"], rows, "lllll")
 
 
+def ranges_table(spec) -> str:
+    """The ``[repeats] ranges`` of ``spec`` (uniform draws of the repeats) with
+    each factor's meaning and unit (``[disturbances]``)."""
+    factor = {f.name: f for f in spec.factors}
+    rows = [[f"`{k}`", factor[k].what, f"[{fmt(lo)}, {fmt(hi)}]", factor[k].unit]
+            for k, lo, hi in spec.sections.ranges]
+    return md_table(["factor", "meaning", "range", "unit"], rows, "llll")
+
+
+def sections_table(spec, planned) -> str:
+    """The ``[[sections]]`` of ``spec`` (number, name, length, source) with the
+    ``planned`` braking time (s) of each."""
+    rows = [[i + 1, s.name, fmt(s.length, 5), fmt(t, 4), s.source]
+            for i, (s, t) in enumerate(zip(spec.sections.sections, planned))]
+    return md_table(["#", "section", "length (m)", "planned braking time (s)", "source"], rows,
+                    "rlrrl")
+
+
 def mc_cells(st, error) -> list:
     """Stops within the tolerance, their share, its Wilson 95 % interval, the
     95th percentile of |error|, the mean error (both as ``error(m)`` writes
@@ -288,6 +331,14 @@ def mc_section(spec, level: str, intro: str, rows, *, heads, align: str, unit: s
                                       f"mean e ({unit})", "overshoots (%)"],
                        [list(k) + mc_cells(st, error) for k, st in rows], align + "rrrrrr")
             + f"\n\n![{alt}]({{figdir}}/mc-stop-errors.png)")
+
+
+def mc_figure(caption: str, panels, tol: float, size, **kw) -> Figure:
+    """The figure ``mc-stop-errors`` that :func:`mc_section` shows:
+    :func:`plot_mc_panels` of ``panels`` (``kw``: its ``unit``, ``scale``,
+    ``linthresh``), ``size`` in inches."""
+    return Figure("mc-stop-errors", caption, lambda fig: plot_mc_panels(fig, panels, tol, **kw),
+                  size=size)
 
 
 def plot_mc_panels(fig, panels, tol: float, *, unit: str = "m", scale: float = 1.0,
@@ -351,6 +402,28 @@ def plot_case_bars(ax, cases, series, tol: float, *, linthresh: float) -> None:
     ax.set_yticklabels(list(cases), fontsize=8)
     ax.invert_yaxis()
     ax.set_xlabel(f"stop error (m, + overshoot; grey: ±{fmt(tol)} m)")
+    ax.legend(fontsize=8)
+
+
+def plot_constant_sweep(ax, sweep, speeds, tol: float, *, chosen: float, chosen_label: str,
+                        xlabel: str) -> None:
+    """The stop error (m) of :func:`.run.constant_sweep` against the constant's
+    value, a line per speed of ``speeds`` (km/h), the value ``chosen``
+    dotted, the tolerance band ``tol`` grey.
+
+    Parameters
+    ----------
+    sweep : dict
+        (value, speed km/h) -> stop error (m), as :func:`.run.constant_sweep`.
+    """
+    for k, s in enumerate(speeds):
+        pts = sorted((x, e) for (x, sp), e in sweep.items() if sp == s)
+        ax.plot([a for a, _ in pts], [b for _, b in pts], "o-", color=f"C{k}",
+                label=f"{fmt(s)} km/h")
+    ax.axvline(chosen, color="k", lw=0.8, ls=":", label=chosen_label)
+    ax.axhspan(-tol, tol, color="0.9", zorder=0, label=f"±{fmt(tol)} m")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("stop error (m, + overshoot)")
     ax.legend(fontsize=8)
 
 

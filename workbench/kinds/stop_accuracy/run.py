@@ -31,9 +31,11 @@ import numpy as np
 from ...jsonable import json_method
 from .pipeline import LAW_NAMES, apply_factors, group_statistics, open_loop_distance
 
-__all__ = ["StopAccuracyResult", "compile_laws", "constant_sweep", "montecarlo_draws", "montecarlo_statistics",
-           "run", "run_sections", "section_runs", "section_statistics", "simulate_cases",
-           "simulate_runs", "stopping_points", "speed_key"]
+__all__ = ["StopAccuracyResult", "compile_laws", "constant_sweep", "controller_index",
+           "controller_montecarlo", "factor_traces", "grid_corners", "montecarlo_draws",
+           "montecarlo_statistics", "run", "run_sections", "section_example", "section_runs",
+           "section_statistics", "simulate_cases", "simulate_runs", "stopping_points",
+           "speed_key"]
 
 
 def speed_key(s: float) -> str:
@@ -62,6 +64,21 @@ class StopAccuracyResult:
                                             for (s, c), m in r.mc.items()},
                    "refinement": lambda r: {x.claim_id: x.outcome for x in r.refinement}}
     to_json = json_method
+
+
+def controller_index(spec, name: str) -> int:
+    """The index of the controller ``name`` in ``spec.controllers``."""
+    return [c.name for c in spec.controllers].index(name)
+
+
+def grid_corners(spec, order=None) -> list:
+    """Every corner of ``[grid]`` (the product of the factors' values, in the
+    order written), each a tuple of its factors' values, the factors as
+    written or in ``order`` (their names)."""
+    import itertools
+    keys = [k for k, _ in spec.grid]
+    at = [keys.index(k) for k in (order or keys)]
+    return [tuple(c[j] for j in at) for c in itertools.product(*(v for _, v in spec.grid))]
 
 
 def _law_names(spec) -> tuple:
@@ -265,7 +282,7 @@ def constant_sweep(spec, controller: str, name: str, values, distance: dict,
     distance : dict
         speed (km/h) -> the stopping point D (m) (:func:`stopping_points`).
     """
-    ctl = [c.name for c in spec.controllers].index(controller)
+    ctl = controller_index(spec, controller)
     keys = [(x, s) for s in spec.speeds_kmh for x in values]
     tr, D = simulate_cases(spec, compile_laws(spec), spec.dt,
                            [(s, ctl, None, distance[s]) for _, s in keys], dt_rec=dt_rec,
@@ -290,6 +307,30 @@ def montecarlo_statistics(spec, laws, cases, keys, dt_rec=None) -> dict:
     mc = spec.montecarlo
     tr, D = simulate_cases(spec, laws, spec.dt, cases, montecarlo_draws(spec, mc), dt_rec=dt_rec)
     return group_statistics(tr.x_stop - D, keys, mc.samples, spec.tolerance)
+
+
+def controller_montecarlo(spec, names, distance: dict, laws=None, dt_rec=None) -> dict:
+    """{(speed km/h, controller): StopStatistics} of the controllers ``names``
+    from every speed to its stopping point (``distance``: speed -> D m) over
+    the ``[montecarlo]`` draws, all meeting the same draws
+    (:func:`montecarlo_statistics`; ``laws`` of :func:`compile_laws`)."""
+    cases = [(s, c) for s in spec.speeds_kmh for c in names]
+    return montecarlo_statistics(spec, compile_laws(spec) if laws is None else laws, [
+        (s, controller_index(spec, c), None, distance[s]) for s, c in cases], cases, dt_rec=dt_rec)
+
+
+def factor_traces(spec, names, speed: float, D: float, factor: str, values,
+                  dt_rec=None) -> dict:
+    """{(value, controller): (position - D (m), speed (m/s))}: the recorded
+    stops of the controllers ``names`` from ``speed`` (km/h) to ``D`` (m) with
+    the factor ``factor`` at each of ``values`` (the others nominal), in one
+    batch (:func:`simulate_cases`)."""
+    tr, Dk = simulate_cases(spec, compile_laws(spec), spec.dt, [
+        (speed, controller_index(spec, c), None, D) for c in names],
+        {factor: np.array(values, float)}, dt_rec=dt_rec)
+    n = len(values)
+    return {(x, c): (tr.x[:, j * n + k] - Dk[j * n + k], tr.v[:, j * n + k])
+            for j, c in enumerate(names) for k, x in enumerate(values)}
 
 
 def section_runs(spec, laws, dt: float):
@@ -328,6 +369,16 @@ def section_runs(spec, laws, dt: float):
     return tr, track, {"controller": ci, "section": si, "repeat": ri, "D": D}
 
 
+def section_example(spec, tr, runs, name: str, section: int = 0) -> tuple:
+    """(t (s), position - D (m), v (m/s), x_d - D (m), v_d (m/s)) of the first
+    repeat of the controller ``name`` on the section ``section`` (index) of
+    :func:`section_runs` (its ``tr`` and ``runs``), with its target."""
+    ci, si, D = runs["controller"], runs["section"], runs["D"]
+    j = int(np.flatnonzero((ci == controller_index(spec, name)) & (si == section))[0])
+    xd, vd, _ = spec.reference.braking(D[j], tr.t)
+    return tr.t, tr.x[:, j] - D[j], tr.v[:, j], xd, vd
+
+
 def section_statistics(spec, tr, runs) -> dict:
     """{(section index, controller): CellStats} of :func:`section_runs`."""
     from .sections import batch_rates, cell_stats
@@ -356,13 +407,10 @@ def run(spec, claims=()) -> StopAccuracyResult:
               for s in spec.speeds_kmh for c in spec.controllers for f in spec.faults}
     mc = {}
     if spec.montecarlo is not None:
-        cases = [(s, i, None, D[s]) for s in spec.speeds_kmh for i in range(len(laws))]
-        mc = montecarlo_statistics(spec, laws, cases,
-                                   [(s, spec.controllers[i].name) for s, i, _, _ in cases])
+        mc = controller_montecarlo(spec, [c.name for c in spec.controllers], D, laws)
     grid = {}
     if spec.grid:
-        import itertools
-        corners = list(itertools.product(*(v for _, v in spec.grid)))
+        corners = grid_corners(spec)
         g = {k: np.array([c[j] for c in corners], float) for j, (k, _) in enumerate(spec.grid)}
         cases = [(s, i, None, D[s]) for s in spec.speeds_kmh for i in range(len(laws))]
         err, _ = _simulate(spec, laws, spec.dt, cases, draws=g)

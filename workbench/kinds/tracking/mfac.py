@@ -21,12 +21,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...controllers.mfac import RESET_CONDITIONS, MFAC, frozen_loop_poles
+from ...controllers.mfac import (RESET_CONDITIONS, MFAC, MFACGains, frozen_loop_poles,
+                                 frozen_ppd_poles)
 from ...plants.train002 import linear_model
 from ...sim.tracking import TrackingRun
 from .spec import Reading
 
-__all__ = ["PPDStats", "SENSITIVITY_KEYS", "before_stop", "frozen", "mean_before_stop",
+__all__ = ["PPDStats", "SENSITIVITY_KEYS", "before_stop", "frozen", "frozen_integrator",
+           "mean_before_stop",
            "most_sensitive", "ppd_stats", "sensitivity"]
 
 SENSITIVITY_KEYS = ("eta", "mu", "rho", "lam")
@@ -124,6 +126,17 @@ def frozen(spec, reading: Reading, v_ref: float, mg: dict, phi: float):
     den = np.polymul(den, np.r_[1.0, np.zeros(int(round(d)))])
     poles = frozen_loop_poles(G, np.trim_zeros(num[0], "f"), den)
     return G, float(np.max(np.abs(poles)))
+
+
+def frozen_integrator(tun, Ts: float) -> tuple:
+    """(G, roots) of the eq 7 law at the chosen point of an MFAC tuning ``tun``
+    with its PPD frozen at phi(1), on a sampled pure integrator
+    (:func:`~workbench.controllers.mfac.frozen_ppd_poles`: G = rho phi /
+    (lambda + phi^2); the roots multiply to 1)."""
+    g = tun.chosen_params()
+    gains = MFACGains(g["lam"], g["rho"], g["eta"], g["mu"], g["phi1"])
+    return (g["rho"] * g["phi1"] / (g["lam"] + g["phi1"] ** 2),
+            frozen_ppd_poles(gains, g["phi1"], Ts))
 
 
 def sensitivity(tun) -> dict:

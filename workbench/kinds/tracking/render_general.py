@@ -11,7 +11,8 @@ from ...report.markdown import Figure, Rendered, fmt, md_table
 from . import figures as F
 from .spec import OBJECTIVE_UNITS, OBJECTIVES
 
-__all__ = ["render", "tuning_figures"]
+__all__ = ["DOC", "LABEL", "line_figure", "pareto_links", "param_table", "params_text", "render",
+           "scale_rows", "tuning_figures"]
 
 H_TUNE = "Tuning per reading and controller"
 H_MAIN = "Chosen points on the main pair"
@@ -28,15 +29,13 @@ def _problem(spec) -> str:
     rows = [[s.name, fmt(s.route.distance, 5), fmt(s.run_time, 4), fmt(s.v_limit * 3.6, 3),
              ", ".join(f"{fmt(g)} from {fmt(x)} m" for x, g in
                        zip(s.route.grade_from, s.route.grade))] for s in secs]
-    prow = [[f"`{k}`", fmt(q.value, 5), q.unit, DOC[k], q.source] for k, q in spec.train.items()]
     return (
         "## Problem\n\nStation pairs (the first is the main pair, where the gains are tuned):"
         "\n\n" + md_table(["pair", "distance (m)", "planned (s)", "limit (km/h)",
                            "gradients"], rows, "lrrrl")
         + "\n\nTrain (`[train]`, model `delay-lag-002` of `workbench/plants/train002.py`: "
         "command → demanded acceleration → delay → lag → speed, Davis resistance and "
-        "gravity):\n\n" + md_table(["parameter", "value", "unit", "meaning", "source"], prow,
-                                    "lrlll")
+        "gravity):\n\n" + param_table(spec.train, DOC)
         + f"\n\nCommand limits {fmt(spec.u_limits[0])} … {fmt(spec.u_limits[1])}. Control "
         f"cycle Ts = {fmt(spec.Ts)} s, plant step {fmt(spec.dt)} s. Target profile: "
         f"acceleration {fmt(spec.profile['accel'])} m/s², braking "
@@ -44,26 +43,43 @@ def _problem(spec) -> str:
         "(`workbench/profiles.py`).")
 
 
-def _params(tun) -> str:
-    return ", ".join(f"{k} = {fmt(v, 3)}" for k, v in tun.chosen_params().items())
+def param_table(params: dict, doc: dict) -> str:
+    """The table of a train's ``params`` (name -> Quantity), each with its
+    meaning of ``doc``."""
+    rows = [[f"`{k}`", fmt(q.value, 5), q.unit, doc[k], q.source] for k, q in params.items()]
+    return md_table(["parameter", "value", "unit", "meaning", "source"], rows, "lrlll")
+
+
+def params_text(tun, symbol: dict | None = None) -> str:
+    """The chosen point of a tuning, each parameter by its ``symbol`` (default its name)."""
+    return ", ".join(f"{(symbol or {}).get(k, k)} = {fmt(v, 3)}"
+                     for k, v in tun.chosen_params().items())
+
+
+def scale_rows(spec) -> list:
+    """Per objective: its name, scale s_j with unit, weight w_j and the scale's source."""
+    return [[k, f"{fmt(spec.scales[k].value)} {OBJECTIVE_UNITS[k]}", fmt(w),
+             spec.scales[k].source] for k, w in zip(OBJECTIVES, spec.weights)]
+
+
+def pareto_links(res) -> str:
+    """The Markdown images of every reading's Pareto fronts."""
+    return "\n\n".join(f"![Pareto fronts, {r.reading.name}]"
+                       f"({{figdir}}/pareto-{r.reading.name}.png)" for r in res.readings)
 
 
 def _tuning(spec, res) -> str:
-    srows = [[k, f"{fmt(spec.scales[k].value)} {OBJECTIVE_UNITS[k]}", fmt(w),
-              spec.scales[k].source] for k, w in zip(OBJECTIVES, spec.weights)]
     rows = []
     for r in res.readings:
         for c, tun in r.tunings:
             pj = r.main.value(c, "peak_jerk")
             rows.append([f"`{r.reading.name}`", c, str(len(tun.cost)),
                          str(int((~tun.reproducible).sum())), str(int(tun.front.sum())),
-                         _params(tun), fmt(pj, 3), ", ".join(tun.edges) or "none"])
+                         params_text(tun), fmt(pj, 3), ", ".join(tun.edges) or "none"])
     lim = spec.peak_jerk
     con = ("No peak-jerk constraint is set." if lim is None else
            f"Comfort is a peak constraint: only runs whose jerk over any 1 s window stays "
            f"within {fmt(lim.value)} m/s³ may be chosen (when any does).")
-    figs = "\n\n".join(f"![Pareto fronts, {r.reading.name}]"
-                       f"({{figdir}}/pareto-{r.reading.name}.png)" for r in res.readings)
     return (
         f"## {H_TUNE}\n\nEvery combination of each controller's grid is simulated on the "
         "main pair. The design point is the run with the smallest weighted sum Σ w_j J_j / s_j "
@@ -72,11 +88,11 @@ def _tuning(spec, res) -> str:
         f"±{fmt(NUDGE)} (relative); a run whose objectives move by more than {fmt(RTOL)} is "
         "no result. A chosen value at the first or last of its grid is not shown to be an "
         "optimum inside the grid.\n\n"
-        + md_table(["objective", "scale s_j", "weight w_j", "source"], srows, "lrrl")
+        + md_table(["objective", "scale s_j", "weight w_j", "source"], scale_rows(spec), "lrrl")
         + "\n\n" + md_table(["reading", "controller", "runs", "not reproducible",
                              "on front", "chosen", "peak |jerk| (m/s³)",
                              "on the grid's edge in"], rows, "llrrrlrl")
-        + "\n\n" + figs + "\n\n![jerk against its limit]({figdir}/jerk.png)")
+        + "\n\n" + pareto_links(res) + "\n\n![jerk against its limit]({figdir}/jerk.png)")
 
 
 def _main(res) -> str:
@@ -115,10 +131,7 @@ def render(design, res) -> Rendered:
     """The general report of a ``tracking`` design (see the module docstring)."""
     spec = design.spec
     sections = [_problem(spec), _tuning(spec, res), _main(res), _line(res)]
-    figs = tuning_figures(spec, res)
-    if res.readings[0].line:
-        figs.append(Figure("line", "Stop error per pair.",
-                           lambda fig: F.plot_line(fig, res), (8.0, 4.0)))
+    figs = tuning_figures(spec, res) + line_figure(res, "Stop error per pair.")
     anchors = ((r"reading\[[^\]]+\]\.line", H_LINE),
                (r"reading\[[^\]]+\]\.(best|[a-z]+\.(grid_edge|front_size|peak_jerk))", H_TUNE),
                (r"reading\[[^\]]+\]\.", H_MAIN), (r"profile\.", H_MAIN))
@@ -137,3 +150,9 @@ def tuning_figures(spec, res) -> list:
                           "limit.", lambda fig: F.plot_jerk(
                               fig, res, None if spec.peak_jerk is None else spec.peak_jerk.value),
                           (8.0, 3.2))]
+
+
+def line_figure(res, caption: str) -> list:
+    """The figure of the stop error per pair (none without a line)."""
+    return [Figure("line", caption, lambda fig: F.plot_line(fig, res), (8.0, 4.0))] if (
+        res.readings[0].line) else []

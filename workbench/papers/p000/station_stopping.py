@@ -13,10 +13,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...features.quantities import Declared, names, units, values
+from ...features.quantities import Declared
+from ...kinds.stop_accuracy.analysis import Analysis
 from ...kinds.stop_accuracy.quantities import mc_family, over
 from .station_stopping_spec import (ABLATION, COMPENSATED, CONTROLLERS, DAMPING, MC_CONTROLLERS,
                                     PAPER_CONTROLLERS, UNCOMPENSATED, load)
+from .station_stopping_render import render
+from .station_stopping_run import run_station_stops
 
 __all__ = ["ANALYSIS", "StationStopping", "TABLE"]
 
@@ -77,28 +80,5 @@ TABLE = (
 )
 
 
-class StationStopping:
-    """The analysis of ``[analysis] module = "p000.station_stopping"``."""
-
-    def load(self, root, spec):
-        return load(root, spec)
-
-    def quantity_names(self, spec) -> set[str]:
-        return names(TABLE, spec)
-
-    def quantity_units(self, spec) -> dict[str, str]:
-        return units(TABLE, spec)
-
-    def run(self, spec):
-        from .station_stopping_run import run_station_stops
-        return run_station_stops(spec)
-
-    def quantities(self, res) -> dict:
-        return values(TABLE, res.spec, res)
-
-    def render(self, design, res):
-        from .station_stopping_render import render
-        return render(design, res)
-
-
-ANALYSIS = StationStopping()
+#: the analysis of ``[analysis] module = "p000.station_stopping"``
+ANALYSIS = Analysis(TABLE, load, run_station_stops, render)

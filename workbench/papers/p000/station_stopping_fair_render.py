@@ -4,7 +4,8 @@ Carlo (pure rendering of a
 :class:`~workbench.papers.p000.station_stopping_run.StopResult`)."""
 from __future__ import annotations
 
-from ...kinds.stop_accuracy.render import mc_section, moving, plot_mc_panels
+from ...kinds.stop_accuracy.render import cm, mc_figure, mc_section
+from ...kinds.stop_accuracy.trace_figures import plot_final_approach, plot_speed_errors
 from ...report.markdown import Figure, fmt, md_table
 from .station_stopping_run import loop_dead_time
 from .station_stopping_spec import (ABLATION_LAWS, COMPENSATED, DAMPING, MC_CONTROLLERS,
@@ -12,12 +13,6 @@ from .station_stopping_spec import (ABLATION_LAWS, COMPENSATED, DAMPING, MC_CONT
 
 GROUP = {**{c: "as in paper 000" for c in UNCOMPENSATED},
          **{c: "with known-delay compensation" for c in MC_CONTROLLERS if c not in UNCOMPENSATED}}
-
-
-def _cm(x_m: float) -> str:
-    """Metres as centimetres to the millimetre (a stop error's meaningful resolution)."""
-    s = f"{100 * x_m:.1f}"
-    return "0.0" if s == "-0.0" else s
 
 
 def fair_section(spec, res) -> str:
@@ -95,10 +90,10 @@ def _pid_part(spec, res) -> str:
 
 
 def _nominal_part(res) -> str:
-    rows = [[label(c), GROUP[c], _cm(res.nominal[c].error)] for c in MC_CONTROLLERS]
+    rows = [[label(c), GROUP[c], cm(res.nominal[c].error)] for c in MC_CONTROLLERS]
     arows = []
     for law, (base, pred, term, both) in ABLATION_LAWS.items():
-        arows.append([law] + [_cm(res.nominal[c].error) for c in (base, pred, term, both)])
+        arows.append([law] + [cm(res.nominal[c].error) for c in (base, pred, term, both)])
     return (
         "### Nominal plant (zero uncertainty)\n\n"
         "Every factor at its nominal value (mass as weighed, Table 1 brake, no gradient), "
@@ -121,55 +116,29 @@ def _mc_part(spec, res) -> str:
         "section reaches v_max before braking, so their braking phases are the same):",
         [((label(c), GROUP[c]), res.mc[c]) for c in MC_CONTROLLERS], heads=("controller",
                                                                          "group"),
-        align="ll", unit="cm", error=_cm, alt="Monte Carlo stop errors")
+        align="ll", unit="cm", error=cm, alt="Monte Carlo stop errors")
 
 
 def figures(res) -> tuple[Figure, ...]:
     return (Figure("pid-speed-error", "Speed error of the nominal stop: PID as in the paper rows "
                    "(rings), damped, damped + compensation.",
-                   lambda fig, res=res: _plot_pid(fig, res), size=(7.0, 3.6)),
+                   lambda fig: plot_speed_errors(fig.add_subplot(111), [
+                       (label(c), res.nominal[c].t, res.nominal[c].v, res.nominal[c].v_d)
+                       for c in DAMPING]), size=(7.0, 3.6)),
             Figure("final-approach", "Final approach on the nominal plant, as in paper 000 and "
                    "with known-delay compensation.",
                    lambda fig, res=res: _plot_final(fig, res), size=(8.0, 3.6)),
-            Figure("mc-stop-errors", "Monte Carlo stop errors per controller.",
-                   lambda fig, res=res: _plot_mc(fig, res), size=(8.0, 4.0)))
-
-
-def _plot_pid(fig, res):
-    ax = fig.add_subplot(111)
-    for k, c in enumerate(DAMPING):
-        n = res.nominal[c]
-        keep = moving(n.v)
-        ax.plot(n.t[keep], 100 * (n.v - n.v_d)[keep], color=f"C{k}", label=label(c))
-    ax.axhline(0, color="k", lw=0.6)
-    ax.set_xlabel("time from braking start (s)")
-    ax.set_ylabel("speed error v − v_d (cm/s)")
-    ax.legend(fontsize=8)
+            mc_figure("Monte Carlo stop errors per controller.", [
+                (title, [(label(c), res.mc[c].errors) for c in ctls]) for title, ctls in (
+                    ("as in paper 000", UNCOMPENSATED),
+                    ("with known-delay compensation", COMPENSATED + ("smarc-comp-nogain",)))],
+                res.tolerance, (8.0, 4.0), unit="cm", scale=100, linthresh=1.0))
 
 
 def _plot_final(fig, res):
     laws = (("PID", "pid", "pid-comp"), ("SMC", "smc", "smc-comp"),
             ("SMARC", "smarc", "smarc-comp"))
-    for i, (name, plain, comp) in enumerate(laws):
-        ax = fig.add_subplot(1, 3, i + 1)
-        for k, c in enumerate((plain, comp)):
-            n = res.nominal[c]
-            keep = (n.dx > -40) & moving(n.v)
-            ax.plot(n.dx[keep], 3.6 * n.v[keep], color=f"C{k}")
-            ax.plot([n.error], [0.0], "o", color=f"C{k}", ms=4,
-                    label=("as in paper" if k == 0 else "compensated")
-                    + f": stop {_cm(n.error)} cm")
-        ax.axvline(0, color="k", lw=0.6)
-        ax.set_xlabel("position − stopping point (m)")
-        if i == 0:
-            ax.set_ylabel("speed (km/h)")
-        ax.set_title(name, fontsize=9)
-        ax.legend(fontsize=7)
-
-
-def _plot_mc(fig, res):
-    groups = (("as in paper 000", UNCOMPENSATED),
-              ("with known-delay compensation", COMPENSATED + ("smarc-comp-nogain",)))
-    plot_mc_panels(fig, [(title, [(label(c), res.mc[c].errors) for c in ctls])
-                         for title, ctls in groups], res.tolerance, unit="cm", scale=100,
-                   linthresh=1.0)
+    plot_final_approach(fig, [(name, [
+        (f"{how}: stop {cm(res.nominal[c].error)} cm", res.nominal[c].dx, res.nominal[c].v,
+         res.nominal[c].error) for how, c in (("as in paper", plain), ("compensated", comp))])
+        for name, plain, comp in laws], window=40)

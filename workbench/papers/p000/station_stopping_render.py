@@ -6,12 +6,14 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from ...features.montecarlo import within_rate
-from ...kinds.stop_accuracy.render import moving, plot_ecdf, quantity_table
+from ...kinds.stop_accuracy.error_samples import (plot_abs_ecdf, plot_grouped_boxes, ride_table,
+                                                  section_table, within_rows)
+from ...kinds.stop_accuracy.render import quantity_table, ranges_table, sections_table
+from ...kinds.stop_accuracy.trace_figures import plot_tracked_stops
 from ...plants.brake000 import brake_model
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .station_stopping_fair_render import fair_section, figures
-from .station_stopping_spec import CONTROLLERS, factor, gains, label, smarc_gains
+from .station_stopping_spec import CONTROLLERS, gains, label, smarc_gains
 
 
 #: Stop window of the accuracy table and figure (m): the usual platform-screen-door tolerance.
@@ -40,10 +42,6 @@ def model_section() -> str:
 
 def render(design, res) -> Rendered:
     spec = design.spec
-    urow = [[f"`{k}`", factor(spec, k).what, f"[{fmt(lo)}, {fmt(hi)}]", factor(spec, k).unit]
-            for k, lo, hi in spec.sections.ranges]
-    srow = [[i + 1, s.name, fmt(s.length, 5), fmt(t, 4), s.source]
-            for i, (s, t) in enumerate(zip(res.sections, res.planned_time))]
     g, pid, ref, rp = smarc_gains(spec), gains(spec, "pid"), spec.reference, spec.sections
     sections = [
         "## Problem\n\nStation stops of paper 000 (section 3.2) on the seven Beijing Line 5 "
@@ -54,9 +52,8 @@ def render(design, res) -> Rendered:
         "same uncertain plants.\n\n"
         + quantity_table("parameter", spec.params, 5)
         + "\n\nUncertainty (uniform, per repeat):\n\n"
-        + md_table(["factor", "meaning", "range", "unit"], urow, "llll")
-        + "\n\n" + md_table(["#", "section", "length (m)", "planned braking time (s)",
-                             "source"], srow, "rlrrl")
+        + ranges_table(spec)
+        + "\n\n" + sections_table(spec, res.planned_time)
         + "\n\nEvery section reaches v_max before braking, so the public data (lengths) do not "
         "distinguish the sections' braking phases: they differ here only by their random "
         "draws. Controllers: PID on the speed error with the target deceleration as "
@@ -69,45 +66,28 @@ def render(design, res) -> Rendered:
         f"{fmt(spec.dt_ctrl)} s, plant stepped at {fmt(spec.dt)} s.",
         model_section(),
     ]
-    ns = len(res.sections)
-    rows = []
-    for i in range(ns):
-        row = [i + 1]
-        for c in CONTROLLERS:
-            s = res.stats[c, i]
-            row += [fmt(s.mean_abs, 3), fmt(s.mean, 3), fmt(s.var, 3)]
-        rows.append(row)
-    rows.append(["all"] + sum(([f"**{fmt(res.overall(c), 3)}**", "", ""] for c in CONTROLLERS), []))
-    head = ["#"] + [f"{label(c)} {h}" for c in CONTROLLERS for h in ("mean abs", "mean", "var")]
-    qrow = []
-    for c in CONTROLLERS:
-        js = [res.stats[c, i].jerk_mean for i in range(ns)]
-        jm = [res.stats[c, i].jerk_max for i in range(ns)]
-        rt = [res.stats[c, i].run_time for i in range(ns)]
-        cr = [res.stats[c, i].command_rate for i in range(ns)]
-        qrow.append([label(c), fmt(np.mean(js), 3), fmt(np.max(jm), 3), fmt(np.mean(cr), 3),
-                     fmt(np.mean(rt), 4), fmt(np.mean(res.planned_time), 4)])
+    cells = [(label(c), [res.stats[c, i] for i in range(len(res.sections))])
+             for c in CONTROLLERS]
+    series = [(lab, [e for c in cs for e in c.errors]) for lab, cs in cells]   # all errors, cm
     sections.append(
         "## Stop accuracy (cf. Tables 3-4)\n\nStop error = stop position − stopping point "
         "(cm, + = overshoot), per section over the repeats: mean |error|, signed mean, "
-        "variance (cm²).\n\n" + md_table(head, rows, "r" * len(head))
+        "variance (cm²).\n\n" + section_table(cells)
         + "\n\nRide quality and time (braking phase, up to standstill):\n\n"
-        + md_table(["controller", "mean |jerk| (m/s³)", "max |jerk| (m/s³)",
-                    "mean |dc/dt| of the command (m/s³)", "mean run time (s)", "planned (s)"],
-                   qrow, "lrrrrr")
+        + ride_table(cells, np.mean(res.planned_time))
         + f"\n\nThe command rate measures chattering of the brake command. With the robust "
         f"gain eta = {fmt(g['eta'])} m/s² the switching term of eq 22 is small beside k_s z, so "
         "the boundary layer changes little here (compare the two SMARC rows); the brake's "
         "delays and lags filter the rest before it reaches the jerk."
         + "\n\nShare of stops beyond the stopping point (overshoots): " + ", ".join(
-            f"{label(c)} {fmt(_overshoot_share(res, c, ns), 3)} %" for c in CONTROLLERS)
+            f"{lab} {fmt(100 * float(np.mean([e > 0 for e in es])), 3)} %" for lab, es in series)
         + ": the errors are mostly a systematic overshoot, set by the air stage's delay and lag "
         "after the hand-over, not scatter."
         + f"\n\nFinal SMARC mass estimates theta_hat span [{fmt(res.theta_hat_final[0], 3)}, "
         f"{fmt(res.theta_hat_final[1], 3)}] (per unit of the nominal mass; > 1 absorbs the "
         "brake's under-delivery, P1 and the air gain).\n\n"
         "![stop errors]({figdir}/stop-errors.png)\n\n![curves]({figdir}/stop-curves.png)"
-        + "\n\n" + _within_section(res))
+        + "\n\n" + _within_section(series))
     sections.append(fair_section(spec, res))
     if spec.paper.published:
         prow = []
@@ -127,26 +107,23 @@ def render(design, res) -> Rendered:
                         "SMARC var printed", "ours", "source"], prow, "rrrrrrrrrrrl")
             + _consistency(spec.paper.published))
     figs = (Figure("stop-errors", "Stop-error distribution per controller and section.",
-                   lambda fig, res=res: _plot_errors(fig, res), size=(7.0, 4.0)),
+                   lambda fig: plot_grouped_boxes(
+                       fig.add_subplot(111), [(lab, [c.errors for c in cs]) for lab, cs in cells],
+                       xlabel="section (Table 3 order)", ylabel="stop error (cm, + overshoot)"),
+                   size=(7.0, 4.0)),
             Figure("stop-curves", "Speed against distance to the stopping point, section 1.",
                    lambda fig, res=res: _plot_curves(fig, res), size=(7.0, 4.0)),
             Figure("stop-error-cdf", "Distribution of |stop error| per controller.",
-                   lambda fig, res=res: _plot_cdf(fig, res), size=(7.0, 4.0))) + figures(res)
+                   lambda fig: plot_abs_ecdf(fig.add_subplot(111), series, 100 * STOP_WINDOW_M,
+                                             window_label=f"{fmt(STOP_WINDOW_M)} m", unit="cm",
+                                             linthresh=1.0), size=(7.0, 4.0))) + figures(res)
     return Rendered(tuple(sections), figs)
 
 
-def _errors(res, c: str) -> list[float]:
-    """Every stop error of controller ``c`` over all sections (cm)."""
-    return [e for i in range(len(res.sections)) for e in res.stats[c, i].errors]
-
-
-def _within_section(res) -> str:
-    """P(|e| <= 30 cm) per controller over all sections, Wilson 95 % interval."""
-    rows = []
-    for c in CONTROLLERS:
-        k, n, p, lo, hi = within_rate(_errors(res, c), 100 * STOP_WINDOW_M)
-        rows.append([label(c), f"{k} / {n}", fmt(p, 3), f"[{fmt(lo, 3)}, {fmt(hi, 3)}]",
-                     fmt(float(np.percentile(np.abs(_errors(res, c)), 95)), 3)])
+def _within_section(series) -> str:
+    """P(|e| <= 30 cm) per ``(label, every stop error (cm))`` of ``series``,
+    Wilson 95 % interval."""
+    rows = within_rows(series, 100 * STOP_WINDOW_M)
     w = fmt(STOP_WINDOW_M)
     return (f"**Stops within ±{w} m** (the usual platform-screen-door tolerance), over all "
             "sections and repeats, with the Wilson 95 % interval of the proportion:\n\n"
@@ -155,23 +132,6 @@ def _within_section(res) -> str:
             + "\n\n![stop error distribution]({figdir}/stop-error-cdf.png)\n\nThese are the paper "
             "rows over the repeats' uniform ranges; the Monte Carlo over continuous distributions, "
             "the nominal row and the rows with known-delay compensation follow.")
-
-
-def _plot_cdf(fig, res):
-    ax = fig.add_subplot(111)
-    for k, c in enumerate(CONTROLLERS):
-        plot_ecdf(ax, np.abs(_errors(res, c)), color=f"C{k}", label=label(c))
-    ax.axvline(100 * STOP_WINDOW_M, color="k", ls="--", lw=0.8, label=f"{fmt(STOP_WINDOW_M)} m")
-    ax.set_xscale("symlog", linthresh=1.0)
-    ax.set_xlim(left=0.0)              # an |error| axis has no negative ticks
-    ax.set_xlabel("|stop error| (cm)")
-    ax.set_ylabel("fraction of stops")
-    ax.legend(fontsize=8)
-
-
-def _overshoot_share(res, c: str, ns: int) -> float:
-    """Percentage of the stops of controller ``c`` beyond the stopping point."""
-    return 100 * float(np.mean([e > 0 for i in range(ns) for e in res.stats[c, i].errors]))
 
 
 def _consistency(published) -> str:
@@ -186,39 +146,7 @@ def _consistency(published) -> str:
             + ". Table 3 must come from other runs (or be another statistic).")
 
 
-def _plot_errors(fig, res):
-    ax = fig.add_subplot(111)
-    ns = len(res.sections)
-    for k, c in enumerate(CONTROLLERS):
-        data = [res.stats[c, i].errors for i in range(ns)]
-        pos = np.arange(ns) + 1 + (k - (len(CONTROLLERS) - 1) / 2) * 0.2
-        b = ax.boxplot(data, positions=pos, widths=0.17, patch_artist=True, showfliers=True,
-                       flierprops={"markersize": 2})
-        for patch in b["boxes"]:
-            patch.set_facecolor(f"C{k}")
-            patch.set_alpha(0.6)
-        ax.plot([], [], "s", color=f"C{k}", label=label(c))
-    ax.axhline(0, color="k", lw=0.6)
-    ax.set_xticks(np.arange(ns) + 1)
-    ax.set_xticklabels([str(i + 1) for i in range(ns)])
-    ax.set_xlabel("section (Table 3 order)")
-    ax.set_ylabel("stop error (cm, + overshoot)")
-    ax.legend(ncol=len(CONTROLLERS), loc="lower center", bbox_to_anchor=(0.5, 1.0),
-              fontsize=8, frameon=False)
-
-
 def _plot_curves(fig, res):
-    ax1, ax2 = fig.add_subplot(121), fig.add_subplot(122)
-    for k, c in enumerate(CONTROLLERS):
-        t, dx, v, _, vd = res.example[c]
-        keep = moving(v)
-        ax1.plot(dx[keep], v[keep] * 3.6, color=f"C{k}", label=label(c))
-        ax2.plot(t[keep], (v[keep] - vd[keep]) * 100, color=f"C{k}", label=label(c))
-    t, _, _, xd, vd = res.example["pid"]
-    ax1.plot(xd, vd * 3.6, "k--", lw=0.8, label="target")
-    ax1.set_xlabel("position − stopping point (m)")
-    ax1.set_ylabel("speed (km/h)")
-    ax1.legend()
-    ax2.set_xlabel("time from braking start (s)")
-    ax2.set_ylabel("speed error (cm/s)")
-    ax2.set_title("speed error (cf. fig 8)")
+    _, _, _, xd, vd = res.example["pid"]
+    plot_tracked_stops(fig, [(label(c), *(res.example[c][j] for j in (0, 1, 2, 4)))
+                             for c in CONTROLLERS], (xd, vd), title="speed error (cf. fig 8)")

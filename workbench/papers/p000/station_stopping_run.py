@@ -5,10 +5,14 @@ Every stop is the kind's (:mod:`workbench.kinds.stop_accuracy.run`): the
 per-section repeats (:func:`~workbench.kinds.stop_accuracy.run.section_runs`),
 the nominal plant and the Monte Carlo
 (:func:`~workbench.kinds.stop_accuracy.run.simulate_cases`, every case
-meeting the same draws). This module adds what is paper 000's: the nominal
-row's traces and speed-error sign changes, the example stops of section 1,
-the SMARC estimates of the repeats and the damping of the PIDs' linearised
-loops (:mod:`workbench.tuning.pid`).
+meeting the same draws), and so are the example stops of section 1
+(:func:`~workbench.kinds.stop_accuracy.run.section_example`), the damping of
+the PIDs' linearised loops and the sign changes of their speed errors
+(:mod:`workbench.kinds.stop_accuracy.loop_damping`). What stays here is
+paper 000's: which runs make its rows (the paper names of
+:mod:`.station_stopping_spec`), the nominal row's tracking window (the first
+80 % of the planned braking) and dead band (:data:`SIGN_DEADBAND`), and the
+result its report and claims read (:class:`StopResult`).
 """
 from __future__ import annotations
 
@@ -16,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .station_stopping_spec import (ABLATION, CONTROLLERS, DAMPING, MC_CONTROLLERS, VARIANTS,
-                                    controller, gains)
+from ...kinds.stop_accuracy.loop_damping import pid_damping, pid_dead_time, sign_changes
+from .station_stopping_spec import ABLATION, CONTROLLERS, DAMPING, MC_CONTROLLERS, VARIANTS
 
 #: Speed errors below this (m/s; 0.18 km/h, below a speedometer's resolution) do not
 #: count as a sign change (oscillation count).
@@ -68,41 +72,20 @@ class StopResult:
 
 
 def loop_dead_time(spec, name: str) -> float:
-    """Dead time (s) of the linearised speed loop of PID ``name``: the
-    electric stage's T1 plus half a control period (sample and hold), or
-    behind the Smith predictor (nominal model exact) the half period only."""
-    hold = spec.dt_ctrl / 2
-    return hold if controller(spec, name).predictor else spec.params["T1"].value + hold
-
-
-def _sign_changes(err: np.ndarray) -> int:
-    s = np.sign(np.where(np.abs(err) < SIGN_DEADBAND, 0.0, err))
-    s = s[s != 0]
-    return int(np.sum(s[1:] != s[:-1]))
-
-
-def _target(spec, L: float, t: np.ndarray):
-    """(x_d - L, v_d) of the target of a section of length ``L`` at ``t`` s
-    from its braking start, and its planned braking time (s)."""
-    one = spec.reference.curve(np.array([L]))
-    tb = one.t_brake[0]
-    xd, vd, _ = one.at(t + tb)
-    return xd - L, vd, float(one.t_final[0] - tb)
+    """Dead time (s) of the linearised speed loop of PID ``name`` (the kind's
+    :func:`~workbench.kinds.stop_accuracy.loop_damping.pid_dead_time`)."""
+    return pid_dead_time(spec, VARIANTS[name][0])
 
 
 def _sections(spec, laws):
-    from ...kinds.stop_accuracy.run import section_runs, section_statistics
+    from ...kinds.stop_accuracy.run import section_example, section_runs, section_statistics
     tr, track, runs = section_runs(spec, laws, spec.dt)
     cells = section_statistics(spec, tr, runs)
     ns = len(spec.sections.sections)
     stats = {(k, s): cells[s, VARIANTS[k][0]] for s in range(ns) for k in CONTROLLERS}
-    D, ci, si = runs["D"], runs["controller"], runs["section"]
-    example = {}
-    for k in CONTROLLERS:
-        j = int(np.flatnonzero((ci == spec.controllers.index(controller(spec, k))) & (si == 0))[0])
-        xd, vd, _ = _target(spec, D[j], tr.t)
-        example[k] = (tr.t, tr.x[:, j] - D[j], tr.v[:, j], xd, vd)
-    planned = tuple(_target(spec, s.length, tr.t[:1])[2] for s in spec.sections.sections)
+    example = {k: section_example(spec, tr, runs, VARIANTS[k][0]) for k in CONTROLLERS}
+    planned = tuple(spec.reference.braking(s.length, tr.t[:1])[2]
+                    for s in spec.sections.sections)
     th = track.smarc[VARIANTS["smarc"][0]].theta_hat
     return stats, example, planned, (float(np.min(th)), float(np.max(th)))
 
@@ -110,24 +93,22 @@ def _sections(spec, laws):
 def run_station_stops(spec) -> StopResult:
     """The per-section repeats, the nominal row (every controller) and the
     Monte Carlo (:data:`MC_CONTROLLERS`) of the design ``spec``."""
-    from ...kinds.stop_accuracy.run import compile_laws, montecarlo_statistics, simulate_cases
-    from ...tuning.pid import damping, speed_loop
+    from ...kinds.stop_accuracy.run import (compile_laws, controller_index, montecarlo_statistics,
+                                            simulate_cases)
     laws = compile_laws(spec)
     stats, example, planned, theta = _sections(spec, laws)
     (speed,), L = spec.speeds_kmh, spec.distance
-    index = {k: spec.controllers.index(controller(spec, k)) for k in VARIANTS}
+    index = {k: controller_index(spec, v) for k, (v, _) in VARIANTS.items()}
     nom = list(MC_CONTROLLERS + ABLATION)
     tr, D = simulate_cases(spec, laws, spec.dt, [(speed, index[k], None, L) for k in nom])
-    _, vd, t_plan = _target(spec, L, tr.t)
+    _, vd, t_plan = spec.reference.braking(L, tr.t)
     track = tr.t < 0.8 * t_plan
     nominal = {k: NominalRun(float(tr.x_stop[j] - D[j]), tr.t, tr.x[:, j] - D[j], tr.v[:, j], vd,
-                             _sign_changes((tr.v[:, j] - vd)[track]))
+                             sign_changes((tr.v[:, j] - vd)[track], SIGN_DEADBAND))
                for j, k in enumerate(nom)}
     mcs = montecarlo_statistics(spec, laws, [(speed, index[k], None, L) for k in MC_CONTROLLERS],
                                 MC_CONTROLLERS)
-    P1, T2 = spec.params["P1"].value, spec.params["T2"].value
-    damp = {k: damping(*speed_loop(**gains(spec, k), P1=P1, T2=T2), loop_dead_time(spec, k))
-            for k in DAMPING}
+    damp = {k: pid_damping(spec, VARIANTS[k][0]) for k in DAMPING}
     return StopResult(spec, spec.sections.sections, planned, stats, example, theta, nominal,
                       mcs, damp, spec.tolerance)
 

@@ -12,7 +12,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ...kinds.stop_accuracy.loop_damping import pid_gains
 from ...kinds.stop_accuracy.needs import require
+from ...kinds.stop_accuracy.run import controller_index
 
 #: Paper name -> (the design's controller, label in the report). The first
 #: four are the controllers of the per-section tables: paper 000's three, then
@@ -79,26 +81,15 @@ class Line5:
     zeta_min: float = 0.7
 
 
-def controller(spec, name: str):
-    """The design's controller of the paper name ``name``."""
-    want = VARIANTS[name][0]
-    return next(c for c in spec.controllers if c.name == want)
-
-
 def gains(spec, name: str) -> dict:
     """kp, ki, kd of the PID of the paper name ``name`` (the named module ``pid``)."""
-    return {k: spec.constants[g].value for k, g in zip(("kp", "ki", "kd"),
-                                                       controller(spec, name).pid[1:])}
+    return pid_gains(spec, VARIANTS[name][0])
 
 
 def smarc_gains(spec) -> dict:
     """c, k_s, eta, phi, lam, theta_min, theta_max of the SMARC row (eqs 22, 26-27)."""
-    return controller(spec, "smarc").smarc.values(spec.constants)
-
-
-def factor(spec, name: str):
-    """The ``[disturbances]`` factor ``name`` (its ``what`` and ``unit``)."""
-    return next(f for f in spec.factors if f.name == name)
+    return spec.controllers[controller_index(spec, VARIANTS["smarc"][0])].smarc.values(
+        spec.constants)
 
 
 def load(root, spec) -> Line5:

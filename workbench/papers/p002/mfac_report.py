@@ -11,22 +11,18 @@ __all__ = ["render"]
 
 import numpy as np
 
-from ...controllers.mfac import RESET_CONDITIONS, MFACGains, frozen_ppd_poles
+from ...controllers.mfac import RESET_CONDITIONS
 from ...features.reproducible import NUDGE, RTOL, count_text
 from ...plants.train002 import latex_equations
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...tuning.pareto import TIE_REL, dominated_share
 from ...kinds.tracking import figures as F
-from ...kinds.tracking.mfac import most_sensitive
-from ...kinds.tracking.render_general import tuning_figures
-from ...kinds.tracking.spec import OBJECTIVE_UNITS, OBJECTIVES
+from ...kinds.tracking.mfac import frozen_integrator, most_sensitive
+from ...kinds.tracking import render_general as G
+from ...kinds.tracking.spec import OBJECTIVES
 
-LABEL = {"stop_error": "stop error (m)", "punctuality": "punctuality (s)",
-         "comfort": "RMS jerk (m/s³)", "energy": "energy (J/kg)",
-         "rms_speed_error": "RMS speed error (m/s)"}
-DOC = {"f": "static map gain", "e": "static map offset", "delay": "pure delay T_d",
-       "lag": "lag time constant T_l", "c0": "Davis, constant (per mass)",
-       "c1": "Davis, linear (per mass)", "c2": "Davis, quadratic (per mass)", "g": "gravity",
+LABEL = {**G.LABEL, "rms_speed_error": "RMS speed error (m/s)"}
+DOC = {**G.DOC, "delay": "pure delay T_d", "lag": "lag time constant T_l",
        "a_min": "brake acceleration limit", "a_max": "traction acceleration limit",
        "u_min": "lowest command", "u_max": "highest command"}
 SYMBOL = {"eta": "η", "mu": "μ", "rho": "ρ", "lam": "λ", "phi1": "φ(1)"}
@@ -74,13 +70,12 @@ def _pct(x) -> str:
 
 
 def _params(tun) -> str:
-    return ", ".join(f"{SYMBOL.get(k, k)} = {fmt(v, 3)}" for k, v in tun.chosen_params().items())
+    return G.params_text(tun, SYMBOL)
 
 
 def _problem(spec, res) -> str:
     m = res.readings[0].main
     rows = [[f"`{r.name}`", f"`{r.model}`", r.source] for r in spec.readings]
-    prow = [[f"`{k}`", fmt(q.value, 5), q.unit, DOC[k], q.source] for k, q in spec.train.items()]
     text = (
         "## Problem\n\n"
         f"Route **{m.section.name}**: {fmt(m.section.route.distance, 5)} m, planned "
@@ -92,14 +87,11 @@ def _problem(spec, res) -> str:
         + md_table(["reading", "model", "what it is, where it comes from"], rows, "lll")
         + "\n\nThe train of `[train]` (the integrating reading's chain; every value our "
         "documented choice, not the paper's):\n\n"
-        + md_table(["parameter", "value", "unit", "meaning", "source"], prow, "lrlll"))
+        + G.param_table(spec.train, DOC))
     for r in spec.readings:
         if r.params:
-            rows = [[f"`{k}`", fmt(q.value, 5), q.unit, DOC[k], q.source]
-                    for k, q in r.params.items()]
             text += (f"\n\nReading `{r.name}` (*our reading*; Davis resistance and gravity "
-                     "as above):\n\n" + md_table(["parameter", "value", "unit", "meaning",
-                                                  "source"], rows, "lrlll"))
+                     "as above):\n\n" + G.param_table(r.params, DOC))
     return text + (f"\n\nCommand limits of the integrating reading {fmt(spec.u_limits[0])} … "
                    f"{fmt(spec.u_limits[1])} m/s². Control sample Ts = {fmt(spec.Ts)} s, plant "
                    f"step {fmt(spec.dt)} s (lags integrated exactly over a step, delay as a FIFO).")
@@ -162,10 +154,7 @@ def _why(spec, res) -> str:
                     + [_pct(s.by_condition[k]) for k in (*RESET_CONDITIONS, "at_limit")]
                     + [_pct(s.saturated), _span(r.mfac.reset_rate[r.mfac.reproducible])])
     integ = res.readings[0]
-    g = integ.mfac.chosen_params()
-    gains = MFACGains(g["lam"], g["rho"], g["eta"], g["mu"], g["phi1"])
-    z = frozen_ppd_poles(gains, g["phi1"], spec.Ts)
-    G = g["rho"] * g["phi1"] / (g["lam"] + g["phi1"] ** 2)
+    G, z = frozen_integrator(integ.mfac, spec.Ts)
     # a real part below 1e-9 |z| is the rounding of 2 - G Ts = 0 (G Ts = 2): printed as 0
     re = [0.0 if abs(x.real) < 1e-9 * abs(x) else x.real for x in z[:2]]
     roots = (f"{fmt(re[0], 3)} ± {fmt(abs(z[0].imag), 2)} j" if abs(z[0].imag) > 1e-6
@@ -220,14 +209,10 @@ def _span(rates) -> str:
 
 
 def _tuning(spec, res) -> str:
-    srows = [[k, f"{fmt(spec.scales[k].value)} {OBJECTIVE_UNITS[k]}", fmt(w),
-              spec.scales[k].source] for k, w in zip(OBJECTIVES, spec.weights)]
     rows = [[f"`{r.reading.name}`", str(len(r.mfac.cost)), _unrepro(r.mfac),
              str(int(r.mfac.front.sum())), _params(r.mfac), str(len(r.pid.cost)),
              _unrepro(r.pid), str(int(r.pid.front.sum())), _params(r.pid)]
             for r in res.readings]
-    figs = "\n\n".join(f"![Pareto fronts, {r.reading.name}]"
-                       f"({{figdir}}/pareto-{r.reading.name}.png)" for r in res.readings)
     return (
         f"## {H_TUNE}\n\nPer reading, every combination of the design's grids (η, μ, ρ, λ and "
         "φ(1) for MFAC; kp, ki, kd for PID) is simulated on the main pair, one batch each. "
@@ -247,12 +232,14 @@ def _tuning(spec, res) -> str:
         "trajectory, so its stop error, jerk and energy are not results. Such runs are counted "
         "(column \"not reproducible\") and take no part in the fronts, the choice, the "
         "counts, the bests and the utopia point (our choice).\n\n"
-        + md_table(["objective", "scale s_j", "weight w_j", "why this scale"], srows, "lrrl")
+        + md_table(["objective", "scale s_j", "weight w_j", "why this scale"], G.scale_rows(spec),
+                   "lrrl")
         + "\n\n" + md_table(["reading", "MFAC runs", "not reproducible", "on front",
                              "MFAC chosen", "PID runs", "not reproducible", "on front",
                              "PID chosen"], rows, "lrrrlrrrl")
         + "\n\nIn the figures: every run (dots), the 4-objective front (rings), the front of "
-        "the two objectives plotted (step line), the chosen points (stars).\n\n" + figs
+        "the two objectives plotted (step line), the chosen points (stars).\n\n"
+        + G.pareto_links(res)
         + "\n\n" + _comfort_and_edges(spec, res))
 
 
@@ -420,12 +407,10 @@ def render(design, res) -> Rendered:
     sections = [_problem(spec, res), _model(spec), _profile(spec, res), _why(spec, res),
                 _tuning(spec, res), _compare(res), _ppd(res), _line(spec, res),
                 _sensitivity(res), _closing(res)]
-    figs = tuning_figures(spec, res) + [
+    figs = G.tuning_figures(spec, res) + [
              Figure("ppd", "PPD estimate and realised PPD of the chosen MFAC runs.",
-                    lambda fig: F.plot_ppd(fig, res), (8.0, 3.8))]
-    if res.readings[0].line:
-        figs.append(Figure("line", "Stop error per section (synthetic line).",
-                           lambda fig: F.plot_line(fig, res), (8.0, 4.0)))
+                    lambda fig: F.plot_ppd(fig, res), (8.0, 3.8))] + G.line_figure(
+        res, "Stop error per section (synthetic line).")
     anchors = ((r"reading\[[^\]]+\]\.(mfac\.reset|mfac\.saturated|grid\.)", H_WHY),
                (r"reading\[[^\]]+\]\.(ppd|plant|frozen)", H_PPD),
                (r"reading\[[^\]]+\]\.line", H_LINE),

@@ -31,21 +31,21 @@ its claims name and the report's wording. The modes:
 """
 from __future__ import annotations
 
-import itertools
-import math
 from dataclasses import dataclass, replace
 from functools import cached_property
 
-from ...features.quantities import Declared, names, units, values
-from ...kinds.stop_accuracy.quantities import feasible, mc_family
-from ...kinds.stop_accuracy.run import run, speed_key
-from ...reader import Reader
-from ...tuning.pid import Damping, damping, deceleration_loop
-from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, ELECTRIC_LOSS, FAULT_NAMES, MC_MODES,
-                                    run_curves, run_horizon_sweep, run_montecarlo)
-from .closed_loop_brake_spec import Paper004, compute_worked, load, loop_values
+from ...features.quantities import Declared, values
+from ...kinds.stop_accuracy.analysis import Analysis
+from ...kinds.stop_accuracy.loop_damping import loop_damping
+from ...kinds.stop_accuracy.quantities import mc_family
+from ...kinds.stop_accuracy.run import grid_corners, run, speed_key
+from ...tuning.pid import Damping
+from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, ELECTRIC_LOSS, FACTORS, FAULT_NAMES,
+                                    MC_MODES, run_curves, run_horizon_sweep, run_montecarlo)
+from .closed_loop_brake_render import render
+from .closed_loop_brake_spec import compute_worked, load
 
-__all__ = ["ANALYSIS", "NOMINAL", "Result004", "compute_worked", "corners", "decel_damping",
+__all__ = ["ANALYSIS", "NOMINAL", "Result004", "compute_worked", "corners",
            "run_grid", "TABLE"]
 
 #: the nominal corner (force error, gradient permille, friction factor)
@@ -56,9 +56,7 @@ _FAULT_KEYS = {v: k for k, v in FAULT_NAMES.items()}
 
 def corners(spec) -> list:
     """(force error, gradient, friction) of every grid corner, in the grid's order."""
-    keys = [k for k, _ in spec.grid]
-    return [tuple(c[keys.index(k)] for k in ("force_error", "gradient", "friction"))
-            for c in itertools.product(*(v for _, v in spec.grid))]
+    return grid_corners(spec, FACTORS)
 
 
 @dataclass(frozen=True)
@@ -70,7 +68,7 @@ class Result004:
     curves: tuple = ()      # (mode, channel, force error, position - D (m), speed (m/s))
     mc: dict | None = None  # (speed km/h, mode) -> StopStatistics of the Monte Carlo
     damping: Damping | None = None   # of the linearised deceleration PID loop
-    sweep: tuple = ()       # (ATO horizon s, speed km/h, nominal closed-loop stop error m)
+    sweep: dict | None = None  # (ATO horizon s, speed km/h) -> nominal closed-loop stop error m
 
     @property
     def spec(self):
@@ -98,15 +96,6 @@ class Result004:
         from ...kinds.stop_accuracy.quantities import TABLE as KIND
         return values(KIND, self.spec, self.kind)
 
-    def max_abs(self, s, mode: str, channel: str = "analogue") -> float:
-        """Largest |stop error| (m) of a mode over the grid; nan if a run did not stop."""
-        e = [abs(x) for x in self.grid(s, mode, channel)]
-        return float(max(e)) if e and all(math.isfinite(x) for x in e) else math.nan
-
-    def feasible(self, s) -> list:
-        """Per grid corner: full service from the first instant stops short of D."""
-        return feasible(self.kind, s)
-
     def stop(self, s, mode: str = "closed", channel: str = "analogue",
              fault: str = "healthy") -> float:
         """Stop error (m) at the nominal corner: healthy, under a sensor fault
@@ -127,17 +116,8 @@ def run_grid(spec, *, montecarlo: bool = True) -> Result004:
     return Result004(res, compute_worked(spec.paper.worked),
                      tuple(run_curves(spec, res.distance, fe)),
                      run_montecarlo(spec, res.distance) if montecarlo else None,
-                     decel_damping(spec),
-                     run_horizon_sweep(spec, res.distance) if montecarlo else ())
-
-
-def decel_damping(spec) -> Damping:
-    """Damping of the linearised deceleration PID loop (electric stage, dead
-    time T1 plus one control period: sample and hold, and the backward
-    difference of the measured speed)."""
-    p, loop = {k: q.value for k, q in spec.params.items()}, loop_values(spec)
-    return damping(*deceleration_loop(loop["kp"], loop["ki"], P1=p["P1"], T2=p["T2"],
-                                      tau=loop["tau_filter"]), p["T1"] + spec.dt_ctrl)
+                     loop_damping(spec, _CLOSED),
+                     run_horizon_sweep(spec, res.distance) if montecarlo else None)
 
 
 def _speeds(*members):
@@ -194,27 +174,5 @@ TABLE = (
 )
 
 
-class ClosedLoopBrake:
-    """The analysis of ``[analysis] module = "p004.closed_loop_brake"``."""
-
-    def load(self, root: Reader, spec) -> Paper004:
-        return load(root, spec)
-
-    def quantity_names(self, spec) -> set[str]:
-        return names(TABLE, spec)
-
-    def quantity_units(self, spec) -> dict[str, str]:
-        return units(TABLE, spec)
-
-    def run(self, spec) -> Result004:
-        return run_grid(spec)
-
-    def quantities(self, res: Result004) -> dict:
-        return values(TABLE, res.spec, res)
-
-    def render(self, design, res):
-        from .closed_loop_brake_render import render
-        return render(design, res)
-
-
-ANALYSIS = ClosedLoopBrake()
+#: the analysis of ``[analysis] module = "p004.closed_loop_brake"``
+ANALYSIS = Analysis(TABLE, load, run_grid, render)

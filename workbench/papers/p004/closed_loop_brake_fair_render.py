@@ -3,17 +3,18 @@ faults and Monte Carlo (pure rendering of a
 :class:`~workbench.papers.p004.closed_loop_brake.Result004`)."""
 from __future__ import annotations
 
-from ...kinds.stop_accuracy.render import mc_section, plot_case_bars, plot_mc_panels
+from ...kinds.stop_accuracy.loop_damping import loop_values
+from ...kinds.stop_accuracy.render import (mc_figure, mc_section, plot_case_bars,
+                                           plot_constant_sweep)
 from ...report.markdown import Figure, fmt, md_table
 from .closed_loop_brake_run import MC_MODES, faults
-from .closed_loop_brake_spec import loop_values
 
 MODE_LABEL = {"ato-open": "ATO open loop", "closed": "closed loop (analogue)"}
 
 
 def retune_section(spec, res) -> str:
     """``## Retuned closed loop``: the horizon, the PID's damping, the nominal corner."""
-    p, loop = {k: q.value for k, q in spec.params.items()}, loop_values(spec)
+    p, loop = {k: q.value for k, q in spec.params.items()}, loop_values(spec, "closed")
     rows = [[fmt(s), fmt(res.stop(s), 3), fmt(res.stop(s, channel="3bit"), 3),
              fmt(res.stop(s, "ato-open"), 3)] for s in res.distance]
     d = res.damping
@@ -41,7 +42,7 @@ def retune_section(spec, res) -> str:
 
 
 def fault_text(spec) -> str:
-    loop = loop_values(spec)
+    loop = loop_values(spec, "closed")
     return ("Axle states: o = healthy, s = sliding (reads "
             f"{fmt(100 * loop['slide_ratio'])} % low), f = failed (reads 0), h = reads high (× "
             f"{fmt(loop['high_ratio'])}, e.g. a wheel diameter set too large), z = stuck at its "
@@ -64,36 +65,17 @@ def monte_carlo(spec, res) -> str:
 
 
 def figures(spec, res) -> tuple[Figure, ...]:
+    axles = faults(spec)
     return (Figure("horizon-sweep", "Closed-loop stop error at the nominal corner against the "
-                   "ATO's prediction horizon.",
-                   lambda fig, res=res, spec=spec: _plot_sweep(fig, res, spec), size=(6.4, 3.6)),
+                   "ATO's prediction horizon.", lambda fig: plot_constant_sweep(
+                       fig.add_subplot(111), res.sweep, list(res.distance), res.tolerance,
+                       chosen=spec.constants["t_p"].value, chosen_label="chosen: T1 + T2",
+                       xlabel="ATO prediction horizon t_predict (s)"), size=(6.4, 3.6)),
             Figure("sensor-faults", "Stop error per axle-sensor case, nominal corner.",
-                   lambda fig, res=res: _plot_faults(fig, res), size=(7.0, 3.8)),
-            Figure("mc-stop-errors", "Monte Carlo stop errors per speed and mode.",
-                   lambda fig, res=res: _plot_mc(fig, res), size=(7.0, 3.8)))
-
-
-def _plot_sweep(fig, res, spec):
-    ax = fig.add_subplot(111)
-    for k, s in enumerate(res.distance):
-        pts = sorted((tp, e) for tp, sp_, e in res.sweep if sp_ == s)
-        ax.plot([a for a, _ in pts], [b for _, b in pts], "o-", color=f"C{k}",
-                label=f"{fmt(s)} km/h")
-    ax.axvline(spec.constants['t_p'].value, color="k", lw=0.8, ls=":", label="chosen: T1 + T2")
-    ax.axhspan(-res.tolerance, res.tolerance, color="0.9", zorder=0, label=f"±{fmt(res.tolerance)} m")
-    ax.set_xlabel("ATO prediction horizon t_predict (s)")
-    ax.set_ylabel("stop error (m, + overshoot)")
-    ax.legend(fontsize=8)
-
-
-def _plot_faults(fig, res):
-    axles = faults(res.spec)
-    plot_case_bars(fig.add_subplot(111), [f"{c} ({a})" for c, a in axles.items()],
-                   [(f"{fmt(s)} km/h", [res.stop(s, fault=f) for f in axles])
-                    for s in res.distance], res.tolerance, linthresh=0.3)
-
-
-def _plot_mc(fig, res):
-    plot_mc_panels(fig, [(f"{fmt(s)} km/h", [(MODE_LABEL[m], res.mc[s, m].errors)
-                                             for m in MC_MODES])
-                         for s in sorted({s for s, _ in res.mc})], res.tolerance)
+                   lambda fig: plot_case_bars(
+                       fig.add_subplot(111), [f"{c} ({a})" for c, a in axles.items()],
+                       [(f"{fmt(s)} km/h", [res.stop(s, fault=f) for f in axles])
+                        for s in res.distance], res.tolerance, linthresh=0.3), size=(7.0, 3.8)),
+            mc_figure("Monte Carlo stop errors per speed and mode.", [
+                (f"{fmt(s)} km/h", [(MODE_LABEL[m], res.mc[s, m].errors) for m in MC_MODES])
+                for s in sorted({s for s, _ in res.mc})], res.tolerance, (7.0, 3.8)))

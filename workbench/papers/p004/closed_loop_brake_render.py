@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ...kinds.stop_accuracy.grid_map import GridAxis, plot_grid_map
-from ...kinds.stop_accuracy.render import plot_speed_distance, quantity_table
+from ...kinds.stop_accuracy.grid_map import GridAxis, plot_grid_map, result_cell
+from ...kinds.stop_accuracy.loop_damping import loop_values
+from ...kinds.stop_accuracy.quantities import feasible
+from ...kinds.stop_accuracy.render import corner_rows, plot_speed_distance, quantity_table
+from ...kinds.stop_accuracy.run import speed_key
 from ...report.markdown import Figure, Rendered, fmt, md_table
-from .closed_loop_brake_spec import loop_values, worked_formulas
 from .closed_loop_brake_fair_render import fault_text, figures, monte_carlo, retune_section
-from .closed_loop_brake_run import CHANNELS, ELECTRIC_LOSS, MODES, faults
+from .closed_loop_brake_run import CHANNELS, CONTROLLERS, ELECTRIC_LOSS, FACTORS, MODES, faults
+from .closed_loop_brake_spec import worked_formulas
 
 MODE_TEXT = {"open": "open loop, single command",
              "ato-open": "open loop + ATO re-commands (a_req sent as the brake demand: no "
@@ -37,7 +40,7 @@ def _worked_section(res, spec) -> str:
 
 
 def render(design, res) -> Rendered:
-    spec, loop = design.spec, loop_values(design.spec)
+    spec, loop = design.spec, loop_values(design.spec, "closed")
     grid = dict(spec.grid)
     sections = [
         "## Problem\n\nPaper 004 argues qualitatively that closing the loop on the measured "
@@ -61,15 +64,15 @@ def render(design, res) -> Rendered:
         _worked_section(res, spec),
         retune_section(spec, res),
     ]
-    rows = []
+    rows, kv, n = [], res.kind_values, len(res.corners())
     for s in res.distance:
         for m in MODES:
             for ch in (CHANNELS if m == "closed" else ("analogue",)):
-                fail = [not abs(e) <= res.tolerance for e in res.grid(s, m, ch)]
-                rows.append([fmt(s), m, ch, fmt(res.max_abs(s, m, ch), 3),
-                             f"{sum(fail)} / {len(fail)}",
-                             sum(f and ok for f, ok in zip(fail, res.feasible(s)))])
-    n_inf = sum(not ok for s in res.distance for ok in res.feasible(s)) // max(
+                q = f"{speed_key(s)}.{CONTROLLERS[m, ch]}.grid."
+                rows.append([fmt(s), m, ch, fmt(kv[q + "max_abs_m"], 3),
+                             f"{kv[q + 'failing_corners']:g} / {n}",
+                             f"{kv[q + 'failing_feasible_corners']:g}"])
+    n_inf = sum(not ok for s in res.distance for ok in feasible(res.kind, s)) // max(
         len(res.distance), 1)
     sections.append(
         f"## Error grid: stop error against the ±{fmt(res.tolerance)} m window\n\n"
@@ -99,7 +102,10 @@ def render(design, res) -> Rendered:
                     "\n\n![curves]({figdir}/speed-distance.png)")
     sections.append(monte_carlo(spec, res))
     figs = (Figure("speed-distance", "Speed against position relative to the stopping point.",
-                   lambda fig, res=res: _plot_curves(fig, res), size=(7.0, 4.0)),
+                   lambda fig: plot_speed_distance(fig, [(f"force error {fmt(100 * fe)} %", [
+                       (f"{m} ({ch})", dx, v) for m, ch, f, dx, v in res.curves if f == fe])
+                       for fe in sorted({c[2] for c in res.curves}, reverse=True)]),
+                   size=(7.0, 4.0)),
             Figure("error-grid", "Closed-loop stop error per grid corner (analogue channel), "
                    "with the open loop for contrast.",
                    lambda fig, res=res, spec=spec: _plot_grid(fig, res, spec), size=(8.0, 5.5)),
@@ -107,22 +113,10 @@ def render(design, res) -> Rendered:
     return Rendered(tuple(sections), figs)
 
 
-def _plot_curves(fig, res):
-    plot_speed_distance(fig, [(f"force error {fmt(100 * fe)} %", [
-        (f"{m} ({ch})", dx, v) for m, ch, f, dx, v in res.curves if f == fe])
-        for fe in sorted({c[2] for c in res.curves}, reverse=True)])
-
-
 def _corner_details(res) -> str:
-    rows = []
-    cs = res.corners()
-    for s in res.distance:
-        ok = res.feasible(s)
-        for k in sorted(range(len(cs)), key=cs.__getitem__):
-            rows.append([fmt(s), fmt(100 * cs[k][0]), fmt(cs[k][1]), fmt(cs[k][2]),
-                         "yes" if ok[k] else "no"] + [fmt(res.grid(s, m, ch)[k], 3) for m, ch in (
-                             ("open", "analogue"), ("ato-open", "analogue"),
-                             ("closed", "analogue"), ("closed", "3bit"))])
+    rows = corner_rows(res.kind, FACTORS, [CONTROLLERS[k] for k in (
+        ("open", "analogue"), ("ato-open", "analogue"), ("closed", "analogue"),
+        ("closed", "3bit"))], (lambda f: fmt(100 * f), fmt, fmt))
     return ("<details><summary>Every corner (stop error, m; + = overshoot)</summary>\n\n"
             + md_table(["km/h", "force error %", "gradient ‰", "friction", "feasible", "open",
                         "ATO open", "closed analogue", "closed 3-bit"], rows, "rrrrlrrrr")
@@ -130,17 +124,12 @@ def _corner_details(res) -> str:
 
 
 def _plot_grid(fig, res, spec):
-    grid, cs = dict(spec.grid), res.corners()
-
-    def cell(s, fe, gr, fr):
-        k = cs.index((fe, gr, fr))
-        return res.grid(s, "closed")[k], res.feasible(s)[k]
-
-    tol = res.tolerance
+    grid, tol = dict(spec.grid), res.tolerance
     plot_grid_map(
         fig, list(res.distance), GridAxis(grid["force_error"], "force error (%)",
                                           lambda f: fmt(100 * f)),
-        GridAxis(grid["gradient"], "gradient (‰, + uphill)"), GridAxis(grid["friction"]), cell,
+        GridAxis(grid["gradient"], "gradient (‰, + uphill)"), GridAxis(grid["friction"]),
+        result_cell(res.kind, CONTROLLERS["closed", "analogue"], FACTORS),
         tol, title=lambda s, fr: f"{fmt(s)} km/h, friction ×{fmt(fr)}",
         suptitle=f"closed-loop stop error (m); green: within ±{fmt(tol)} m, orange to red: "
         f"beyond it, dark red: ≥ {fmt(3 * tol)} m",

@@ -1,19 +1,21 @@
 """Paper 004's runs (designs/closed-loop-brake-004.toml) on the
 ``stop-accuracy`` kind's general run (:func:`workbench.kinds.stop_accuracy.run.run`):
 its error grid (``[grid]``, feasibility by ``feasible_with``), its axle-sensor
-faults and the electric-brake loss (``[[faults]]``), and its Monte Carlo
-(:func:`~workbench.kinds.stop_accuracy.run.montecarlo_statistics`).
+faults and the electric-brake loss (``[[faults]]``), its Monte Carlo
+(:func:`~workbench.kinds.stop_accuracy.run.controller_montecarlo`), the
+speed-distance curves (:func:`~workbench.kinds.stop_accuracy.run.factor_traces`)
+and the horizon sweep (:func:`~workbench.kinds.stop_accuracy.run.constant_sweep`).
 
 What stays here, and why: the names its report and claims use for the modes,
-channels and faults (``ato-open``, ``3bit``, "1 sliding"), the speed-distance
-curves of two grid corners and the ATO-horizon sweep of ``[retuning]`` (runs
-of paper 004's report that the kind does not make).
+channels and faults (``ato-open``, ``3bit``, "1 sliding"), and which runs its
+report makes: the curves of two grid corners, the Monte Carlo of two modes
+(recorded every 0.5 s) and the ATO-horizon sweep of ``[retuning]``.
 """
 from __future__ import annotations
 
-import numpy as np
-
 MODES = ("open", "ato-open", "closed")
+#: the factors of the error grid, in the report's order
+FACTORS = ("force_error", "gradient", "friction")
 #: not a control mode: full service from t = 0, to test each corner's feasibility
 FULL = "full-service"
 CHANNELS = ("analogue", "3bit")
@@ -38,47 +40,38 @@ def faults(spec) -> dict:
                                   if f.name in FAULT_NAMES}}
 
 
-def _index(spec, mode: str, channel: str = "analogue") -> int:
-    return [c.name for c in spec.controllers].index(CONTROLLERS[mode, channel])
-
-
 def run_curves(spec, distance: dict, force_errors) -> list:
     """(mode, channel, force error, position - D (m), speed (m/s)) of every mode
     at the first speed and each of ``force_errors`` (gradient 0, friction x1),
-    recorded every 0.5 s (:func:`~workbench.kinds.stop_accuracy.run.simulate_cases`)."""
-    from ...kinds.stop_accuracy.run import compile_laws, simulate_cases
-    s = spec.speeds_kmh[0]
-    modes = [k for k in CONTROLLERS if k[0] != FULL]
-    tr, D = simulate_cases(spec, compile_laws(spec), spec.dt,
-                           [(s, _index(spec, *k), None, distance[s]) for k in modes],
-                           {"force_error": np.array(force_errors, float)}, dt_rec=0.5)
-    n = len(force_errors)
-    return [(m, ch, fe, tr.x[:, j * n + k] - D[j * n + k], tr.v[:, j * n + k])
-            for k, fe in enumerate(force_errors) for j, (m, ch) in enumerate(modes)]
+    recorded every 0.5 s (:func:`~workbench.kinds.stop_accuracy.run.factor_traces`)."""
+    from ...kinds.stop_accuracy.run import factor_traces
+    s, modes = spec.speeds_kmh[0], [k for k in CONTROLLERS if k[0] != FULL]
+    tr = factor_traces(spec, [CONTROLLERS[k] for k in modes], s, distance[s], "force_error",
+                       force_errors, dt_rec=0.5)
+    return [(m, ch, fe, *tr[fe, CONTROLLERS[m, ch]]) for fe in force_errors for m, ch in modes]
 
 
 def run_montecarlo(spec, distance: dict) -> dict:
     """Stop statistics per (speed km/h, mode) over the Monte Carlo draws
     (analogue channel, healthy sensors; every mode and speed meets the same
     draws), the kind's Monte Carlo batch
-    (:func:`~workbench.kinds.stop_accuracy.run.montecarlo_statistics`):
+    (:func:`~workbench.kinds.stop_accuracy.run.controller_montecarlo`):
     {(speed, mode): StopStatistics}."""
-    from ...kinds.stop_accuracy.run import compile_laws, montecarlo_statistics
-    cases = [(s, m) for s in spec.speeds_kmh for m in MC_MODES]
-    return montecarlo_statistics(spec, compile_laws(spec), [
-        (s, _index(spec, m), None, distance[s]) for s, m in cases], cases, dt_rec=0.5)
+    from ...kinds.stop_accuracy.run import controller_montecarlo
+    st = controller_montecarlo(spec, [CONTROLLERS[m, "analogue"] for m in MC_MODES], distance,
+                               dt_rec=0.5)
+    return {(s, m): st[s, CONTROLLERS[m, "analogue"]] for s in spec.speeds_kmh for m in MC_MODES}
 
 
-def run_horizon_sweep(spec, distance: dict) -> tuple:
+def run_horizon_sweep(spec, distance: dict) -> dict:
     """Stop error (m) of the closed loop (analogue) at the nominal corner for
     each ATO prediction horizon (the constant ``t_p``) of ``[retuning]
     t_predict_sweep`` (:func:`~workbench.kinds.stop_accuracy.run.constant_sweep`):
-    ((t_predict, speed km/h, error), ...)."""
+    {(t_predict, speed km/h): error}."""
     from ...kinds.stop_accuracy.run import constant_sweep
-    return tuple((tp, s, e) for (tp, s), e in constant_sweep(
-        spec, CONTROLLERS["closed", "analogue"], "t_p", spec.paper.t_predict_sweep, distance,
-        dt_rec=0.5).items())
+    return constant_sweep(spec, CONTROLLERS["closed", "analogue"], "t_p",
+                          spec.paper.t_predict_sweep, distance, dt_rec=0.5)
 
 
-__all__ = ["CHANNELS", "CONTROLLERS", "ELECTRIC_LOSS", "FAULT_NAMES", "FULL", "MC_MODES", "MODES",
-           "faults", "run_curves", "run_horizon_sweep", "run_montecarlo"]
+__all__ = ["CHANNELS", "CONTROLLERS", "ELECTRIC_LOSS", "FACTORS", "FAULT_NAMES", "FULL", "MC_MODES",
+           "MODES", "faults", "run_curves", "run_horizon_sweep", "run_montecarlo"]

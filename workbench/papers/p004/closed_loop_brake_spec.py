@@ -14,10 +14,9 @@ import sympy as sp
 
 from ...kinds.stop_accuracy.needs import require
 from ...reader import Quantity, Reader
-from .closed_loop_brake_run import ELECTRIC_LOSS, FAULT_NAMES
+from .closed_loop_brake_run import ELECTRIC_LOSS, FACTORS, FAULT_NAMES
 
-__all__ = ["NEEDS", "Paper004", "Worked", "compute_worked", "load", "loop_values",
-           "worked_formulas"]
+__all__ = ["NEEDS", "Paper004", "Worked", "compute_worked", "load", "worked_formulas"]
 
 
 @lru_cache(maxsize=1)
@@ -60,7 +59,7 @@ def load(root: Reader, spec) -> Paper004:
     """Check that ``spec`` has what the report's runs need and read ``[worked]``
     and ``[retuning]``."""
     require(root, spec, "p004.closed_loop_brake", controllers=NEEDS,
-            loops=("closed", "closed_3bit"), grid=("force_error", "gradient", "friction"),
+            loops=("closed", "closed_3bit"), grid=FACTORS,
             feasible_with="full_service", faults=(*FAULT_NAMES, ELECTRIC_LOSS),
             constants=("t_p", "d_min"), tables=("command", "montecarlo"))
     w = root.table("worked")
@@ -81,11 +80,6 @@ def load(root: Reader, spec) -> Paper004:
         raise rt.fail("t_predict_sweep", list(sweep), "horizons in [0, 5] s")
     rt.finish()
     return Paper004(worked, tuple(sweep))
-
-
-def loop_values(spec) -> dict:
-    """The closed loop's command-generator values (gains, scales, sensor ratios)."""
-    return spec.controllers[NEEDS.index("closed")].loop.values(spec.constants)
 
 
 def compute_worked(w: Worked) -> dict:
