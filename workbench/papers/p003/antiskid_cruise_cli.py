@@ -15,9 +15,10 @@ def synthesize_command(design, *, eps=None, as_json: bool = False) -> int:
     from . import antiskid_cruise
     spec = design.spec
     _, lam_solved, lam, lin = antiskid_cruise.operating_point(spec)
-    rows = synthesize_delay_bound(lin.A, lin.B, tuple(eps) if eps else spec.eps, spec.settings)
+    sw = spec.sweep
+    rows = synthesize_delay_bound(lin.A, lin.B, tuple(eps) if eps else sw.eps, sw.settings)
     return print_sweep(
         design.name, f"{design.name}: problem (60) of paper 003 at v_d = "
         f"{fmt(spec.v_d.value)} m/s, lambda_d = {fmt(lam, 5)} "
         f"({'pinned' if spec.lambda_d_pinned else 'solved'}; solved {fmt(lam_solved, 6)})",
-        rows, spec.settings, as_json)
+        rows, sw.settings, as_json)
