@@ -26,7 +26,7 @@ def _requirements(spec, res) -> str:
 
 
 def render(design, res) -> Rendered:
-    rg, pts = res.robust, res.points
+    rg, pts = res.robust, res.spec.points
     ids = [p.id for p in pts]
     prob = ("## Problem\n\nOne state-feedback gain K for the cruise error system "
             "E' = A_i E + B_i K E(t - h) of paper 003 (eq 32) at every operating point i below "
@@ -48,7 +48,7 @@ def render(design, res) -> Rendered:
     gain = robust_gain_section(ids, rg)
     if rg.synthesis.K is None:
         return Rendered((prob, gain))
-    cmp_ = compare_section(ids, res.compare, res.compared, rg.checks, "robust K (this design)")
+    cmp_ = compare_section(ids, res.spec.compare, res.compared, rg.checks, "robust K (this design)")
     fig = eps_search_figure(rg)
     return Rendered((prob, gain, cmp_, f"## eps search\n\n![eps]({{figdir}}/{fig.name}.png)"),
                     (fig,))
