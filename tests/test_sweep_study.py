@@ -83,3 +83,18 @@ def test_sections_render_each_comparison(toy):
                     "## Gains designed elsewhere, on this loop", "## Figures"):
         assert heading in text
     assert {"delay-bound-vs-eps", "loop"} <= {f.name for f in figs}
+
+
+def test_loop_sweep_command_prints_the_sweep_of_a_study_that_owns_its_loop(monkeypatch,
+                                                                          capsys):
+    """``synthesize delay-bound`` of a kind with ``loop(design)`` and a spec's
+    ``.sweep`` (workbench.kinds.delay_feedback.cli.loop_sweep_command)."""
+    from workbench import kinds
+    from workbench.kinds.delay_feedback.cli import loop_sweep_command
+    study = SimpleNamespace(loop=lambda design: (A, B, "toy loop header"))
+    monkeypatch.setattr(kinds, "REGISTRY", {"toy-loop": study})
+    design = SimpleNamespace(kind="toy-loop", name="toy", spec=_spec(
+        {"synthesis": {"eps": [1.0], "rel_tol": 1e-3, "h_max": 10.0}}))
+    assert loop_sweep_command(design, eps=[0.5]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("toy loop header\n") and "| 0.5 |" in out

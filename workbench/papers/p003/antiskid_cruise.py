@@ -140,5 +140,16 @@ class AntiskidCruise:
     def quantities(self, res: CruiseResult) -> dict:
         return values(TABLE, res.spec, res)
 
+    def loop(self, design) -> tuple:
+        """(A, B, header) of ``workbench synthesize delay-bound``
+        (:func:`workbench.kinds.delay_feedback.cli.loop_sweep_command`)."""
+        from ...report.markdown import fmt
+        spec = design.spec
+        _, lam_solved, lam, lin = operating_point(spec)
+        return lin.A, lin.B, (
+            f"{design.name}: problem (60) of paper 003 at v_d = {fmt(spec.v_d.value)} m/s, "
+            f"lambda_d = {fmt(lam, 5)} ({'pinned' if spec.lambda_d_pinned else 'solved'}; "
+            f"solved {fmt(lam_solved, 6)})")
+
 
 STUDY = AntiskidCruise()

@@ -14,6 +14,7 @@ from ...features.other_gains import ANCHOR
 from ...features.sweep_study_render import sweep_sections
 from ...plants.adhesion import adhesion_model
 from ...report.markdown import Rendered, fmt, latex_matrix, md_table
+from .antiskid_cruise import PARAM_DOC
 
 
 def _model_section() -> str:
@@ -43,7 +44,7 @@ def render(design, res) -> Rendered:
     spec = design.spec
     sections = []
     # -- problem --------------------------------------------------------------
-    prow = [[f"`{k}`", fmt(q.value, 6), q.unit, _doc(k), q.source]
+    prow = [[f"`{k}`", fmt(q.value, 6), q.unit, PARAM_DOC.get(k, ""), q.source]
             for k, q in spec.params.items()]
     prow.append(["`v_d`", fmt(spec.v_d.value, 6), spec.v_d.unit, "cruise speed", spec.v_d.source])
     if spec.lambda_d_pinned:
@@ -83,8 +84,3 @@ def render(design, res) -> Rendered:
         where=f"{spec.rail} rail, v_d = {fmt(spec.v_d.value)} m/s", law="the cruise law",
         title="Problem (60): certified delay bound vs eps")
     return Rendered(tuple(sections + more), figs, (ANCHOR,))
-
-
-def _doc(k):
-    from .antiskid_cruise import PARAM_DOC
-    return PARAM_DOC.get(k, "")
