@@ -35,7 +35,7 @@ def outputs():
 def test_same_eps_list():
     from workbench.design import load_design
     g, s = load_design(GENERIC), load_design(SPECIAL)
-    assert g.spec.synthesis.eps == s.spec.eps
+    assert g.spec.synthesis.eps == s.spec.sweep.eps
 
 
 def test_same_linearisation_to_rounding():

@@ -58,7 +58,8 @@ def test_run_study_once_per_equal_spec():
     try:
         a = memo.run_study(d, run)
         assert memo.run_study(load_design(DATA / "small-cruise.toml"), run) is a
-        other = dataclasses.replace(d, spec=dataclasses.replace(d.spec, eps=(0.5,)))
+        other = dataclasses.replace(d, spec=dataclasses.replace(
+            d.spec, sweep=dataclasses.replace(d.spec.sweep, eps=(0.5,))))
         assert memo.run_study(other, run) is not a
         assert len(calls) == 2
         assert [t.design for t in memo.study_times()] == ["small-cruise", "small-cruise"]

@@ -19,7 +19,7 @@ REPORTS = Path(__file__).resolve().parents[1] / "reports"
 def wet():
     design = load_design("designs/antiskid-cruise-wet.toml")
     lin = operating_point(design.spec)[3]
-    return design, lin, check_other_gains(lin.A, lin.B, design.spec.other_gains)
+    return design, lin, check_other_gains(lin.A, lin.B, design.spec.sweep.other_gains)
 
 
 def test_table3_gains_are_unstable_on_wet_rail(wet):
@@ -42,7 +42,7 @@ def test_table3_gains_are_unstable_on_wet_rail(wet):
 def test_the_same_gains_are_stable_where_they_were_designed():
     dry = load_design("designs/antiskid-cruise-dry.toml")
     lin = operating_point(dry.spec)[3]
-    gains = load_design("designs/antiskid-cruise-wet.toml").spec.other_gains
+    gains = load_design("designs/antiskid-cruise-wet.toml").spec.sweep.other_gains
     assert all(c.stable for c in check_other_gains(lin.A, lin.B, gains))
 
 

@@ -53,3 +53,29 @@ def test_quantities_match_their_names(robust):
     text = robust_gain_section(IDS, robust)
     assert text.startswith("## Robust gain") and "`a1.2`" in text
     assert eps_search_figure(robust).name == "eps-search"
+
+
+def test_robust_points_study_on_toy_points():
+    """The general study over points (workbench/kinds/delay_feedback/robust_points.py):
+    any points with an id and A, B; its tables read, its quantities declared
+    exactly as computed."""
+    from types import SimpleNamespace
+
+    from workbench.features.quantities import names, values
+    from workbench.kinds.delay_feedback.robust_points import (load_robust_points,
+                                                              robust_points_quantities,
+                                                              run_robust_points)
+    pts = [SimpleNamespace(id=i, A=A, B=B_) for i, (A, B_) in zip(IDS, POINTS)]
+    root = Reader("toy.toml", {"synthesis": TABLE, "compare": [
+        {"name": "zero", "K": [0.0, 0.0], "source": "the open loop, unstable"}]})
+    spec = load_robust_points(root, pts)
+    assert spec.ids == IDS and spec.requirements is None and spec.compare[0].name == "zero"
+    res = run_robust_points(spec)
+    table = robust_points_quantities()
+    q = values(table, spec, res)
+    assert set(q) == names(table, spec)
+    assert q["compare[zero].all_stable"] == "no" and q["compare[zero].unstable_points"] == 2.0
+    assert q["synthesis.K1"] == float(res.robust.synthesis.K[0, 0])
+    with pytest.raises(DesignError, match="compare"):
+        load_robust_points(Reader("toy.toml", {"synthesis": TABLE, "compare": [
+            {"name": "short", "K": [1.0], "source": "x"}]}), pts)

@@ -44,7 +44,7 @@ CAPABILITIES: dict[str, dict[str, str]] = {
         "simulate": "workbench.papers.p003.antiskid_run:simulate_command",
         "sweep": "workbench.papers.p003.antiskid_run:sweep_command"},
     "antiskid-cruise": {
-        "synthesize delay-bound": "workbench.papers.p003.antiskid_cruise_cli:synthesize_command"},
+        "synthesize delay-bound": "workbench.kinds.delay_feedback.cli:loop_sweep_command"},
     "brake-fit": {"fit": "workbench.papers.p000.brake_fit:fit_command"},
     "delay-benchmark": {"benchmark delay": "workbench.benchmark:benchmark_delay"},
     "tracking": {"simulate": "workbench.kinds.tracking.cli:simulate_command"},

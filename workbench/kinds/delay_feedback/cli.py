@@ -49,6 +49,20 @@ def print_sweep(name: str, header: str, rows, settings, as_json: bool) -> int:
     return 0 if all(r.status.value == "certified" for r in rows) else 1
 
 
+def loop_sweep_command(design, *, eps=None, as_json: bool = False) -> int:
+    """``workbench synthesize delay-bound`` of a study that owns its loop: the
+    sweep over ``eps`` (default the spec's ``sweep``,
+    :class:`workbench.features.sweep_study.SweepSpec`) on the (A, B) of the
+    study's ``loop(design) -> (A, B, header)``, printed under ``header``
+    (:func:`print_sweep`); exit 0 if every row is certified, else 1."""
+    from .. import REGISTRY
+    from ...synthesis import synthesize_delay_bound
+    A, B, header = REGISTRY[design.kind].loop(design)
+    sw = design.spec.sweep
+    rows = synthesize_delay_bound(A, B, tuple(eps) if eps else sw.eps, sw.settings)
+    return print_sweep(design.name, header, rows, sw.settings, as_json)
+
+
 def _op_text(spec, op) -> str:
     from ...report.markdown import fmt
     vals = op.as_dict(spec.plant)

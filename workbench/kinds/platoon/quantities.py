@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 
-from ...features.quantities import Declared, Group
+from ...features.quantities import Declared, Group, names, units, values
 from .realism import CASES
 
 __all__ = ["TABLE"]
@@ -139,8 +139,9 @@ TABLE = (
     Declared("delay_sweep.{law}.{k}", "{u}", _sweep_value, over=lambda spec: [] if spec.margin
              is None else [{"law": law, "k": k, "u": u} for law in spec.margin.sweep
                            for k, u in _SWEEP.items()]),
-    Group(names=lambda spec: spec.analysis.quantity_names(spec),
-          values=lambda r: r.spec.analysis.quantities(r.spec, r),
+    # an [analysis] module's own Declared entries (its QUANTITIES)
+    Group(names=lambda spec: names(spec.analysis.QUANTITIES, spec),
+          values=lambda r: values(r.spec.analysis.QUANTITIES, r.spec, r),
           present=lambda spec: spec.analysis is not None,
-          units=lambda spec: spec.analysis.quantity_units(spec)),
+          units=lambda spec: units(spec.analysis.QUANTITIES, spec)),
 )

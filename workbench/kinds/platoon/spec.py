@@ -283,7 +283,10 @@ def _read_margin(root: Reader, laws) -> MarginSpec | None:
 def _read_analysis(root: Reader):
     """``[analysis] module = "pNNN.name"``: a paper's module (under
     ``workbench.papers``) with a ``PLATOON_ANALYSIS`` object, for what a
-    design cannot express (its docstring says why)."""
+    design cannot express (its docstring says why): ``load(root, spec)``,
+    ``QUANTITIES`` (:class:`~workbench.features.quantities.Declared` entries
+    read from the result), optionally ``run(spec, res)`` and the report hooks
+    of :mod:`.render`."""
     return read_paper_module(root, _analysis,
                              "a module of workbench.papers with PLATOON_ANALYSIS")
 

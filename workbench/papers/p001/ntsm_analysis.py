@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from ...controllers.ntsm import NTSMGains
 from ...errors import DesignError
+from ...features.quantities import Declared
 from ...report.markdown import fmt
 
 __all__ = ["PLATOON_ANALYSIS", "NTSMAnalysis"]
@@ -55,6 +56,16 @@ def _c(spec, name: str) -> float:
     return spec.constants[name].value
 
 
+def _lowest_power(g: NTSMGains) -> float:
+    """The smallest power of eq 13 near e = e' = 0 (below 1: no linearisation)."""
+    return min(2.0 - g.b / g.a, g.alpha / g.xi)
+
+
+def _spring(g: NTSMGains) -> float:
+    """The only linear term of eq 13: e'' = -(beta a j / b) e (1/s^2)."""
+    return g.beta * g.a * g.j / g.b
+
+
 class NTSMAnalysis:
     """Paper 001's part of a ``platoon`` design (see the module docstring)."""
 
@@ -70,23 +81,14 @@ class NTSMAnalysis:
             raise DesignError(spec.path, f"constants.{name}.value", value, expected)
         return g
 
-    def quantity_names(self, spec) -> set[str]:
-        return {"delay_margin.linearisable", "delay_margin.lowest_power", "delay_margin.spring"}
-
-    def quantity_units(self, spec) -> dict[str, str]:
-        return {"delay_margin.linearisable": "", "delay_margin.lowest_power": "1",
-                "delay_margin.spring": "1/s^2"}
-
-    def run(self, spec, res):
-        return None
-
-    def quantities(self, spec, res) -> dict:
-        g = spec.analysis_spec
-        lowest = min(2.0 - g.b / g.a, g.alpha / g.xi)
-        return {"delay_margin.linearisable": "yes" if lowest >= 1.0
-                and spec.G_w + spec.G_d == 0.0 else "no",
-                "delay_margin.lowest_power": lowest,
-                "delay_margin.spring": g.beta * g.a * g.j / g.b}
+    #: Eq 13's delay-margin argument as claimable quantities (read by the
+    #: platoon kind from its result ``r``, which holds the spec).
+    QUANTITIES = (
+        Declared("delay_margin.linearisable", "", lambda r: "yes" if _lowest_power(
+            r.spec.analysis_spec) >= 1.0 and r.spec.G_w + r.spec.G_d == 0.0 else "no"),
+        Declared("delay_margin.lowest_power", "1", lambda r: _lowest_power(r.spec.analysis_spec)),
+        Declared("delay_margin.spring", "1/s^2", lambda r: _spring(r.spec.analysis_spec)),
+    )
 
     # -- the report's paper wording (hooks of workbench.kinds.platoon.render) --------
     def problem_note(self, spec, res) -> str:
@@ -155,7 +157,6 @@ class NTSMAnalysis:
         from ...kinds.platoon.realism_render import margin_body
         rz = res.realism
         m, g = rz.margin, spec.analysis_spec
-        q = self.quantities(spec, res)
         f = m.factors
         return (
             "## Delay margin of the NTSM\n\n"
@@ -164,7 +165,7 @@ class NTSMAnalysis:
             "ė^(2−b/a) and s^(α/ξ) have infinite slope at 0, and (G_w + G_d) sign(s) jumps "
             f"by {fmt(2 * (spec.G_w + spec.G_d))} N there; only e enters s to first order "
             "(ė^(b/a) has zero slope). The Lipschitz part linearises to "
-            f"ë = −(βaj/b) e = −{fmt(q['delay_margin.spring'], 4)} e: a spring without "
+            f"ë = −(βaj/b) e = −{fmt(_spring(g), 4)} e: a spring without "
             "damping, not asymptotically stable, so it has no delay margin at all. The "
             "surrogate taken here is the NTSM family's **linear member**: b = a and α = ξ "
             "(every power 1), without the switching term, i.e. the linear sliding-mode law on "

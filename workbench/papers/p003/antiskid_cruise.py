@@ -2,23 +2,16 @@
 certified delay bound of problem (60), cross-checked with exact margins.
 
 Design tables read here: ``[plant]`` (parameters with units and sources),
-``[operating_point]`` (v_d, optional pinned lambda_d), ``[synthesis]``
-(eps sweep and numerical settings), ``[[synthesis.published]]`` (rows a
-paper printed, compared with what we compute — data, never used as inputs
-to the synthesis itself) and the optional ``[tight]`` (Wirtinger-based
-synthesis with its scalar searched automatically,
-:mod:`workbench.lmi.tight_synthesis`, shown next to the paper's row) and
-``[[other_gains]]`` (gains designed elsewhere, checked on this loop:
-:mod:`workbench.features.other_gains`).
+``[operating_point]`` (v_d, optional pinned lambda_d); the sweep of
+``[synthesis]`` over eps with the rows a paper printed
+(``[[synthesis.published]]``), the optional ``[tight]`` and
+``[[other_gains]]`` are the general :mod:`workbench.features.sweep_study`'s,
+which reads, computes and declares them on any single-input loop.
 
-The general pieces live in :mod:`workbench.features` (the printed-row
-comparison :mod:`~workbench.features.published_rows`, the foreign gains
-:mod:`~workbench.features.other_gains`, the eps sweep's figures
-:mod:`~workbench.features.eps_sweep`, which serve ``delay-feedback`` designs
-too, and the ``[tight]`` comparison :mod:`~workbench.features.tight_compare`).
-This module keeps what is paper 003's: the cruise linearisation of its
-adhesion plant (eqs 17-32, :func:`operating_point`), the design tables in
-its parameter names and the quantity names of its reports.
+What stays here is paper 003's: the cruise linearisation of its adhesion
+plant (eqs 17-32, :func:`operating_point`), the plant and operating-point
+tables in its parameter names and the quantities of that operating point
+(lambda_opt, lambda_d, the Taylor coefficients of eqs 18 and 23).
 """
 from __future__ import annotations
 
@@ -26,21 +19,14 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ...errors import DesignError, ModelError
+from ...features.quantities import Declared, names, values
+from ...features.sweep_study import SweepResult, SweepSpec, load_sweep, sweep_quantities
 from ...jsonable import json_method
 from ...plants.units import ADHESION_003 as PARAMETER_UNITS
 from ...reader import Quantity, Reader
-from ...features.other_gains import (GainCheck, OtherGain, check_other_gains, load_other_gains,
-                                     other_gain_quantities)
-from ...features.other_gains import quantity_names as other_gain_names
-from ...features.eps_sweep import read_eps, read_settings
-from ...features.published_rows import (Published, PublishedCheck, load_published,
-                                        published_quantities, published_quantity_names)
-from ...features.tight_compare import (TIGHT_QUANTITIES, TightComparison, TightSettings,
-                                       load_tight, run_tight, tight_quantities)
 
-if TYPE_CHECKING:   # the solvers and the symbolic model load when a design runs
+if TYPE_CHECKING:   # the symbolic model loads when a design runs
     from ...symbolic.linearise import Linearisation
-    from ...synthesis import SynthesisRow, SynthesisSettings
 
 PARAM_DOC = {
     "a": "adhesion peak parameter", "b": "adhesion slope parameter",
@@ -48,6 +34,9 @@ PARAM_DOC = {
     "m": "mass (quarter train)", "zeta": "viscous friction", "c0": "resistance, constant",
     "c1": "resistance, linear", "c2": "resistance, quadratic", "g": "gravity",
 }
+#: The Taylor coefficients of eqs (18) and (23) (quantities ``linearisation.<name>``).
+COEFFICIENTS = ("a1", "a2", "a3", "b1", "b2", "b3", "b4", "b5", "b6",
+                "d1", "d2", "d3", "d4", "d5", "d6")
 
 
 @dataclass(frozen=True)
@@ -56,12 +45,12 @@ class CruiseSpec:
     params: dict
     v_d: Quantity
     lambda_d_pinned: Quantity | None
-    eps: tuple[float, ...]
-    settings: SynthesisSettings
-    published: tuple[Published, ...]
-    compare_published: bool
-    tight: TightSettings | None = None
-    other_gains: tuple[OtherGain, ...] = ()
+    sweep: SweepSpec
+
+    @property
+    def published(self) -> tuple:
+        """The printed rows (read by :mod:`.antiskid_cruise_sampled`)."""
+        return self.sweep.published
 
 
 @dataclass(frozen=True)
@@ -70,22 +59,13 @@ class CruiseResult:
     lambda_d_solved: float
     lambda_d_used: float
     lin: Linearisation
-    rows: tuple[SynthesisRow, ...]
-    published: tuple[PublishedCheck, ...]
-    tight: TightComparison | None = None
-    #: (h, spectral abscissa of x' = A x + B K x(t - h)) for the canonical gain
-    #: of the row with the largest certified bound (the figure of the loop's set)
-    abscissa_vs_h: tuple = ()
-    #: gains of ``[[other_gains]]`` on this loop (:mod:`workbench.features.other_gains`)
-    other_gains: tuple[GainCheck, ...] = ()
-
-    def row(self, eps: float) -> SynthesisRow:
-        return next(r for r in self.rows if r.eps == eps)
+    sweep: SweepResult
+    spec: CruiseSpec
 
     #: The JSON of the result (:func:`workbench.jsonable.to_json`).
     JSON_FIELDS = {"lambda_opt": "lambda_opt", "lambda_d_solved": "lambda_d_solved",
                    "lambda_d_used": "lambda_d_used", "A": "lin.A", "B": "lin.B",
-                   "rows": "rows"}
+                   "rows": "sweep.rows"}
     to_json = json_method
 
 
@@ -107,8 +87,16 @@ def operating_point(spec: CruiseSpec) -> tuple[float, float, float, Linearisatio
     return plant.lambda_opt(), lam_solved, lam_used, lin
 
 
-def _eps_key(eps: float) -> str:
-    return f"{eps:g}"
+#: Every claimable quantity of an ``antiskid-cruise`` design.
+TABLE = (
+    Declared("operating_point.lambda_d", "1", lambda r: r.lambda_d_used),
+    Declared("operating_point.lambda_d_solved", "1", lambda r: r.lambda_d_solved),
+    Declared("operating_point.lambda_opt", "1", lambda r: r.lambda_opt),
+    Declared("operating_point.y1_residual", "m/s^2", lambda r: r.lin.y1_residual),
+    Declared("linearisation.{k}", "?", lambda r, k: r.lin.coefficients[k],
+             over=lambda spec: [{"k": k} for k in COEFFICIENTS]),
+    *sweep_quantities(),
+)
 
 
 class AntiskidCruise:
@@ -129,12 +117,7 @@ class AntiskidCruise:
         op.finish()
         syn = root.table("synthesis")
         syn.string("method", choices=("free-weighting-003",))
-        eps, settings = read_eps(syn), read_settings(syn)
-        published = load_published(syn)
-        compare = syn.boolean("compare_published", default=True)
-        syn.finish()
-        tight = load_tight(root, eps)
-        other = load_other_gains(root)
+        sweep = load_sweep(root, syn)
         from ...plants.adhesion import NumericAdhesion
         plant_values = {k: q.value for k, q in params.items()}
         try:  # an impossible operating point is bad input, found at load time
@@ -142,66 +125,31 @@ class AntiskidCruise:
         except ModelError as exc:
             raise DesignError(root.path, "operating_point.v_d", v_d.value,
                               f"a speed with a creep-region equilibrium ({exc})") from None
-        return CruiseSpec(rail, params, v_d, pinned, eps, settings, published, compare,
-                          tight, other)
+        return CruiseSpec(rail, params, v_d, pinned, sweep)
 
     def quantity_names(self, spec: CruiseSpec) -> set[str]:
-        names = {"operating_point.lambda_d", "operating_point.lambda_d_solved",
-                 "operating_point.lambda_opt", "operating_point.y1_residual", "exact_margin",
-                 "synthesis.best.h_certified"}
-        names |= {f"linearisation.{k}" for k in
-                  ("a1", "a2", "a3", "b1", "b2", "b3", "b4", "b5", "b6",
-                   "d1", "d2", "d3", "d4", "d5", "d6")}
-        for e in spec.eps:
-            for f in ("h_certified", "h_refuted", "K1", "K2", "exact_margin",
-                      "exact_margin_siso", "ratio", "status"):
-                names.add(f"synthesis.rows[eps={_eps_key(e)}].{f}")
-        names |= published_quantity_names(spec.published)
-        if spec.tight:
-            names |= {f"tight.{k}" for k in TIGHT_QUANTITIES}
-        return names | other_gain_names(spec.other_gains)
+        return names(TABLE, spec)
 
     # -- run -------------------------------------------------------------------
     def run(self, design) -> CruiseResult:
-        from ...features.eps_sweep import abscissa_vs_h
-        from ...features.published_rows import check_published
-        from ...synthesis import synthesize_delay_bound
-        spec: CruiseSpec = design.spec
-        lam_opt, lam_solved, lam_used, lin = operating_point(spec)
-        rows = synthesize_delay_bound(lin.A, lin.B, spec.eps, spec.settings)
-        checks = (check_published(lin.A, lin.B, rows, spec.published, spec.eps, spec.settings)
-                  if spec.compare_published else ())
-        tight = (run_tight(lin.A, lin.B, spec.tight, spec.settings, rows, spec.published)
-                 if spec.tight else None)
-        return CruiseResult(lam_opt, lam_solved, lam_used, lin, rows, checks, tight,
-                            abscissa_vs_h(lin.A, lin.B, rows),
-                            check_other_gains(lin.A, lin.B, spec.other_gains))
+        from ...features.sweep_study import run_sweep
+        lam_opt, lam_solved, lam_used, lin = operating_point(design.spec)
+        return CruiseResult(lam_opt, lam_solved, lam_used, lin,
+                            run_sweep(lin.A, lin.B, design.spec.sweep), design.spec)
 
     def quantities(self, res: CruiseResult) -> dict:
-        q = {"operating_point.lambda_d": res.lambda_d_used,
-             "operating_point.lambda_d_solved": res.lambda_d_solved,
-             "operating_point.lambda_opt": res.lambda_opt,
-             "operating_point.y1_residual": res.lin.y1_residual}
-        q.update({f"linearisation.{k}": v for k, v in res.lin.coefficients.items()})
-        for r in res.rows:
-            base = f"synthesis.rows[eps={_eps_key(r.eps)}]"
-            certified = r.status.value == "certified"
-            q[f"{base}.h_certified"] = r.h_certified if certified else None
-            q[f"{base}.h_refuted"] = r.h_refuted
-            q[f"{base}.K1"] = r.K[0] if r.K else None
-            q[f"{base}.K2"] = r.K[1] if r.K else None
-            q[f"{base}.exact_margin"] = r.exact.h if r.exact else None
-            q[f"{base}.exact_margin_siso"] = r.exact_siso.h if r.exact_siso else None
-            q[f"{base}.ratio"] = r.ratio
-            q[f"{base}.status"] = r.status.value
-        best = max(res.rows, key=lambda r: r.h_certified)
-        q["synthesis.best.h_certified"] = best.h_certified if best.h_certified > 0 else None
-        q["exact_margin"] = best.exact.h if best.exact else None
-        q.update(published_quantities(res.published))
-        if res.tight:
-            q.update(tight_quantities(res.tight))
-        q.update(other_gain_quantities(res.other_gains))
-        return q
+        return values(TABLE, res.spec, res)
+
+    def loop(self, design) -> tuple:
+        """(A, B, header) of ``workbench synthesize delay-bound``
+        (:func:`workbench.kinds.delay_feedback.cli.loop_sweep_command`)."""
+        from ...report.markdown import fmt
+        spec = design.spec
+        _, lam_solved, lam, lin = operating_point(spec)
+        return lin.A, lin.B, (
+            f"{design.name}: problem (60) of paper 003 at v_d = {fmt(spec.v_d.value)} m/s, "
+            f"lambda_d = {fmt(lam, 5)} ({'pinned' if spec.lambda_d_pinned else 'solved'}; "
+            f"solved {fmt(lam_solved, 6)})")
 
 
 STUDY = AntiskidCruise()

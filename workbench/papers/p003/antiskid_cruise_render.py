@@ -1,23 +1,20 @@
 """Markdown and figures of the ``antiskid-cruise`` study (pure rendering).
 
-The sweep table and figures, the printed-row comparison and the foreign gains
-are the general renderings of :mod:`workbench.features`; this module keeps
-paper 003's model section and its problem and operating-point wording (the
-``[tight]`` comparison is :mod:`workbench.features.tight_compare_render`'s).
+The sweep's sections and figures (table, printed rows, ``[tight]``, foreign
+gains) are :func:`workbench.features.sweep_study_render.sweep_sections`; this
+module keeps paper 003's model section and its problem and operating-point
+wording.
 """
 from __future__ import annotations
 
 import numpy as np
 import sympy as sp
 
-from ...features.eps_sweep import (eps_sweep_figures, eps_sweep_notes, eps_sweep_table,
-                                   infinite_note)
-from ...features.other_gains import ANCHOR, other_gains_section
-from ...features.published_rows import published_section
-from ...features.tight_compare_render import tight_section
+from ...features.other_gains import ANCHOR
+from ...features.sweep_study_render import sweep_sections
 from ...plants.adhesion import adhesion_model
 from ...report.markdown import Rendered, fmt, latex_matrix, md_table
-from ...report.synthesis_text import recheck_table
+from .antiskid_cruise import PARAM_DOC
 
 
 def _model_section() -> str:
@@ -47,7 +44,7 @@ def render(design, res) -> Rendered:
     spec = design.spec
     sections = []
     # -- problem --------------------------------------------------------------
-    prow = [[f"`{k}`", fmt(q.value, 6), q.unit, _doc(k), q.source]
+    prow = [[f"`{k}`", fmt(q.value, 6), q.unit, PARAM_DOC.get(k, ""), q.source]
             for k, q in spec.params.items()]
     prow.append(["`v_d`", fmt(spec.v_d.value, 6), spec.v_d.unit, "cruise speed", spec.v_d.source])
     if spec.lambda_d_pinned:
@@ -79,27 +76,11 @@ def render(design, res) -> Rendered:
         f"Eigenvalues of $A$: {', '.join(fmt(complex(e).real, 4) for e in ev)} "
         "(the open loop is already stable).\n\n<details><summary>Taylor coefficients "
         "(eqs 18, 23)</summary>\n\n" + co + "\n\n</details>")
-    # -- synthesis --------------------------------------------------------------
-    st = spec.settings
-    sections.append(
-        "## Certified delay bounds (problem 60, cf. Table 3)\n\n"
-        + eps_sweep_table(res.rows, st) + "\n\n" + eps_sweep_notes(st) + "\n\n"
-        + infinite_note(res.rows) + "\n\n" + recheck_table(res))
-    if res.published:
-        sections.append(published_section(res.published))
-    if res.tight:
-        sections.append(tight_section(res.tight, res.lin.A, res.lin.B,
-                                      "ours: problem (60), free weighting, eps fixed"))
-    if res.other_gains:
-        sections.append(other_gains_section(
-            res.other_gains, f"{spec.rail} rail, v_d = {fmt(spec.v_d.value)} m/s",
-            res.lin.A, res.lin.B, "the cruise law"))
-    figs, text = eps_sweep_figures(res.rows, res.published, res.lin.A, res.lin.B,
-                                   res.abscissa_vs_h, "Problem (60): certified delay bound vs eps")
-    sections.append("## Figures\n\n" + text)
-    return Rendered(tuple(sections), figs, (ANCHOR,))
-
-
-def _doc(k):
-    from .antiskid_cruise import PARAM_DOC
-    return PARAM_DOC.get(k, "")
+    # -- synthesis, comparisons, figures ----------------------------------------
+    more, figs = sweep_sections(
+        res.sweep, spec.sweep.settings, lin.A, lin.B,
+        heading="Certified delay bounds (problem 60, cf. Table 3)",
+        reference="ours: problem (60), free weighting, eps fixed",
+        where=f"{spec.rail} rail, v_d = {fmt(spec.v_d.value)} m/s", law="the cruise law",
+        title="Problem (60): certified delay bound vs eps")
+    return Rendered(tuple(sections + more), figs, (ANCHOR,))

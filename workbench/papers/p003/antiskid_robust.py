@@ -12,30 +12,25 @@ Each operating point is the cruise linearisation of paper 003 (eqs 17-32,
 :func:`~workbench.symbolic.linearise.linearise_cruise`) at its solved
 equilibrium lambda_d. Certificates hold at the listed points only.
 
-The robust synthesis, its per-point checks (:mod:`workbench.features.robust_gain`),
-the gains compared at every point and their table are general
-(:mod:`workbench.features.point_gains`, rows read as
-:class:`~workbench.features.other_gains.OtherGain`); this module keeps paper
-003's operating points (its adhesion plant per rail, speed and mass, and
-their lambda_d quantities).
+The robust synthesis over points, its per-point checks, the gains compared
+at every point and the design to requirements are general
+(:mod:`workbench.kinds.delay_feedback.robust_points`, which takes any points
+with an id and their A, B); this module keeps paper 003's operating points
+(its adhesion plant per rail, speed and mass, and their lambda_d quantities).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import DesignError, ModelError
-from ...features.other_gains import OtherGain, load_other_gains
-from ...features.robust_gain import (RobustGain, RobustSettings, load_robust_settings,
-                                     robust_quantities, robust_quantity_names, run_robust)
-from ...jsonable import json_method
+from ...features.quantities import Declared, names, values
+from ...kinds.delay_feedback.robust_points import (RobustPoints, RobustPointsResult,
+                                                   load_robust_points, robust_points_quantities,
+                                                   run_robust_points)
 from ...plants.units import ADHESION_003 as PARAMETER_UNITS
 from ...reader import Quantity, Reader
-
-if TYPE_CHECKING:   # the solvers load when a design runs
-    from ...crosscheck import PointCheck
 
 RAIL_KEYS = ("a", "b", "c")
 
@@ -55,31 +50,6 @@ class Point:
     @property
     def id(self) -> str:
         return f"{self.rail}-v{self.v_d:g}-m{self.mass_factor:g}"
-
-
-@dataclass(frozen=True)
-class RobustSpec:
-    common: dict
-    rails: dict
-    points: tuple[Point, ...]
-    settings: RobustSettings
-    compare: tuple[OtherGain, ...]
-    requirements: object = None     # RequirementsSpec ([requirements]) or None
-
-
-@dataclass(frozen=True)
-class RobustResult:
-    points: tuple[Point, ...]
-    compare: tuple[OtherGain, ...]
-    robust: RobustGain                       # the robust K and its per-point checks
-    compared: tuple[tuple[PointCheck, ...], ...]
-    requirements: object = None     # workbench.requirements.RequirementResult or None
-
-    #: The JSON of the result (:func:`workbench.jsonable.to_json`).
-    JSON_FIELDS = {"eps": "robust.synthesis.eps",
-                   "h_certified": "robust.synthesis.bracket.h_certified",
-                   "K": "robust.synthesis.K", "reason": "robust.synthesis.reason"}
-    to_json = json_method
 
 
 def _points(path, common, rails, op: Reader) -> tuple[Point, ...]:
@@ -110,10 +80,16 @@ def _points(path, common, rails, op: Reader) -> tuple[Point, ...]:
     return tuple(out)
 
 
+#: Every claimable quantity of an ``antiskid-robust`` design.
+TABLE = (*robust_points_quantities(),
+         Declared("points[{i}].lambda_d", "1", lambda r, i, p: p.lambda_d,
+                  over=lambda spec: [{"i": p.id, "p": p} for p in spec.points]))
+
+
 class AntiskidRobust:
     kind = "antiskid-robust"
 
-    def load(self, root: Reader) -> RobustSpec:
+    def load(self, root: Reader) -> RobustPoints:
         plant = root.table("plant")
         cm = plant.table("common")
         common = {k: cm.quantity(k, u, positive=True)
@@ -126,51 +102,17 @@ class AntiskidRobust:
                 rails[rail] = {k: rt.quantity(k, "1", positive=True) for k in RAIL_KEYS}
                 rt.finish()
         plant.finish()
-        points = _points(root.path, common, rails, root.table("operating_points"))
-        syn = root.table("synthesis")
-        settings = load_robust_settings(syn)
-        syn.finish()
-        compare = load_other_gains(root, points[0].B.shape[0], "compare")
-        from ...kinds.delay_feedback.requirements import load_rate_requirements
-        return RobustSpec(common, rails, points, settings, compare,
-                          load_rate_requirements(root))
+        return load_robust_points(root, _points(root.path, common, rails,
+                                                root.table("operating_points")))
 
-    def quantity_names(self, spec: RobustSpec) -> set[str]:
-        ids = [p.id for p in spec.points]
-        names = robust_quantity_names(ids, spec.points[0].A.shape[0])
-        names |= {f"points[{i}].lambda_d" for i in ids}
-        from ...kinds.delay_feedback.requirements import requirement_quantity_names
-        names |= requirement_quantity_names(spec.requirements)
-        names |= {"requirements.K1", "requirements.K2"} if spec.requirements else set()
-        from ...features.point_gains import compare_quantity_names
-        return names | compare_quantity_names(ids, spec.compare)
+    def quantity_names(self, spec: RobustPoints) -> set[str]:
+        return names(TABLE, spec)
 
-    def run(self, design) -> RobustResult:
-        s: RobustSpec = design.spec
-        pts = [(p.A, p.B) for p in s.points]
-        from ...features.point_gains import check_named_gains
-        robust = run_robust(pts, s.settings)
-        compared = check_named_gains(pts, s.compare, s.settings.order, s.settings.margin)
-        req = None
-        if s.requirements is not None:       # the design to requirements (issue 31)
-            from ...requirements import Requirements, design_to_requirements
-            r = s.requirements
-            req = design_to_requirements(pts, Requirements(r.delay, r.decay_rate,
-                                                           objective=r.objective))
-        return RobustResult(s.points, s.compare, robust, compared, req)
+    def run(self, design) -> RobustPointsResult:
+        return run_robust_points(design.spec)
 
-    def quantities(self, res: RobustResult) -> dict:
-        ids = [p.id for p in res.points]
-        q = robust_quantities(ids, res.points[0].A.shape[0], res.robust)
-        q |= {f"points[{p.id}].lambda_d": p.lambda_d for p in res.points}
-        if res.requirements is not None:
-            from ...kinds.delay_feedback.requirements import requirement_quantities
-            q.update(requirement_quantities(res.requirements))
-            K = res.requirements.K
-            q["requirements.K1"] = None if K is None else float(K[0, 0])
-            q["requirements.K2"] = None if K is None else float(K[0, 1])
-        from ...features.point_gains import compare_quantities
-        return q | compare_quantities(ids, res.compare, res.compared)
+    def quantities(self, res: RobustPointsResult) -> dict:
+        return values(TABLE, res.spec, res)
 
 
 STUDY = AntiskidRobust()

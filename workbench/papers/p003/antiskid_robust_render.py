@@ -1,11 +1,10 @@
 """Markdown and figure of the ``antiskid-robust`` study (pure rendering): paper
-003's problem and requirements wording. The robust gain's section and eps
-figure are :mod:`workbench.features.robust_gain_render`'s, the per-point and
-compared-gain tables :mod:`workbench.features.point_gains`'."""
+003's problem and requirements wording. The robust gain's section, the
+compared gains and the eps figure are
+:func:`workbench.kinds.delay_feedback.robust_points_render.robust_points_sections`."""
 from __future__ import annotations
 
-from ...features.point_gains import compare_section
-from ...features.robust_gain_render import eps_search_figure, robust_gain_section
+from ...kinds.delay_feedback.robust_points_render import robust_points_sections
 from ...report.markdown import Rendered, fmt, md_table
 
 
@@ -26,8 +25,7 @@ def _requirements(spec, res) -> str:
 
 
 def render(design, res) -> Rendered:
-    rg, pts = res.robust, res.points
-    ids = [p.id for p in pts]
+    rg, pts = res.robust, res.spec.points
     prob = ("## Problem\n\nOne state-feedback gain K for the cruise error system "
             "E' = A_i E + B_i K E(t - h) of paper 003 (eq 32) at every operating point i below "
             f"(rail x cruise speed x mass factor; {len(pts)} points, each linearised at its own "
@@ -45,10 +43,5 @@ def render(design, res) -> Rendered:
                         for p in pts], "llrrr"))
     if res.requirements is not None:
         prob = _requirements(design.spec, res) + "\n\n" + prob
-    gain = robust_gain_section(ids, rg)
-    if rg.synthesis.K is None:
-        return Rendered((prob, gain))
-    cmp_ = compare_section(ids, res.compare, res.compared, rg.checks, "robust K (this design)")
-    fig = eps_search_figure(rg)
-    return Rendered((prob, gain, cmp_, f"## eps search\n\n![eps]({{figdir}}/{fig.name}.png)"),
-                    (fig,))
+    sections, figs = robust_points_sections(res, "robust K (this design)")
+    return Rendered((prob, *sections), figs)
