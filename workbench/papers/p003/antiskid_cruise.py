@@ -49,7 +49,7 @@ class CruiseSpec:
 
     @property
     def published(self) -> tuple:
-        """The printed rows (read by :mod:`.antiskid_cruise_sampled`)."""
+        """The printed rows (the sampled-data check of issue 34 reads them)."""
         return self.sweep.published
 
 
