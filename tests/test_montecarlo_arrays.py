@@ -179,3 +179,16 @@ def test_share_findings_of_a_toy_sweep_over_three_levels():
     assert levels("toy.fraction.grew", 0.2).decides == ("holds", "undecided", "undecided")
     assert levels("toy.halving.fraction_agree", 1.0).reason.startswith("a comparison of two")
     assert levels("toy.fraction.grew", 0.2, None).reason.endswith("step check of its Monte Carlo runs")
+
+
+def test_draws_from_declared_distributions():
+    from workbench.features.montecarlo import Distribution
+    from workbench.sim.batch import uniform_draws
+    norm = Distribution("normal", 1.0, 0.04, 0.85, 1.15, "toy")
+    got = draw_runs(50, 7, {"a": (0.5, 2.0), "m": norm, "g": Distribution(
+        "uniform", -3.0, 3.0, -3.0, 3.0, "toy")}, start=10)
+    ref = uniform_draws(50, 7, {"a": (0.5, 2.0), "m": (0.0, 1.0), "g": (-3.0, 3.0)}, 10)
+    np.testing.assert_array_equal(got["a"], ref["a"])      # bit for bit as uniform_draws
+    np.testing.assert_array_equal(got["g"], ref["g"])
+    np.testing.assert_array_equal(got["m"], norm.ppf(ref["m"]))
+    assert 0.85 <= got["m"].min() and got["m"].max() <= 1.15

@@ -1,7 +1,9 @@
 """What a Monte Carlo run draws, from (seed, run index) only (issue 35: one
 sampling of a sweep's runs).
 
-* named parameters, uniform on declared ranges: row i of one seeded draw
+* named parameters, uniform on declared ranges or from a declared
+  :class:`~workbench.features.montecarlo.Distribution` (its inverse CDF):
+  row i of one seeded draw of uniforms
   (:func:`workbench.sim.batch.uniform_draws`), so the first n runs of a
   larger sweep with the same seed draw the same values and a chunk of runs
   draws its own rows (:func:`draw_runs`);
@@ -32,8 +34,11 @@ def draw_runs(n: int, seed: int, ranges: dict, start: int = 0,
     ----------
     n, seed, start : int
     ranges : dict
-        name -> (lo, hi): uniform, row i of one seeded draw
-        (:func:`~workbench.sim.batch.uniform_draws`).
+        name -> (lo, hi), uniform, or a
+        :class:`~workbench.features.montecarlo.Distribution` (its ``ppf``
+        of the uniform): row i of one seeded draw of uniforms on [0, 1)
+        (:func:`~workbench.sim.batch.uniform_draws`; lo + (hi - lo) u, as
+        there).
     streams : dict, optional
         name -> (stream, (lo, hi)): uniform, the first number of the run's
         key in that counter-based stream
@@ -42,7 +47,9 @@ def draw_runs(n: int, seed: int, ranges: dict, start: int = 0,
     """
     from ..sim.batch import uniform_draws
     from ..sim.counter_rng import run_key, uniform
-    out = uniform_draws(n, seed, ranges, start)
+    u = uniform_draws(n, seed, dict.fromkeys(ranges, (0.0, 1.0)), start)
+    out = {k: r.ppf(u[k]) if hasattr(r, "ppf") else r[0] + (r[1] - r[0]) * u[k]
+           for k, r in ranges.items()}
     runs = np.arange(start, n)
     for name, (stream, (lo, hi)) in (streams or {}).items():
         out[name] = lo + (hi - lo) * uniform(run_key(seed, stream, runs), 0)
