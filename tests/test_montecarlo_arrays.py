@@ -147,7 +147,8 @@ def test_claimed_members_and_unstepped_levels():
     from workbench.claims import ClaimResult, Verdict
     from workbench.features.refinement import claimed_members, unstepped_levels
     claims = [_claim("a", "runs[fast].converged", "==", "yes"),
-              _claim("b", "runs[slow].peak", "<=", 1.0), _claim("c", "runs[x].converged.no", "==", 1)]
+              _claim("b", "runs[slow].peak", "<=", 1.0),
+              _claim("c", "runs[x].converged.no", "==", 1)]
     assert claimed_members(claims, r"runs\[([^\]]+)\]\.converged") == {"fast"}
     lv = unstepped_levels(ClaimResult(claims[1], 0.1234567, Verdict.PASS), "no step")
     assert lv.values == ("0.123457",) * 3 and lv.parameter == "no step"
@@ -178,7 +179,8 @@ def test_share_findings_of_a_toy_sweep_over_three_levels():
     assert lv.values[1] == "0 of the first 4, so 0-6 of 10 grew: holds"
     assert levels("toy.fraction.grew", 0.2).decides == ("holds", "undecided", "undecided")
     assert levels("toy.halving.fraction_agree", 1.0).reason.startswith("a comparison of two")
-    assert levels("toy.fraction.grew", 0.2, None).reason.endswith("step check of its Monte Carlo runs")
+    assert levels("toy.fraction.grew", 0.2, None).reason.endswith(
+        "step check of its Monte Carlo runs")
 
 
 def test_draws_from_declared_distributions():

@@ -38,7 +38,8 @@ from ..sim.convergence import (CONVERGED, INCONCLUSIVE, LEVELS, NOT_CONVERGED, P
                               ROUNDING, Refinement, refinement_check)
 
 __all__ = ["LEVELS", "Levels", "ROUNDING", "RefinementRow", "RefinementTable", "claim_tolerance",
-           "claimed_members", "guarded_check", "not_converged_text", "refine_by_readers", "refine_findings",
+           "claimed_members", "guarded_check", "not_converged_text", "refine_by_readers",
+           "refine_findings",
            "refinement_row", "screen", "screen_levels", "screen_reason", "screen_tolerances",
            "share_claim_levels", "share_levels", "share_value", "unstepped_levels"]
 
