@@ -196,26 +196,22 @@ def _rate_levels(design, result, cache, m, r) -> Levels:
 def _mc_levels(design, result, cache, m, r) -> Levels:
     """A Monte Carlo share finding at the sweep's dt, dt/2, dt/4 (the runs
     the halving check refines,
-    :func:`workbench.features.montecarlo_halving.sweep_share_levels`)."""
+    :func:`workbench.features.montecarlo_halving.sweep_share_levels`; dt/4:
+    the first n runs by the sweep's own chunk function,
+    :func:`~workbench.papers.p003.antiskid_montecarlo.range_worker`)."""
     def quarter():
         if "mc" not in cache:
-            cache["mc"] = _mc_quarter(design, result, result.halving.n, result.halving.dt / 4)
+            from .antiskid_halving import _step_values
+            from .antiskid_kernel import default_kernel
+            from .antiskid_montecarlo import range_runs, range_worker
+            hc = result.halving
+            out = range_worker({"design": design, "K": tuple(result.K), "i0": 0, "i1": hc.n,
+                                "seed": design.spec.montecarlo.seed, "step": hc.dt / 4,
+                                "kernel": default_kernel()})
+            cache["mc"] = _step_values(*range_runs(out, design.spec.scenario["t_brake"]))
         return cache["mc"]
     return sweep_share_levels(r, lambda k: result.montecarlo.violations[k], result.halving,
                               MC_OUTCOMES, quarter, "montecarlo")
-
-
-def _mc_quarter(design, result, n: int, step: float) -> dict:
-    """Outcomes of the first n sweep runs at ``step``, the sweep's dt/4 (the sweep's
-    own chunk function, :func:`~workbench.papers.p003.antiskid_montecarlo.range_worker`)."""
-    from .antiskid_halving import _step_values
-    from .antiskid_kernel import default_kernel
-    from .antiskid_montecarlo import range_runs, range_worker
-    out = range_worker({"design": design, "K": tuple(result.K), "i0": 0, "i1": n,
-                        "seed": design.spec.montecarlo.seed, "kernel": default_kernel(),
-                        "step": step})
-    vals = _step_values(*range_runs(out, design.spec.scenario["t_brake"]))
-    return {k: tuple(bool(x) for x in vals[k]) for k in ("diverged", "above_lambda_opt")}
 
 
 def quarter_cases(design) -> frozenset:
