@@ -189,7 +189,7 @@ def agree(a: float, b: float, rtol: float, atol: float) -> bool:
 
 
 def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict, metrics,
-                  outcomes=()) -> tuple[dict, dict, dict]:
+                  outcomes=(), masked: dict | None = None) -> tuple[dict, dict, dict]:
     """Per-run values at dt (``coarse``) and dt/2 (``fine``) compared.
 
     Parameters
@@ -201,6 +201,9 @@ def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict, metrics,
     atol : dict
         Metric -> absolute tolerance (missing: 0).
     metrics, outcomes : sequence of str
+    masked : dict, optional
+        Metric -> per-run flags: a flagged run's metric is NaN at both steps
+        (not compared; e.g. a value a run did not determine at one step).
 
     Returns
     -------
@@ -211,6 +214,9 @@ def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict, metrics,
     """
     c, f = ({**{k: tuple(float(x) for x in vals[k]) for k in metrics},
              **{k: tuple(bool(x) for x in vals[k]) for k in outcomes}} for vals in (coarse, fine))
+    for k, flags in (masked or {}).items():
+        for vals in (c, f):
+            vals[k] = tuple(math.nan if m else x for x, m in zip(vals[k], flags))
     same = {k: tuple(agree(a, b, rtol, atol.get(k, 0.0)) for a, b in zip(c[k], f[k]))
             for k in metrics}
     same.update({k: tuple(a == b for a, b in zip(c[k], f[k])) for k in outcomes})

@@ -10,7 +10,9 @@ holds them), which of them are compared, and the comparison itself
 (typically :func:`workbench.features.convergence.compare_steps`, with the
 study's own rules). The dt side is either run here too or taken from the
 sweep's first n runs (each run of a batch follows its single-run trajectory,
-so a run's values do not depend on its chunk).
+so a run's values do not depend on its chunk). :func:`sweep_share_levels`
+refines a finding on the share of a sweep's runs with an outcome over the
+sweep's runs at dt and the first n at dt/2 and dt/4.
 """
 from __future__ import annotations
 
@@ -20,7 +22,7 @@ from typing import Callable
 
 from .convergence import StepComparison
 
-__all__ = ["HalvingCheck", "halving_quantity_names", "start_halving"]
+__all__ = ["HalvingCheck", "halving_quantity_names", "start_halving", "sweep_share_levels"]
 
 
 @dataclass(frozen=True)
@@ -96,3 +98,32 @@ def halving_quantity_names(prefix: str) -> set[str]:
     ``prefix``: runs checked, runs whose every metric and outcome agrees,
     and their fraction."""
     return {f"{prefix}.runs", f"{prefix}.agree", f"{prefix}.fraction_agree"}
+
+
+def sweep_share_levels(finding, at_dt: Callable, check, outcomes: dict, at_quarter: Callable,
+                       prefix: str):
+    """A finding on the share of a sweep's runs with an outcome at the
+    sweep's dt, dt/2 and dt/4: all N runs at dt (``at_dt(outcome)``: its N
+    flags, e.g. of the sweep's
+    :class:`~workbench.features.montecarlo_stats.RunsResult`), the first n
+    at dt/2 (``check``, the :class:`HalvingCheck`; None: the design has
+    none) and at dt/4 (``at_quarter()``: outcome -> n bools, called only
+    when needed), by
+    :func:`workbench.features.refinement.share_claim_levels`.
+
+    ``outcomes``: share quantity -> the outcome behind it (a flag of the
+    sweep and of the check); ``prefix``: of the sweep's quantities (its
+    ``<prefix>.halving.fraction_agree`` compares two steps and is not
+    refined; the levels are named ``<prefix>.dt``).
+    """
+    from .refinement import Levels, share_claim_levels
+    qn = finding.claim.quantity
+    if check is None:
+        return Levels((), reason="the design has no step check of its Monte Carlo runs")
+    if qn == f"{prefix}.halving.fraction_agree":
+        return Levels((), reason="a comparison of two steps, not a metric of the runs; the "
+                      "outcomes behind the Monte Carlo findings are refined three levels in "
+                      "the rows of the share findings (first runs at dt, dt/2, dt/4)")
+    key = outcomes[qn]
+    return share_claim_levels(finding.claim, at_dt(key), check.fine[key],
+                              at_quarter()[key], key.replace("_", " "), f"{prefix}.dt", check.dt)

@@ -10,7 +10,9 @@ every finding at the three levels with
 says what tolerance the Richardson estimate must stay below. A finding
 whose metric has not converged is INCONCLUSIVE (:mod:`workbench.verify`).
 A study that refines its own parameters gives :class:`Levels` per finding,
-read by :func:`refine_by_readers` (quantity pattern -> metric reader).
+read by :func:`refine_by_readers` (quantity pattern -> metric reader;
+:func:`unstepped_levels` for a metric without a step, :func:`claimed_members`
+for the members a claim asks to refine once more).
 
 Also here: :func:`guarded_check` (a sequence whose differences change sign
 is not in its asymptotic range), :func:`screen` over several metrics and the
@@ -36,9 +38,10 @@ from ..sim.convergence import (CONVERGED, INCONCLUSIVE, LEVELS, NOT_CONVERGED, P
                               ROUNDING, Refinement, refinement_check)
 
 __all__ = ["LEVELS", "Levels", "ROUNDING", "RefinementRow", "RefinementTable", "claim_tolerance",
-           "guarded_check", "not_converged_text", "refine_by_readers", "refine_findings",
+           "claimed_members", "guarded_check", "not_converged_text", "refine_by_readers",
+           "refine_findings",
            "refinement_row", "screen", "screen_levels", "screen_reason", "screen_tolerances",
-           "share_claim_levels", "share_levels", "share_value"]
+           "share_claim_levels", "share_levels", "share_value", "unstepped_levels"]
 
 
 @dataclass(frozen=True)
@@ -318,6 +321,23 @@ def refine_by_readers(findings, readers) -> dict:
         out[r.claim.id] = (read[1](read[0], r) if read else
                            Levels((), reason=f"no three-level check of `{qn}` in this study"))
     return out
+
+
+def claimed_members(claims, pattern: str) -> frozenset:
+    r"""The first group of ``pattern`` (a regular expression matching a whole
+    quantity, e.g. ``r"cases\[([^\]]+)\]\.converged"``) over the quantities of
+    ``claims``: the members (cases, scenarios) a claim speaks of, which a
+    study may refine once more."""
+    import re
+    return frozenset(m.group(1) for c in claims if (m := re.fullmatch(pattern, c.quantity)))
+
+
+def unstepped_levels(finding, label: str) -> Levels:
+    """The :class:`Levels` of a finding whose metric has no step (e.g. a
+    certificate at a printed point): its printed value (6 digits) at every
+    level; ``label`` says why."""
+    v = fmt(finding.got, 6)
+    return Levels((v, v, v), label)
 
 
 def share_value(quantity: str, k: int, n: int) -> float:

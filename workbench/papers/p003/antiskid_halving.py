@@ -15,7 +15,7 @@ at the two steps.
 """
 from __future__ import annotations
 
-import math
+from functools import partial
 
 import numpy as np
 
@@ -56,29 +56,23 @@ def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict) -> tuple[di
         :func:`workbench.features.convergence.compare_steps` (a metric by
         :func:`~workbench.features.convergence.agree`: both NaN agree, one
         NaN disagrees; an outcome when it is equal). Paper-specific:
-        ``lam_max_over_opt`` is set NaN at both steps (not compared) for a
-        run that diverged in a traction phase (``phase_diverged`` <
-        BRAKE_IN) at either step: its maximum there is where the divergence
-        test fired, as for the nominal cases
+        ``lam_max_over_opt`` is masked (not compared) for a run that
+        diverged in a traction phase (``phase_diverged`` < BRAKE_IN) at
+        either step: its maximum there is where the divergence test fired,
+        as for the nominal cases
         (:func:`~workbench.papers.p003.antiskid_run.case_metrics`).
     """
     from ...controllers.antiskid003_settings import BRAKE_IN
     from ...features.convergence import compare_steps as compare
-
     traction = (np.asarray(coarse["phase_diverged"], float) < BRAKE_IN) | (
         np.asarray(fine["phase_diverged"], float) < BRAKE_IN)
-    masked = [{**vals, "lam_max_over_opt": tuple(
-        math.nan if t else float(x) for x, t in zip(vals["lam_max_over_opt"], traction))}
-        for vals in (coarse, fine)]
-    return compare(*masked, rtol, atol, HALVING_METRICS, HALVING_OUTCOMES)
+    return compare(coarse, fine, rtol, atol, HALVING_METRICS, HALVING_OUTCOMES,
+                   masked={"lam_max_over_opt": traction})
 
 
 def _step_values(metrics: dict, viol: dict) -> dict:
     """Per-run metrics and outcomes of one step, as :func:`compare_steps` takes them."""
-    return {**{k: np.asarray(metrics[k], float) for k in HALVING_METRICS + ("phase_diverged",)},
-            "diverged": np.asarray(viol["diverged"], bool),
-            "stopped": ~np.asarray(viol["not_stopped"], bool),
-            "above_lambda_opt": np.asarray(viol["above_lambda_opt"], bool)}
+    return {**metrics, **viol, "stopped": ~np.asarray(viol["not_stopped"], bool)}
 
 
 def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
@@ -117,12 +111,7 @@ def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
                          check, inp["dt"], n, coarse=coarse, pool=pool)
 
 
-def halving_quantity_names() -> set[str]:
-    """Quantities of :func:`halving_quantities`."""
-    return general_names(PREFIX)
-
-
-def halving_quantities(hc: HalvingCheck) -> dict:
-    """Runs checked, runs whose every metric and outcome agrees, and their
-    fraction (:meth:`StepComparison.quantities`)."""
-    return hc.quantities(PREFIX)
+#: Quantities of the check under :data:`PREFIX`: runs checked, runs whose every
+#: metric and outcome agrees, and their fraction (:meth:`StepComparison.quantities`).
+halving_quantity_names = partial(general_names, PREFIX)
+halving_quantities = partial(HalvingCheck.quantities, prefix=PREFIX)

@@ -21,47 +21,39 @@ mass): the sweep measures robustness, not re-tuning.
 One path (:func:`start_sweep`): a chunk is a pure function of (design,
 gain, seed, sample range, step), :func:`range_worker`, which draws its own
 samples (from ``start``), so a payload is a few kilobytes whatever the
-sweep's size. The chunks' arrays are held in memory
-(:func:`workbench.features.montecarlo_chunks.start_batches`) or, with
-``out`` (``workbench sweep --out DIR [--resume]``), streamed: one ``.npz``
-file per chunk written as it finishes, ``resume`` skipping the files
-already written and a folder of another sweep (other design data, seed,
-size, chunking or step path) refused
-(:func:`workbench.features.montecarlo_chunks.start_streaming`; why ``.npz``
-per chunk and not one Parquet file: each chunk is one atomic file that numpy
-reads without a new dependency, ~50 kB for 250 runs). Either way the
-result is made from the same arrays, so a streamed sweep equals the
-in-memory one bit for bit. File ``chunk-<i0>-<i1>.npz`` (runs i0 <= i < i1):
-``index``, ``draw.<name>`` (the samples), ``raw.<field>`` (the
-:class:`RunMetrics` of each run) and ``lambda_opt`` (of each run's adhesion
-curve); ``sweep.json``: design, size, seed, chunking, step path, t_brake and
-a hash of the data every run shares.
+sweep's size. The driver (chunks, pool or Dask, progress, ``.npz`` files
+per chunk with ``workbench sweep --out DIR [--resume]``, the manifest) is
+the general :func:`workbench.features.montecarlo_arrays.start_array_sweep`,
+the draws :func:`workbench.features.montecarlo_draws.draw_runs` and the
+statistics of the runs
+:class:`workbench.features.montecarlo_stats.RunsResult`. A chunk file holds
+``index``, ``draw.<name>``, ``raw.<field>`` (the :class:`RunMetrics` of
+each run) and ``lambda_opt`` (of each run's adhesion curve); ``sweep.json``:
+design, size, seed, chunking, step path, t_brake and a hash of the data
+every run shares.
 
-The drivers (chunks, pool or Dask, progress, files, resume) are the general
-:mod:`workbench.features.montecarlo_chunks` and the statistics of the runs
-:class:`workbench.features.montecarlo_stats.RunsResult`; this module keeps
-what is paper 003's: what a run draws, its kernel's payloads and call, what
-identifies its sweep, and its metrics and outcomes (the creep ratio against
-each run's own lambda_opt). The step-size check of the sweep's runs is
+This module keeps what is paper 003's: what a run draws and how the draws
+enter its plant (mass factor, wet-dry interpolation of the adhesion curve),
+its kernel's payloads and call, what identifies its sweep, and its metrics
+and outcomes (the creep ratio against each run's own lambda_opt). The
+step-size check of the sweep's runs is
 :mod:`workbench.papers.p003.antiskid_halving`; the rendering is
 :mod:`workbench.papers.p003.antiskid_montecarlo_render`.
 """
 from __future__ import annotations
 
-import dataclasses
-import hashlib
-import json
 import math
 from dataclasses import asdict, dataclass
-from functools import lru_cache
+from functools import partial
 from typing import ClassVar
 
 import numpy as np
 
-from ...features.montecarlo_chunks import (default_chunk, read_streamed, start_batches,
-                                           start_streaming as stream)
+from ...features.montecarlo_arrays import (chunk_arrays, draws_of, inputs_digest,
+                                           start_array_sweep)
+from ...features.montecarlo_chunks import read_streamed
 from ...features.montecarlo_stats import OK, RunsResult, quantity_names
-from ...sim.batch import PendingBatch, available_cpus, uniform_draws
+from ...sim.batch import PendingBatch
 from .antiskid_run_spec import SweepSpec
 
 #: Summary statistics reported per metric. The time to the stop (v <= v_stop)
@@ -94,17 +86,13 @@ class SweepResult(RunsResult):
     OUTCOMES: ClassVar[tuple] = OUTCOMES
 
 
-def montecarlo_quantity_names() -> set[str]:
-    """Quantities of a sweep run by the ``antiskid-run`` study:
-    ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
-    ``montecarlo.fraction.<violation>`` and ``montecarlo.wilson.<outcome>.lo``
-    / ``.hi`` (the Wilson 95 % interval of an outcome's rate)."""
-    return quantity_names("montecarlo", SUMMARY_METRICS, VIOLATIONS, OUTCOMES)
-
-
-def montecarlo_quantities(res: SweepResult) -> dict:
-    """The values of :func:`montecarlo_quantity_names` (None: no finite value)."""
-    return res.quantities("montecarlo")
+#: Quantities of a sweep run by the ``antiskid-run`` study (None: no finite
+#: value): ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
+#: ``montecarlo.fraction.<violation>`` and ``montecarlo.wilson.<outcome>.lo``
+#: / ``.hi`` (the Wilson 95 % interval of an outcome's rate).
+montecarlo_quantity_names = partial(quantity_names, "montecarlo", SUMMARY_METRICS, VIOLATIONS,
+                                    OUTCOMES)
+montecarlo_quantities = partial(SweepResult.quantities, prefix="montecarlo")
 
 
 def draw_samples(n: int, seed: int, spec: SweepSpec, start: int = 0) -> dict:
@@ -114,31 +102,14 @@ def draw_samples(n: int, seed: int, spec: SweepSpec, start: int = 0) -> dict:
     period) per run, uniform, from the counter-based generator of
     (seed, run) (:mod:`workbench.sim.counter_rng`): the first four draws
     are those of the same design without perturbations."""
-    out = uniform_draws(n, seed, {"mass": spec.mass, "adhesion": spec.adhesion, "h": spec.h,
-                                  "v0": spec.v0}, start)
+    from ...features.montecarlo_draws import draw_runs
+    from ...sim.counter_rng import DELAY_PERIOD, DELAY_PHASE
     pt = spec.perturb
-    if pt is not None and pt.delay_period is not None:
-        from ...sim.counter_rng import DELAY_PERIOD, DELAY_PHASE, run_key, uniform
-        runs = np.arange(start, n)
-        lo, hi = pt.delay_period
-        out["delay_period"] = lo + (hi - lo) * uniform(run_key(seed, DELAY_PERIOD, runs), 0)
-        out["delay_phase"] = uniform(run_key(seed, DELAY_PHASE, runs), 0)
-    return out
-
-
-def perturbations(p: dict | None, sl: slice):
-    """The :class:`~workbench.sim.perturb.Perturbations` of a payload's
-    ``perturb`` entry (None: none)."""
-    if p is None:
-        return None
-    from ...sim.counter_rng import GRADE, NOISE_OMEGA, NOISE_V, run_key
-    from ...sim.perturb import Perturbations
-    run = np.asarray(p["run"], np.int64)[sl]
-    keys = {c: tuple(run_key(p["seed"], k, run).tolist())
-            for c, k in (("v", NOISE_V), ("omega", NOISE_OMEGA), ("grade", GRADE))}
-    return Perturbations(tuple(run.tolist()), keys, p["noise_v"], p["noise_omega"],
-                         p["noise_every"], p["grade"], p["segment"], p["delay"],
-                         tuple(p["period"][sl]), tuple(p["phase"][sl]))
+    varying = pt is not None and pt.delay_period is not None
+    return draw_runs(n, seed, {"mass": spec.mass, "adhesion": spec.adhesion, "h": spec.h,
+                               "v0": spec.v0}, start,
+                     {"delay_period": (DELAY_PERIOD, pt.delay_period),
+                      "delay_phase": (DELAY_PHASE, (0.0, 1.0))} if varying else None)
 
 
 def chunk_worker(payload: dict) -> dict:
@@ -156,7 +127,7 @@ def chunk_worker(payload: dict) -> dict:
     run = RunSettings(plant, cs, np.asarray(payload["h"], float),
                       (np.asarray(payload["v0"], float), payload["lambda0"]),
                       payload["u_init"], payload["t_end"],
-                      perturbations(payload.get("perturb"), slice(None)))
+                      payload.get("perturb"))
     m = simulate_batch(run, payload["dt"], payload.get("kernel", "numpy"))
     return {"index": payload["index"], "metrics": {k: np.asarray(v, float).tolist()
                                                    for k, v in vars(m).items()}}
@@ -198,56 +169,36 @@ def chunk_payload(inp: dict, i0: int, i1: int, dt: float, kernel: str = "numpy")
            "h": d["h"][sl].tolist(), "v0": d["v0"][sl].tolist(),
            "lambda0": sc["lambda0"], "u_init": sc["u_init"], "t_end": sc["t_end"], "dt": dt}
     pt = inp.get("perturb")
-    if pt is not None:
-        # the noise is held over the sweep's step: a run at dt / 2 sees the same noise
-        every = round(inp["dt"] / dt)
-        if not abs(every * dt - inp["dt"]) <= 1e-12 * inp["dt"]:
-            raise ValueError(f"dt = {dt!r}: the noise needs a step that divides {inp['dt']!r}")
-        varying = pt.delay_period is not None
-        out["perturb"] = {
-            "seed": inp["seed"], "run": inp["run"][sl].tolist(), "noise_v": pt.noise_v,
-            "noise_omega": pt.noise_omega, "noise_every": every,
-            "grade": None if pt.gradient is None else tuple(g / 1000 for g in pt.gradient),
-            "segment": pt.segment, "delay": tuple(inp["h_range"]) if varying else None,
-            "period": d["delay_period"][sl].tolist() if varying else [],
-            "phase": d["delay_phase"][sl].tolist() if varying else []}
+    if pt is not None:      # the sim's Perturbations of runs i0 <= i < i1
+        from ...features.montecarlo_draws import hold_steps, stream_keys
+        from ...sim.counter_rng import GRADE, NOISE_OMEGA, NOISE_V
+        from ...sim.perturb import Perturbations
+        run, varying = inp["run"][sl], pt.delay_period is not None
+        wave = {k: tuple(d[k][sl].tolist()) if varying else ()
+                for k in ("delay_period", "delay_phase")}
+        out["perturb"] = Perturbations(
+            tuple(run.tolist()),
+            stream_keys(inp["seed"], {"v": NOISE_V, "omega": NOISE_OMEGA, "grade": GRADE}, run),
+            noise_v=pt.noise_v, noise_omega=pt.noise_omega,
+            noise_every=hold_steps(inp["dt"], dt),  # a run at dt / 2 sees the same noise
+            grade=None if pt.gradient is None else tuple(g / 1000 for g in pt.gradient),
+            segment=pt.segment, delay=tuple(inp["h_range"]) if varying else None,
+            period=wave["delay_period"], phase=wave["delay_phase"])
     return out
-
-
-@lru_cache(maxsize=1)
-def _dmu_traction():
-    """d mu / d lambda of the traction curve (eq 6), lambdified (``math``)
-    from the one sympy model, parameters as arguments (PARAM_ORDER)."""
-    import sympy as sp
-
-    from ...plants.adhesion import adhesion_model
-    from ...sim.wheel_slip import PARAM_ORDER
-    mdl = adhesion_model()
-    return sp.lambdify((mdl.lam, *[mdl.params[k] for k in PARAM_ORDER]),
-                       sp.diff(mdl.mu_traction, mdl.lam), "math")
 
 
 def lambda_opt_of(plant: dict) -> np.ndarray:
     """lambda_opt (argmax of mu on lambda > 0) of each run's own adhesion
-    curve: the root of d mu / d lambda on (0, 1), as
+    curve: the root of d mu / d lambda on (0, 1)
+    (:func:`workbench.features.curve_peaks.peaks`), as
     :meth:`~workbench.plants.adhesion.NumericAdhesion.lambda_opt` (same
-    bracket and tolerances) but with one lambdified derivative for every run
-    (~0.1 ms a run instead of a sympy substitution and lambdify per run)."""
-    from scipy.optimize import brentq
-
-    from ...errors import ModelError
+    bracket and tolerances)."""
+    from ...features.curve_peaks import peaks, slope_function
+    from ...plants.adhesion import adhesion_model
     from ...sim.wheel_slip import PARAM_ORDER
-    f = _dmu_traction()
-    cols = [np.asarray(plant[k], float) for k in PARAM_ORDER]
-    out = np.empty(len(cols[0]))
-    for i in range(out.size):
-        row = tuple(float(c[i]) for c in cols)
-        g = lambda lam: f(lam, *row)     # noqa: E731
-        if not g(1e-12) > 0 or g(1.0) > 0:
-            raise ModelError(f"run {i}: adhesion curve without a peak on (0, 1) "
-                             f"(a, b, c = {row[:3]})")
-        out[i] = brentq(g, 1e-12, 1.0, xtol=1e-15, rtol=1e-14)
-    return out
+    mdl = adhesion_model()      # d mu / d lambda of the traction curve (eq 6), lambdified once
+    slope = slope_function(mdl.mu_traction, mdl.lam, tuple(mdl.params[k] for k in PARAM_ORDER))
+    return peaks(slope, [plant[k] for k in PARAM_ORDER], 1e-12, 1.0, "adhesion curve")
 
 
 def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]:
@@ -272,6 +223,11 @@ def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]
 READ = ("lam_max_traction", "t_cruise", "t_omega3", "t_diverged", "phase_diverged", "t_stop")
 
 
+def _read_back(name: str) -> bool:
+    """The columns of a streamed sweep its result is made from (:func:`runs_result`)."""
+    return name == "lambda_opt" or name.startswith("draw.") or name in {f"raw.{k}" for k in READ}
+
+
 def range_worker(payload: dict) -> dict:
     """Simulate runs ``i0 <= i < i1`` of a design's sweep (payload: design,
     K, seed, i0, i1, kernel; ``step``: the step if not the sweep's) and
@@ -280,10 +236,8 @@ def range_worker(payload: dict) -> dict:
     inp = sweep_inputs(d, i1, payload["seed"], payload["K"], start=i0)
     out = chunk_worker(chunk_payload(inp, 0, i1 - i0, payload.get("step") or inp["dt"],
                                      payload["kernel"]))
-    arrays = {"index": np.arange(i0, i1), "lambda_opt": lambda_opt_of(inp["plant"])}
-    arrays.update({f"draw.{k}": np.asarray(v) for k, v in inp["draws"].items()})
-    arrays.update({f"raw.{k}": np.asarray(v, float) for k, v in out["metrics"].items()})
-    return arrays
+    return chunk_arrays(i0, i1, inp["draws"], out["metrics"],
+                        lambda_opt=lambda_opt_of(inp["plant"]))
 
 
 def range_runs(arrays: dict, t_brake: float) -> tuple[dict, dict]:
@@ -296,8 +250,7 @@ def runs_result(arrays: dict, t_brake: float, seconds: float = math.nan,
     """The :class:`SweepResult` of a sweep's :func:`range_worker` arrays
     (concatenated over its chunks, in run order)."""
     metrics, viol = range_runs(arrays, t_brake)
-    return SweepResult({k[5:]: v.tolist() for k, v in arrays.items() if k.startswith("draw.")},
-                       {k: v.tolist() for k, v in metrics.items()},
+    return SweepResult(draws_of(arrays), {k: v.tolist() for k, v in metrics.items()},
                        {k: v.tolist() for k, v in viol.items()}, seconds, workers)
 
 
@@ -309,83 +262,44 @@ def _manifest(design, samples: int, seed: int, chunk: int, kernel: str, K) -> di
     shared["ranges"] = [ms.mass, ms.adhesion, ms.h, ms.v0, sorted(ms.wet.items())]
     if ms.perturb is not None:      # absent: the digest of a sweep without perturbations
         shared["perturb"] = ms.perturb
-    digest = hashlib.sha256(json.dumps(shared, sort_keys=True, default=repr).encode())
     return {"design": design.name, "samples": samples, "seed": seed, "chunk": chunk,
             "kernel": kernel, "t_brake": inp["scenario"]["t_brake"],
-            "inputs_sha256": digest.hexdigest()}
+            "inputs_sha256": inputs_digest(shared)}
 
 
 def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
                 chunk: int | None = None, pool: bool | None = None,
                 K: tuple | None = None, kernel: str | None = None,
                 scheduler: str | None = None, out=None, resume: bool = False) -> PendingBatch:
-    """Start the Monte Carlo sweep of an ``antiskid-run`` design;
-    :meth:`PendingBatch.result` returns its :class:`SweepResult`.
+    """Start the Monte Carlo sweep of an ``antiskid-run`` design (with a
+    ``[montecarlo]`` table): the general
+    :func:`~workbench.features.montecarlo_arrays.start_array_sweep` of
+    :func:`range_worker` (``workers``, ``chunk``, ``pool``, ``scheduler``,
+    ``out``, ``resume`` as there; the results depend on ``chunk``, not on
+    the workers, the executor or the chunking of a resumed sweep,
+    ``tests/test_sweep_executors.py``); :meth:`PendingBatch.result` returns
+    its :class:`SweepResult`.
 
-    Parameters
-    ----------
-    design : workbench.design.Design
-        Of kind ``antiskid-run`` with a ``[montecarlo]`` table.
-    samples, seed : int
-    workers : int, optional
-        Process count (default: the CPUs granted,
-        :func:`~workbench.sim.batch.available_cpus`); 1 runs in-process.
-    chunk : int, optional
-        Samples per batch (default:
-        :func:`~workbench.features.montecarlo_chunks.default_chunk`).
-        The results depend on it, not on ``workers``.
-    pool : bool, optional
-        Run the chunks in a process pool now, so the caller can work
-        meanwhile (default: ``workers > 1``), else in-process in
-        :meth:`PendingBatch.result`.
-    K : tuple, optional
-        The cruise gain if the caller has it (default:
-        :func:`~workbench.papers.p003.antiskid_run.gain_for`).
-    kernel : {"compiled", "numpy"}, optional
-        The stepping path (default: compiled when numba is installed); the
-        results agree to rounding (``tests/test_compiled_kernel.py``).
-    scheduler : str, optional
-        Run the chunks on a Dask distributed cluster: ``"local"`` (a
-        LocalCluster of ``workers`` processes) or a scheduler address. The
-        results do not depend on the executor, the worker count or the
-        chunking (``tests/test_sweep_executors.py``).
-    out : path, optional
-        Write each chunk to this folder as it finishes (module docstring; a
-        pool when ``workers > 1``); the result is read back from the files.
-    resume : bool
-        With ``out``: skip the chunk files already written.
-
-    Raises
-    ------
-    FileExistsError
-        ``out`` holds chunk files or another sweep and ``resume`` is false,
-        or it holds another sweep (its ``sweep.json`` differs).
+    ``K``: the cruise gain if the caller has it (default:
+    :func:`~workbench.papers.p003.antiskid_run.gain_for`). ``kernel``:
+    ``"compiled"`` or ``"numpy"``, the stepping path (default: compiled when
+    numba is installed); the results agree to rounding
+    (``tests/test_compiled_kernel.py``).
     """
     from .antiskid_kernel import compile_kernel, default_kernel
     from .antiskid_run_spec import gain_for
-    workers = max(1, workers or available_cpus())
-    chunk = chunk or default_chunk(samples)
     kernel = kernel or default_kernel()
     K = tuple(gain_for(design.spec)[0] if K is None else K)
     t_brake = design.spec.scenario["t_brake"]
-    before = compile_kernel if kernel == "compiled" else None
-
-    def payload(i0: int, i1: int) -> dict:
-        return {"design": design, "K": K, "seed": seed, "i0": i0, "i1": i1, "kernel": kernel}
-
-    if out is not None:
-        return stream(out, _manifest(design, samples, seed, chunk, kernel, K), payload,
-                      range_worker, lambda seconds, n_workers: dataclasses.replace(
-                          load_sweep(out), seconds=seconds, workers=n_workers),
-                      resume=resume, workers=workers, scheduler=scheduler, before_pool=before)
-
-    def collect(outs: list, seconds: float, n_workers: int) -> SweepResult:
-        return runs_result({k: np.concatenate([o[k] for o in outs]) for k in outs[0]},
-                           t_brake, seconds, n_workers)
-
-    return start_batches(range_worker, payload, samples, chunk, collect, workers=workers,
-                         pool=workers > 1 if pool is None else pool, scheduler=scheduler,
-                         before_pool=before)
+    return start_array_sweep(
+        range_worker, lambda i0, i1: {"design": design, "K": K, "seed": seed, "i0": i0,
+                                      "i1": i1, "kernel": kernel},
+        samples, lambda cols, seconds, n_workers: runs_result(cols, t_brake, seconds,
+                                                              n_workers),
+        chunk=chunk, workers=workers, pool=pool, scheduler=scheduler,
+        before_pool=compile_kernel if kernel == "compiled" else None, out=out,
+        manifest=lambda ch: _manifest(design, samples, seed, ch, kernel, K), resume=resume,
+        select=_read_back)
 
 
 def start_streaming(design, samples: int, seed: int, out, **kw) -> PendingBatch:
@@ -396,8 +310,7 @@ def start_streaming(design, samples: int, seed: int, out, **kw) -> PendingBatch:
 def load_sweep(out) -> SweepResult:
     """The :class:`SweepResult` of a streamed sweep, from its chunk files
     (only the columns the summaries use are read)."""
-    keep = {"lambda_opt", *(f"raw.{k}" for k in READ)}
-    man, col = read_streamed(out, lambda k: k in keep or k.startswith("draw."))
+    man, col = read_streamed(out, _read_back)
     return runs_result(col, float(man["t_brake"]))
 
 

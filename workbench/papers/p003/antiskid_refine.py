@@ -21,13 +21,11 @@ level of what enters a finding, and only that:
 * ``montecarlo.*``: a share claim is refined on the outcome behind it,
   per run: all N runs of the sweep at its dt, the first n
   (``halving_samples``) again at dt/2 (the halving check) and at dt/4 (run
-  here, compiled kernel when the sweep uses it). At dt/2 and dt/4 the
-  other N - n runs are bounded, not run: the count lies in [k_n, k_n + N -
-  n] whatever they do, and a level decides the claim only when its verdict
-  is the same over that whole range
-  (:func:`workbench.features.refinement.share_claim_levels`; our choice:
-  all 64 runs at dt/2 and dt/4 cost about 6 and 18 CPU s, against 1.2 and
-  2.7 s for the first 16);
+  here, compiled kernel when the sweep uses it), the other N - n runs
+  bounding the count, not run
+  (:func:`workbench.features.montecarlo_halving.sweep_share_levels`; our
+  choice: all 64 runs at dt/2 and dt/4 cost about 6 and 18 CPU s, against
+  1.2 and 2.7 s for the first 16);
 * ``basin.*`` of the k2 sweep: no step (a certificate at the printed switch
   state (v_d, lambda_opt)), the same value at every level.
 
@@ -40,17 +38,19 @@ and runs its kernels to read them, and which case metric to claim instead
 of one that does not converge (:data:`CONVERGED_INSTEAD`). The checks
 themselves (three levels against the claim's tolerance, the screen of the
 case metrics, the share bound over partly refined runs, the dispatch on
-the quantity) are :mod:`workbench.features.convergence` and
-:mod:`workbench.features.refinement`.
+the quantity, the readers of a share of Monte Carlo runs and of a metric
+without a step) are :mod:`workbench.features.convergence`,
+:mod:`workbench.features.refinement` and
+:mod:`workbench.features.montecarlo_halving`.
 """
 from __future__ import annotations
 
 import dataclasses
 import re
 
-from ...features.refinement import (Levels, refine_by_readers, screen_levels, screen_reason,
-                                    share_claim_levels)
-from ...report.markdown import fmt
+from ...features.montecarlo_halving import sweep_share_levels
+from ...features.refinement import (Levels, claimed_members, refine_by_readers, screen_levels,
+                                    screen_reason, unstepped_levels)
 
 __all__ = ["CONVERGED_INSTEAD", "READERS", "quarter_cases",
            "refine_levels", "three_level_metrics", "unconverged_reason"]
@@ -196,50 +196,29 @@ def _rate_levels(design, result, cache, m, r) -> Levels:
 def _mc_levels(design, result, cache, m, r) -> Levels:
     """A Monte Carlo share finding at the sweep's dt, dt/2, dt/4 (the runs
     the halving check refines,
-    :func:`workbench.features.refinement.share_claim_levels`)."""
-    hc, qn = result.halving, r.claim.quantity
-    if hc is None:
-        return Levels((), reason="the design has no step check of its Monte Carlo runs")
-    if qn == "montecarlo.halving.fraction_agree":
-        return Levels((), reason="a comparison of two steps, not a metric of the runs; the "
-                      "outcomes behind the Monte Carlo findings are refined three levels in "
-                      "the rows of the share findings (first runs at dt, dt/2, dt/4)")
-    if "mc" not in cache:
-        cache["mc"] = _mc_quarter(design, result, hc.n, hc.dt / 4)
-    key = MC_OUTCOMES[qn]
-    return share_claim_levels(r.claim, result.montecarlo.violations[key], hc.fine[key],
-                              cache["mc"][key], key.replace("_", " "), "montecarlo.dt", hc.dt)
-
-
-def _basin_levels(design, result, cache, m, r) -> Levels:
-    """A basin finding: no step, the same printed value at every level."""
-    v = fmt(r.got, 6)
-    return Levels((v, v, v), "none (a certificate at the printed switch state, no step)")
-
-
-def _mc_quarter(design, result, n: int, step: float) -> dict:
-    """Outcomes of the first n sweep runs at ``step``, the sweep's dt/4 (the sweep's
-    own chunk function, :func:`~workbench.papers.p003.antiskid_montecarlo.range_worker`)."""
-    from .antiskid_halving import _step_values
-    from .antiskid_kernel import default_kernel
-    from .antiskid_montecarlo import range_runs, range_worker
-    out = range_worker({"design": design, "K": tuple(result.K), "i0": 0, "i1": n,
-                        "seed": design.spec.montecarlo.seed, "kernel": default_kernel(),
-                        "step": step})
-    vals = _step_values(*range_runs(out, design.spec.scenario["t_brake"]))
-    return {k: tuple(bool(x) for x in vals[k]) for k in ("diverged", "above_lambda_opt")}
+    :func:`workbench.features.montecarlo_halving.sweep_share_levels`; dt/4:
+    the first n runs by the sweep's own chunk function,
+    :func:`~workbench.papers.p003.antiskid_montecarlo.range_worker`)."""
+    def quarter():
+        if "mc" not in cache:
+            from .antiskid_halving import _step_values
+            from .antiskid_kernel import default_kernel
+            from .antiskid_montecarlo import range_runs, range_worker
+            hc = result.halving
+            out = range_worker({"design": design, "K": tuple(result.K), "i0": 0, "i1": hc.n,
+                                "seed": design.spec.montecarlo.seed, "step": hc.dt / 4,
+                                "kernel": default_kernel()})
+            cache["mc"] = _step_values(*range_runs(out, design.spec.scenario["t_brake"]))
+        return cache["mc"]
+    return sweep_share_levels(r, lambda k: result.montecarlo.violations[k], result.halving,
+                              MC_OUTCOMES, quarter, "montecarlo")
 
 
 def quarter_cases(design) -> frozenset:
     """Names of the cases whose convergence a claim of ``design`` states
     (``cases[NAME].converged`` or ``.comfort_converged``): only they are run
     a third time, at dt / 4 (the refinement of the findings reuses that run)."""
-    out = set()
-    for c in design.claims:
-        m = re.fullmatch(r"cases\[([^\]]+)\]\.(converged|comfort_converged)", c.quantity)
-        if m:
-            out.add(m.group(1))
-    return frozenset(out)
+    return claimed_members(design.claims, r"cases\[([^\]]+)\]\.(?:converged|comfort_converged)")
 
 
 def three_level_metrics(spec, coarse: dict, fine: dict, quarter: dict) -> tuple:
@@ -277,4 +256,5 @@ READERS = ((re.compile(r"switch\.(cruise|brake)\[([^\]]+)\]\.in_basin$"), _switc
            (re.compile(r"sampled\.([a-z_]+)\.rate\[([^\]]+)\]\."), _rate_levels),
            (re.compile("(" + "|".join(map(re.escape, MC_OUTCOMES))
                        + r"|montecarlo\.halving\.fraction_agree)$"), _mc_levels),
-           (re.compile(r"basin\."), _basin_levels))
+           (re.compile(r"basin\."), lambda d, res, cache, m, r: unstepped_levels(
+               r, "none (a certificate at the printed switch state, no step)")))
