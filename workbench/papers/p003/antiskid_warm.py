@@ -20,12 +20,19 @@ KERNELS = ("batch", "sampled")
 
 
 def warm(which: str) -> float:
-    """Compile (or load) kernel ``which`` ("batch": Monte Carlo and halving;
-    "sampled": ``[sampled]`` runs) in this process; CPU seconds spent."""
+    """Compile (or load) kernel ``which`` ("batch": Monte Carlo and halving,
+    and the metric update of every run; "sampled": ``[sampled]`` runs) in
+    this process; CPU seconds spent."""
     c0 = time.process_time()
     if which == "batch":
+        from numba import boolean, float64, int64
+
         from .antiskid_kernel import compile_kernel
+        from .antiskid_scenario import metric_updates
         compile_kernel()
+        m2 = float64[:, ::1]     # the metric update as a single run calls it
+        metric_updates()[0].compile((float64, float64, float64, int64, boolean, boolean, boolean,
+                                     float64, m2, m2, int64, float64[::1], float64, float64))
     elif which == "sampled":
         from pathlib import Path
 
