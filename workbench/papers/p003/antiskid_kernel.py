@@ -87,6 +87,7 @@ def _build():
     jit = numba.njit(nogil=True, error_model="numpy")
     DT, control_pre, control_post = C.DT, C.control_pre, C.control_post
     record, _ = metric_updates()
+    r_i = PARAM_ORDER.index("r")      # the plant's wheel radius in a row of ``plant``
     # the model parameters (PARAM_ORDER, then the slope: 0 for the
     # controller's model) and the settings (:data:`C.CFG`) as tuples of floats
     params_tuple, row_tuple = tuple_readers(jit, len(PARAM_ORDER), 1)
@@ -118,7 +119,6 @@ def _build():
         predictor rollouts are interleaved (:func:`~workbench.controllers.antiskid003_jit.rollout_lanes`);
         every run performs the operations of a run simulated alone."""
         dt = cfg[DT]
-        r_i = 4      # PARAM_ORDER index of r (checked by the caller)
         sv, sw, every = pert[0], pert[1], int(pert[2])
         noisy, graded, varying = sv > 0 or sw > 0, pert[3] != 0.0, pert[7] != 0.0
         B, P, K = plant.shape[0], plant.shape[1], LANES
@@ -253,9 +253,6 @@ def simulate_batch_compiled(run: RunSettings, dt: float, *,
         As :class:`~workbench.papers.p003.antiskid_scenario.MetricsRecorder`.
     """
     from ...controllers.antiskid003_jit import initial_state, settings_array
-    from ...sim.wheel_slip import PARAM_ORDER
-    if PARAM_ORDER.index("r") != 4:
-        raise RuntimeError("PARAM_ORDER changed: update run_batch's index of r")
     compile_kernel()
     B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))
     plant = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(x, float), (B,))

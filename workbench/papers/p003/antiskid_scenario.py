@@ -9,8 +9,10 @@ parameter samples, optionally on a refined mesh (:class:`Mesh`, the general
 rate, :func:`~workbench.sim.wheel_slip.creep_rate_coefficient`, ~3800/v 1/s
 on dry rail).
 :class:`MetricsRecorder` accumulates the run's metrics (:class:`RunMetrics`)
-sample by sample; the controller's own phase events (handover, divergence)
-are merged in at the end.
+sample by sample with :func:`metric_updates`, the one compiled definition of
+the metrics that the compiled batch (:mod:`workbench.papers.p003.antiskid_kernel`)
+inlines too; the controller's own phase events (handover, divergence) are
+merged in at the end.
 
 Why this stays paper code: every metric here is a definition of paper 003's
 study (time to v_d, creep ratio in traction and braking against lambda_opt,
@@ -20,8 +22,8 @@ that loop is close to neutral (near a creep ratio with slope J,
 lambda' ~ J lambda - (J + k) lambda(t - h), roots decaying at only
 (1/h) ln(|J| / |J + k|)), so fast features of width ~1/|J| set at the start
 persist for seconds; the exponential step keeps them stable but only a step
-below 1/|J| resolves them. The batch form is mirrored bit for bit by the
-compiled kernel (:mod:`workbench.papers.p003.antiskid_kernel`), so its
+below 1/|J| resolves them. The numpy batch form (controller and plant step)
+is the reference the compiled kernel is compared with run by run, so its
 operations stay as they are. Its tables and figures are rendered by the general
 :mod:`workbench.report.case_tables` and :mod:`workbench.report.case_figures`.
 """
