@@ -42,7 +42,7 @@ def reference_run(rs, dt: float, t_end: float) -> tuple[float, float]:
     """(time to cruise, wall s): sampled controller, solve_ivp plant."""
     fns = model_functions("math")
     p = rs.plant_params
-    rec = MetricsRecorder(rs.controller, rs.x0, None, p[PARAM_ORDER.index("r")])
+    rec = MetricsRecorder(rs.controller, rs.x0, None, p[PARAM_ORDER.index("r")], dt)
     ctrl = Antiskid003(rs.controller, rs.x0, rs.u_init, dt, None, recorder=rec)
     line = DelayLine(rs.h, dt, rs.u_init)
     x = np.array(rs.x0, float)

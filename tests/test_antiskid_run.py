@@ -15,6 +15,7 @@ from workbench.design import load_design
 from workbench.papers.p003 import antiskid_run as R
 from workbench.papers.p003 import antiskid_run_spec as S
 from workbench.papers.p003.antiskid_scenario import simulate_antiskid
+from workbench.sim.wheel_slip import ScalarOps
 
 DRY = Path("designs/antiskid-run-dry.toml")
 K_TABLE3 = (-0.0049, 10.5080)   # paper 003, Table 3, eps = 0.35
@@ -122,34 +123,52 @@ def test_sweep_is_seeded(tmp_path, capsys):
     assert fig.exists() and "outcome" in out and "Wilson 95 % interval" in out
 
 
-def test_scalar_metrics_recorder_is_the_generic_one_bit_for_bit(spec, monkeypatch):
-    """MetricsRecorder's scalar path (:meth:`_scalar`, used by every case run)
-    against its generic body fed the same floats, over traction, the
-    switch to braking, the tracking window, omega = 3 rad/s and the stop."""
-    from workbench.papers.p003 import antiskid_scenario as A
-    from workbench.sim.wheel_slip import ScalarOps
+def test_compiled_metric_updates_match_the_recorded_trajectory(spec):
+    """The one metric update (``antiskid_scenario.metric_updates``, compiled,
+    shared by the case runs, the numpy batch and the compiled batch) against
+    the metrics' definitions evaluated with numpy on the run's trajectory
+    recorded at every sample, over traction, the switch to braking, the
+    tracking window, omega = 3 rad/s and the stop; and a batch of two runs
+    (its row form, on the numpy batch's trajectory, equal to the single run's
+    up to the last bits) giving the single run's metrics."""
+    from workbench.controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED
     sc = {**spec.scenario, "t_brake": 40.0, "t_end": 140.0}
     short = dataclasses.replace(spec, scenario=sc)
     case = next(c for c in short.cases if c.name == "compensated")
-    rs = S.run_settings(short, S.controller_settings(short, K_TABLE3, case))
-    fast = simulate_antiskid(rs, 0.01, record_dt=0.05)
-    generic_ops = type("GenericScalarOps", (ScalarOps,), {"batch": True})
-
-    def generic(self, *a):       # the generic body on floats (its batch branches)
-        self.xp = generic_ops
-        try:
-            return A.MetricsRecorder.__call__(self, *a)
-        finally:
-            self.xp = ScalarOps
-    monkeypatch.setattr(A.MetricsRecorder, "_scalar", generic)
-    slow = simulate_antiskid(rs, 0.01, record_dt=0.05)
-    mf, ms = vars(fast[1]), vars(slow[1])
-    assert math.isfinite(mf["t_stop"]) and math.isfinite(mf["t_omega3"])
-    assert math.isfinite(mf["evs_max_tracking"]) and math.isfinite(mf["t_cruise"])
-    for k in mf:
-        a, b = float(mf[k]), float(ms[k])
-        assert (math.isnan(a) and math.isnan(b)) or a == b, k
-    np.testing.assert_array_equal(fast[0].x, slow[0].x)
+    cs = S.controller_settings(short, K_TABLE3, case)
+    rs = S.run_settings(short, cs)
+    dt = 0.01
+    res, m = simulate_antiskid(rs, dt, record_dt=dt)
+    t, (v, lam), ph = res.t, res.x, res.phase
+    assert np.allclose(np.diff(t), dt) and ph[-1] == STOPPED
+    trac, brk = ph < BRAKE_IN, (ph == BRAKE_IN) | (ph == BRAKE)
+    assert m.lam_max_traction == lam[trac].max() and m.v_max == v[trac].max()
+    assert m.lam_min_brake == lam[brk].min()
+    assert m.t_stop == t[-1] and m.t_lam_negative == t[brk & (lam < 0)][0]
+    i = np.flatnonzero(v >= cs.v_d)[0]         # v = v_d, interpolated between samples
+    assert m.t_cruise == pytest.approx(t[i] - dt * (v[i] - cs.v_d) / (v[i] - v[i - 1]),
+                                       rel=1e-12)
+    assert (m.v_at_cruise, m.lam_at_cruise) == (v[i], lam[i])
+    k = np.flatnonzero(brk)[0]
+    assert (m.lam_at_brake, m.v_err_at_brake) == (lam[k], v[k] - cs.v_d)
+    r = rs.plant_params[4]
+    omega = np.where(lam >= 0, v / (1.0 - np.minimum(lam, 0.999)), v * (1.0 + lam)) / r
+    w = np.flatnonzero(brk & (omega <= cs.profile.omega_switch))[0]
+    assert t[w - 1] <= m.t_omega3 <= t[w]
+    vs = np.where(lam >= 0, lam * v / (1.0 - np.minimum(lam, 0.999)), lam * v)
+    vs_on = np.array([cs.profile(tt, vv, 0.0, math.inf, ScalarOps)[0] for tt, vv in zip(t, v)])
+    e = np.abs(vs - np.where(omega > cs.profile.omega_switch, vs_on, 0.0))
+    assert m.evs_last == e[brk][-1]        # the last braking sample (the stop ends it)
+    window = brk & (t >= sc["t_brake"] + 5.0) & (t < m.t_omega3)
+    assert window.sum() > 100 and m.evs_max_tracking >= e[window].max()
+    assert m.evs_max_tracking == pytest.approx(max(e[window].max(), np.abs(vs - vs_on)[w]),
+                                               rel=0.05)
+    plant = tuple(np.full(2, x) for x in rs.plant_params)
+    _, mb = simulate_antiskid(dataclasses.replace(rs, plant_params=plant, h=np.full(2, rs.h)),
+                              dt, record_dt=None, batch=2)
+    for key, a in vars(m).items():
+        b = getattr(mb, key)
+        assert (math.isnan(a) and np.isnan(b).all()) or b == pytest.approx([a, a], rel=1e-9), key
 
 
 @pytest.mark.parametrize("case_name", ["paper", "compensated", "uncompensated", "recursive"])

@@ -49,7 +49,7 @@ import tempfile
 from functools import lru_cache
 from pathlib import Path
 
-__all__ = ["cache_dir", "cached", "source_stamp"]
+__all__ = ["cache_dir", "cached", "require_numba", "source_stamp"]
 
 
 @lru_cache(maxsize=None)
@@ -195,3 +195,13 @@ def cached(dispatcher, name: str):
     if d is not None:
         dispatcher._cache = _cache_class()(dispatcher.py_func, name, d)
     return dispatcher
+
+
+def require_numba(what: str) -> None:
+    """Raise :class:`~workbench.errors.ModelError` naming ``what`` (the
+    computation that runs compiled code) when numba is not installed."""
+    from importlib.util import find_spec
+    if find_spec("numba") is None:
+        from ..errors import ModelError
+        raise ModelError(f"{what} runs a compiled loop, which needs numba: "
+                         "pip install 'traincontrol-workbench[fast]'")

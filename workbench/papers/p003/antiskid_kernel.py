@@ -4,9 +4,9 @@ no recording) with numba, :data:`LANES` runs in flight at a time.
 
 Per run and per sample, as the batched numpy path: the controller
 (:func:`workbench.controllers.antiskid003_jit.control`: phase logic,
-predictor rollout, laws), the metrics of
-:class:`~workbench.papers.p003.antiskid_scenario.MetricsRecorder`
-(:func:`record`), the plant's input delay line and the plant step with
+predictor rollout, laws), the metrics
+(:func:`~workbench.papers.p003.antiskid_scenario.metric_updates`, the one
+definition that the numpy path's recorder calls too), the plant's input delay line and the plant step with
 per-run adaptive halving (:func:`workbench.sim.wheel_slip_jit.stiff_step`).
 A run ends when it stops or diverges, as its lane of the batch freezes.
 
@@ -33,16 +33,15 @@ metric of the first 64 runs of the dry design's sweep.
 from __future__ import annotations
 
 import math
-from dataclasses import fields
 from importlib.util import find_spec
 from typing import Literal
 
 import numpy as np
 
-from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED
+from ...controllers.antiskid003_settings import STOPPED
 from ...sim.history import split_delay
 from ...sim.perturb import perturbation_arrays
-from .antiskid_scenario import RunMetrics, RunSettings
+from .antiskid_scenario import METRIC_FIELDS, RunMetrics, RunSettings, metric_updates
 
 #: The stepping paths of a sweep: "compiled" (numba, this module) or "numpy"
 #: (:func:`~workbench.papers.p003.antiskid_scenario.simulate_antiskid` with ``batch``).
@@ -54,10 +53,6 @@ Kernel = Literal["compiled", "numpy"]
 #: were split in two passes (one process, ns per sample): 1 lane 828, 2 lanes
 #: 632, 4 lanes 619; lanes cost nothing when runs end (a lane takes the next run).
 LANES = 4
-
-#: Field order of the metrics array (RunMetrics; PhaseEvents first).
-METRIC_FIELDS = tuple(f.name for f in fields(RunMetrics))
-
 
 def compiled_available() -> bool:
     """Whether numba is installed (the compiled kernel can run)."""
@@ -84,23 +79,15 @@ def _build():
     from ...sim.jit_cache import cached
     from ...sim.jit_tuples import tuple_readers
     from ...sim.wheel_slip import PARAM_ORDER
-    from ...sim.wheel_slip_jit import (BY_SIGN, GRADED, creep_speed, delay_at, fmax, fmin, forms,
-                                       measured_state, split_delay, stiff_step_at, wheel_speed)
+    from ...sim.wheel_slip_jit import (BY_SIGN, GRADED, delay_at, fmax, forms, measured_state,
+                                       split_delay, stiff_step_at)
 
     _, uniform, normal4 = jit_functions()
 
     jit = numba.njit(nogil=True, error_model="numpy")
-    jiti = numba.njit(nogil=True, error_model="numpy", inline="always")
-    M = {k: i for i, k in enumerate(METRIC_FIELDS)}
-    T_CRUISE, V_CRUISE, L_CRUISE = M["t_cruise"], M["v_at_cruise"], M["lam_at_cruise"]
-    L_MAX, V_MAX, L_BRAKE = M["lam_max_traction"], M["v_max"], M["lam_at_brake"]
-    VE_BRAKE, LE_BRAKE, T_NEG = M["v_err_at_brake"], M["lam_err_at_brake"], M["t_lam_negative"]
-    L_MIN, T_OM3, T_STOP, T_PEAK = (M["lam_min_brake"], M["t_omega3"], M["t_stop"],
-                                    M["t_past_peak"])
-    E_LAST, E_MAX = M["evs_last"], M["evs_max_tracking"]
-    V_D, L_D, L_OPT, DT = C.V_D, C.LAMBDA_D, C.LAMBDA_OPT, C.DT
-    WS, TB = C.OMEGA_SWITCH, C.T_BRAKE
-    profile, control_pre, control_post = C.profile, C.control_pre, C.control_post
+    DT, control_pre, control_post = C.DT, C.control_pre, C.control_post
+    record, _ = metric_updates()
+    r_i = PARAM_ORDER.index("r")      # the plant's wheel radius in a row of ``plant``
     # the model parameters (PARAM_ORDER, then the slope: 0 for the
     # controller's model) and the settings (:data:`C.CFG`) as tuples of floats
     params_tuple, row_tuple = tuple_readers(jit, len(PARAM_ORDER), 1)
@@ -119,65 +106,6 @@ def _build():
         v[j], lam[j], pos[j], T[j], n[j], run[j], active[j] = v0[i], lam0, 0.0, 0, 0, i, True
 
     @jit
-    def clip(x):
-        return fmin(fmax(x, 0.0), 1.0)
-
-    @jit
-    def fmax_nan(a, b):      # NaN = no value yet
-        return b if a != a else fmax(a, b)
-
-    @jiti
-    def record(t, v, lam, ph, to_cruise, to_brake, to_stop, M, RS, j, cfg, r_p, settle):
-        """:meth:`MetricsRecorder.__call__` for run ``j`` (metrics ``M[j]``,
-        ``RS[j]`` = (v_prev, has_track, omega_prev, e_prev, lam_prev))."""
-        dt = cfg[DT]
-        frac = (v - cfg[V_D]) / fmax(v - RS[j, 0], 1e-12)
-        if to_cruise:
-            M[j, T_CRUISE] = t - dt * fmin(frac, 1.0)
-            M[j, V_CRUISE], M[j, L_CRUISE] = v, lam
-        RS[j, 0] = v
-        if ph < BRAKE_IN:
-            M[j, L_MAX], M[j, V_MAX] = fmax(M[j, L_MAX], lam), fmax(M[j, V_MAX], v)
-        if to_brake:
-            M[j, L_BRAKE], M[j, VE_BRAKE], M[j, LE_BRAKE] = lam, v - cfg[V_D], lam - cfg[L_D]
-        if to_stop:
-            M[j, T_STOP] = t
-        if not (ph == BRAKE_IN or ph == BRAKE):
-            return
-        if lam < 0 and M[j, T_NEG] != M[j, T_NEG]:
-            M[j, T_NEG] = t
-        M[j, L_MIN] = fmin(M[j, L_MIN], lam)
-        omega = wheel_speed(fmax(v, cfg[C.V_FLOOR]), lam, r_p)
-        ws = cfg[WS]
-        vs_on, _ = profile(t, v, 0.0 * v, math.inf + 0.0 * v, cfg)
-        vs_star = vs_on if omega > ws else 0.0
-        vs = creep_speed(v, lam)
-        e, e_on = abs(vs - vs_star), abs(vs - vs_on)
-        M[j, E_LAST] = e
-        in_window = M[j, T_OM3] != M[j, T_OM3] and M[j, T_PEAK] != M[j, T_PEAK]
-        cross_w = omega <= ws and M[j, T_OM3] != M[j, T_OM3]
-        cross_l = lam < -cfg[L_OPT] and M[j, T_PEAK] != M[j, T_PEAK]
-        if RS[j, 1] == 0.0:
-            f_w = f_l = 1.0 + 0.0 * v
-            e_prev = e_on
-        else:
-            w_prev, e_prev, l_prev = RS[j, 2], RS[j, 3], RS[j, 4]
-            f_w = clip((w_prev - ws) / fmax(w_prev - omega, 1e-300))
-            f_l = clip((l_prev + cfg[L_OPT]) / fmax(l_prev - lam, 1e-300))
-        if cross_w:
-            M[j, T_OM3] = t - dt * (1.0 - f_w)
-        if cross_l:
-            M[j, T_PEAK] = t - dt * (1.0 - f_l)
-        settled = in_window and t >= cfg[TB] + settle
-        if settled and not cross_w and not cross_l:
-            M[j, E_MAX] = fmax_nan(M[j, E_MAX], e)
-        f_end = fmin(f_w if cross_w else 1.0, f_l if cross_l else 1.0)
-        e_end = e_prev + f_end * (e_on - e_prev)
-        if settled and (cross_w or cross_l):
-            M[j, E_MAX] = fmax_nan(M[j, E_MAX], e_end)
-        RS[j, 1], RS[j, 2], RS[j, 3], RS[j, 4] = 1.0, omega, e_on, lam
-
-    @jit
     def run_batch(plant, Np, fp, v0, lam0, u_init, T_end, cfg, pc, settle, st0, ub0, m0,
                   keys, pert, period, phase, out):
         """Simulate each run i (plant parameters ``plant[i]``, input delay
@@ -191,7 +119,6 @@ def _build():
         predictor rollouts are interleaved (:func:`~workbench.controllers.antiskid003_jit.rollout_lanes`);
         every run performs the operations of a run simulated alone."""
         dt = cfg[DT]
-        r_i = 4      # PARAM_ORDER index of r (checked by the caller)
         sv, sw, every = pert[0], pert[1], int(pert[2])
         noisy, graded, varying = sv > 0 or sw > 0, pert[3] != 0.0, pert[7] != 0.0
         B, P, K = plant.shape[0], plant.shape[1], LANES
@@ -252,7 +179,7 @@ def _build():
                 u, ph = control_post(t, vm[j], lm[j], Pv[j], Pl[j], phs[j],
                                      (fm[j, 0], fm[j, 1], fm[j, 2], fm[j, 3], fm[j, 4]), st,
                                      ubuf, m, j, cfg)
-                record(t, v[j], lam[j], ph, tcs[j], tbs[j], tss[j], m, rs, j, cfg,
+                record(t, v[j], lam[j], ph, tcs[j], tbs[j], tss[j], dt, m, rs, j, cfg,
                        pg[j, r_i], settle)
                 L = Lp[j]
                 pbuf[j, n[j] % L] = u
@@ -326,9 +253,6 @@ def simulate_batch_compiled(run: RunSettings, dt: float, *,
         As :class:`~workbench.papers.p003.antiskid_scenario.MetricsRecorder`.
     """
     from ...controllers.antiskid003_jit import initial_state, settings_array
-    from ...sim.wheel_slip import PARAM_ORDER
-    if PARAM_ORDER.index("r") != 4:
-        raise RuntimeError("PARAM_ORDER changed: update run_batch's index of r")
     compile_kernel()
     B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))
     plant = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(x, float), (B,))

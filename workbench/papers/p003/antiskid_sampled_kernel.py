@@ -220,11 +220,8 @@ def kernel():
     stopping distance from ``t_brake``. Results in ``out`` (:data:`OUT`)."""
     global _KERNEL
     if _KERNEL is None:
-        from importlib.util import find_spec
-        if find_spec("numba") is None:
-            from ...errors import ModelError
-            raise ModelError("a design's [sampled] table runs a compiled loop, which needs "
-                             "numba: pip install 'traincontrol-workbench[fast]'")
+        from ...sim.jit_cache import require_numba
+        require_numba("a design's [sampled] table")
         _KERNEL = _build()
     return _KERNEL
 

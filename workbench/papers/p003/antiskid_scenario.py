@@ -9,8 +9,10 @@ parameter samples, optionally on a refined mesh (:class:`Mesh`, the general
 rate, :func:`~workbench.sim.wheel_slip.creep_rate_coefficient`, ~3800/v 1/s
 on dry rail).
 :class:`MetricsRecorder` accumulates the run's metrics (:class:`RunMetrics`)
-sample by sample; the controller's own phase events (handover, divergence)
-are merged in at the end.
+sample by sample with :func:`metric_updates`, the one compiled definition of
+the metrics that the compiled batch (:mod:`workbench.papers.p003.antiskid_kernel`)
+inlines too; the controller's own phase events (handover, divergence) are
+merged in at the end.
 
 Why this stays paper code: every metric here is a definition of paper 003's
 study (time to v_d, creep ratio in traction and braking against lambda_opt,
@@ -20,15 +22,16 @@ that loop is close to neutral (near a creep ratio with slope J,
 lambda' ~ J lambda - (J + k) lambda(t - h), roots decaying at only
 (1/h) ln(|J| / |J + k|)), so fast features of width ~1/|J| set at the start
 persist for seconds; the exponential step keeps them stable but only a step
-below 1/|J| resolves them. The batch form is mirrored bit for bit by the
-compiled kernel (:mod:`workbench.papers.p003.antiskid_kernel`), so its
+below 1/|J| resolves them. The numpy batch form (controller and plant step)
+is the reference the compiled kernel is compared with run by run, so its
 operations stay as they are. Its tables and figures are rendered by the general
 :mod:`workbench.report.case_tables` and :mod:`workbench.report.case_figures`.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
+from functools import lru_cache
 
 import numpy as np
 
@@ -65,8 +68,124 @@ class RunMetrics(PhaseEvents):
     evs_max_tracking: object = math.nan   # NaN: the tracking window was never entered
 
 
+#: Field order of the metrics array (RunMetrics; PhaseEvents first).
+METRIC_FIELDS = tuple(f.name for f in fields(RunMetrics))
+
+
+@lru_cache(maxsize=None)
+def metric_updates():
+    """The metric update of one sample, compiled (numba): ``(record,
+    record_rows)``, the one definition of the run's metrics (:class:`RunMetrics`)
+    that every closed loop of the study calls, the compiled batch
+    (:mod:`workbench.papers.p003.antiskid_kernel`, ``record`` inlined into
+    its loop) and :class:`MetricsRecorder` (a single run or a numpy batch).
+
+    ``record(t, v, lam, ph, to_cruise, to_brake, to_stop, dt_prev, M, RS, j,
+    cfg, r_p, settle)`` updates run ``j``: its metrics ``M[j]``
+    (:data:`METRIC_FIELDS` order) and its state ``RS[j]`` = (v_prev,
+    has_track, omega_prev, e_prev, lam_prev); ``cfg`` the controller's settings
+    (:func:`~workbench.controllers.antiskid003_jit.settings_array`), ``r_p`` the
+    plant's wheel radius, ``settle`` as :class:`MetricsRecorder`'s
+    ``evs_settle``. ``record_rows`` does every row of ``M``, with ``v``,
+    ``lam``, ``ph``, the flags and ``r_p`` arrays (one value per run)."""
+    from ...sim.jit_cache import cached, require_numba
+    require_numba("an antiskid run's metrics")
+    import numba
+
+    from ...controllers import antiskid003_jit as C
+    from ...sim.wheel_slip_jit import creep_speed, fmax, fmin, wheel_speed
+
+    jit = numba.njit(nogil=True, error_model="numpy")
+    M_ = {k: i for i, k in enumerate(METRIC_FIELDS)}
+    T_CRUISE, V_CRUISE, L_CRUISE = M_["t_cruise"], M_["v_at_cruise"], M_["lam_at_cruise"]
+    L_MAX, V_MAX, L_BRAKE = M_["lam_max_traction"], M_["v_max"], M_["lam_at_brake"]
+    VE_BRAKE, LE_BRAKE, T_NEG = M_["v_err_at_brake"], M_["lam_err_at_brake"], M_["t_lam_negative"]
+    L_MIN, T_OM3, T_STOP, T_PEAK = (M_["lam_min_brake"], M_["t_omega3"], M_["t_stop"],
+                                    M_["t_past_peak"])
+    E_LAST, E_MAX = M_["evs_last"], M_["evs_max_tracking"]
+    V_D, L_D, L_OPT, V_FLOOR = C.V_D, C.LAMBDA_D, C.LAMBDA_OPT, C.V_FLOOR
+    WS, TB, profile = C.OMEGA_SWITCH, C.T_BRAKE, C.profile
+
+    @jit
+    def clip(x):
+        return fmin(fmax(x, 0.0), 1.0)
+
+    @jit
+    def fmax_nan(a, b):      # NaN = no value yet
+        return b if a != a else fmax(a, b)
+
+    @numba.njit(nogil=True, error_model="numpy", inline="always")
+    def record(t, v, lam, ph, to_cruise, to_brake, to_stop, dt, M, RS, j, cfg, r_p, settle):
+        """One sample of run ``j`` (:func:`metric_updates`)."""
+        # crossing time of v = v_d, interpolated between the last two samples
+        frac = (v - cfg[V_D]) / fmax(v - RS[j, 0], 1e-12)
+        if to_cruise:
+            M[j, T_CRUISE] = t - dt * fmin(frac, 1.0)
+            M[j, V_CRUISE], M[j, L_CRUISE] = v, lam
+        RS[j, 0] = v
+        if ph < BRAKE_IN:
+            M[j, L_MAX], M[j, V_MAX] = fmax(M[j, L_MAX], lam), fmax(M[j, V_MAX], v)
+        if to_brake:
+            M[j, L_BRAKE], M[j, VE_BRAKE], M[j, LE_BRAKE] = lam, v - cfg[V_D], lam - cfg[L_D]
+        if to_stop:
+            M[j, T_STOP] = t
+        if not (ph == BRAKE_IN or ph == BRAKE):
+            return
+        if lam < 0 and M[j, T_NEG] != M[j, T_NEG]:
+            M[j, T_NEG] = t
+        M[j, L_MIN] = fmin(M[j, L_MIN], lam)
+        omega = wheel_speed(fmax(v, cfg[V_FLOOR]), lam, r_p)
+        ws = cfg[WS]
+        # creep-speed error of Theorem 3, e_vs = v_s - v_s*(t) (measured), and
+        # its left limit at omega = omega_switch (v_s* still on the profile)
+        vs_on, _ = profile(t, v, 0.0 * v, math.inf + 0.0 * v, cfg)
+        vs_star = vs_on if omega > ws else 0.0          # eq (76)
+        vs = creep_speed(v, lam)
+        e, e_on = abs(vs - vs_star), abs(vs - vs_on)
+        M[j, E_LAST] = e
+        # The tracking window runs from t_brake + evs_settle to the first of
+        # omega <= omega_switch (v_s* drops to 0, eq 76) and the lock onset,
+        # lambda < -lambda_opt (the wheel passes the braking adhesion peak; the
+        # divergence metrics report what follows). Both crossings are
+        # interpolated linearly between the samples around them: the error
+        # may be steep there, and the first sample past a crossing alone would
+        # make the metric depend on where the grid falls.
+        in_window = M[j, T_OM3] != M[j, T_OM3] and M[j, T_PEAK] != M[j, T_PEAK]
+        cross_w = omega <= ws and M[j, T_OM3] != M[j, T_OM3]
+        cross_l = lam < -cfg[L_OPT] and M[j, T_PEAK] != M[j, T_PEAK]
+        if RS[j, 1] == 0.0:
+            f_w = f_l = 1.0 + 0.0 * v
+            e_prev = e_on
+        else:
+            w_prev, e_prev, l_prev = RS[j, 2], RS[j, 3], RS[j, 4]
+            f_w = clip((w_prev - ws) / fmax(w_prev - omega, 1e-300))
+            f_l = clip((l_prev + cfg[L_OPT]) / fmax(l_prev - lam, 1e-300))
+        if cross_w:
+            M[j, T_OM3] = t - dt * (1.0 - f_w)
+        if cross_l:
+            M[j, T_PEAK] = t - dt * (1.0 - f_l)
+        settled = in_window and t >= cfg[TB] + settle
+        if settled and not cross_w and not cross_l:
+            M[j, E_MAX] = fmax_nan(M[j, E_MAX], e)
+        f_end = fmin(f_w if cross_w else 1.0, f_l if cross_l else 1.0)
+        e_end = e_prev + f_end * (e_on - e_prev)
+        if settled and (cross_w or cross_l):
+            M[j, E_MAX] = fmax_nan(M[j, E_MAX], e_end)
+        RS[j, 1], RS[j, 2], RS[j, 3], RS[j, 4] = 1.0, omega, e_on, lam
+
+    @jit
+    def record_rows(t, v, lam, ph, to_cruise, to_brake, to_stop, dt, M, RS, cfg, r_p, settle):
+        for j in range(M.shape[0]):
+            record(t, v[j], lam[j], ph[j], to_cruise[j], to_brake[j], to_stop[j], dt, M, RS, j,
+                   cfg, r_p[j], settle)
+
+    return (cached(record, "antiskid_scenario.record"),
+            cached(record_rows, "antiskid_scenario.record_rows"))
+
+
 class MetricsRecorder:
-    """Online metrics of a run, updated once per sample by the controller.
+    """Online metrics of a run, updated once per sample by the controller
+    with the compiled update of :func:`metric_updates` (needs numba).
 
     Parameters
     ----------
@@ -77,147 +196,44 @@ class MetricsRecorder:
         None: floats; else the number of runs stepped together.
     plant_r : float or array
         Wheel radius of the plant (for the measured wheel speed).
+    dt : float
+        The run's step (s).
     evs_settle : float
         The creep-speed error is tracked from t_brake + evs_settle (s) while
         omega > omega_switch (``evs_max_tracking``); ``evs_last`` is its
         value at the last braking sample.
     """
 
-    def __init__(self, s: ControllerSettings, x0, batch, plant_r, evs_settle: float = 5.0):
-        self.s, self.r_p, self.evs_settle = s, plant_r, evs_settle
-        self.xp = ScalarOps if batch is None else ArrayOps
-        self._v_prev = x0[0] + (0.0 if batch is None else np.zeros(batch))
-        self._track_prev = None    # (omega, e_vs left of the switch) of the last tracked sample
-        self.m = RunMetrics()
-        if batch is not None:
-            for k, v in vars(self.m).items():
-                setattr(self.m, k, np.full(batch, v, float))
+    def __init__(self, s: ControllerSettings, x0, batch, plant_r, dt: float,
+                 evs_settle: float = 5.0):
+        from ...controllers.antiskid003_jit import settings_array
+        n, self.batch = (1 if batch is None else batch), batch
+        self._record, self._rows = metric_updates()
+        # the metrics read the settings, not the predictor: any predictor's
+        # settings are laid out as the compiled controller's
+        self.cfg = settings_array(replace(s, predictor="rollout"), dt)
+        self.M = np.tile([getattr(RunMetrics(), k) for k in METRIC_FIELDS], (n, 1))
+        self.RS = np.zeros((n, 5))
+        self.RS[:, 0] = x0[0]
+        self.r_p = np.broadcast_to(np.asarray(plant_r, float), (n,)).copy()
+        self.settle = float(evs_settle)
 
     def __call__(self, t, v, lam, ph, to_cruise, to_brake, to_stop, dt_prev):
-        """Update the metrics with one sample (see the class docstring)."""
-        if not self.xp.batch:
-            return self._scalar(t, v, lam, ph, to_cruise, to_brake, to_stop, dt_prev)
-        s, xp, m = self.s, self.xp, self.m
-        w = xp.where
-        # crossing time of v = v_d, interpolated between the last two samples
-        frac = (v - s.v_d) / xp.maximum(v - self._v_prev, 1e-12)
-        m.t_cruise = w(to_cruise, t - dt_prev * xp.minimum(frac, 1.0), m.t_cruise)
-        self._v_prev = v
-        m.v_at_cruise = w(to_cruise, v, m.v_at_cruise)
-        m.lam_at_cruise = w(to_cruise, lam, m.lam_at_cruise)
-        trac = ph < BRAKE_IN
-        m.lam_max_traction = w(trac, xp.maximum(m.lam_max_traction, lam), m.lam_max_traction)
-        m.v_max = w(trac, xp.maximum(m.v_max, v), m.v_max)
-        m.lam_at_brake = w(to_brake, lam, m.lam_at_brake)
-        m.v_err_at_brake = w(to_brake, v - s.v_d, m.v_err_at_brake)
-        m.lam_err_at_brake = w(to_brake, lam - s.lambda_d, m.lam_err_at_brake)
-        m.t_stop = w(to_stop, t, m.t_stop)
-        brk = (ph == BRAKE_IN) | (ph == BRAKE) if xp.batch else ph in (BRAKE_IN, BRAKE)
-        if not xp.any(brk):
-            return
-        first_neg = brk & (lam < 0) & (m.t_lam_negative != m.t_lam_negative) if xp.batch else (
-            lam < 0 and math.isnan(m.t_lam_negative))
-        m.t_lam_negative = w(first_neg, t, m.t_lam_negative)
-        m.lam_min_brake = w(brk, xp.minimum(m.lam_min_brake, lam), m.lam_min_brake)
-        omega = wheel_speed(xp.maximum(v, s.v_floor), lam, self.r_p, xp)
-        ws, no = s.profile.omega_switch, xp.logical_not
-        # creep-speed error of Theorem 3, e_vs = v_s - v_s*(t) (measured), and
-        # its left limit at omega = omega_switch (v_s* still on the profile)
-        vs_on, _ = s.profile(t, v, 0.0 * v, math.inf + 0.0 * v, xp)
-        vs_star = xp.where(omega > ws, vs_on, 0.0)          # eq (76)
-        vs = creep_speed(v, lam, xp)
-        e, e_on = xp.abs(vs - vs_star), xp.abs(vs - vs_on)
-        m.evs_last = w(brk, e, m.evs_last)
-        # The tracking window runs from t_brake + evs_settle to the first of
-        # omega <= omega_switch (v_s* drops to 0, eq 76) and the lock onset,
-        # lambda < -lambda_opt (the wheel passes the braking adhesion peak; the
-        # divergence metrics report what follows). Both crossings are
-        # interpolated linearly between the samples around them: the error
-        # may be steep there, and the first sample past a crossing alone would
-        # make the metric depend on where the grid falls.
-        in_window = (m.t_omega3 != m.t_omega3) & (m.t_past_peak != m.t_past_peak)
-        cross_w = brk & (omega <= ws) & (m.t_omega3 != m.t_omega3)
-        cross_l = brk & (lam < -s.lambda_opt) & (m.t_past_peak != m.t_past_peak)
-        if self._track_prev is None:
-            f_w = f_l = 1.0 + 0.0 * v
-            e_prev = e_on
+        """Update the metrics with one sample."""
+        if self.batch is None:
+            self._record(float(t), float(v), float(lam), int(ph), bool(to_cruise),
+                         bool(to_brake), bool(to_stop), float(dt_prev), self.M, self.RS, 0,
+                         self.cfg, self.r_p[0], self.settle)
         else:
-            w_prev, e_prev, l_prev = self._track_prev
-            clip = lambda x: xp.minimum(xp.maximum(x, 0.0), 1.0)
-            f_w = clip((w_prev - ws) / xp.maximum(w_prev - omega, 1e-300))
-            f_l = clip((l_prev + s.lambda_opt) / xp.maximum(l_prev - lam, 1e-300))
-        m.t_omega3 = w(cross_w, t - dt_prev * (1.0 - f_w), m.t_omega3)
-        m.t_past_peak = w(cross_l, t - dt_prev * (1.0 - f_l), m.t_past_peak)
-        settled = brk & in_window & (t >= s.profile.t_brake + self.evs_settle)
-        inside = settled & no(cross_w) & no(cross_l)
-        fmax = lambda a, b: w(a != a, b, xp.maximum(a, b))   # NaN = no value yet
-        m.evs_max_tracking = w(inside, fmax(m.evs_max_tracking, e), m.evs_max_tracking)
-        f_end = xp.minimum(w(cross_w, f_w, 1.0), w(cross_l, f_l, 1.0))
-        e_end = e_prev + f_end * (e_on - e_prev)
-        end = settled & (cross_w | cross_l)
-        m.evs_max_tracking = w(end, fmax(m.evs_max_tracking, e_end), m.evs_max_tracking)
-        self._track_prev = (omega, e_on, lam)
+            self._rows(float(t), v, lam, np.asarray(ph, np.int64), to_cruise, to_brake, to_stop,
+                       float(dt_prev), self.M, self.RS, self.cfg, self.r_p, self.settle)
 
-    def _scalar(self, t, v, lam, ph, to_cruise, to_brake, to_stop, dt_prev):
-        """:meth:`__call__` of a single run: the same operations on floats, in
-        the same order, each done only where its result is kept (a single
-        run's case runs call this once a step: ``tests/test_antiskid_run.py``
-        compares it with the batch form bit for bit)."""
-        s, m = self.s, self.m
-        if to_cruise:
-            frac = (v - s.v_d) / max(v - self._v_prev, 1e-12)
-            m.t_cruise = t - dt_prev * min(frac, 1.0)
-            m.v_at_cruise = v
-            m.lam_at_cruise = lam
-        self._v_prev = v
-        if ph < BRAKE_IN:
-            m.lam_max_traction = max(m.lam_max_traction, lam)
-            m.v_max = max(m.v_max, v)
-        if to_brake:
-            m.lam_at_brake = lam
-            m.v_err_at_brake = v - s.v_d
-            m.lam_err_at_brake = lam - s.lambda_d
-        if to_stop:
-            m.t_stop = t
-        if ph not in (BRAKE_IN, BRAKE):
-            return
-        if lam < 0 and math.isnan(m.t_lam_negative):
-            m.t_lam_negative = t
-        m.lam_min_brake = min(m.lam_min_brake, lam)
-        omega = wheel_speed(max(v, s.v_floor), lam, self.r_p, ScalarOps)
-        ws = s.profile.omega_switch
-        vs_on, _ = s.profile(t, v, 0.0 * v, math.inf + 0.0 * v, ScalarOps)
-        vs_star = vs_on if omega > ws else 0.0
-        vs = creep_speed(v, lam, ScalarOps)
-        e, e_on = abs(vs - vs_star), abs(vs - vs_on)
-        m.evs_last = e
-        in_window = m.t_omega3 != m.t_omega3 and m.t_past_peak != m.t_past_peak
-        cross_w = omega <= ws and m.t_omega3 != m.t_omega3
-        cross_l = lam < -s.lambda_opt and m.t_past_peak != m.t_past_peak
-        prev = self._track_prev
-        if prev is None:
-            f_w = f_l = 1.0 + 0.0 * v
-            e_prev = e_on
-        else:
-            w_prev, e_prev, l_prev = prev
-            if cross_w:
-                f_w = min(max((w_prev - ws) / max(w_prev - omega, 1e-300), 0.0), 1.0)
-            if cross_l:
-                f_l = min(max((l_prev + s.lambda_opt) / max(l_prev - lam, 1e-300), 0.0), 1.0)
-        if cross_w:
-            m.t_omega3 = t - dt_prev * (1.0 - f_w)
-        if cross_l:
-            m.t_past_peak = t - dt_prev * (1.0 - f_l)
-        if in_window and t >= s.profile.t_brake + self.evs_settle:
-            if not cross_w and not cross_l:
-                a = m.evs_max_tracking
-                m.evs_max_tracking = e if a != a else max(a, e)
-            elif cross_w or cross_l:
-                f_end = min(f_w if cross_w else 1.0, f_l if cross_l else 1.0)
-                e_end = e_prev + f_end * (e_on - e_prev)
-                a = m.evs_max_tracking
-                m.evs_max_tracking = e_end if a != a else max(a, e_end)
-        self._track_prev = (omega, e_on, lam)
+    @property
+    def m(self) -> RunMetrics:
+        """The metrics so far: floats for a single run, arrays for a batch."""
+        if self.batch is None:
+            return RunMetrics(**{k: float(x) for k, x in zip(METRIC_FIELDS, self.M[0])})
+        return RunMetrics(**{k: self.M[:, j].copy() for j, k in enumerate(METRIC_FIELDS)})
 
 
 @dataclass(frozen=True)
@@ -263,7 +279,7 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     xp = ScalarOps if batch is None else ArrayOps
     fns = model_functions("math" if batch is None else "numpy")
     p = run.plant_params
-    rec = MetricsRecorder(run.controller, run.x0, batch, p[PARAM_ORDER.index("r")])
+    rec = MetricsRecorder(run.controller, run.x0, batch, p[PARAM_ORDER.index("r")], dt)
     ctrl = Antiskid003(run.controller, run.x0, run.u_init, dt, batch, recorder=rec,
                        k_max=None if mesh is None else mesh.k_max)
     zero = 0.0 if batch is None else np.zeros(batch)
@@ -319,6 +335,7 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     else:
         res = SimResult(res.t, res.x, res.u, res.u_applied, res.phase, ("v", "lambda"),
                         ("u",), dt)
+    m = rec.m
     for k, v in vars(ctrl.events).items():      # the phase logic's events
-        setattr(rec.m, k, v)
-    return res, rec.m
+        setattr(m, k, v)
+    return res, m

@@ -3,7 +3,7 @@
 ``make install`` runs ``python -m workbench.papers.p003.antiskid_warm`` (issue 36,
 item 3: the compiled kernels compile once per machine, and that once belongs to
 the install, not to the five-minute check). Each kernel is compiled in its own
-process, both at once; with a warm cache (:mod:`workbench.sim.jit_cache`) each
+process, both at once (:func:`workbench.sim.jit_warm.warm_in_processes`); with a warm cache (:mod:`workbench.sim.jit_cache`) each
 is only loaded, a few seconds. Nothing is computed that a study reads: the
 cache holds machine code, and its key is the package's source, so a kernel
 compiled here is the one a study would have compiled.
@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 
 __all__ = ["warm", "main"]
 
@@ -20,12 +19,19 @@ KERNELS = ("batch", "sampled")
 
 
 def warm(which: str) -> float:
-    """Compile (or load) kernel ``which`` ("batch": Monte Carlo and halving;
-    "sampled": ``[sampled]`` runs) in this process; CPU seconds spent."""
+    """Compile (or load) kernel ``which`` ("batch": Monte Carlo and halving,
+    and the metric update of every run; "sampled": ``[sampled]`` runs) in
+    this process; CPU seconds spent."""
     c0 = time.process_time()
     if which == "batch":
+        from numba import boolean, float64, int64
+
         from .antiskid_kernel import compile_kernel
+        from .antiskid_scenario import metric_updates
         compile_kernel()
+        m2 = float64[:, ::1]     # the metric update as a single run calls it
+        metric_updates()[0].compile((float64, float64, float64, int64, boolean, boolean, boolean,
+                                     float64, m2, m2, int64, float64[::1], float64, float64))
     elif which == "sampled":
         from pathlib import Path
 
@@ -45,15 +51,8 @@ def warm(which: str) -> float:
 
 def main() -> int:
     """Warm both kernels on two processes; one line of figures on stdout."""
-    from importlib.util import find_spec
-    if find_spec("numba") is None:
-        print("compiled kernels: numba not installed, nothing to compile")
-        return 0
-    w0 = time.perf_counter()
-    with ProcessPoolExecutor(len(KERNELS)) as ex:
-        cpu = list(ex.map(warm, KERNELS))
-    print(f"compiled kernels ready in the disk cache: {time.perf_counter() - w0:.0f} s wall, "
-          + ", ".join(f"{k} {c:.0f} CPU s" for k, c in zip(KERNELS, cpu)))
+    from ...sim.jit_warm import warm_in_processes
+    print(warm_in_processes(warm, KERNELS))
     return 0
 
 
