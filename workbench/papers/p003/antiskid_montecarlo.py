@@ -187,18 +187,25 @@ def chunk_payload(inp: dict, i0: int, i1: int, dt: float, kernel: str = "numpy")
     return out
 
 
+def traction_slope():
+    """d mu / d lambda of the traction curve (eq 6), lambdified once from the
+    one sympy model: ``slope(lam, *params)``, parameters in ``PARAM_ORDER``."""
+    from ...features.curve_peaks import slope_function
+    from ...plants.adhesion import adhesion_model
+    from ...sim.wheel_slip import PARAM_ORDER
+    mdl = adhesion_model()
+    return slope_function(mdl.mu_traction, mdl.lam, tuple(mdl.params[k] for k in PARAM_ORDER))
+
+
 def lambda_opt_of(plant: dict) -> np.ndarray:
     """lambda_opt (argmax of mu on lambda > 0) of each run's own adhesion
     curve: the root of d mu / d lambda on (0, 1)
     (:func:`workbench.features.curve_peaks.peaks`), as
     :meth:`~workbench.plants.adhesion.NumericAdhesion.lambda_opt` (same
     bracket and tolerances)."""
-    from ...features.curve_peaks import peaks, slope_function
-    from ...plants.adhesion import adhesion_model
+    from ...features.curve_peaks import peaks
     from ...sim.wheel_slip import PARAM_ORDER
-    mdl = adhesion_model()      # d mu / d lambda of the traction curve (eq 6), lambdified once
-    slope = slope_function(mdl.mu_traction, mdl.lam, tuple(mdl.params[k] for k in PARAM_ORDER))
-    return peaks(slope, [plant[k] for k in PARAM_ORDER], 1e-12, 1.0, "adhesion curve")
+    return peaks(traction_slope(), [plant[k] for k in PARAM_ORDER], 1e-12, 1.0, "adhesion curve")
 
 
 def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]:

@@ -31,8 +31,8 @@ from ...sim.delay import SimResult
 from ...sim.wheel_slip import model_functions
 from .antiskid_basin_run import basin_quantities, basin_quantity_names, run_basin
 from .antiskid_halving import halving_quantities, halving_quantity_names, start_halving
-from .antiskid_montecarlo import (_dmu_traction, montecarlo_quantities,
-                                  montecarlo_quantity_names, start_streaming, start_sweep, sweep)
+from .antiskid_montecarlo import (montecarlo_quantities, montecarlo_quantity_names,
+                                  start_streaming, start_sweep, sweep, traction_slope)
 from .antiskid_refine import (quarter_cases, refine_levels, three_level_metrics,
                               unconverged_reason)
 from .antiskid_run_spec import (METRICS, Case, RunSpec, case_mesh, case_metrics,
@@ -121,7 +121,7 @@ def switch_check(cs: ControllerSettings, v: float, lam: float) -> SwitchCheck:
     gain = rhs(np.array([v, lam]))[1]
     Ad = gain * np.array([[0.0], [1.0]]) @ np.array([cs.K])
     fl = freeze(lambda x: rhs(x)[0], (v, lam), (1e-4 * max(v, 1.0), 1e-7), Ad)
-    return SwitchCheck(v, lam, float(_dmu_traction()(lam, *cs.params)), fl.A, fl.abscissa,
+    return SwitchCheck(v, lam, float(traction_slope()(lam, *cs.params)), fl.A, fl.abscissa,
                        fl.margin)
 
 
