@@ -149,3 +149,27 @@ def test_general_report_without_an_analysis_module(synth):
     assert {f.name for f in out.figures} == {"pareto-nominal", "tracking", "jerk", "line"}
     assert "MFAC" not in "".join(out.sections)
     assert "| `nominal` | PID | 27 | 0 |" in out.sections[1]
+
+
+def test_render_tables_on_a_pid_only_design(synth):
+    """The tables a paper's report reuses (kinds/tracking/render_tables) work
+    on a non-paper design with one controller: no MFAC column, winner row,
+    front dominance, PPD, reset or sensitivity rows."""
+    from workbench.kinds.tracking import render_tables as T
+    design, res = synth
+    (r,) = res.readings
+    (row,) = T.tuning_rows(res)
+    assert row[:4] == ["`nominal`", "27", "0", str(int(r.pid.front.sum()))]
+    assert len(row) == 5 and row[4].startswith("kp = ")
+    (cmp,) = T.compare_rows(res)                      # one controller: no winner row
+    assert cmp[1] == "PID" and len(cmp) == 2 + 5 + 1
+    (best,) = T.best_rows(res)
+    assert len(best) == 5 and not any(" / " in x for x in best)
+    assert T.dominated_rows(res) == [] and T.ppd_rows(res) == [] and T.reset_rows(res) == []
+    assert T.sensitivity_rows(res, ("kp",), {}) == []
+    (line,) = T.line_rows(res)
+    assert line[1] == r.line[0].section.name and len(line) == 4 + 4
+    text = T.comfort_section(design.spec, res)
+    assert "| `nominal` | PID |" in text and "| yes |" in text and "MFAC" not in text
+    assert T.pct(0.5) == "50 %" and T.pct(None) == "—" and T.span([]) == "—"
+    assert T.span([0.25, 0.5, 0.1]) == "10 % … 50 %"

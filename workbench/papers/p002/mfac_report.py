@@ -9,16 +9,15 @@ from __future__ import annotations
 
 __all__ = ["render"]
 
-import numpy as np
-
 from ...controllers.mfac import RESET_CONDITIONS
 from ...features.reproducible import NUDGE, RTOL, count_text
 from ...plants.train002 import latex_equations
 from ...report.markdown import Figure, Rendered, fmt, md_table
-from ...tuning.pareto import TIE_REL, dominated_share
+from ...tuning.pareto import TIE_REL
 from ...kinds.tracking import figures as F
-from ...kinds.tracking.mfac import frozen_integrator, most_sensitive
+from ...kinds.tracking.mfac import frozen_integrator
 from ...kinds.tracking import render_general as G
+from ...kinds.tracking import render_tables as T
 from ...kinds.tracking.spec import OBJECTIVES
 
 LABEL = {**G.LABEL, "rms_speed_error": "RMS speed error (m/s)"}
@@ -63,14 +62,6 @@ $$
 \text{design point: } \min \sum_j w_j \frac{J_j}{s_j} \ \text{ over the runs with } J_s \le
 \text{the stop requirement}
 $$"""
-
-
-def _pct(x) -> str:
-    return "—" if x is None else f"{fmt(100 * x, 3)} %"
-
-
-def _params(tun) -> str:
-    return G.params_text(tun, SYMBOL)
 
 
 def _problem(spec, res) -> str:
@@ -147,14 +138,9 @@ def _end_error(prof) -> str:
 
 
 def _why(spec, res) -> str:
-    rows = []
-    for r in res.readings:
-        s = r.ppd
-        rows.append([f"`{r.reading.name}`", str(s.samples), _pct(s.reset_rate)]
-                    + [_pct(s.by_condition[k]) for k in (*RESET_CONDITIONS, "at_limit")]
-                    + [_pct(s.saturated), _span(r.mfac.reset_rate[r.mfac.reproducible])])
+    rows = T.reset_rows(res)
     integ = res.readings[0]
-    G, z = frozen_integrator(integ.mfac, spec.Ts)
+    gain, z = frozen_integrator(integ.mfac, spec.Ts)
     # a real part below 1e-9 |z| is the rounding of 2 - G Ts = 0 (G Ts = 2): printed as 0
     re = [0.0 if abs(x.real) < 1e-9 * abs(x) else x.real for x in z[:2]]
     roots = (f"{fmt(re[0], 3)} ± {fmt(abs(z[0].imag), 2)} j" if abs(z[0].imag) > 1e-6
@@ -166,7 +152,7 @@ def _why(spec, res) -> str:
            f"{count_text(int(ok.sum()), near)} stop within {fmt(res.stop_tolerance)} m"
            + (f" ({near} with a stop error within its band of the limit: undecided)"
               if near else "") + "; their reset rates span "
-           f"{_span(tun.reset_rate[ok])}"
+           f"{T.span(tun.reset_rate[ok])}"
            if ok.any() else f"None of its {int(tun.reproducible.sum())} reproducible MFAC runs "
            f"stops within {fmt(res.stop_tolerance)} m")
     return (
@@ -182,8 +168,8 @@ def _why(spec, res) -> str:
         "The CFDL law is integral action u(k) = u(k−1) + G e(k), G = ρφ/(λ + φ²), and the "
         "speed integrates the command, so with φ frozen at φ(1) on a sampled pure integrator "
         "the characteristic polynomial is z² − (2 − G Ts) z + 1, whose roots multiply to 1. "
-        f"At the integrating reading's chosen point (`{_params(integ.mfac)}`) G Ts = "
-        f"{fmt(G * spec.Ts, 3)}, roots {roots}, "
+        f"At the integrating reading's chosen point (`{G.params_text(integ.mfac, SYMBOL)}`) G Ts = "
+        f"{fmt(gain * spec.Ts, 3)}, roots {roots}, "
         f"|z| = {fmt(abs(z[0]), 3)}, {fmt(abs(z[1]), 3)}: no damping at all; G Ts = 4 is the "
         "double pole at z = −1 of the issue. Lag and delay move the roots outside (the "
         f"frozen loop around the sampled linearised plant: spectral radius "
@@ -198,21 +184,8 @@ def _why(spec, res) -> str:
         "rule's, not the plant's; the grid holds runs that are never reset.")
 
 
-def _unrepro(tun) -> str:
-    return str(int((~tun.reproducible).sum()))
-
-
-def _span(rates) -> str:
-    """Range of reset rates ("—" when there are none)."""
-    rates = np.asarray(rates, float)
-    return f"{_pct(float(rates.min()))} … {_pct(float(rates.max()))}" if rates.size else "—"
-
-
 def _tuning(spec, res) -> str:
-    rows = [[f"`{r.reading.name}`", str(len(r.mfac.cost)), _unrepro(r.mfac),
-             str(int(r.mfac.front.sum())), _params(r.mfac), str(len(r.pid.cost)),
-             _unrepro(r.pid), str(int(r.pid.front.sum())), _params(r.pid)]
-            for r in res.readings]
+    rows = T.tuning_rows(res, SYMBOL)
     return (
         f"## {H_TUNE}\n\nPer reading, every combination of the design's grids (η, μ, ρ, λ and "
         "φ(1) for MFAC; kp, ki, kd for PID) is simulated on the main pair, one batch each. "
@@ -240,50 +213,11 @@ def _tuning(spec, res) -> str:
         + "\n\nIn the figures: every run (dots), the 4-objective front (rings), the front of "
         "the two objectives plotted (step line), the chosen points (stars).\n\n"
         + G.pareto_links(res)
-        + "\n\n" + _comfort_and_edges(spec, res))
-
-
-def _comfort_and_edges(spec, res) -> str:
-    """Peak jerk of the chosen points against the constraint, and whether a
-    chosen point lies on its grid's edge (issue 33, items 2 and 4)."""
-    lim = spec.peak_jerk
-    rows = []
-    for r in res.readings:
-        for c, tun in (("MFAC", r.mfac), ("PID", r.pid)):
-            pj = r.main.value(c, "peak_jerk")
-            ok = "—" if lim is None or not np.isfinite(pj) else (
-                "yes" if pj <= lim.value else "**no**")
-            rows.append([f"`{r.reading.name}`", c, fmt(pj, 3), ok,
-                         ", ".join(tun.edges) or "none"])
-    con = ("No peak-jerk constraint is set (`[tuning] peak_jerk`)." if lim is None else
-           f"Comfort is a **peak constraint**: only runs whose jerk over any 1 s window stays "
-           f"within {fmt(lim.value)} m/s³ ({lim.source}) may be chosen (a grid with no such "
-           "run keeps the stop requirement alone, and the table says no).")
-    return (
-        f"{con} A chosen point whose value of a parameter is the first or last of that "
-        "parameter's grid has not been shown to be an optimum inside the grid: the design "
-        "point is then INCONCLUSIVE until the grid is extended in that parameter.\n\n"
-        + md_table(["reading", "controller", "peak |jerk| (m/s³)", "within the limit",
-                    "on the grid's edge in"], rows, "llrll")
-        + "\n\n![jerk against its limit]({figdir}/jerk.png)")
+        + "\n\n" + T.comfort_section(spec, res))
 
 
 def _compare(res) -> str:
-    rows, brows, drows = [], [], []
-    for r in res.readings:
-        m = r.main
-        for c in ("MFAC", "PID"):
-            rows.append([f"`{r.reading.name}`", c]
-                        + [fmt(m.value(c, i), 3) for i in (*OBJECTIVES, "rms_speed_error")]
-                        + [fmt(r.cost(c), 3)])
-        rows.append([f"`{r.reading.name}`", "**winner**"] + [m.winner(i) for i in OBJECTIVES]
-                    + ["", f"**{r.verdict}**"])
-        brows.append([f"`{r.reading.name}`"]
-                     + [f"{fmt(r.mfac.best(i), 3)} / {fmt(r.pid.best(i), 3)}"
-                        for i in OBJECTIVES])
-        mf, pf = r.mfac.objectives[r.mfac.front], r.pid.objectives[r.pid.front]
-        drows.append([f"`{r.reading.name}`", _pct(dominated_share(mf, pf)),
-                      _pct(dominated_share(pf, mf))])
+    rows, brows, drows = T.compare_rows(res), T.best_rows(res), T.dominated_rows(res)
     return (
         f"## {H_CMP}\n\nThe chosen points on the main pair. Cost: the weighted sum counted from "
         "the reading's utopia point (the best value of each objective over both grids), so "
@@ -305,13 +239,7 @@ def _compare(res) -> str:
 
 
 def _ppd(res) -> str:
-    rows = []
-    for r in res.readings:
-        s = r.ppd
-        rows.append([f"`{r.reading.name}`", fmt(r.dc_gain, 3), fmt(r.time_constant, 3),
-                     f"{fmt(s.phi_min, 2)} … {fmt(s.phi_max, 3)}", str(s.updates),
-                     _pct(s.data_sign_agreement), fmt(s.data_median, 3), fmt(s.data_p95, 3),
-                     fmt(r.frozen_gain, 3), fmt(r.frozen_radius, 3)])
+    rows = T.ppd_rows(res)
     return (
         f"## {H_PPD}\n\nCFDL-MFAC rests on the data model Δy(k+1) = φ(k)Δu(k) with a PPD φ "
         "that is bounded and keeps its sign (paper 002's assumptions 1-3 and Theorem 1, which "
@@ -340,13 +268,7 @@ def _ppd(res) -> str:
 def _line(spec, res) -> str:
     if not res.readings[0].line:
         return ""
-    rows = []
-    for r in res.readings:
-        for c in r.line:
-            rows.append([f"`{r.reading.name}`", c.section.name, fmt(c.section.route.distance, 5),
-                         " ".join(fmt(x * 1000, 3) for x in c.section.route.grade)]
-                        + [f"{fmt(c.value('MFAC', i), 3)} / {fmt(c.value('PID', i), 3)}"
-                           for i in OBJECTIVES])
+    rows = T.line_rows(res)
     return (
         f"## {H_LINE}\n\nThe station data of Nanning Line 1 are not public in the paper: these "
         "sections (distances, planned times, gradient sections in ‰) are **synthetic**, "
@@ -359,9 +281,7 @@ def _line(spec, res) -> str:
 
 def _sensitivity(res) -> str:
     keys = ("eta", "mu", "rho", "lam")
-    rows = [[f"`{r.reading.name}`"] + ["—" if np.isnan(r.sensitivity[k]) else
-                                       fmt(r.sensitivity[k], 3) for k in keys]
-            + [SYMBOL[most_sensitive(r.sensitivity)]] for r in res.readings]
+    rows = T.sensitivity_rows(res, keys, SYMBOL)
     return (
         f"## {H_SENS}\n\nPaper 002 §3 says λ is the parameter the controller is most "
         "sensitive to. From the grid itself (no extra run): the largest relative change of "
@@ -385,10 +305,10 @@ def _closing(res) -> str:
             f"cost ({fmt(r.cost('MFAC'), 3)} MFAC, {fmt(r.cost('PID'), 3)} PID); MFAC is "
             f"better in {sum(r.main.winner(i) == 'MFAC' for i in OBJECTIVES)} of "
             f"{len(OBJECTIVES)} objectives at the chosen points. The published reset fires in "
-            f"{_pct(s.reset_rate)} of the chosen MFAC run's samples "
-            f"({_pct(s.by_condition['at_limit'])} with the command held at a limit); the "
+            f"{T.pct(s.reset_rate)} of the chosen MFAC run's samples "
+            f"({T.pct(s.by_condition['at_limit'])} with the command held at a limit); the "
             f"realised PPD has the sign of φ(1) on "
-            f"{_pct(s.data_sign_agreement)} of the samples where the command moves; the "
+            f"{T.pct(s.data_sign_agreement)} of the samples where the command moves; the "
             f"frozen-PPD loop's spectral radius is {fmt(r.frozen_radius, 3)}.")
     verdicts = {r.verdict for r in res.readings}
     if any(r.mfac.edges or r.pid.edges for r in res.readings):
