@@ -5,8 +5,8 @@ import pytest
 
 from workbench.errors import DesignError
 from workbench.features.param_fit import fit, pooled_rmse, synthetic_log
-from workbench.features.param_fit_study import (read_recovery, recover, recovery_rows,
-                                                relative_errors)
+from workbench.features.param_fit_study import (compare, read_recovery, recover,
+                                                recovery_table, relative_errors)
 from workbench.reader import Reader
 
 NAMES = ("K", "tau", "L")
@@ -69,12 +69,22 @@ def test_fit_rejects_an_unknown_method():
         fit(lag_dead_time, [], spec.bounds, method="nelder", seed=0)
 
 
-def test_recovery_rows_show_truth_fits_and_derived_names():
+def test_recovery_table_shows_truth_fits_and_derived_names():
     rec = recover(lag_dead_time, TRUE, read(toy_root(iterations=3)))
-    head, rows = recovery_rows(rec, lambda v: {**v, "K/tau": v["K"] / v["tau"]})
-    assert head[:3] == ["parameter", "true", "fruit fly"] and len(head) == 6
-    assert [r[0] for r in rows] == ["K", "tau", "L", "K/tau", "RMSE", "model runs"]
-    assert rows[-1][2] == str(24 * 4)
+    lines = recovery_table(rec, lambda v: {**v, "K/tau": v["K"] / v["tau"]}).splitlines()
+    assert "fruit fly" in lines[0] and "diff. evolution" in lines[0]
+    firsts = [ln.split("|")[1].strip() for ln in lines[2:]]
+    assert firsts == ["K", "tau", "L", "K/tau", "RMSE", "model runs"]
+    assert str(24 * 4) in lines[-1]
+
+
+def test_compare_scores_a_reference_model_and_returns_curves():
+    rec = recover(lag_dead_time, TRUE, read(toy_root(iterations=3)))
+    no_delay = dict(TRUE, L=0.05)
+    err, curves = compare(rec, lag_dead_time, lag_dead_time, np.array(list(no_delay.values())))
+    assert err > rec.rmse_truth                 # the wrong dead time fits worse than the truth
+    (t, logged, fitted, ref), = curves
+    assert t.shape == logged.shape == fitted.shape == ref.shape
 
 
 def test_bad_bounds_and_step_are_design_errors():

@@ -25,7 +25,6 @@ import numpy as np
 
 from .features import param_fit
 from .features.param_fit import FitResult, Log, fruit_fly  # noqa: F401 (re-exported)
-from .plants.brake000 import BrakeParams, existing_model
 from .sim.stopping import batch_params, simulate
 
 FITTED = ("T1", "T2", "T3", "T4", "K1", "K2")
@@ -60,7 +59,7 @@ def model_speeds(base: dict, values: np.ndarray, log: Log, *, dt: float,
     return out[:, :len(log.t)]
 
 
-def truth(base: dict) -> np.ndarray:
+def fitted_row(base: dict) -> np.ndarray:
     """The fitted parameters :data:`FITTED` of ``base``, as one row."""
     return np.array([base[k] for k in FITTED])
 
@@ -72,7 +71,7 @@ def synthetic_log(base: dict, steps: tuple, *, v0: float, duration: float, dt_lo
     Speed noise is Gaussian (sd ``noise_sd`` m/s), negative speeds are clipped to 0,
     then quantised to ``quantum`` m/s.
     """
-    return param_fit.synthetic_log(partial(model_speeds, base, dt=dt), truth(base), steps,
+    return param_fit.synthetic_log(partial(model_speeds, base, dt=dt), fitted_row(base), steps,
                                    y0=v0, duration=duration, dt_log=dt_log, noise_sd=noise_sd,
                                    quantum=quantum, seed=seed, floor=0.0)
 
@@ -88,14 +87,3 @@ def fit(base: dict, logs: list[Log], bounds: np.ndarray, *, method: str, dt: flo
     return param_fit.fit(partial(model_speeds, base, dt=dt), logs, bounds, method=method,
                          seed=seed, flies=flies, iterations=iterations, scale=100.0)
 
-
-def rmse_at(base: dict, logs: list[Log], *, dt: float) -> float:
-    """Eq 12 (cm/s) over all ``logs`` of the brake model with all parameters ``base``."""
-    return float(param_fit.pooled_rmse(partial(model_speeds, base, dt=dt),
-                                       np.array([truth(base)]), logs, 100.0)[0])
-
-
-def existing_rmse(base: dict, logs: list[Log], *, delay: float, lag: float, dt: float) -> float:
-    """RMSE (cm/s) of the paper's existing delay + lag model on the logs (not fitted)."""
-    return rmse_at(existing_model(BrakeParams.from_dict(base), delay=delay, lag=lag).as_dict(),
-                   logs, dt=dt)

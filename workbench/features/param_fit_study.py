@@ -18,7 +18,7 @@ from typing import Callable
 import numpy as np
 
 from ..reader import Reader
-from ..report.markdown import fmt
+from ..report.markdown import fmt, md_table
 from .param_fit import FitResult, fit, pooled_rmse, synthetic_log
 
 #: The two optimisers of a recovery study and their table headings.
@@ -124,8 +124,9 @@ def fit_json(rec: Recovery, method: str, rmse_key: str = "rmse") -> dict:
     return {"values": fit_values(rec, method), rmse_key: r.rmse, "evaluations": r.evaluations}
 
 
-def recovery_rows(rec: Recovery, derived: Callable = dict, rmse_label: str = "RMSE"):
-    """Header and rows: true value, each fit and its error % per name of ``derived``."""
+def recovery_table(rec: Recovery, derived: Callable = dict, rmse_label: str = "RMSE") -> str:
+    """Markdown table: true value, each fit and its error % per name of ``derived``,
+    then the RMSEs (``rmse_label``) and the model runs of each fit."""
     tru = derived(rec.truth)
     rows = []
     for k in tru:
@@ -140,4 +141,24 @@ def recovery_rows(rec: Recovery, derived: Callable = dict, rmse_label: str = "RM
     head = ["parameter", "true"]
     for _, label in METHODS:
         head += [label, "error %"]
-    return head, rows
+    return md_table(head, rows, "l" + "r" * (len(head) - 1))
+
+
+def compare(rec: Recovery, simulate: Callable, reference: Callable, ref_row: np.ndarray,
+            scale: float = 1.0) -> tuple[float, tuple]:
+    """RMSE (times ``scale``) of a ``reference`` model at ``ref_row`` (not fitted) on the
+    logs, and per log the curves (t, logged, fruit-fly fit, reference)."""
+    err = float(pooled_rmse(reference, np.array([ref_row]), list(rec.logs), scale)[0])
+    return err, tuple((lg.t, lg.output, simulate(np.array([rec.foa.values]), lg)[0],
+                       reference(np.array([ref_row]), lg)[0]) for lg in rec.logs)
+
+
+def plot_curves(ax, curves: tuple, labels: tuple, scale: float = 1.0) -> None:
+    """Per log of :func:`compare`: logged dots, fitted line, reference dashed line.
+
+    ``labels`` are three formats of the log number ``{i}`` (logged, fitted, reference).
+    """
+    for i, (t, *ys) in enumerate(curves):
+        for y, style, label in zip(ys, (".", "-", "--"), labels):
+            ax.plot(t, y * scale, style, color=f"C{i}", label=label.format(i=i + 1),
+                    **({"ms": 2} if style == "." else {"lw": 1}))
