@@ -40,14 +40,16 @@ class RecoverySpec:
     dt: float            # integration step of the model, dividing dt_log
 
 
-def read_recovery(root: Reader, names: tuple, y0: Callable[[Reader], float]) -> RecoverySpec:
-    """Read ``[[logs]]``, ``[noise]`` and ``[fit]``; ``y0`` reads a log's initial output."""
+def read_recovery(root: Reader, names: tuple, y0: Callable[[Reader], float],
+                  commands: str = "commands") -> RecoverySpec:
+    """Read ``[[logs]]``, ``[noise]`` and ``[fit]``; ``y0`` reads a log's initial output,
+    ``commands`` names the step levels (with their unit) in error messages."""
     logs = []
     for lg in root.tables("logs"):
         start = y0(lg)
         dur = lg.number("duration", positive=True, hi=200.0)
         times = lg.numbers("step_times", what="times (s)")
-        levels = lg.numbers("step_levels", what="commands")
+        levels = lg.numbers("step_levels", what=commands)
         if len(times) != len(levels):
             raise lg.fail("step_levels", list(levels), f"{len(times)} levels, one per step time")
         logs.append((start, dur, tuple(zip(times, levels))))

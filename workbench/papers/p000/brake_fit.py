@@ -41,8 +41,7 @@ class FitStudyResult:
     curves: tuple      # per log: (t, logged, foa model, existing model)
 
     #: The JSON of the result (:func:`workbench.jsonable.to_json`).
-    JSON_FIELDS = {"truth": lambda res: res.rec.truth,
-                   "rmse_truth_cm_s": lambda res: res.rec.rmse_truth,
+    JSON_FIELDS = {"truth": "rec.truth", "rmse_truth_cm_s": "rec.rmse_truth",
                    "rmse_existing_cm_s": "rmse_existing",
                    **{m: (lambda res, m=m: fit_json(res.rec, m, "rmse_cm_s"))
                       for m in ("foa", "de")}}
@@ -52,7 +51,8 @@ class FitStudyResult:
 def _load(root: Reader) -> FitSpec:
     params = read_brake_plant(root)
     rec = read_recovery(root, FITTED,
-                        lambda lg: lg.quantity("v0", "m/s", positive=True, hi=40.0).value)
+                        lambda lg: lg.quantity("v0", "m/s", positive=True, hi=40.0).value,
+                        "commands (m/s^2)")
     ex = root.table("existing")
     spec = FitSpec(params, rec, ex.quantity("delay", "s", positive=True).value,
                    ex.quantity("lag", "s", positive=True).value)
