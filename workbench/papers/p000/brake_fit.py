@@ -48,18 +48,6 @@ class FitStudyResult:
     to_json = json_method
 
 
-def _load(root: Reader) -> FitSpec:
-    params = read_brake_plant(root)
-    rec = read_recovery(root, FITTED,
-                        lambda lg: lg.quantity("v0", "m/s", positive=True, hi=40.0).value,
-                        "commands (m/s^2)")
-    ex = root.table("existing")
-    spec = FitSpec(params, rec, ex.quantity("delay", "s", positive=True).value,
-                   ex.quantity("lag", "s", positive=True).value)
-    ex.finish()
-    return spec
-
-
 def _with_ratio(values: dict) -> dict:
     """``values`` (name -> value of :data:`~workbench.fit.FITTED`) and K1/K2,
     the ratio eq 7 identifies (K1 and K2 alone are not)."""
@@ -86,7 +74,15 @@ class BrakeFit:
     uses_solver = False    # no convex solver runs: the report says so
 
     def load(self, root: Reader) -> FitSpec:
-        return _load(root)
+        params = read_brake_plant(root)
+        rec = read_recovery(root, FITTED,
+                            lambda lg: lg.quantity("v0", "m/s", positive=True, hi=40.0).value,
+                            "commands (m/s^2)")
+        ex = root.table("existing")
+        spec = FitSpec(params, rec, ex.quantity("delay", "s", positive=True).value,
+                       ex.quantity("lag", "s", positive=True).value)
+        ex.finish()
+        return spec
 
     def quantity_names(self, spec) -> set[str]:
         return names(TABLE, spec)
