@@ -19,10 +19,10 @@ def log():
 
 def test_synthetic_log_is_sampled_quantised_and_noisy(log):
     assert np.allclose(np.diff(log.t), 0.2)
-    assert np.allclose(log.speed * 100, np.round(log.speed * 100))
+    assert np.allclose(log.output * 100, np.round(log.output * 100))
     clean = model_speeds(TABLE1, np.array([[TABLE1[k] for k in FITTED]]), log, dt=0.04)[0]
-    assert 3.0 < rmse_cm(clean, log.speed) < 7.0        # the 5 cm/s noise, seen by eq 12
-    assert log.speed[-1] < 0.2                          # stopped (one-sided noise at 0)
+    assert 3.0 < rmse_cm(clean, log.output) < 7.0        # the 5 cm/s noise, seen by eq 12
+    assert log.output[-1] < 0.2                          # stopped (one-sided noise at 0)
 
 
 def test_k1_k2_enter_only_as_ratio(log):
@@ -47,7 +47,7 @@ def test_fruit_fly_finds_a_quadratic_minimum():
 def test_fit_reaches_the_noise_floor_and_recovers_identifiable_parameters(log, method):
     r = fit(TABLE1, [log], BOUNDS, method=method, dt=0.04, seed=3, flies=24, iterations=25)
     clean = model_speeds(TABLE1, np.array([[TABLE1[k] for k in FITTED]]), log, dt=0.04)[0]
-    floor = float(rmse_cm(clean, log.speed))
+    floor = float(rmse_cm(clean, log.output))
     assert r.rmse < 1.3 * floor
     got = dict(zip(FITTED, r.values))
     # T1 and T2 trade off; their sum (electric dead time + lag) is identified
