@@ -149,12 +149,13 @@ def test_pool_workers_die_with_their_parent(tmp_path):
 def test_a_chunk_write_failure_names_the_folder_not_the_scheduler(tmp_path, monkeypatch,
                                                                     capsys):
     """Under any scheduler, an OSError writing a chunk is an --out problem."""
-    from workbench.papers.p003 import antiskid_montecarlo
+    from workbench.papers.p003 import antiskid_run
 
     class Refused:
         def result(self, progress=False):    # a chunk's file cannot be written
             raise OSError(28, "No space left on device")
-    monkeypatch.setattr(antiskid_montecarlo, "start_streaming", lambda *a, **k: Refused())
+    # the name the sweep command calls (imported into antiskid_run)
+    monkeypatch.setattr(antiskid_run, "start_streaming", lambda *a, **k: Refused())
     code = main(["sweep", str(ROOT / "designs/antiskid-run-dry.toml"), "--samples", "2",
                  "--seed", "1", "--workers", "1", "--kernel", "numpy",
                  "--out", str(tmp_path / "chunks")])
