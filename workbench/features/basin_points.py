@@ -17,6 +17,7 @@ terminal events of its escape; nothing here knows the plant or the law.
 * :func:`sweep_gain_entry` -- :func:`point_in_basin` along one entry of a gain
   (:func:`~workbench.features.basin_sweep.gain_edge`), plus labelled gains
   compared;
+* :func:`gain_sweep_quantities` -- its claimable edge and compared count;
 * :func:`read_gain_sweep`, :func:`load_gain_sweep` -- the ``[basin]`` table's
   keys of that sweep.
 """
@@ -184,6 +185,21 @@ def sweep_gain_entry(judge, point, gain, index: int, grid, *, compare=(),
     compared = tuple(row(tuple(float(v) for v in K), str(lab)) for lab, K in compare)
     return GainSweep(tuple(point), gain, index, sw.rows, compared, sw.edge, min(grid),
                      sw.certified_below_edge)
+
+
+def gain_sweep_quantity_names(entry: str) -> set:
+    """Names of :func:`gain_sweep_quantities` (``entry``: the swept entry's name)."""
+    return {f"basin.{entry}_safe_max", f"basin.{entry}_unsafe_min", "basin.compared_certified"}
+
+
+def gain_sweep_quantities(sweep: GainSweep, entry: str) -> dict:
+    """Claimable values of a :class:`GainSweep`: the edge of the certified
+    range (``basin.{entry}_safe_max``, ``basin.{entry}_unsafe_min``; None
+    without an edge) and how many compared gains are CERTIFIED."""
+    lo, hi = (None, None) if sweep.edge is None else sweep.edge
+    return {f"basin.{entry}_safe_max": lo, f"basin.{entry}_unsafe_min": hi,
+            "basin.compared_certified": sum(r.verdict.outcome is Outcome.CERTIFIED
+                                            for r in sweep.compared)}
 
 
 @dataclass(frozen=True)

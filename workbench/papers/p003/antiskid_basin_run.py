@@ -20,9 +20,12 @@ each case's state at t_brake against the braking law (69) frozen at that
 instant (:mod:`.antiskid_basin_brake`). The basin uses the controller's nominal
 model (a design's plant mass factor is not in it; the report says so).
 
-What stays here is paper 003's: the k2 key, where the switches are in a
-case's metrics and the claim names; the level and point quantities are the
-general ones of :mod:`workbench.features.basin`, the table (``enabled``,
+What stays here is paper 003's: the k2 key, the switch names, where the
+switches are in a case's metrics, and which law judges each switch. The
+switch states, the per-case switch verdicts and their quantities are the
+general ones of :mod:`workbench.features.basin_switch`, the level and gain
+sweep quantities those of :mod:`workbench.features.basin` and
+:mod:`workbench.features.basin_points`, and the table (``enabled``,
 ``seed``, ``compare_*``, ``bisect``) is read by
 :func:`workbench.features.basin_points.load_gain_sweep`.
 """
@@ -31,9 +34,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ...features.basin import (LEVEL_QUANTITIES, level_quantities, point_quantities,
-                                point_quantity_names)
-from ...features.basin_points import GainSweep, GainSweepSettings, load_gain_sweep
+from ...features.basin import LEVEL_QUANTITIES, level_quantities
+from ...features.basin_points import (GainSweep, GainSweepSettings, gain_sweep_quantities,
+                                      gain_sweep_quantity_names, load_gain_sweep)
+from ...features.basin_switch import switch_quantities, switch_quantity_names, switch_states
 from .antiskid_basin import CruiseBasin, cruise_basin, safe_k2_range
 
 
@@ -55,30 +59,20 @@ def load_basin_settings(root) -> GainSweepSettings | None:
     return load_gain_sweep(root, "k2_grid", 2, what="cruise gains k2")
 
 
-#: Key of a case's acceleration -> cruise switch quantities.
-_CRUISE = "switch.cruise[{label}]"
-
-
 def switch_points(cases) -> list:
     """(case name, (v, lambda)) where law (61) took over, per case (cases whose
     cruise law never started are left out)."""
-    out = []
-    for c in cases:
+    def at(c):
         key = "handover" if c.case.cruise_entry == "creep" else "cruise"
-        v, lam = c.metrics.get(f"v_at_{key}", math.nan), c.metrics.get(f"lam_at_{key}", math.nan)
-        if math.isfinite(v) and math.isfinite(lam):
-            out.append((c.case.name, (float(v), float(lam))))
-    return out
+        return c.case.name, (c.metrics.get(f"v_at_{key}", math.nan),
+                             c.metrics.get(f"lam_at_{key}", math.nan))
+    return switch_states(cases, at)
 
 
 def brake_points(cases, v_d: float) -> list:
     """(case name, (v, lambda)) at t_brake, per case that reached braking."""
-    out = []
-    for c in cases:
-        dv, lam = c.metrics.get("v_err_at_brake", math.nan), c.metrics.get("lam_at_brake", math.nan)
-        if math.isfinite(dv) and math.isfinite(lam):
-            out.append((c.case.name, (v_d + float(dv), float(lam))))
-    return out
+    return switch_states(cases, lambda c: (c.case.name, (
+        v_d + c.metrics.get("v_err_at_brake", math.nan), c.metrics.get("lam_at_brake", math.nan))))
 
 
 def run_basin(settings: GainSweepSettings, values: dict, v_d: float, K, lambda_opt: float, cases,
@@ -121,24 +115,16 @@ def basin_quantities(basin, sweep, labels=(), brake=()) -> dict:
     """Claim quantities of the basin check (``labels``: every case; a case
     whose cruise law never started, or that never braked, gets None)."""
     q = level_quantities(basin.check.estimate)
-    for lab in labels:
-        q[f"switch.cruise[{lab}].in_basin"] = q[f"switch.cruise[{lab}].fate"] = None
-        q[f"switch.brake[{lab}].in_basin"] = q[f"switch.brake[{lab}].fate"] = None
-    for b in brake:
-        q[f"switch.brake[{b.label}].in_basin"] = b.outcome.name
-        q[f"switch.brake[{b.label}].fate"] = b.fate
-    q.update(point_quantities(basin.check, _CRUISE, fate=[tr.fate for tr in basin.trajectories]))
+    q.update(switch_quantities(labels, {
+        "cruise": [(p.label, p.verdict.outcome, tr.fate)
+                   for p, tr in zip(basin.check.points, basin.trajectories)],
+        "brake": [(b.label, b.outcome, b.fate) for b in brake]}))
     if sweep is not None:
-        q["basin.k2_safe_max"] = None if sweep.edge is None else sweep.edge[0]
-        q["basin.k2_unsafe_min"] = None if sweep.edge is None else sweep.edge[1]
-        q["basin.compared_certified"] = sum(r.verdict.outcome.name == "CERTIFIED"
-                                            for r in sweep.compared)
+        q.update(gain_sweep_quantities(sweep, "k2"))
     return q
 
 
 def basin_quantity_names(labels, with_sweep: bool) -> set:
-    names = (set(LEVEL_QUANTITIES) | point_quantity_names(labels, _CRUISE, ("in_basin", "fate"))
-             | point_quantity_names(labels, "switch.brake[{label}]", ("in_basin", "fate")))
-    if with_sweep:
-        names |= {"basin.k2_safe_max", "basin.k2_unsafe_min", "basin.compared_certified"}
-    return names
+    """Names of :func:`basin_quantities` (``with_sweep``: the k2 rule's too)."""
+    names = set(LEVEL_QUANTITIES) | switch_quantity_names(labels, ("cruise", "brake"))
+    return (names | gain_sweep_quantity_names("k2")) if with_sweep else names
