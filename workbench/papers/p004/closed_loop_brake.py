@@ -9,7 +9,9 @@ ATO law an expression, the command generator its named module
 ``[montecarlo]``, the sensor faults and the electric-brake loss its
 ``[[faults]]``; the grid, the faults and the nominal stops are the kind's
 general run (:func:`workbench.kinds.stop_accuracy.run.run`, kept whole in
-:attr:`Result004.kind`), the rest its batches (:mod:`.closed_loop_brake_run`).
+:attr:`Result004.kind` and read under the report's names through
+:mod:`workbench.kinds.stop_accuracy.kind_view`), the rest its batches
+(:mod:`.closed_loop_brake_run`).
 What stays here is paper 004's: the worked numbers of section 1.3 (sympy
 expressions written here once, ``[worked]``), the names of its report's
 runs (``open``, ``ato-open``, ``closed``; channels ``analogue`` and
