@@ -120,3 +120,20 @@ def test_recovery_study_runs_a_toy_kind_with_its_quantities_json_and_verb(capsys
     assert js["foa"]["rmse_u"] == q["rmse.lagged_foa"]
     assert study.command(design, "{name}: {logs} log", lambda r: "TABLE") == 0
     assert capsys.readouterr().out.splitlines()[:2] == ["toy: 1 log", "TABLE"]
+
+
+def test_plot_curves_labels_the_axes_and_the_logs():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from workbench.features.param_fit_study import plot_curves
+    rec = recover(lag_dead_time, TRUE, read(toy_root(iterations=3)))
+    _, curves = compare(rec, lag_dead_time, lag_dead_time, np.array(list(TRUE.values())))
+    fig = plt.figure()
+    ax = fig.add_subplot(111)
+    plot_curves(ax, curves, ("log {i}", "fit {i}", "ref {i}"), 10.0, ylabel="y (0.1 units)")
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("time (s)", "y (0.1 units)")
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["log 1", "fit 1", "ref 1"]
+    assert np.allclose(ax.lines[0].get_ydata(), 10.0 * curves[0][1])
+    plt.close(fig)

@@ -70,15 +70,6 @@ def _table(res) -> str:
     return recovery_table(res.rec, _with_ratio, "RMSE (cm/s)")
 
 
-def _plot(fig, res):
-    ax = fig.add_subplot(111)
-    plot_curves(ax, res.curves, ("log {i} (synthetic)", "fitted precise {i}", "existing {i}"),
-                100)
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel("speed (cm/s)")
-    ax.legend(fontsize=7)
-
-
 def render(design, res) -> Rendered:
     """Report sections of a ``brake-fit`` design (pure)."""
     s, r = design.spec, design.spec.recovery
@@ -103,7 +94,9 @@ def render(design, res) -> Rendered:
                  fmt(res.rmse_reference, 4)]], "lr")
             + "\n\n![fit]({figdir}/fit-curves.png)")
     figs = (Figure("fit-curves", "Synthetic logs, fitted precise model, existing model.",
-                   lambda fig, res=res: _plot(fig, res), size=(7.0, 4.0)),)
+                   lambda fig: plot_curves(fig.add_subplot(111), res.curves, (
+                       "log {i} (synthetic)", "fitted precise {i}", "existing {i}"), 100,
+                       ylabel="speed (cm/s)"), size=(7.0, 4.0)),)
     return Rendered((text,), figs)
 
 
