@@ -92,3 +92,48 @@ def test_bad_bounds_and_step_are_design_errors():
         read(toy_root(bounds={"K": [2.0, 1.0], "tau": [0.3, 4.0], "L": [0.05, 1.0]}))
     with pytest.raises(DesignError, match="dividing noise.dt_log"):
         read(toy_root(dt=0.03))
+
+
+def test_recovery_study_runs_a_toy_kind_with_its_quantities_json_and_verb(capsys):
+    """The study object of :mod:`workbench.features.param_fit_kind` on the toy lag,
+    the reference model being the lag without dead time."""
+    from types import SimpleNamespace
+
+    from workbench.features.param_fit_kind import (RecoveryModel, RecoveryNames,
+                                                   RecoveryStudy)
+    ref = dict(TRUE, L=0.0)
+    study = RecoveryStudy(
+        "toy-fit", lambda root: SimpleNamespace(recovery=read(root)),
+        lambda spec: RecoveryModel(lag_dead_time, TRUE, lag_dead_time,
+                                   np.array(list(ref.values()))),
+        RecoveryNames("lagged", "undelayed", "1", "u"), NAMES,
+        lambda v: {**v, "K/tau": v["K"] / v["tau"]})
+    design = SimpleNamespace(name="toy", spec=study.load(toy_root(iterations=3)))
+    res = study.run(design)
+    q = study.quantities(res)
+    assert set(q) == study.quantity_names(design.spec)
+    assert q["rmse.undelayed"] > q["rmse.truth"]         # no dead time fits worse than the truth
+    assert q["rmse.ratio_undelayed_over_lagged"] == q["rmse.undelayed"] / q["rmse.lagged_foa"]
+    assert {"foa.K/tau.rel_error", "de.L.rel_error"} <= set(q)
+    js = res.to_json()
+    assert list(js) == ["truth", "rmse_truth_u", "rmse_undelayed_u", "foa", "de"]
+    assert js["foa"]["rmse_u"] == q["rmse.lagged_foa"]
+    assert study.command(design, "{name}: {logs} log", lambda r: "TABLE") == 0
+    assert capsys.readouterr().out.splitlines()[:2] == ["toy: 1 log", "TABLE"]
+
+
+def test_plot_curves_labels_the_axes_and_the_logs():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from workbench.features.param_fit_study import plot_curves
+    rec = recover(lag_dead_time, TRUE, read(toy_root(iterations=3)))
+    _, curves = compare(rec, lag_dead_time, lag_dead_time, np.array(list(TRUE.values())))
+    fig = plt.figure()
+    ax = fig.add_subplot(111)
+    plot_curves(ax, curves, ("log {i}", "fit {i}", "ref {i}"), 10.0, ylabel="y (0.1 units)")
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("time (s)", "y (0.1 units)")
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["log 1", "fit 1", "ref 1"]
+    assert np.allclose(ax.lines[0].get_ydata(), 10.0 * curves[0][1])
+    plt.close(fig)

@@ -155,12 +155,19 @@ def compare(rec: Recovery, simulate: Callable, reference: Callable, ref_row: np.
                        reference(np.array([ref_row]), lg)[0]) for lg in rec.logs)
 
 
-def plot_curves(ax, curves: tuple, labels: tuple, scale: float = 1.0) -> None:
+def plot_curves(ax, curves: tuple, labels: tuple, scale: float = 1.0, *,
+                ylabel: str | None = None) -> None:
     """Per log of :func:`compare`: logged dots, fitted line, reference dashed line.
 
     ``labels`` are three formats of the log number ``{i}`` (logged, fitted, reference).
+    With ``ylabel`` (the output times ``scale``, with its unit) the axes are
+    labelled (time in s) and the legend drawn.
     """
     for i, (t, *ys) in enumerate(curves):
         for y, style, label in zip(ys, (".", "-", "--"), labels):
             ax.plot(t, y * scale, style, color=f"C{i}", label=label.format(i=i + 1),
                     **({"ms": 2} if style == "." else {"lw": 1}))
+    if ylabel is not None:
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel(ylabel)
+        ax.legend(fontsize=7)

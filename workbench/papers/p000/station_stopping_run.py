@@ -6,7 +6,9 @@ per-section repeats (:func:`~workbench.kinds.stop_accuracy.run.section_runs`),
 the nominal plant and the Monte Carlo
 (:func:`~workbench.kinds.stop_accuracy.run.simulate_cases`, every case
 meeting the same draws), and so are the example stops of section 1
-(:func:`~workbench.kinds.stop_accuracy.run.section_example`), the damping of
+(:func:`~workbench.kinds.stop_accuracy.run.section_example`), the nominal
+stops with their oscillation counts
+(:func:`~workbench.kinds.stop_accuracy.tracked_stops.tracked_stops`), the damping of
 the PIDs' linearised loops and the sign changes of their speed errors
 (:mod:`workbench.kinds.stop_accuracy.loop_damping`). What stays here is
 paper 000's: which runs make its rows (the paper names of
@@ -20,37 +22,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...kinds.stop_accuracy.loop_damping import pid_damping, pid_dead_time, sign_changes
+from ...kinds.stop_accuracy.loop_damping import pid_damping, pid_dead_time
+from ...kinds.stop_accuracy.tracked_stops import tracked_stops
 from .station_stopping_spec import ABLATION, CONTROLLERS, DAMPING, MC_CONTROLLERS, VARIANTS
 
 #: Speed errors below this (m/s; 0.18 km/h, below a speedometer's resolution) do not
 #: count as a sign change (oscillation count).
 SIGN_DEADBAND = 0.05
-
-
-@dataclass(frozen=True)
-class NominalRun:
-    """One stop on the nominal plant (no uncertainty).
-
-    Attributes
-    ----------
-    error : float
-        Stop error (m, + = overshoot).
-    t, dx, v, v_d : ndarray
-        Time from the braking start (s), position - stopping point (m),
-        speed and target speed (m/s).
-    sign_changes : int
-        Sign changes of the speed error v - v_d while tracking (before the
-        last 20 % of the planned braking time), errors below
-        :data:`SIGN_DEADBAND` ignored: the oscillation count.
-    """
-
-    error: float
-    t: np.ndarray
-    dx: np.ndarray
-    v: np.ndarray
-    v_d: np.ndarray
-    sign_changes: int
 
 
 @dataclass(frozen=True)
@@ -61,7 +39,7 @@ class StopResult:
     stats: dict                           # (controller, section index) -> CellStats
     example: dict                         # controller -> (t, x - x_stop, v, x_d, v_d) of one run
     theta_hat_final: tuple[float, float]  # SMARC estimate range at the end
-    nominal: dict                         # paper name -> NominalRun
+    nominal: dict                         # paper name -> TrackedStop
     mc: dict                              # paper name -> StopStatistics (m)
     damping: dict                         # PID paper name -> Damping of its linearised loop
     tolerance: float                      # m
@@ -93,24 +71,19 @@ def _sections(spec, laws):
 def run_station_stops(spec) -> StopResult:
     """The per-section repeats, the nominal row (every controller) and the
     Monte Carlo (:data:`MC_CONTROLLERS`) of the design ``spec``."""
-    from ...kinds.stop_accuracy.run import (compile_laws, controller_index, montecarlo_statistics,
-                                            simulate_cases)
+    from ...kinds.stop_accuracy.run import compile_laws, controller_index, montecarlo_statistics
     laws = compile_laws(spec)
     stats, example, planned, theta = _sections(spec, laws)
     (speed,), L = spec.speeds_kmh, spec.distance
-    index = {k: controller_index(spec, v) for k, (v, _) in VARIANTS.items()}
-    nom = list(MC_CONTROLLERS + ABLATION)
-    tr, D = simulate_cases(spec, laws, spec.dt, [(speed, index[k], None, L) for k in nom])
-    _, vd, t_plan = spec.reference.braking(L, tr.t)
-    track = tr.t < 0.8 * t_plan
-    nominal = {k: NominalRun(float(tr.x_stop[j] - D[j]), tr.t, tr.x[:, j] - D[j], tr.v[:, j], vd,
-                             sign_changes((tr.v[:, j] - vd)[track], SIGN_DEADBAND))
-               for j, k in enumerate(nom)}
-    mcs = montecarlo_statistics(spec, laws, [(speed, index[k], None, L) for k in MC_CONTROLLERS],
-                                MC_CONTROLLERS)
+    nom = MC_CONTROLLERS + ABLATION
+    stops = tracked_stops(spec, laws, [VARIANTS[k][0] for k in nom], speed, L,
+                          track_share=0.8, deadband=SIGN_DEADBAND)
+    nominal = {k: stops[VARIANTS[k][0]] for k in nom}
+    mcs = montecarlo_statistics(spec, laws, [(speed, controller_index(spec, VARIANTS[k][0]), None,
+                                              L) for k in MC_CONTROLLERS], MC_CONTROLLERS)
     damp = {k: pid_damping(spec, VARIANTS[k][0]) for k in DAMPING}
     return StopResult(spec, spec.sections.sections, planned, stats, example, theta, nominal,
                       mcs, damp, spec.tolerance)
 
 
-__all__ = ["NominalRun", "StopResult", "loop_dead_time", "run_station_stops"]
+__all__ = ["StopResult", "loop_dead_time", "run_station_stops"]

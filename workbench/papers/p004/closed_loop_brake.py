@@ -9,7 +9,9 @@ ATO law an expression, the command generator its named module
 ``[montecarlo]``, the sensor faults and the electric-brake loss its
 ``[[faults]]``; the grid, the faults and the nominal stops are the kind's
 general run (:func:`workbench.kinds.stop_accuracy.run.run`, kept whole in
-:attr:`Result004.kind`), the rest its batches (:mod:`.closed_loop_brake_run`).
+:attr:`Result004.kind` and read under the report's names through
+:mod:`workbench.kinds.stop_accuracy.kind_view`), the rest its batches
+(:mod:`.closed_loop_brake_run`).
 What stays here is paper 004's: the worked numbers of section 1.3 (sympy
 expressions written here once, ``[worked]``), the names of its report's
 runs (``open``, ``ato-open``, ``closed``; channels ``analogue`` and
@@ -32,13 +34,13 @@ its claims name and the report's wording. The modes:
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from functools import cached_property
 
-from ...features.quantities import Declared, values
+from ...features.quantities import Declared
 from ...kinds.stop_accuracy.analysis import Analysis
+from ...kinds.stop_accuracy.kind_view import KindView, kind_quantity, per_speed
 from ...kinds.stop_accuracy.loop_damping import loop_damping
 from ...kinds.stop_accuracy.quantities import mc_family
-from ...kinds.stop_accuracy.run import grid_corners, run, speed_key
+from ...kinds.stop_accuracy.run import grid_corners, run
 from ...tuning.pid import Damping
 from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, ELECTRIC_LOSS, FACTORS, FAULT_NAMES,
                                     MC_MODES, run_curves, run_horizon_sweep, run_montecarlo)
@@ -60,7 +62,7 @@ def corners(spec) -> list:
 
 
 @dataclass(frozen=True)
-class Result004:
+class Result004(KindView):
     """The kind's general run and what paper 004's report adds to it."""
 
     kind: object            # StopAccuracyResult: grid per (speed, controller), faults, nominal
@@ -70,31 +72,12 @@ class Result004:
     damping: Damping | None = None   # of the linearised deceleration PID loop
     sweep: dict | None = None  # (ATO horizon s, speed km/h) -> nominal closed-loop stop error m
 
-    @property
-    def spec(self):
-        return self.kind.spec
-
-    @property
-    def distance(self) -> dict:
-        return self.kind.distance
-
-    @property
-    def tolerance(self) -> float:
-        return self.kind.spec.tolerance
-
     def corners(self) -> list:
         return corners(self.spec)
 
     def grid(self, s, mode: str, channel: str = "analogue") -> tuple:
         """Stop errors (m) of a mode at every grid corner (healthy sensors)."""
         return self.kind.grid[s, CONTROLLERS[mode, channel]]
-
-    @cached_property
-    def kind_values(self) -> dict:
-        """The kind's quantities of :attr:`kind`
-        (:mod:`workbench.kinds.stop_accuracy.quantities`)."""
-        from ...kinds.stop_accuracy.quantities import TABLE as KIND
-        return values(KIND, self.spec, self.kind)
 
     def stop(self, s, mode: str = "closed", channel: str = "analogue",
              fault: str = "healthy") -> float:
@@ -120,18 +103,6 @@ def run_grid(spec, *, montecarlo: bool = True) -> Result004:
                      run_horizon_sweep(spec, res.distance) if montecarlo else None)
 
 
-def _speeds(*members):
-    """``over`` of a family: per speed ``s`` (km/h) ``{"b": "v<s>", "s": s}``,
-    times each member (a dict) of ``members``."""
-    return lambda spec: [{"b": speed_key(s), "s": s} | x for s in spec.speeds_kmh
-                         for x in (members or ({},))]
-
-
-def _kind(name: str, f=lambda x: x):
-    """Read ``f`` of the kind's quantity ``name`` (a template over the index)."""
-    return lambda r, **ix: None if (x := r.kind_values[name.format(**ix)]) is None else f(x)
-
-
 #: the report's names -> the design's controllers
 _MODES = [{"m": m, "c": CONTROLLERS[m, "analogue"]} for m in ("open", "ato-open")]
 _CH = [{"ch": ch, "c": CONTROLLERS["closed", ch]} for ch in CHANNELS]
@@ -145,31 +116,31 @@ TABLE = (
     Declared("worked.{k}", "{u}", lambda r, k, u: r.worked[k], over=lambda spec: [
         {"k": k, "u": "%" if k.startswith("share") else "m/s^2" if k.startswith("a2") else "m"}
         for k in compute_worked(spec.paper.worked)]),
-    Declared("{b}.{m}.max_abs_m", "m", _kind("{b}.{c}.grid.max_abs_m"), over=_speeds(*_MODES)),
-    *(Declared("{b}.closed.{ch}.%s" % name, unit, _kind("{b}.{c}.grid.%s" % name),
-               over=_speeds(*_CH))
+    Declared("{b}.{m}.max_abs_m", "m", kind_quantity("{b}.{c}.grid.max_abs_m"), over=per_speed(*_MODES)),
+    *(Declared("{b}.closed.{ch}.%s" % name, unit, kind_quantity("{b}.{c}.grid.%s" % name),
+               over=per_speed(*_CH))
       for name, unit in (("max_abs_m", "m"), ("failing_corners", "1"),
                          ("failing_feasible_corners", "1"), ("feasible_max_abs_m", "m"))),
     Declared("{b}.closed.3bit_minus_analogue_m", "m", lambda r, b, s: None if None in (
         x := [r.kind_values[f"{b}.{c['c']}.grid.feasible_max_abs_m"] for c in _CH]) else
-        x[1] - x[0], over=_speeds()),
-    Declared("{b}.fault[{f}].abs_m", "m", _kind("{b}.%s.fault[{k}].error_m" % _CLOSED, abs),
-             over=_speeds(*_FAULTS)),
-    Declared("{b}.fault[{f}].error_m", "m", _kind("{b}.%s.fault[{k}].error_m" % _CLOSED),
-             over=_speeds(*_FAULTS)),
+        x[1] - x[0], over=per_speed()),
+    Declared("{b}.fault[{f}].abs_m", "m", kind_quantity("{b}.%s.fault[{k}].error_m" % _CLOSED, abs),
+             over=per_speed(*_FAULTS)),
+    Declared("{b}.fault[{f}].error_m", "m", kind_quantity("{b}.%s.fault[{k}].error_m" % _CLOSED),
+             over=per_speed(*_FAULTS)),
     Declared("{b}.fault[{f}].change_vs_healthy_m", "m",
-             _kind("{b}.%s.fault[{k}].change_m" % _CLOSED), over=_speeds(*_FAULTS)),
-    Declared("{b}.nominal.closed.{ch}.abs_m", "m", _kind("{b}.{c}.nominal_m", abs),
-             over=_speeds(*_CH)),
-    Declared("{b}.nominal.ato-open.abs_m", "m", _kind("{b}.%s.nominal_m" % _MODES[1]["c"], abs),
-             over=_speeds()),
+             kind_quantity("{b}.%s.fault[{k}].change_m" % _CLOSED), over=per_speed(*_FAULTS)),
+    Declared("{b}.nominal.closed.{ch}.abs_m", "m", kind_quantity("{b}.{c}.nominal_m", abs),
+             over=per_speed(*_CH)),
+    Declared("{b}.nominal.ato-open.abs_m", "m", kind_quantity("{b}.%s.nominal_m" % _MODES[1]["c"], abs),
+             over=per_speed()),
     Declared("{b}.electric_loss.{m}.abs_m", "m",
-             _kind("{b}.{c}.fault[%s].error_m" % ELECTRIC_LOSS, abs), over=_speeds(
+             kind_quantity("{b}.{c}.fault[%s].error_m" % ELECTRIC_LOSS, abs), over=per_speed(
                  *({"m": m, "c": CONTROLLERS[m, "analogue"]} for m in ("closed", "ato-open")))),
-    mc_family("{b}.mc.{m}", _speeds(*({"m": m} for m in MC_MODES)),
+    mc_family("{b}.mc.{m}", per_speed(*({"m": m} for m in MC_MODES)),
               lambda r, b, s, m: r.mc[s, m]),
     Declared("{b}.mc.closed_minus_ato-open_p", "1",
-             lambda r, b, s: r.mc[s, "closed"].p - r.mc[s, "ato-open"].p, over=_speeds()),
+             lambda r, b, s: r.mc[s, "closed"].p - r.mc[s, "ato-open"].p, over=per_speed()),
     Declared("pid.damping_zeta", "1", lambda r: r.damping.zeta),
 )
 
