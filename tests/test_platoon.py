@@ -172,3 +172,14 @@ def test_study_claims_are_ok():
     m = ev.result.metrics
     assert max(m["pd"].max_abs_e) > 100 * max(m["ntsm"].max_abs_e)
     assert all(c.slide_measured is not None for c in ev.result.convergence)
+
+
+def test_constant_values_of_a_non_paper_platoon():
+    """PlatoonSpec.constant_values on the synthetic platoon (no paper): values in
+    the order asked, a missing constant names its key and what needs it."""
+    spec = load_design("designs/platoon-synthetic.toml").spec
+    keys = tuple(spec.constants)[:2]
+    assert spec.constant_values(keys, "x") == tuple(spec.constants[k].value for k in keys)
+    with pytest.raises(DesignError) as exc:
+        spec.constant_values(keys + ("no_such_gain",), "the gains of my law")
+    assert exc.value.key == "constants.no_such_gain" and "the gains of my law" in str(exc.value)

@@ -11,8 +11,8 @@ from ...report.markdown import Figure, Rendered, fmt, md_table
 from . import figures as F
 from .spec import OBJECTIVE_UNITS, OBJECTIVES
 
-__all__ = ["DOC", "LABEL", "line_figure", "pareto_links", "param_table", "params_text", "render",
-           "scale_rows", "scale_table", "tuning_figures"]
+__all__ = ["DOC", "LABEL", "line_figure", "pareto_links", "param_table", "params_text",
+           "ppd_figure", "render", "scale_rows", "scale_table", "tuning_figures"]
 
 H_TUNE = "Tuning per reading and controller"
 H_MAIN = "Chosen points on the main pair"
@@ -157,6 +157,14 @@ def tuning_figures(spec, res) -> list:
                           "limit.", lambda fig: F.plot_jerk(
                               fig, res, None if spec.peak_jerk is None else spec.peak_jerk.value),
                           (8.0, 3.2))]
+
+
+def ppd_figure(res) -> list:
+    """The figure of the chosen MFAC runs' PPD estimate and realised PPD (none
+    unless every reading has an MFAC)."""
+    return [Figure("ppd", "PPD estimate and realised PPD of the chosen MFAC runs.",
+                   lambda fig: F.plot_ppd(fig, res), (8.0, 3.8))] if all(
+        r.ppd is not None for r in res.readings) else []
 
 
 def line_figure(res, caption: str) -> list:

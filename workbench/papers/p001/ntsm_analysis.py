@@ -70,11 +70,8 @@ class NTSMAnalysis:
     """Paper 001's part of a ``platoon`` design (see the module docstring)."""
 
     def load(self, root, spec) -> NTSMGains:
-        missing = [k for k in GAINS + ("kp", "kd", "kp_ff", "kd_ff") if k not in spec.constants]
-        if missing:
-            raise DesignError(spec.path, f"constants.{missing[0]}", "<missing>",
-                              "eq 13's gains and the PD gains as [constants] (p001.ntsm_analysis)")
-        g = NTSMGains(*(_c(spec, k) for k in GAINS))
+        g = NTSMGains(*spec.constant_values(GAINS + ("kp", "kd", "kp_ff", "kd_ff"), (
+            "eq 13's gains and the PD gains as [constants] (p001.ntsm_analysis)"))[:len(GAINS)])
         bad = g.problems()
         if bad:
             name, value, expected = bad[0]

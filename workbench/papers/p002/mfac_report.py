@@ -11,9 +11,8 @@ __all__ = ["render"]
 
 from ...features.reproducible import NUDGE, RTOL
 from ...plants.train002 import latex_equations
-from ...report.markdown import Figure, Rendered, fmt
+from ...report.markdown import Rendered, fmt
 from ...tuning.pareto import TIE_REL
-from ...kinds.tracking import figures as F
 from ...kinds.tracking.mfac import SENSITIVITY_KEYS, frozen_integrator
 from ...kinds.tracking import render_general as G
 from ...kinds.tracking import render_tables as T
@@ -280,10 +279,8 @@ def render(design, res) -> Rendered:
     sections = [_problem(spec, res), _model(spec), _profile(spec, res), _why(spec, res),
                 _tuning(spec, res), _compare(res), _ppd(res), _line(spec, res),
                 _sensitivity(res), _closing(res)]
-    figs = G.tuning_figures(spec, res) + [
-             Figure("ppd", "PPD estimate and realised PPD of the chosen MFAC runs.",
-                    lambda fig: F.plot_ppd(fig, res), (8.0, 3.8))] + G.line_figure(
-        res, "Stop error per section (synthetic line).")
+    figs = (G.tuning_figures(spec, res) + G.ppd_figure(res)
+            + G.line_figure(res, "Stop error per section (synthetic line)."))
     anchors = ((r"reading\[[^\]]+\]\.(mfac\.reset|mfac\.saturated|grid\.)", H_WHY),
                (r"reading\[[^\]]+\]\.(ppd|plant|frozen)", H_PPD),
                (r"reading\[[^\]]+\]\.line", H_LINE),
