@@ -194,6 +194,11 @@ def test_headed_tables_on_a_pid_only_design(synth):
         "| reading | k_p | k_i | most sensitive |")
     assert r.line[0].section.name in T.line_table(res)
     assert T.readings_table(design.spec).count("`nominal`") == 1
+    from workbench.features.reproducible import NUDGE, RTOL
+    from workbench.report.markdown import fmt
+    assert f"+{fmt(NUDGE)} and −{fmt(NUDGE)}" in T.reproducible_text()
+    assert f"more than {fmt(RTOL)} (relative)" in T.reproducible_text()
+    assert T.dominated_text().startswith("Weight-free comparison of the fronts")
     assert T.edges_text(r) == ("" if not r.pid.edges else "PID in " + ", ".join(r.pid.edges))
     assert T.end_error_text(SimpleNamespace(s=[0.0, 10.0], spec=SimpleNamespace(
         distance=10.0 + 1e-12))) == "below 1 nm"

@@ -11,18 +11,19 @@ from __future__ import annotations
 import numpy as np
 
 from ...controllers.mfac import RESET_CONDITIONS
-from ...features.reproducible import count_text
+from ...features.reproducible import NUDGE, RTOL, count_text
 from ...report.markdown import fmt, md_table
-from ...tuning.pareto import dominated_share
+from ...tuning.pareto import TIE_REL, dominated_share
 from .mfac import most_sensitive
 from .render_general import LABEL, params_text
 from .spec import OBJECTIVES
 
 __all__ = ["RESET_LABELS", "admissible_text", "best_rows", "best_table", "comfort_section",
-           "compare_rows", "compare_table", "dominated_rows", "dominated_table", "edges_text",
-           "end_error_text", "line_rows", "line_table", "pct", "ppd_rows", "ppd_table",
-           "readings_table", "reset_rows", "reset_table", "roots_text", "sensitivity_rows",
-           "sensitivity_table", "span", "tuning_rows", "tuning_table"]
+           "compare_rows", "compare_table", "dominated_rows", "dominated_table", "dominated_text",
+           "edges_text", "end_error_text", "line_rows", "line_table", "pct", "ppd_rows",
+           "ppd_table", "readings_table", "reproducible_text", "reset_rows", "reset_table",
+           "roots_text", "sensitivity_rows", "sensitivity_table", "span", "tuning_rows",
+           "tuning_table"]
 
 #: The reset conditions of the MFAC estimate (``"at_limit"`` and
 #: :data:`~workbench.controllers.mfac.RESET_CONDITIONS`) as column headings.
@@ -160,6 +161,20 @@ def _table(head: list, rows: list, first: str = "l") -> str:
     return md_table(head, rows, first + "r" * (len(head) - len(first)))
 
 
+def reproducible_text() -> str:
+    """Why a tuning keeps only its reproducible runs, and how it finds them
+    (:mod:`workbench.features.reproducible`; RTOL / NUDGE = 1e6)."""
+    return (
+        "**Reproducible runs only.** Each grid is simulated again with every parameter of the "
+        f"train but its delay (whole plant steps) moved by +{fmt(NUDGE)} and −{fmt(NUDGE)} "
+        f"(relative). A run whose objectives move by more than {fmt(RTOL)} (relative) between "
+        "the three amplifies its inputs' differences more than a million times: a switching "
+        "(relay-like) loop turns a last-bit difference, as between two CPUs, into another "
+        "trajectory, so its stop error, jerk and energy are not results. Such runs are counted "
+        "(column \"not reproducible\") and take no part in the fronts, the choice, the "
+        "counts, the bests and the utopia point (our choice).")
+
+
 def readings_table(spec) -> str:
     """The plant readings of a design: name, model and source."""
     return md_table(["reading", "model", "what it is, where it comes from"],
@@ -197,6 +212,14 @@ def dominated_table(res) -> str:
     a, b = _controllers(res)
     return _table(["reading", f"{b} front dominated by {a}", f"{a} front dominated by {b}"],
                   dominated_rows(res))
+
+
+def dominated_text() -> str:
+    """What :func:`dominated_table` counts (:func:`~workbench.tuning.pareto.dominated_share`)."""
+    return ("Weight-free comparison of the fronts: the share of one controller's front that "
+            "a point of the other's front dominates (better or equal in all four, better in "
+            f"one; values within {fmt(TIE_REL)} relative of each other count as equal, so "
+            "that no share rests on the last bits of two near-equal runs):")
 
 
 def line_table(res) -> str:

@@ -9,10 +9,8 @@ from __future__ import annotations
 
 __all__ = ["render"]
 
-from ...features.reproducible import NUDGE, RTOL
 from ...plants.train002 import latex_equations
 from ...report.markdown import Rendered, fmt
-from ...tuning.pareto import TIE_REL
 from ...kinds.tracking.mfac import SENSITIVITY_KEYS, frozen_integrator
 from ...kinds.tracking import render_general as G
 from ...kinds.tracking import render_tables as T
@@ -167,14 +165,7 @@ def _tuning(spec, res) -> str:
         "`[tuning]`. A minimiser of a positive weighted sum is always on the front; with a zero "
         "weight or the peak-jerk constraint below it need not be (a run off the front can be "
         "the best one that meets the constraint).\n\n"
-        "**Reproducible runs only.** Each grid is simulated again with every parameter of the "
-        f"train but its delay (whole plant steps) moved by +{fmt(NUDGE)} and −{fmt(NUDGE)} "
-        f"(relative). A run whose objectives move by more than {fmt(RTOL)} (relative) between "
-        "the three amplifies its inputs' differences more than a million times: a switching "
-        "(relay-like) loop turns a last-bit difference, as between two CPUs, into another "
-        "trajectory, so its stop error, jerk and energy are not results. Such runs are counted "
-        "(column \"not reproducible\") and take no part in the fronts, the choice, the "
-        "counts, the bests and the utopia point (our choice).\n\n"
+        + T.reproducible_text() + "\n\n"
         + G.scale_table(spec, "why this scale") + "\n\n" + T.tuning_table(res, SYMBOL)
         + "\n\nIn the figures: every run (dots), the 4-objective front (rings), the front of "
         "the two objectives plotted (step line), the chosen points (stars).\n\n"
@@ -192,11 +183,7 @@ def _compare(res) -> str:
         + "\n\nBest value of each objective anywhere in the grid (MFAC / PID), what each "
         "controller can reach when that objective alone counts:\n\n"
         + T.best_table(res)
-        + "\n\nWeight-free comparison of the fronts: the share of one controller's front that "
-        "a point of the other's front dominates (better or equal in all four, better in "
-        f"one; values within {fmt(TIE_REL)} relative of each other count as equal, so that no "
-        "share rests on the last bits of two near-equal runs):\n\n"
-        + T.dominated_table(res)
+        + "\n\n" + T.dominated_text() + "\n\n" + T.dominated_table(res)
         + "\n\n![tracking at the chosen points]({figdir}/tracking.png)")
 
 

@@ -21,7 +21,8 @@ from typing import TYPE_CHECKING
 from ...errors import DesignError, ModelError
 from ...features.declared_study import DeclaredStudy
 from ...features.quantities import Declared
-from ...features.sweep_study import SweepResult, SweepSpec, load_sweep, sweep_quantities
+from ...features.sweep_study import (SweepResult, SweepSpec, load_sweep, run_sweep,
+                                     sweep_quantities)
 from ...jsonable import json_method
 from ...plants.units import ADHESION_003 as PARAMETER_UNITS
 from ...reader import Quantity, Reader
@@ -124,7 +125,6 @@ class AntiskidCruise(DeclaredStudy):
 
     # -- run -------------------------------------------------------------------
     def run(self, design) -> CruiseResult:
-        from ...features.sweep_study import run_sweep
         lam_opt, lam_solved, lam_used, lin = operating_point(design.spec)
         return CruiseResult(lam_opt, lam_solved, lam_used, lin,
                             run_sweep(lin.A, lin.B, design.spec.sweep), design.spec)
