@@ -199,6 +199,7 @@ def test_headed_tables_on_a_pid_only_design(synth):
     assert f"+{fmt(NUDGE)} and −{fmt(NUDGE)}" in T.reproducible_text()
     assert f"more than {fmt(RTOL)} (relative)" in T.reproducible_text()
     assert T.dominated_text().startswith("Weight-free comparison of the fronts")
+    assert T.ppd_text().startswith("Each reading, at the chosen MFAC run:")
     assert T.edges_text(r) == ("" if not r.pid.edges else "PID in " + ", ".join(r.pid.edges))
     assert T.end_error_text(SimpleNamespace(s=[0.0, 10.0], spec=SimpleNamespace(
         distance=10.0 + 1e-12))) == "below 1 nm"

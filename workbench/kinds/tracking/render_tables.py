@@ -21,9 +21,9 @@ from .spec import OBJECTIVES
 __all__ = ["RESET_LABELS", "admissible_text", "best_rows", "best_table", "comfort_section",
            "compare_rows", "compare_table", "dominated_rows", "dominated_table", "dominated_text",
            "edges_text", "end_error_text", "line_rows", "line_table", "pct", "ppd_rows",
-           "ppd_table", "readings_table", "reproducible_text", "reset_rows", "reset_table",
-           "roots_text", "sensitivity_rows", "sensitivity_table", "span", "tuning_rows",
-           "tuning_table"]
+           "ppd_table", "ppd_text", "readings_table", "reproducible_text", "reset_rows",
+           "reset_table", "roots_text", "sensitivity_rows", "sensitivity_table", "span",
+           "tuning_rows", "tuning_table"]
 
 #: The reset conditions of the MFAC estimate (``"at_limit"`` and
 #: :data:`~workbench.controllers.mfac.RESET_CONDITIONS`) as column headings.
@@ -234,6 +234,15 @@ def ppd_table(res) -> str:
                      "estimate range", "samples with |Δu| > ε", "realised PPD: sign of φ(1)",
                      "median", "95th pct", "frozen G", "frozen-loop spectral radius"],
                     ppd_rows(res), "lrrlrrrrrr")
+
+
+def ppd_text() -> str:
+    """What the first columns of :func:`ppd_table` hold (one sentence)."""
+    return ("Each reading, at the chosen MFAC run: the plant's steady-state gain and "
+            "slowest time constant at the cruise speed (from the sympy model), the range of the "
+            "estimate in use, and the *realised* PPD Δy(k+1)/Δu(k) of the run on the samples "
+            "where |Δu(k)| > ε (where the estimator learns): the share with the sign of φ(1), "
+            "its median and 95th percentile magnitude.")
 
 
 def sensitivity_table(res, keys, symbol: dict) -> str:
