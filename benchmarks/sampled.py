@@ -105,7 +105,7 @@ def cruise() -> None:
     t0 = time.perf_counter()
     spec = load_design("designs/antiskid-cruise-dry.toml").spec
     lin = operating_point(spec)[3]
-    c = published_row_sampling(lin.A, lin.B, spec.published, 0.35, 0.002)
+    c = published_row_sampling(lin.A, lin.B, spec.sweep.published, 0.35, 0.002)
     sec = time.perf_counter() - t0
     for label, r, sim in (
             ("predictor (exact prediction: delay-free sampled loop)", c.predictor,

@@ -172,3 +172,28 @@ def test_study_claims_are_ok():
     m = ev.result.metrics
     assert max(m["pd"].max_abs_e) > 100 * max(m["ntsm"].max_abs_e)
     assert all(c.slide_measured is not None for c in ev.result.convergence)
+
+
+def test_constant_values_of_a_non_paper_platoon():
+    """PlatoonSpec.constant_values on the synthetic platoon (no paper): values in
+    the order asked, a missing constant names its key and what needs it."""
+    spec = load_design("designs/platoon-synthetic.toml").spec
+    keys = tuple(spec.constants)[:2]
+    assert spec.constant_values(keys, "x") == tuple(spec.constants[k].value for k in keys)
+    with pytest.raises(DesignError) as exc:
+        spec.constant_values(keys + ("no_such_gain",), "the gains of my law")
+    assert exc.value.key == "constants.no_such_gain" and "the gains of my law" in str(exc.value)
+
+
+def test_linear_law_math_with_and_without_symbolic_forms():
+    """realism_render.linear_law_math, general (synthetic platoon's gains) and with
+    a law's symbolic forms before the values (as paper 001 writes them)."""
+    from types import SimpleNamespace
+
+    from workbench.kinds.platoon.realism_render import linear_law_math
+    m = SimpleNamespace(k_e=0.2, k_d=0.9)
+    assert linear_law_math(m) == ("$$\n(u - u_1)/m = \\dot v_{i-1} + k_e e + k_d \\dot e, "
+                                  "\\qquad k_e = 0.2\\ \\mathrm{s^{-2}},\\quad k_d = 0.9"
+                                  "\\ \\mathrm{s^{-1}}\n$$")
+    assert "k_e = \\beta(j + k) = 0.2\\ " in linear_law_math(m, "\\beta(j + k) = ", "x = ")
+    assert "k_d = x = 0.9\\ " in linear_law_math(m, "\\beta(j + k) = ", "x = ")

@@ -34,6 +34,18 @@ def test_a_feature_group_counts_only_when_the_design_has_it():
     assert units(TABLE, spec)["basin.c"] == "?"                 # the group declares no unit
 
 
+def test_a_declared_study_expands_its_table():
+    """features.declared_study on a toy study: its quantity methods expand the
+    class's TABLE against the spec the result holds."""
+    from workbench.features.declared_study import DeclaredStudy
+
+    class Toy(DeclaredStudy):
+        TABLE = TABLE
+    res = SimpleNamespace(gain=2.5, peak={"s": 4.0}, c=3.0, spec=SPEC)
+    assert Toy().quantity_names(SPEC) == {"gain", "peak.v", "peak.s"}
+    assert Toy().quantities(res) == {"gain": 2.5, "peak.v": None, "peak.s": 4.0}
+
+
 def test_every_delay_feedback_quantity_has_a_unit():
     from workbench.design import load_design
     from workbench.kinds.delay_feedback import STUDY

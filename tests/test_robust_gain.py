@@ -7,7 +7,8 @@ import pytest
 from workbench.errors import DesignError
 from workbench.features.robust_gain import (load_robust_settings, robust_quantities,
                                             robust_quantity_names, run_robust)
-from workbench.features.robust_gain_render import eps_search_figure, robust_gain_section
+from workbench.features.robust_gain_render import (eps_search_figure, robust_gain_section,
+                                                   robust_method_text)
 from workbench.margins import spectral_abscissa
 from workbench.reader import Reader
 
@@ -53,6 +54,8 @@ def test_quantities_match_their_names(robust):
     text = robust_gain_section(IDS, robust)
     assert text.startswith("## Robust gain") and "`a1.2`" in text
     assert eps_search_figure(robust).name == "eps-search"
+    method = robust_method_text(robust.settings)
+    assert method.startswith("Synthesis: descriptor method") and "order 2." in method
 
 
 def test_robust_points_study_on_toy_points():

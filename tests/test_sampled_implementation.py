@@ -200,7 +200,7 @@ def test_cruise_loop_003_certified_rate():
     from workbench.papers.p003.antiskid_cruise import operating_point
     spec = load_design("designs/antiskid-cruise-dry.toml").spec
     lin = operating_point(spec)[3]
-    c = published_row_sampling(lin.A, lin.B, spec.published, 0.35, 0.002)
+    c = published_row_sampling(lin.A, lin.B, spec.sweep.published, 0.35, 0.002)
     assert c.delayed.outcome is Outcome.CERTIFIED and c.delayed.recheck_passed
     assert 0.1 < c.delayed.T_certified <= c.delayed.first_unstable
     assert c.rate_delayed < 25.0

@@ -173,3 +173,45 @@ def test_render_tables_on_a_pid_only_design(synth):
     assert "| `nominal` | PID |" in text and "| yes |" in text and "MFAC" not in text
     assert T.pct(0.5) == "50 %" and T.pct(None) == "—" and T.span([]) == "—"
     assert T.span([0.25, 0.5, 0.1]) == "10 % … 50 %"
+
+
+def test_headed_tables_on_a_pid_only_design(synth):
+    """The headed tables of kinds/tracking/render_tables on a non-paper design
+    with one controller: headings name its controller, no MFAC column; the
+    MFAC-only tables have a heading and no row."""
+    from types import SimpleNamespace
+
+    from workbench.kinds.tracking import render_tables as T
+    design, res = synth
+    (r,) = res.readings
+    head = T.tuning_table(res).splitlines()[0]
+    assert "PID runs" in head and "PID chosen" in head and "MFAC" not in head
+    assert T.tuning_table(res).splitlines()[1].count("|") == 6
+    assert "| cost |" in T.compare_table(res).splitlines()[0]
+    assert len(T.best_table(res).splitlines()) == 3
+    assert len(T.ppd_table(res).splitlines()) == 2 and len(T.reset_table(res).splitlines()) == 2
+    assert T.sensitivity_table(res, ("kp", "ki"), {"kp": "k_p", "ki": "k_i"}).startswith(
+        "| reading | k_p | k_i | most sensitive |")
+    assert r.line[0].section.name in T.line_table(res)
+    assert T.readings_table(design.spec).count("`nominal`") == 1
+    from workbench.features.reproducible import NUDGE, RTOL
+    from workbench.report.markdown import fmt
+    assert f"+{fmt(NUDGE)} and −{fmt(NUDGE)}" in T.reproducible_text()
+    assert f"more than {fmt(RTOL)} (relative)" in T.reproducible_text()
+    assert T.dominated_text().startswith("Weight-free comparison of the fronts")
+    assert T.ppd_text().startswith("Each reading, at the chosen MFAC run:")
+    assert T.edges_text(r) == ("" if not r.pid.edges else "PID in " + ", ".join(r.pid.edges))
+    assert T.end_error_text(SimpleNamespace(s=[0.0, 10.0], spec=SimpleNamespace(
+        distance=10.0 + 1e-12))) == "below 1 nm"
+    assert T.end_error_text(SimpleNamespace(s=[9.99], spec=SimpleNamespace(distance=10.0))) \
+        == "0.01 m"
+    assert T.roots_text([complex(1e-12, 1.0), complex(1e-12, -1.0)]) == "0 ± 1 j"
+    assert T.roots_text([complex(0.5, 0.0), complex(-0.25, 0.0)]) == "0.5 and -0.25"
+    tun = SimpleNamespace(stops=np.array([-1, 0, 1, -1]),
+                          reproducible=np.array([1, 1, 1, 0], bool),
+                          reset_rate=np.array([0.2, 0.3, 0.4, 0.9]))
+    assert T.admissible_text(tun, 0.5) == (
+        "Of its 3 reproducible MFAC runs, 1-2 stop within 0.5 m (1 with a stop error within "
+        "its band of the limit: undecided); their reset rates span 20 % … 20 %")
+    tun.stops = np.array([1, 1, 1, 1])
+    assert T.admissible_text(tun, 0.5) == "None of its 3 reproducible MFAC runs stops within 0.5 m"

@@ -10,7 +10,18 @@ import numpy as np
 from ..report.markdown import Figure, fmt, latex_matrix
 from .point_gains import point_table
 
-__all__ = ["eps_search_figure", "robust_gain_section"]
+__all__ = ["eps_search_figure", "robust_gain_section", "robust_method_text"]
+
+
+def robust_method_text(settings) -> str:
+    """How :func:`~workbench.features.robust_gain.run_robust` synthesises and
+    checks the gain (a paragraph's sentences; ``settings`` a ``RobustSettings``)."""
+    return ("Synthesis: descriptor method with the Jensen inequality, slack P3 = eps P2, "
+            "common Y and V (K = V Y^{-1}), Lyapunov-Krasovskii matrices per point "
+            "(`workbench.lmi.robust.DescriptorSynthesis`); eps searched automatically "
+            "(log grid, then golden section). The certificate holds at the listed points, not "
+            "in between. Each gain is then re-checked per point by the exact margin and the "
+            f"Bessel-Legendre analysis of order {settings.order}.")
 
 
 def robust_gain_section(ids, r) -> str:

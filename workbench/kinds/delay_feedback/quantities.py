@@ -73,16 +73,9 @@ def _h_certified(r):
 
 
 def _row(r, e, f):
+    from ...features.sweep_study import row_value
     row = _last(x for x in r.synthesis.rows if _eps_key(x.eps) == e)
-    if row is None:
-        return None
-    if f == "h_certified":
-        return row.h_certified if row.status.value == "certified" else None
-    if f == "status":
-        return row.status.value
-    if f == "exact_margin":
-        return row.exact.h if row.exact else None
-    return getattr(row, f)
+    return None if row is None else row_value(row, f)
 
 
 def _vertex(r, v, f):

@@ -8,7 +8,8 @@ from ...features.reproducible import window
 from ...report.markdown import Figure, fmt, latex_matrix, md_table
 from .realism import CASES
 
-__all__ = ["figures", "gap_section", "margin_body", "margin_section", "scenario_section"]
+__all__ = ["figures", "gap_section", "linear_law_math", "margin_body", "margin_section",
+           "scenario_section"]
 
 WORDS = {2: "two", 3: "three", 4: "four", 5: "five", 6: "six"}
 CASE_LABEL = {"constant": "constant delay", "random": "random delay + loss"}
@@ -166,15 +167,21 @@ def margin_body(spec, rz) -> str:
                     "first follower saturated (% of steps)"], srows, "llrrrrr"))
 
 
+def linear_law_math(m, k_e_form: str = "", k_d_form: str = "") -> str:
+    """The display equation of the linear law of a delay margin ``m`` (its
+    gains k_e, k_d), each gain after its symbolic form (e.g. ``"\\beta(j + k) = "``)."""
+    return ("$$\n(u - u_1)/m = \\dot v_{i-1} + k_e e + k_d \\dot e, \\qquad k_e = "
+            f"{k_e_form}{fmt(m.k_e, 4)}\\ \\mathrm{{s^{{-2}}}},\\quad k_d = {k_d_form}"
+            f"{fmt(m.k_d, 4)}\\ \\mathrm{{s^{{-1}}}}\n$$")
+
+
 def margin_section(spec, rz) -> str:
     """The general delay-margin section: the linear law's gains, then :func:`margin_body`."""
     m = rz.margin
     return (
         "## Delay margin\n\n"
         f"The exact margin is computed on the linear law '{_labels(spec)[m.law]}':\n\n"
-        "$$\n(u - u_1)/m = \\dot v_{i-1} + k_e e + k_d \\dot e, \\qquad k_e = "
-        f"{fmt(m.k_e, 4)}\\ \\mathrm{{s^{{-2}}}},\\quad k_d = {fmt(m.k_d, 4)}"
-        "\\ \\mathrm{s^{-1}}\n$$\n\n" + margin_body(spec, rz)
+        + linear_law_math(m) + "\n\n" + margin_body(spec, rz)
         + "\n\n![delay sweep]({figdir}/delay-sweep.png)")
 
 

@@ -154,6 +154,15 @@ class PlatoonSpec:
     def run_spec(self, name: str) -> RunSpec:
         return next(x for x in self.runs if x.name == name)
 
+    def constant_values(self, keys, needed_as: str) -> tuple[float, ...]:
+        """The values of the ``[constants]`` ``keys``; a missing one is bad
+        input, expected as ``needed_as`` (what needs it)."""
+        missing = [k for k in keys if k not in self.constants]
+        if missing:
+            from ...errors import DesignError
+            raise DesignError(self.path, f"constants.{missing[0]}", "<missing>", needed_as)
+        return tuple(self.constants[k].value for k in keys)
+
 
 def _multiple(r: Reader, name: str, q: Quantity, T: float) -> None:
     k = round(q.value / T)

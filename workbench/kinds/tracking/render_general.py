@@ -11,8 +11,8 @@ from ...report.markdown import Figure, Rendered, fmt, md_table
 from . import figures as F
 from .spec import OBJECTIVE_UNITS, OBJECTIVES
 
-__all__ = ["DOC", "LABEL", "line_figure", "pareto_links", "param_table", "params_text", "render",
-           "scale_rows", "tuning_figures"]
+__all__ = ["DOC", "LABEL", "line_figure", "pareto_links", "param_table", "params_text",
+           "ppd_figure", "render", "scale_rows", "scale_table", "tuning_figures"]
 
 H_TUNE = "Tuning per reading and controller"
 H_MAIN = "Chosen points on the main pair"
@@ -21,7 +21,8 @@ DOC = {"f": "static map gain", "e": "static map offset", "delay": "pure delay",
        "lag": "lag time constant", "c0": "Davis, constant (per mass)",
        "c1": "Davis, linear (per mass)", "c2": "Davis, quadratic (per mass)", "g": "gravity"}
 LABEL = {"stop_error": "stop error (m)", "punctuality": "punctuality (s)",
-         "comfort": "RMS jerk (m/s³)", "energy": "energy (J/kg)"}
+         "comfort": "RMS jerk (m/s³)", "energy": "energy (J/kg)",
+         "rms_speed_error": "RMS speed error (m/s)"}
 
 
 def _problem(spec) -> str:
@@ -62,6 +63,11 @@ def scale_rows(spec) -> list:
              spec.scales[k].source] for k, w in zip(OBJECTIVES, spec.weights)]
 
 
+def scale_table(spec, why: str = "source") -> str:
+    """The table of :func:`scale_rows`; ``why`` heads the sources' column."""
+    return md_table(["objective", "scale s_j", "weight w_j", why], scale_rows(spec), "lrrl")
+
+
 def pareto_links(res) -> str:
     """The Markdown images of every reading's Pareto fronts."""
     return "\n\n".join(f"![Pareto fronts, {r.reading.name}]"
@@ -88,7 +94,7 @@ def _tuning(spec, res) -> str:
         f"±{fmt(NUDGE)} (relative); a run whose objectives move by more than {fmt(RTOL)} is "
         "no result. A chosen value at the first or last of its grid is not shown to be an "
         "optimum inside the grid.\n\n"
-        + md_table(["objective", "scale s_j", "weight w_j", "source"], scale_rows(spec), "lrrl")
+        + scale_table(spec)
         + "\n\n" + md_table(["reading", "controller", "runs", "not reproducible",
                              "on front", "chosen", "peak |jerk| (m/s³)",
                              "on the grid's edge in"], rows, "llrrrlrl")
@@ -103,8 +109,9 @@ def _main(res) -> str:
                         + [fmt(r.main.value(c, i), 3) for i in (*OBJECTIVES,
                                                                  "rms_speed_error")])
     return (f"## {H_MAIN}\n\n" + md_table(["reading", "controller"]
-                                          + [LABEL[i] for i in OBJECTIVES]
-                                          + ["RMS speed error (m/s)"], rows, "llrrrrr")
+                                          + [LABEL[i] for i in (*OBJECTIVES,
+                                                                "rms_speed_error")],
+                                          rows, "llrrrrr")
             + "\n\n![speed error and acceleration]({figdir}/tracking.png)")
 
 
@@ -150,6 +157,14 @@ def tuning_figures(spec, res) -> list:
                           "limit.", lambda fig: F.plot_jerk(
                               fig, res, None if spec.peak_jerk is None else spec.peak_jerk.value),
                           (8.0, 3.2))]
+
+
+def ppd_figure(res) -> list:
+    """The figure of the chosen MFAC runs' PPD estimate and realised PPD (none
+    unless every reading has an MFAC)."""
+    return [Figure("ppd", "PPD estimate and realised PPD of the chosen MFAC runs.",
+                   lambda fig: F.plot_ppd(fig, res), (8.0, 3.8))] if all(
+        r.ppd is not None for r in res.readings) else []
 
 
 def line_figure(res, caption: str) -> list:

@@ -11,14 +11,25 @@ from __future__ import annotations
 import numpy as np
 
 from ...controllers.mfac import RESET_CONDITIONS
+from ...features.reproducible import NUDGE, RTOL, count_text
 from ...report.markdown import fmt, md_table
-from ...tuning.pareto import dominated_share
+from ...tuning.pareto import TIE_REL, dominated_share
 from .mfac import most_sensitive
-from .render_general import params_text
+from .render_general import LABEL, params_text
 from .spec import OBJECTIVES
 
-__all__ = ["best_rows", "comfort_section", "compare_rows", "dominated_rows", "line_rows",
-           "pct", "ppd_rows", "reset_rows", "sensitivity_rows", "span", "tuning_rows"]
+__all__ = ["RESET_LABELS", "admissible_text", "best_rows", "best_table", "comfort_section",
+           "compare_rows", "compare_table", "dominated_rows", "dominated_table", "dominated_text",
+           "edges_text", "end_error_text", "line_rows", "line_table", "pct", "ppd_rows",
+           "ppd_table", "ppd_text", "readings_table", "reproducible_text", "reset_rows",
+           "reset_table", "roots_text", "sensitivity_rows", "sensitivity_table", "span",
+           "tuning_rows", "tuning_table"]
+
+#: The reset conditions of the MFAC estimate (``"at_limit"`` and
+#: :data:`~workbench.controllers.mfac.RESET_CONDITIONS`) as column headings.
+RESET_LABELS = {"small_phi": "|φ(k)| ≤ ε", "small_du": "|Δu(k−1)| ≤ ε",
+                "sign_change": "sign φ(k) ≠ sign φ(1)",
+                "at_limit": "|Δu(k−1)| ≤ ε, u at a limit"}
 
 
 def pct(x) -> str:
@@ -138,3 +149,142 @@ def reset_rows(res) -> list:
             + [pct(s.by_condition[k]) for k in (*RESET_CONDITIONS, "at_limit")]
             + [pct(s.saturated), span(r.mfac.reset_rate[r.mfac.reproducible])]
             for r in res.readings if (s := r.ppd) is not None]
+
+
+# -- the tables of the rows above, headed (controllers named as in the first reading) ---------
+def _controllers(res) -> list[str]:
+    return [c for c, _ in res.readings[0].tunings]
+
+
+def _table(head: list, rows: list, first: str = "l") -> str:
+    """A table whose first column(s) ``first`` are left-aligned, the rest right-aligned."""
+    return md_table(head, rows, first + "r" * (len(head) - len(first)))
+
+
+def reproducible_text() -> str:
+    """Why a tuning keeps only its reproducible runs, and how it finds them
+    (:mod:`workbench.features.reproducible`; RTOL / NUDGE = 1e6)."""
+    return (
+        "**Reproducible runs only.** Each grid is simulated again with every parameter of the "
+        f"train but its delay (whole plant steps) moved by +{fmt(NUDGE)} and −{fmt(NUDGE)} "
+        f"(relative). A run whose objectives move by more than {fmt(RTOL)} (relative) between "
+        "the three amplifies its inputs' differences more than a million times: a switching "
+        "(relay-like) loop turns a last-bit difference, as between two CPUs, into another "
+        "trajectory, so its stop error, jerk and energy are not results. Such runs are counted "
+        "(column \"not reproducible\") and take no part in the fronts, the choice, the "
+        "counts, the bests and the utopia point (our choice).")
+
+
+def readings_table(spec) -> str:
+    """The plant readings of a design: name, model and source."""
+    return md_table(["reading", "model", "what it is, where it comes from"],
+                    [[f"`{r.name}`", f"`{r.model}`", r.source] for r in spec.readings], "lll")
+
+
+def edges_text(r) -> str:
+    """Per controller of a reading's result ``r``, the parameters whose chosen
+    value lies on its grid's edge ("" when none does)."""
+    return "; ".join(f"{c} in {', '.join(t.edges)}" for c, t in r.tunings if t.edges)
+
+
+def tuning_table(res, symbol: dict | None = None) -> str:
+    """The table of :func:`tuning_rows`: per controller its runs, not
+    reproducible runs, front size and chosen point."""
+    cs = _controllers(res)
+    return md_table(["reading"] + [h for c in cs for h in (f"{c} runs", "not reproducible",
+                                                           "on front", f"{c} chosen")],
+                    tuning_rows(res, symbol), "l" + "rrrl" * len(cs))
+
+
+def compare_table(res) -> str:
+    """The table of :func:`compare_rows`."""
+    return _table(["reading", "controller"] + [LABEL[i] for i in (*OBJECTIVES, "rms_speed_error")]
+                  + ["cost"], compare_rows(res), "ll")
+
+
+def best_table(res) -> str:
+    """The table of :func:`best_rows`."""
+    return _table(["reading"] + [LABEL[i] for i in OBJECTIVES], best_rows(res))
+
+
+def dominated_table(res) -> str:
+    """The table of :func:`dominated_rows` (a design with two controllers)."""
+    a, b = _controllers(res)
+    return _table(["reading", f"{b} front dominated by {a}", f"{a} front dominated by {b}"],
+                  dominated_rows(res))
+
+
+def dominated_text() -> str:
+    """What :func:`dominated_table` counts (:func:`~workbench.tuning.pareto.dominated_share`)."""
+    return ("Weight-free comparison of the fronts: the share of one controller's front that "
+            "a point of the other's front dominates (better or equal in all four, better in "
+            f"one; values within {fmt(TIE_REL)} relative of each other count as equal, so "
+            "that no share rests on the last bits of two near-equal runs):")
+
+
+def line_table(res) -> str:
+    """The table of :func:`line_rows`."""
+    return md_table(["reading", "section", "S (m)", "gradients (‰)"]
+                    + [LABEL[i] for i in OBJECTIVES], line_rows(res), "llrlrrrr")
+
+
+def ppd_table(res) -> str:
+    """The table of :func:`ppd_rows`."""
+    return md_table(["reading", "DC gain ((m/s) per unit)", "slowest time constant (s)",
+                     "estimate range", "samples with |Δu| > ε", "realised PPD: sign of φ(1)",
+                     "median", "95th pct", "frozen G", "frozen-loop spectral radius"],
+                    ppd_rows(res), "lrrlrrrrrr")
+
+
+def ppd_text() -> str:
+    """What the first columns of :func:`ppd_table` hold (one sentence)."""
+    return ("Each reading, at the chosen MFAC run: the plant's steady-state gain and "
+            "slowest time constant at the cruise speed (from the sympy model), the range of the "
+            "estimate in use, and the *realised* PPD Δy(k+1)/Δu(k) of the run on the samples "
+            "where |Δu(k)| > ε (where the estimator learns): the share with the sign of φ(1), "
+            "its median and 95th percentile magnitude.")
+
+
+def sensitivity_table(res, keys, symbol: dict) -> str:
+    """The table of :func:`sensitivity_rows`."""
+    return md_table(["reading"] + [symbol[k] for k in keys] + ["most sensitive"],
+                    sensitivity_rows(res, keys, symbol), "l" + "r" * len(keys) + "l")
+
+
+def reset_table(res) -> str:
+    """The table of :func:`reset_rows`, the conditions headed by :data:`RESET_LABELS`."""
+    return _table(["reading", "samples", "reset"]
+                  + [RESET_LABELS[k] for k in (*RESET_CONDITIONS, "at_limit")]
+                  + ["command at a limit", "grid range"], reset_rows(res))
+
+
+def admissible_text(tun, tolerance: float) -> str:
+    """How many of an MFAC tuning's reproducible runs stop within
+    ``tolerance`` (m; a range when some are undecided, their stop error within
+    its band of the limit), and the span of their reset rates."""
+    ok = (tun.stops == -1) & tun.reproducible
+    near = int(((tun.stops == 0) & tun.reproducible).sum())
+    n = int(tun.reproducible.sum())
+    if not ok.any():
+        return f"None of its {n} reproducible MFAC runs stops within {fmt(tolerance)} m"
+    return (f"Of its {n} reproducible MFAC runs, {count_text(int(ok.sum()), near)} stop "
+            f"within {fmt(tolerance)} m"
+            + (f" ({near} with a stop error within its band of the limit: undecided)"
+               if near else "") + f"; their reset rates span {span(tun.reset_rate[ok])}")
+
+
+def roots_text(z) -> str:
+    """The first two roots ``z`` of a real polynomial: "a ± b j" or "a and b".
+    A real part below 1e-9 |z| is printed as 0 (it is the rounding of an exact
+    0, e.g. 2 - G Ts = 0 of a frozen integrator loop)."""
+    re = [0.0 if abs(x.real) < 1e-9 * abs(x) else x.real for x in z[:2]]
+    return (f"{fmt(re[0], 3)} ± {fmt(abs(z[0].imag), 2)} j" if abs(z[0].imag) > 1e-6
+            else f"{fmt(re[0], 3)} and {fmt(re[1], 3)}")
+
+
+def end_error_text(prof) -> str:
+    """A profile's end position error to 1 nm: below, it is rounding of the
+    closed-form integration whose digits move under a few-ulp change of the
+    inputs."""
+    e = round(abs(prof.s[-1] - prof.spec.distance), 9)
+    return "below 1 nm" if e == 0.0 else f"{fmt(e, 2)} m"

@@ -70,11 +70,8 @@ class NTSMAnalysis:
     """Paper 001's part of a ``platoon`` design (see the module docstring)."""
 
     def load(self, root, spec) -> NTSMGains:
-        missing = [k for k in GAINS + ("kp", "kd", "kp_ff", "kd_ff") if k not in spec.constants]
-        if missing:
-            raise DesignError(spec.path, f"constants.{missing[0]}", "<missing>",
-                              "eq 13's gains and the PD gains as [constants] (p001.ntsm_analysis)")
-        g = NTSMGains(*(_c(spec, k) for k in GAINS))
+        g = NTSMGains(*spec.constant_values(GAINS + ("kp", "kd", "kp_ff", "kd_ff"), (
+            "eq 13's gains and the PD gains as [constants] (p001.ntsm_analysis)"))[:len(GAINS)])
         bad = g.problems()
         if bad:
             name, value, expected = bad[0]
@@ -154,7 +151,7 @@ class NTSMAnalysis:
         return "Paper 001 has no communication, actuator or emergency. "
 
     def margin_section(self, spec, res) -> str:
-        from ...kinds.platoon.realism_render import margin_body
+        from ...kinds.platoon.realism_render import linear_law_math, margin_body
         rz = res.realism
         m, g = rz.margin, spec.analysis_spec
         f = m.factors
@@ -170,9 +167,7 @@ class NTSMAnalysis:
             "surrogate taken here is the NTSM family's **linear member**: b = a and α = ξ "
             "(every power 1), without the switching term, i.e. the linear sliding-mode law on "
             "s = e + ė/β with ṡ = −(j + k) s:\n\n"
-            "$$\n(u - u_1)/m = \\dot v_{i-1} + k_e e + k_d \\dot e, \\qquad k_e = \\beta(j + k) = "
-            f"{fmt(m.k_e, 4)}\\ \\mathrm{{s^{{-2}}}},\\quad k_d = \\beta + j + k = {fmt(m.k_d, 4)}"
-            "\\ \\mathrm{s^{-1}}\n$$\n\n"
+            + linear_law_math(m, "\\beta(j + k) = ", "\\beta + j + k = ") + "\n\n"
             + margin_body(spec, rz)
             + "\n\nThe linear member loses stability where the exact margin says (its first "
             f"follower's oscillation jumps between {fmt(f[1])} h* and "

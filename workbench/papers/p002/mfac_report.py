@@ -9,24 +9,17 @@ from __future__ import annotations
 
 __all__ = ["render"]
 
-from ...controllers.mfac import RESET_CONDITIONS
-from ...features.reproducible import NUDGE, RTOL, count_text
 from ...plants.train002 import latex_equations
-from ...report.markdown import Figure, Rendered, fmt, md_table
-from ...tuning.pareto import TIE_REL
-from ...kinds.tracking import figures as F
-from ...kinds.tracking.mfac import frozen_integrator
+from ...report.markdown import Rendered, fmt
+from ...kinds.tracking.mfac import SENSITIVITY_KEYS, frozen_integrator
 from ...kinds.tracking import render_general as G
 from ...kinds.tracking import render_tables as T
 from ...kinds.tracking.spec import OBJECTIVES
 
-LABEL = {**G.LABEL, "rms_speed_error": "RMS speed error (m/s)"}
 DOC = {**G.DOC, "delay": "pure delay T_d", "lag": "lag time constant T_l",
        "a_min": "brake acceleration limit", "a_max": "traction acceleration limit",
        "u_min": "lowest command", "u_max": "highest command"}
 SYMBOL = {"eta": "η", "mu": "μ", "rho": "ρ", "lam": "λ", "phi1": "φ(1)"}
-COND = {"small_phi": "|φ(k)| ≤ ε", "small_du": "|Δu(k−1)| ≤ ε",
-        "sign_change": "sign φ(k) ≠ sign φ(1)", "at_limit": "|Δu(k−1)| ≤ ε, u at a limit"}
 
 H_WHY = "Why the MFAC resets in almost every sample"
 H_TUNE = "Multi-objective tuning"
@@ -66,7 +59,6 @@ $$"""
 
 def _problem(spec, res) -> str:
     m = res.readings[0].main
-    rows = [[f"`{r.name}`", f"`{r.model}`", r.source] for r in spec.readings]
     text = (
         "## Problem\n\n"
         f"Route **{m.section.name}**: {fmt(m.section.route.distance, 5)} m, planned "
@@ -75,7 +67,7 @@ def _problem(spec, res) -> str:
         "lost** in the extracted text, and with it the form of eq 2. The paper calls A = f u + e "
         "a *desired acceleration* (eq 1) and u *the ATO's desired output speed*; the two "
         "readings below follow one or the other, and the whole comparison is run on each:\n\n"
-        + md_table(["reading", "model", "what it is, where it comes from"], rows, "lll")
+        + T.readings_table(spec)
         + "\n\nThe train of `[train]` (the integrating reading's chain; every value our "
         "documented choice, not the paper's):\n\n"
         + G.param_table(spec.train, DOC))
@@ -127,41 +119,17 @@ def _profile(spec, res) -> str:
         f"`workbench/profiles.py`): acceleration {fmt(spec.profile['accel'])} m/s², braking "
         f"{fmt(spec.profile['brake'])} m/s², jerk {fmt(spec.profile['jerk'])} m/s³; the cruise "
         f"speed solves T(v) = T_o: **{fmt(prof.v_cruise * 3.6, 4)} km/h** (end position error "
-        f"of the sampled curve {_end_error(prof)}).")
-
-
-def _end_error(prof) -> str:
-    """The profile's end error to 1 nm: below, it is rounding of the closed-form
-    integration whose digits move under a few-ulp change of the inputs."""
-    e = round(abs(prof.s[-1] - prof.spec.distance), 9)
-    return "below 1 nm" if e == 0.0 else f"{fmt(e, 2)} m"
+        f"of the sampled curve {T.end_error_text(prof)}).")
 
 
 def _why(spec, res) -> str:
-    rows = T.reset_rows(res)
     integ = res.readings[0]
     gain, z = frozen_integrator(integ.mfac, spec.Ts)
-    # a real part below 1e-9 |z| is the rounding of 2 - G Ts = 0 (G Ts = 2): printed as 0
-    re = [0.0 if abs(x.real) < 1e-9 * abs(x) else x.real for x in z[:2]]
-    roots = (f"{fmt(re[0], 3)} ± {fmt(abs(z[0].imag), 2)} j" if abs(z[0].imag) > 1e-6
-             else f"{fmt(re[0], 3)} and {fmt(re[1], 3)}")
-    tun = integ.mfac
-    ok = (tun.stops == -1) & tun.reproducible
-    near = int(((tun.stops == 0) & tun.reproducible).sum())
-    adm = (f"Of its {int(tun.reproducible.sum())} reproducible MFAC runs, "
-           f"{count_text(int(ok.sum()), near)} stop within {fmt(res.stop_tolerance)} m"
-           + (f" ({near} with a stop error within its band of the limit: undecided)"
-              if near else "") + "; their reset rates span "
-           f"{T.span(tun.reset_rate[ok])}"
-           if ok.any() else f"None of its {int(tun.reproducible.sum())} reproducible MFAC runs "
-           f"stops within {fmt(res.stop_tolerance)} m")
     return (
         f"## {H_WHY}\n\nThe reset of eq 9 fires on any of three conditions. Counted over the "
         "samples of the chosen MFAC run up to its stop (a sample may meet several conditions; "
         "the last column is the range over every reproducible run of the reading's grid):\n\n"
-        + md_table(["reading", "samples", "reset"] + [COND[k] for k in (*RESET_CONDITIONS,
-                                                                        "at_limit")]
-                   + ["command at a limit", "grid range"], rows, "lrrrrrrrr")
+        + T.reset_table(res)
         + "\n\n**Diagnosis.** On the integrating reading the resets come from the second "
         "condition with the command held at a limit: Δu(k−1) = 0 because the command "
         "saturated, not because the loop settled. The saturation is itself the loop's doing. "
@@ -169,14 +137,15 @@ def _why(spec, res) -> str:
         "speed integrates the command, so with φ frozen at φ(1) on a sampled pure integrator "
         "the characteristic polynomial is z² − (2 − G Ts) z + 1, whose roots multiply to 1. "
         f"At the integrating reading's chosen point (`{G.params_text(integ.mfac, SYMBOL)}`) G Ts = "
-        f"{fmt(gain * spec.Ts, 3)}, roots {roots}, "
+        f"{fmt(gain * spec.Ts, 3)}, roots {T.roots_text(z)}, "
         f"|z| = {fmt(abs(z[0]), 3)}, {fmt(abs(z[1]), 3)}: no damping at all; G Ts = 4 is the "
         "double pole at z = −1 of the issue. Lag and delay move the roots outside (the "
         f"frozen loop around the sampled linearised plant: spectral radius "
         f"{fmt(integ.frozen_radius, 3)}, see [{H_PPD}](#the-cfdl-data-model-per-reading)); "
         "the command limits bound the oscillation, and a held limit resets the estimate, "
         "which keeps G at its φ(1) value: the loop is a relay. The multi-objective rule below "
-        f"picks this regime on the integrating reading. {adm}; the chosen run has the "
+        f"picks this regime on the integrating reading. "
+        f"{T.admissible_text(integ.mfac, res.stop_tolerance)}; the chosen run has the "
         "smallest weighted cost among them.\n\n"
         "On the first-order reading no reset comes from a held limit or a sign change: every "
         "reset is |Δu(k−1)| ≤ ε with the command inside its range, i.e. the loop has settled "
@@ -185,7 +154,6 @@ def _why(spec, res) -> str:
 
 
 def _tuning(spec, res) -> str:
-    rows = T.tuning_rows(res, SYMBOL)
     return (
         f"## {H_TUNE}\n\nPer reading, every combination of the design's grids (η, μ, ρ, λ and "
         "φ(1) for MFAC; kp, ki, kd for PID) is simulated on the main pair, one batch each. "
@@ -197,19 +165,8 @@ def _tuning(spec, res) -> str:
         "`[tuning]`. A minimiser of a positive weighted sum is always on the front; with a zero "
         "weight or the peak-jerk constraint below it need not be (a run off the front can be "
         "the best one that meets the constraint).\n\n"
-        "**Reproducible runs only.** Each grid is simulated again with every parameter of the "
-        f"train but its delay (whole plant steps) moved by +{fmt(NUDGE)} and −{fmt(NUDGE)} "
-        f"(relative). A run whose objectives move by more than {fmt(RTOL)} (relative) between "
-        "the three amplifies its inputs' differences more than a million times: a switching "
-        "(relay-like) loop turns a last-bit difference, as between two CPUs, into another "
-        "trajectory, so its stop error, jerk and energy are not results. Such runs are counted "
-        "(column \"not reproducible\") and take no part in the fronts, the choice, the "
-        "counts, the bests and the utopia point (our choice).\n\n"
-        + md_table(["objective", "scale s_j", "weight w_j", "why this scale"], G.scale_rows(spec),
-                   "lrrl")
-        + "\n\n" + md_table(["reading", "MFAC runs", "not reproducible", "on front",
-                             "MFAC chosen", "PID runs", "not reproducible", "on front",
-                             "PID chosen"], rows, "lrrrlrrrl")
+        + T.reproducible_text() + "\n\n"
+        + G.scale_table(spec, "why this scale") + "\n\n" + T.tuning_table(res, SYMBOL)
         + "\n\nIn the figures: every run (dots), the 4-objective front (rings), the front of "
         "the two objectives plotted (step line), the chosen points (stars).\n\n"
         + G.pareto_links(res)
@@ -217,44 +174,28 @@ def _tuning(spec, res) -> str:
 
 
 def _compare(res) -> str:
-    rows, brows, drows = T.compare_rows(res), T.best_rows(res), T.dominated_rows(res)
     return (
         f"## {H_CMP}\n\nThe chosen points on the main pair. Cost: the weighted sum counted from "
         "the reading's utopia point (the best value of each objective over both grids), so "
         "the energy every run needs does not hide a difference; equal at 3 significant digits "
         "is a tie, and the cost decides the verdict.\n\n"
-        + md_table(["reading", "controller"] + [LABEL[i] for i in (*OBJECTIVES,
-                                                                    "rms_speed_error")]
-                   + ["cost"], rows, "llrrrrrr")
+        + T.compare_table(res)
         + "\n\nBest value of each objective anywhere in the grid (MFAC / PID), what each "
         "controller can reach when that objective alone counts:\n\n"
-        + md_table(["reading"] + [LABEL[i] for i in OBJECTIVES], brows, "lrrrr")
-        + "\n\nWeight-free comparison of the fronts: the share of one controller's front that "
-        "a point of the other's front dominates (better or equal in all four, better in "
-        f"one; values within {fmt(TIE_REL)} relative of each other count as equal, so that no "
-        "share rests on the last bits of two near-equal runs):\n\n"
-        + md_table(["reading", "PID front dominated by MFAC", "MFAC front dominated by PID"],
-                   drows, "lrr")
+        + T.best_table(res)
+        + "\n\n" + T.dominated_text() + "\n\n" + T.dominated_table(res)
         + "\n\n![tracking at the chosen points]({figdir}/tracking.png)")
 
 
 def _ppd(res) -> str:
-    rows = T.ppd_rows(res)
     return (
         f"## {H_PPD}\n\nCFDL-MFAC rests on the data model Δy(k+1) = φ(k)Δu(k) with a PPD φ "
         "that is bounded and keeps its sign (paper 002's assumptions 1-3 and Theorem 1, which "
         "the paper declares satisfied by the train; Hou & Jin's analysis also fixes the sign "
-        "of φ). Each reading, at the chosen MFAC run: the plant's steady-state gain and "
-        "slowest time constant at the cruise speed (from the sympy model), the range of the "
-        "estimate in use, and the *realised* PPD Δy(k+1)/Δu(k) of the run on the samples "
-        "where |Δu(k)| > ε (where the estimator learns): the share with the sign of φ(1), its "
-        "median and 95th percentile magnitude. Last, the eq 7 law with φ frozen at the "
-        "estimate's median (gain G) around the ZOH-sampled linearised plant with its "
-        "delay: the spectral radius of that loop (below 1: stable).\n\n"
-        + md_table(["reading", "DC gain ((m/s) per unit)", "slowest time constant (s)",
-                    "estimate range", "samples with |Δu| > ε", "realised PPD: sign of φ(1)",
-                    "median", "95th pct", "frozen G", "frozen-loop spectral radius"], rows,
-                   "lrrlrrrrrr")
+        "of φ). " + T.ppd_text() + " Last, the eq 7 law with φ frozen at the estimate's "
+        "median (gain G) around the ZOH-sampled linearised plant with its delay: the spectral "
+        "radius of that loop (below 1: stable).\n\n"
+        + T.ppd_table(res)
         + "\n\nOn the integrating reading the speed's slowest mode (the Davis resistance's) "
         f"is {fmt(res.readings[0].time_constant / res.readings[0].main.section.run_time, 2)} "
         "times the planned run, so over a run the speed integrates the command: Δy "
@@ -268,36 +209,30 @@ def _ppd(res) -> str:
 def _line(spec, res) -> str:
     if not res.readings[0].line:
         return ""
-    rows = T.line_rows(res)
     return (
         f"## {H_LINE}\n\nThe station data of Nanning Line 1 are not public in the paper: these "
         "sections (distances, planned times, gradient sections in ‰) are **synthetic**, "
         "metro-like, and labelled so. Each reading's chosen gains, no re-tuning. Cells are "
         "MFAC / PID.\n\n"
-        + md_table(["reading", "section", "S (m)", "gradients (‰)"]
-                   + [LABEL[i] for i in OBJECTIVES], rows, "llrlrrrr")
+        + T.line_table(res)
         + "\n\n![line stop errors]({figdir}/line.png)")
 
 
 def _sensitivity(res) -> str:
-    keys = ("eta", "mu", "rho", "lam")
-    rows = T.sensitivity_rows(res, keys, SYMBOL)
     return (
         f"## {H_SENS}\n\nPaper 002 §3 says λ is the parameter the controller is most "
         "sensitive to. From the grid itself (no extra run): the largest relative change of "
         "the weighted cost when one parameter alone moves to a neighbouring grid value "
         "(∞: a neighbour never stops; a neighbour that is not reproducible is left out, "
         "— when none is left).\n\n"
-        + md_table(["reading"] + [SYMBOL[k] for k in keys] + ["most sensitive"], rows,
-                   "lrrrrl"))
+        + T.sensitivity_table(res, SENSITIVITY_KEYS, SYMBOL))
 
 
 def _closing(res) -> str:
     items = []
     for r in res.readings:
         s = r.ppd
-        edges = "; ".join(f"{c} in {', '.join(t.edges)}" for c, t in
-                          (("MFAC", r.mfac), ("PID", r.pid)) if t.edges)
+        edges = T.edges_text(r)
         who = (f"**not determined** (chosen points on their grids' edges: {edges}); at these "
                f"points {r.verdict}" if edges else f"**{r.verdict}**")
         items.append(
@@ -327,10 +262,8 @@ def render(design, res) -> Rendered:
     sections = [_problem(spec, res), _model(spec), _profile(spec, res), _why(spec, res),
                 _tuning(spec, res), _compare(res), _ppd(res), _line(spec, res),
                 _sensitivity(res), _closing(res)]
-    figs = G.tuning_figures(spec, res) + [
-             Figure("ppd", "PPD estimate and realised PPD of the chosen MFAC runs.",
-                    lambda fig: F.plot_ppd(fig, res), (8.0, 3.8))] + G.line_figure(
-        res, "Stop error per section (synthetic line).")
+    figs = (G.tuning_figures(spec, res) + G.ppd_figure(res)
+            + G.line_figure(res, "Stop error per section (synthetic line)."))
     anchors = ((r"reading\[[^\]]+\]\.(mfac\.reset|mfac\.saturated|grid\.)", H_WHY),
                (r"reading\[[^\]]+\]\.(ppd|plant|frozen)", H_PPD),
                (r"reading\[[^\]]+\]\.line", H_LINE),

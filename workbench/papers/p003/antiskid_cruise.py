@@ -19,8 +19,10 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ...errors import DesignError, ModelError
-from ...features.quantities import Declared, names, values
-from ...features.sweep_study import SweepResult, SweepSpec, load_sweep, sweep_quantities
+from ...features.declared_study import DeclaredStudy
+from ...features.quantities import Declared
+from ...features.sweep_study import (SweepResult, SweepSpec, load_sweep, run_sweep,
+                                     sweep_quantities)
 from ...jsonable import json_method
 from ...plants.units import ADHESION_003 as PARAMETER_UNITS
 from ...reader import Quantity, Reader
@@ -46,11 +48,6 @@ class CruiseSpec:
     v_d: Quantity
     lambda_d_pinned: Quantity | None
     sweep: SweepSpec
-
-    @property
-    def published(self) -> tuple:
-        """The printed rows (the sampled-data check of issue 34 reads them)."""
-        return self.sweep.published
 
 
 @dataclass(frozen=True)
@@ -99,17 +96,16 @@ TABLE = (
 )
 
 
-class AntiskidCruise:
+class AntiskidCruise(DeclaredStudy):
     kind = "antiskid-cruise"
+    TABLE = TABLE
 
     # -- load ----------------------------------------------------------------
     def load(self, root: Reader) -> CruiseSpec:
         plant = root.table("plant")
         plant.string("model", choices=("adhesion-003",))
         rail = plant.string("rail", choices=("dry", "wet"))
-        params = {}
-        for k, unit in PARAMETER_UNITS.items():
-            params[k] = plant.quantity(k, unit, positive=True)
+        params = {k: plant.quantity(k, u, positive=True) for k, u in PARAMETER_UNITS.items()}
         plant.finish()
         op = root.table("operating_point")
         v_d = op.quantity("v_d", "m/s", positive=True, hi=150.0)
@@ -127,18 +123,11 @@ class AntiskidCruise:
                               f"a speed with a creep-region equilibrium ({exc})") from None
         return CruiseSpec(rail, params, v_d, pinned, sweep)
 
-    def quantity_names(self, spec: CruiseSpec) -> set[str]:
-        return names(TABLE, spec)
-
     # -- run -------------------------------------------------------------------
     def run(self, design) -> CruiseResult:
-        from ...features.sweep_study import run_sweep
         lam_opt, lam_solved, lam_used, lin = operating_point(design.spec)
         return CruiseResult(lam_opt, lam_solved, lam_used, lin,
                             run_sweep(lin.A, lin.B, design.spec.sweep), design.spec)
-
-    def quantities(self, res: CruiseResult) -> dict:
-        return values(TABLE, res.spec, res)
 
     def loop(self, design) -> tuple:
         """(A, B, header) of ``workbench synthesize delay-bound``

@@ -20,12 +20,14 @@ with an id and their A, B); this module keeps paper 003's operating points
 """
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
 from ...errors import DesignError, ModelError
-from ...features.quantities import Declared, names, values
+from ...features.declared_study import DeclaredStudy
+from ...features.quantities import Declared
 from ...kinds.delay_feedback.robust_points import (RobustPoints, RobustPointsResult,
                                                    load_robust_points, robust_points_quantities,
                                                    run_robust_points)
@@ -62,21 +64,17 @@ def _points(path, common, rails, op: Reader) -> tuple[Point, ...]:
     factors = op.numbers("mass_factor", positive=True, what="mass factors")
     op.finish()
     out = []
-    for rail in names:
-        for v in speeds:
-            for f in factors:
-                vals = {k: q.value for k, q in common.items()}
-                vals.update({k: q.value for k, q in rails[rail].items()})
-                vals["m"] *= f
-                plant = NumericAdhesion.from_dict(vals)
-                try:
-                    lam = plant.cruise_lambda(v)
-                except ModelError as exc:
-                    raise DesignError(path, "operating_points.v_d", v,
-                                      f"a speed with a cruise equilibrium on {rail} rail "
-                                      f"({exc})") from None
-                lin = linearise_cruise(plant, v, lam)
-                out.append(Point(rail, v, f, lam, lin.A, lin.B))
+    for rail, v, f in itertools.product(names, speeds, factors):
+        vals = {k: q.value for k, q in (common | rails[rail]).items()}
+        vals["m"] *= f
+        plant = NumericAdhesion.from_dict(vals)
+        try:
+            lam = plant.cruise_lambda(v)
+        except ModelError as exc:
+            raise DesignError(path, "operating_points.v_d", v, f"a speed with a cruise "
+                              f"equilibrium on {rail} rail ({exc})") from None
+        lin = linearise_cruise(plant, v, lam)
+        out.append(Point(rail, v, f, lam, lin.A, lin.B))
     return tuple(out)
 
 
@@ -86,8 +84,9 @@ TABLE = (*robust_points_quantities(),
                   over=lambda spec: [{"i": p.id, "p": p} for p in spec.points]))
 
 
-class AntiskidRobust:
+class AntiskidRobust(DeclaredStudy):
     kind = "antiskid-robust"
+    TABLE = TABLE
 
     def load(self, root: Reader) -> RobustPoints:
         plant = root.table("plant")
@@ -105,14 +104,8 @@ class AntiskidRobust:
         return load_robust_points(root, _points(root.path, common, rails,
                                                 root.table("operating_points")))
 
-    def quantity_names(self, spec: RobustPoints) -> set[str]:
-        return names(TABLE, spec)
-
     def run(self, design) -> RobustPointsResult:
         return run_robust_points(design.spec)
-
-    def quantities(self, res: RobustPointsResult) -> dict:
-        return values(TABLE, res.spec, res)
 
 
 STUDY = AntiskidRobust()

@@ -4,6 +4,7 @@ compared gains and the eps figure are
 :func:`workbench.kinds.delay_feedback.robust_points_render.robust_points_sections`."""
 from __future__ import annotations
 
+from ...features.robust_gain_render import robust_method_text
 from ...kinds.delay_feedback.robust_points_render import robust_points_sections
 from ...report.markdown import Rendered, fmt, md_table
 
@@ -32,12 +33,7 @@ def render(design, res) -> Rendered:
             "solved lambda_d), with exponential decay rate "
             f"alpha = {fmt(rg.settings.alpha)} 1/s certified at the delay h (stability for every "
             "constant delay in [0, h] and beyond follows from the exact margins below). "
-            "Synthesis: descriptor method with the Jensen inequality, slack P3 = eps P2, "
-            "common Y and V (K = V Y^{-1}), Lyapunov-Krasovskii matrices per point "
-            "(`workbench.lmi.robust.DescriptorSynthesis`); eps searched automatically "
-            "(log grid, then golden section). The certificate holds at the listed points, not "
-            "in between. Each gain is then re-checked per point by the exact margin and the "
-            f"Bessel-Legendre analysis of order {rg.settings.order}.\n\n"
+            + robust_method_text(rg.settings) + "\n\n"
             + md_table(["point", "rail", "v_d (m/s)", "mass factor", "lambda_d"],
                        [[f"`{p.id}`", p.rail, fmt(p.v_d), fmt(p.mass_factor), fmt(p.lambda_d, 4)]
                         for p in pts], "llrrr"))
