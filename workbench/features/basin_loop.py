@@ -73,6 +73,13 @@ class GainBasin:
     check: object
     trajectories: tuple
 
+    @property
+    def judged(self) -> list:
+        """(label, outcome, fate) of each judged state
+        (:func:`~workbench.features.basin_switch.switch_quantities`)."""
+        return [(p.label, p.verdict.outcome, tr.fate)
+                for p, tr in zip(self.check.points, self.trajectories)]
+
 
 @dataclass(frozen=True, eq=False)
 class GainLoop:

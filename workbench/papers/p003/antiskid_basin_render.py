@@ -4,16 +4,15 @@
 
 Paper 003's wording (laws (61), (69), eqs (75)-(76), the k2 rule) and the
 cruise figure's look stay here; the figure itself is the general
-:func:`workbench.features.basin_plot.plot_basin`, the switch-state and gain
+:func:`workbench.features.basin_plot.basin_figure`, the switch-state and gain
 tables and the certified gain range's sentence those of
 :mod:`workbench.features.basin_points_render`."""
 from __future__ import annotations
 
-from ...features.basin_plot import BasinPlotStyle
-from ...features.basin_plot import plot_basin as draw_basin
+from ...features.basin_plot import BasinPlotStyle, basin_figure
 from ...features.basin_points_render import gain_edge_text, gain_sweep_table, points_table
-from ...features.basin_scalar_render import scalar_verdict_text
-from ...report.markdown import fmt, md_table
+from ...features.basin_scalar_render import frozen_switch_table
+from ...report.markdown import fmt
 from ...roa.render import render_basin_markdown
 from .antiskid_basin import LAM_DIVERGED
 
@@ -57,18 +56,9 @@ def render_basin_result(res, *, rail: str) -> str:
 
 def brake_text(brake) -> str:
     """Subsection of the cruise -> braking switch (:mod:`.antiskid_basin_brake`;
-    the frozen loop's verdict in words:
-    :func:`workbench.features.basin_scalar_render.scalar_verdict_text`)."""
+    the table: :func:`workbench.features.basin_scalar_render.frozen_switch_table`)."""
     from .antiskid_basin_brake import FATE_RTOL, LAM_LIMIT, T_FATE, TRACK_TOL
-    rows = []
-    for b in brake:
-        v, lam = b.x
-        frozen = scalar_verdict_text(b.verdict, lam, LAM_LIMIT, name="lambda")
-        fate = (f"diverges: |lambda| = {fmt(LAM_LIMIT)} at t_brake + {fmt(b.t_fate, 2)} s"
-                if b.fate == "diverges" else b.fate)
-        rows.append([f"`{b.label}`", fmt(v, 4), fmt(lam, 4), fmt(b.reference, 4), frozen,
-                     b.outcome.name, fate])
-    if not rows:
+    if not brake:
         return ("\n### Switch states (cruise → braking)\n\nNo case reached the braking "
                 "phase.\n")
     return (
@@ -91,9 +81,10 @@ def brake_text(brake) -> str:
         "v and lambda integrated and v_s*(t), d v_s*/dt of eq (76) as printed (Radau, rtol "
         f"{fmt(FATE_RTOL)}, over {fmt(T_FATE)} s; \"tracks\": lambda < 0 and |v lambda - "
         f"v_s*| < {fmt(TRACK_TOL)} m/s at the end).\n\n"
-        + md_table(["case", "v (m/s)", "lambda", "v_s* frozen (m/s)", "frozen loop",
-                    "in a basin of law (69)?", "delay-free loop, time-varying"], rows,
-                   "lrrrlll")
+        + frozen_switch_table(brake, ["case", "v (m/s)", "lambda", "v_s* frozen (m/s)",
+                                      "frozen loop", "in a basin of law (69)?",
+                                      "delay-free loop, time-varying"], LAM_LIMIT, index=1,
+                              name="lambda", at="t_brake")
         + "\n\nREFUTED here means that the state lies in the basin of no equilibrium of the "
           "frozen loop: on the traction side the braking form that law (69) is built on "
           "(its adhesion branch grows like e^{b lambda} for lambda > 0) is not the plant, "
@@ -128,12 +119,9 @@ _STYLE = BasinPlotStyle(sampled_lw=0.7, sampled_alpha=0.8, point_lw=1.8, point_m
 def plot_basin(fig, basin) -> None:
     """(v - v_d, lambda - lambda_d) plane: certified and refuted level sets,
     the counterexample, sampled delay-free trajectories, switch states
-    (:func:`workbench.features.basin_plot.plot_basin`), lambda = lambda_opt."""
-    ax = fig.add_subplot(111)
-    draw_basin(ax, basin.check.estimate, basin.check.points, basin.trajectories, (0, 1), _STYLE)
-    ax.axhline(basin.lambda_opt - basin.lambda_d, color="tab:purple", ls=":", lw=0.8,
-               label="lambda = lambda_opt")
-    ax.set_xlabel("v - v_d (m/s)")
-    ax.set_ylabel("lambda - lambda_d")
-    ax.set_ylim(-0.15, 0.3)
-    ax.legend(fontsize=6, loc=_STYLE.legend_loc, framealpha=0.9)
+    (:func:`workbench.features.basin_plot.basin_figure`), lambda = lambda_opt."""
+    basin_figure(fig, basin.check.estimate, basin.check.points, basin.trajectories, (0, 1),
+                 _STYLE, ("v - v_d (m/s)", "lambda - lambda_d"), ylim=(-0.15, 0.3),
+                 extra=lambda ax: ax.axhline(basin.lambda_opt - basin.lambda_d,
+                                             color="tab:purple", ls=":", lw=0.8,
+                                             label="lambda = lambda_opt"))
