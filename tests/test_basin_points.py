@@ -225,7 +225,7 @@ def test_switch_basin_quantities_and_figure_of_a_toy_switched_run():
 
     from workbench.features.basin_plot import BasinPlotStyle, basin_figure
     from workbench.features.basin_scalar import FrozenSwitch, scalar_verdict
-    from workbench.features.basin_scalar_render import frozen_switch_table
+    from workbench.features.basin_scalar_render import frozen_switch_table, scalar_method_text
     from workbench.features.basin_switch import (switch_basin_quantities,
                                                  switch_basin_quantity_names)
     loop, K = _duffing(), (-2.0, -3.0)
@@ -253,6 +253,9 @@ def test_switch_basin_quantities_and_figure_of_a_toy_switched_run():
                                 index=1, name="z", at="t_s")
     assert "| `up` | 0 | 0.5 | 1 | no equilibrium from the state up to z = 2" in table
     assert "| REFUTED | diverges: \\|z\\| = 2 at t_s + 1.5 s |" in table
+    method = scalar_method_text(2.0, name="z")
+    assert method.startswith("The frozen loop has one state, z' = g(z), so")
+    assert "between the state and |z| = 2 (the sign of g proven" in method
     fig = MplFigure()
     ax = basin_figure(fig, res.check.estimate, res.check.points, res.trajectories, (0, 1),
                       BasinPlotStyle(), ("x1", "x2"), ylim=(-5.0, 5.0),

@@ -36,6 +36,18 @@ def scalar_verdict_text(sv, x_s: float, limit: float, *, name: str = "x",
     return sv.why.replace("sign not", f"sign of {name}' not")
 
 
+def scalar_method_text(limit: float, *, name: str = "x") -> str:
+    """How :func:`~workbench.features.basin_scalar.scalar_verdict` judges a
+    state of a loop frozen to one state on [-limit, limit] (``name``: the
+    state's display name), in one sentence for a report."""
+    return (f"The frozen loop has one state, {name}' = g({name}), so its trajectory moves "
+            "monotonically to the nearest equilibrium in the direction of g: the verdict is "
+            f"REFUTED when no equilibrium lies between the state and |{name}| = {fmt(limit)} "
+            "(the sign of g proven by interval arithmetic on the whole interval), CERTIFIED "
+            "when the state reaches a certified level set of a stable equilibrium (a level "
+            "set of `workbench/roa`, with the sign of g proven on the way to it).")
+
+
 def frozen_switch_table(switches, header, limit: float, *, index: int, name: str = "x",
                         at: str = "the switch") -> str:
     """One row per :class:`~workbench.features.basin_scalar.FrozenSwitch`: its

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from ...features.basin_plot import BasinPlotStyle, basin_figure
 from ...features.basin_points_render import gain_edge_text, gain_sweep_table, points_table
-from ...features.basin_scalar_render import frozen_switch_table
+from ...features.basin_scalar_render import frozen_switch_table, scalar_method_text
 from ...report.markdown import fmt
 from ...roa.render import render_basin_markdown
 from .antiskid_basin import LAM_DIVERGED
@@ -56,7 +56,9 @@ def render_basin_result(res, *, rail: str) -> str:
 
 def brake_text(brake) -> str:
     """Subsection of the cruise -> braking switch (:mod:`.antiskid_basin_brake`;
-    the table: :func:`workbench.features.basin_scalar_render.frozen_switch_table`)."""
+    the table and the frozen loop's method:
+    :func:`workbench.features.basin_scalar_render.frozen_switch_table`,
+    :func:`~workbench.features.basin_scalar_render.scalar_method_text`)."""
     from .antiskid_basin_brake import FATE_RTOL, LAM_LIMIT, T_FATE, TRACK_TOL
     if not brake:
         return ("\n### Switch states (cruise → braking)\n\nNo case reached the braking "
@@ -71,13 +73,8 @@ def brake_text(brake) -> str:
         "v_s* frozen at v_s*(t_brake), with d v_s*/dt = 0; the controller's nominal model, "
         "traction form (eq 12) for lambda >= 0 and braking form (eq 15) below, as the "
         "plant; law (69) computed on the braking form (eq 16) whatever the sign of lambda, "
-        "as printed. The frozen loop has one state, lambda' = g(lambda), so its trajectory "
-        "moves monotonically to the nearest equilibrium in the direction of g: the verdict "
-        "is REFUTED when no equilibrium lies between the state and |lambda| = "
-        f"{fmt(LAM_LIMIT)} (the sign of g proven by interval arithmetic on the whole "
-        "interval), CERTIFIED when the state reaches a certified level set of a stable "
-        "equilibrium (a level set of `workbench/roa`, with the sign of g proven on the "
-        "way to it). The last column drops the frozen assumptions: the delay-free loop with "
+        "as printed. " + scalar_method_text(LAM_LIMIT, name="lambda")
+        + " The last column drops the frozen assumptions: the delay-free loop with "
         "v and lambda integrated and v_s*(t), d v_s*/dt of eq (76) as printed (Radau, rtol "
         f"{fmt(FATE_RTOL)}, over {fmt(T_FATE)} s; \"tracks\": lambda < 0 and |v lambda - "
         f"v_s*| < {fmt(TRACK_TOL)} m/s at the end).\n\n"
