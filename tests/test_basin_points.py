@@ -253,6 +253,10 @@ def test_switch_basin_quantities_and_figure_of_a_toy_switched_run():
                                 index=1, name="z", at="t_s")
     assert "| `up` | 0 | 0.5 | 1 | no equilibrium from the state up to z = 2" in table
     assert "| REFUTED | diverges: \\|z\\| = 2 at t_s + 1.5 s |" in table
+    from workbench.features.basin_points_render import points_verdict_text
+    note = points_verdict_text("toy", "\"diverges\": |x1| reaches 4")
+    assert note.startswith("CERTIFIED: V at the state is below c_certified, so the toy loop")
+    assert note.endswith("what the toy trajectory does (\"diverges\": |x1| reaches 4).")
     method = scalar_method_text(2.0, name="z")
     assert method.startswith("The frozen loop has one state, z' = g(z), so")
     assert "between the state and |z| = 2 (the sign of g proven" in method
@@ -262,3 +266,28 @@ def test_switch_basin_quantities_and_figure_of_a_toy_switched_run():
                       extra=lambda a: a.axhline(1.0, label="mark"))
     assert (ax.get_xlabel(), ax.get_ylabel(), ax.get_ylim()) == ("x1", "x2", (-5.0, 5.0))
     assert "mark" in [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_gain_loop_sweep_shared_once_per_run(tmp_path, monkeypatch):
+    """GainLoop.sweep with ``share``: computed once in the process, read from
+    the run folder by another process of the run (the in-process results
+    emptied), computed again for another argument; without ``share`` every
+    call computes."""
+    from workbench import memo
+    from workbench.features import basin_loop
+    loop, calls = _duffing(), []
+    orig = basin_loop.sweep_gain_entry
+    monkeypatch.setattr(basin_loop, "sweep_gain_entry",
+                        lambda *a, **k: calls.append(1) or orig(*a, **k))
+    monkeypatch.setenv(memo.CACHE_ENV, str(tmp_path))
+    monkeypatch.setattr(memo, "_RESULTS", {})
+    args = ((-2.0, 0.0), (0.2, 0.0), 1, [-3.0, -1.0], 20.0)
+    a = loop.sweep(*args, bisect=1, share=("toy.sweep", "duffing"))
+    assert loop.sweep(*args, bisect=1, share=("toy.sweep", "duffing")) is a and len(calls) == 1
+    monkeypatch.setattr(memo, "_RESULTS", {})
+    b = loop.sweep(*args, bisect=1, share=("toy.sweep", "duffing"))
+    assert b == a and len(calls) == 1 and len(list(tmp_path.glob("*.pickle"))) == 1
+    loop.sweep(*args, bisect=2, share=("toy.sweep", "duffing"))
+    assert len(calls) == 2
+    assert loop.sweep(*args, bisect=1) == a and len(calls) == 3
+    assert a.point == (0.2, 0.0) and [r.gain for r in a.rows][:2] == [(-2.0, -3.0), (-2.0, -2.0)]

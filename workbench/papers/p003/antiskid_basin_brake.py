@@ -45,9 +45,8 @@ from ...features.basin_trajectory import limit_event
 from ...plants.adhesion import adhesion_model
 from ...plants.lambdify_cache import lambdify
 from ...sim.wheel_slip import ScalarOps, wheel_speed
+from .antiskid_basin import LAM_DIVERGED as LAM_LIMIT      # the wheel spins or locks
 
-#: |lambda| at which the wheel spins or locks (the runs' divergence test).
-LAM_LIMIT = 0.9
 #: Horizon (s) of the time-varying delay-free loop from the switch state.
 T_FATE = 5.0
 #: Relative tolerance of its Radau integration.

@@ -5,14 +5,16 @@
 Paper 003's wording (laws (61), (69), eqs (75)-(76), the k2 rule) and the
 cruise figure's look stay here; the figure itself is the general
 :func:`workbench.features.basin_plot.basin_figure`, the switch-state and gain
-tables and the certified gain range's sentence those of
-:mod:`workbench.features.basin_points_render`."""
+tables, what their verdicts mean and the certified gain range's sentence
+those of :mod:`workbench.features.basin_points_render`."""
 from __future__ import annotations
 
 from ...features.basin_plot import BasinPlotStyle, basin_figure
-from ...features.basin_points_render import gain_edge_text, gain_sweep_table, points_table
+from ...features.basin_points_render import (gain_edge_text, gain_sweep_table, points_table,
+                                              points_verdict_text)
 from ...features.basin_scalar_render import frozen_switch_table, scalar_method_text
 from ...report.markdown import fmt
+from ...report.synthesis_text import gain_text
 from ...roa.render import render_basin_markdown
 from .antiskid_basin import LAM_DIVERGED
 
@@ -26,10 +28,9 @@ def render_basin_result(res, *, rail: str) -> str:
     """Section of a :class:`~workbench.papers.p003.antiskid_basin_run.BasinResult`:
     loop, certified bracket, switch verdicts, k2 rule."""
     basin = res.basin
-    K = "[" + ", ".join(fmt(k, 4) for k in basin.K) + "]"
     head = (
         f"## {HEADING}\n\n"
-        f"Cruise law (61) with K = {K} on {rail} rail, at (v_d, lambda_d) = "
+        f"Cruise law (61) with K = {gain_text(basin.K)} on {rail} rail, at (v_d, lambda_d) = "
         f"({fmt(basin.v_d)} m/s, {fmt(basin.lambda_d, 4)}). The loop is the **delay-free** "
         "loop under exact prediction (as paper 003's Theorems 2-3 argue for laws (64) and "
         "(69)): law (61) as printed feeds the current error K E(t) to its numerator, so the "
@@ -42,10 +43,8 @@ def render_basin_result(res, *, rail: str) -> str:
           + points_table(basin.check, [tr.fate for tr in basin.trajectories],
                          ["case", "v (m/s)", "lambda", "V", "in the certified basin?",
                           "delay-free trajectory"], shift=(basin.v_d, basin.lambda_d))
-          + "\n\nCERTIFIED: V at the state is below c_certified, so the delay-free loop "
-            "converges from it. REFUTED: its level holds a point with V' >= 0, so this V "
-            "cannot certify it; the last column says what the delay-free trajectory does "
-            f"(\"diverges\": |lambda| reaches {fmt(LAM_DIVERGED)}, the wheel spins).\n")
+          + "\n\n" + points_verdict_text("delay-free", f"\"diverges\": |lambda| reaches "
+                                         f"{fmt(LAM_DIVERGED)}, the wheel spins") + "\n")
     text = head + body + sw + brake_text(res.brake) + _k2_text(res.sweep, res.compare_source)
     if res.mass_factor != 1.0:
         text += (f"\nThe plant of this design has {fmt(res.mass_factor, 3)} x the nominal mass; "
