@@ -115,19 +115,22 @@ def test_switch_verdict_equals_the_eager_path(switch, k2, monkeypatch):
 def test_k2_sweep_is_shared_through_the_run_folder(tmp_path, monkeypatch):
     """Designs that differ only in the plant's mass share the controller's
     nominal model and so the k2 sweep: a second process of the same run reads
-    it from the run folder (here: the same key, the in-process cache bypassed)."""
+    it from the run folder (here: the same key, the in-process results emptied)."""
     from workbench import memo
+    from workbench.features import basin_loop
     from workbench.features.basin_points import GainSweep
     calls = []
 
-    def fake(*key):
-        calls.append(key)
-        return GainSweep(key[3], (key[2], 0.0), 1, (), (), None, min(key[4]), False)
+    def fake(judge, point, K, index, grid, **kw):
+        calls.append((point, K, grid, kw))
+        return GainSweep(point, K, index, (), (), None, min(grid), False)
 
     monkeypatch.setenv(memo.CACHE_ENV, str(tmp_path))
-    monkeypatch.setattr(AB, "_k2_sweep", fake)
+    monkeypatch.setattr(basin_loop, "sweep_gain_entry", fake)
+    monkeypatch.setattr(memo, "_RESULTS", {})
     args = dict(grid=[0.0, 2.0], compare=[("row", (K[0], 10.5))], bisect=2, seed=0)
     a = AB.safe_k2_range(DRY, 70.0, K[0], (70.0, 0.1), **args)
+    monkeypatch.setattr(memo, "_RESULTS", {})
     b = AB.safe_k2_range(dict(reversed(list(DRY.items()))), 70, K[0], (70.0, 0.1), **args)
     assert a == b and len(calls) == 1 and len(list(tmp_path.glob("*.pickle"))) == 1
     AB.safe_k2_range(DRY, 70.0, K[0], (70.0, 0.1), **dict(args, seed=1))

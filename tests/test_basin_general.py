@@ -173,3 +173,30 @@ def test_frozen_switch_of_a_toy_tracking_loop_and_its_text():
     # from 0.5 down to -2: a distance of 2.5
     assert "down to z = −2" in text
     assert float(text.split("within ")[1].split(" ")[0]) >= 2.5 / down.rate
+
+
+def test_frozen_switch_from_a_toy_field_with_a_symbolic_reference():
+    """frozen_switch on a two-state toy (y slow, x fast) tracking r(t) = 0.5 +
+    0.1 sin t: x' = -2 (x - r) + dr/dt frozen at t0 = 0 goes to x* = r(0) = 0.5
+    (CERTIFIED) and the time-varying loop tracks; frozen at pi/2, x* = 0.6. The
+    unstable x' = x - r from x = 0.6 > r(0) has no equilibrium ahead (REFUTED) and
+    the time-varying loop reaches |x| = 2 (its escape), at a time > 0."""
+    import math
+    from workbench.features.basin_scalar import frozen_switch
+    from workbench.features.basin_trajectory import limit_event
+    R, DR = sp.symbols("r dr", real=True)
+    ref = lambda t, s: (0.5 + 0.1 * math.sin(t), 0.1 * math.cos(t))     # noqa: E731
+    args = dict(T=10.0, settled=lambda s, r: abs(s[1] - r) < 0.01,
+                events=[limit_event(1, 2.0)], name="x")
+    stable = [-0.01 * Y, -2 * (X - R) + DR]
+    sw = frozen_switch("on", stable, (Y, X), (R, DR), (1.0, 0.2), 1, ref, 0.0, -2.0, 2.0, **args)
+    assert (sw.outcome, sw.fate, sw.t_fate, sw.x) == (Outcome.CERTIFIED, "tracks", None, (1.0, 0.2))
+    assert sw.reference == pytest.approx(0.5) and sw.verdict.star == pytest.approx(0.5)
+    later = frozen_switch("on", stable, (Y, X), (R, DR), (1.0, 0.2), 1, ref, 0.0, -2.0, 2.0,
+                          t_frozen=math.pi / 2, **args)
+    assert later.verdict.star == pytest.approx(0.6) and later.fate == "tracks"
+    bad = frozen_switch("up", [0 * Y, X - R], (Y, X), (R, DR), (1.0, 0.6), 1, ref, 0.0, -2.0,
+                        2.0, **args)
+    assert (bad.outcome, bad.verdict.why, bad.fate) == (Outcome.REFUTED, "no equilibrium",
+                                                        "diverges")
+    assert 0 < bad.t_fate < 10.0

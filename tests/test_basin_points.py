@@ -212,3 +212,82 @@ def test_gain_loop_sweep_on_a_toy_system():
     assert by[-3.0].outcome is Outcome.CERTIFIED and by[-3.0].fate == "converges"
     assert by[0.0].outcome is Outcome.REFUTED and not by[0.0].hurwitz
     assert sw.compared[0].source == "far" and sw.compared[0].verdict == by[-3.0]
+
+
+def test_switch_basin_quantities_and_figure_of_a_toy_switched_run():
+    """The Duffing toy's basin judged at two switch states, a one-state loop
+    z' = 1 frozen at another switch (no equilibrium: REFUTED), the gain sweep:
+    the claimable quantities of all three (basin_switch.switch_basin_quantities),
+    the frozen switches' table and the figure on one axes (basin_plot.basin_figure)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure as MplFigure
+
+    from workbench.features.basin_plot import BasinPlotStyle, basin_figure
+    from workbench.features.basin_scalar import FrozenSwitch, scalar_verdict
+    from workbench.features.basin_scalar_render import frozen_switch_table, scalar_method_text
+    from workbench.features.basin_switch import (switch_basin_quantities,
+                                                 switch_basin_quantity_names)
+    loop, K = _duffing(), (-2.0, -3.0)
+    res = loop.basin(K, [("near", (0.2, 0.0)), ("far", (3.0, 0.0))], n_traj=2, T=20.0,
+                     scale=(1, 1), pad=(0, 0), default=(1, 1))
+    assert res.judged == [("near", Outcome.CERTIFIED, "converges"),
+                          ("far", Outcome.REFUTED, "diverges")]
+    z = sp.symbols("z", real=True)
+    sw = FrozenSwitch("up", (0.0, 0.5), 1.0, scalar_verdict(1 + 0 * z, z, 0.5, -2.0, 2.0),
+                      "diverges", 1.5)
+    assert sw.judged == ("up", Outcome.REFUTED, "diverges")
+    sweep = loop.sweep((-2.0, 0.0), (0.2, 0.0), 1, [-3.0, -1.0], 20.0, bisect=1)
+    labels = ["near", "far", "up", "never"]
+    judged = {"fixed": res.judged, "frozen": [sw.judged]}
+    q = switch_basin_quantities(res.check.estimate, labels, judged, sweep, "k2")
+    assert set(q) == switch_basin_quantity_names(labels, ("fixed", "frozen"), "k2")
+    assert q["basin.c_certified"] == res.check.estimate.c_certified
+    assert (q["switch.fixed[far].in_basin"], q["switch.frozen[up].fate"]) == ("REFUTED",
+                                                                              "diverges")
+    assert q["switch.frozen[never].in_basin"] is None and "basin.k2_safe_max" in q
+    bare = switch_basin_quantities(res.check.estimate, labels, judged)
+    assert set(bare) == switch_basin_quantity_names(labels, ("fixed", "frozen"))
+    assert not any(k.startswith("basin.k2") for k in bare)
+    table = frozen_switch_table([sw], ["s", "y", "z", "r", "frozen", "verdict", "fate"], 2.0,
+                                index=1, name="z", at="t_s")
+    assert "| `up` | 0 | 0.5 | 1 | no equilibrium from the state up to z = 2" in table
+    assert "| REFUTED | diverges: \\|z\\| = 2 at t_s + 1.5 s |" in table
+    from workbench.features.basin_points_render import points_verdict_text
+    note = points_verdict_text("toy", "\"diverges\": |x1| reaches 4")
+    assert note.startswith("CERTIFIED: V at the state is below c_certified, so the toy loop")
+    assert note.endswith("what the toy trajectory does (\"diverges\": |x1| reaches 4).")
+    method = scalar_method_text(2.0, name="z")
+    assert method.startswith("The frozen loop has one state, z' = g(z), so")
+    assert "between the state and |z| = 2 (the sign of g proven" in method
+    fig = MplFigure()
+    ax = basin_figure(fig, res.check.estimate, res.check.points, res.trajectories, (0, 1),
+                      BasinPlotStyle(), ("x1", "x2"), ylim=(-5.0, 5.0),
+                      extra=lambda a: a.axhline(1.0, label="mark"))
+    assert (ax.get_xlabel(), ax.get_ylabel(), ax.get_ylim()) == ("x1", "x2", (-5.0, 5.0))
+    assert "mark" in [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_gain_loop_sweep_shared_once_per_run(tmp_path, monkeypatch):
+    """GainLoop.sweep with ``share``: computed once in the process, read from
+    the run folder by another process of the run (the in-process results
+    emptied), computed again for another argument; without ``share`` every
+    call computes."""
+    from workbench import memo
+    from workbench.features import basin_loop
+    loop, calls = _duffing(), []
+    orig = basin_loop.sweep_gain_entry
+    monkeypatch.setattr(basin_loop, "sweep_gain_entry",
+                        lambda *a, **k: calls.append(1) or orig(*a, **k))
+    monkeypatch.setenv(memo.CACHE_ENV, str(tmp_path))
+    monkeypatch.setattr(memo, "_RESULTS", {})
+    args = ((-2.0, 0.0), (0.2, 0.0), 1, [-3.0, -1.0], 20.0)
+    a = loop.sweep(*args, bisect=1, share=("toy.sweep", "duffing"))
+    assert loop.sweep(*args, bisect=1, share=("toy.sweep", "duffing")) is a and len(calls) == 1
+    monkeypatch.setattr(memo, "_RESULTS", {})
+    b = loop.sweep(*args, bisect=1, share=("toy.sweep", "duffing"))
+    assert b == a and len(calls) == 1 and len(list(tmp_path.glob("*.pickle"))) == 1
+    loop.sweep(*args, bisect=2, share=("toy.sweep", "duffing"))
+    assert len(calls) == 2
+    assert loop.sweep(*args, bisect=1) == a and len(calls) == 3
+    assert a.point == (0.2, 0.0) and [r.gain for r in a.rows][:2] == [(-2.0, -3.0), (-2.0, -2.0)]

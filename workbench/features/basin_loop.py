@@ -73,6 +73,13 @@ class GainBasin:
     check: object
     trajectories: tuple
 
+    @property
+    def judged(self) -> list:
+        """(label, outcome, fate) of each judged state
+        (:func:`~workbench.features.basin_switch.switch_quantities`)."""
+        return [(p.label, p.verdict.outcome, tr.fate)
+                for p, tr in zip(self.check.points, self.trajectories)]
+
 
 @dataclass(frozen=True, eq=False)
 class GainLoop:
@@ -164,15 +171,29 @@ class GainLoop:
                               max_step=self.max_step, seed=seed)
 
     def sweep(self, K, x, index: int, grid, T: float, *, point=None, compare=(), bisect: int = 4,
-              seed: int = 0) -> GainSweep:
+              seed: int = 0, share: tuple | None = None) -> GainSweep:
         """Entry ``index`` of the gain ``K`` over ``grid``, the state ``x`` judged by
         :meth:`judge` over [0, T] at each gain, the edge of the certified range
         bisected, and the labelled gains ``compare`` judged the same way
         (:func:`~.basin_points.sweep_gain_entry`; ``point``: the state as the
-        result records it, default ``x``, e.g. in the design's own coordinates)."""
-        return sweep_gain_entry(lambda G: self.judge(G, x, T, seed=seed),
-                                x if point is None else point, K, index, grid, compare=compare,
-                                bisect=bisect)
+        result records it, default ``x``, e.g. in the design's own coordinates).
+
+        ``share`` = (name, key identifying this loop): the sweep is computed once
+        per run (:func:`workbench.memo.computed_once`: in this process, and in
+        the run folder for the run's other processes), keyed by ``key`` and
+        every argument above."""
+        point = tuple(float(p) for p in (x if point is None else point))
+        compare = tuple((str(lab), tuple(float(g) for g in G)) for lab, G in compare)
+
+        def compute():
+            return sweep_gain_entry(lambda G: self.judge(G, x, T, seed=seed), point, K, index,
+                                    grid, compare=compare, bisect=bisect)
+        if share is None:
+            return compute()
+        from ..memo import computed_once
+        key = (share[1], tuple(float(k) for k in K), tuple(float(v) for v in x), int(index),
+               tuple(float(g) for g in grid), float(T), point, compare, int(bisect), int(seed))
+        return computed_once(share[0], key, compute)
 
     def trajectory(self, fn, x0, T: float, inside, *, path_dt=None) -> Trajectory:
         """One trajectory of x' = fn(*x) from x0 and its fate, escaping by the

@@ -6,7 +6,8 @@ counterexample, sampled trajectories coloured by fate, and the judged points
 Pure rendering of a :class:`workbench.roa.BasinEstimate`, its
 :class:`workbench.roa.check.PointCheck` points and
 :class:`workbench.features.basin_trajectory.Trajectory` paths; the look of a
-family of figures is a :class:`BasinPlotStyle`.
+family of figures is a :class:`BasinPlotStyle`; :func:`basin_figure` draws
+it on a figure's one axes with the axis labels, limits and legend.
 """
 from __future__ import annotations
 
@@ -107,3 +108,22 @@ def plot_basin(ax, est, points, trajectories, plane=(0, 1), style: BasinPlotStyl
         ax.plot(*_xy(tr.path, plane, style.clip), color=FATE_COLOR[tr.fate], lw=style.point_lw)
         ax.plot(p.x[i], p.x[j], MARK[name], color="tab:blue", ms=style.point_ms, mec="k",
                 label=style.point_label.format(label=p.label, outcome=name))
+
+
+def basin_figure(fig, est, points, trajectories, plane, style: BasinPlotStyle, labels, *,
+                 xlim=None, ylim=None, extra=None):
+    """One axes of ``fig`` with :func:`plot_basin` (arguments as there), then
+    ``extra(ax)`` (the caller's own marks, e.g. a reference line), the axis
+    ``labels`` (x, y), the limits given and the legend; returns the axes."""
+    ax = fig.add_subplot(111)
+    plot_basin(ax, est, points, trajectories, plane, style)
+    if extra is not None:
+        extra(ax)
+    if xlim is not None:
+        ax.set_xlim(*xlim)
+    if ylim is not None:
+        ax.set_ylim(*ylim)
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
+    ax.legend(fontsize=6, loc=style.legend_loc, framealpha=0.9)
+    return ax

@@ -1,5 +1,5 @@
-"""Markdown tables of judged states and of a gain sweep, and the sentence of
-the sweep's certified range (pure rendering of
+"""Markdown tables of judged states (and what their verdicts mean) and of a
+gain sweep, and the sentence of the sweep's certified range (pure rendering of
 :class:`~workbench.roa.check.BasinCheck` points and of
 :class:`~workbench.features.basin_points.GainSweep`); the headings and the
 words around them are the caller's."""
@@ -21,6 +21,15 @@ def points_table(check, fates, header, *, shift=None, digits: int = 4) -> str:
                      fmt_level(p.verdict.level, "up"), p.verdict.outcome.name, fate])
     n = len(header) - 4
     return md_table(header, rows, "l" + "r" * (n + 1) + "ll")
+
+
+def points_verdict_text(kind: str, escape: str) -> str:
+    """What the verdict and fate columns of :func:`points_table` mean, for a
+    loop described by the adjective ``kind`` (e.g. "delay-free"); ``escape``:
+    what its escape word means (in parentheses at the end)."""
+    return (f"CERTIFIED: V at the state is below c_certified, so the {kind} loop converges "
+            "from it. REFUTED: its level holds a point with V' >= 0, so this V cannot certify "
+            f"it; the last column says what the {kind} trajectory does ({escape}).")
 
 
 def gain_sweep_table(sweep, header, *, digits=None) -> str:

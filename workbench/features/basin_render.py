@@ -7,8 +7,7 @@ import numpy as np
 from ..report.markdown import Figure, fmt
 from ..roa.render import fmt_level, render_basin_markdown
 from .basin import BOUNDARY, N_INSIDE, RADAU_RTOL
-from .basin_plot import FATE_COLOR, BasinPlotStyle
-from .basin_plot import plot_basin as draw_basin
+from .basin_plot import FATE_COLOR, BasinPlotStyle, basin_figure
 
 _STYLE = BasinPlotStyle(point_label="scenario {label}: {outcome}")
 _OUTCOME = {
@@ -90,12 +89,12 @@ def render_basin_section(spec, res, basin) -> tuple[str, tuple]:
 
 def plot_basin(fig, basin, names) -> None:
     """Level sets, counterexample, sampled trajectories and scenario states
-    (``names``: axis labels, one per state; :func:`.basin_plot.plot_basin`)."""
+    (``names``: axis labels, one per state; :func:`.basin_plot.basin_figure`)."""
     est = basin.check.estimate
-    ax = fig.add_subplot(111)
     P, x_eq = np.array(est.P), np.array(est.x_eq)
     lo, hi = np.array(basin.box[0]), np.array(basin.box[1])
     if len(names) == 1:
+        ax = fig.add_subplot(111)
         for tr in basin.sampled:
             t = np.linspace(0, 1, len(tr.path))
             ax.plot(t, tr.path[:, 0], color=FATE_COLOR[tr.fate], lw=0.8)
@@ -107,11 +106,8 @@ def plot_basin(fig, basin, names) -> None:
         ax.legend(fontsize=7)
         return
     i, j = basin.plane
-    draw_basin(ax, est, basin.check.points, basin.sampled, (i, j), _STYLE)
-    ax.plot(x_eq[i], x_eq[j], "k+", ms=10, label="operating point x*")
     pad_i, pad_j = 0.05 * (hi[i] - lo[i]), 0.05 * (hi[j] - lo[j])
-    ax.set_xlim(lo[i] - pad_i, hi[i] + pad_i)
-    ax.set_ylim(lo[j] - pad_j, hi[j] + pad_j)
-    ax.set_xlabel(names[i])
-    ax.set_ylabel(names[j])
-    ax.legend(fontsize=6, loc=_STYLE.legend_loc, framealpha=0.9)
+    basin_figure(fig, est, basin.check.points, basin.sampled, (i, j), _STYLE, (names[i], names[j]),
+                 xlim=(lo[i] - pad_i, hi[i] + pad_i), ylim=(lo[j] - pad_j, hi[j] + pad_j),
+                 extra=lambda ax: ax.plot(x_eq[i], x_eq[j], "k+", ms=10,
+                                          label="operating point x*"))

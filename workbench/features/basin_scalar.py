@@ -20,7 +20,9 @@ reference varies in time takes over: the verdict of the loop frozen at the
 switch instant (reference held, the fast state alone moving), and the fate of
 the time-varying loop from the same state
 (:func:`~workbench.features.basin_trajectory.time_varying_fate`), which drops
-the frozen assumptions. Rendering: :mod:`.basin_scalar_render`.
+the frozen assumptions; :func:`frozen_switch` builds both from the loop's
+vector field in its states and the reference (and its rate) as symbols.
+Rendering: :mod:`.basin_scalar_render`.
 """
 from __future__ import annotations
 
@@ -28,11 +30,13 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import sympy as sp
 
 from ..outcome import Outcome
 from ..plants.lambdify_cache import lambdify
 from ..roa import BasinProblem, estimate_basin, lyapunov_P
 from ..roa.interval import IntervalFunction
+from .basin_trajectory import time_varying_fate
 
 
 @dataclass(frozen=True)
@@ -177,3 +181,59 @@ class FrozenSwitch:
     @property
     def outcome(self) -> Outcome:
         return self.verdict.outcome
+
+    @property
+    def judged(self) -> tuple:
+        """(label, outcome, fate) (:func:`~workbench.features.basin_switch.switch_quantities`)."""
+        return self.label, self.outcome, self.fate
+
+
+def frozen_switch(label: str, field, states, refs, x, index: int, reference, t0: float,
+                  lo: float, hi: float, *, T: float, settled, events=(), rtol: float = 1e-8,
+                  max_step: float = math.inf, t_frozen: float | None = None, name: str = "x",
+                  seed: int = 0) -> FrozenSwitch:
+    """The :class:`FrozenSwitch` of the state ``x`` where a law tracking a
+    time-varying reference takes over at ``t0`` (module docstring).
+
+    Parameters
+    ----------
+    label : str
+    field : sequence of sympy expressions
+        The closed loop's vector field, in ``states`` and ``refs``.
+    states : tuple of sympy Symbol
+    refs : (Symbol, Symbol)
+        The reference r and its rate dr/dt as they enter ``field``.
+    x : sequence of float
+        The state at the switch.
+    index : int
+        The fast state: the frozen loop is ``field[index]`` in it alone, the
+        other states held at ``x``, r held at its value at ``t_frozen`` and dr/dt = 0;
+        its verdict is :func:`scalar_verdict` on [lo, hi].
+    reference : callable
+        (t, x) -> (r, dr/dt) along the time-varying loop.
+    t0 : float
+        The switch instant; the time-varying loop runs over [t0, t0 + T].
+    lo, hi : float
+        Interval of the fast state (its ends: the loop has left its model).
+    T : float
+    settled : callable
+        (x, r) -> bool: the time-varying loop has settled at its end ("tracks").
+    events, rtol, max_step
+        Of the time-varying loop (:func:`~.basin_trajectory.time_varying_fate`).
+    t_frozen : float, optional
+        The instant the loop is frozen at (default ``t0``).
+    name : str
+        Display name of the fast state.
+    seed : int
+        Falsifier seed of the level-set case.
+    """
+    x = tuple(float(v) for v in x)
+    r0 = float(reference(t0 if t_frozen is None else t_frozen, x)[0])
+    held = {s: sp.Float(v) for i, (s, v) in enumerate(zip(states, x)) if i != index}
+    g = field[index].xreplace({**held, refs[0]: sp.Float(r0), refs[1]: sp.Integer(0)})
+    sv = scalar_verdict(g, states[index], x[index], lo, hi, name=name, seed=seed)
+    fn = lambdify((*states, *refs), list(field), "math")
+    fate, t_fate = time_varying_fate(lambda t, *s: fn(*s, *reference(t, s)), x, t0, T,
+                                     lambda t, s: settled(s, reference(t, s)[0]), events=events,
+                                     rtol=rtol, max_step=max_step)
+    return FrozenSwitch(label, x, r0, sv, fate, t_fate)

@@ -14,10 +14,15 @@ or the cases' metrics.
 Quantities, per switch ``s`` and case label ``c``:
 ``switch.{s}[{c}].in_basin`` (the outcome's name) and ``switch.{s}[{c}].fate``;
 a case not judged at that switch (it never reached it) gets None for both.
+:func:`switch_basin_quantities` adds those of the certified level set of the
+law with a fixed equilibrium and of a gain sweep at a switch state.
 """
 from __future__ import annotations
 
 import math
+
+from .basin import LEVEL_QUANTITIES, level_quantities
+from .basin_points import gain_sweep_quantities, gain_sweep_quantity_names
 
 #: Key of a case's quantities at one switch.
 SWITCH_KEY = "switch.{switch}[{label}]"
@@ -56,4 +61,25 @@ def switch_quantities(labels, judged: dict) -> dict:
         for lab, outcome, fate in rows:
             at = SWITCH_KEY.format(switch=s, label=lab)
             q[f"{at}.in_basin"], q[f"{at}.fate"] = outcome.name, fate
+    return q
+
+
+def switch_basin_quantity_names(labels, switches, entry: str | None = None) -> set:
+    """Names of :func:`switch_basin_quantities`: the certified level
+    (:data:`~workbench.features.basin.LEVEL_QUANTITIES`), each case of ``labels``
+    at each of the ``switches`` and, given the swept ``entry``, the gain sweep's
+    (:func:`~workbench.features.basin_points.gain_sweep_quantity_names`)."""
+    names = set(LEVEL_QUANTITIES) | switch_quantity_names(labels, switches)
+    return names if entry is None else names | gain_sweep_quantity_names(entry)
+
+
+def switch_basin_quantities(estimate, labels, judged: dict, sweep=None, entry: str = "") -> dict:
+    """Values of :func:`switch_basin_quantity_names`: the level set ``estimate``'s
+    (a :class:`~workbench.roa.BasinEstimate`), :func:`switch_quantities` of
+    ``judged`` and, when ``sweep`` is given, its
+    :func:`~workbench.features.basin_points.gain_sweep_quantities` of ``entry``."""
+    q = level_quantities(estimate)
+    q.update(switch_quantities(labels, judged))
+    if sweep is not None:
+        q.update(gain_sweep_quantities(sweep, entry))
     return q

@@ -57,7 +57,6 @@ from ...errors import ModelError
 from ...features.basin_loop import GainBasin, GainLoop
 from ...features.basin_points import GainSweep
 from ...features.basin_trajectory import limit_event
-from ...memo import shared
 from ...plants.adhesion import NumericAdhesion, adhesion_model
 from ...symbolic.linearise import linearise_cruise
 
@@ -165,14 +164,6 @@ def cruise_basin(values: dict, v_d: float, K, switch_points, *, seed: int = 0,
     return CruiseBasin(best.K, best.w, best.check, best.trajectories, v_d, lam_d, lam_opt)
 
 
-@lru_cache(maxsize=8)
-def _k2_sweep(values: tuple, v_d: float, k1: float, point: tuple, grid: tuple, compare: tuple,
-              bisect: int, seed: int) -> GainSweep:
-    loop, lam_d, _ = cruise_loop(values, v_d)
-    return loop.sweep((k1, 0.0), (point[0] - v_d, point[1] - lam_d), 1, grid, T_JUDGE,
-                      point=point, compare=compare, bisect=bisect, seed=seed)
-
-
 def safe_k2_range(values: dict, v_d: float, k1: float, point, *, grid, compare=(),
                   bisect: int = 4, seed: int = 0) -> GainSweep:
     """Cruise gains k2 (k1 kept) for which ``point`` lies in a certified basin
@@ -202,9 +193,10 @@ def safe_k2_range(values: dict, v_d: float, k1: float, point, *, grid, compare=(
     GainSweep
         Of k2 (entry 1) with k1 = ``gain[0]`` kept; ``grid_min`` the smallest k2 of the grid.
     """
-    cmp_ = tuple((str(lab), (float(g[0]), float(g[1]))) for lab, g in compare)
-    key = (_values(values), float(v_d), float(k1), tuple(float(p) for p in point),
-           tuple(float(g) for g in grid), cmp_, int(bisect), int(seed))
+    vals = _values(values)
+    loop, lam_d, _ = cruise_loop(vals, float(v_d))
     # the designs that differ only in the plant's mass share the controller's
     # nominal model, hence this sweep: computed once per run (run folder)
-    return shared("antiskid_basin.k2_sweep", key, lambda: _k2_sweep(*key))
+    return loop.sweep((k1, 0.0), (point[0] - v_d, point[1] - lam_d), 1, grid, T_JUDGE,
+                      point=point, compare=compare, bisect=bisect, seed=seed,
+                      share=("antiskid_basin.k2_sweep", (vals, float(v_d))))

@@ -4,16 +4,17 @@
 
 Paper 003's wording (laws (61), (69), eqs (75)-(76), the k2 rule) and the
 cruise figure's look stay here; the figure itself is the general
-:func:`workbench.features.basin_plot.plot_basin`, the switch-state and gain
-tables and the certified gain range's sentence those of
-:mod:`workbench.features.basin_points_render`."""
+:func:`workbench.features.basin_plot.basin_figure`, the switch-state and gain
+tables, what their verdicts mean and the certified gain range's sentence
+those of :mod:`workbench.features.basin_points_render`."""
 from __future__ import annotations
 
-from ...features.basin_plot import BasinPlotStyle
-from ...features.basin_plot import plot_basin as draw_basin
-from ...features.basin_points_render import gain_edge_text, gain_sweep_table, points_table
-from ...features.basin_scalar_render import scalar_verdict_text
-from ...report.markdown import fmt, md_table
+from ...features.basin_plot import BasinPlotStyle, basin_figure
+from ...features.basin_points_render import (gain_edge_text, gain_sweep_table, points_table,
+                                              points_verdict_text)
+from ...features.basin_scalar_render import frozen_switch_table, scalar_method_text
+from ...report.markdown import fmt
+from ...report.synthesis_text import gain_text
 from ...roa.render import render_basin_markdown
 from .antiskid_basin import LAM_DIVERGED
 
@@ -27,10 +28,9 @@ def render_basin_result(res, *, rail: str) -> str:
     """Section of a :class:`~workbench.papers.p003.antiskid_basin_run.BasinResult`:
     loop, certified bracket, switch verdicts, k2 rule."""
     basin = res.basin
-    K = "[" + ", ".join(fmt(k, 4) for k in basin.K) + "]"
     head = (
         f"## {HEADING}\n\n"
-        f"Cruise law (61) with K = {K} on {rail} rail, at (v_d, lambda_d) = "
+        f"Cruise law (61) with K = {gain_text(basin.K)} on {rail} rail, at (v_d, lambda_d) = "
         f"({fmt(basin.v_d)} m/s, {fmt(basin.lambda_d, 4)}). The loop is the **delay-free** "
         "loop under exact prediction (as paper 003's Theorems 2-3 argue for laws (64) and "
         "(69)): law (61) as printed feeds the current error K E(t) to its numerator, so the "
@@ -43,10 +43,8 @@ def render_basin_result(res, *, rail: str) -> str:
           + points_table(basin.check, [tr.fate for tr in basin.trajectories],
                          ["case", "v (m/s)", "lambda", "V", "in the certified basin?",
                           "delay-free trajectory"], shift=(basin.v_d, basin.lambda_d))
-          + "\n\nCERTIFIED: V at the state is below c_certified, so the delay-free loop "
-            "converges from it. REFUTED: its level holds a point with V' >= 0, so this V "
-            "cannot certify it; the last column says what the delay-free trajectory does "
-            f"(\"diverges\": |lambda| reaches {fmt(LAM_DIVERGED)}, the wheel spins).\n")
+          + "\n\n" + points_verdict_text("delay-free", f"\"diverges\": |lambda| reaches "
+                                         f"{fmt(LAM_DIVERGED)}, the wheel spins") + "\n")
     text = head + body + sw + brake_text(res.brake) + _k2_text(res.sweep, res.compare_source)
     if res.mass_factor != 1.0:
         text += (f"\nThe plant of this design has {fmt(res.mass_factor, 3)} x the nominal mass; "
@@ -57,18 +55,11 @@ def render_basin_result(res, *, rail: str) -> str:
 
 def brake_text(brake) -> str:
     """Subsection of the cruise -> braking switch (:mod:`.antiskid_basin_brake`;
-    the frozen loop's verdict in words:
-    :func:`workbench.features.basin_scalar_render.scalar_verdict_text`)."""
+    the table and the frozen loop's method:
+    :func:`workbench.features.basin_scalar_render.frozen_switch_table`,
+    :func:`~workbench.features.basin_scalar_render.scalar_method_text`)."""
     from .antiskid_basin_brake import FATE_RTOL, LAM_LIMIT, T_FATE, TRACK_TOL
-    rows = []
-    for b in brake:
-        v, lam = b.x
-        frozen = scalar_verdict_text(b.verdict, lam, LAM_LIMIT, name="lambda")
-        fate = (f"diverges: |lambda| = {fmt(LAM_LIMIT)} at t_brake + {fmt(b.t_fate, 2)} s"
-                if b.fate == "diverges" else b.fate)
-        rows.append([f"`{b.label}`", fmt(v, 4), fmt(lam, 4), fmt(b.reference, 4), frozen,
-                     b.outcome.name, fate])
-    if not rows:
+    if not brake:
         return ("\n### Switch states (cruise → braking)\n\nNo case reached the braking "
                 "phase.\n")
     return (
@@ -81,19 +72,15 @@ def brake_text(brake) -> str:
         "v_s* frozen at v_s*(t_brake), with d v_s*/dt = 0; the controller's nominal model, "
         "traction form (eq 12) for lambda >= 0 and braking form (eq 15) below, as the "
         "plant; law (69) computed on the braking form (eq 16) whatever the sign of lambda, "
-        "as printed. The frozen loop has one state, lambda' = g(lambda), so its trajectory "
-        "moves monotonically to the nearest equilibrium in the direction of g: the verdict "
-        "is REFUTED when no equilibrium lies between the state and |lambda| = "
-        f"{fmt(LAM_LIMIT)} (the sign of g proven by interval arithmetic on the whole "
-        "interval), CERTIFIED when the state reaches a certified level set of a stable "
-        "equilibrium (a level set of `workbench/roa`, with the sign of g proven on the "
-        "way to it). The last column drops the frozen assumptions: the delay-free loop with "
+        "as printed. " + scalar_method_text(LAM_LIMIT, name="lambda")
+        + " The last column drops the frozen assumptions: the delay-free loop with "
         "v and lambda integrated and v_s*(t), d v_s*/dt of eq (76) as printed (Radau, rtol "
         f"{fmt(FATE_RTOL)}, over {fmt(T_FATE)} s; \"tracks\": lambda < 0 and |v lambda - "
         f"v_s*| < {fmt(TRACK_TOL)} m/s at the end).\n\n"
-        + md_table(["case", "v (m/s)", "lambda", "v_s* frozen (m/s)", "frozen loop",
-                    "in a basin of law (69)?", "delay-free loop, time-varying"], rows,
-                   "lrrrlll")
+        + frozen_switch_table(brake, ["case", "v (m/s)", "lambda", "v_s* frozen (m/s)",
+                                      "frozen loop", "in a basin of law (69)?",
+                                      "delay-free loop, time-varying"], LAM_LIMIT, index=1,
+                              name="lambda", at="t_brake")
         + "\n\nREFUTED here means that the state lies in the basin of no equilibrium of the "
           "frozen loop: on the traction side the braking form that law (69) is built on "
           "(its adhesion branch grows like e^{b lambda} for lambda > 0) is not the plant, "
@@ -128,12 +115,9 @@ _STYLE = BasinPlotStyle(sampled_lw=0.7, sampled_alpha=0.8, point_lw=1.8, point_m
 def plot_basin(fig, basin) -> None:
     """(v - v_d, lambda - lambda_d) plane: certified and refuted level sets,
     the counterexample, sampled delay-free trajectories, switch states
-    (:func:`workbench.features.basin_plot.plot_basin`), lambda = lambda_opt."""
-    ax = fig.add_subplot(111)
-    draw_basin(ax, basin.check.estimate, basin.check.points, basin.trajectories, (0, 1), _STYLE)
-    ax.axhline(basin.lambda_opt - basin.lambda_d, color="tab:purple", ls=":", lw=0.8,
-               label="lambda = lambda_opt")
-    ax.set_xlabel("v - v_d (m/s)")
-    ax.set_ylabel("lambda - lambda_d")
-    ax.set_ylim(-0.15, 0.3)
-    ax.legend(fontsize=6, loc=_STYLE.legend_loc, framealpha=0.9)
+    (:func:`workbench.features.basin_plot.basin_figure`), lambda = lambda_opt."""
+    basin_figure(fig, basin.check.estimate, basin.check.points, basin.trajectories, (0, 1),
+                 _STYLE, ("v - v_d (m/s)", "lambda - lambda_d"), ylim=(-0.15, 0.3),
+                 extra=lambda ax: ax.axhline(basin.lambda_opt - basin.lambda_d,
+                                             color="tab:purple", ls=":", lw=0.8,
+                                             label="lambda = lambda_opt"))

@@ -22,11 +22,10 @@ model (a design's plant mass factor is not in it; the report says so).
 
 What stays here is paper 003's: the k2 key, the switch names, where the
 switches are in a case's metrics, and which law judges each switch. The
-switch states, the per-case switch verdicts and their quantities are the
-general ones of :mod:`workbench.features.basin_switch`, the level and gain
-sweep quantities those of :mod:`workbench.features.basin` and
-:mod:`workbench.features.basin_points`, and the table (``enabled``,
-``seed``, ``compare_*``, ``bisect``) is read by
+switch states, the per-case switch verdicts and their quantities (with the
+level and gain sweep quantities) are the general ones of
+:mod:`workbench.features.basin_switch`, and the table (``enabled``, ``seed``,
+``compare_*``, ``bisect``) is read by
 :func:`workbench.features.basin_points.load_gain_sweep`.
 """
 from __future__ import annotations
@@ -34,10 +33,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ...features.basin import LEVEL_QUANTITIES, level_quantities
-from ...features.basin_points import (GainSweep, GainSweepSettings, gain_sweep_quantities,
-                                      gain_sweep_quantity_names, load_gain_sweep)
-from ...features.basin_switch import switch_quantities, switch_quantity_names, switch_states
+from ...features.basin_points import GainSweep, GainSweepSettings, load_gain_sweep
+from ...features.basin_switch import (switch_basin_quantities, switch_basin_quantity_names,
+                                      switch_states)
 from .antiskid_basin import CruiseBasin, cruise_basin, safe_k2_range
 
 
@@ -114,17 +112,10 @@ def run_basin(settings: GainSweepSettings, values: dict, v_d: float, K, lambda_o
 def basin_quantities(basin, sweep, labels=(), brake=()) -> dict:
     """Claim quantities of the basin check (``labels``: every case; a case
     whose cruise law never started, or that never braked, gets None)."""
-    q = level_quantities(basin.check.estimate)
-    q.update(switch_quantities(labels, {
-        "cruise": [(p.label, p.verdict.outcome, tr.fate)
-                   for p, tr in zip(basin.check.points, basin.trajectories)],
-        "brake": [(b.label, b.outcome, b.fate) for b in brake]}))
-    if sweep is not None:
-        q.update(gain_sweep_quantities(sweep, "k2"))
-    return q
+    return switch_basin_quantities(basin.check.estimate, labels, {
+        "cruise": basin.judged, "brake": [b.judged for b in brake]}, sweep, "k2")
 
 
 def basin_quantity_names(labels, with_sweep: bool) -> set:
     """Names of :func:`basin_quantities` (``with_sweep``: the k2 rule's too)."""
-    names = set(LEVEL_QUANTITIES) | switch_quantity_names(labels, ("cruise", "brake"))
-    return (names | gain_sweep_quantity_names("k2")) if with_sweep else names
+    return switch_basin_quantity_names(labels, ("cruise", "brake"), "k2" if with_sweep else None)
