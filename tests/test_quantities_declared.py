@@ -55,3 +55,21 @@ def test_every_delay_feedback_quantity_has_a_unit():
     assert got["exact_margin"] == "s" and got["synthesis.h_gain"] == "s"
     assert all(u != "?" for n, u in got.items() if not n.startswith(("basin.", "implementation.",
                                                                         "requirements.")))
+
+
+def test_determined_and_a_group_of_a_part_that_did_not_run():
+    from workbench.features.quantities import DeclaredQuantities, determined
+    assert determined(float("nan")) is None and determined(None) is None
+    assert determined(0.0) == 0.0 and determined("yes") == "yes"
+    table = (Declared("gain", "1", lambda r: determined(r.gain)),
+             Group(lambda spec: {"mc.runs"}, lambda mc: {"mc.runs": mc.n},
+                   part=lambda r: r.mc))
+
+    class Toy(DeclaredQuantities):
+        TABLE = table
+
+    ran = SimpleNamespace(spec=SPEC, gain=float("nan"), mc=SimpleNamespace(n=7))
+    assert Toy().quantities(ran) == {"gain": None, "mc.runs": 7}
+    assert Toy().quantities(SimpleNamespace(spec=SPEC, gain=1.0, mc=None)) == {"gain": 1.0}
+    assert Toy().quantity_names(SPEC) == {"gain", "mc.runs"}
+    assert Toy().quantity_units(SPEC) == {"gain": "1", "mc.runs": "?"}

@@ -42,3 +42,15 @@ def test_step_tolerances_per_metric():
     big = Reader("toy.toml", {"convergence_rtol": 0.5, "convergence_atol": {}}, "numerics")
     with pytest.raises(DesignError, match="convergence_rtol"):
         read_step_tolerances(big, ("peak",))
+
+
+def test_keyed_numbers_takes_only_known_keys_within_bounds():
+    from workbench.features.spec_readers import keyed_numbers
+    t = Reader("toy.toml", {"x": 1.5, "y": -2.0}, "scenario.target")
+    assert keyed_numbers(t, ("x", "y", "z"), "a state: x, y, z", lo=-10.0) == {"x": 1.5, "y": -2.0}
+    bad = Reader("toy.toml", {"w": 1.0}, "scenario.target")
+    with pytest.raises(DesignError, match="a state: x, y"):
+        keyed_numbers(bad, ("x", "y"), "a state: x, y")
+    low = Reader("toy.toml", {"x": -1.0}, "scenario.target")
+    with pytest.raises(DesignError, match="scenario.target.x"):
+        keyed_numbers(low, ("x",), "a state", positive=True)

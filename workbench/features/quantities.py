@@ -15,15 +15,23 @@ name cannot be claimable without a reader, nor read without being claimable::
     values(TABLE, spec, result) # {"exact_margin": 0.43, ...}
 
 A reader returns ``None`` for a value that is not determined (the claim is then
-INCONCLUSIVE, as for a name the old ``quantities`` left out).
+INCONCLUSIVE, as for a name the old ``quantities`` left out; :func:`determined`).
+A study class gets its three quantity methods from its table by deriving from
+:class:`DeclaredQuantities`.
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["Declared", "Group", "names", "units", "values"]
+__all__ = ["Declared", "DeclaredQuantities", "Group", "determined", "names", "units", "values"]
+
+
+def determined(x):
+    """``x``, or None when it is not determined (None or a float NaN)."""
+    return None if x is None or (isinstance(x, float) and math.isnan(x)) else x
 
 
 @dataclass(frozen=True)
@@ -66,13 +74,23 @@ class Group:
     not yet written as :class:`Declared` entries), included when ``present``.
 
     ``names(spec) -> set``, ``values(result) -> dict``, ``units(spec) -> dict``
-    (default: no unit known, ``"?"``) and ``present(spec) -> bool``.
+    (default: no unit known, ``"?"``) and ``present(spec) -> bool``. With
+    ``part``, ``values`` reads ``part(result)``, the result of the feature,
+    and the group has no value when that is None (the part did not run).
     """
 
     names: Callable[[Any], set]
     values: Callable[[Any], dict]
     present: Callable[[Any], bool] = lambda spec: True
     units: Callable[[Any], dict] | None = None
+    part: Callable[[Any], Any] | None = None
+
+    def values_of(self, result) -> dict:
+        """The group's values in ``result`` (see ``part``)."""
+        if self.part is None:
+            return self.values(result)
+        x = self.part(result)
+        return {} if x is None else self.values(x)
 
 
 def names(table, spec) -> set[str]:
@@ -92,7 +110,7 @@ def values(table, spec, result) -> dict:
     for d in table:
         if isinstance(d, Group):
             if d.present(spec):
-                out.update(d.values(result))
+                out.update(d.values_of(result))
         else:
             for n, index in d.members(spec):
                 out[n] = d.read(result, **index)
@@ -110,3 +128,25 @@ def units(table, spec) -> dict[str, str]:
         else:
             out.update({n: d.unit.format(**index) for n, index in d.members(spec)})
     return out
+
+
+class DeclaredQuantities:
+    """The quantity methods of a study whose quantities are declared in its
+    class attribute ``TABLE`` (a mixin): ``quantity_names(spec)``,
+    ``quantity_units(spec)`` and ``quantities(result)``, the latter for the
+    spec :meth:`result_spec` gives (``result.spec`` unless overridden)."""
+
+    TABLE: tuple = ()
+
+    def quantity_names(self, spec) -> set[str]:
+        return names(self.TABLE, spec)
+
+    def quantity_units(self, spec) -> dict[str, str]:
+        return units(self.TABLE, spec)
+
+    def quantities(self, result) -> dict:
+        return values(self.TABLE, self.result_spec(result), result)
+
+    def result_spec(self, result):
+        """The spec whose quantities ``result`` holds."""
+        return result.spec

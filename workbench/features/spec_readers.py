@@ -1,12 +1,12 @@
 """Readers of design-table entries that any simulating study can use (issue 35):
-a ``[low, high]`` range, an event time on a decimal grid, and the step-halving
-tolerances of a ``[numerics]`` table (one relative tolerance and an absolute
-one per metric). Bad input is a :class:`~workbench.errors.DesignError` naming
+a ``[low, high]`` range, an event time on a decimal grid, a table of numbers
+keyed by known names, and the step-halving tolerances of a ``[numerics]``
+table (one relative tolerance and an absolute one per metric). Bad input is a :class:`~workbench.errors.DesignError` naming
 the key (exit 2 at the CLI).
 """
 from __future__ import annotations
 
-__all__ = ["EVENT_DIGITS", "event_time", "read_range", "read_step_tolerances"]
+__all__ = ["EVENT_DIGITS", "event_time", "keyed_numbers", "read_range", "read_step_tolerances"]
 
 #: Significant digits of the event times of a scenario (:func:`event_time`).
 EVENT_DIGITS = 12
@@ -40,6 +40,19 @@ def read_range(t, key: str, **kw) -> tuple[float, float]:
     return lo_hi
 
 
+def keyed_numbers(t, allowed, expected: str, **kw) -> dict[str, float]:
+    """``{key = number, ...}`` of the table ``t`` (a :class:`workbench.reader.Reader`,
+    finished here), each key one of ``allowed`` (else ``expected`` is the
+    message); ``kw``: the bounds of :meth:`~workbench.reader.Reader.number`."""
+    out = {}
+    for k in list(t.data):
+        if k not in allowed:
+            raise t.fail(k, t.data[k], expected)
+        out[k] = t.number(k, **kw)
+    t.finish()
+    return out
+
+
 def read_step_tolerances(t, metrics, *, rtol_key: str = "convergence_rtol",
                          atol_key: str = "convergence_atol",
                          rtol_max: float = 0.1) -> tuple[float, dict]:
@@ -48,10 +61,5 @@ def read_step_tolerances(t, metrics, *, rtol_key: str = "convergence_rtol",
     (0, ``rtol_max``] and the table ``atol_key`` of non-negative absolute
     tolerances, each keyed by one of ``metrics`` (a metric left out: 0)."""
     rtol = t.number(rtol_key, positive=True, hi=rtol_max)
-    at = t.table(atol_key)
-    atol = {k: at.number(k, nonneg=True) for k in list(at.data)}
-    for k in atol:
-        if k not in metrics:
-            raise at.fail(k, atol[k], "a metric name: " + ", ".join(metrics))
-    at.finish()
-    return rtol, atol
+    return rtol, keyed_numbers(t.table(atol_key), metrics, "a metric name: " + ", ".join(metrics),
+                               nonneg=True)

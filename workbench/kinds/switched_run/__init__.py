@@ -41,9 +41,12 @@ from dataclasses import dataclass
 
 from ...reader import Reader
 from ...features.convergence import LEVELS, ClaimTarget, claim_targets, load_convergence
+from ...features.quantities import DeclaredQuantities
+from ...features.spec_readers import keyed_numbers
 from ..delay_feedback import NAME_PATTERN as _NAME
 from ..delay_feedback import read_plant
 from ..delay_feedback.spec import PlantSpec
+from .quantities import TABLE
 
 __all__ = ["Phase", "Scenario", "SwitchedRunSpec", "STUDY", "MAX_STEPS", "whole_steps"]
 
@@ -164,19 +167,6 @@ def _phases(root: Reader, plant: PlantSpec, names: set[str]) -> tuple[Phase, ...
     return tuple(out)
 
 
-def _keyed_numbers(t: Reader, allowed, expected: str, **kw) -> dict[str, float]:
-    """``{key = number, ...}`` of the table ``t``, each key one of ``allowed``
-    (else ``expected`` is the message); ``kw``: the bounds of
-    :meth:`~workbench.reader.Reader.number`."""
-    out = {}
-    for k in list(t.data):
-        if k not in allowed:
-            raise t.fail(k, t.data[k], expected)
-        out[k] = t.number(k, **kw)
-    t.finish()
-    return out
-
-
 def whole_steps(value: float, dt: float) -> bool:
     """``value`` is a whole number (>= 1) of steps ``dt`` (to 1e-9 relative)."""
     k = value / dt
@@ -217,9 +207,9 @@ def _scenarios(root: Reader, spec_plant: PlantSpec, phases, h: float, convergenc
         if sampled is not None:
             _multiple(r, "dt", sampled.period, dt, f"the control period {sampled.period:g} s")
         phase = r.string("phase", choices=phase_names)
-        over = _keyed_numbers(r.table("parameters", default=None), spec_plant.parameters,
+        over = keyed_numbers(r.table("parameters", default=None), spec_plant.parameters,
                               "a parameter of [parameters]", lo=-1e15, hi=1e15)
-        target = _keyed_numbers(r.table("target", default=None), states,
+        target = keyed_numbers(r.table("target", default=None), states,
                                 "a state: " + ", ".join(states), lo=-1e12, hi=1e12)
         rate = r.number("max_switch_rate", default=10.0, positive=True, hi=1e6,
                         what="number of switches per second")
@@ -233,7 +223,7 @@ def _sampled(root: Reader, plant: PlantSpec) -> SampledSpec | None:
         return None
     t = root.table("sampled")
     period = t.number("period", positive=True, hi=1e3, what="control period (s)")
-    q = _keyed_numbers(t.table("quantisation", default=None), plant.state_names,
+    q = keyed_numbers(t.table("quantisation", default=None), plant.state_names,
                        "a state: " + ", ".join(plant.state_names), positive=True, hi=1e12,
                        what="quantisation step")
     t.finish()
@@ -257,10 +247,12 @@ def _check_law_units(plant: PlantSpec, model, phases, usable) -> None:
     check_expression_units(plant, items)
 
 
-class SwitchedRun:
-    """The ``switched-run`` study (see the module docstring)."""
+class SwitchedRun(DeclaredQuantities):
+    """The ``switched-run`` study (see the module docstring); its claimable
+    quantities are :data:`.quantities.TABLE`."""
 
     kind = "switched-run"
+    TABLE = TABLE
     uses_solver = False
 
     def load(self, root: Reader) -> SwitchedRunSpec:
@@ -307,25 +299,9 @@ class SwitchedRun:
         from dataclasses import replace
         return replace(spec, claims=claims)
 
-    def quantity_names(self, spec: SwitchedRunSpec) -> set[str]:
-        from ...features.quantities import names
-        from .quantities import TABLE
-        return names(TABLE, spec)
-
-    def quantity_units(self, spec: SwitchedRunSpec) -> dict[str, str]:
-        """name -> unit of every claimable quantity (:mod:`.quantities`)."""
-        from ...features.quantities import units
-        from .quantities import TABLE
-        return units(TABLE, spec)
-
     def run(self, design):
         from .study import run
         return run(design.spec)
-
-    def quantities(self, res) -> dict:
-        from ...features.quantities import values
-        from .quantities import TABLE
-        return values(TABLE, res.spec, res)
 
     def unconverged(self, res) -> dict[str, str]:
         """claim id -> reason, for the claims whose metric did not converge

@@ -23,9 +23,8 @@ probability; n >= 299 runs without a failure show P >= 0.99).
 """
 from __future__ import annotations
 
-import math
 
-from ...features.quantities import Declared
+from ...features.quantities import Declared, determined
 
 __all__ = ["TABLE", "scenario_metrics"]
 
@@ -50,12 +49,6 @@ def scenario_metrics(spec, scenario: str) -> dict[str, str]:
         u = next(v.unit for v in plant.states if v.name == spec.speed)
         out |= metric_units(u, spec.comfort)
     return out
-
-
-def _num(v):
-    """A float, or None when not determined (nan)."""
-    v = float(v)
-    return None if math.isnan(v) else v
 
 
 def _scenario_members(spec):
@@ -102,7 +95,7 @@ def _nanmin(v):
 
 TABLE = (
     Declared("scenario.{s}.{metric}", "{unit}",
-             lambda r, s, metric, unit: _num(_run(r, s).values[metric]), over=_scenario_members),
+             lambda r, s, metric, unit: determined(float(_run(r, s).values[metric])), over=_scenario_members),
     Declared("montecarlo.{s}.runs", "1",
              lambda r, s: _run(r, s).montecarlo.samples, over=_mc_scenarios),
     Declared("montecarlo.{s}.diverged", "1",

@@ -23,7 +23,7 @@ from ...features.comfort import COMFORT_QUANTITIES, comfort_of, comfort_quantiti
 from ...features.convergence import agree
 from ...features.frozen_loop import freeze
 from ...features.linear_delay_check import LinearDelayCheck, linear_delay_check
-from ...features.quantities import Declared, Group, names, values
+from ...features.quantities import Declared, DeclaredQuantities, Group, determined
 from ...jsonable import OMIT, json_method
 from ...margins import DelayMargin
 from ...reader import Reader
@@ -231,11 +231,6 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     return 0
 
 
-def _num(x):
-    """A value, None when not determined (None or nan)."""
-    return None if x is None or (isinstance(x, float) and math.isnan(x)) else x
-
-
 def _cases(spec):
     return [{"c": c.name} for c in spec.cases]
 
@@ -251,11 +246,6 @@ def _factors(spec):
 def _switch(r, c, field):
     sw = r.case(c).switch
     return None if sw is None else sw.margin.h if field == "margin" else getattr(sw, field)
-
-
-def _of(f, x) -> dict:
-    """``f(x)``, no quantity when the part ``x`` did not run (None)."""
-    return {} if x is None else f(x)
 
 
 def _comfort_values(r) -> dict:
@@ -277,7 +267,7 @@ TABLE = (
              lambda r: max(x for _, x in r.linear.ratios)),
     Declared("linear.finite.ratio[{f}]", "1", lambda r, f, fac: next(
         (x for g, _, x in r.linear.ratios_finite if g == fac), None), over=_factors),
-    Declared("cases[{c}].{m}", "{unit}", lambda r, c, m, unit: _num(r.case(c).metrics[m]),
+    Declared("cases[{c}].{m}", "{unit}", lambda r, c, m, unit: determined(r.case(c).metrics[m]),
              over=_case_metrics),
     Declared("cases[{c}].diverged", "", lambda r, c: "no" if math.isnan(
         r.case(c).metrics["t_diverged"]) else "yes", over=_cases),
@@ -289,23 +279,23 @@ TABLE = (
       for f, u in (("abscissa", "1/s"), ("margin", "s"), ("dmu_dlam", "1"))),
     Group(lambda spec: {f"cases[{c.name}].{k}" for c in spec.cases for k in COMFORT_QUANTITIES},
           _comfort_values, present=lambda spec: spec.comfort is not None),
-    Group(lambda spec: montecarlo_quantity_names(),
-          lambda r: _of(montecarlo_quantities, r.montecarlo),
-          present=lambda spec: spec.montecarlo is not None),
-    Group(lambda spec: halving_quantity_names(), lambda r: _of(halving_quantities, r.halving),
+    Group(lambda spec: montecarlo_quantity_names(), montecarlo_quantities,
+          present=lambda spec: spec.montecarlo is not None, part=lambda r: r.montecarlo),
+    Group(lambda spec: halving_quantity_names(), halving_quantities, part=lambda r: r.halving,
           present=lambda spec: spec.montecarlo is not None and bool(spec.montecarlo.halving)),
     Group(lambda spec: basin_quantity_names([c.name for c in spec.cases], True),
-          lambda r: _of(lambda b: basin_quantities(b.basin, b.sweep, [c.case.name for c in
-                                                                         r.cases], b.brake),
-                        r.basin), present=lambda spec: spec.basin is not None),
-    Group(lambda spec: sampled_quantity_names(spec.sampled),
-          lambda r: _of(sampled_quantities, r.sampled),
-          present=lambda spec: spec.sampled is not None),
+          lambda r: basin_quantities(r.basin.basin, r.basin.sweep,
+                                     [c.case.name for c in r.cases], r.basin.brake),
+          present=lambda spec: spec.basin is not None,
+          part=lambda r: None if r.basin is None else r),
+    Group(lambda spec: sampled_quantity_names(spec.sampled), sampled_quantities,
+          present=lambda spec: spec.sampled is not None, part=lambda r: r.sampled),
 )
 
 
-class AntiskidRun:
+class AntiskidRun(DeclaredQuantities):
     kind = "antiskid-run"
+    TABLE = TABLE
     #: Findings' metrics refined three levels (issue 33, item 4) by :meth:`refine_levels`.
     refine_field, refine_unit = "dt", "s"
 
@@ -323,9 +313,6 @@ class AntiskidRun:
 
     def load(self, root: Reader) -> RunSpec:
         return load_run_spec(root)
-
-    def quantity_names(self, spec: RunSpec) -> set[str]:
-        return names(TABLE, spec)
 
     def start(self, design):
         """Start the Monte Carlo part of :meth:`run` (its process pools) now,
@@ -374,43 +361,38 @@ class AntiskidRun:
                          spec.dt, mc, hc, bs, sampled, spec)
 
     def _cases(self, spec: RunSpec, K, quarter: frozenset = frozenset()) -> list[CaseResult]:
-        cases = []
+        cases, t_b = [], spec.scenario["t_brake"]
         for case in spec.cases:
             cs = controller_settings(spec, K, case)
-            rs = run_settings(spec, cs)
-            t_b = spec.scenario["t_brake"]
-            mesh = case_mesh(spec, case)
-            run1, m1 = simulate_antiskid(rs, spec.dt, record_dt=RECORD_DT, mesh=mesh)
-            run2, m2 = simulate_antiskid(rs, spec.dt / 2, record_dt=RECORD_DT, mesh=mesh)
-            coarse, fine = case_metrics(m1, cs, t_b), case_metrics(m2, cs, t_b)
+            rs, mesh = run_settings(spec, cs), case_mesh(spec, case)
+            # dt, dt / 2 and, for a claimed convergence, the third level dt / 4
+            levels = [simulate_antiskid(rs, spec.dt / k, record_dt=RECORD_DT, mesh=mesh)
+                      for k in ((1, 2, 4) if case.name in quarter else (1, 2))]
+            runs, mets = [r for r, _ in levels], [case_metrics(m, cs, t_b) for _, m in levels]
+            comfort = [None] * 3
+            if spec.comfort is not None:
+                u_peak = cs.u_range / spec.torque_range
+                comfort = [comfort_of(r, spec.comfort, u_peak, RECORD_DT) for r in runs] + [None]
+            coarse, fine = mets[:2]
             conv = {k: agree(coarse[k], fine[k], spec.conv_rtol, spec.conv_atol.get(k, 0.0))
                     for k in METRICS}
-            q4 = None
-            if case.name in quarter:   # a claimed convergence: the third level, dt / 4
-                run4, m4 = simulate_antiskid(rs, spec.dt / 4, record_dt=RECORD_DT, mesh=mesh)
-                q4 = (case_metrics(m4, cs, t_b), run4)
+            q4, bad, why = None, (), ""
+            if len(mets) == 3:
+                conv, bad = three_level_metrics(spec, *mets)
+                why = unconverged_reason(spec, case.name, *mets, bad)
+                q4 = (mets[2], runs[2], comfort[2])
             sw = None   # state where the cruise law (61) takes over
             key = "handover" if case.cruise_entry == "creep" else "cruise"
             if math.isfinite(fine[f"lam_at_{key}"]):
                 sw = switch_check(cs, fine[f"v_at_{key}"], fine[f"lam_at_{key}"])
-            comfort = (None, None)
-            if spec.comfort is not None:
-                u_peak = cs.u_range / spec.torque_range
-                comfort = tuple(comfort_of(r, spec.comfort, u_peak, RECORD_DT)
-                                for r in (run2, run1) + ((q4[1],) if q4 else ()))
-            bad, why = (), ""
-            if q4 is not None:
-                conv, bad = three_level_metrics(spec, coarse, fine, q4[0])
-                why = unconverged_reason(spec, case.name, coarse, fine, q4[0], bad)
-                q4 = (q4[0], q4[1], comfort[2] if spec.comfort is not None else None)
-            cases.append(CaseResult(case, fine, coarse, conv, run2, sw, *comfort[:2],
+            cases.append(CaseResult(case, fine, coarse, conv, runs[1], sw, comfort[1], comfort[0],
                                     quarter=q4, unconverged=bad, why=why))
         return cases
 
-    def quantities(self, res: RunResult) -> dict:
-        """The values of :data:`TABLE` for the cases ``res`` holds (all of the
-        design's, or one: :func:`~workbench.papers.p003.antiskid_refine.refine_levels`)."""
-        return values(TABLE, replace(res.spec, cases=tuple(c.case for c in res.cases)), res)
+    def result_spec(self, res: RunResult) -> RunSpec:
+        """The spec of the cases ``res`` holds (all of the design's, or one:
+        :func:`~workbench.papers.p003.antiskid_refine.refine_levels`)."""
+        return replace(res.spec, cases=tuple(c.case for c in res.cases))
 
 
 STUDY = AntiskidRun()
