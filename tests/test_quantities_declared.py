@@ -35,11 +35,11 @@ def test_a_feature_group_counts_only_when_the_design_has_it():
 
 
 def test_a_declared_study_expands_its_table():
-    """features.declared_study on a toy study: its quantity methods expand the
-    class's TABLE against the spec the result holds."""
-    from workbench.features.declared_study import DeclaredStudy
+    """features.quantities.DeclaredQuantities on a toy study: its quantity
+    methods expand the class's TABLE against the spec the result holds."""
+    from workbench.features.quantities import DeclaredQuantities
 
-    class Toy(DeclaredStudy):
+    class Toy(DeclaredQuantities):
         TABLE = TABLE
     res = SimpleNamespace(gain=2.5, peak={"s": 4.0}, c=3.0, spec=SPEC)
     assert Toy().quantity_names(SPEC) == {"gain", "peak.v", "peak.s"}

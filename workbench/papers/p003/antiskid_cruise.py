@@ -19,8 +19,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ...errors import DesignError, ModelError
-from ...features.declared_study import DeclaredStudy
-from ...features.quantities import Declared
+from ...features.quantities import Declared, DeclaredQuantities
 from ...features.sweep_study import (SweepResult, SweepSpec, load_sweep, run_sweep,
                                      sweep_quantities)
 from ...jsonable import json_method
@@ -96,7 +95,7 @@ TABLE = (
 )
 
 
-class AntiskidCruise(DeclaredStudy):
+class AntiskidCruise(DeclaredQuantities):
     kind = "antiskid-cruise"
     TABLE = TABLE
 

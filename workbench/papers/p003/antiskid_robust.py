@@ -26,8 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import DesignError, ModelError
-from ...features.declared_study import DeclaredStudy
-from ...features.quantities import Declared
+from ...features.quantities import Declared, DeclaredQuantities
 from ...kinds.delay_feedback.robust_points import (RobustPoints, RobustPointsResult,
                                                    load_robust_points, robust_points_quantities,
                                                    run_robust_points)
@@ -84,7 +83,7 @@ TABLE = (*robust_points_quantities(),
                   over=lambda spec: [{"i": p.id, "p": p} for p in spec.points]))
 
 
-class AntiskidRobust(DeclaredStudy):
+class AntiskidRobust(DeclaredQuantities):
     kind = "antiskid-robust"
     TABLE = TABLE
 
