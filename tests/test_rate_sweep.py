@@ -358,3 +358,17 @@ def test_three_levels_of_a_claimed_rate_quantity_of_a_toy_sweep():
         "rate 50 Hz is not a grid rate")
     assert sec.rate_pattern().match("toy.zoh_q_tau.rate[1e3].ok").groups() == (
         "zoh_q_tau", "1e3")
+
+
+def test_the_outcome_words_of_a_toy_rate():
+    """:func:`outcome` and :func:`missed` of the general rendering on a toy
+    rate with two requirements, one met, one missed (diverged or not)."""
+    from workbench.features import rate_sweep_render as RR
+    m = {"decay_ok": "no", "decay_diverged": 0.30625, "bound_ok": "yes",
+         "bound_diverged": math.nan}
+    assert RR.outcome(m, "decay", "slow") == "diverged, t = 0.3063 s"
+    assert RR.outcome(m, "bound", "too high") == "meets"
+    word = lambda m, r: RR.outcome(m, r, "slow")          # noqa: E731
+    assert RR.missed(m, ("decay", "bound"), word) == "decay (diverged, t = 0.3063 s)"
+    m.update(decay_diverged=math.nan, bound_ok="no")
+    assert RR.missed(m, ("decay", "bound"), word) == "decay (slow) and bound (slow)"
