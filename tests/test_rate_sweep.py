@@ -322,3 +322,53 @@ def test_a_sweep_table_is_read_and_checked():
     assert sec.claimed(table, [{"quantity": "toy.zoh.rate[20].x_minus_ref"},
                                {"quantity": "toy.zoh_q_tau.rate[100].ok"}]) == (
         ("zoh", 20.0, "x_end"),)                  # 100 Hz: above max_rate
+
+
+def test_three_levels_of_a_claimed_rate_quantity_of_a_toy_sweep():
+    """:meth:`Section.levels` on the toy loop: a claimed rate metric at a rate
+    the sweep's checks cover takes their rows (no run made); one above
+    ``max_rate`` runs the rate at step / 2 and / 4 (once, whatever quantity
+    asks); a difference to the reference stays one; a rate off the grid has
+    no levels."""
+    from workbench.features.refinement import Levels
+    runs, calls = _counted()
+    sec = RQ.Section("toy", ("x_end", "ok"), 50.0, "reference", (), {"x_minus_ref": "x_end"})
+    table = RS.SweepTable((5.0, 20.0, 100.0), 1e-4, 0, three_level=sec.claimed(
+        RS.SweepTable((5.0, 20.0, 100.0), 1e-4, 0), [{"quantity": "toy.zoh.rate[20].x_end"}]))
+    res = RS.SweepResult(table, RS.RateRow(math.nan, {"x_end": 0.25, "ok": "yes"}), 1e-4,
+                         RS.sweep(runs, DECL, table))
+    made = []
+
+    def row_at(rate, step, q, tau):
+        made.append((rate, step))
+        return RS.rate_row(runs, DECL, rate, q, tau, step)
+    memo: dict = {}
+    n = len(calls)
+    lv = sec.levels(res, "toy.zoh.rate[20].x_end", row_at, memo)
+    assert isinstance(lv, Levels) and len(calls) == n and made == []
+    assert lv.values == res.variant("zoh").three_level[0].values
+    assert (lv.parameter, lv.step) == ("plant_step", 1e-4)
+    top = sec.levels(res, "toy.zoh.rate[100].x_end", row_at, memo)
+    assert made == [(100.0, 5e-5), (100.0, 2.5e-5)]
+    assert top.values[0] == res.variant("zoh").row(100.0).metrics["x_end"]
+    assert top.values[2] == toy_run(100.0, 0, 0.0, 0.0, 2.5e-5)["x_end"] != top.values[0]
+    diff = sec.levels(res, "toy.zoh.rate[100].x_minus_ref", row_at, memo)
+    assert len(made) == 2 and diff.values == tuple(x - 0.25 for x in top.values)
+    assert sec.levels(res, "toy.zoh.rate[50].ok", row_at, memo).reason == (
+        "rate 50 Hz is not a grid rate")
+    assert sec.rate_pattern().match("toy.zoh_q_tau.rate[1e3].ok").groups() == (
+        "zoh_q_tau", "1e3")
+
+
+def test_the_outcome_words_of_a_toy_rate():
+    """:func:`outcome` and :func:`missed` of the general rendering on a toy
+    rate with two requirements, one met, one missed (diverged or not)."""
+    from workbench.features import rate_sweep_render as RR
+    m = {"decay_ok": "no", "decay_diverged": 0.30625, "bound_ok": "yes",
+         "bound_diverged": math.nan}
+    assert RR.outcome(m, "decay", "slow") == "diverged, t = 0.3063 s"
+    assert RR.outcome(m, "bound", "too high") == "meets"
+    word = lambda m, r: RR.outcome(m, r, "slow")          # noqa: E731
+    assert RR.missed(m, ("decay", "bound"), word) == "decay (diverged, t = 0.3063 s)"
+    m.update(decay_diverged=math.nan, bound_ok="no")
+    assert RR.missed(m, ("decay", "bound"), word) == "decay (slow) and bound (slow)"

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Mapping
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Callable, Mapping
 
 if TYPE_CHECKING:
     from .rate_sweep import SweepTable, Variant
@@ -54,6 +54,46 @@ class Section:
         """Their values for ``res`` (a :class:`workbench.features.rate_sweep.SweepResult`)."""
         return sweep_quantities(self.prefix, res.variants, self.metrics, self.reference,
                                 res.reference.metrics, self.gaps, self.differences)
+
+    def rate_pattern(self) -> re.Pattern:
+        """The start of a rate quantity ``<prefix>.<variant>.rate[<f>].``
+        (groups: the variant, the rate)."""
+        return re.compile(re.escape(self.prefix) + r"\.([a-z_]+)\.rate\[([^\]]+)\]\.")
+
+    def levels(self, res, quantity: str, row_at: Callable, memo: dict):
+        """A rate quantity ``<prefix>.<variant>.rate[<f>].<m>`` of the sweep
+        ``res`` at plant_step (reported), plant_step / 2 and plant_step / 4, as
+        :class:`workbench.features.refinement.Levels`: each finer level is
+        the sweep's own row when it ran one there (the mesh check's at / 2,
+        the three-level check's at / 4, which has the scenarios ``m``
+        needs), else ``row_at(rate, step, q, tau)`` (a
+        :class:`~workbench.features.rate_sweep.RateRow`, made once per
+        variant, rate and step in ``memo``); the value at a level is the
+        quantity of the sweep with that row in place of the grid's (so a
+        difference to the reference stays one)."""
+        from .refinement import Levels
+        m = self.rate_pattern().match(quantity)
+        name, rate = m[1], float(m[2])
+        if rate not in res.spec.rates:
+            return Levels((), reason=f"rate {rate:g} Hz is not a grid rate")
+        v, metric = res.variant(name), quantity.rsplit(".", 1)[1]
+        metric = self.differences.get(metric, metric)
+        half = next((r for r in v.mesh_rows if r.rate == rate), None)
+        quarter = next((r for r in v.quarter_rows if r.rate == rate and metric in r.metrics),
+                       None)
+        if quarter is not None:   # the scenarios it ran, the grid's metrics for the others
+            quarter = replace(quarter, metrics={**v.row(rate).metrics, **quarter.metrics})
+        vals = [self.quantities(res).get(quantity)]
+        for k, row in ((1, half), (2, quarter)):
+            step = res.spec.plant_step / 2 ** k
+            if row is None:
+                if (name, rate, step) not in memo:
+                    memo[name, rate, step] = row_at(rate, step, v.q, v.tau)
+                row = memo[name, rate, step]
+            alt = replace(v, rows=tuple(row if x.rate == rate else x for x in v.rows))
+            vals.append(self.quantities(replace(res, variants=tuple(
+                alt if x.name == name else x for x in res.variants))).get(quantity))
+        return Levels(tuple(vals), "plant_step", res.spec.plant_step)
 
 
 def claimed_rate_metrics(prefix: str, variants, rates: tuple, names: tuple, max_rate: float,

@@ -13,7 +13,8 @@ from ..printed_grid import printed_digits
 from ..report.markdown import fmt, md_table
 from ..sim.convergence import P_MAX, P_MIN
 
-__all__ = ["bound", "variant_label", "variant_sources", "summary_lines", "rate_tables",
+__all__ = ["bound", "variant_label", "variant_sources", "summary_lines", "outcome", "missed",
+           "rate_tables",
            "mesh_table", "mesh_text", "three_level_text", "replay_table", "replay_text", "plot_rate_metric",
            "plot_rate_panels", "plot_traces"]
 
@@ -66,6 +67,24 @@ def summary_lines(variants, label, why=None, *, requirement: str = "both require
         out.append(f"- **{label(v)}**: lowest rate of the grid meeting {requirement} "
                    f"(and every higher grid rate) **{fmt(v.min_rate)} Hz**; " + refine + ".")
     return out
+
+
+def outcome(m: dict, which: str, fails: str) -> str:
+    """Requirement ``which`` at a rate, in words, from the rate's metrics
+    ``<which>_diverged`` (a time, NaN: no divergence) and ``<which>_ok``:
+    ``diverged, t = <t> s``, ``meets``, else ``fails`` (why it misses)."""
+    t = m[f"{which}_diverged"]
+    if not math.isnan(t):
+        return f"diverged, t = {fmt(t, 4)} s"
+    return "meets" if m[f"{which}_ok"] == "yes" else fails
+
+
+def missed(m: dict, requirements: tuple, outcome_of) -> str:
+    """The requirements of ``requirements`` a rate misses (its metric
+    ``<r>_ok`` is "no"), each with ``outcome_of(m, r)`` in brackets, joined
+    by "and": the ``why`` of :func:`summary_lines`."""
+    return " and ".join(f"{r} ({outcome_of(m, r)})" for r in requirements
+                        if m[f"{r}_ok"] == "no")
 
 
 def bound(x: float) -> str:

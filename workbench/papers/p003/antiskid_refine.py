@@ -157,40 +157,17 @@ def _switch_levels(design, result, cache, m, r) -> Levels:
 
 
 def _rate_levels(design, result, cache, m, r) -> Levels:
-    """A sampled rate's metric at plant_step (reported), /2 and /4."""
-    spec, variant, rate, qn = design.spec, m.group(1), float(m.group(2)), r.claim.quantity
+    """A sampled rate's metric at plant_step (reported), /2 and /4
+    (:meth:`workbench.features.rate_sweep_quantities.Section.levels`), a
+    level the study has not run made here by the sampled kernel."""
     from .antiskid_run_spec import sampled_context
-    from .antiskid_sampled import TO_EMULATION, rate_row, sampled_quantities
-    sp = spec.sampled
-    res = result.sampled
-    v = res.variant(variant)
-    if rate not in sp.rates:
-        return Levels((), reason=f"rate {rate:g} Hz is not a grid rate")
-    half = next((r for r in v.mesh_rows if r.rate == rate), None)   # the mesh check's
-    metric = qn.rsplit(".", 1)[1]
-    quarter = next((r for r in v.quarter_rows if r.rate == rate
-                    and TO_EMULATION.get(metric, metric) in r.metrics), None)
-    if quarter is not None:   # the study's three-level check ran the scenario at plant_step/4
-        quarter = dataclasses.replace(quarter, metrics={**v.row(rate).metrics,
-                                                        **quarter.metrics})
-    rows = []
-    for k, have in ((1, half), (2, quarter)):
-        key = ("rate", variant, rate, k, None if have is None else metric)
-        if key not in cache:
-            if have is None:
-                ctx = cache.get("ctx") or cache.setdefault(
-                    "ctx", sampled_context(spec, result.K))
-                have = rate_row(ctx, rate, dt_p=sp.plant_step / 2 ** k,
-                                predictor_step=sp.predictor_step, q=v.q, tau=v.tau)
-            cache[key] = have
-        rows.append(cache[key])
-    vals = [sampled_quantities(res).get(qn)]
-    for row in rows:
-        alt = dataclasses.replace(v, rows=tuple(row if x.rate == rate else x for x in v.rows))
-        alt_res = dataclasses.replace(res, variants=tuple(alt if x.name == variant else x
-                                                          for x in res.variants))
-        vals.append(sampled_quantities(alt_res).get(qn))
-    return Levels(tuple(vals), "plant_step", sp.plant_step)
+    from .antiskid_sampled import SECTION, rate_row
+
+    def row_at(rate, step, q, tau):
+        ctx = cache.get("ctx") or cache.setdefault("ctx", sampled_context(design.spec, result.K))
+        return rate_row(ctx, rate, dt_p=step, predictor_step=design.spec.sampled.predictor_step,
+                        q=q, tau=tau)
+    return SECTION.levels(result.sampled, r.claim.quantity, row_at, cache)
 
 
 def _mc_levels(design, result, cache, m, r) -> Levels:

@@ -10,6 +10,7 @@ headings and the two figures' layout."""
 from __future__ import annotations
 
 import math
+from functools import partial
 
 from ...features import rate_sweep_render as RR
 from ...printed_grid import printed_digits
@@ -29,21 +30,17 @@ _COLORS = {"zoh": "tab:blue", "zoh_q_tau": "tab:red", "emulation": "k"}
 EVS_BOUND = 0.01
 
 
-def variant_label(v) -> str:
-    """What a variant is, in words (the torque in N m:
-    :func:`workbench.features.rate_sweep_render.variant_label`)."""
-    return RR.variant_label(v, "torque", "N m")
+#: What a variant is, in words (:func:`workbench.features.rate_sweep_render.variant_label`).
+variant_label = partial(RR.variant_label, input_name="torque", unit="N m")
 
 
 def _outcome(m: dict, which: str) -> str:
-    t = m[f"{which}_diverged"]
-    if not math.isnan(t):
-        return f"diverged, t = {fmt(t, 4)} s"
-    if m[f"{which}_ok"] == "yes":
-        return "meets"
-    if which == "traction" and not math.isnan(m["lam_max_over_opt"]):
-        return "λ > requirement"
-    return "no cruise" if which == "traction" else "no stop"
+    """Traction or braking at a rate, in words
+    (:func:`workbench.features.rate_sweep_render.outcome`)."""
+    if which == "braking":
+        return RR.outcome(m, which, "no stop")
+    return RR.outcome(m, which, "no cruise" if math.isnan(m["lam_max_over_opt"]) else
+                      "λ > requirement")
 
 
 def _row(label: str, m: dict) -> list:
@@ -53,12 +50,6 @@ def _row(label: str, m: dict) -> list:
             _outcome(m, "traction"), n("braking_duration", 3), n("stop_distance", 4),
             n("lam_min_brake", 3), n("evs_max_tracking", 2), n("u_max_over_peak", 3),
             _outcome(m, "braking")]
-
-
-def _why(v, row) -> str:
-    """Which requirement the highest failing rate misses (for the summary)."""
-    miss = [w for w in ("traction", "braking") if row.metrics[f"{w}_ok"] == "no"]
-    return " and ".join(f"{w} ({_outcome(row.metrics, w)})" for w in miss)
 
 
 def sampled_section(res, rail: str) -> str:
@@ -101,7 +92,8 @@ def sampled_section(res, rail: str) -> str:
         f"T_adh: the peak adhesion torque mu(lambda_opt) m g r = {fmt(res.u_peak / 1e3, 3)} "
         "kN m.\n\n"
         f"**Lowest control rate meeting both requirements, {rail} rail:**\n\n"
-        + "\n".join(RR.summary_lines(res.variants, variant_label, _why)) + "\n\n" + "\n\n".join(tables)
+        + "\n".join(RR.summary_lines(res.variants, variant_label, lambda v, row: RR.missed(
+            row.metrics, ("traction", "braking"), _outcome))) + "\n\n" + "\n\n".join(tables)
         + "\n\n![sampled]({figdir}/sampled.png)\n\n" + SAMPLED_CAPTION
         + "\n\n![sampled traction]({figdir}/sampled-traction.png)\n\n"
         + TRACE_CAPTION + "\n\n" + _checks_text(res))
