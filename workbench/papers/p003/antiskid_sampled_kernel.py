@@ -58,7 +58,6 @@ from ...sim.wheel_slip import PARAM_ORDER, model_functions
 OUT = ("t_end", "lam_max", "lam_min", "time_above", "time_past_peak", "t_cruise",
        "t_handover", "t_stop", "stop_distance", "t_omega3", "evs_max", "t_diverged",
        "u_max_abs", "samples", "plant_steps", "unresolved", "v_end", "lam_end")
-IDX = {k: i for i, k in enumerate(OUT)}
 
 #: Scenario codes of :func:`kernel`'s loop.
 TRACTION_SCENARIO, BRAKING_SCENARIO = 0, 1
@@ -177,13 +176,12 @@ def _build():
                     if scenario == BRAKING_SCENARIO and nv <= v_stop:
                         out[T_STOP] = t + step * (v - v_stop) / (v - nv)
                         dist -= 0.5 * (v_stop + nv) * (tp - out[T_STOP])
-                        v, lam, t = nv, nl, tp
                         finished = True
-                        break
+                    elif not abs(nl) < lam_div or not nv == nv:
+                        out[T_DIV] = tp
+                        finished = True
                     v, lam, t = nv, nl, tp
-                    if not abs(lam) < lam_div or not v == v:
-                        out[T_DIV] = t
-                        finished = True
+                    if finished:
                         break
             if not finished:
                 t = t_next
