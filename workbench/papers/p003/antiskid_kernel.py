@@ -34,6 +34,7 @@ compares every metric of the first 64 runs of the dry design's sweep.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -41,7 +42,7 @@ from ...controllers.antiskid003_settings import STOPPED
 from ...sim.history import split_delay
 from ...sim.kernel_path import KERNELS, Kernel, chosen_path, compiled_available, default_kernel
 from ...sim.perturb import perturbation_arrays
-from .antiskid_scenario import METRIC_FIELDS, RunMetrics, RunSettings, metric_updates
+from .antiskid_scenario import EVS_SETTLE, METRIC_FIELDS, RunMetrics, RunSettings, metric_updates
 
 #: Runs a compiled batch keeps in flight at a time, their predictor rollouts
 #: and plant steps interleaved. Measured on the dry sweep before the steps
@@ -50,9 +51,14 @@ from .antiskid_scenario import METRIC_FIELDS, RunMetrics, RunSettings, metric_up
 LANES = 4
 
 
-def _build():
-    """Compile-on-first-use: the numba functions of this kernel."""
+@lru_cache(maxsize=None)
+def compile_kernel():
+    """The compiled kernel ``run_batch`` (below), compiled in this process at
+    the first call (a few seconds, once per machine: later processes load it
+    from the disk cache of :mod:`workbench.sim.jit_cache`). A process pool
+    started afterwards by ``fork`` inherits the compiled code."""
     import numba
+    from numba import float64, int64, uint64
 
     from ...controllers import antiskid003_jit as C
     from ...sim.counter_rng import jit_functions
@@ -184,29 +190,14 @@ def _build():
                     T[j] += 1
                     go[j] = False
 
-    return cached(run_batch, "antiskid_kernel.run_batch")
+    a1, a2 = float64[::1], float64[:, ::1]
+    run_batch = cached(run_batch, "antiskid_kernel.run_batch")
+    run_batch.compile((a2, int64[::1], a1, a1, float64, float64, int64, a1, a1, float64, a1, a1,
+                       a1, uint64[:, ::1], a1, a1, a1, a2))
+    return run_batch
 
 
-_KERNEL = None
-
-
-def compile_kernel() -> None:
-    """Compile the kernel in this process now (a few seconds, once per
-    machine: later processes load it from the disk cache of
-    :mod:`workbench.sim.jit_cache`). A process pool started afterwards by
-    ``fork`` inherits the compiled code."""
-    global _KERNEL
-    if _KERNEL is None:
-        from numba import float64, int64, uint64
-        k = _build()
-        a1, a2 = float64[::1], float64[:, ::1]
-        k.compile((a2, int64[::1], a1, a1, float64, float64, int64, a1, a1, float64, a1, a1,
-                   a1, uint64[:, ::1], a1, a1, a1, a2))
-        _KERNEL = k
-
-
-def simulate_batch_compiled(run: RunSettings, dt: float, *,
-                            evs_settle: float = 5.0) -> RunMetrics:
+def simulate_batch_compiled(run: RunSettings, dt: float) -> RunMetrics:
     """Compiled counterpart of ``simulate_antiskid(run, dt, record_dt=None,
     batch=B)``: the same :class:`RunMetrics` (arrays of B runs).
 
@@ -216,11 +207,8 @@ def simulate_batch_compiled(run: RunSettings, dt: float, *,
         ``plant_params`` entries, ``h`` and ``x0[0]`` may be (B,) arrays.
     dt : float
         Step and sampling period (s).
-    evs_settle : float
-        As :class:`~workbench.papers.p003.antiskid_scenario.MetricsRecorder`.
     """
     from ...controllers.antiskid003_jit import initial_state, settings_array
-    compile_kernel()
     B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))
     plant = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(x, float), (B,))
                                            for x in run.plant_params], axis=1))
@@ -235,10 +223,10 @@ def simulate_batch_compiled(run: RunSettings, dt: float, *,
     keys, pert, period, phase = perturbation_arrays(run.perturb, B)
     if run.perturb is not None and run.perturb.delay is not None:
         Np[:] = split_delay(run.perturb.delay[1], dt)[0]     # the ring holds the longest delay
-    _KERNEL(plant, Np, fp, v0, float(run.x0[1]), float(run.u_init),
-            int(round(run.t_end / dt)), settings_array(cs, dt),
-            np.asarray(cs.params, float), float(evs_settle), st0, ub0, m0,
-            keys, pert, period, phase, out)
+    compile_kernel()(plant, Np, fp, v0, float(run.x0[1]), float(run.u_init),
+                     int(round(run.t_end / dt)), settings_array(cs, dt),
+                     np.asarray(cs.params, float), EVS_SETTLE, st0, ub0, m0,
+                     keys, pert, period, phase, out)
     return RunMetrics(**{k: out[:, j].copy() for j, k in enumerate(METRIC_FIELDS)})
 
 
