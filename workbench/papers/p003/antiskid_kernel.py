@@ -25,28 +25,24 @@ hoists: 1/c, 1/J of the controller's model are computed once). Each run
 performs exactly the operations it performs alone (a test compares runs in
 flight together with runs alone, bit for bit).
 
-:data:`KERNELS` names the two paths a sweep may take; :func:`compiled_available`
-says whether numba is installed (``pip install 'traincontrol-workbench[fast]'``).
-The numpy path is the reference: ``tests/test_compiled_kernel.py`` compares every
-metric of the first 64 runs of the dry design's sweep.
+:data:`KERNELS` names the two paths a sweep may take, "compiled" (this
+module) or "numpy" (:func:`~workbench.papers.p003.antiskid_scenario.simulate_antiskid`
+with ``batch``): :mod:`workbench.sim.kernel_path`, re-exported for the
+study's modules. The numpy path is the reference: ``tests/test_compiled_kernel.py``
+compares every metric of the first 64 runs of the dry design's sweep.
 """
 from __future__ import annotations
 
 import math
-from importlib.util import find_spec
-from typing import Literal
+from functools import lru_cache
 
 import numpy as np
 
 from ...controllers.antiskid003_settings import STOPPED
 from ...sim.history import split_delay
+from ...sim.kernel_path import KERNELS, Kernel, chosen_path, compiled_available, default_kernel
 from ...sim.perturb import perturbation_arrays
-from .antiskid_scenario import METRIC_FIELDS, RunMetrics, RunSettings, metric_updates
-
-#: The stepping paths of a sweep: "compiled" (numba, this module) or "numpy"
-#: (:func:`~workbench.papers.p003.antiskid_scenario.simulate_antiskid` with ``batch``).
-KERNELS = ("compiled", "numpy")
-Kernel = Literal["compiled", "numpy"]
+from .antiskid_scenario import EVS_SETTLE, METRIC_FIELDS, RunMetrics, RunSettings, metric_updates
 
 #: Runs a compiled batch keeps in flight at a time, their predictor rollouts
 #: and plant steps interleaved. Measured on the dry sweep before the steps
@@ -54,25 +50,15 @@ Kernel = Literal["compiled", "numpy"]
 #: 632, 4 lanes 619; lanes cost nothing when runs end (a lane takes the next run).
 LANES = 4
 
-def compiled_available() -> bool:
-    """Whether numba is installed (the compiled kernel can run)."""
-    return find_spec("numba") is not None
 
-
-def default_kernel() -> Kernel:
-    """"compiled" when numba is installed, else "numpy"."""
-    return "compiled" if compiled_available() else "numpy"
-
-
-def compiled_covers(s) -> bool:
-    """Whether the compiled kernel covers the controller settings ``s`` (the
-    literal recursive predictor is numpy-only)."""
-    return not (s.compensate and s.predictor != "rollout")
-
-
-def _build():
-    """Compile-on-first-use: the numba functions of this kernel."""
+@lru_cache(maxsize=None)
+def compile_kernel():
+    """The compiled kernel ``run_batch`` (below), compiled in this process at
+    the first call (a few seconds, once per machine: later processes load it
+    from the disk cache of :mod:`workbench.sim.jit_cache`). A process pool
+    started afterwards by ``fork`` inherits the compiled code."""
     import numba
+    from numba import float64, int64, uint64
 
     from ...controllers import antiskid003_jit as C
     from ...sim.counter_rng import jit_functions
@@ -94,18 +80,6 @@ def _build():
     cfg_tuple, _ = tuple_readers(jit, len(C.CFG))
 
     @jit
-    def load(j, i, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf, st, ubuf, m, rs,
-             v, lam, pos, f, Lp, N, T, n, run, active):
-        """Put run i, at t = 0, into lane j of :func:`run_batch`."""
-        pg[j, :plant.shape[1]] = plant[i]
-        N[j], f[j], Lp[j] = Np[i], fp[i], Np[i] + 2
-        pbuf[j, :Lp[j]] = u_init
-        st[j], ubuf[j], m[j] = st0, ub0, m0
-        rs[j] = 0.0
-        rs[j, 0] = v0[i]
-        v[j], lam[j], pos[j], T[j], n[j], run[j], active[j] = v0[i], lam0, 0.0, 0, 0, i, True
-
-    @jit
     def run_batch(plant, Np, fp, v0, lam0, u_init, T_end, cfg, pc, settle, st0, ub0, m0,
                   keys, pert, period, phase, out):
         """Simulate each run i (plant parameters ``plant[i]``, input delay
@@ -115,16 +89,14 @@ def _build():
         (:func:`~workbench.sim.perturb.perturbation_arrays`).
 
         :data:`LANES` runs are in flight at a time, each with its own state and
-        clock; a lane that ends takes the next run. Per sample, the lanes'
+        clock; a lane that ends takes the next run at the next sample. Per sample, the lanes'
         predictor rollouts are interleaved (:func:`~workbench.controllers.antiskid003_jit.rollout_lanes`);
         every run performs the operations of a run simulated alone."""
         dt = cfg[DT]
         sv, sw, every = pert[0], pert[1], int(pert[2])
         noisy, graded, varying = sv > 0 or sw > 0, pert[3] != 0.0, pert[7] != 0.0
         B, P, K = plant.shape[0], plant.shape[1], LANES
-        Lmax = 2
-        for i in range(B):
-            Lmax = max(Lmax, Np[i] + 2)
+        Lmax = max(2, np.max(Np) + 2)
         pg = np.zeros((K, P + 1))                 # plant parameters (+ the slope)
         pbuf = np.empty((K, Lmax))                # plant input delay line
         st, ubuf = np.empty((K, st0.shape[0])), np.empty((K, ub0.shape[0]))
@@ -143,14 +115,19 @@ def _build():
         pc = params_tuple(pc)     # the controller's model: constants the compiler hoists
         cfg = cfg_tuple(cfg)      # the settings (:data:`~workbench.controllers.antiskid003_jit.CFG`)
         nxt = 0
-        for j in range(K):
-            if nxt < B:
-                load(j, nxt, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf, st, ubuf,
-                     m, rs, v, lam, pos, f, Lp, N, T, n, run, active)
-                nxt += 1
         while True:
             busy = False
             for j in range(K):
+                if not active[j] and nxt < B:     # the lane takes the next run, at t = 0
+                    pg[j, :P] = plant[nxt]
+                    N[j], f[j], Lp[j] = Np[nxt], fp[nxt], Np[nxt] + 2
+                    pbuf[j, :Lp[j]] = u_init
+                    st[j], ubuf[j], m[j] = st0, ub0, m0
+                    rs[j] = 0.0
+                    rs[j, 0] = v0[nxt]
+                    v[j], lam[j], pos[j], T[j], n[j] = v0[nxt], lam0, 0.0, 0, 0
+                    run[j], active[j] = nxt, True
+                    nxt += 1
                 if not active[j]:
                     continue
                 busy = True
@@ -192,10 +169,6 @@ def _build():
                 if T[j] >= T_end or ph >= STOPPED:
                     out[run[j]] = m[j]
                     active[j] = False
-                    if nxt < B:
-                        load(j, nxt, plant, Np, fp, v0, lam0, u_init, st0, ub0, m0, pg, pbuf,
-                             st, ubuf, m, rs, v, lam, pos, f, Lp, N, T, n, run, active)
-                        nxt += 1
                     continue
                 if graded:
                     jj = np.uint64(math.floor(fmax(pos[j], 0.0) / pert[6]))
@@ -217,29 +190,14 @@ def _build():
                     T[j] += 1
                     go[j] = False
 
-    return cached(run_batch, "antiskid_kernel.run_batch")
+    a1, a2 = float64[::1], float64[:, ::1]
+    run_batch = cached(run_batch, "antiskid_kernel.run_batch")
+    run_batch.compile((a2, int64[::1], a1, a1, float64, float64, int64, a1, a1, float64, a1, a1,
+                       a1, uint64[:, ::1], a1, a1, a1, a2))
+    return run_batch
 
 
-_KERNEL = None
-
-
-def compile_kernel() -> None:
-    """Compile the kernel in this process now (a few seconds, once per
-    machine: later processes load it from the disk cache of
-    :mod:`workbench.sim.jit_cache`). A process pool started afterwards by
-    ``fork`` inherits the compiled code."""
-    global _KERNEL
-    if _KERNEL is None:
-        from numba import float64, int64, uint64
-        k = _build()
-        a1, a2 = float64[::1], float64[:, ::1]
-        k.compile((a2, int64[::1], a1, a1, float64, float64, int64, a1, a1, float64, a1, a1,
-                   a1, uint64[:, ::1], a1, a1, a1, a2))
-        _KERNEL = k
-
-
-def simulate_batch_compiled(run: RunSettings, dt: float, *,
-                            evs_settle: float = 5.0) -> RunMetrics:
+def simulate_batch_compiled(run: RunSettings, dt: float) -> RunMetrics:
     """Compiled counterpart of ``simulate_antiskid(run, dt, record_dt=None,
     batch=B)``: the same :class:`RunMetrics` (arrays of B runs).
 
@@ -249,11 +207,8 @@ def simulate_batch_compiled(run: RunSettings, dt: float, *,
         ``plant_params`` entries, ``h`` and ``x0[0]`` may be (B,) arrays.
     dt : float
         Step and sampling period (s).
-    evs_settle : float
-        As :class:`~workbench.papers.p003.antiskid_scenario.MetricsRecorder`.
     """
     from ...controllers.antiskid003_jit import initial_state, settings_array
-    compile_kernel()
     B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))
     plant = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(x, float), (B,))
                                            for x in run.plant_params], axis=1))
@@ -268,19 +223,19 @@ def simulate_batch_compiled(run: RunSettings, dt: float, *,
     keys, pert, period, phase = perturbation_arrays(run.perturb, B)
     if run.perturb is not None and run.perturb.delay is not None:
         Np[:] = split_delay(run.perturb.delay[1], dt)[0]     # the ring holds the longest delay
-    _KERNEL(plant, Np, fp, v0, float(run.x0[1]), float(run.u_init),
-            int(round(run.t_end / dt)), settings_array(cs, dt),
-            np.asarray(cs.params, float), float(evs_settle), st0, ub0, m0,
-            keys, pert, period, phase, out)
+    compile_kernel()(plant, Np, fp, v0, float(run.x0[1]), float(run.u_init),
+                     int(round(run.t_end / dt)), settings_array(cs, dt),
+                     np.asarray(cs.params, float), EVS_SETTLE, st0, ub0, m0,
+                     keys, pert, period, phase, out)
     return RunMetrics(**{k: out[:, j].copy() for j, k in enumerate(METRIC_FIELDS)})
 
 
 def simulate_batch(run: RunSettings, dt: float, kernel: Kernel) -> RunMetrics:
     """A batch's :class:`RunMetrics` by the ``kernel`` path (:data:`KERNELS`;
-    "compiled" runs the numpy path where :func:`compiled_covers` says no)."""
-    if kernel not in KERNELS:
-        raise ValueError(f"kernel = {kernel!r}; expected one of {KERNELS}")
-    if kernel == "compiled" and compiled_covers(run.controller):
+    "compiled" runs the numpy path for the literal recursive predictor, which
+    the compiled kernel does not cover)."""
+    cs = run.controller
+    if chosen_path(kernel, not (cs.compensate and cs.predictor != "rollout")) == "compiled":
         return simulate_batch_compiled(run, dt)
     from .antiskid_scenario import simulate_antiskid
     B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))

@@ -48,17 +48,18 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
 from ...controllers.antiskid003_settings import CRUISE
 from ...sim.wheel_slip import PARAM_ORDER, model_functions
+from .antiskid_scenario import EVS_SETTLE
 
 #: Entries of the result array of the loop (:func:`kernel`; NaN: did not happen).
 OUT = ("t_end", "lam_max", "lam_min", "time_above", "time_past_peak", "t_cruise",
        "t_handover", "t_stop", "stop_distance", "t_omega3", "evs_max", "t_diverged",
        "u_max_abs", "samples", "plant_steps", "unresolved", "v_end", "lam_end")
-IDX = {k: i for i, k in enumerate(OUT)}
 
 #: Scenario codes of :func:`kernel`'s loop.
 TRACTION_SCENARIO, BRAKING_SCENARIO = 0, 1
@@ -66,14 +67,31 @@ TRACTION_SCENARIO, BRAKING_SCENARIO = 0, 1
 TRACTION_TAIL = 5.0
 #: Seconds of cruise at (v_d, lambda_d) before t_brake in the braking scenario.
 BRAKING_LEAD = 5.0
-#: Creep-speed error tracked from t_brake + this (s), as the run's own metric.
-EVS_SETTLE = 5.0
-
-_KERNEL = None
 
 
-def _build():
-    """The numba loop (compiled on first use)."""
+@lru_cache(maxsize=None)
+def kernel():
+    """The compiled loop ``run(p, cfg, pc, v0, lam0, t0, Tc, h, tau_m, q, dt_p,
+    u_init, st, ubuf, ev, scenario, t_cap, tail, lam_thr, lam_peak, v_d,
+    v_stop, lam_div, omega_sw, r, t_brake, settle, rec_t0, rec_t1, rec, rec_u,
+    out)`` (compiled on first use, about 10 s, once per machine: the disk cache of
+    :mod:`workbench.sim.jit_cache`).
+
+    ``p``, ``pc``: plant and controller parameters (PARAM_ORDER); ``cfg``,
+    ``st``, ``ubuf``, ``ev``: the compiled controller's settings (step T_c),
+    state, input history and events; from ``t0`` at (``v0``, ``lam0``), the
+    wheel receiving ``u_init`` until the first command arrives; commands
+    rounded to multiples of ``q`` (0: none); plant sub-steps <= ``dt_p``.
+    ``scenario``: TRACTION_SCENARIO ends ``tail`` s after the handover to the
+    cruise law, BRAKING_SCENARIO at v <= ``v_stop`` (interpolated); both at
+    ``t_cap`` or a divergence (the controller's test, or |lambda| >=
+    ``lam_div`` on the mesh). On the mesh: the time with lambda >
+    ``lam_thr`` and with lambda < -``lam_peak`` (past the braking peak); the
+    largest creep-speed error |v_s - v_s*| of eq (76) from ``t_brake +
+    settle`` while omega > ``omega_sw`` and lambda >= -``lam_peak``; the
+    stopping distance from ``t_brake``. Results in ``out`` (:data:`OUT`)."""
+    from ...sim.jit_cache import require_numba
+    require_numba("a design's [sampled] table")
     import numba
 
     from ...controllers import antiskid003_jit as C
@@ -177,13 +195,12 @@ def _build():
                     if scenario == BRAKING_SCENARIO and nv <= v_stop:
                         out[T_STOP] = t + step * (v - v_stop) / (v - nv)
                         dist -= 0.5 * (v_stop + nv) * (tp - out[T_STOP])
-                        v, lam, t = nv, nl, tp
                         finished = True
-                        break
+                    elif not abs(nl) < lam_div or not nv == nv:
+                        out[T_DIV] = tp
+                        finished = True
                     v, lam, t = nv, nl, tp
-                    if not abs(lam) < lam_div or not v == v:
-                        out[T_DIV] = t
-                        finished = True
+                    if finished:
                         break
             if not finished:
                 t = t_next
@@ -196,34 +213,6 @@ def _build():
         return nrec, nrecu
 
     return cached(run, "antiskid_sampled_kernel.run")
-
-
-def kernel():
-    """The compiled loop ``run(p, cfg, pc, v0, lam0, t0, Tc, h, tau_m, q, dt_p,
-    u_init, st, ubuf, ev, scenario, t_cap, tail, lam_thr, lam_peak, v_d,
-    v_stop, lam_div, omega_sw, r, t_brake, settle, rec_t0, rec_t1, rec, rec_u,
-    out)`` (compiled on first use, about 10 s, once per machine: the disk cache of
-    :mod:`workbench.sim.jit_cache`).
-
-    ``p``, ``pc``: plant and controller parameters (PARAM_ORDER); ``cfg``,
-    ``st``, ``ubuf``, ``ev``: the compiled controller's settings (step T_c),
-    state, input history and events; from ``t0`` at (``v0``, ``lam0``), the
-    wheel receiving ``u_init`` until the first command arrives; commands
-    rounded to multiples of ``q`` (0: none); plant sub-steps <= ``dt_p``.
-    ``scenario``: TRACTION_SCENARIO ends ``tail`` s after the handover to the
-    cruise law, BRAKING_SCENARIO at v <= ``v_stop`` (interpolated); both at
-    ``t_cap`` or a divergence (the controller's test, or |lambda| >=
-    ``lam_div`` on the mesh). On the mesh: the time with lambda >
-    ``lam_thr`` and with lambda < -``lam_peak`` (past the braking peak); the
-    largest creep-speed error |v_s - v_s*| of eq (76) from ``t_brake +
-    settle`` while omega > ``omega_sw`` and lambda >= -``lam_peak``; the
-    stopping distance from ``t_brake``. Results in ``out`` (:data:`OUT`)."""
-    global _KERNEL
-    if _KERNEL is None:
-        from ...sim.jit_cache import require_numba
-        require_numba("a design's [sampled] table")
-        _KERNEL = _build()
-    return _KERNEL
 
 
 @dataclass(frozen=True)

@@ -70,6 +70,9 @@ class RunMetrics(PhaseEvents):
 
 #: Field order of the metrics array (RunMetrics; PhaseEvents first).
 METRIC_FIELDS = tuple(f.name for f in fields(RunMetrics))
+#: The creep-speed error is tracked from t_brake + EVS_SETTLE (s) while omega >
+#: omega_switch (``evs_max_tracking``), in every run of the study.
+EVS_SETTLE = 5.0
 
 
 @lru_cache(maxsize=None)
@@ -85,8 +88,7 @@ def metric_updates():
     (:data:`METRIC_FIELDS` order) and its state ``RS[j]`` = (v_prev,
     has_track, omega_prev, e_prev, lam_prev); ``cfg`` the controller's settings
     (:func:`~workbench.controllers.antiskid003_jit.settings_array`), ``r_p`` the
-    plant's wheel radius, ``settle`` as :class:`MetricsRecorder`'s
-    ``evs_settle``. ``record_rows`` does every row of ``M``, with ``v``,
+    plant's wheel radius, ``settle`` (:data:`EVS_SETTLE`). ``record_rows`` does every row of ``M``, with ``v``,
     ``lam``, ``ph``, the flags and ``r_p`` arrays (one value per run)."""
     from ...sim.jit_cache import cached, require_numba
     require_numba("an antiskid run's metrics")
@@ -143,7 +145,7 @@ def metric_updates():
         vs = creep_speed(v, lam)
         e, e_on = abs(vs - vs_star), abs(vs - vs_on)
         M[j, E_LAST] = e
-        # The tracking window runs from t_brake + evs_settle to the first of
+        # The tracking window runs from t_brake + settle to the first of
         # omega <= omega_switch (v_s* drops to 0, eq 76) and the lock onset,
         # lambda < -lambda_opt (the wheel passes the braking adhesion peak; the
         # divergence metrics report what follows). Both crossings are
@@ -198,14 +200,9 @@ class MetricsRecorder:
         Wheel radius of the plant (for the measured wheel speed).
     dt : float
         The run's step (s).
-    evs_settle : float
-        The creep-speed error is tracked from t_brake + evs_settle (s) while
-        omega > omega_switch (``evs_max_tracking``); ``evs_last`` is its
-        value at the last braking sample.
     """
 
-    def __init__(self, s: ControllerSettings, x0, batch, plant_r, dt: float,
-                 evs_settle: float = 5.0):
+    def __init__(self, s: ControllerSettings, x0, batch, plant_r, dt: float):
         from ...controllers.antiskid003_jit import settings_array
         n, self.batch = (1 if batch is None else batch), batch
         self._record, self._rows = metric_updates()
@@ -216,17 +213,16 @@ class MetricsRecorder:
         self.RS = np.zeros((n, 5))
         self.RS[:, 0] = x0[0]
         self.r_p = np.broadcast_to(np.asarray(plant_r, float), (n,)).copy()
-        self.settle = float(evs_settle)
 
     def __call__(self, t, v, lam, ph, to_cruise, to_brake, to_stop, dt_prev):
         """Update the metrics with one sample."""
         if self.batch is None:
             self._record(float(t), float(v), float(lam), int(ph), bool(to_cruise),
                          bool(to_brake), bool(to_stop), float(dt_prev), self.M, self.RS, 0,
-                         self.cfg, self.r_p[0], self.settle)
+                         self.cfg, self.r_p[0], EVS_SETTLE)
         else:
             self._rows(float(t), v, lam, np.asarray(ph, np.int64), to_cruise, to_brake, to_stop,
-                       float(dt_prev), self.M, self.RS, self.cfg, self.r_p, self.settle)
+                       float(dt_prev), self.M, self.RS, self.cfg, self.r_p, EVS_SETTLE)
 
     @property
     def m(self) -> RunMetrics:
@@ -312,9 +308,6 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
         ctrl.unresolved = unres & ~stop
         return (np.where(stop, x[0], nx[0]), np.where(stop, x[1], nx[1]))
 
-    def done(t, x, ph):
-        return bool((ph >= STOPPED).all()) if batch is not None else ph >= STOPPED
-
     every = 10**12 if record_dt is None else max(int(round(record_dt / dt)), 1)
     x0 = (run.x0[0] + zero, run.x0[1] + zero)
     line = None if batch is None else BatchDelayLine(np.broadcast_to(run.h, (batch,)), dt,
@@ -328,13 +321,11 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
     with np.errstate(all="ignore"):
         res = simulate_closed_loop(step, ctrl, x0, h=float(np.max(run.h)), dt=dt,
                                    t_end=run.t_end, u_init=run.u_init + zero,
-                                   record_every=every, done=done, line=line, level=level,
+                                   record_every=every, line=line, level=level,
+                                   done=lambda t, x, ph: bool(np.all(ph >= STOPPED)),
                                    k_max=0 if mesh is None else mesh.k_max)
-    if record_dt is None:
-        res = None
-    else:
-        res = SimResult(res.t, res.x, res.u, res.u_applied, res.phase, ("v", "lambda"),
-                        ("u",), dt)
+    res = None if record_dt is None else SimResult(res.t, res.x, res.u, res.u_applied,
+                                                   res.phase, ("v", "lambda"), ("u",), dt)
     m = rec.m
     for k, v in vars(ctrl.events).items():      # the phase logic's events
         setattr(m, k, v)

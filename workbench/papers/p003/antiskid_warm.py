@@ -11,48 +11,46 @@ compiled here is the one a study would have compiled.
 from __future__ import annotations
 
 import sys
-import time
 
-__all__ = ["warm", "main"]
-
-KERNELS = ("batch", "sampled")
+__all__ = ["WARMERS", "main"]
 
 
-def warm(which: str) -> float:
-    """Compile (or load) kernel ``which`` ("batch": Monte Carlo and halving,
-    and the metric update of every run; "sampled": ``[sampled]`` runs) in
-    this process; CPU seconds spent."""
-    c0 = time.process_time()
-    if which == "batch":
-        from numba import boolean, float64, int64
+def warm_batch() -> None:
+    """Compile (or load) the batch kernel (Monte Carlo and halving) and the
+    metric update of every run, as a single run calls it."""
+    from numba import boolean, float64, int64
 
-        from .antiskid_kernel import compile_kernel
-        from .antiskid_scenario import metric_updates
-        compile_kernel()
-        m2 = float64[:, ::1]     # the metric update as a single run calls it
-        metric_updates()[0].compile((float64, float64, float64, int64, boolean, boolean, boolean,
-                                     float64, m2, m2, int64, float64[::1], float64, float64))
-    elif which == "sampled":
-        from pathlib import Path
+    from .antiskid_kernel import compile_kernel
+    from .antiskid_scenario import metric_updates
+    compile_kernel()
+    m2 = float64[:, ::1]
+    metric_updates()[0].compile((float64, float64, float64, int64, boolean, boolean, boolean,
+                                 float64, m2, m2, int64, float64[::1], float64, float64))
 
-        from ...design import load_design
-        from . import antiskid_sampled as S
-        from .antiskid_run_spec import sampled_context
-        path = Path(__file__).resolve().parents[3] / "designs" / "antiskid-run-dry.toml"
-        if not path.is_file():           # an installed package without the repository
-            return 0.0
+
+def warm_sampled() -> None:
+    """Compile (or load) the sampled kernel (``[sampled]`` runs) by a short
+    run of the dry design (nothing without the repository's designs)."""
+    from pathlib import Path
+
+    from ...design import load_design
+    from . import antiskid_sampled as S
+    from .antiskid_run_spec import sampled_context
+    path = Path(__file__).resolve().parents[3] / "designs" / "antiskid-run-dry.toml"
+    if path.is_file():           # else an installed package without the repository
         d = load_design(path)
         ctx = sampled_context(d.spec, d.spec.K_table)
         S.run_once(ctx, 100.0, 0, dt_p=1e-4, predictor_step=1e-3, t_cap=0.05)
-    else:
-        raise ValueError(f"kernel {which!r}: expected one of {KERNELS}")
-    return time.process_time() - c0
+
+
+#: The kernels by name, with their warm-up.
+WARMERS = {"batch": warm_batch, "sampled": warm_sampled}
 
 
 def main() -> int:
     """Warm both kernels on two processes; one line of figures on stdout."""
     from ...sim.jit_warm import warm_in_processes
-    print(warm_in_processes(warm, KERNELS))
+    print(warm_in_processes(WARMERS))
     return 0
 
 
