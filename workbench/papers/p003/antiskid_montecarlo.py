@@ -44,7 +44,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
-from functools import partial
 from typing import ClassVar
 
 import numpy as np
@@ -52,7 +51,7 @@ import numpy as np
 from ...features.montecarlo_arrays import (chunk_arrays, draws_of, inputs_digest,
                                            start_array_sweep)
 from ...features.montecarlo_chunks import read_streamed
-from ...features.montecarlo_stats import OK, RunsResult, quantity_names
+from ...features.montecarlo_stats import OK, RunsResult, runs_quantities
 from ...sim.batch import PendingBatch
 from .antiskid_run_spec import SweepSpec
 
@@ -86,13 +85,12 @@ class SweepResult(RunsResult):
     OUTCOMES: ClassVar[tuple] = OUTCOMES
 
 
-#: Quantities of a sweep run by the ``antiskid-run`` study (None: no finite
-#: value): ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
+#: Quantities of a sweep run by the ``antiskid-run`` study:
+#: ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
 #: ``montecarlo.fraction.<violation>`` and ``montecarlo.wilson.<outcome>.lo``
 #: / ``.hi`` (the Wilson 95 % interval of an outcome's rate).
-montecarlo_quantity_names = partial(quantity_names, "montecarlo", SUMMARY_METRICS, VIOLATIONS,
-                                    OUTCOMES)
-montecarlo_quantities = partial(SweepResult.quantities, prefix="montecarlo")
+QUANTITIES = runs_quantities("montecarlo", SUMMARY_METRICS, VIOLATIONS, OUTCOMES,
+                             lambda r: r.montecarlo, lambda spec: spec.montecarlo is not None)
 
 
 def draw_samples(n: int, seed: int, spec: SweepSpec, start: int = 0) -> dict:

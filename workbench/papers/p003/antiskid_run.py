@@ -30,9 +30,10 @@ from ...reader import Reader
 from ...sim.delay import SimResult
 from ...sim.wheel_slip import model_functions
 from .antiskid_basin_run import basin_quantities, basin_quantity_names, run_basin
-from .antiskid_halving import halving_quantities, halving_quantity_names, start_halving
-from .antiskid_montecarlo import (montecarlo_quantities, montecarlo_quantity_names,
-                                  start_streaming, start_sweep, sweep, traction_slope)
+from .antiskid_halving import QUANTITIES as HALVING_QUANTITIES
+from .antiskid_halving import start_halving
+from .antiskid_montecarlo import QUANTITIES as MONTECARLO_QUANTITIES
+from .antiskid_montecarlo import start_streaming, start_sweep, sweep, traction_slope
 from .antiskid_refine import (quarter_cases, refine_levels, three_level_metrics,
                               unconverged_reason)
 from .antiskid_run_spec import (METRICS, Case, RunSpec, case_mesh, case_metrics,
@@ -289,11 +290,8 @@ TABLE = (
       for f, u in (("abscissa", "1/s"), ("margin", "s"), ("dmu_dlam", "1"))),
     Group(lambda spec: {f"cases[{c.name}].{k}" for c in spec.cases for k in COMFORT_QUANTITIES},
           _comfort_values, present=lambda spec: spec.comfort is not None),
-    Group(lambda spec: montecarlo_quantity_names(),
-          lambda r: _of(montecarlo_quantities, r.montecarlo),
-          present=lambda spec: spec.montecarlo is not None),
-    Group(lambda spec: halving_quantity_names(), lambda r: _of(halving_quantities, r.halving),
-          present=lambda spec: spec.montecarlo is not None and bool(spec.montecarlo.halving)),
+    *MONTECARLO_QUANTITIES,
+    *HALVING_QUANTITIES,
     Group(lambda spec: basin_quantity_names([c.name for c in spec.cases], True),
           lambda r: _of(lambda b: basin_quantities(b.basin, b.sweep, [c.case.name for c in
                                                                          r.cases], b.brake),
