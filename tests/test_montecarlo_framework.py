@@ -271,6 +271,10 @@ def test_halving_check_of_a_toy_sweep(rtol):
         start(False).result()(EulerRuns({}, {"x_end": [1.0] * 3}, {"grew": [False] * 3},
                                         math.nan, 1))
     assert hc.atol == {"x_end": 0.0} and hc.case == "toy" and hc.seed == SPEC.seed
+    with pytest.raises(ValueError, match="need at least 1"):
+        start_halving(euler_chunk, lambda step: {}, runs_of, step_values,
+                      Compared(("x_end",), ()), dt, 0, rtol=rtol, atol={}, case="toy",
+                      seed=SPEC.seed, draws={})
     assert hc.draws == {k: tuple(v.tolist()) for k, v in first.items()}
     cv, fv, agree = compare_steps({k: hc.coarse[k] for k in ("x_end", "grew")},
                                   {k: hc.fine[k] for k in ("x_end", "grew")}, rtol,

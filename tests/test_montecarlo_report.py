@@ -16,7 +16,7 @@ from workbench.features.quantities import names, values
 from workbench.papers.p003 import antiskid_run as R
 from workbench.papers.p003.antiskid_montecarlo import (QUANTITIES, VIOLATIONS, draw_samples,
                                                        start_sweep, sweep)
-from workbench.papers.p003.antiskid_montecarlo_render import summary_tables
+from workbench.papers.p003.antiskid_montecarlo_render import WORDS
 from workbench.papers.p003.antiskid_run_render import _montecarlo_section
 
 DRY = Path("designs/antiskid-run-dry.toml")
@@ -55,7 +55,7 @@ def test_same_seed_same_summary_any_worker_count(tmp_path):
     for r in runs[1:]:
         np.testing.assert_equal(r.metrics, in_process.metrics)    # bit for bit (NaN = NaN)
         np.testing.assert_equal(r.statistics(), in_process.statistics())
-        assert summary_tables(r, 3) == summary_tables(in_process, 3)
+        assert WORDS.tables(r, 3) == WORDS.tables(in_process, 3)
     assert np.isfinite(in_process.metrics["lam_max_over_opt"]).all()
 
 

@@ -93,6 +93,11 @@ def start_halving(run: Callable, payload_at: Callable, runs_of: Callable, values
         Run the batches in a process pool now (the caller can work
         meanwhile), else in-process in ``result()``.
 
+    Raises
+    ------
+    ValueError
+        ``n`` < 1.
+
     Returns
     -------
     workbench.sim.batch.PendingBatch
@@ -100,6 +105,8 @@ def start_halving(run: Callable, payload_at: Callable, runs_of: Callable, values
         a function of the sweep's result that makes it.
     """
     from ..sim.batch import PendingBatch
+    if not n >= 1:
+        raise ValueError(f"halving check of {n} runs: need at least 1")
     payloads = ([payload_at(dt)] if coarse else []) + [payload_at(dt / 2)]
     atol = {k: atol.get(k, 0.0) for k in compared.metrics}
     draws = {k: tuple(v.tolist()) for k, v in draws.items()}

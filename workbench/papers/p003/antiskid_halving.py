@@ -67,8 +67,6 @@ def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
     kernel = kernel or default_kernel()
     spec = design.spec
     ms: SweepSpec = spec.montecarlo
-    if not n >= 1:
-        raise ValueError(f"halving check of {n} runs: need at least 1")
     K = tuple(gain_for(spec)[0] if K is None else K)
     inp = sweep_inputs(design, n, ms.seed, K)
     return start_batches(range_worker, lambda step: {"design": design, "K": K, "seed": ms.seed,

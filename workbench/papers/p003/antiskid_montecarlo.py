@@ -42,7 +42,7 @@ step-size check of the sweep's runs is
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from typing import ClassVar
 
 import numpy as np
@@ -74,7 +74,6 @@ VIOLATIONS = {"above_lambda_opt": "creep ratio above the sample's lambda_opt in 
 OUTCOMES = (*VIOLATIONS, OK)
 
 
-@dataclass(frozen=True)
 class SweepResult(RunsResult):
     """The runs of a sweep (:class:`~workbench.features.montecarlo_stats.RunsResult`)
     with the paper's summary metrics and outcomes."""
@@ -289,11 +288,6 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
         before_pool=compile_kernel if kernel == "compiled" else None, out=out,
         manifest=lambda ch: _manifest(design, samples, seed, ch, kernel, K), resume=resume,
         select=RUNS.select)
-
-
-def start_streaming(design, samples: int, seed: int, out, **kw) -> PendingBatch:
-    """:func:`start_sweep` written to the folder ``out`` (the CLI's ``--out``)."""
-    return start_sweep(design, samples, seed, out=out, **kw)
 
 
 def load_sweep(out) -> SweepResult:
