@@ -17,11 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...features.montecarlo_halving import Compared
-from ...features.montecarlo_halving import halving_quantities
+from ...features.montecarlo_halving import Compared, halving_quantities
 from ...features.montecarlo_halving import start_halving as start_batches
 from ...sim.batch import PendingBatch
-from .antiskid_montecarlo import SUMMARY_METRICS, range_runs, range_worker, sweep_inputs
+from .antiskid_montecarlo import RUNS, SUMMARY_METRICS, range_worker, sweep_inputs
 from .antiskid_run_spec import SweepSpec
 
 
@@ -72,7 +71,7 @@ def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
     return start_batches(range_worker, lambda step: {"design": design, "K": K, "seed": ms.seed,
                                                      "i0": 0, "i1": n, "kernel": kernel,
                                                      "step": step},
-                         lambda out: range_runs(out, spec.scenario["t_brake"]), _step_values,
+                         lambda out: RUNS.runs(out, spec.scenario["t_brake"]), _step_values,
                          COMPARED, inp["dt"], n, rtol=spec.conv_rtol, atol=spec.conv_atol,
                          case=ms.case, seed=ms.seed, draws=inp["draws"], coarse=coarse, pool=pool)
 

@@ -236,10 +236,9 @@ def range_worker(payload: dict) -> dict:
 
 #: How a sweep's runs are made from its chunk arrays: :func:`per_run` of the
 #: raw metrics it needs and each run's ``lambda_opt``, with the scenario's
-#: ``t_brake``; ``range_runs(arrays, t_brake)``: (metrics, violations).
+#: ``t_brake`` (``RUNS.runs(arrays, t_brake)``: metrics and violations).
 RUNS = ArrayRuns(per_run, ("lam_max_traction", "t_cruise", "t_omega3", "t_diverged",
                            "phase_diverged", "t_stop"), ("lambda_opt",), SweepResult)
-range_runs = RUNS.runs
 
 
 def _manifest(design, samples: int, seed: int, chunk: int, kernel: str, K) -> dict:
@@ -296,11 +295,8 @@ def load_sweep(out) -> SweepResult:
     return RUNS.load(out, lambda manifest: (float(manifest["t_brake"]),))
 
 
-def sweep(design, samples: int, seed: int, *, workers: int | None = None,
-          chunk: int | None = None, progress: bool = True,
-          kernel: str | None = None, scheduler: str | None = None) -> SweepResult:
+def sweep(design, samples: int, seed: int, *, progress: bool = True, **kw) -> SweepResult:
     """Run the Monte Carlo sweep of an ``antiskid-run`` design in memory
-    (:func:`start_sweep`, same parameters), a progress bar on stderr when
-    ``progress``."""
-    return start_sweep(design, samples, seed, workers=workers, chunk=chunk,
-                       kernel=kernel, scheduler=scheduler).result(progress)
+    (:func:`start_sweep`, the same keywords ``kw``), a progress bar on stderr
+    when ``progress``."""
+    return start_sweep(design, samples, seed, **kw).result(progress)
