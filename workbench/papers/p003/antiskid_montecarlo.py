@@ -82,8 +82,8 @@ class SweepResult(RunsResult):
     OUTCOMES: ClassVar[tuple] = OUTCOMES
 
 
-#: Quantities of a sweep run by the ``antiskid-run`` study:
-#: ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
+#: Quantities of a sweep run by the ``antiskid-run`` study (None: no finite
+#: value): ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
 #: ``montecarlo.fraction.<violation>`` and ``montecarlo.wilson.<outcome>.lo``
 #: / ``.hi`` (the Wilson 95 % interval of an outcome's rate).
 QUANTITIES = runs_quantities("montecarlo", SUMMARY_METRICS, VIOLATIONS, OUTCOMES,
