@@ -155,7 +155,7 @@ def test_a_chunk_write_failure_names_the_folder_not_the_scheduler(tmp_path, monk
         def result(self, progress=False):    # a chunk's file cannot be written
             raise OSError(28, "No space left on device")
     # the name the sweep command calls (imported into antiskid_run)
-    monkeypatch.setattr(antiskid_run, "start_streaming", lambda *a, **k: Refused())
+    monkeypatch.setattr(antiskid_run, "start_sweep", lambda *a, **k: Refused())
     code = main(["sweep", str(ROOT / "designs/antiskid-run-dry.toml"), "--samples", "2",
                  "--seed", "1", "--workers", "1", "--kernel", "numpy",
                  "--out", str(tmp_path / "chunks")])

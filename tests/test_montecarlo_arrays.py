@@ -11,8 +11,8 @@ import sympy as sp
 
 from workbench.errors import ModelError
 from workbench.features.curve_peaks import peaks, slope_function
-from workbench.features.montecarlo_arrays import (chunk_arrays, concat_chunks, draws_of,
-                                                  inputs_digest, start_array_sweep)
+from workbench.features.montecarlo_arrays import (ArrayRuns, chunk_arrays, concat_chunks,
+                                                  draws_of, inputs_digest, start_array_sweep)
 from workbench.features.montecarlo_draws import draw_runs, hold_steps, stream_keys
 from workbench.features.montecarlo_stats import OK, RunsResult
 
@@ -79,6 +79,37 @@ def test_streamed_sweep_equals_in_memory_and_resumes(tmp_path):
     other = lambda ch: {**man(ch), "seed": SEED + 1}                      # noqa: E731
     with pytest.raises(FileExistsError, match="another sweep"):
         start(chunk=6, out=out, manifest=other, resume=True)
+
+
+def toy_per_run(raw: dict, scale: np.ndarray, level: float) -> tuple[dict, dict]:
+    """The toy's runs from its raw fields, its own column and a context value."""
+    return {"x_end": raw["x_end"] * scale}, {"above_one": raw["x_end"] > level}
+
+
+def toy_scaled(payload: dict) -> dict:
+    """:func:`toy_chunk` with an own column ``scale`` (2 for every run)."""
+    arrays = toy_chunk(payload)
+    return {**arrays, "scale": np.full(len(arrays["index"]), 2.0)}
+
+
+def test_array_runs_make_the_result_in_memory_and_from_the_files(tmp_path):
+    runs = ArrayRuns(toy_per_run, ("x_end",), ("scale",), ToyResult)
+    assert runs.select("raw.x_end") and runs.select("scale") and runs.select("draw.a")
+    assert not runs.select("raw.t_below") and not runs.select("index")
+    payload = lambda i0, i1: {"i0": i0, "i1": i1, "dt": 0.01}       # noqa: E731
+    man = lambda ch: {"samples": N, "chunk": ch, "level": 1.5}      # noqa: E731
+    mem = start_array_sweep(toy_scaled, payload, N, lambda c, s, w: runs.result_of(c, s, w, 1.5),
+                            workers=1, chunk=7).result(False)
+    plain = start(chunk=N).result(False)
+    assert mem.samples == plain.samples and mem.n == N and mem.workers == 1
+    assert mem.metrics["x_end"] == [2 * x for x in plain.metrics["x_end"]]
+    assert mem.violations["above_one"] == [x > 1.5 for x in plain.metrics["x_end"]]
+    start_array_sweep(toy_scaled, payload, N, lambda c, s, w: None, workers=1, chunk=7,
+                      out=tmp_path, manifest=man).result(False)
+    back = runs.load(tmp_path, lambda manifest: (manifest["level"],))
+    assert (back.samples, back.metrics, back.violations) == (mem.samples, mem.metrics,
+                                                             mem.violations)
+    assert math.isnan(back.seconds) and back.workers == 0
 
 
 def test_array_helpers():

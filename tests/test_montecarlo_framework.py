@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from types import SimpleNamespace
 from typing import ClassVar
 
 import numpy as np
@@ -26,14 +27,15 @@ from workbench.features.montecarlo_chunks import (Chunk, FolderTaken, Group, chu
                                                   read_streamed, run_chunks, run_groups,
                                                   start_batches,
                                                   start_chunks, start_streaming, write_npz)
-from workbench.features.montecarlo_halving import (HalvingCheck, halving_quantity_names,
+from workbench.features.montecarlo_halving import (Compared, HalvingCheck, halving_quantities,
                                                    start_halving)
 from workbench.features.montecarlo_render import (DRAWS_TEXT, draw_outcome_scatter,
                                                   halving_section, halving_tables,
                                                   montecarlo_figures, rates_text,
                                                   summary_tables, SweepWords)
-from workbench.features.montecarlo_stats import (OK, RunsResult, finite_span, quantity_names,
-                                                 summary_row)
+from workbench.features.montecarlo_stats import (OK, STATISTICS, RunsResult, finite_span,
+                                                 runs_quantities, summary_row)
+from workbench.features.quantities import names, values
 
 N, T = 37, 2.0
 SPEC = MonteCarloSpec(N, 11, {
@@ -154,10 +156,17 @@ def test_statistics_of_the_runs():
     rates = dict((o, rest) for o, *rest in res.outcome_rates())
     assert rates["grew"] == list(wilson_interval(grew, N))
     assert rates[OK] == list(wilson_interval(N - grew, N))
-    q = res.quantities("toy")
-    assert set(q) == quantity_names("toy", Decay.SUMMARY, res.violations, Decay.OUTCOMES)
+    # the toy's quantities declared once (a result holding the runs as ``.mc``)
+    table = runs_quantities("toy", Decay.SUMMARY, res.violations, Decay.OUTCOMES,
+                            lambda r: r.mc, lambda spec: spec == "with mc")
+    q = values(table, "with mc", SimpleNamespace(mc=res))
+    assert set(q) == names(table, "with mc") == {"toy.samples", "toy.fraction.grew"} | {
+        f"toy.x_end.{s}" for s in STATISTICS} | {f"toy.wilson.{o}.{b}" for o in ("grew", OK)
+                                                 for b in ("lo", "hi")}
     assert q["toy.x_end.max"] == float(np.max(m["x_end"])) and q["toy.samples"] == N
     assert q["toy.fraction.grew"] == grew / N
+    assert names(table, "no mc") == set() and values(table, "no mc", None) == {}
+    assert set(values(table, "with mc", SimpleNamespace(mc=None)).values()) == {None}
     assert summary_row("x", [math.nan]) == ["x", 0, None, None, None, None]
     assert finite_span([math.nan, 2.0, -1.0]) == (-1.0, 2.0)
     assert finite_span([math.nan]) == (None, None)
@@ -236,21 +245,18 @@ def test_halving_check_of_a_toy_sweep(rtol):
     d, n, dt = drawn_factors(SPEC, ORDER), 12, 0.1
     first = {k: v[:n] for k, v in d.items()}
 
-    def values(metrics, viol):
+    def step_values(metrics, viol):
         return {"x_end": np.asarray(metrics["x_end"], float),
                 "grew": np.asarray(viol["grew"], bool)}
-
-    def check(c, f, seconds, workers):
-        cv, fv, agree = compare_steps(c, f, rtol, {"x_end": 0.0}, ("x_end",), ("grew",))
-        return HalvingCheck(dt, rtol, {"x_end": 0.0}, cv, fv, agree, "toy", SPEC.seed,
-                            {k: tuple(v.tolist()) for k, v in first.items()}, seconds, workers)
 
     def runs_of(o):
         return {"x_end": o["x_end"]}, {"grew": o["grew"]}
 
     def start(coarse):
         return start_halving(euler_chunk, lambda step: {**first, "dt": step}, runs_of,
-                             values, check, dt, n, coarse=coarse, pool=False)
+                             step_values, Compared(("x_end",), ("grew",)), dt, n, rtol=rtol,
+                             atol={}, case="toy", seed=SPEC.seed, draws=first, coarse=coarse,
+                             pool=False)
 
     hc = start(True).result()
     assert hc.n == n and hc.coarse["x_end"] == tuple(euler_chunk({**first, "dt": dt})["x_end"])
@@ -264,7 +270,24 @@ def test_halving_check_of_a_toy_sweep(rtol):
     with pytest.raises(ValueError, match="the sweep has 3 runs"):
         start(False).result()(EulerRuns({}, {"x_end": [1.0] * 3}, {"grew": [False] * 3},
                                         math.nan, 1))
-    assert set(hc.quantities("toy.halving")) == halving_quantity_names("toy.halving")
+    assert hc.atol == {"x_end": 0.0} and hc.case == "toy" and hc.seed == SPEC.seed
+    with pytest.raises(ValueError, match="need at least 1"):
+        start_halving(euler_chunk, lambda step: {}, runs_of, step_values,
+                      Compared(("x_end",), ()), dt, 0, rtol=rtol, atol={}, case="toy",
+                      seed=SPEC.seed, draws={})
+    assert hc.draws == {k: tuple(v.tolist()) for k, v in first.items()}
+    cv, fv, agree = compare_steps({k: hc.coarse[k] for k in ("x_end", "grew")},
+                                  {k: hc.fine[k] for k in ("x_end", "grew")}, rtol,
+                                  {"x_end": 0.0}, ("x_end",), ("grew",))
+    assert (cv, fv, agree) == (hc.coarse, hc.fine, hc.agree)
+    table = halving_quantities("toy.halving", lambda r: r, lambda spec: True)
+    assert values(table, None, hc) == hc.quantities("toy.halving") == {
+        "toy.halving.runs": n, "toy.halving.agree": sum(hc.run_agree),
+        "toy.halving.fraction_agree": sum(hc.run_agree) / n}
+    # a study's mask: a masked metric is NaN at both steps, so it agrees
+    masked = Compared(("x_end",), ("grew",), lambda c, f: {"x_end": [True] * n}).compare(
+        hc.coarse, hc.fine, rtol, {"x_end": 0.0})
+    assert all(math.isnan(x) for x in masked[0]["x_end"]) and all(masked[2]["x_end"])
     text = halving_tables(hc, ("x_end",), ("grew",), (("a", "rate a"),))
     assert text.count("| `x_end` |") == 1 + (0 if rtol == 0.3 else n)
     assert text.endswith(" none.") == (rtol == 0.3)

@@ -6,15 +6,17 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from workbench.controllers.antiskid003_settings import BRAKE, BRAKE_IN, CRUISE
 from workbench.design import load_design
-from workbench.papers.p003.antiskid_halving import (HALVING_METRICS, HALVING_OUTCOMES, HalvingCheck,
-                                                    compare_steps, halving_quantities,
-                                                    halving_quantity_names, start_halving)
+from workbench.features.montecarlo_halving import HalvingCheck
+from workbench.features.quantities import names, values
+from workbench.papers.p003.antiskid_halving import (COMPARED, HALVING_METRICS, HALVING_OUTCOMES,
+                                                    QUANTITIES, start_halving)
 from workbench.papers.p003.antiskid_montecarlo import draw_samples, sweep
 from workbench.papers.p003.antiskid_montecarlo_render import WORDS
 from workbench.papers.p003.antiskid_run_spec import SweepSpec, gain_for
@@ -26,6 +28,12 @@ def halving_section(hc, spec) -> str:
 
 
 N = 4
+
+
+def halving_quantities(hc) -> dict:
+    """The study's quantities of the check (its declared table on a result holding it)."""
+    return values(QUANTITIES, load_design("designs/antiskid-run-dry.toml").spec,
+                  SimpleNamespace(halving=hc))
 
 
 @pytest.fixture(scope="module")
@@ -93,7 +101,7 @@ def test_flags_follow_the_rule(check):
                                     for i in range(N))
     assert np.isfinite(check.fine["t_cruise"]).any()   # the short runs do reach cruise
     q = halving_quantities(check)
-    assert set(q) == halving_quantity_names()
+    assert set(q) == names(QUANTITIES, load_design("designs/antiskid-run-dry.toml").spec)
     assert q["montecarlo.halving.runs"] == N
     assert q["montecarlo.halving.agree"] == sum(check.run_agree)
     assert q["montecarlo.halving.fraction_agree"] == sum(check.run_agree) / N
@@ -117,7 +125,7 @@ def test_compare_steps_on_hand_made_values():
     fine["omega3_after_brake"][4] = 86.37   # outside: the bound is d < 1.3637
     fine["stopped"][5] = False                                  # outcome flips
     atol = {"t_cruise": 0.01, "omega3_after_brake": 0.5, "t_diverged": 0.5}
-    c, f, agree = compare_steps(base, fine, 0.01, atol)
+    c, f, agree = COMPARED.compare(base, fine, 0.01, atol)
     assert agree["t_cruise"] == (True, True, False, True, True, True)     # [1]: both NaN
     assert math.isnan(c["lam_max_over_opt"][3]) and math.isnan(f["lam_max_over_opt"][3])
     assert agree["lam_max_over_opt"] == (True,) * 6
@@ -130,7 +138,7 @@ def test_compare_steps_on_hand_made_values():
                                 (BRAKE_IN, nan, False)):
         cc = {**base, "phase_diverged": [ph_c] * 6}
         ff = {**fine, "phase_diverged": [ph_f] * 6}
-        c2, _, ag = compare_steps(cc, ff, 0.01, atol)
+        c2, _, ag = COMPARED.compare(cc, ff, 0.01, atol)
         assert math.isnan(c2["lam_max_over_opt"][0]) == dropped
         assert ag["lam_max_over_opt"][3] == dropped     # 1.20 against 5.0 when compared
 

@@ -5,18 +5,18 @@ in `workbench verify`)."""
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from workbench.cli import main
 from workbench.design import load_design
+from workbench.features.quantities import names, values
 from workbench.papers.p003 import antiskid_run as R
-from workbench.papers.p003.antiskid_montecarlo import (VIOLATIONS, draw_samples,
-                                                       montecarlo_quantities,
-                                                       montecarlo_quantity_names, start_sweep,
-                                                       sweep)
-from workbench.papers.p003.antiskid_montecarlo_render import summary_tables
+from workbench.papers.p003.antiskid_montecarlo import (QUANTITIES, VIOLATIONS, draw_samples,
+                                                       start_sweep, sweep)
+from workbench.papers.p003.antiskid_montecarlo_render import WORDS
 from workbench.papers.p003.antiskid_run_render import _montecarlo_section
 
 DRY = Path("designs/antiskid-run-dry.toml")
@@ -55,19 +55,20 @@ def test_same_seed_same_summary_any_worker_count(tmp_path):
     for r in runs[1:]:
         np.testing.assert_equal(r.metrics, in_process.metrics)    # bit for bit (NaN = NaN)
         np.testing.assert_equal(r.statistics(), in_process.statistics())
-        assert summary_tables(r, 3) == summary_tables(in_process, 3)
+        assert WORDS.tables(r, 3) == WORDS.tables(in_process, 3)
     assert np.isfinite(in_process.metrics["lam_max_over_opt"]).all()
 
 
 def test_study_quantities_and_identical_markdown(tmp_path):
     d = load_design(_short(tmp_path, samples=4, chunk=4, workers=1))
     spec = d.spec
-    assert montecarlo_quantity_names() <= R.STUDY.quantity_names(spec)
+    declared = names(QUANTITIES, spec)
+    assert declared <= R.STUDY.quantity_names(spec)
     # the study's Monte Carlo part only (the cases are covered elsewhere)
     res = [sweep(d, 4, spec.montecarlo.seed, workers=w, chunk=2, progress=False)
            for w in (1, 2)]
-    q = montecarlo_quantities(res[0])
-    assert set(q) == montecarlo_quantity_names() and q["montecarlo.samples"] == 4
+    q = values(QUANTITIES, spec, SimpleNamespace(montecarlo=res[0]))
+    assert set(q) == declared and q["montecarlo.samples"] == 4
     stats = {k.removeprefix("montecarlo."): v for k, v in q.items()}
     t_c = np.asarray(res[0].metrics["t_cruise"])
     assert stats["t_cruise.n_finite"] == np.isfinite(t_c).sum()

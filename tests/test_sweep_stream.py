@@ -53,7 +53,7 @@ def test_a_chunk_draws_its_own_samples():
 @pytest.mark.slow
 def test_stream_resume_and_refusals(short, in_memory, tmp_path, monkeypatch):
     out = tmp_path / "run"
-    res = S.start_streaming(short, N, 5, out, workers=1, chunk=CHUNK).result()
+    res = S.start_sweep(short, N, 5, out=out, workers=1, chunk=CHUNK).result()
     files = sorted(out.glob("chunk-*.npz"))
     assert [f.name for f in files] == [chunk_file(out, i, i + CHUNK).name
                                        for i in range(0, N, CHUNK)]
@@ -65,18 +65,18 @@ def test_stream_resume_and_refusals(short, in_memory, tmp_path, monkeypatch):
     with pytest.raises(FileNotFoundError, match="1 of 3 chunks not written"):
         S.load_sweep(out)
     with pytest.raises(FileExistsError, match="already holds a sweep"):
-        S.start_streaming(short, N, 5, out, workers=1, chunk=CHUNK)
+        S.start_sweep(short, N, 5, out=out, workers=1, chunk=CHUNK)
     with pytest.raises(FileExistsError, match="another sweep"):
-        S.start_streaming(short, N, 6, out, resume=True, workers=1, chunk=CHUNK)
+        S.start_sweep(short, N, 6, out=out, resume=True, workers=1, chunk=CHUNK)
     ran = []
     worker = S.range_worker
     monkeypatch.setattr(S, "range_worker", lambda p: ran.append(p["i0"]) or worker(p))
-    res = S.start_streaming(short, N, 5, out, resume=True, workers=1, chunk=CHUNK).result()
+    res = S.start_sweep(short, N, 5, out=out, resume=True, workers=1, chunk=CHUNK).result()
     assert ran == [CHUNK]
     assert_identical(res, in_memory)
     # every chunk written: nothing runs, the summaries come from the files (pool or not)
     for workers in (1, 2):
-        res = S.start_streaming(short, N, 5, out, resume=True, workers=workers,
+        res = S.start_sweep(short, N, 5, out=out, resume=True, workers=workers,
                                 chunk=CHUNK).result()
         assert ran == [CHUNK]
         assert_identical(res, in_memory)

@@ -23,19 +23,23 @@ streamed sweep equals the in-memory one bit for bit.
 The chunk file convention of :func:`chunk_arrays`: ``index`` (the runs),
 ``draw.<name>`` (the samples, :func:`draws_of` reads them back) and
 ``raw.<field>`` (what the run function computed), plus the study's own
-columns.
+columns; :class:`ArrayRuns` makes the runs' metrics, outcome flags and
+result from them (in memory or read back from the files).
 """
 from __future__ import annotations
 
 import hashlib
 import json
+import math
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
 from .montecarlo_chunks import default_chunk, read_streamed, start_batches, start_streaming
 
-__all__ = ["chunk_arrays", "concat_chunks", "draws_of", "inputs_digest", "start_array_sweep"]
+__all__ = ["ArrayRuns", "chunk_arrays", "concat_chunks", "draws_of", "inputs_digest",
+           "start_array_sweep"]
 
 
 def chunk_arrays(i0: int, i1: int, draws: dict, raw: dict, **extra) -> dict:
@@ -52,6 +56,55 @@ def draws_of(columns: dict) -> dict:
     """Sample name -> list of the runs' draws, from the ``draw.<name>``
     columns of a sweep (:func:`chunk_arrays`)."""
     return {k[5:]: v.tolist() for k, v in columns.items() if k.startswith("draw.")}
+
+
+@dataclass(frozen=True)
+class ArrayRuns:
+    """How a study's runs are made from its sweep's columns (:func:`chunk_arrays`).
+
+    Attributes
+    ----------
+    per_run : callable
+        ``per_run(raw, *own, *context) -> (metrics, violations)``: per-run
+        arrays from ``raw`` (field -> the ``raw.<field>`` column of each
+        field of ``read``), the study's ``own`` columns and ``context`` (what
+        every run shares, e.g. a scenario time).
+    read : tuple of str
+        The raw fields the runs are made from.
+    own : tuple of str
+        The study's own columns they are made from.
+    result : type
+        The result (a :class:`~workbench.features.montecarlo_stats.RunsResult`
+        subclass).
+    """
+
+    per_run: Callable
+    read: tuple
+    own: tuple
+    result: type
+
+    def select(self, name: str) -> bool:
+        """The columns the runs are made from (all a streamed sweep reads back)."""
+        return name in self.own or name.startswith("draw.") or name in {f"raw.{k}"
+                                                                        for k in self.read}
+
+    def runs(self, columns: dict, *context) -> tuple[dict, dict]:
+        """(metrics, violations) per run of ``columns``."""
+        return self.per_run({k: columns[f"raw.{k}"] for k in self.read},
+                            *(columns[k] for k in self.own), *context)
+
+    def result_of(self, columns: dict, seconds: float, workers: int, *context):
+        """The sweep's :attr:`result` (draws, metrics and flags as lists)."""
+        metrics, viol = self.runs(columns, *context)
+        return self.result(draws_of(columns), {k: v.tolist() for k, v in metrics.items()},
+                           {k: v.tolist() for k, v in viol.items()}, seconds, workers)
+
+    def load(self, out, context: Callable):
+        """The result of a streamed sweep read back from its folder ``out``
+        (only the :meth:`select` columns); ``context(manifest)``: the
+        ``context`` of :attr:`per_run` from the folder's ``sweep.json``."""
+        man, columns = read_streamed(out, self.select)
+        return self.result_of(columns, math.nan, 0, *context(man))
 
 
 def concat_chunks(outputs: list) -> dict:

@@ -6,10 +6,10 @@ Nothing here knows what a run is. A study gives the batch run function
 (payload -> output, module-level when it runs in a pool), the payload of the
 first n runs at a step, how a batch's output becomes per-run metrics and
 outcome flags (as :class:`~workbench.features.montecarlo_stats.RunsResult`
-holds them), which of them are compared, and the comparison itself
-(typically :func:`workbench.features.convergence.compare_steps`, with the
-study's own rules). The dt side is either run here too or taken from the
-sweep's first n runs (each run of a batch follows its single-run trajectory,
+holds them) and which of them are compared, with the study's own rule of
+what is not compared (:class:`Compared`, by
+:func:`workbench.features.convergence.compare_steps`). The dt side is either
+run here too or taken from the sweep's first n runs (each run of a batch follows its single-run trajectory,
 so a run's values do not depend on its chunk). :func:`sweep_share_levels`
 refines a finding on the share of a sweep's runs with an outcome over the
 sweep's runs at dt and the first n at dt/2 and dt/4.
@@ -20,9 +20,10 @@ import math
 from dataclasses import dataclass, field
 from typing import Callable
 
-from .convergence import StepComparison
+from .convergence import StepComparison, compare_steps
 
-__all__ = ["HalvingCheck", "halving_quantity_names", "start_halving", "sweep_share_levels"]
+__all__ = ["Compared", "HalvingCheck", "halving_quantities", "start_halving",
+           "sweep_share_levels"]
 
 
 @dataclass(frozen=True)
@@ -40,9 +41,27 @@ class HalvingCheck(StepComparison):
     workers: int = field(default=1, compare=False)
 
 
+@dataclass(frozen=True)
+class Compared:
+    """What a study compares per run at dt and dt / 2: ``metrics`` (numbers)
+    and ``outcomes`` (flags); ``masked(coarse, fine)`` -> metric -> per-run
+    flags of the runs whose metric is not compared (e.g. a value a run did
+    not determine at one step; default: none)."""
+
+    metrics: tuple
+    outcomes: tuple
+    masked: Callable = lambda coarse, fine: {}
+
+    def compare(self, coarse: dict, fine: dict, rtol: float, atol: dict) -> tuple:
+        """(coarse, fine, agree) of
+        :func:`workbench.features.convergence.compare_steps` on these names."""
+        return compare_steps(coarse, fine, rtol, atol, self.metrics, self.outcomes,
+                             self.masked(coarse, fine))
+
+
 def start_halving(run: Callable, payload_at: Callable, runs_of: Callable, values: Callable,
-                  check: Callable, dt: float, n: int, *, coarse: bool = True,
-                  pool: bool = True):
+                  compared: Compared, dt: float, n: int, *, rtol: float, atol: dict,
+                  case: str, seed: int, draws: dict, coarse: bool = True, pool: bool = True):
     """Start the step-halving check of the first ``n`` runs of a sweep.
 
     Parameters
@@ -56,12 +75,16 @@ def start_halving(run: Callable, payload_at: Callable, runs_of: Callable, values
         arrays of a batch.
     values : callable
         ``values(metrics, violations) -> dict``: the per-run values compared.
-    check : callable
-        ``check(at_dt, at_half, seconds, workers)``: the result (e.g. a
-        :class:`HalvingCheck`) of the values at the two steps.
+    compared : Compared
+        The names compared and the study's mask.
     dt : float
         The sweep's step.
     n : int
+    rtol : float
+    atol : dict
+        Metric -> absolute tolerance (missing: 0).
+    case, seed, draws
+        As :class:`HalvingCheck` (``draws``: name -> the n runs' draws).
     coarse : bool
         Run the dt batch too; else ``result()`` returns a function of the
         sweep's :class:`~workbench.features.montecarlo_stats.RunsResult`,
@@ -70,12 +93,27 @@ def start_halving(run: Callable, payload_at: Callable, runs_of: Callable, values
         Run the batches in a process pool now (the caller can work
         meanwhile), else in-process in ``result()``.
 
+    Raises
+    ------
+    ValueError
+        ``n`` < 1.
+
     Returns
     -------
     workbench.sim.batch.PendingBatch
+        ``result()``: the :class:`HalvingCheck`, or with ``coarse=False``
+        a function of the sweep's result that makes it.
     """
     from ..sim.batch import PendingBatch
+    if not n >= 1:
+        raise ValueError(f"halving check of {n} runs: need at least 1")
     payloads = ([payload_at(dt)] if coarse else []) + [payload_at(dt / 2)]
+    atol = {k: atol.get(k, 0.0) for k in compared.metrics}
+    draws = {k: tuple(v.tolist()) for k, v in draws.items()}
+
+    def check(at_dt: dict, at_half: dict, seconds: float, n_workers: int) -> HalvingCheck:
+        return HalvingCheck(dt, rtol, atol, *compared.compare(at_dt, at_half, rtol, atol), case,
+                            seed, draws, seconds, n_workers)
 
     def collect(outs: list, seconds: float, n_workers: int):
         steps = [values(*runs_of(o)) for o in outs]
@@ -93,11 +131,20 @@ def start_halving(run: Callable, payload_at: Callable, runs_of: Callable, values
     return PendingBatch(run, payloads, collect, len(payloads) if pool else 1, pool)
 
 
-def halving_quantity_names(prefix: str) -> set[str]:
-    """Quantities of a check's :meth:`StepComparison.quantities` under
-    ``prefix``: runs checked, runs whose every metric and outcome agrees,
-    and their fraction."""
-    return {f"{prefix}.runs", f"{prefix}.agree", f"{prefix}.fraction_agree"}
+def halving_quantities(prefix: str, part: Callable, present: Callable) -> tuple:
+    """The check's quantities, declared once
+    (:class:`~workbench.features.quantities.Declared`) when ``present(spec)``:
+    ``<prefix>.runs`` (runs checked), ``.agree`` (runs whose every metric
+    and outcome agrees) and ``.fraction_agree``
+    (:meth:`~workbench.features.convergence.StepComparison.quantities`) of
+    the check ``part(result)`` (None: not run, no value)."""
+    from .quantities import Declared
+
+    def read(result, q: str):
+        hc = part(result)
+        return None if hc is None else hc.quantities(prefix)[f"{prefix}.{q}"]
+    return (Declared(prefix + ".{q}", "1", read, over=lambda spec: [
+        {"q": q} for q in ("runs", "agree", "fraction_agree")] if present(spec) else []),)
 
 
 def sweep_share_levels(finding, at_dt: Callable, check, outcomes: dict, at_quarter: Callable,

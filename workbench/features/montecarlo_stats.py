@@ -8,8 +8,8 @@ run did not determine one) and per-run outcome flags ("violations"), plus
 the wall time and worker count. A study declares which metrics it summarises
 and which outcomes it rates (class attributes of a subclass), and reads them
 back as flat ``"<metric>.<statistic>"``, ``"fraction.<flag>"`` and
-``"wilson.<outcome>.lo|hi"`` quantities (:meth:`RunsResult.statistics`,
-:func:`quantity_names`).
+``"wilson.<outcome>.lo|hi"`` quantities (:meth:`RunsResult.statistics`),
+declared once for its claims (:func:`runs_quantities`).
 
 The outcome ``OK`` is a run with none of the flags.
 """
@@ -22,7 +22,7 @@ import numpy as np
 
 from .montecarlo import wilson_interval
 
-__all__ = ["OK", "STATISTICS", "RunsResult", "finite_span", "quantity_names", "summary_row"]
+__all__ = ["OK", "STATISTICS", "RunsResult", "finite_span", "runs_quantities", "summary_row"]
 
 #: Statistics of each summarised metric (over its finite values).
 STATISTICS = ("n_finite", "min", "median", "p95", "max")
@@ -110,17 +110,23 @@ class RunsResult:
             out[f"wilson.{o}.lo"], out[f"wilson.{o}.hi"] = lo, hi
         return out
 
-    def quantities(self, prefix: str) -> dict:
-        """The values of :func:`quantity_names` (None: no finite value)."""
-        return {f"{prefix}.samples": self.n,
-                **{f"{prefix}.{k}": v for k, v in self.statistics().items()}}
 
+def runs_quantities(prefix: str, summary, flags, outcomes, part, present) -> tuple:
+    """A sweep's quantities, declared once
+    (:class:`~workbench.features.quantities.Declared`) when ``present(spec)``:
+    ``<prefix>.samples`` (the runs), ``<prefix>.<metric>.<statistic>`` of each
+    ``summary`` metric, ``<prefix>.fraction.<flag>`` of each of ``flags`` and
+    ``<prefix>.wilson.<outcome>.lo`` / ``.hi`` of each of ``outcomes``
+    (:meth:`RunsResult.statistics`; None: no finite value) of the runs
+    ``part(result)`` (None: not run, no value)."""
+    from .quantities import Declared
+    keys = ([f"{m}.{s}" for m in summary for s in STATISTICS] + [f"fraction.{k}" for k in flags]
+            + [f"wilson.{o}.{b}" for o in outcomes for b in ("lo", "hi")])
 
-def quantity_names(prefix: str, summary, flags, outcomes) -> set[str]:
-    """The quantities of :meth:`RunsResult.quantities`: ``<prefix>.samples``,
-    ``<prefix>.<metric>.<statistic>``, ``<prefix>.fraction.<flag>`` and
-    ``<prefix>.wilson.<outcome>.lo`` / ``.hi``."""
-    return ({f"{prefix}.samples"}
-            | {f"{prefix}.{m}.{s}" for m in summary for s in STATISTICS}
-            | {f"{prefix}.fraction.{k}" for k in flags}
-            | {f"{prefix}.wilson.{o}.{b}" for o in outcomes for b in ("lo", "hi")})
+    def read(result, key: str | None = None):
+        res = part(result)
+        return None if res is None else res.n if key is None else res.statistics()[key]
+    return (Declared(f"{prefix}.samples", "1", read, over=lambda spec: [{}] if present(spec)
+                     else []),
+            Declared(prefix + ".{key}", "?", read, over=lambda spec: [
+                {"key": k} for k in keys] if present(spec) else []))

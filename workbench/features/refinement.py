@@ -344,7 +344,7 @@ def share_value(quantity: str, k: int, n: int) -> float:
     """The value of a Monte Carlo share quantity when k of n runs have its
     outcome: ``<prefix>.fraction.<flag>`` is k / n and
     ``<prefix>.wilson.<outcome>.lo`` / ``.hi`` a bound of the Wilson interval
-    (the names of :func:`workbench.features.montecarlo_stats.quantity_names`)."""
+    (the names of :func:`workbench.features.montecarlo_stats.runs_quantities`)."""
     from .montecarlo import wilson_interval
     if ".wilson." in quantity and quantity.endswith((".lo", ".hi")):
         _, _, _, lo, hi = wilson_interval(k, n)

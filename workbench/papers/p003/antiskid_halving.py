@@ -4,10 +4,10 @@
 draws) as one batch at the design's dt and as one batch at dt / 2, and
 compares their metrics and outcomes per run with the design's convergence
 tolerances (:class:`~workbench.features.montecarlo_halving.HalvingCheck`;
-rendered by :func:`workbench.papers.p003.antiskid_montecarlo_render.halving_section`).
+rendered by :data:`workbench.papers.p003.antiskid_montecarlo_render.WORDS`).
 The batches and the check are the general
 :func:`workbench.features.montecarlo_halving.start_halving` and the comparison
-the general :func:`workbench.features.convergence.compare_steps`; this module
+:class:`~workbench.features.montecarlo_halving.Compared`; this module
 keeps what is paper 003's: which metrics and outcomes of its kernel's runs are
 compared and the traction-divergence rule; its batches are the sweep's own
 chunk function (:func:`~workbench.papers.p003.antiskid_montecarlo.range_worker`)
@@ -15,63 +15,37 @@ at the two steps.
 """
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 
-from ...features.montecarlo_halving import HalvingCheck
-from ...features.montecarlo_halving import halving_quantity_names as general_names
+from ...features.montecarlo_halving import Compared, halving_quantities
 from ...features.montecarlo_halving import start_halving as start_batches
 from ...sim.batch import PendingBatch
-from .antiskid_montecarlo import SUMMARY_METRICS, range_runs, range_worker, sweep_inputs
+from .antiskid_montecarlo import RUNS, SUMMARY_METRICS, range_worker, sweep_inputs
 from .antiskid_run_spec import SweepSpec
+
+
+def _in_traction(coarse: dict, fine: dict) -> dict:
+    """Paper-specific: ``lam_max_over_opt`` is not compared for a run that
+    diverged in a traction phase (``phase_diverged`` < BRAKE_IN, NaN: did
+    not diverge) at either step: its maximum there is where the divergence
+    test fired, as for the nominal cases
+    (:func:`~workbench.papers.p003.antiskid_run.case_metrics`)."""
+    from ...controllers.antiskid003_settings import BRAKE_IN
+    return {"lam_max_over_opt": (np.asarray(coarse["phase_diverged"], float) < BRAKE_IN) | (
+        np.asarray(fine["phase_diverged"], float) < BRAKE_IN)}
+
 
 #: Metrics compared at dt and dt / 2 by :func:`start_halving`.
 HALVING_METRICS = SUMMARY_METRICS + ("t_diverged",)
-
 #: Outcomes compared (as booleans) at dt and dt / 2.
 HALVING_OUTCOMES = ("diverged", "stopped", "above_lambda_opt")
-
-#: The prefix of the check's quantities.
-PREFIX = "montecarlo.halving"
-
-
-def compare_steps(coarse: dict, fine: dict, rtol: float, atol: dict) -> tuple[dict, dict, dict]:
-    """Compare per-run values at dt (``coarse``) and dt / 2 (``fine``).
-
-    Parameters
-    ----------
-    coarse, fine : dict
-        :data:`HALVING_METRICS` -> floats per run, :data:`HALVING_OUTCOMES`
-        -> bools per run, and ``phase_diverged`` (phase index where the run
-        diverged, NaN if it did not).
-    rtol : float
-    atol : dict
-        Metric -> absolute tolerance (missing: 0).
-
-    Returns
-    -------
-    (coarse, fine, agree) : dict, dict, dict
-        Values (tuples per run) and agree flags, by the general comparison
-        :func:`workbench.features.convergence.compare_steps` (a metric by
-        :func:`~workbench.features.convergence.agree`: both NaN agree, one
-        NaN disagrees; an outcome when it is equal). Paper-specific:
-        ``lam_max_over_opt`` is masked (not compared) for a run that
-        diverged in a traction phase (``phase_diverged`` < BRAKE_IN) at
-        either step: its maximum there is where the divergence test fired,
-        as for the nominal cases
-        (:func:`~workbench.papers.p003.antiskid_run.case_metrics`).
-    """
-    from ...controllers.antiskid003_settings import BRAKE_IN
-    from ...features.convergence import compare_steps as compare
-    traction = (np.asarray(coarse["phase_diverged"], float) < BRAKE_IN) | (
-        np.asarray(fine["phase_diverged"], float) < BRAKE_IN)
-    return compare(coarse, fine, rtol, atol, HALVING_METRICS, HALVING_OUTCOMES,
-                   masked={"lam_max_over_opt": traction})
+#: The comparison (``COMPARED.compare(coarse, fine, rtol, atol)`` of per-run
+#: values with ``phase_diverged``).
+COMPARED = Compared(HALVING_METRICS, HALVING_OUTCOMES, _in_traction)
 
 
 def _step_values(metrics: dict, viol: dict) -> dict:
-    """Per-run metrics and outcomes of one step, as :func:`compare_steps` takes them."""
+    """Per-run metrics and outcomes of one step, as :data:`COMPARED` takes them."""
     return {**metrics, **viol, "stopped": ~np.asarray(viol["not_stopped"], bool)}
 
 
@@ -92,26 +66,16 @@ def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
     kernel = kernel or default_kernel()
     spec = design.spec
     ms: SweepSpec = spec.montecarlo
-    if not n >= 1:
-        raise ValueError(f"halving check of {n} runs: need at least 1")
     K = tuple(gain_for(spec)[0] if K is None else K)
     inp = sweep_inputs(design, n, ms.seed, K)
-    atol = {k: spec.conv_atol.get(k, 0.0) for k in HALVING_METRICS}
-
-    def check(at_dt: dict, at_half: dict, seconds: float, n_workers: int) -> HalvingCheck:
-        c, f, agree = compare_steps(at_dt, at_half, spec.conv_rtol, atol)
-        return HalvingCheck(inp["dt"], spec.conv_rtol, atol, c, f, agree, ms.case, ms.seed,
-                            {k: tuple(v.tolist()) for k, v in inp["draws"].items()},
-                            seconds, n_workers)
-
     return start_batches(range_worker, lambda step: {"design": design, "K": K, "seed": ms.seed,
                                                      "i0": 0, "i1": n, "kernel": kernel,
                                                      "step": step},
-                         lambda out: range_runs(out, spec.scenario["t_brake"]), _step_values,
-                         check, inp["dt"], n, coarse=coarse, pool=pool)
+                         lambda out: RUNS.runs(out, spec.scenario["t_brake"]), _step_values,
+                         COMPARED, inp["dt"], n, rtol=spec.conv_rtol, atol=spec.conv_atol,
+                         case=ms.case, seed=ms.seed, draws=inp["draws"], coarse=coarse, pool=pool)
 
 
-#: Quantities of the check under :data:`PREFIX`: runs checked, runs whose every
-#: metric and outcome agrees, and their fraction (:meth:`StepComparison.quantities`).
-halving_quantity_names = partial(general_names, PREFIX)
-halving_quantities = partial(HalvingCheck.quantities, prefix=PREFIX)
+#: The check's quantities (``montecarlo.halving.runs``, ``.agree``, ``.fraction_agree``).
+QUANTITIES = halving_quantities("montecarlo.halving", lambda r: r.halving, lambda spec: (
+    spec.montecarlo is not None and bool(spec.montecarlo.halving)))

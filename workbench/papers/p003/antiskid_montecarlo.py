@@ -42,17 +42,14 @@ step-size check of the sweep's runs is
 """
 from __future__ import annotations
 
-import math
-from dataclasses import asdict, dataclass
-from functools import partial
+from dataclasses import asdict
 from typing import ClassVar
 
 import numpy as np
 
-from ...features.montecarlo_arrays import (chunk_arrays, draws_of, inputs_digest,
+from ...features.montecarlo_arrays import (ArrayRuns, chunk_arrays, inputs_digest,
                                            start_array_sweep)
-from ...features.montecarlo_chunks import read_streamed
-from ...features.montecarlo_stats import OK, RunsResult, quantity_names
+from ...features.montecarlo_stats import OK, RunsResult, runs_quantities
 from ...sim.batch import PendingBatch
 from .antiskid_run_spec import SweepSpec
 
@@ -77,7 +74,6 @@ VIOLATIONS = {"above_lambda_opt": "creep ratio above the sample's lambda_opt in 
 OUTCOMES = (*VIOLATIONS, OK)
 
 
-@dataclass(frozen=True)
 class SweepResult(RunsResult):
     """The runs of a sweep (:class:`~workbench.features.montecarlo_stats.RunsResult`)
     with the paper's summary metrics and outcomes."""
@@ -90,9 +86,8 @@ class SweepResult(RunsResult):
 #: value): ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
 #: ``montecarlo.fraction.<violation>`` and ``montecarlo.wilson.<outcome>.lo``
 #: / ``.hi`` (the Wilson 95 % interval of an outcome's rate).
-montecarlo_quantity_names = partial(quantity_names, "montecarlo", SUMMARY_METRICS, VIOLATIONS,
-                                    OUTCOMES)
-montecarlo_quantities = partial(SweepResult.quantities, prefix="montecarlo")
+QUANTITIES = runs_quantities("montecarlo", SUMMARY_METRICS, VIOLATIONS, OUTCOMES,
+                             lambda r: r.montecarlo, lambda spec: spec.montecarlo is not None)
 
 
 def draw_samples(n: int, seed: int, spec: SweepSpec, start: int = 0) -> dict:
@@ -210,7 +205,8 @@ def lambda_opt_of(plant: dict) -> np.ndarray:
 
 def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]:
     """(metrics, violations) per run, as arrays, from a batch's raw
-    :class:`~workbench.papers.p003.antiskid_scenario.RunMetrics` arrays."""
+    :class:`~workbench.papers.p003.antiskid_scenario.RunMetrics` arrays
+    (those of :data:`RUNS`)."""
     from ...controllers.antiskid003_settings import BRAKE_IN
     # the max over the phase a run diverged in is where the test fired
     in_traction = raw["phase_diverged"] < BRAKE_IN      # NaN (not diverged): False
@@ -226,15 +222,6 @@ def per_run(raw: dict, lam_opt: np.ndarray, t_brake: float) -> tuple[dict, dict]
     return metrics, viol
 
 
-#: Raw metrics a run's outcomes are made from (what :func:`per_run` needs).
-READ = ("lam_max_traction", "t_cruise", "t_omega3", "t_diverged", "phase_diverged", "t_stop")
-
-
-def _read_back(name: str) -> bool:
-    """The columns of a streamed sweep its result is made from (:func:`runs_result`)."""
-    return name == "lambda_opt" or name.startswith("draw.") or name in {f"raw.{k}" for k in READ}
-
-
 def range_worker(payload: dict) -> dict:
     """Simulate runs ``i0 <= i < i1`` of a design's sweep (payload: design,
     K, seed, i0, i1, kernel; ``step``: the step if not the sweep's) and
@@ -247,18 +234,11 @@ def range_worker(payload: dict) -> dict:
                         lambda_opt=lambda_opt_of(inp["plant"]))
 
 
-def range_runs(arrays: dict, t_brake: float) -> tuple[dict, dict]:
-    """(metrics, violations) per run (:func:`per_run`) of :func:`range_worker` arrays."""
-    return per_run({k: arrays[f"raw.{k}"] for k in READ}, arrays["lambda_opt"], t_brake)
-
-
-def runs_result(arrays: dict, t_brake: float, seconds: float = math.nan,
-                workers: int = 0) -> SweepResult:
-    """The :class:`SweepResult` of a sweep's :func:`range_worker` arrays
-    (concatenated over its chunks, in run order)."""
-    metrics, viol = range_runs(arrays, t_brake)
-    return SweepResult(draws_of(arrays), {k: v.tolist() for k, v in metrics.items()},
-                       {k: v.tolist() for k, v in viol.items()}, seconds, workers)
+#: How a sweep's runs are made from its chunk arrays: :func:`per_run` of the
+#: raw metrics it needs and each run's ``lambda_opt``, with the scenario's
+#: ``t_brake`` (``RUNS.runs(arrays, t_brake)``: metrics and violations).
+RUNS = ArrayRuns(per_run, ("lam_max_traction", "t_cruise", "t_omega3", "t_diverged",
+                           "phase_diverged", "t_stop"), ("lambda_opt",), SweepResult)
 
 
 def _manifest(design, samples: int, seed: int, chunk: int, kernel: str, K) -> dict:
@@ -301,31 +281,22 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
     return start_array_sweep(
         range_worker, lambda i0, i1: {"design": design, "K": K, "seed": seed, "i0": i0,
                                       "i1": i1, "kernel": kernel},
-        samples, lambda cols, seconds, n_workers: runs_result(cols, t_brake, seconds,
-                                                              n_workers),
+        samples, lambda cols, seconds, n_workers: RUNS.result_of(cols, seconds, n_workers,
+                                                                 t_brake),
         chunk=chunk, workers=workers, pool=pool, scheduler=scheduler,
         before_pool=compile_kernel if kernel == "compiled" else None, out=out,
         manifest=lambda ch: _manifest(design, samples, seed, ch, kernel, K), resume=resume,
-        select=_read_back)
-
-
-def start_streaming(design, samples: int, seed: int, out, **kw) -> PendingBatch:
-    """:func:`start_sweep` written to the folder ``out`` (the CLI's ``--out``)."""
-    return start_sweep(design, samples, seed, out=out, **kw)
+        select=RUNS.select)
 
 
 def load_sweep(out) -> SweepResult:
     """The :class:`SweepResult` of a streamed sweep, from its chunk files
     (only the columns the summaries use are read)."""
-    man, col = read_streamed(out, _read_back)
-    return runs_result(col, float(man["t_brake"]))
+    return RUNS.load(out, lambda manifest: (float(manifest["t_brake"]),))
 
 
-def sweep(design, samples: int, seed: int, *, workers: int | None = None,
-          chunk: int | None = None, progress: bool = True,
-          kernel: str | None = None, scheduler: str | None = None) -> SweepResult:
+def sweep(design, samples: int, seed: int, *, progress: bool = True, **kw) -> SweepResult:
     """Run the Monte Carlo sweep of an ``antiskid-run`` design in memory
-    (:func:`start_sweep`, same parameters), a progress bar on stderr when
-    ``progress``."""
-    return start_sweep(design, samples, seed, workers=workers, chunk=chunk,
-                       kernel=kernel, scheduler=scheduler).result(progress)
+    (:func:`start_sweep`, the same keywords ``kw``), a progress bar on stderr
+    when ``progress``."""
+    return start_sweep(design, samples, seed, **kw).result(progress)

@@ -31,6 +31,3 @@ WORDS = SweepWords(
     shade=("diverged", "t_diverged", "diverged at t (s)"),
     # with a varying delay h(t) the constant h draw is not used
     alternates={"h": ("delay_period", "h(t) period (s)", "period of the varying delay h(t) (s)")})
-
-#: What ``workbench sweep`` prints and draws (:func:`.antiskid_run.sweep_command`).
-summary_tables, draw_histograms = WORDS.tables, WORDS.histograms

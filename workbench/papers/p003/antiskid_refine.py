@@ -180,12 +180,12 @@ def _mc_levels(design, result, cache, m, r) -> Levels:
         if "mc" not in cache:
             from .antiskid_halving import _step_values
             from .antiskid_kernel import default_kernel
-            from .antiskid_montecarlo import range_runs, range_worker
+            from .antiskid_montecarlo import RUNS, range_worker
             hc = result.halving
             out = range_worker({"design": design, "K": tuple(result.K), "i0": 0, "i1": hc.n,
                                 "seed": design.spec.montecarlo.seed, "step": hc.dt / 4,
                                 "kernel": default_kernel()})
-            cache["mc"] = _step_values(*range_runs(out, design.spec.scenario["t_brake"]))
+            cache["mc"] = _step_values(*RUNS.runs(out, design.spec.scenario["t_brake"]))
         return cache["mc"]
     return sweep_share_levels(r, lambda k: result.montecarlo.violations[k], result.halving,
                               MC_OUTCOMES, quarter, "montecarlo")

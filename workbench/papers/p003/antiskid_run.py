@@ -30,9 +30,10 @@ from ...reader import Reader
 from ...sim.delay import SimResult
 from ...sim.wheel_slip import model_functions
 from .antiskid_basin_run import basin_quantities, basin_quantity_names, run_basin
-from .antiskid_halving import halving_quantities, halving_quantity_names, start_halving
-from .antiskid_montecarlo import (montecarlo_quantities, montecarlo_quantity_names,
-                                  start_streaming, start_sweep, sweep, traction_slope)
+from .antiskid_halving import QUANTITIES as HALVING_QUANTITIES
+from .antiskid_halving import start_halving
+from .antiskid_montecarlo import QUANTITIES as MONTECARLO_QUANTITIES
+from .antiskid_montecarlo import start_sweep, sweep, traction_slope
 from .antiskid_refine import (quarter_cases, refine_levels, three_level_metrics,
                               unconverged_reason)
 from .antiskid_run_spec import (METRICS, Case, RunSpec, case_mesh, case_metrics,
@@ -197,7 +198,7 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     from ...features.cli_plumbing import check_sweep_flags, run_sweep
     from ...report.markdown import Figure
     from .antiskid_kernel import KERNELS, compiled_available
-    from .antiskid_montecarlo_render import draw_histograms, summary_tables
+    from .antiskid_montecarlo_render import WORDS
     check_sweep_flags(samples, workers)
     if design.spec.montecarlo is None:
         raise DesignError(design.path, "montecarlo", "<missing>",
@@ -210,13 +211,13 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
                           "(pip install 'traincontrol-workbench[fast]')")
     res = run_sweep(lambda: sweep(design, samples, seed, workers=workers, kernel=kernel,
                                   progress=not as_json, scheduler=scheduler),
-                    lambda: start_streaming(design, samples, seed, out, resume=resume,
-                                            workers=workers, kernel=kernel, scheduler=scheduler),
+                    lambda: start_sweep(design, samples, seed, out=out, resume=resume,
+                                        workers=workers, kernel=kernel, scheduler=scheduler),
                     out=out, resume=resume, scheduler=scheduler, progress=not as_json)
     if figure:
         from ...report.figures import save_figure
         save_figure(Figure(Path(figure).stem, "Monte Carlo histograms",
-                           lambda fig: draw_histograms(fig, res), (9.0, 3.2)), Path(figure))
+                           lambda fig: WORDS.histograms(fig, res), (9.0, 3.2)), Path(figure))
     if as_json:
         print(json.dumps({"design": design.name, "samples": samples, "seed": seed,
                           "seconds": res.seconds, "workers": res.workers,
@@ -225,7 +226,7 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
         return 0
     print(f"{design.name}: {samples} runs, seed {seed}, {res.workers} worker(s), "
           f"{res.seconds:.1f} s")
-    print(summary_tables(res, 4))
+    print(WORDS.tables(res, 4))
     if figure:
         print(f"wrote {figure}")
     return 0
@@ -279,10 +280,8 @@ TABLE = (
       for f, u in (("abscissa", "1/s"), ("margin", "s"), ("dmu_dlam", "1"))),
     Group(lambda spec: {f"cases[{c.name}].{k}" for c in spec.cases for k in COMFORT_QUANTITIES},
           _comfort_values, present=lambda spec: spec.comfort is not None),
-    Group(lambda spec: montecarlo_quantity_names(), montecarlo_quantities,
-          present=lambda spec: spec.montecarlo is not None, part=lambda r: r.montecarlo),
-    Group(lambda spec: halving_quantity_names(), halving_quantities, part=lambda r: r.halving,
-          present=lambda spec: spec.montecarlo is not None and bool(spec.montecarlo.halving)),
+    *MONTECARLO_QUANTITIES,
+    *HALVING_QUANTITIES,
     Group(lambda spec: basin_quantity_names([c.name for c in spec.cases], True),
           lambda r: basin_quantities(r.basin.basin, r.basin.sweep,
                                      [c.case.name for c in r.cases], r.basin.brake),
