@@ -9,11 +9,12 @@ import sympy as sp
 from ...kinds.stop_accuracy.error_samples import (plot_abs_ecdf, plot_grouped_boxes, ride_table,
                                                   section_table, within_rows)
 from ...kinds.stop_accuracy.render import quantity_table, ranges_table, sections_table
+from ...kinds.stop_accuracy.run import controller_index
 from ...kinds.stop_accuracy.trace_figures import plot_tracked_stops
 from ...plants.brake000 import brake_model
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .station_stopping_fair_render import fair_section, figures
-from .station_stopping_spec import CONTROLLERS, gains, label, smarc_gains
+from .station_stopping_spec import CONTROLLERS, VARIANTS, gains, label
 
 
 #: Stop window of the accuracy table and figure (m): the usual platform-screen-door tolerance.
@@ -42,7 +43,9 @@ def model_section() -> str:
 
 def render(design, res) -> Rendered:
     spec = design.spec
-    g, pid, ref, rp = smarc_gains(spec), gains(spec, "pid"), spec.reference, spec.sections
+    # c, k_s, eta, phi, lam, theta_min, theta_max of the SMARC row (eqs 22, 26-27)
+    g = spec.controllers[controller_index(spec, VARIANTS["smarc"][0])].smarc.values(spec.constants)
+    pid, ref, rp = gains(spec, "pid"), spec.reference, spec.sections
     sections = [
         "## Problem\n\nStation stops of paper 000 (section 3.2) on the seven Beijing Line 5 "
         "sections of Table 3, **synthetic**: the ATO logs are not public. Each run starts "

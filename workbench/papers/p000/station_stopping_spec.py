@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 from ...kinds.stop_accuracy.loop_damping import pid_gains
 from ...kinds.stop_accuracy.needs import require
-from ...kinds.stop_accuracy.run import controller_index
 
 #: Paper name -> (the design's controller, label in the report). The first
 #: four are the controllers of the per-section tables: paper 000's three, then
@@ -84,12 +83,6 @@ class Line5:
 def gains(spec, name: str) -> dict:
     """kp, ki, kd of the PID of the paper name ``name`` (the named module ``pid``)."""
     return pid_gains(spec, VARIANTS[name][0])
-
-
-def smarc_gains(spec) -> dict:
-    """c, k_s, eta, phi, lam, theta_min, theta_max of the SMARC row (eqs 22, 26-27)."""
-    return spec.controllers[controller_index(spec, VARIANTS["smarc"][0])].smarc.values(
-        spec.constants)
 
 
 def load(root, spec) -> Line5:

@@ -47,18 +47,12 @@ from .closed_loop_brake_run import (CHANNELS, CONTROLLERS, ELECTRIC_LOSS, FACTOR
 from .closed_loop_brake_render import render
 from .closed_loop_brake_spec import compute_worked, load
 
-__all__ = ["ANALYSIS", "NOMINAL", "Result004", "compute_worked", "corners",
-           "run_grid", "TABLE"]
+__all__ = ["ANALYSIS", "NOMINAL", "Result004", "compute_worked", "run_grid", "TABLE"]
 
 #: the nominal corner (force error, gradient permille, friction factor)
 NOMINAL = (0.0, 0.0, 1.0)
 #: a sensor fault's name in the report -> the design's fault
 _FAULT_KEYS = {v: k for k, v in FAULT_NAMES.items()}
-
-
-def corners(spec) -> list:
-    """(force error, gradient, friction) of every grid corner, in the grid's order."""
-    return grid_corners(spec, FACTORS)
 
 
 @dataclass(frozen=True)
@@ -73,7 +67,8 @@ class Result004(KindView):
     sweep: dict | None = None  # (ATO horizon s, speed km/h) -> nominal closed-loop stop error m
 
     def corners(self) -> list:
-        return corners(self.spec)
+        """(force error, gradient, friction) of every grid corner, in the grid's order."""
+        return grid_corners(self.spec, FACTORS)
 
     def grid(self, s, mode: str, channel: str = "analogue") -> tuple:
         """Stop errors (m) of a mode at every grid corner (healthy sensors)."""
@@ -94,7 +89,7 @@ def run_grid(spec, *, montecarlo: bool = True) -> Result004:
     without its Monte Carlo) and the curves; with ``montecarlo`` also the
     Monte Carlo of :data:`MC_MODES` and the horizon sweep."""
     res = run(replace(spec, montecarlo=None, convergence=False))
-    cs = corners(spec)
+    cs = grid_corners(spec, FACTORS)
     fe = sorted({min(c[0] for c in cs), 0.0} & {c[0] for c in cs if c[1:] == NOMINAL[1:]})
     return Result004(res, compute_worked(spec.paper.worked),
                      tuple(run_curves(spec, res.distance, fe)),

@@ -12,7 +12,7 @@ from ...kinds.stop_accuracy.render import corner_rows, plot_speed_distance, quan
 from ...kinds.stop_accuracy.run import speed_key
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .closed_loop_brake_fair_render import fault_text, figures, monte_carlo, retune_section
-from .closed_loop_brake_run import CHANNELS, CONTROLLERS, ELECTRIC_LOSS, FACTORS, MODES, faults
+from .closed_loop_brake_run import ELECTRIC_LOSS, FACTORS, MODES, RUNS, faults
 from .closed_loop_brake_spec import worked_formulas
 
 MODE_TEXT = {"open": "open loop, single command",
@@ -66,12 +66,11 @@ def render(design, res) -> Rendered:
     ]
     rows, kv, n = [], res.kind_values, len(res.corners())
     for s in res.distance:
-        for m in MODES:
-            for ch in (CHANNELS if m == "closed" else ("analogue",)):
-                q = f"{speed_key(s)}.{CONTROLLERS[m, ch]}.grid."
-                rows.append([fmt(s), m, ch, fmt(kv[q + "max_abs_m"], 3),
-                             f"{kv[q + 'failing_corners']:g} / {n}",
-                             f"{kv[q + 'failing_feasible_corners']:g}"])
+        for (m, ch), c in RUNS.items():
+            q = f"{speed_key(s)}.{c}.grid."
+            rows.append([fmt(s), m, ch, fmt(kv[q + "max_abs_m"], 3),
+                         f"{kv[q + 'failing_corners']:g} / {n}",
+                         f"{kv[q + 'failing_feasible_corners']:g}"])
     n_inf = sum(not ok for s in res.distance for ok in feasible(res.kind, s)) // max(
         len(res.distance), 1)
     sections.append(
@@ -114,9 +113,7 @@ def render(design, res) -> Rendered:
 
 
 def _corner_details(res) -> str:
-    rows = corner_rows(res.kind, FACTORS, [CONTROLLERS[k] for k in (
-        ("open", "analogue"), ("ato-open", "analogue"), ("closed", "analogue"),
-        ("closed", "3bit"))], (lambda f: fmt(100 * f), fmt, fmt))
+    rows = corner_rows(res.kind, FACTORS, list(RUNS.values()), (lambda f: fmt(100 * f), fmt, fmt))
     return ("<details><summary>Every corner (stop error, m; + = overshoot)</summary>\n\n"
             + md_table(["km/h", "force error %", "gradient ‰", "friction", "feasible", "open",
                         "ATO open", "closed analogue", "closed 3-bit"], rows, "rrrrlrrrr")
@@ -129,7 +126,7 @@ def _plot_grid(fig, res, spec):
         fig, list(res.distance), GridAxis(grid["force_error"], "force error (%)",
                                           lambda f: fmt(100 * f)),
         GridAxis(grid["gradient"], "gradient (‰, + uphill)"), GridAxis(grid["friction"]),
-        result_cell(res.kind, CONTROLLERS["closed", "analogue"], FACTORS),
+        result_cell(res.kind, RUNS["closed", "analogue"], FACTORS),
         tol, title=lambda s, fr: f"{fmt(s)} km/h, friction ×{fmt(fr)}",
         suptitle=f"closed-loop stop error (m); green: within ±{fmt(tol)} m, orange to red: "
         f"beyond it, dark red: ≥ {fmt(3 * tol)} m",

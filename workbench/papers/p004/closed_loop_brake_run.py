@@ -32,6 +32,8 @@ MC_MODES = ("ato-open", "closed")
 CONTROLLERS = {("open", "analogue"): "open", ("ato-open", "analogue"): "ato_open",
                ("closed", "analogue"): "closed", ("closed", "3bit"): "closed_3bit",
                (FULL, "analogue"): "full_service"}
+#: (mode, channel) -> controller of the report's runs (every one but full service)
+RUNS = {k: c for k, c in CONTROLLERS.items() if k[0] != FULL}
 
 
 def faults(spec) -> dict:
@@ -45,10 +47,10 @@ def run_curves(spec, distance: dict, force_errors) -> list:
     at the first speed and each of ``force_errors`` (gradient 0, friction x1),
     recorded every 0.5 s (:func:`~workbench.kinds.stop_accuracy.run.factor_traces`)."""
     from ...kinds.stop_accuracy.run import factor_traces
-    s, modes = spec.speeds_kmh[0], [k for k in CONTROLLERS if k[0] != FULL]
-    tr = factor_traces(spec, [CONTROLLERS[k] for k in modes], s, distance[s], "force_error",
-                       force_errors, dt_rec=0.5)
-    return [(m, ch, fe, *tr[fe, CONTROLLERS[m, ch]]) for fe in force_errors for m, ch in modes]
+    s = spec.speeds_kmh[0]
+    tr = factor_traces(spec, list(RUNS.values()), s, distance[s], "force_error", force_errors,
+                       dt_rec=0.5)
+    return [(m, ch, fe, *tr[fe, c]) for fe in force_errors for (m, ch), c in RUNS.items()]
 
 
 def run_montecarlo(spec, distance: dict) -> dict:
@@ -74,4 +76,4 @@ def run_horizon_sweep(spec, distance: dict) -> dict:
 
 
 __all__ = ["CHANNELS", "CONTROLLERS", "ELECTRIC_LOSS", "FACTORS", "FAULT_NAMES", "FULL", "MC_MODES",
-           "MODES", "faults", "run_curves", "run_horizon_sweep", "run_montecarlo"]
+           "MODES", "RUNS", "faults", "run_curves", "run_horizon_sweep", "run_montecarlo"]
