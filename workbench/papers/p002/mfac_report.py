@@ -10,6 +10,7 @@ from __future__ import annotations
 __all__ = ["render"]
 
 from ...plants.train002 import latex_equations
+from ...report.display_math import display_math
 from ...report.markdown import Rendered, fmt
 from ...kinds.tracking.mfac import SENSITIVITY_KEYS, frozen_integrator
 from ...kinds.tracking import render_general as G
@@ -81,8 +82,8 @@ def _problem(spec, res) -> str:
 
 
 def _model(spec) -> str:
-    eqs_i = "\n\n".join(f"$$\n{e}\n$$" for e in latex_equations())
-    eqs_f = "\n\n".join(f"$$\n{e}\n$$" for e in latex_equations("first-order-002"))
+    eqs_i = display_math(latex_equations())
+    eqs_f = display_math(latex_equations("first-order-002"))
     return (
         "## Model, controllers and objectives\n\nIntegrating reading (rendered from "
         "`workbench/plants/train002.py`; i is the gradient):\n\n" + eqs_i

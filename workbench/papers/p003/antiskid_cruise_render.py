@@ -13,6 +13,7 @@ import sympy as sp
 from ...features.other_gains import ANCHOR
 from ...features.sweep_study_render import sweep_sections
 from ...plants.adhesion import adhesion_model
+from ...report.display_math import display_math
 from ...report.markdown import Rendered, fmt, latex_matrix, md_table
 from .antiskid_cruise import PARAM_DOC
 
@@ -34,10 +35,9 @@ def _model_section() -> str:
         r"\text{braking (eq 16): } \dot v = z_1,\ \dot\lambda = z_2 + z_3 u(t-h)",
         r"z_2 = " + ren(z2), r"z_3 = " + ren(z3),
     ]
-    body = "\n\n".join(f"$$\n{e}\n$$" for e in eqs)
     return ("## Model (paper 003, eqs 4-16)\n\nRendered from the workbench's sympy model "
             "(`workbench/plants/adhesion.py`), the single source of every numeric function "
-            "and Jacobian below.\n\n" + body)
+            "and Jacobian below.\n\n" + display_math(eqs))
 
 
 def render(design, res) -> Rendered:
