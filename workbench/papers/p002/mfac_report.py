@@ -12,6 +12,7 @@ __all__ = ["render"]
 from ...plants.train002 import latex_equations
 from ...report.display_math import display_math
 from ...report.markdown import Rendered, fmt
+from ...report.param_table import param_table
 from ...kinds.tracking.mfac import SENSITIVITY_KEYS, frozen_integrator
 from ...kinds.tracking import render_general as G
 from ...kinds.tracking import render_tables as T
@@ -71,11 +72,11 @@ def _problem(spec, res) -> str:
         + T.readings_table(spec)
         + "\n\nThe train of `[train]` (the integrating reading's chain; every value our "
         "documented choice, not the paper's):\n\n"
-        + G.param_table(spec.train, DOC))
+        + param_table(spec.train, DOC, 5))
     for r in spec.readings:
         if r.params:
             text += (f"\n\nReading `{r.name}` (*our reading*; Davis resistance and gravity "
-                     "as above):\n\n" + G.param_table(r.params, DOC))
+                     "as above):\n\n" + param_table(r.params, DOC, 5))
     return text + (f"\n\nCommand limits of the integrating reading {fmt(spec.u_limits[0])} … "
                    f"{fmt(spec.u_limits[1])} m/s². Control sample Ts = {fmt(spec.Ts)} s, plant "
                    f"step {fmt(spec.dt)} s (lags integrated exactly over a step, delay as a FIFO).")
