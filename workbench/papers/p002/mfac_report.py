@@ -31,32 +31,24 @@ H_LINE = "Line of adjacent stations (SYNTHETIC)"
 H_SENS = "Sensitivity of the chosen MFAC point"
 H_END = "Closing note: the MFAC verdict per plant reading"
 
-MFAC_EQS = r"""$$
-\hat\phi(k) = \hat\phi(k-1) + \frac{\eta\,\Delta u(k-1)}{\mu + \Delta u(k-1)^2}
-\big(\Delta y(k) - \hat\phi(k-1)\Delta u(k-1)\big) \qquad \text{(eq 9)}
-$$
-
-$$
-\hat\phi(k) = \hat\phi(1) \ \text{ if } |\hat\phi(k)| \le \varepsilon \text{ or } |\Delta u(k-1)|
+MFAC_EQS = display_math([
+    r"""\hat\phi(k) = \hat\phi(k-1) + \frac{\eta\,\Delta u(k-1)}{\mu + \Delta u(k-1)^2}
+\big(\Delta y(k) - \hat\phi(k-1)\Delta u(k-1)\big) \qquad \text{(eq 9)}""",
+    r"""\hat\phi(k) = \hat\phi(1) \ \text{ if } |\hat\phi(k)| \le \varepsilon \text{ or } """
+    r"""|\Delta u(k-1)|
 \le \varepsilon \text{ or } \operatorname{sign}\hat\phi(k) \ne \operatorname{sign}\hat\phi(1)
-\qquad \text{(eq 9, reset)}
-$$
+\qquad \text{(eq 9, reset)}""",
+    r"""u(k) = u(k-1) + \frac{\rho\,\hat\phi(k)}{\lambda + \hat\phi(k)^2}\big(y^*(k+1) - y(k)\big)
+\qquad \text{(eq 7)}""",
+])
 
-$$
-u(k) = u(k-1) + \frac{\rho\,\hat\phi(k)}{\lambda + \hat\phi(k)^2}\big(y^*(k+1) - y(k)\big)
-\qquad \text{(eq 7)}
-$$"""
-
-OBJ_FORMULAS = r"""$$
-J_s = |s_t - S|, \qquad J_t = |T_t - T_o|, \qquad
+OBJ_FORMULAS = display_math([
+    r"""J_s = |s_t - S|, \qquad J_t = |T_t - T_o|, \qquad
 J_c = \Big(\frac{1}{N}\sum_{k < T_t/T_s} \big(\tfrac{a(k+1) - a(k)}{T_s}\big)^2\Big)^{1/2}, \qquad
-J_e = \int_0^{T_t} \max(a_{\mathrm{applied}}, 0)\, v \, dt
-$$
-
-$$
-\text{design point: } \min \sum_j w_j \frac{J_j}{s_j} \ \text{ over the runs with } J_s \le
-\text{the stop requirement}
-$$"""
+J_e = \int_0^{T_t} \max(a_{\mathrm{applied}}, 0)\, v \, dt""",
+    r"""\text{design point: } \min \sum_j w_j \frac{J_j}{s_j} \ \text{ over the runs with } J_s \le
+\text{the stop requirement}""",
+])
 
 
 def _problem(spec, res) -> str:
