@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from ...printed_grid import printed_digits
+from ...report.display_math import display_math
 from ...report.markdown import (Figure, Rendered, fmt, fmt_floor, latex_matrix, md_table,
                                noise_cell, noise_peak)
 from ...report.synthesis_text import (capped_text, closed_loop_eigs_text, exact_margin_text,
@@ -99,7 +100,7 @@ def render(design, res) -> Rendered:
         f"is derived. Input delay: {delay} ({d.source}).\n\n"
         + md_table(["name", "role", "unit", "meaning", "source"], var, "lllll")
         + "\n\n" + md_table(["parameter", "value", "unit", "source"], par, "lrll"))
-    sections.append("## Model\n\n" + "\n\n".join(f"$$\n{e}\n$$" for e in model_latex(spec))
+    sections.append("## Model\n\n" + display_math(model_latex(spec))
                     + "\n\nThe input acts with the delay: u = u(t − h) in the equations.")
     # -- operating point and linearisation ----------------------------------------------
     vals = res.op.as_dict(p)

@@ -10,6 +10,7 @@ import numpy as np
 
 from ...features.reproducible import window
 from ...report.markdown import Figure, Rendered, fmt, md_table
+from ...report.param_table import param_table
 from . import realism_render as realism
 
 __all__ = ["HOOKS", "render"]
@@ -71,7 +72,6 @@ def render(design, res) -> Rendered:
     spec = design.spec
     labels = {r.name: r.label for r in spec.runs}
     sec = []
-    prow = [[f"`{k}`", fmt(q.value, 4), q.unit, DOC[k], q.source] for k, q in spec.plant.items()]
     sec.append(
         "## Problem\n\n"
         f"{spec.n} trains, leader-follower, spacing D = {fmt(spec.D.value)} m"
@@ -85,7 +85,7 @@ def render(design, res) -> Rendered:
         f"gain {fmt(spec.leader_gain)} 1/s. Gradients "
         f"{', '.join(fmt(x * 1000) for x in spec.route.grade)} ‰ "
         f"from {', '.join(fmt(x) for x in spec.route.grade_from)} m (ours).\n\n"
-        + md_table(["parameter", "value", "unit", "meaning", "source"], prow, "lrlll")
+        + param_table(spec.plant, DOC, 4)
         + "\n\n" + _hook(spec, "problem_note", res, lambda: _constants_note(spec, res)))
     sec.append(_hook(spec, "law_section", res, lambda: _law_section(spec, res)))
     rows = []

@@ -8,10 +8,11 @@ import numpy as np
 
 from ...features.reproducible import NUDGE, RTOL
 from ...report.markdown import Figure, Rendered, fmt, md_table
+from ...report.param_table import param_table
 from . import figures as F
 from .spec import OBJECTIVE_UNITS, OBJECTIVES
 
-__all__ = ["DOC", "LABEL", "line_figure", "pareto_links", "param_table", "params_text",
+__all__ = ["DOC", "LABEL", "line_figure", "pareto_links", "params_text",
            "ppd_figure", "render", "scale_rows", "scale_table", "tuning_figures"]
 
 H_TUNE = "Tuning per reading and controller"
@@ -36,19 +37,12 @@ def _problem(spec) -> str:
                            "gradients"], rows, "lrrrl")
         + "\n\nTrain (`[train]`, model `delay-lag-002` of `workbench/plants/train002.py`: "
         "command → demanded acceleration → delay → lag → speed, Davis resistance and "
-        "gravity):\n\n" + param_table(spec.train, DOC)
+        "gravity):\n\n" + param_table(spec.train, DOC, 5)
         + f"\n\nCommand limits {fmt(spec.u_limits[0])} … {fmt(spec.u_limits[1])}. Control "
         f"cycle Ts = {fmt(spec.Ts)} s, plant step {fmt(spec.dt)} s. Target profile: "
         f"acceleration {fmt(spec.profile['accel'])} m/s², braking "
         f"{fmt(spec.profile['brake'])} m/s², jerk {fmt(spec.profile['jerk'])} m/s³ "
         "(`workbench/profiles.py`).")
-
-
-def param_table(params: dict, doc: dict) -> str:
-    """The table of a train's ``params`` (name -> Quantity), each with its
-    meaning of ``doc``."""
-    rows = [[f"`{k}`", fmt(q.value, 5), q.unit, doc[k], q.source] for k, q in params.items()]
-    return md_table(["parameter", "value", "unit", "meaning", "source"], rows, "lrlll")
 
 
 def params_text(tun, symbol: dict | None = None) -> str:

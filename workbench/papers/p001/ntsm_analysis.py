@@ -27,6 +27,7 @@ from __future__ import annotations
 from ...controllers.ntsm import NTSMGains
 from ...errors import DesignError
 from ...features.quantities import Declared
+from ...report.display_math import display_math
 from ...report.markdown import fmt
 
 __all__ = ["PLATOON_ANALYSIS", "NTSMAnalysis"]
@@ -34,22 +35,16 @@ __all__ = ["PLATOON_ANALYSIS", "NTSMAnalysis"]
 #: The [constants] that hold eq 13's gains.
 GAINS = ("beta", "a", "b", "j", "k", "alpha", "xi")
 
-LAW = r"""$$
-e_i = x_{i-1} - x_i - D, \qquad s_i = e_i + \tfrac{1}{\beta}\,\dot e_i^{\,b/a}
-\qquad \text{(eqs 7, 10)}
-$$
-
-$$
-u_i = \underbrace{c_0 + c_1 v_i + c_2 v_i^2 + m g \sin\varphi}_{u_1}
+LAW = display_math([
+    r"""e_i = x_{i-1} - x_i - D, \qquad s_i = e_i + \tfrac{1}{\beta}\,\dot e_i^{\,b/a}
+\qquad \text{(eqs 7, 10)}""",
+    r"""u_i = \underbrace{c_0 + c_1 v_i + c_2 v_i^2 + m g \sin\varphi}_{u_1}
 + \underbrace{\tfrac{\beta a m}{b}\,\dot e_i^{\,2-b/a}}_{u_2}
 + \underbrace{\tfrac{\beta a m}{b}\,(j s_i + k s_i^{\alpha/\xi})}_{u_3}
 + \underbrace{(G_w + G_d)\operatorname{sign}(s_i) + m\dot v_{i-1}}_{u_4}
-\qquad \text{(eq 13)}
-$$
-
-$$
-t_f - t_e = \frac{b}{b-a}\,\beta^{-a/b}\,|e_i(t_e)|^{1-a/b} \qquad \text{(eq 22)}
-$$"""
+\qquad \text{(eq 13)}""",
+    r"""t_f - t_e = \frac{b}{b-a}\,\beta^{-a/b}\,|e_i(t_e)|^{1-a/b} \qquad \text{(eq 22)}""",
+])
 
 
 def _c(spec, name: str) -> float:

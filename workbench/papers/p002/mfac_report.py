@@ -10,7 +10,9 @@ from __future__ import annotations
 __all__ = ["render"]
 
 from ...plants.train002 import latex_equations
+from ...report.display_math import display_math
 from ...report.markdown import Rendered, fmt
+from ...report.param_table import param_table
 from ...kinds.tracking.mfac import SENSITIVITY_KEYS, frozen_integrator
 from ...kinds.tracking import render_general as G
 from ...kinds.tracking import render_tables as T
@@ -29,32 +31,24 @@ H_LINE = "Line of adjacent stations (SYNTHETIC)"
 H_SENS = "Sensitivity of the chosen MFAC point"
 H_END = "Closing note: the MFAC verdict per plant reading"
 
-MFAC_EQS = r"""$$
-\hat\phi(k) = \hat\phi(k-1) + \frac{\eta\,\Delta u(k-1)}{\mu + \Delta u(k-1)^2}
-\big(\Delta y(k) - \hat\phi(k-1)\Delta u(k-1)\big) \qquad \text{(eq 9)}
-$$
-
-$$
-\hat\phi(k) = \hat\phi(1) \ \text{ if } |\hat\phi(k)| \le \varepsilon \text{ or } |\Delta u(k-1)|
+MFAC_EQS = display_math([
+    r"""\hat\phi(k) = \hat\phi(k-1) + \frac{\eta\,\Delta u(k-1)}{\mu + \Delta u(k-1)^2}
+\big(\Delta y(k) - \hat\phi(k-1)\Delta u(k-1)\big) \qquad \text{(eq 9)}""",
+    r"""\hat\phi(k) = \hat\phi(1) \ \text{ if } |\hat\phi(k)| \le \varepsilon \text{ or } """
+    r"""|\Delta u(k-1)|
 \le \varepsilon \text{ or } \operatorname{sign}\hat\phi(k) \ne \operatorname{sign}\hat\phi(1)
-\qquad \text{(eq 9, reset)}
-$$
+\qquad \text{(eq 9, reset)}""",
+    r"""u(k) = u(k-1) + \frac{\rho\,\hat\phi(k)}{\lambda + \hat\phi(k)^2}\big(y^*(k+1) - y(k)\big)
+\qquad \text{(eq 7)}""",
+])
 
-$$
-u(k) = u(k-1) + \frac{\rho\,\hat\phi(k)}{\lambda + \hat\phi(k)^2}\big(y^*(k+1) - y(k)\big)
-\qquad \text{(eq 7)}
-$$"""
-
-OBJ_FORMULAS = r"""$$
-J_s = |s_t - S|, \qquad J_t = |T_t - T_o|, \qquad
+OBJ_FORMULAS = display_math([
+    r"""J_s = |s_t - S|, \qquad J_t = |T_t - T_o|, \qquad
 J_c = \Big(\frac{1}{N}\sum_{k < T_t/T_s} \big(\tfrac{a(k+1) - a(k)}{T_s}\big)^2\Big)^{1/2}, \qquad
-J_e = \int_0^{T_t} \max(a_{\mathrm{applied}}, 0)\, v \, dt
-$$
-
-$$
-\text{design point: } \min \sum_j w_j \frac{J_j}{s_j} \ \text{ over the runs with } J_s \le
-\text{the stop requirement}
-$$"""
+J_e = \int_0^{T_t} \max(a_{\mathrm{applied}}, 0)\, v \, dt""",
+    r"""\text{design point: } \min \sum_j w_j \frac{J_j}{s_j} \ \text{ over the runs with } J_s \le
+\text{the stop requirement}""",
+])
 
 
 def _problem(spec, res) -> str:
@@ -70,19 +64,19 @@ def _problem(spec, res) -> str:
         + T.readings_table(spec)
         + "\n\nThe train of `[train]` (the integrating reading's chain; every value our "
         "documented choice, not the paper's):\n\n"
-        + G.param_table(spec.train, DOC))
+        + param_table(spec.train, DOC, 5))
     for r in spec.readings:
         if r.params:
             text += (f"\n\nReading `{r.name}` (*our reading*; Davis resistance and gravity "
-                     "as above):\n\n" + G.param_table(r.params, DOC))
+                     "as above):\n\n" + param_table(r.params, DOC, 5))
     return text + (f"\n\nCommand limits of the integrating reading {fmt(spec.u_limits[0])} … "
                    f"{fmt(spec.u_limits[1])} m/s². Control sample Ts = {fmt(spec.Ts)} s, plant "
                    f"step {fmt(spec.dt)} s (lags integrated exactly over a step, delay as a FIFO).")
 
 
 def _model(spec) -> str:
-    eqs_i = "\n\n".join(f"$$\n{e}\n$$" for e in latex_equations())
-    eqs_f = "\n\n".join(f"$$\n{e}\n$$" for e in latex_equations("first-order-002"))
+    eqs_i = display_math(latex_equations())
+    eqs_f = display_math(latex_equations("first-order-002"))
     return (
         "## Model, controllers and objectives\n\nIntegrating reading (rendered from "
         "`workbench/plants/train002.py`; i is the gradient):\n\n" + eqs_i

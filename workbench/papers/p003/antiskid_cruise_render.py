@@ -13,7 +13,9 @@ import sympy as sp
 from ...features.other_gains import ANCHOR
 from ...features.sweep_study_render import sweep_sections
 from ...plants.adhesion import adhesion_model
+from ...report.display_math import display_math
 from ...report.markdown import Rendered, fmt, latex_matrix, md_table
+from ...report.param_table import param_table
 from .antiskid_cruise import PARAM_DOC
 
 
@@ -34,26 +36,22 @@ def _model_section() -> str:
         r"\text{braking (eq 16): } \dot v = z_1,\ \dot\lambda = z_2 + z_3 u(t-h)",
         r"z_2 = " + ren(z2), r"z_3 = " + ren(z3),
     ]
-    body = "\n\n".join(f"$$\n{e}\n$$" for e in eqs)
     return ("## Model (paper 003, eqs 4-16)\n\nRendered from the workbench's sympy model "
             "(`workbench/plants/adhesion.py`), the single source of every numeric function "
-            "and Jacobian below.\n\n" + body)
+            "and Jacobian below.\n\n" + display_math(eqs))
 
 
 def render(design, res) -> Rendered:
     spec = design.spec
     sections = []
     # -- problem --------------------------------------------------------------
-    prow = [[f"`{k}`", fmt(q.value, 6), q.unit, PARAM_DOC.get(k, ""), q.source]
-            for k, q in spec.params.items()]
-    prow.append(["`v_d`", fmt(spec.v_d.value, 6), spec.v_d.unit, "cruise speed", spec.v_d.source])
+    prow = [["`v_d`", fmt(spec.v_d.value, 6), spec.v_d.unit, "cruise speed", spec.v_d.source]]
     if spec.lambda_d_pinned:
         q = spec.lambda_d_pinned
         prow.append(["`lambda_d` (pinned)", fmt(q.value, 6), q.unit, "cruise creep ratio", q.source])
     sections.append(f"## Problem\n\nRail: **{spec.rail}**. Delay-bound synthesis for the cruise "
                     "error system of paper 003 (Theorem 1 with Remark 3, problem (60)).\n\n"
-                    + md_table(["parameter", "value", "unit", "meaning", "source"], prow,
-                               "lrlll"))
+                    + param_table(spec.params, PARAM_DOC, 6, prow))
     sections.append(_model_section())
     # -- operating point ------------------------------------------------------
     lin = res.lin
