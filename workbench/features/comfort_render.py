@@ -1,6 +1,7 @@
-"""Table columns, the stretches above the jerk limit with the events near
-them, and the acceleration/jerk figure of :mod:`workbench.features.comfort`
-(pure rendering; the study adds its own columns, wording and event markers).
+"""Table columns and the per-case table (:func:`comfort_table`), the
+stretches above the jerk limit with the events near them (:func:`jerk_text`),
+and the acceleration/jerk figure of :mod:`workbench.features.comfort` (pure
+rendering; the study adds its own columns, wording and event markers).
 Events of a phase-scheduled run are its phase switches
 (:func:`phase_switches`). Test on a toy: ``tests/test_comfort.py``."""
 from __future__ import annotations
