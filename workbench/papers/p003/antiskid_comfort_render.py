@@ -15,7 +15,7 @@ from ...controllers.antiskid003_settings import PHASE_NAMES
 from ...features.comfort_render import comfort_table, converged_text, jerk_text, phase_switches
 from ...features.comfort_render import plot_comfort as plot_comfort_traces
 from ...report.case_figures import plot_against_limits
-from ...report.markdown import Figure, fmt
+from ...report.markdown import fmt
 from .antiskid_run import RECORD_DT
 from .antiskid_run_figures import color_of
 from .antiskid_run_spec import peak_adhesion_torque
@@ -81,18 +81,6 @@ def comfort_section(res, spec) -> str:
         "against time with the comfort limits (dashed); dotted: the phase switches of the "
         "first case that does not diverge."
         "\n\n![torque]({figdir}/torque.png)\n\n" + TORQUE_CAPTION)
-
-
-def comfort_figure(res, spec) -> Figure:
-    """``comfort.png``: acceleration and jerk against time (a design with ``[comfort]``)."""
-    return Figure("comfort", "Acceleration and jerk against time, with the comfort limits.",
-                  lambda fig, res=res, sp=spec: plot_comfort(fig, res, sp), (7.0, 5.5))
-
-
-def torque_figure(res, spec) -> Figure:
-    """``torque.png``: commanded torque against ±T_adh and the torque range."""
-    return Figure("torque", "Commanded wheel torque against the adhesion and torque limits.",
-                  lambda fig, res=res, sp=spec: plot_torque(fig, res, sp), (7.0, 4.0))
 
 
 #: Caption of ``torque.png`` (in the comfort section, or under Figures without one).

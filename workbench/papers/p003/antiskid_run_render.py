@@ -24,8 +24,8 @@ from ...report.synthesis_text import gain_text
 from ...sim.convergence import P_MIN
 from ...sim.wheel_slip import MAX_DLAMBDA, MAX_HALVINGS
 from .antiskid_basin_render import HEADING as BASIN_HEADING
-from .antiskid_comfort_render import (HEADING, PATTERN, TORQUE_CAPTION, comfort_figure,
-                                      comfort_section, torque_figure)
+from .antiskid_comfort_render import (HEADING, PATTERN, TORQUE_CAPTION, comfort_section,
+                                      plot_comfort, plot_torque)
 from .antiskid_montecarlo_render import WORDS
 from .antiskid_run_figures import plot_adhesion, plot_creep, plot_evs, plot_speed
 
@@ -80,10 +80,12 @@ def render(design, res) -> Rendered:
                 "What happens"),
                (r"switch\.|basin\.", BASIN_HEADING),
                (r"montecarlo\.", "Monte Carlo robustness (reduced sample)")]
-    extra_figs = (torque_figure(res, spec),)
+    extra_figs = (Figure("torque", "Commanded wheel torque against the adhesion and torque limits.",
+                         lambda fig: plot_torque(fig, res, spec), (7.0, 4.0)),)
     if spec.comfort is not None:
         sections.append(comfort_section(res, spec))
-        extra_figs += (comfort_figure(res, spec),)
+        extra_figs += (Figure("comfort", "Acceleration and jerk against time, with the comfort "
+                              "limits.", lambda fig: plot_comfort(fig, res, spec), (7.0, 5.5)),)
         anchors.insert(0, (PATTERN, HEADING))
     if res.sampled is not None:
         from .antiskid_sampled_render import (HEADING as SAMPLED_HEADING, PATTERN as SAMPLED,
