@@ -19,7 +19,7 @@ from workbench.report.case_figures import (Palette, plot_cases, plot_phase_plane
                                            snapped, time_window)
 from workbench.report.case_tables import (CaseLevels, case_convergence_section,  # noqa: E402
                                           case_convergence_table, case_metric_table, case_rows,
-                                          fmt_finite)
+                                          event_cell, fmt_finite)
 from workbench.report.delay_cross_check import (delay_cross_check, envelope_verdict,  # noqa: E402
                                                 plot_envelopes)
 
@@ -170,3 +170,14 @@ def test_binned_fractions_last_bin_closed_and_empty_bin_dashed():
     assert rows[0][2:] == ["1", "0"] and rows[3][2:] == ["0", "1"]
     empty = binned_fraction_rows(gain, 0.0, 2.0, 4, [unstable])
     assert empty[3][1:] == [0, "—"] and sum(r[1] for r in empty) == len(gain)
+
+
+def test_event_cell_says_whether_and_when():
+    """report.case_tables.event_cell on the toy decay: x <= 1/10 by t = 2
+    for the fast case only; ``where`` is not evaluated for the slow one."""
+    slow, fast = (_decay(a, 0.01)["t_tenth"] for a in CASES.values())
+
+    def boom():
+        raise AssertionError("where() evaluated for an event that did not happen")
+    assert event_cell(slow, boom) == "no"
+    assert event_cell(fast, lambda: "fast", 3) == f"yes, t = {fmt_finite(fast, 3)} s (fast)"

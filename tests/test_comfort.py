@@ -206,3 +206,29 @@ def test_converged_column_on_a_toy():
     assert converged_head() == "converged, dt to dt/4 (1 %)"
     assert converged_text(0.02).startswith("Converged: the |a| and |jerk| peaks at dt, dt/2 "
                                            "and dt/4 have a Richardson error estimate within 2 %")
+
+
+def test_comfort_table_and_jerk_text_on_a_toy():
+    """features.comfort_render.comfort_table / jerk_text on speed ramps
+    (no paper's run): one row per case with the study's extra column, and
+    the stretches above the jerk limit with the events near them."""
+    from workbench.features.comfort import comfort_of_speed
+    from workbench.features.comfort_render import (comfort_cells, comfort_headers, comfort_table,
+                                                   converged_head, jerk_text)
+    from workbench.report.markdown import md_table
+    t = np.arange(0.0, 20.0 + 1e-9, 0.05)
+    ramp = lambda k: comfort_of_speed(t, np.where(t < 5, k * t, 5 * k), SPEC, 0.05)
+    levels = (ramp(0.84), ramp(0.8), ramp(0.798))
+    md = comfort_table([("gentle", ramp(0.8), levels, ["x1"]), ("steep", ramp(3.0), None, ["x2"])],
+                       SPEC, ["extra"])
+    head = md_table(["case", *comfort_headers(SPEC), "extra", converged_head()],
+                    [["`gentle`", *comfort_cells(ramp(0.8)), "x1", "yes"]], "lrrrrrl")
+    assert md.splitlines()[:3] == head.splitlines()
+    assert md.splitlines()[3].endswith("| x2 | — |")
+    steep = ramp(3.0)
+    assert steep.jerk_windows                     # the ramp's corners exceed the jerk limit
+    text = jerk_text("steep", steep, [(5.0, "run → hold")], SPEC)
+    assert text.startswith(f"`steep`: |jerk| > {SPEC.jerk_max.value:g} m/s³ at ")
+    assert "run → hold at 5 s" in text and text.endswith(").")
+    assert jerk_text("flat", ramp(0.0), [], SPEC) == (
+        f"`flat`: |jerk| > {SPEC.jerk_max.value:g} m/s³ at no time.")

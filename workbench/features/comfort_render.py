@@ -1,6 +1,7 @@
-"""Table columns, the stretches above the jerk limit with the events near
-them, and the acceleration/jerk figure of :mod:`workbench.features.comfort`
-(pure rendering; the study adds its own columns, wording and event markers).
+"""Table columns and the per-case table (:func:`comfort_table`), the
+stretches above the jerk limit with the events near them (:func:`jerk_text`),
+and the acceleration/jerk figure of :mod:`workbench.features.comfort` (pure
+rendering; the study adds its own columns, wording and event markers).
 Events of a phase-scheduled run are its phase switches
 (:func:`phase_switches`). Test on a toy: ``tests/test_comfort.py``."""
 from __future__ import annotations
@@ -9,12 +10,13 @@ import math
 
 import numpy as np
 
-from ..report.markdown import fmt
+from ..report.markdown import fmt, md_table
 from ..sim.convergence import P_MIN
 from .comfort import COMFORT_RTOL, peaks_converged
 
-__all__ = ["comfort_headers", "comfort_cells", "converged_head", "converged_cell",
-           "converged_text", "phase_switches", "windows_text", "plot_comfort"]
+__all__ = ["comfort_headers", "comfort_cells", "comfort_table", "converged_head",
+           "converged_cell", "converged_text", "jerk_text", "phase_switches", "windows_text",
+           "plot_comfort"]
 
 
 def comfort_headers(limits, accel_unit: str = "m/s²", jerk_unit: str = "m/s³") -> list[str]:
@@ -49,6 +51,17 @@ def converged_text(rtol: float = COMFORT_RTOL) -> str:
             f"error estimate within {fmt(100 * rtol)} % of the peak (levels whose "
             f"differences change sign: the larger difference at order {fmt(P_MIN)}); — : no "
             "dt/4 run")
+
+
+def comfort_table(cases, limits, extra_heads=()) -> str:
+    """One row per case (name, Comfort, levels, extra cells): the name in
+    code font, :func:`comfort_cells`, the study's extra cells under
+    ``extra_heads``, then :func:`converged_cell` of ``levels`` (three
+    Comfort results at dt, dt/2, dt/4, or None)."""
+    rows = [[f"`{name}`", *comfort_cells(c), *extra, converged_cell(levels)]
+            for name, c, levels, extra in cases]
+    return md_table(["case", *comfort_headers(limits), *extra_heads, converged_head()], rows,
+                    "l" + "r" * (4 + len(extra_heads)) + "l")
 
 
 def phase_switches(t, phase, names, pinned=None) -> list[tuple[float, str]]:
@@ -95,6 +108,14 @@ def windows_text(windows, events, window: float, jerk_unit: str = "m/s³") -> st
                      + ("; ".join(near) if near else "no phase switch within the window")
                      + ")")
     return "; ".join(parts)
+
+
+def jerk_text(name: str, c, events, limits, jerk_unit: str = "m/s³") -> str:
+    """"`name`: |jerk| > limit at" the stretches of ``c.jerk_windows`` with
+    the events near them (:func:`windows_text`), or "no time"."""
+    return (f"`{name}`: |jerk| > {fmt(limits.jerk_max.value)} {jerk_unit} at "
+            + (windows_text(c.jerk_windows, events, limits.window.value, jerk_unit)
+               or "no time") + ".")
 
 
 def plot_comfort(fig, traces, limits, events=(), accel_unit: str = "m/s²",

@@ -10,6 +10,8 @@ functions only lay the values out:
 * :func:`case_convergence_table`: each case's metrics at dt, dt/2 and, when
   run, dt/4, with the convergence verdict; :func:`case_convergence_section`:
   that table under a heading that says how the levels are judged;
+* :func:`event_cell`: whether and when an event happened, a cell of an
+  extra row of :func:`case_metric_table`;
 * :func:`case_rows`: one row per case with a placeholder row for a case
   without the item (a phase switch never reached, say).
 
@@ -38,6 +40,13 @@ def present(x: float | None) -> float | None:
 def fmt_finite(x: float | None, sig: int) -> str:
     """``x`` with ``sig`` digits, :data:`MISSING` for None, NaN or an infinity."""
     return MISSING if x is None or not math.isfinite(x) else fmt(x, sig)
+
+
+def event_cell(t: float, where: Callable[[], str], sig: int = 4) -> str:
+    """Whether and when an event (a divergence, say) happened in a case's
+    run: "no" for a NaN time ``t``, else "yes, t = <t> s (<where()>)";
+    ``where`` is called only when it happened (its values exist then)."""
+    return "no" if math.isnan(t) else f"yes, t = {fmt(t, sig)} s ({where()})"
 
 
 def case_metric_table(names: Sequence[str], metrics: Sequence[Mapping[str, float]],

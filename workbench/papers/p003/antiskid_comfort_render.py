@@ -12,12 +12,10 @@ from __future__ import annotations
 import numpy as np
 
 from ...controllers.antiskid003_settings import PHASE_NAMES
-from ...features.comfort_render import (comfort_cells, comfort_headers, converged_cell,
-                                        converged_head, converged_text, phase_switches,
-                                        windows_text)
+from ...features.comfort_render import comfort_table, converged_text, jerk_text, phase_switches
 from ...features.comfort_render import plot_comfort as plot_comfort_traces
 from ...report.case_figures import plot_against_limits
-from ...report.markdown import Figure, fmt, md_table
+from ...report.markdown import fmt
 from .antiskid_run import RECORD_DT
 from .antiskid_run_figures import color_of
 from .antiskid_run_spec import peak_adhesion_torque
@@ -52,14 +50,12 @@ def comfort_section(res, spec) -> str:
     """``## Passenger comfort and wheel torque``."""
     cf = spec.comfort
     u_peak = peak_adhesion_torque(spec)
-    rows = [[f"`{c.case.name}`", *comfort_cells(c.comfort), fmt(c.comfort.u_max_over_peak, 3),
-             converged_cell(None if c.quarter is None else
-                            (c.comfort_coarse, c.comfort, c.quarter[2]))]
-            for c in res.cases]
+    table = comfort_table([(c.case.name, c.comfort, None if c.quarter is None else (
+        c.comfort_coarse, c.comfort, c.quarter[2]), [fmt(c.comfort.u_max_over_peak, 3)])
+        for c in res.cases], cf, ["max |u| / T_adh"])
     done = [c for c in res.cases if np.isnan(c.metrics["t_diverged"])]
-    where = "".join(f"\n\n`{c.case.name}`: |jerk| > {fmt(cf.jerk_max.value)} m/s³ at "
-                    + (windows_text(c.comfort.jerk_windows, _switches(c, spec),
-                                    cf.window.value) or "no time") + "." for c in done)
+    where = "".join("\n\n" + jerk_text(c.case.name, c.comfort, _switches(c, spec), cf)
+                    for c in done)
     if done:   # why a run that works still commands more than T_adh in traction
         J, r = spec.params["J"].value, spec.params["r"].value
         extra = J * float(np.max(done[0].comfort.a)) / r
@@ -78,26 +74,13 @@ def comfort_section(res, spec) -> str:
         "model, the most the rail transmits in steady state (the paper gives no drive or "
         f"brake limit; the design's only torque bound, `torque_range` = "
         f"{fmt(spec.torque_range)} T_adh, is its divergence test).\n\n"
-        + md_table(["case", *comfort_headers(cf), "max |u| / T_adh", converged_head()],
-                   rows, "lrrrrrl")
+        + table
         + "\n\n" + converged_text() + " (no claim states the case's convergence)."
         + where
         + "\n\n![comfort]({figdir}/comfort.png)\n\nAcceleration (top) and jerk (bottom) "
         "against time with the comfort limits (dashed); dotted: the phase switches of the "
         "first case that does not diverge."
         "\n\n![torque]({figdir}/torque.png)\n\n" + TORQUE_CAPTION)
-
-
-def comfort_figure(res, spec) -> Figure:
-    """``comfort.png``: acceleration and jerk against time (a design with ``[comfort]``)."""
-    return Figure("comfort", "Acceleration and jerk against time, with the comfort limits.",
-                  lambda fig, res=res, sp=spec: plot_comfort(fig, res, sp), (7.0, 5.5))
-
-
-def torque_figure(res, spec) -> Figure:
-    """``torque.png``: commanded torque against ±T_adh and the torque range."""
-    return Figure("torque", "Commanded wheel torque against the adhesion and torque limits.",
-                  lambda fig, res=res, sp=spec: plot_torque(fig, res, sp), (7.0, 4.0))
 
 
 #: Caption of ``torque.png`` (in the comfort section, or under Figures without one).

@@ -28,7 +28,7 @@ def plot_speed(fig, res):
     for c in res.cases:
         r, name = c.run, c.case.name
         v, lam = r.x
-        vw = np.where(lam >= 0, v / (1 - np.minimum(lam, 0.999)), v * (1 + lam))
+        vw = wheel_speed(v, lam, 1.0, ArrayOps)          # v_w = omega r, eqs (4)-(5)
         plot_cases(ax, [(name, r.t, v, f"{name}: v")], color_of, vmax)
         plot_cases(ax, [(name, r.t, vw, f"{name}: v_w")], color_of, vmax, ls=":")
     ax.set_ylim(-5.0, axis_end(1.3 * vmax))   # a data-derived end moves every pixel

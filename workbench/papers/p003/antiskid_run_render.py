@@ -1,7 +1,7 @@
 """Markdown and figures of the ``antiskid-run`` study (pure rendering).
 
 The layout is general (:mod:`workbench.report.case_tables`: per-case metrics
-and convergence tables, rows per case; :mod:`workbench.report.delay_cross_check`:
+and convergence tables, rows per case; :mod:`workbench.features.linear_delay_check_render`:
 the linear cross-check of the LMI delay bound; :mod:`workbench.report.case_figures`;
 :mod:`workbench.features.frozen_loop_render`: the loop frozen at a phase switch;
 :mod:`workbench.features.montecarlo_render`: the Monte Carlo tables, figures and
@@ -15,16 +15,17 @@ import math
 
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
 from ...features.frozen_loop_render import frozen_loop_cells
-from ...features.linear_delay_check import TEST_PROBLEM as HALVING_PROBLEM
+from ...features.linear_delay_check_render import linear_check_figure, linear_check_section
 from ...report.binned_fractions import binned_fraction_rows
-from ...report.case_tables import CaseLevels, case_convergence_section, case_metric_table, case_rows
-from ...report.delay_cross_check import delay_cross_check, plot_envelopes
+from ...report.case_tables import (CaseLevels, case_convergence_section, case_metric_table,
+                                   case_rows, event_cell)
 from ...report.markdown import Figure, Rendered, fmt, md_table
+from ...report.synthesis_text import gain_text
 from ...sim.convergence import P_MIN
 from ...sim.wheel_slip import MAX_DLAMBDA, MAX_HALVINGS
 from .antiskid_basin_render import HEADING as BASIN_HEADING
-from .antiskid_comfort_render import (HEADING, PATTERN, TORQUE_CAPTION, comfort_figure,
-                                      comfort_section, torque_figure)
+from .antiskid_comfort_render import (HEADING, PATTERN, TORQUE_CAPTION, comfort_section,
+                                      plot_comfort, plot_torque)
 from .antiskid_montecarlo_render import WORDS
 from .antiskid_run_figures import plot_adhesion, plot_creep, plot_evs, plot_speed
 
@@ -45,19 +46,15 @@ _LABELS = {  # metric -> (label, unit, sig)
 
 
 def _diverged_text(c) -> str:
-    t = c.metrics["t_diverged"]
-    if math.isnan(t):
-        return "no"
-    ph, how = c.metrics["phase_diverged"], c.metrics["diverged_how"]
-    return f"yes, t = {fmt(t, 4)} s ({PHASE_NAMES[int(ph)]}; {DIVERGED_HOW[int(how)]})"
+    m = c.metrics
+    return event_cell(m["t_diverged"], lambda: f"{PHASE_NAMES[int(m['phase_diverged'])]}; "
+                                               f"{DIVERGED_HOW[int(m['diverged_how'])]}")
 
 
 def render(design, res) -> Rendered:
     spec = design.spec
     sc = spec.scenario
     sections = []
-    K = "[" + ", ".join(fmt(k, 4) for k in res.K) + "]"
-    Kt = "[" + ", ".join(fmt(k, 5) for k in spec.K_table) + "]"
     rows = [["v(0), lambda(0)", f"{fmt(sc['v0'])} m/s, {fmt(sc['lambda0'])}"],
             ["u on [-h, 0)", f"{fmt(sc['u_init'])} N m"],
             ["input delay h (plant and predictor)", f"{fmt(sc['h'], 4)} s"],
@@ -65,9 +62,9 @@ def render(design, res) -> Rendered:
              f"{fmt(sc['v_d'])} m/s, {fmt(res.lambda_d, 4)}, {fmt(res.lambda_opt, 4)}"],
             ["braking from", f"{fmt(sc['t_brake'])} s"],
             ["plant mass / nominal", fmt(spec.mass_factor, 3) + " (the controller keeps the nominal model)"],
-            ["cruise gain K used", f"{K} — {res.K_how}"
+            ["cruise gain K used", f"{gain_text(res.K)} — {res.K_how}"
              + (f", h_certified = {fmt(res.h_certified, 4)} s" if res.h_certified else "")],
-            ["printed gain", f"{Kt} ({spec.K_source})"],
+            ["printed gain", f"{gain_text(spec.K_table, 5)} ({spec.K_source})"],
             ["k_ac, k_de", f"{fmt(spec.k_ac)}, {fmt(spec.k_de)} 1/s"],
             ["step dt (reported at dt/2)", f"{fmt(res.dt)} s ({fmt(res.dt / 2)} s)"]]
     sections.append(
@@ -83,10 +80,12 @@ def render(design, res) -> Rendered:
                 "What happens"),
                (r"switch\.|basin\.", BASIN_HEADING),
                (r"montecarlo\.", "Monte Carlo robustness (reduced sample)")]
-    extra_figs = (torque_figure(res, spec),)
+    extra_figs = (Figure("torque", "Commanded wheel torque against the adhesion and torque limits.",
+                         lambda fig: plot_torque(fig, res, spec), (7.0, 4.0)),)
     if spec.comfort is not None:
         sections.append(comfort_section(res, spec))
-        extra_figs += (comfort_figure(res, spec),)
+        extra_figs += (Figure("comfort", "Acceleration and jerk against time, with the comfort "
+                              "limits.", lambda fig: plot_comfort(fig, res, spec), (7.0, 5.5)),)
         anchors.insert(0, (PATTERN, HEADING))
     if res.sampled is not None:
         from .antiskid_sampled_render import (HEADING as SAMPLED_HEADING, PATTERN as SAMPLED,
@@ -104,9 +103,7 @@ def render(design, res) -> Rendered:
         *extra_figs,
         Figure("creep-speed-error", "Creep-speed tracking error in braking.",
                lambda fig, res=res, sp=spec: plot_evs(fig, res, sp), (7.0, 4.0)),
-        Figure("linear-checks", "Linear error system E' = A E + B K E(t-h).",
-               lambda fig, lc=res.linear: plot_envelopes(
-                   fig, (f for f, _, _ in lc.ratios_finite), lc.runs), (7.0, 4.0)),
+        linear_check_figure(res.linear, "Linear error system E' = A E + B K E(t-h)."),
         Figure("adhesion", "The plant's adhesion curve with each run's operating points.",
                lambda fig, res=res, sp=spec: plot_adhesion(fig, res, sp), (9.0, 3.8)),
     )
@@ -151,9 +148,7 @@ def _cases_text(spec) -> str:
 
 
 def _results_section(res) -> str:
-    keys = ("t_cruise", "lam_max_traction", "lam_max_over_opt", "v_max", "v_err_at_brake",
-            "braking_duration", "omega3_after_brake", "lam_min_brake", "evs_max_tracking",
-            "evs_last")
+    keys = [k for k in _LABELS if k not in ("lam_err_at_brake", "t_diverged")]
     return ("## What happens\n\n"
             + case_metric_table([c.case.name for c in res.cases], [c.metrics for c in res.cases],
                                 keys, _LABELS,
@@ -236,12 +231,8 @@ def _convergence_section(res, spec) -> str:
 
 
 def _linear_section(res) -> str:
-    lc = res.linear
-    return delay_cross_check(
-        linearisation="the cruise linearisation", test_problem=HALVING_PROBLEM,
-        halving=lc.halving, K_finite=lc.K_finite, finite_margin=lc.finite_margin,
-        ratios_finite=lc.ratios_finite, K_synth=lc.K, synth_margin=lc.margin,
-        ratios_synth=lc.ratios,
+    return linear_check_section(
+        res.linear, linearisation="the cruise linearisation",
         closing=": with this gain the loop decays at delays two orders of magnitude above h_m, "
         "as its infinite exact margin says.")
 
