@@ -165,6 +165,19 @@ def test_statistics_of_the_runs():
                                                  for b in ("lo", "hi")}
     assert q["toy.x_end.max"] == float(np.max(m["x_end"])) and q["toy.samples"] == N
     assert q["toy.fraction.grew"] == grew / N
+
+    class Counted(Decay):                 # the statistics are computed once per result
+        calls = 0
+
+        def summary_rows(self):
+            type(self).calls += 1
+            return super().summary_rows()
+    once = Counted(res.samples, res.metrics, res.violations, math.nan, 1)
+    q_once = values(table, "with mc", SimpleNamespace(mc=once))
+    assert set(q_once) == set(q) and q_once["toy.x_end.max"] == q["toy.x_end.max"]
+    assert Counted.calls == 1
+    once.statistics()["toy"] = 0.0        # a copy: the memo is not changed by its reader
+    assert "toy" not in once.statistics() and Counted.calls == 1
     assert names(table, "no mc") == set() and values(table, "no mc", None) == {}
     assert set(values(table, "with mc", SimpleNamespace(mc=None)).values()) == {None}
     assert summary_row("x", [math.nan]) == ["x", 0, None, None, None, None]

@@ -103,12 +103,19 @@ class RunsResult:
     def statistics(self) -> dict:
         """``{"<metric>.<statistic>": value}`` from :meth:`summary_rows`,
         ``{"fraction.<flag>": value}`` (fraction of all runs) and
-        ``{"wilson.<outcome>.lo" | ".hi": bound}`` (:meth:`outcome_rates`)."""
-        out = {f"{r[0]}.{s}": x for r in self.summary_rows() for s, x in zip(STATISTICS, r[1:])}
-        out.update({f"fraction.{k}": sum(v) / self.n for k, v in self.violations.items()})
-        for o, _, _, _, lo, hi in self.outcome_rates():
-            out[f"wilson.{o}.lo"], out[f"wilson.{o}.hi"] = lo, hi
-        return out
+        ``{"wilson.<outcome>.lo" | ".hi": bound}`` (:meth:`outcome_rates`).
+
+        Computed once per result (the result is frozen; :func:`runs_quantities`
+        reads one key per declared quantity); a copy is returned."""
+        memo = self.__dict__.get("_statistics")
+        if memo is None:
+            memo = {f"{r[0]}.{s}": x for r in self.summary_rows()
+                    for s, x in zip(STATISTICS, r[1:])}
+            memo.update({f"fraction.{k}": sum(v) / self.n for k, v in self.violations.items()})
+            for o, _, _, _, lo, hi in self.outcome_rates():
+                memo[f"wilson.{o}.lo"], memo[f"wilson.{o}.hi"] = lo, hi
+            object.__setattr__(self, "_statistics", memo)
+        return dict(memo)
 
 
 def runs_quantities(prefix: str, summary, flags, outcomes, part, present) -> tuple:
