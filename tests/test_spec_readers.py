@@ -54,3 +54,19 @@ def test_keyed_numbers_takes_only_known_keys_within_bounds():
     low = Reader("toy.toml", {"x": -1.0}, "scenario.target")
     with pytest.raises(DesignError, match="scenario.target.x"):
         keyed_numbers(low, ("x",), "a state", positive=True)
+
+
+def test_named_tables_need_one_table_and_distinct_matching_names():
+    import re
+    from workbench.features.spec_readers import named_tables
+    ok = Reader("toy.toml", {"modes": [{"name": "a", "k": 1.0}, {"name": "b", "k": 2.0}]}, "")
+    got = named_tables(ok, "modes", re.compile(r"[a-z]+$"))
+    assert [n for _, n in got] == ["a", "b"] and got[1][0].number("k") == 2.0
+    with pytest.raises(DesignError, match=r"at least one \[\[modes\]\]"):
+        named_tables(Reader("toy.toml", {"modes": []}, ""), "modes")
+    twice = Reader("toy.toml", {"modes": [{"name": "a"}, {"name": "a"}]}, "")
+    with pytest.raises(DesignError, match=r"modes\[1\].name.*used once"):
+        named_tables(twice, "modes")
+    with pytest.raises(DesignError, match="letters, digits"):
+        named_tables(Reader("toy.toml", {"modes": [{"name": "a-b"}]}, ""), "modes",
+                     re.compile(r"\w+$"))

@@ -6,7 +6,8 @@ the key (exit 2 at the CLI).
 """
 from __future__ import annotations
 
-__all__ = ["EVENT_DIGITS", "event_time", "keyed_numbers", "read_range", "read_step_tolerances"]
+__all__ = ["EVENT_DIGITS", "event_time", "keyed_numbers", "named_tables", "read_range",
+           "read_step_tolerances"]
 
 #: Significant digits of the event times of a scenario (:func:`event_time`).
 EVENT_DIGITS = 12
@@ -50,6 +51,25 @@ def keyed_numbers(t, allowed, expected: str, **kw) -> dict[str, float]:
             raise t.fail(k, t.data[k], expected)
         out[k] = t.number(k, **kw)
     t.finish()
+    return out
+
+
+def named_tables(root, key: str, pattern=None) -> list[tuple[object, str]]:
+    """The ``[[key]]`` tables of ``root`` (at least one) with their ``name``
+    strings, each name used once and, given ``pattern`` (a compiled regex),
+    matching it: ``[(reader, name), ...]`` in file order, the readers not
+    finished (the caller reads their other keys)."""
+    tables = root.tables(key)
+    if not tables:
+        raise root.fail(key, [], f"at least one [[{key}]] table")
+    out, seen = [], set()
+    for t in tables:
+        name = t.string("name")
+        if (pattern is not None and not pattern.match(name)) or name in seen:
+            raise t.fail("name", name, "a name used once"
+                         + (" of letters, digits and _" if pattern is not None else ""))
+        seen.add(name)
+        out.append((t, name))
     return out
 
 

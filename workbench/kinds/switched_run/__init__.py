@@ -42,7 +42,7 @@ from dataclasses import dataclass
 from ...reader import Reader
 from ...features.convergence import LEVELS, ClaimTarget, claim_targets, load_convergence
 from ...features.quantities import DeclaredQuantities
-from ...features.spec_readers import keyed_numbers
+from ...features.spec_readers import keyed_numbers, named_tables
 from ..delay_feedback import NAME_PATTERN as _NAME
 from ..delay_feedback import read_plant
 from ..delay_feedback.spec import PlantSpec
@@ -131,16 +131,9 @@ def _all(plant: PlantSpec) -> set[str]:
 
 def _phases(root: Reader, plant: PlantSpec, names: set[str]) -> tuple[Phase, ...]:
     from ...expr import check_expression
-    tables = root.tables("phases")
-    if not tables:
-        raise root.fail("phases", [], "at least one [[phases]] table")
-    known, out = [], []
-    for t in tables:                       # every name first: a guard may point ahead
-        name = t.string("name")
-        if not _NAME.match(name) or name in known:
-            raise t.fail("name", name, "a phase name of letters, digits and _, used once")
-        known.append(name)
-    for t, name in zip(tables, known):
+    named = named_tables(root, "phases", _NAME)   # every name first: a guard may point ahead
+    known, out = [name for _, name in named], []
+    for t, name in named:
         lt = t.table("law")
         laws = []
         for u in plant.input_names:
@@ -181,17 +174,10 @@ def _multiple(r: Reader, key: str, value: float, dt: float, what: str) -> None:
 
 def _scenarios(root: Reader, spec_plant: PlantSpec, phases, h: float, convergence: bool,
                sampled) -> tuple[Scenario, ...]:
-    out, seen = [], set()
+    out = []
     states, phase_names = spec_plant.state_names, [p.name for p in phases]
     finest = 2 ** LEVELS[-1] if convergence else 1
-    tables = root.tables("scenarios")
-    if not tables:
-        raise root.fail("scenarios", [], "at least one [[scenarios]] table")
-    for r in tables:
-        name = r.string("name")
-        if not _NAME.match(name) or name in seen:
-            raise r.fail("name", name, "a new name of letters, digits and _")
-        seen.add(name)
+    for r, name in named_tables(root, "scenarios", _NAME):
         xt = r.table("x0")
         x0 = []
         for s in states:

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from ...controllers.antiskid003_settings import BRAKE_IN, ControllerSettings, CreepSpeedProfile
 from ...errors import DesignError, ModelError
 from ...features.linear_delay_check import LinearCheckSpec, load_linear_check
-from ...features.spec_readers import event_time, read_range, read_step_tolerances
+from ...features.spec_readers import event_time, named_tables, read_range, read_step_tolerances
 from ...plants.adhesion import PARAMETER_UNITS, NumericAdhesion
 from ...reader import Reader
 from ...sim.wheel_slip import PARAM_ORDER
@@ -337,8 +337,8 @@ def load_run_spec(root: Reader) -> RunSpec:
     if scen["h"] < dt and scen["h"] > 0:
         raise DesignError(root.path, "numerics.dt", dt, f"a step no larger than h = {scen['h']}")
     cases = []
-    for cr in root.tables("cases"):
-        cases.append(Case(cr.string("name"), cr.string("description"),
+    for cr, name in named_tables(root, "cases"):
+        cases.append(Case(name, cr.string("description"),
                           cr.boolean("compensate"),
                           cr.string("cruise_entry", choices=("speed", "creep")),
                           cr.string("brake_entry", choices=("time", "creep")),
@@ -346,8 +346,6 @@ def load_run_spec(root: Reader) -> RunSpec:
                                     choices=("rollout", "recursive"))))
         cr.finish()
     names = [c.name for c in cases]
-    if not cases or len(set(names)) != len(names):
-        raise DesignError(root.path, "cases", names, "at least one case, distinct names")
     linear = load_linear_check(root)
     mc = None
     if root.has("montecarlo"):
