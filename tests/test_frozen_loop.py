@@ -25,6 +25,7 @@ def test_freeze_scalar_delayed_loop_margin_and_abscissa():
     assert fl.A[0, 0] == pytest.approx(-1.0, abs=1e-9)
     assert fl.abscissa == pytest.approx(-3.0, abs=1e-9)
     assert fl.margin.h == pytest.approx(math.acos(-0.5) / math.sqrt(3.0), rel=1e-6)
+    assert fl.x0 == (0.0,)                  # the state it is frozen at, kept
     # |k| < 1: stable for every delay
     assert math.isinf(freeze(lambda x: -x, (1.0,), (1e-6,), np.array([[0.5]])).margin.h)
 

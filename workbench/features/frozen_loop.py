@@ -37,15 +37,17 @@ def central_jacobian(f, x0, steps) -> np.ndarray:
 class FrozenLoop:
     """``A``: Jacobian of the undelayed part; ``abscissa``: spectral abscissa
     of A + A_d (the loop without delay); ``margin``: exact delay margin of
-    x' = A x + A_d x(t - h)."""
+    x' = A x + A_d x(t - h); ``x0``: the state it is frozen at."""
 
     A: np.ndarray
     abscissa: float
     margin: object
+    x0: tuple = ()
 
 
 def freeze(f, x0, steps, Ad) -> FrozenLoop:
     """The loop x' = f(x) + A_d x(t - h) frozen at ``x0`` (module docstring)."""
     from ..margins import delay_margin_eig
     A = central_jacobian(f, x0, steps)
-    return FrozenLoop(A, float(np.max(np.linalg.eigvals(A + Ad).real)), delay_margin_eig(A, Ad))
+    return FrozenLoop(A, float(np.max(np.linalg.eigvals(A + Ad).real)), delay_margin_eig(A, Ad),
+                      tuple(float(x) for x in x0))

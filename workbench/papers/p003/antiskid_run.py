@@ -21,7 +21,7 @@ from ...errors import DesignError
 from ...features.cli_plumbing import pick_case, trajectory_csv
 from ...features.comfort import COMFORT_QUANTITIES, comfort_of, comfort_quantities
 from ...features.convergence import agree
-from ...features.frozen_loop import freeze
+from ...features.frozen_loop import FrozenLoop, freeze
 from ...features.linear_delay_check import LinearDelayCheck, linear_delay_check
 from ...features.quantities import Declared, DeclaredQuantities, Group, determined
 from ...jsonable import OMIT, json_method
@@ -47,19 +47,15 @@ RECORD_DT = 0.05
 
 
 @dataclass(frozen=True)
-class SwitchCheck:
-    """Frozen linearisation of the cruise loop at the state where cruise starts.
+class SwitchCheck(FrozenLoop):
+    """The cruise loop frozen at x0 = (v, lambda) where cruise starts
+    (:class:`~workbench.features.frozen_loop.FrozenLoop`; the render's names
+    v, lam, A_loc), with the plant's adhesion slope d mu/d lambda there."""
 
-    ``abscissa``: spectral abscissa of A_loc + A_d (delay-free);
-    ``margin``: exact delay margin of x' = A_loc x + A_d x(t - h).
-    """
-
-    v: float
-    lam: float
-    dmu_dlam: float
-    A_loc: np.ndarray
-    abscissa: float
-    margin: DelayMargin
+    dmu_dlam: float = math.nan
+    v = property(lambda s: s.x0[0])
+    lam = property(lambda s: s.x0[1])
+    A_loc = property(lambda s: s.A)
 
 
 @dataclass(frozen=True)
@@ -122,8 +118,8 @@ def switch_check(cs: ControllerSettings, v: float, lam: float) -> SwitchCheck:
     gain = rhs(np.array([v, lam]))[1]
     Ad = gain * np.array([[0.0], [1.0]]) @ np.array([cs.K])
     fl = freeze(lambda x: rhs(x)[0], (v, lam), (1e-4 * max(v, 1.0), 1e-7), Ad)
-    return SwitchCheck(v, lam, float(traction_slope()(lam, *cs.params)), fl.A, fl.abscissa,
-                       fl.margin)
+    return SwitchCheck(fl.A, fl.abscissa, fl.margin, fl.x0,
+                       float(traction_slope()(lam, *cs.params)))
 
 
 def linear_check(spec: RunSpec, A, B, K) -> LinearDelayCheck:

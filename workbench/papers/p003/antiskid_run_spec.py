@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 from ...controllers.antiskid003_settings import BRAKE_IN, ControllerSettings, CreepSpeedProfile
 from ...errors import DesignError, ModelError
+from ...features.gain_choice import GainChoice, chosen_gain, read_gain_choice
 from ...features.linear_delay_check import LinearCheckSpec, load_linear_check
 from ...features.spec_readers import event_time, named_tables, read_range, read_step_tolerances
 from ...plants.adhesion import PARAMETER_UNITS, NumericAdhesion
@@ -259,31 +260,18 @@ def evs_floor(e: float) -> float:
     return 0.0 if abs(e) < EVS_FLOOR else e
 
 
-#: gain_for's answers in this process, keyed by what they depend on (the
-#: sweep, the halving check and the cases of a design all ask for the same K).
 def gain_for(spec: RunSpec) -> tuple[tuple, str, float | None]:
-    """(K, how it was obtained, h_certified or None): from the certified
-    synthesis of problem (60) at the design's eps on the nominal cruise
-    linearisation, or the design's table gain. The answer depends on the
-    nominal plant, v_d and eps only: each synthesis runs once per process and
-    run folder (:func:`workbench.memo.computed_once`; the test session of
-    ``make test`` reads what ``workbench check`` computed)."""
-    if spec.gain == "table":
-        return tuple(spec.K_table), spec.K_source, None
-    from ...memo import computed_once, spec_key
-    key = spec_key((spec.params, spec.scenario["v_d"], spec.eps))
-    if key is None:
-        return _synthesized_gain(spec)
-    return computed_once("antiskid-run-gain", key, lambda: _synthesized_gain(spec))
-
-
-def _synthesized_gain(spec: RunSpec) -> tuple[tuple, str, float | None]:
-    from ...synthesis import synthesize_delay_bound
-    _, _, lin = nominal_cruise(spec)
-    row = synthesize_delay_bound(lin.A, lin.B, (spec.eps,))[0]
-    if row.K is None:
-        raise ModelError(f"synthesis at eps = {spec.eps} certified no gain")
-    return row.K, f"synthesis, problem (60) at eps = {spec.eps:g}", row.h_certified
+    """(K, how it was obtained, h_certified or None): the design's table gain,
+    or the certified synthesis of problem (60) at the design's eps on the
+    nominal cruise linearisation (:func:`workbench.features.gain_choice.chosen_gain`),
+    which depends on the nominal plant, v_d and eps only: it runs once per
+    process and run folder (the sweep, the halving check and the cases of a
+    design share it; the test session of ``make test`` reads what
+    ``workbench check`` computed)."""
+    return chosen_gain(GainChoice(spec.gain, spec.eps, spec.K_table, spec.K_source),
+                       lambda: nominal_cruise(spec)[2], "antiskid-run-gain",
+                       (spec.params, spec.scenario["v_d"], spec.eps),
+                       f"synthesis, problem (60) at eps = {spec.eps:g}")
 
 
 def load_run_spec(root: Reader) -> RunSpec:
@@ -307,12 +295,7 @@ def load_run_spec(root: Reader) -> RunSpec:
     if not scen["t_end"] > scen["t_brake"]:
         raise DesignError(root.path, "scenario.t_end", scen["t_end"], "a time after t_brake")
     ct = root.table("controller")
-    gain = ct.string("gain", choices=("synthesis", "table"))
-    eps = ct.number("eps", positive=True)
-    K_table = ct.numbers("K_table", min_len=2, what="gain entries")
-    if len(K_table) != 2:
-        raise ct.fail("K_table", list(K_table), "two gain entries [k1, k2]")
-    K_source = ct.string("K_source")
+    g = read_gain_choice(ct, 2)
     k_ac = ct.number("k_ac", positive=True)
     k_de = ct.number("k_de", positive=True)
     pr = ct.table("profile")
@@ -376,7 +359,7 @@ def load_run_spec(root: Reader) -> RunSpec:
     except ModelError as exc:
         raise DesignError(root.path, "scenario.v_d", scen["v_d"],
                           f"a speed with a creep-region equilibrium ({exc})") from None
-    return RunSpec(rail, params, mass_factor, scen, gain, eps, K_table, K_source, k_ac, k_de,
+    return RunSpec(rail, params, mass_factor, scen, g.gain, g.eps, g.K_table, g.K_source, k_ac, k_de,
                    profile, dt, v_stop, band, torque_range, mesh_courant, mesh_levels, rtol, atol,
                    tuple(cases), linear, mc, load_basin_settings(root), load_comfort(root),
                    load_sampled(root, names))
