@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from workbench.errors import DesignError
-from workbench.features.cli_plumbing import (check_sweep_flags, pick_case, run_sweep,
-                                             sweep_errors, trajectory_csv)
+from workbench.features.cli_plumbing import (check_sweep_flags, pick_case, pick_named,
+                                             run_sweep, sweep_errors, timed, trajectory_csv)
 from workbench.sim.batch import SchedulerUnreachable
 from workbench.sim.delay import simulate_linear_dde
 
@@ -19,6 +19,16 @@ def test_pick_case():
     assert pick_case(["a", "b"], "b") == "b"
     with pytest.raises(DesignError, match="--case = 'c'; expected one of a, b"):
         pick_case(["a", "b"], "c")
+
+
+def test_pick_named_and_timed():
+    from types import SimpleNamespace
+    items = (SimpleNamespace(name="a", x=1), SimpleNamespace(name="b", x=2))
+    assert pick_named(items, None).x == 1 and pick_named(items, "b").x == 2
+    with pytest.raises(DesignError, match="--case = 'c'; expected one of a, b"):
+        pick_named(items, "c")
+    out, wall = timed(lambda: sum(range(1000)))
+    assert out == 499500 and wall >= 0.0
 
 
 def test_trajectory_csv_of_a_linear_run_reads_back():
@@ -38,6 +48,16 @@ def test_sweep_flags():
         check_sweep_flags(0, None)
     with pytest.raises(DesignError, match="--workers"):
         check_sweep_flags(3, 0)
+    check_sweep_flags(1, None, "numpy")
+    with pytest.raises(DesignError, match="--kernel = 'fortran'; expected compiled or numpy"):
+        check_sweep_flags(1, None, "fortran")
+
+
+def test_compiled_kernel_flag_needs_numba(monkeypatch):
+    import workbench.sim.kernel_path as kp
+    monkeypatch.setattr(kp, "compiled_available", lambda: False)
+    with pytest.raises(DesignError, match="numba is not installed"):
+        check_sweep_flags(1, None, "compiled")
 
 
 def test_sweep_errors_name_the_flag():

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from workbench.errors import DesignError
-from workbench.features.spec_readers import event_time, read_range, read_step_tolerances
+from workbench.features.spec_readers import (event_time, read_range, read_step_tolerances,
+                                             sourced_range)
 from workbench.reader import Reader
 
 
@@ -22,6 +23,19 @@ def test_read_range_checks_order_and_bounds():
         read_range(t, "neg", positive=True)
     with pytest.raises(DesignError, match="allowed values"):
         read_range(t, "gain", lo=1.0)
+
+
+def test_sourced_range_reads_range_unit_and_source():
+    t = Reader("toy.toml", {"band": {"span": [1.0, 3.0], "unit": "m", "source": "toy",
+                                     "step": 0.5}}, "toy")
+    lo_hi, source, sub = sourced_range(t, "band", "span", "m", positive=True)
+    assert tuple(lo_hi) == (1.0, 3.0) and source == "toy"
+    assert sub.number("step", positive=True) == 0.5      # the caller reads the rest
+    sub.finish()
+    bad = Reader("toy.toml", {"band": {"span": [1.0, 3.0], "unit": "km", "source": "toy"}},
+                 "toy")
+    with pytest.raises(DesignError, match="band.unit"):
+        sourced_range(bad, "band", "span", "m")
 
 
 def test_event_time_absorbs_last_bit_moves():

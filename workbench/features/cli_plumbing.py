@@ -1,6 +1,7 @@
 """Plumbing of the ``workbench simulate`` and ``workbench sweep`` commands
-(issue 35): picking the ``--case``, the trajectory CSV of a recorded
-:class:`~workbench.sim.delay.SimResult`, the checks of the sweep's flags, and
+(issue 35): picking the ``--case``, timing a run, the trajectory CSV of a recorded
+:class:`~workbench.sim.delay.SimResult`, the checks of the sweep's flags
+(``--kernel`` among :data:`workbench.sim.kernel_path.KERNELS`), and
 the translation of a sweep's failures (an unreachable Dask scheduler, an
 ``--out`` folder that cannot be written) into one clear
 :class:`~workbench.errors.DesignError` each (exit 2, no traceback).
@@ -9,7 +10,7 @@ The driver of a sweep with ``--out`` / ``--resume`` / ``--scheduler``,
 :func:`run_sweep`, takes the study's two ways to run (in memory, or streamed
 to a folder) as callbacks and owns the flag checks and the failures.
 
-Who uses what today: ``switched-run`` uses :func:`pick_case`; the
+Who uses what today: ``switched-run`` uses :func:`pick_named` and :func:`timed`; the
 ``antiskid-run`` commands use all of it (the only sweep with ``--scheduler``).
 The ``delay-feedback`` and ``switched-run`` CSVs keep their own format
 (``repr`` floats, :func:`workbench.kinds.delay_feedback.cli.csv_text`), which
@@ -23,8 +24,8 @@ import numpy as np
 
 from ..errors import DesignError
 
-__all__ = ["check_scheduler", "check_sweep_flags", "pick_case", "run_sweep", "sweep_errors",
-           "trajectory_csv"]
+__all__ = ["check_scheduler", "check_sweep_flags", "pick_case", "pick_named", "run_sweep",
+           "sweep_errors", "timed", "trajectory_csv"]
 
 
 def pick_case(names, case: str | None) -> str:
@@ -33,6 +34,21 @@ def pick_case(names, case: str | None) -> str:
     if case is not None and case not in names:
         raise DesignError("<cli>", "--case", case, "one of " + ", ".join(names))
     return case if case is not None else names[0]
+
+
+def pick_named(items, case: str | None):
+    """The item of ``items`` (each with a ``name``) named ``case``, the first
+    when None (:func:`pick_case`)."""
+    names = [x.name for x in items]
+    return items[names.index(pick_case(names, case))]
+
+
+def timed(run):
+    """(``run()``, the wall-clock seconds it took)."""
+    import time
+    t0 = time.perf_counter()
+    out = run()
+    return out, time.perf_counter() - t0
 
 
 def trajectory_csv(run) -> str:
@@ -47,12 +63,21 @@ def trajectory_csv(run) -> str:
                                           for row in cols.T)
 
 
-def check_sweep_flags(samples, workers) -> None:
-    """``--samples`` and ``--workers`` (None: the default) positive integers."""
+def check_sweep_flags(samples, workers, kernel: str | None = None) -> None:
+    """``--samples`` and ``--workers`` (None: the default) positive integers;
+    ``--kernel`` (None: the default) one of :data:`~workbench.sim.kernel_path.KERNELS`,
+    "compiled" only where numba is installed."""
+    from ..sim.kernel_path import KERNELS, compiled_available
     if not samples >= 1:
         raise DesignError("<cli>", "--samples", samples, "a positive integer")
     if workers is not None and not workers >= 1:
         raise DesignError("<cli>", "--workers", workers, "a positive integer")
+    if kernel is not None and kernel not in KERNELS:
+        raise DesignError("<cli>", "--kernel", kernel, " or ".join(KERNELS))
+    if kernel == "compiled" and not compiled_available():
+        raise DesignError("<cli>", "--kernel", kernel,
+                          "numpy here: numba is not installed "
+                          "(pip install 'traincontrol-workbench[fast]')")
 
 
 def check_scheduler(scheduler) -> None:

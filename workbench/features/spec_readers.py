@@ -1,5 +1,5 @@
 """Readers of design-table entries that any simulating study can use (issue 35):
-a ``[low, high]`` range, an event time on a decimal grid, a table of numbers
+a ``[low, high]`` range (also as a sub-table with its unit and source), an event time on a decimal grid, a table of numbers
 keyed by known names, and the step-halving tolerances of a ``[numerics]``
 table (one relative tolerance and an absolute one per metric). Bad input is a :class:`~workbench.errors.DesignError` naming
 the key (exit 2 at the CLI).
@@ -7,7 +7,7 @@ the key (exit 2 at the CLI).
 from __future__ import annotations
 
 __all__ = ["EVENT_DIGITS", "event_time", "keyed_numbers", "named_tables", "read_range",
-           "read_step_tolerances"]
+           "read_step_tolerances", "sourced_range"]
 
 #: Significant digits of the event times of a scenario (:func:`event_time`).
 EVENT_DIGITS = 12
@@ -39,6 +39,17 @@ def read_range(t, key: str, **kw) -> tuple[float, float]:
                 "hi" in kw and x > kw["hi"]:
             raise t.fail(key, list(lo_hi), f"a range within the allowed values ({kw})")
     return lo_hi
+
+
+def sourced_range(t, key: str, range_key: str, unit: str, **kw):
+    """The sub-table ``key = { <range_key> = [low, high], unit = "<unit>",
+    source = "..." }`` of ``t``: (range (:func:`read_range`, ``kw`` its
+    bounds), source, the sub-table's reader, not finished: the caller reads
+    its other keys); ``unit`` is the only unit accepted."""
+    s = t.table(key)
+    lo_hi = read_range(s, range_key, **kw)
+    s.string("unit", choices=(unit,))
+    return lo_hi, s.string("source"), s
 
 
 def keyed_numbers(t, allowed, expected: str, **kw) -> dict[str, float]:

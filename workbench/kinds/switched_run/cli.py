@@ -22,15 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ...features.cli_plumbing import pick_named, timed
 from ...features.montecarlo_chunks import CHUNK
 
 __all__ = ["CHUNK", "simulate_command", "sweep_command", "trajectory_csv"]
-
-
-def _scenario(design, case):
-    from ...features.cli_plumbing import pick_case
-    names = [s.name for s in design.spec.scenarios]
-    return design.spec.scenarios[names.index(pick_case(names, case))]
 
 
 def _step(spec, sc, dt) -> float:
@@ -57,17 +52,13 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
                      csv: str | None = None) -> int:
     """``workbench simulate`` of one scenario: its metrics (with ``csv`` its
     trajectory, :func:`trajectory_csv`); exit 0."""
-    import time
-
     from ...report.markdown import fmt
     from ..delay_feedback.cli import print_run
     from .simulate import Compiled, simulate
     spec = design.spec
-    sc = _scenario(design, case)
+    sc = pick_named(spec.scenarios, case)
     step = _step(spec, sc, dt)
-    t0 = time.perf_counter()
-    b = simulate(spec, Compiled(spec), sc, step, record=True)
-    wall = time.perf_counter() - t0
+    b, wall = timed(lambda: simulate(spec, Compiled(spec), sc, step, record=True))
     m = {k: float(v[0]) for k, v in b.metrics.items()}
     if csv:
         from ...report.files import atomic_write
@@ -104,7 +95,7 @@ def sweep_command(design, *, samples: int, seed: int, as_json: bool, case: str |
     spec = design.spec
     mc = sweep_draws(design, samples, seed, 100_000)
     check_resume(out, resume)
-    sc = _scenario(design, case)
+    sc = pick_named(spec.scenarios, case)
     if samples * sc.t_end / sc.dt > MAX_WORK:
         raise DesignError("<cli>", "--samples", samples, f"at most {MAX_WORK:g} samples x "
                           "steps")

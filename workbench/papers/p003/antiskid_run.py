@@ -18,7 +18,7 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import DesignError
-from ...features.cli_plumbing import pick_case, trajectory_csv
+from ...features.cli_plumbing import pick_named, timed, trajectory_csv
 from ...features.comfort import COMFORT_QUANTITIES, comfort_of, comfort_quantities
 from ...features.convergence import agree
 from ...features.frozen_loop import FrozenLoop, freeze
@@ -137,24 +137,20 @@ def simulate_design(design, case_name: str | None, dt: float | None,
     """One case of an ``antiskid-run`` design at one step (for ``workbench
     simulate``): metrics, wall time and the real-time factor; with ``record``
     also the trajectory (``"run"``, a SimResult recorded every :data:`CSV_DT` s)."""
-    import time
     spec: RunSpec = design.spec
-    name = pick_case([c.name for c in spec.cases], case_name)
+    case = pick_named(spec.cases, case_name)
     dt = dt or spec.dt
     if not (dt > 0 and (dt <= spec.scenario["h"] or spec.scenario["h"] == 0)):
         raise DesignError("<cli>", "--dt", dt, "a positive step no larger than the delay (s)")
-    case = next(c for c in spec.cases if c.name == name)
     K, how, _ = gain_for(spec)
     cs = controller_settings(spec, K, case)
-    t0 = time.perf_counter()
-    run, m = simulate_antiskid(run_settings(spec, cs), dt,
-                               record_dt=max(CSV_DT, dt) if record else None,
-                               mesh=case_mesh(spec, case))
-    wall = time.perf_counter() - t0
+    (run, m), wall = timed(lambda: simulate_antiskid(
+        run_settings(spec, cs), dt, record_dt=max(CSV_DT, dt) if record else None,
+        mesh=case_mesh(spec, case)))
     metrics = case_metrics(m, cs, spec.scenario["t_brake"])
     end = m.t_stop if math.isfinite(m.t_stop) else (
         m.t_diverged if math.isfinite(m.t_diverged) else spec.scenario["t_end"])
-    return {"design": design.name, "case": name, "dt": dt, "K": list(K), "K_source": how,
+    return {"design": design.name, "case": case.name, "dt": dt, "K": list(K), "K_source": how,
             "metrics": metrics, "simulated_s": float(end), "wall_s": wall,
             "realtime_factor": float(end) / wall, **({"run": run} if record else {})}
 
@@ -193,18 +189,11 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
 
     from ...features.cli_plumbing import check_sweep_flags, run_sweep
     from ...report.markdown import Figure
-    from .antiskid_kernel import KERNELS, compiled_available
     from .antiskid_montecarlo_render import WORDS
-    check_sweep_flags(samples, workers)
+    check_sweep_flags(samples, workers, kernel)
     if design.spec.montecarlo is None:
         raise DesignError(design.path, "montecarlo", "<missing>",
                           "an antiskid-run design with a [montecarlo] table")
-    if kernel is not None and kernel not in KERNELS:
-        raise DesignError("<cli>", "--kernel", kernel, " or ".join(KERNELS))
-    if kernel == "compiled" and not compiled_available():
-        raise DesignError("<cli>", "--kernel", kernel,
-                          "numpy here: numba is not installed "
-                          "(pip install 'traincontrol-workbench[fast]')")
     res = run_sweep(lambda: sweep(design, samples, seed, workers=workers, kernel=kernel,
                                   progress=not as_json, scheduler=scheduler),
                     lambda: start_sweep(design, samples, seed, out=out, resume=resume,

@@ -24,7 +24,8 @@ from ...controllers.antiskid003_settings import BRAKE_IN, ControllerSettings, Cr
 from ...errors import DesignError, ModelError
 from ...features.gain_choice import GainChoice, chosen_gain, read_gain_choice
 from ...features.linear_delay_check import LinearCheckSpec, load_linear_check
-from ...features.spec_readers import event_time, named_tables, read_range, read_step_tolerances
+from ...features.spec_readers import (event_time, named_tables, read_range, read_step_tolerances,
+                                      sourced_range)
 from ...plants.adhesion import PARAMETER_UNITS, NumericAdhesion
 from ...reader import Reader
 from ...sim.wheel_slip import PARAM_ORDER
@@ -129,17 +130,13 @@ def load_perturbations(mt: Reader) -> SweepPerturbations | None:
             q = mt.quantity(k, unit, nonneg=True, hi=10.0)
             out[k], src[k] = q.value, q.source
     if mt.has("gradient"):
-        g = mt.table("gradient")
-        out["gradient"] = read_range(g, "range", lo=-100.0, hi=100.0)
-        g.string("unit", choices=("per mille",))
+        out["gradient"], src["gradient"], g = sourced_range(mt, "gradient", "range", "per mille",
+                                                            lo=-100.0, hi=100.0)
         out["segment"] = g.number("segment", positive=True, what="number (m)")
-        src["gradient"] = g.string("source")
         g.finish()
     if mt.has("delay_variation"):
-        d = mt.table("delay_variation")
-        out["delay_period"] = read_range(d, "period", positive=True)
-        d.string("unit", choices=("s",))
-        src["delay_variation"] = d.string("source")
+        out["delay_period"], src["delay_variation"], d = sourced_range(
+            mt, "delay_variation", "period", "s", positive=True)
         d.finish()
     return SweepPerturbations(**out, sources=tuple(src.items()))
 
