@@ -9,7 +9,8 @@ import pytest
 
 from workbench.errors import DesignError
 from workbench.features.cli_plumbing import (check_sweep_flags, pick_case, pick_named,
-                                             run_sweep, sweep_errors, timed, trajectory_csv)
+                                             run_sweep, save_plot, sweep_errors, timed,
+                                             trajectory_csv, write_output)
 from workbench.sim.batch import SchedulerUnreachable
 from workbench.sim.delay import simulate_linear_dde
 
@@ -40,6 +41,15 @@ def test_trajectory_csv_of_a_linear_run_reads_back():
     back = np.array([[float(v) for v in row.split(",")] for row in rows])
     np.testing.assert_allclose(back[:, 0], r.t, rtol=1e-8)
     np.testing.assert_allclose(back[:, 1:].T, r.x, rtol=1e-8)
+
+
+def test_write_output_and_save_plot(tmp_path, capsys):
+    write_output(str(tmp_path / "toy.csv"), "t_s,x0\n0,1\n")
+    assert (tmp_path / "toy.csv").read_text() == "t_s,x0\n0,1\n"
+    assert capsys.readouterr().out == f"wrote {tmp_path / 'toy.csv'}\n"
+    save_plot(str(tmp_path / "toy.png"), "a toy line",
+              lambda fig: fig.add_subplot(111).plot([0, 1], [1, 0]), (3.0, 2.0))
+    assert (tmp_path / "toy.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_sweep_flags():

@@ -1,5 +1,6 @@
 """Plumbing of the ``workbench simulate`` and ``workbench sweep`` commands
-(issue 35): picking the ``--case``, timing a run, the trajectory CSV of a recorded
+(issue 35): picking the ``--case``, timing a run, writing an output file or
+a figure (``--csv``, ``--figure``), the trajectory CSV of a recorded
 :class:`~workbench.sim.delay.SimResult`, the checks of the sweep's flags
 (``--kernel`` among :data:`workbench.sim.kernel_path.KERNELS`), and
 the translation of a sweep's failures (an unreachable Dask scheduler, an
@@ -11,7 +12,8 @@ The driver of a sweep with ``--out`` / ``--resume`` / ``--scheduler``,
 to a folder) as callbacks and owns the flag checks and the failures.
 
 Who uses what today: ``switched-run`` uses :func:`pick_named` and :func:`timed`; the
-``antiskid-run`` commands use all of it (the only sweep with ``--scheduler``).
+``antiskid-run`` commands use all of it (the only sweep with ``--scheduler``)
+but :func:`pick_case`.
 The ``delay-feedback`` and ``switched-run`` CSVs keep their own format
 (``repr`` floats, :func:`workbench.kinds.delay_feedback.cli.csv_text`), which
 their users' files already read; :func:`trajectory_csv` prints nine digits.
@@ -25,7 +27,7 @@ import numpy as np
 from ..errors import DesignError
 
 __all__ = ["check_scheduler", "check_sweep_flags", "pick_case", "pick_named", "run_sweep",
-           "sweep_errors", "timed", "trajectory_csv"]
+           "save_plot", "sweep_errors", "timed", "trajectory_csv", "write_output"]
 
 
 def pick_case(names, case: str | None) -> str:
@@ -49,6 +51,25 @@ def timed(run):
     t0 = time.perf_counter()
     out = run()
     return out, time.perf_counter() - t0
+
+
+def write_output(path: str, text: str) -> None:
+    """``text`` written to the file ``path`` (atomically), and ``wrote <path>`` printed."""
+    from pathlib import Path
+
+    from ..report.files import atomic_write
+    atomic_write(Path(path), text)
+    print(f"wrote {path}")
+
+
+def save_plot(path: str, caption: str, draw, size: tuple[float, float]) -> None:
+    """The figure ``draw(fig)`` (``size`` in inches) as a PNG at ``path``,
+    named by the file's stem (:func:`workbench.report.figures.save_figure`)."""
+    from pathlib import Path
+
+    from ..report.figures import save_figure
+    from ..report.markdown import Figure
+    save_figure(Figure(Path(path).stem, caption, draw, size), Path(path))
 
 
 def trajectory_csv(run) -> str:

@@ -18,7 +18,7 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import ControllerSettings
 from ...errors import DesignError
-from ...features.cli_plumbing import pick_named, timed, trajectory_csv
+from ...features.cli_plumbing import pick_named, timed, trajectory_csv, write_output
 from ...features.comfort import COMFORT_QUANTITIES, comfort_of, comfort_quantities
 from ...features.convergence import agree
 from ...features.frozen_loop import FrozenLoop, freeze
@@ -148,8 +148,7 @@ def simulate_design(design, case_name: str | None, dt: float | None,
         run_settings(spec, cs), dt, record_dt=max(CSV_DT, dt) if record else None,
         mesh=case_mesh(spec, case)))
     metrics = case_metrics(m, cs, spec.scenario["t_brake"])
-    end = m.t_stop if math.isfinite(m.t_stop) else (
-        m.t_diverged if math.isfinite(m.t_diverged) else spec.scenario["t_end"])
+    end = next(t for t in (m.t_stop, m.t_diverged, spec.scenario["t_end"]) if math.isfinite(t))
     return {"design": design.name, "case": case.name, "dt": dt, "K": list(K), "K_source": how,
             "metrics": metrics, "simulated_s": float(end), "wall_s": wall,
             "realtime_factor": float(end) / wall, **({"run": run} if record else {})}
@@ -160,15 +159,11 @@ def simulate_command(design, *, case: str | None, dt: float | None, as_json: boo
     """``workbench simulate`` on a loaded ``antiskid-run`` design: print the
     metrics of one case (with ``csv`` also write its trajectory, every
     :data:`CSV_DT` s, :func:`~workbench.features.cli_plumbing.trajectory_csv`); exit 0."""
-    from pathlib import Path
-
     from ...kinds.delay_feedback.cli import print_run
-    from ...report.files import atomic_write
     from ...report.markdown import fmt
     out = simulate_design(design, case, dt, record=bool(csv))
     if csv:
-        atomic_write(Path(csv), trajectory_csv(out.pop("run")))
-        print(f"wrote {csv}")
+        write_output(csv, trajectory_csv(out.pop("run")))
     print_run(out, f"{out['design']} / {out['case']}: dt = {fmt(out['dt'])} s, K = {out['K']} "
               f"({out['K_source']})", {k: v for k, v in out["metrics"].items()
                                        if not (isinstance(v, float) and math.isnan(v))}, as_json)
@@ -185,10 +180,8 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
     """``workbench sweep`` on a loaded ``antiskid-run`` design: run, print summary statistics (and JSON), write
     the histogram figure; exit 0 (violations are reported, not failures)."""
     import json
-    from pathlib import Path
 
-    from ...features.cli_plumbing import check_sweep_flags, run_sweep
-    from ...report.markdown import Figure
+    from ...features.cli_plumbing import check_sweep_flags, run_sweep, save_plot
     from .antiskid_montecarlo_render import WORDS
     check_sweep_flags(samples, workers, kernel)
     if design.spec.montecarlo is None:
@@ -200,9 +193,8 @@ def sweep_command(design, *, samples: int, seed: int, workers: int | None,
                                         workers=workers, kernel=kernel, scheduler=scheduler),
                     out=out, resume=resume, scheduler=scheduler, progress=not as_json)
     if figure:
-        from ...report.figures import save_figure
-        save_figure(Figure(Path(figure).stem, "Monte Carlo histograms",
-                           lambda fig: WORDS.histograms(fig, res), (9.0, 3.2)), Path(figure))
+        save_plot(figure, "Monte Carlo histograms", lambda fig: WORDS.histograms(fig, res),
+                  (9.0, 3.2))
     if as_json:
         print(json.dumps({"design": design.name, "samples": samples, "seed": seed,
                           "seconds": res.seconds, "workers": res.workers,
