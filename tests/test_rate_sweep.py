@@ -52,7 +52,7 @@ def combine(got):
 
 
 DECL = RS.RateMetrics(("x_end", "peak", "decays", "bounded", "ok"), (0, 1), combine,
-                      {"x_end": (0,), "decays": (0,), "peak": (1,), "bounded": (1,)},
+                      {0: ("x_end", "decays"), 1: ("peak", "bounded")},
                       {"x_end": 1e-2}, mesh_max_rate=50.0, outputs=("x_end", "peak"))
 RATES = (5.0, 10.0, 20.0, 50.0, 100.0)
 
@@ -337,24 +337,18 @@ def test_three_levels_of_a_claimed_rate_quantity_of_a_toy_sweep():
         RS.SweepTable((5.0, 20.0, 100.0), 1e-4, 0), [{"quantity": "toy.zoh.rate[20].x_end"}]))
     res = RS.SweepResult(table, RS.RateRow(math.nan, {"x_end": 0.25, "ok": "yes"}), 1e-4,
                          RS.sweep(runs, DECL, table))
-    made = []
-
-    def row_at(rate, step, q, tau):
-        made.append((rate, step))
-        return RS.rate_row(runs, DECL, rate, q, tau, step)
-    memo: dict = {}
     n = len(calls)
-    lv = sec.levels(res, "toy.zoh.rate[20].x_end", row_at, memo)
-    assert isinstance(lv, Levels) and len(calls) == n and made == []
+    lv = sec.levels(res, "toy.zoh.rate[20].x_end", runs, DECL)
+    assert isinstance(lv, Levels) and len(calls) == n
     assert lv.values == res.variant("zoh").three_level[0].values
     assert (lv.parameter, lv.step) == ("plant_step", 1e-4)
-    top = sec.levels(res, "toy.zoh.rate[100].x_end", row_at, memo)
-    assert made == [(100.0, 5e-5), (100.0, 2.5e-5)]
+    top = sec.levels(res, "toy.zoh.rate[100].x_end", runs, DECL)
+    assert [(c[0], c[4]) for c in calls[n:]] == [(100.0, 5e-5)] * 2 + [(100.0, 2.5e-5)] * 2
     assert top.values[0] == res.variant("zoh").row(100.0).metrics["x_end"]
     assert top.values[2] == toy_run(100.0, 0, 0.0, 0.0, 2.5e-5)["x_end"] != top.values[0]
-    diff = sec.levels(res, "toy.zoh.rate[100].x_minus_ref", row_at, memo)
-    assert len(made) == 2 and diff.values == tuple(x - 0.25 for x in top.values)
-    assert sec.levels(res, "toy.zoh.rate[50].ok", row_at, memo).reason == (
+    diff = sec.levels(res, "toy.zoh.rate[100].x_minus_ref", runs, DECL)
+    assert len(calls) == n + 4 and diff.values == tuple(x - 0.25 for x in top.values)
+    assert sec.levels(res, "toy.zoh.rate[50].ok", runs, DECL).reason == (
         "rate 50 Hz is not a grid rate")
     assert sec.rate_pattern().match("toy.zoh_q_tau.rate[1e3].ok").groups() == (
         "zoh_q_tau", "1e3")

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Callable, Mapping
+from typing import TYPE_CHECKING, Mapping
 
 if TYPE_CHECKING:
     from .rate_sweep import SweepTable, Variant
@@ -60,17 +60,19 @@ class Section:
         (groups: the variant, the rate)."""
         return re.compile(re.escape(self.prefix) + r"\.([a-z_]+)\.rate\[([^\]]+)\]\.")
 
-    def levels(self, res, quantity: str, row_at: Callable, memo: dict):
+    def levels(self, res, quantity: str, runs, decl):
         """A rate quantity ``<prefix>.<variant>.rate[<f>].<m>`` of the sweep
         ``res`` at plant_step (reported), plant_step / 2 and plant_step / 4, as
         :class:`workbench.features.refinement.Levels`: each finer level is
         the sweep's own row when it ran one there (the mesh check's at / 2,
         the three-level check's at / 4, which has the scenarios ``m``
-        needs), else ``row_at(rate, step, q, tau)`` (a
-        :class:`~workbench.features.rate_sweep.RateRow`, made once per
-        variant, rate and step in ``memo``); the value at a level is the
-        quantity of the sweep with that row in place of the grid's (so a
-        difference to the reference stays one)."""
+        needs), else the rate's row made by the model ``runs``, ``decl`` (a
+        :class:`~workbench.features.rate_sweep.Runs` memo, each run made
+        once whatever quantity asks, and its
+        :class:`~workbench.features.rate_sweep.RateMetrics`); the value at a
+        level is the quantity of the sweep with that row in place of the
+        grid's (so a difference to the reference stays one)."""
+        from .rate_sweep import rate_row
         from .refinement import Levels
         m = self.rate_pattern().match(quantity)
         name, rate = m[1], float(m[2])
@@ -85,11 +87,8 @@ class Section:
             quarter = replace(quarter, metrics={**v.row(rate).metrics, **quarter.metrics})
         vals = [self.quantities(res).get(quantity)]
         for k, row in ((1, half), (2, quarter)):
-            step = res.spec.plant_step / 2 ** k
             if row is None:
-                if (name, rate, step) not in memo:
-                    memo[name, rate, step] = row_at(rate, step, v.q, v.tau)
-                row = memo[name, rate, step]
+                row = rate_row(runs, decl, rate, v.q, v.tau, res.spec.plant_step / 2 ** k)
             alt = replace(v, rows=tuple(row if x.rate == rate else x for x in v.rows))
             vals.append(self.quantities(replace(res, variants=tuple(
                 alt if x.name == name else x for x in res.variants))).get(quantity))

@@ -48,6 +48,7 @@ from __future__ import annotations
 import dataclasses
 import re
 
+from ...features.comfort import comfort_of
 from ...features.montecarlo_halving import sweep_share_levels
 from ...features.refinement import (Levels, claimed_members, refine_by_readers, screen_levels,
                                     screen_reason, unstepped_levels)
@@ -98,10 +99,7 @@ def _case_levels(spec, result, cache, name):
         run4, m4 = simulate_antiskid(run_settings(spec, cs), spec.dt / 4, record_dt=rec,
                                      mesh=case_mesh(spec, cr.case))
         q4 = case_metrics(m4, cs, spec.scenario["t_brake"])
-        c4 = None
-        if spec.comfort is not None:
-            from ...features.comfort import comfort_of
-            c4 = comfort_of(run4, spec.comfort, cs.u_range / spec.torque_range, rec)
+        c4 = comfort_of(run4, spec.comfort, cs.u_range / spec.torque_range, rec)
     coarse = dataclasses.replace(cr, metrics=cr.metrics_coarse, switch=None,
                                  comfort=cr.comfort_coarse, quarter=None)
     quarter = dataclasses.replace(cr, metrics=q4, metrics_coarse=q4, run=run4, switch=None,
@@ -134,9 +132,7 @@ def _switch_levels(design, result, cache, m, r) -> Levels:
     from .antiskid_run_spec import controller_settings, plant_values
     levels = _case_levels(spec, result, cache, name)
     v_d = spec.scenario["v_d"]
-    pick = (lambda c: switch_points([c])) if which == "cruise" else (
-        lambda c: brake_points([c], v_d))
-    pts = [pick(c) for c in levels]
+    pts = [switch_points([c]) if which == "cruise" else brake_points([c], v_d) for c in levels]
     if which == "cruise":
         from .antiskid_basin import cruise_basin
         extra = [(f"{name}@{k}", p[0][1]) for k, p in zip(("dt", "dt/4"), (pts[0], pts[2]))
@@ -159,15 +155,14 @@ def _switch_levels(design, result, cache, m, r) -> Levels:
 def _rate_levels(design, result, cache, m, r) -> Levels:
     """A sampled rate's metric at plant_step (reported), /2 and /4
     (:meth:`workbench.features.rate_sweep_quantities.Section.levels`), a
-    level the study has not run made here by the sampled kernel."""
+    level the study has not run made here by the sampled kernel
+    (:func:`~workbench.papers.p003.antiskid_sampled.model`)."""
     from .antiskid_run_spec import sampled_context
-    from .antiskid_sampled import SECTION, rate_row
-
-    def row_at(rate, step, q, tau):
-        ctx = cache.get("ctx") or cache.setdefault("ctx", sampled_context(design.spec, result.K))
-        return rate_row(ctx, rate, dt_p=step, predictor_step=design.spec.sampled.predictor_step,
-                        q=q, tau=tau)
-    return SECTION.levels(result.sampled, r.claim.quantity, row_at, cache)
+    from .antiskid_sampled import SECTION, model
+    if "rates" not in cache:
+        cache["rates"] = model(sampled_context(design.spec, result.K),
+                               design.spec.sampled.predictor_step)
+    return SECTION.levels(result.sampled, r.claim.quantity, *cache["rates"])
 
 
 def _mc_levels(design, result, cache, m, r) -> Levels:
