@@ -322,6 +322,11 @@ def test_a_sweep_table_is_read_and_checked():
     assert sec.claimed(table, [{"quantity": "toy.zoh.rate[20].x_minus_ref"},
                                {"quantity": "toy.zoh_q_tau.rate[100].ok"}]) == (
         ("zoh", 20.0, "x_end"),)                  # 100 Hz: above max_rate
+    # the section's other quantities (of its own checks, say) join its names and values
+    more = dataclasses.replace(sec, extra_names=("toy.runs",),
+                               extra=lambda r: {"toy.runs": len(r.variants)})
+    assert more.quantity_names(table) == sec.quantity_names(table) | {"toy.runs"}
+    assert more.quantities(res) == {**got, "toy.runs": 2}
 
 
 def test_three_levels_of_a_claimed_rate_quantity_of_a_toy_sweep():
@@ -366,3 +371,18 @@ def test_the_outcome_words_of_a_toy_rate():
     assert RR.missed(m, ("decay", "bound"), word) == "decay (diverged, t = 0.3063 s)"
     m.update(decay_diverged=math.nan, bound_ok="no")
     assert RR.missed(m, ("decay", "bound"), word) == "decay (slow) and bound (slow)"
+
+
+def test_the_trace_records_of_a_toy_table():
+    """:func:`trace_records`: every variant at the asked rates on the grid, at
+    the table's plant_step, then the reference at its own rate and step."""
+    from types import SimpleNamespace
+    table = RS.SweepTable((5.0, 20.0), 1e-3, 0, quantisation=SimpleNamespace(value=40.0))
+    got = RS.trace_records(table, (20.0, 50.0), lambda *a: a, ("reference", 200.0, 5e-3))
+    assert got == [("zoh", 20.0, (20.0, 0.0, 0.0, 1e-3, False)),
+                   ("zoh_q_tau", 20.0, (20.0, 40.0, 0.0, 1e-3, False)),
+                   ("reference", 200.0, (200.0, 0.0, 0.0, 5e-3, True))]
+    # the records are the toy loop's own runs
+    assert RS.trace_records(table, (5.0,), lambda f, q, tau, step, ref: toy_run(
+        f, 0, q, tau, step)["x_end"], ("reference", 5.0, 1e-3))[0][2] == toy_run(
+        5.0, 0, 0.0, 0.0, 1e-3)["x_end"]

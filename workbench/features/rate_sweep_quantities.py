@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Mapping
+from typing import TYPE_CHECKING, Callable, Mapping
 
 if TYPE_CHECKING:
     from .rate_sweep import SweepTable, Variant
@@ -28,7 +28,9 @@ class Section:
     (:func:`sweep_quantities`) of the rate metrics ``metrics``, the ``gaps``
     to the reference and the ``differences`` (quantity -> the rate metric
     it is the difference to the reference of); the three-level checks
-    cover grid rates up to ``max_rate`` (Hz)."""
+    cover grid rates up to ``max_rate`` (Hz); ``extra_names`` are the
+    section's other quantities (of its replay checks, say), ``extra(res)``
+    their values."""
 
     prefix: str
     metrics: tuple
@@ -36,6 +38,8 @@ class Section:
     reference: str
     gaps: tuple = ()
     differences: Mapping[str, str] = field(default_factory=dict)
+    extra_names: tuple = ()
+    extra: Callable | None = None
 
     def claimed(self, table, claims) -> tuple:
         """The rate metrics the ``[[claims]]`` tables ``claims`` compare on
@@ -48,12 +52,13 @@ class Section:
     def quantity_names(self, table) -> set[str]:
         """The quantities of a sweep of ``table`` (:func:`sweep_quantity_names`)."""
         return sweep_quantity_names(self.prefix, table, self.metrics, self.reference, self.gaps,
-                                    tuple(self.differences))
+                                    tuple(self.differences)) | set(self.extra_names)
 
     def quantities(self, res) -> dict:
         """Their values for ``res`` (a :class:`workbench.features.rate_sweep.SweepResult`)."""
-        return sweep_quantities(self.prefix, res.variants, self.metrics, self.reference,
-                                res.reference.metrics, self.gaps, self.differences)
+        return {**sweep_quantities(self.prefix, res.variants, self.metrics, self.reference,
+                                   res.reference.metrics, self.gaps, self.differences),
+                **(self.extra(res) if self.extra else {})}
 
     def rate_pattern(self) -> re.Pattern:
         """The start of a rate quantity ``<prefix>.<variant>.rate[<f>].``

@@ -79,8 +79,7 @@ def refine_levels(design, result, findings, *, quantities, record_dt: float) -> 
         Record step (s) of the study's runs (the comfort peaks).
     """
     cache: dict = {"quantities": quantities, "record_dt": record_dt}
-    return refine_by_readers(findings, [(p, lambda m, r, f=f: f(design, result, cache, m, r))
-                                        for p, f in READERS])
+    return refine_by_readers(findings, READERS, design, result, cache)
 
 
 def _case_levels(spec, result, cache, name):
@@ -215,9 +214,8 @@ def unconverged_reason(spec, name: str, coarse: dict, fine: dict, quarter: dict,
     :func:`workbench.features.refinement.screen_reason`, with the quantity
     to use instead (:data:`CONVERGED_INSTEAD`; "" when every metric
     converged)."""
-    use = {k: f"`cases[{name}].{a}`" for k, a in CONVERGED_INSTEAD.items() if a not in bad}
     return screen_reason({k: (coarse[k], fine[k], quarter[k]) for k in bad}, spec.conv_rtol,
-                         spec.conv_atol, lambda k: f"cases[{name}].{k}", use,
+                         spec.conv_atol, lambda k: f"cases[{name}].{k}", CONVERGED_INSTEAD,
                          "a metric of the case that converges")
 
 

@@ -78,10 +78,12 @@ GAP_METRICS = ("lam_max_over_opt", "t_cruise", "braking_duration", "stop_distanc
 #: (the emulation does not depend on plant_step).
 TO_EMULATION = {"stop_time_minus_emulation": "braking_duration",
                 "stop_distance_minus_emulation": "stop_distance"}
-#: The section's quantities and the rate metrics its claims compare (a difference to the
-#: emulation counts as its rate metric).
+#: The section's quantities (with those of the Radau check, :mod:`.antiskid_sampled_check`)
+#: and the rate metrics its claims compare (a difference to the emulation counts as its rate
+#: metric).
 SECTION = RQ.Section("sampled", RATE_METRICS, MESH_CHECK_MAX_HZ, "emulation", GAP_METRICS,
-                     TO_EMULATION)
+                     TO_EMULATION, RADAU_QUANTITIES,
+                     lambda res: radau_quantities(res.checks, res.lambda_opt))
 
 
 @dataclass(frozen=True)
@@ -180,11 +182,6 @@ def trace_records(ctx: Context, spec: SampledSpec, dt_e: float) -> list:
     return RS.trace_records(spec, TRACE_RATES_HZ, record, ("emulation", 1.0 / dt_e, dt_e))
 
 
-def sampled_quantity_names(spec: SampledSpec) -> set[str]:
-    """The ``sampled.*`` quantities a design with ``[sampled]`` has."""
-    return SECTION.quantity_names(spec) | set(RADAU_QUANTITIES)
-
-
-def sampled_quantities(res: SampledResult) -> dict:
-    """Values of :func:`sampled_quantity_names`."""
-    return {**SECTION.quantities(res), **radau_quantities(res.checks, res.lambda_opt)}
+#: The ``sampled.*`` quantities a design with ``[sampled]`` has (of its table) and their
+#: values (of a :class:`SampledResult`).
+sampled_quantity_names, sampled_quantities = SECTION.quantity_names, SECTION.quantities
