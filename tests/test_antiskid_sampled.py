@@ -11,6 +11,7 @@ import pytest
 
 from workbench.cli import main
 from workbench.design import load_design
+from workbench.features import rate_sweep as RS
 from workbench.papers.p003 import antiskid_sampled as S
 from workbench.papers.p003.antiskid_run_spec import sampled_context
 from workbench.features.mesh_replay import replay, window
@@ -73,13 +74,12 @@ def test_metrics_do_not_depend_on_the_plant_step(ctx):
     # halving the plant's sub-step moves no metric beyond the mesh tolerances
     # (and the outcome not at all); a sub-step of 5 ms, the emulation's
     # dt/2, is outside them: the bound is not vacuous
-    kw = dict(predictor_step=1e-3, q=8.0, tau=0.002)
-    a = S.rate_row(ctx, 100.0, dt_p=1e-4, **kw).metrics
-    b = S.rate_row(ctx, 100.0, dt_p=5e-5, **kw).metrics
+    row = lambda step: RS.rate_row(*S.model(ctx, 1e-3), 100.0, 8.0, 0.002, step)  # noqa: E731
+    a, b = row(1e-4).metrics, row(5e-5).metrics
     assert a["ok"] == b["ok"]
     for key, tol in S.MESH_ATOL.items():
         assert abs(a[key] - b[key]) <= tol, key
-    c = S.rate_row(ctx, 100.0, dt_p=5e-3, **kw).metrics
+    c = row(5e-3).metrics
     assert any(not abs(a[k] - c[k]) <= tol for k, tol in S.MESH_ATOL.items())
 
 
@@ -112,8 +112,9 @@ def test_radau_replay_agrees_and_sees_a_tampered_record(ctx):
 def test_the_braking_entry_sets_the_lowest_dry_rate(ctx):
     # at 20 Hz braking diverges at the braking entry (the law of eq 69 held
     # for 50 ms on the traction side); at 50 Hz the train stops
-    lo = S.rate_row(ctx, 20.0, dt_p=1e-4, predictor_step=1e-3).metrics
-    hi = S.rate_row(ctx, 50.0, dt_p=1e-4, predictor_step=1e-3).metrics
+    runs, decl = S.model(ctx, 1e-3)
+    lo = RS.rate_row(runs, decl, 20.0, 0.0, 0.0, 1e-4).metrics
+    hi = RS.rate_row(runs, decl, 50.0, 0.0, 0.0, 1e-4).metrics
     assert lo["traction_ok"] == "yes" and lo["braking_ok"] == "no"
     assert ctx.t_brake <= lo["braking_diverged"] <= ctx.t_brake + 2.0
     assert hi["ok"] == "yes" and math.isfinite(hi["stop_distance"])
@@ -144,7 +145,7 @@ def test_a_memoised_run_and_a_cut_record_are_those_of_separate_runs(ctx):
     from a longer record (the figure's trace, or one run over both braking
     windows) holds the rows of a run recording that window alone."""
     from workbench.papers.p003.antiskid_sampled_kernel import run_once
-    runs = S.runs_of(ctx, 1e-3)
+    runs = S.model(ctx, 1e-3)[0]
     kept = runs(100.0, 1, 0.0, 0.0, 2e-4)
     assert runs(100.0, 1, 0.0, 0.0, 2e-4) is kept and runs.made == 1
     own = run_once(ctx, 100.0, 1, dt_p=2e-4, predictor_step=1e-3)[0]

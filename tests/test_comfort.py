@@ -38,6 +38,7 @@ def test_within_the_limits_nothing_is_flagged():
     t = np.arange(0.0, 60.0 + 1e-9, 0.05)
     v = 0.25 * t**2 / 60.0 * 2           # a = t / 60 <= 1 m/s^2, jerk 1/60 m/s^3
     c = comfort_of(_run(t, v, np.zeros_like(t)), SPEC, 1e4, 0.05)
+    assert comfort_of(_run(t, v, np.zeros_like(t)), None, 1e4, 0.05) is None   # no table
     assert c.a_max_abs <= 1.0 and c.time_above_a == 0.0
     assert c.jerk_max_abs == pytest.approx(1 / 60, rel=1e-6) and c.jerk_windows == ()
 

@@ -65,9 +65,13 @@ def test_screen_levels_and_reason_on_a_toy_ode():
     tol = R.screen_tolerances(vals, 0.01, {"y1": 1e-3})
     assert math.isclose(tol["y1"], 1e-3 + 0.01 * max(vals["y1"])) and tol["never"] == 0.0
     why = R.screen_reason({k: vals[k] for k in bad}, 0.01, {}, lambda k: f"toy.{k}",
-                          {"wobble": "`toy.y1`"}, "another metric")
+                          {"wobble": "y1"}, "another metric")
     assert why.startswith("not converged: toy.wobble 10 / 11 / 10.2 at dt, dt/2, dt/4, ")
     assert why.endswith("; use `toy.y1` instead") and "Richardson error" in why
+    # an alternative that did not converge either is not offered
+    both = R.screen_reason({k: vals[k] for k in ("wobble", "y1")}, 0.01, {}, str,
+                           {"wobble": "y1"}, "another metric")
+    assert "use `y1` instead" not in both and both.count("use another metric instead") == 2
     assert R.screen_reason({}, 0.01, {}, str, {}, "x") == ""
 
 

@@ -52,7 +52,7 @@ def combine(got):
 
 
 DECL = RS.RateMetrics(("x_end", "peak", "decays", "bounded", "ok"), (0, 1), combine,
-                      {"x_end": (0,), "decays": (0,), "peak": (1,), "bounded": (1,)},
+                      {0: ("x_end", "decays"), 1: ("peak", "bounded")},
                       {"x_end": 1e-2}, mesh_max_rate=50.0, outputs=("x_end", "peak"))
 RATES = (5.0, 10.0, 20.0, 50.0, 100.0)
 
@@ -322,6 +322,11 @@ def test_a_sweep_table_is_read_and_checked():
     assert sec.claimed(table, [{"quantity": "toy.zoh.rate[20].x_minus_ref"},
                                {"quantity": "toy.zoh_q_tau.rate[100].ok"}]) == (
         ("zoh", 20.0, "x_end"),)                  # 100 Hz: above max_rate
+    # the section's other quantities (of its own checks, say) join its names and values
+    more = dataclasses.replace(sec, extra_names=("toy.runs",),
+                               extra=lambda r: {"toy.runs": len(r.variants)})
+    assert more.quantity_names(table) == sec.quantity_names(table) | {"toy.runs"}
+    assert more.quantities(res) == {**got, "toy.runs": 2}
 
 
 def test_three_levels_of_a_claimed_rate_quantity_of_a_toy_sweep():
@@ -337,24 +342,18 @@ def test_three_levels_of_a_claimed_rate_quantity_of_a_toy_sweep():
         RS.SweepTable((5.0, 20.0, 100.0), 1e-4, 0), [{"quantity": "toy.zoh.rate[20].x_end"}]))
     res = RS.SweepResult(table, RS.RateRow(math.nan, {"x_end": 0.25, "ok": "yes"}), 1e-4,
                          RS.sweep(runs, DECL, table))
-    made = []
-
-    def row_at(rate, step, q, tau):
-        made.append((rate, step))
-        return RS.rate_row(runs, DECL, rate, q, tau, step)
-    memo: dict = {}
     n = len(calls)
-    lv = sec.levels(res, "toy.zoh.rate[20].x_end", row_at, memo)
-    assert isinstance(lv, Levels) and len(calls) == n and made == []
+    lv = sec.levels(res, "toy.zoh.rate[20].x_end", runs, DECL)
+    assert isinstance(lv, Levels) and len(calls) == n
     assert lv.values == res.variant("zoh").three_level[0].values
     assert (lv.parameter, lv.step) == ("plant_step", 1e-4)
-    top = sec.levels(res, "toy.zoh.rate[100].x_end", row_at, memo)
-    assert made == [(100.0, 5e-5), (100.0, 2.5e-5)]
+    top = sec.levels(res, "toy.zoh.rate[100].x_end", runs, DECL)
+    assert [(c[0], c[4]) for c in calls[n:]] == [(100.0, 5e-5)] * 2 + [(100.0, 2.5e-5)] * 2
     assert top.values[0] == res.variant("zoh").row(100.0).metrics["x_end"]
     assert top.values[2] == toy_run(100.0, 0, 0.0, 0.0, 2.5e-5)["x_end"] != top.values[0]
-    diff = sec.levels(res, "toy.zoh.rate[100].x_minus_ref", row_at, memo)
-    assert len(made) == 2 and diff.values == tuple(x - 0.25 for x in top.values)
-    assert sec.levels(res, "toy.zoh.rate[50].ok", row_at, memo).reason == (
+    diff = sec.levels(res, "toy.zoh.rate[100].x_minus_ref", runs, DECL)
+    assert len(calls) == n + 4 and diff.values == tuple(x - 0.25 for x in top.values)
+    assert sec.levels(res, "toy.zoh.rate[50].ok", runs, DECL).reason == (
         "rate 50 Hz is not a grid rate")
     assert sec.rate_pattern().match("toy.zoh_q_tau.rate[1e3].ok").groups() == (
         "zoh_q_tau", "1e3")
@@ -372,3 +371,18 @@ def test_the_outcome_words_of_a_toy_rate():
     assert RR.missed(m, ("decay", "bound"), word) == "decay (diverged, t = 0.3063 s)"
     m.update(decay_diverged=math.nan, bound_ok="no")
     assert RR.missed(m, ("decay", "bound"), word) == "decay (slow) and bound (slow)"
+
+
+def test_the_trace_records_of_a_toy_table():
+    """:func:`trace_records`: every variant at the asked rates on the grid, at
+    the table's plant_step, then the reference at its own rate and step."""
+    from types import SimpleNamespace
+    table = RS.SweepTable((5.0, 20.0), 1e-3, 0, quantisation=SimpleNamespace(value=40.0))
+    got = RS.trace_records(table, (20.0, 50.0), lambda *a: a, ("reference", 200.0, 5e-3))
+    assert got == [("zoh", 20.0, (20.0, 0.0, 0.0, 1e-3, False)),
+                   ("zoh_q_tau", 20.0, (20.0, 40.0, 0.0, 1e-3, False)),
+                   ("reference", 200.0, (200.0, 0.0, 0.0, 5e-3, True))]
+    # the records are the toy loop's own runs
+    assert RS.trace_records(table, (5.0,), lambda f, q, tau, step, ref: toy_run(
+        f, 0, q, tau, step)["x_end"], ("reference", 5.0, 1e-3))[0][2] == toy_run(
+        5.0, 0, 0.0, 0.0, 1e-3)["x_end"]

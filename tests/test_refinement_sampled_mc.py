@@ -114,7 +114,7 @@ def test_the_claimed_rate_metrics_of_a_design():
         ("zoh", 20.0, "braking_ok"), ("zoh_q_tau", 50.0, "traction_ok"),
         ("zoh_q_tau", 100.0, "evs_max_tracking"), ("zoh_q_tau", 100.0, "ok"),
         ("zoh_q_tau", 1000.0, "stop_distance"))
-    decl = S.declaration(None)         # the context is used only when a row is computed
+    decl = S.model(None, 1e-3)[1]      # the context is used only when a row is computed
     assert decl.scenarios_of("traction_ok") == (0,)
     assert decl.scenarios_of("stop_distance") == (1,)
     assert decl.scenarios_of("ok") == (0, 1) and decl.scenarios_of("u_max_over_peak") == (0, 1)
@@ -128,14 +128,14 @@ def test_a_partial_row_is_the_rate_row_of_its_scenarios():
     from workbench.papers.p003.antiskid_run_spec import sampled_context
     design = load_design(DRY)
     ctx = sampled_context(design.spec, design.spec.K_table)
-    kw = dict(dt_p=1e-3, predictor_step=1e-3, q=8.0, tau=0.002)
-    full = S.rate_row(ctx, 100.0, **kw).metrics
+    runs, decl = S.model(ctx, 1e-3)
+    full = RS.rate_row(runs, decl, 100.0, 8.0, 0.002, 1e-3).metrics
 
-    def part(scenarios):
-        return RS.partial_row(S.runs_of(ctx, 1e-3), S.declaration(ctx), 100.0, scenarios,
-                              8.0, 0.002, 1e-3).metrics
+    def part(scenarios):       # a fresh memo: runs of their own, the same numbers
+        return RS.partial_row(*S.model(ctx, 1e-3), 100.0, scenarios, 8.0, 0.002,
+                              1e-3).metrics
     brake = part((1,))
-    assert set(brake) == set(S.BRAKING_METRICS) | {"braking_diverged"}
+    assert set(brake) == set(S.NEEDS[1])
     assert {k: repr(v) for k, v in brake.items()} == {k: repr(full[k]) for k in brake}
     both = part((0, 1))
     assert {k: repr(v) for k, v in both.items()} == {k: repr(full[k]) for k in both}

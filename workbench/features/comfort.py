@@ -204,11 +204,14 @@ class RunComfort(Comfort):
     u_max_over_peak: float
 
 
-def comfort_of(run, limits: ComfortLimits, u_peak: float, step: float,
-               speed: int = 0) -> RunComfort:
+def comfort_of(run, limits: ComfortLimits | None, u_peak: float, step: float,
+               speed: int = 0) -> RunComfort | None:
     """:class:`RunComfort` of a recorded run (``run.t``, ``run.x[speed]`` the
     speed, ``run.u[0]`` the input) on a uniform grid of ``step`` seconds
-    (:func:`comfort_of_speed`), the input over ``u_peak``."""
+    (:func:`comfort_of_speed`), the input over ``u_peak``; None without
+    ``limits`` (a design with no comfort table)."""
+    if limits is None:
+        return None
     c = comfort_of_speed(run.t, run.x[speed], limits, step)
     u = np.asarray(run.u[0], float)
     return RunComfort(**{f.name: getattr(c, f.name) for f in fields(c)},

@@ -131,13 +131,15 @@ def load_table(root, key: str, cls: type, unit: str, plant_step_hi: float, secti
 
 
 def trace_records(table: SweepTable, rates: tuple, record: Callable, reference: tuple) -> list:
-    """[(variant, rate, record), ...]: ``record(rate, q, tau)`` of every
-    variant of ``table`` at each of ``rates`` on its grid, then
-    ``record(rate, reference=True)`` of ``reference`` = (name, rate) (the
-    records a figure's :class:`Trace` are cut from)."""
-    out = [(name, f, record(f, q, tau)) for name, q, tau in table.variants()
-           for f in rates if f in table.rates]
-    return out + [(reference[0], reference[1], record(reference[1], reference=True))]
+    """[(variant, rate, record), ...]: ``record(rate, q, tau, step, False)``
+    of every variant of ``table`` at each of ``rates`` on its grid (``step``:
+    its ``plant_step``), then ``record(rate, 0, 0, step, True)`` of
+    ``reference`` = (name, rate, step) (the records a figure's
+    :class:`Trace` are cut from)."""
+    out = [(name, f, record(f, q, tau, table.plant_step, False))
+           for name, q, tau in table.variants() for f in rates if f in table.rates]
+    name, rate, step = reference
+    return out + [(name, rate, record(rate, 0.0, 0.0, step, True))]
 
 
 @dataclass(frozen=True)
@@ -158,8 +160,8 @@ class RateMetrics:
     ``names``: the metrics of a rate (quantities ``<prefix>.<variant>.rate[<f>].<name>``);
     ``scenarios``: the scenarios a rate runs; ``combine``: {scenario: outputs
     or None (not run)} -> the metrics of a rate (``names``, ``ok`` and any
-    others the rendering needs); ``needs``: metric -> the scenarios it is
-    computed from (absent: every scenario); ``mesh_atol``: metric -> largest
+    others the rendering needs); ``needs``: scenario -> the metrics computed
+    from it alone (a metric in none: from every scenario); ``mesh_atol``: metric -> largest
     difference between ``step`` and ``step`` / 2 (the mesh check);
     ``mesh_max_rate``: the mesh and three-level checks cover grid rates up
     to this (Hz); ``outputs``: the names of a run's outputs, given: a
@@ -175,7 +177,7 @@ class RateMetrics:
 
     def scenarios_of(self, metric: str) -> tuple:
         """The scenarios ``metric`` is computed from."""
-        return tuple(self.needs.get(metric, self.scenarios))
+        return tuple(s for s, ms in self.needs.items() if metric in ms) or tuple(self.scenarios)
 
     def metrics(self, got: dict) -> dict:
         """``combine`` of {scenario: outputs or None (not run)}."""

@@ -28,7 +28,9 @@ class Section:
     (:func:`sweep_quantities`) of the rate metrics ``metrics``, the ``gaps``
     to the reference and the ``differences`` (quantity -> the rate metric
     it is the difference to the reference of); the three-level checks
-    cover grid rates up to ``max_rate`` (Hz)."""
+    cover grid rates up to ``max_rate`` (Hz); ``extra_names`` are the
+    section's other quantities (of its replay checks, say), ``extra(res)``
+    their values."""
 
     prefix: str
     metrics: tuple
@@ -36,6 +38,8 @@ class Section:
     reference: str
     gaps: tuple = ()
     differences: Mapping[str, str] = field(default_factory=dict)
+    extra_names: tuple = ()
+    extra: Callable | None = None
 
     def claimed(self, table, claims) -> tuple:
         """The rate metrics the ``[[claims]]`` tables ``claims`` compare on
@@ -48,29 +52,32 @@ class Section:
     def quantity_names(self, table) -> set[str]:
         """The quantities of a sweep of ``table`` (:func:`sweep_quantity_names`)."""
         return sweep_quantity_names(self.prefix, table, self.metrics, self.reference, self.gaps,
-                                    tuple(self.differences))
+                                    tuple(self.differences)) | set(self.extra_names)
 
     def quantities(self, res) -> dict:
         """Their values for ``res`` (a :class:`workbench.features.rate_sweep.SweepResult`)."""
-        return sweep_quantities(self.prefix, res.variants, self.metrics, self.reference,
-                                res.reference.metrics, self.gaps, self.differences)
+        return {**sweep_quantities(self.prefix, res.variants, self.metrics, self.reference,
+                                   res.reference.metrics, self.gaps, self.differences),
+                **(self.extra(res) if self.extra else {})}
 
     def rate_pattern(self) -> re.Pattern:
         """The start of a rate quantity ``<prefix>.<variant>.rate[<f>].``
         (groups: the variant, the rate)."""
         return re.compile(re.escape(self.prefix) + r"\.([a-z_]+)\.rate\[([^\]]+)\]\.")
 
-    def levels(self, res, quantity: str, row_at: Callable, memo: dict):
+    def levels(self, res, quantity: str, runs, decl):
         """A rate quantity ``<prefix>.<variant>.rate[<f>].<m>`` of the sweep
         ``res`` at plant_step (reported), plant_step / 2 and plant_step / 4, as
         :class:`workbench.features.refinement.Levels`: each finer level is
         the sweep's own row when it ran one there (the mesh check's at / 2,
         the three-level check's at / 4, which has the scenarios ``m``
-        needs), else ``row_at(rate, step, q, tau)`` (a
-        :class:`~workbench.features.rate_sweep.RateRow`, made once per
-        variant, rate and step in ``memo``); the value at a level is the
-        quantity of the sweep with that row in place of the grid's (so a
-        difference to the reference stays one)."""
+        needs), else the rate's row made by the model ``runs``, ``decl`` (a
+        :class:`~workbench.features.rate_sweep.Runs` memo, each run made
+        once whatever quantity asks, and its
+        :class:`~workbench.features.rate_sweep.RateMetrics`); the value at a
+        level is the quantity of the sweep with that row in place of the
+        grid's (so a difference to the reference stays one)."""
+        from .rate_sweep import rate_row
         from .refinement import Levels
         m = self.rate_pattern().match(quantity)
         name, rate = m[1], float(m[2])
@@ -85,11 +92,8 @@ class Section:
             quarter = replace(quarter, metrics={**v.row(rate).metrics, **quarter.metrics})
         vals = [self.quantities(res).get(quantity)]
         for k, row in ((1, half), (2, quarter)):
-            step = res.spec.plant_step / 2 ** k
             if row is None:
-                if (name, rate, step) not in memo:
-                    memo[name, rate, step] = row_at(rate, step, v.q, v.tau)
-                row = memo[name, rate, step]
+                row = rate_row(runs, decl, rate, v.q, v.tau, res.spec.plant_step / 2 ** k)
             alt = replace(v, rows=tuple(row if x.rate == rate else x for x in v.rows))
             vals.append(self.quantities(replace(res, variants=tuple(
                 alt if x.name == name else x for x in res.variants))).get(quantity))

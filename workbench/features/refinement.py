@@ -300,7 +300,7 @@ def _own_row(r: ClaimResult, lv: Levels | None, field: str) -> RefinementRow:
 
 
 
-def refine_by_readers(findings, readers) -> dict:
+def refine_by_readers(findings, readers, *context) -> dict:
     """claim id -> :class:`Levels` of every finding, for a study that refines
     its own parameters (its ``refine_levels``).
 
@@ -309,16 +309,19 @@ def refine_by_readers(findings, readers) -> dict:
     findings : list of ClaimResult
         The findings and their values.
     readers : sequence of (re.Pattern, callable)
-        Quantity pattern and its metric reader, ``(match, finding) ->
-        Levels``; the first pattern that matches the start of a finding's
+        Quantity pattern and its metric reader, ``(*context, match, finding)
+        -> Levels``; the first pattern that matches the start of a finding's
         quantity reads it. A finding no pattern matches has no three-level
         check (INCONCLUSIVE, :func:`refine_findings`).
+    *context
+        What every reader is given first (the design, the study's result, a
+        memo the readers share, say).
     """
     out = {}
     for r in findings:
         qn = r.claim.quantity
         read = next(((m, f) for p, f in readers if (m := p.match(qn))), None)
-        out[r.claim.id] = (read[1](read[0], r) if read else
+        out[r.claim.id] = (read[1](*context, read[0], r) if read else
                            Levels((), reason=f"no three-level check of `{qn}` in this study"))
     return out
 
@@ -394,11 +397,13 @@ def screen_reason(values: dict, rtol: float, atol: dict, name_of, instead: dict,
     ``values`` (metric -> (q1, q2, q4), the metrics that did not converge)
     in the words of :func:`not_converged_text`,
     named ``name_of(metric)``, with its :func:`guarded_check` error and the
-    quantity to use instead (``instead[metric]``, else ``otherwise``); ""
+    quantity to use instead: the metric ``instead[metric]`` (named
+    ``name_of``) unless it did not converge either, else ``otherwise``; ""
     when ``values`` is empty."""
     tol = screen_tolerances(values, rtol, atol)
+    use = {k: f"`{name_of(a)}`" for k, a in instead.items() if a not in values}
     parts = [not_converged_text(name_of(k), v, guarded_check(*v, tolerance=tol[k]).estimate,
-                                tol[k], instead.get(k, otherwise)) for k, v in values.items()]
+                                tol[k], use.get(k, otherwise)) for k, v in values.items()]
     return "not converged: " + "; ".join(parts) if parts else ""
 
 

@@ -48,9 +48,19 @@ from __future__ import annotations
 import dataclasses
 import re
 
+from ...features.comfort import comfort_of
 from ...features.montecarlo_halving import sweep_share_levels
 from ...features.refinement import (Levels, claimed_members, refine_by_readers, screen_levels,
                                     screen_reason, unstepped_levels)
+from ...sim.kernel_path import default_kernel
+from .antiskid_basin import cruise_basin
+from .antiskid_basin_run import brake_points, switch_points
+from .antiskid_halving import _step_values
+from .antiskid_montecarlo import RUNS, range_worker
+from .antiskid_run_spec import (METRICS, case_mesh, case_metrics, controller_settings,
+                                plant_values, run_settings, sampled_context)
+from .antiskid_sampled import SECTION, model
+from .antiskid_scenario import simulate_antiskid
 
 __all__ = ["CONVERGED_INSTEAD", "READERS", "quarter_cases",
            "refine_levels", "three_level_metrics", "unconverged_reason"]
@@ -78,8 +88,7 @@ def refine_levels(design, result, findings, *, quantities, record_dt: float) -> 
         Record step (s) of the study's runs (the comfort peaks).
     """
     cache: dict = {"quantities": quantities, "record_dt": record_dt}
-    return refine_by_readers(findings, [(p, lambda m, r, f=f: f(design, result, cache, m, r))
-                                        for p, f in READERS])
+    return refine_by_readers(findings, READERS, design, result, cache)
 
 
 def _case_levels(spec, result, cache, name):
@@ -87,8 +96,6 @@ def _case_levels(spec, result, cache, name):
     key = ("case", name)
     if key in cache:
         return cache[key]
-    from .antiskid_run_spec import case_mesh, case_metrics, controller_settings, run_settings
-    from .antiskid_scenario import simulate_antiskid
     cr = result.case(name)
     if cr.quarter is not None:   # the study's own dt/4 run (a claimed convergence)
         q4, run4, c4 = cr.quarter
@@ -98,10 +105,7 @@ def _case_levels(spec, result, cache, name):
         run4, m4 = simulate_antiskid(run_settings(spec, cs), spec.dt / 4, record_dt=rec,
                                      mesh=case_mesh(spec, cr.case))
         q4 = case_metrics(m4, cs, spec.scenario["t_brake"])
-        c4 = None
-        if spec.comfort is not None:
-            from ...features.comfort import comfort_of
-            c4 = comfort_of(run4, spec.comfort, cs.u_range / spec.torque_range, rec)
+        c4 = comfort_of(run4, spec.comfort, cs.u_range / spec.torque_range, rec)
     coarse = dataclasses.replace(cr, metrics=cr.metrics_coarse, switch=None,
                                  comfort=cr.comfort_coarse, quarter=None)
     quarter = dataclasses.replace(cr, metrics=q4, metrics_coarse=q4, run=run4, switch=None,
@@ -130,15 +134,10 @@ def _switch_levels(design, result, cache, m, r) -> Levels:
     spec, (which, name), got = design.spec, m.groups(), r.got
     if spec.basin is None:
         return Levels((), reason="the design has no basin check")
-    from .antiskid_basin_run import brake_points, switch_points
-    from .antiskid_run_spec import controller_settings, plant_values
     levels = _case_levels(spec, result, cache, name)
     v_d = spec.scenario["v_d"]
-    pick = (lambda c: switch_points([c])) if which == "cruise" else (
-        lambda c: brake_points([c], v_d))
-    pts = [pick(c) for c in levels]
+    pts = [switch_points([c]) if which == "cruise" else brake_points([c], v_d) for c in levels]
     if which == "cruise":
-        from .antiskid_basin import cruise_basin
         extra = [(f"{name}@{k}", p[0][1]) for k, p in zip(("dt", "dt/4"), (pts[0], pts[2]))
                  if p]
         basin = cruise_basin(plant_values(spec), v_d, result.K,
@@ -159,15 +158,12 @@ def _switch_levels(design, result, cache, m, r) -> Levels:
 def _rate_levels(design, result, cache, m, r) -> Levels:
     """A sampled rate's metric at plant_step (reported), /2 and /4
     (:meth:`workbench.features.rate_sweep_quantities.Section.levels`), a
-    level the study has not run made here by the sampled kernel."""
-    from .antiskid_run_spec import sampled_context
-    from .antiskid_sampled import SECTION, rate_row
-
-    def row_at(rate, step, q, tau):
-        ctx = cache.get("ctx") or cache.setdefault("ctx", sampled_context(design.spec, result.K))
-        return rate_row(ctx, rate, dt_p=step, predictor_step=design.spec.sampled.predictor_step,
-                        q=q, tau=tau)
-    return SECTION.levels(result.sampled, r.claim.quantity, row_at, cache)
+    level the study has not run made here by the sampled kernel
+    (:func:`~workbench.papers.p003.antiskid_sampled.model`)."""
+    if "rates" not in cache:
+        cache["rates"] = model(sampled_context(design.spec, result.K),
+                               design.spec.sampled.predictor_step)
+    return SECTION.levels(result.sampled, r.claim.quantity, *cache["rates"])
 
 
 def _mc_levels(design, result, cache, m, r) -> Levels:
@@ -178,9 +174,6 @@ def _mc_levels(design, result, cache, m, r) -> Levels:
     :func:`~workbench.papers.p003.antiskid_montecarlo.range_worker`)."""
     def quarter():
         if "mc" not in cache:
-            from .antiskid_halving import _step_values
-            from .antiskid_kernel import default_kernel
-            from .antiskid_montecarlo import RUNS, range_worker
             hc = result.halving
             out = range_worker({"design": design, "K": tuple(result.K), "i0": 0, "i1": hc.n,
                                 "seed": design.spec.montecarlo.seed, "step": hc.dt / 4,
@@ -202,7 +195,6 @@ def three_level_metrics(spec, coarse: dict, fine: dict, quarter: dict) -> tuple:
     """(metric -> converged, metrics not converged) of the case metrics over
     dt, dt/2, dt/4: :func:`workbench.features.refinement.screen_levels` with
     the design's two-level screen (rtol, atol)."""
-    from .antiskid_run_spec import METRICS
     return screen_levels({k: (coarse[k], fine[k], quarter[k]) for k in METRICS},
                          spec.conv_rtol, spec.conv_atol)
 
@@ -220,9 +212,8 @@ def unconverged_reason(spec, name: str, coarse: dict, fine: dict, quarter: dict,
     :func:`workbench.features.refinement.screen_reason`, with the quantity
     to use instead (:data:`CONVERGED_INSTEAD`; "" when every metric
     converged)."""
-    use = {k: f"`cases[{name}].{a}`" for k, a in CONVERGED_INSTEAD.items() if a not in bad}
     return screen_reason({k: (coarse[k], fine[k], quarter[k]) for k in bad}, spec.conv_rtol,
-                         spec.conv_atol, lambda k: f"cases[{name}].{k}", use,
+                         spec.conv_atol, lambda k: f"cases[{name}].{k}", CONVERGED_INSTEAD,
                          "a metric of the case that converges")
 
 

@@ -42,9 +42,8 @@ bisection bracket, the mesh check at ``plant_step`` / 2 up to
 claimed rate metric, the result, every run made once; its quantities and
 claimed rate metrics: :mod:`workbench.features.rate_sweep_quantities`).
 What stays here is paper 003's: the case, margin and predictor keys, the
-kernel as the sweep's ``run`` callback (:func:`runs_of`), the metrics of a
-rate and their tolerances (:func:`rate_metrics`, :func:`declaration`,
-:data:`SECTION`), the emulation as the reference, the traces' records, and the Radau windows
+kernel as the sweep's ``run`` callback and the metrics of a rate and their
+tolerances (:func:`model`, :func:`rate_metrics`, :data:`SECTION`), the emulation as the reference, the traces' records, and the Radau windows
 (:mod:`.antiskid_sampled_check`).
 """
 from __future__ import annotations
@@ -66,13 +65,11 @@ MESH_ATOL = {"lam_max_over_opt": 2e-5, "t_cruise": 0.005, "braking_duration": 0.
 RATE_METRICS = ("lam_max_over_opt", "time_above", "t_cruise", "u_max_over_peak",
                 "braking_duration", "stop_distance", "lam_min_brake", "evs_max_tracking",
                 "omega3_after_brake", "traction_ok", "braking_ok", "ok")
-#: Rate metrics of the traction run and of the braking run (the others need both).
-TRACTION_METRICS = ("lam_max_over_opt", "time_above", "t_cruise", "traction_ok")
-BRAKING_METRICS = ("braking_duration", "stop_distance", "lam_min_brake", "evs_max_tracking",
-                   "omega3_after_brake", "braking_ok")
-#: Metric -> the scenarios (0 traction, 1 braking) it is computed from (absent: both).
-NEEDS = {**dict.fromkeys(TRACTION_METRICS + ("traction_diverged",), (0,)),
-         **dict.fromkeys(BRAKING_METRICS + ("braking_diverged",), (1,))}
+#: Scenario (0 traction, 1 braking) -> the rate metrics computed from its run alone (the
+#: others need both).
+NEEDS = {0: ("lam_max_over_opt", "time_above", "t_cruise", "traction_ok", "traction_diverged"),
+         1: ("braking_duration", "stop_distance", "lam_min_brake", "evs_max_tracking",
+             "omega3_after_brake", "braking_ok", "braking_diverged")}
 #: Rates (Hz, those of the grid) and seconds of the traction traces of the figure.
 TRACE_RATES_HZ, TRACE_SECONDS = (100.0, 1000.0), 4.0
 #: Metrics compared between the highest grid rate and the emulation.
@@ -81,10 +78,12 @@ GAP_METRICS = ("lam_max_over_opt", "t_cruise", "braking_duration", "stop_distanc
 #: (the emulation does not depend on plant_step).
 TO_EMULATION = {"stop_time_minus_emulation": "braking_duration",
                 "stop_distance_minus_emulation": "stop_distance"}
-#: The section's quantities and the rate metrics its claims compare (a difference to the
-#: emulation counts as its rate metric).
+#: The section's quantities (with those of the Radau check, :mod:`.antiskid_sampled_check`)
+#: and the rate metrics its claims compare (a difference to the emulation counts as its rate
+#: metric).
 SECTION = RQ.Section("sampled", RATE_METRICS, MESH_CHECK_MAX_HZ, "emulation", GAP_METRICS,
-                     TO_EMULATION)
+                     TO_EMULATION, RADAU_QUANTITIES,
+                     lambda res: radau_quantities(res.checks, res.lambda_opt))
 
 
 @dataclass(frozen=True)
@@ -138,28 +137,18 @@ def rate_metrics(ctx: Context, trac: dict, brake: dict) -> dict:
             "traction_diverged": trac["t_diverged"], "braking_diverged": brake["t_diverged"]}
 
 
-def declaration(ctx: Context) -> RS.RateMetrics:
-    """The metric declarations of the sampled section: :data:`RATE_METRICS`
-    of a rate from its traction (0) and braking (1) runs (:func:`rate_metrics`;
+def model(ctx: Context, predictor_step: float, emulation: bool = False) -> tuple:
+    """(runs, declarations) of the sampled controller, the model of
+    :mod:`workbench.features.rate_sweep`: the memo of the kernel's runs
+    (:func:`.antiskid_sampled_kernel.run_once`, its outputs; ``emulation``:
+    of the case's own controller, every step) and :data:`RATE_METRICS` of
+    a rate from its traction (0) and braking (1) runs (:func:`rate_metrics`;
     a scenario not run counts as NaN outputs)."""
-    return RS.RateMetrics(RATE_METRICS, (0, 1), lambda got: rate_metrics(ctx, got[0], got[1]),
-                          NEEDS, MESH_ATOL, MESH_CHECK_MAX_HZ, OUT)
-
-
-def runs_of(ctx: Context, predictor_step: float, emulation: bool = False) -> RS.Runs:
-    """The memo of the kernel's runs (:func:`.antiskid_sampled_kernel.run_once`,
-    its outputs) of the sampled controller (``emulation``: of the case's own
-    controller, every step)."""
-    return RS.Runs(lambda rate, s, q, tau, step: run_once(
+    return (RS.Runs(lambda rate, s, q, tau, step: run_once(
         ctx, rate, s, q=q, tau=tau, dt_p=step, predictor_step=predictor_step,
-        emulation=emulation)[0])
-
-
-def rate_row(ctx: Context, rate: float, *, dt_p: float, predictor_step: float,
-             q: float = 0.0, tau: float = 0.0, emulation: bool = False) -> RS.RateRow:
-    """Both scenarios at one rate, run now (the study's runs: :func:`run_sampled`)."""
-    return RS.rate_row(runs_of(ctx, predictor_step, emulation), declaration(ctx), rate, q,
-                       tau, dt_p)
+        emulation=emulation)[0]),
+        RS.RateMetrics(RATE_METRICS, (0, 1), lambda got: rate_metrics(ctx, got[0], got[1]),
+                       NEEDS, MESH_ATOL, MESH_CHECK_MAX_HZ, OUT))
 
 
 def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:
@@ -170,9 +159,8 @@ def run_sampled(spec: SampledSpec, ctx: Context, dt: float) -> SampledResult:
     the traces of the figure, the Radau check (on the grid's runs and the
     traces' records)."""
     dt_e = dt / 2
-    decl = declaration(ctx)
-    emu = RS.rate_row(runs_of(ctx, 0.0, emulation=True), decl, 1.0 / dt_e, 0.0, 0.0, dt_e)
-    runs = runs_of(ctx, spec.predictor_step)
+    emu = RS.rate_row(*model(ctx, 0.0, emulation=True), 1.0 / dt_e, 0.0, 0.0, dt_e)
+    runs, decl = model(ctx, spec.predictor_step)
     variants = RS.sweep(runs, decl, spec)
     recs = trace_records(ctx, spec, dt_e)
     shown = tuple(RS.Trace(name, f, rec[:, 0].copy(), rec[:, 2] / ctx.cs.lambda_opt - 1.0)
@@ -186,20 +174,14 @@ def trace_records(ctx: Context, spec: SampledSpec, dt_e: float) -> list:
     """[(variant, rate, mesh record), ...]: the first :data:`TRACE_SECONDS`
     of traction of each variant at :data:`TRACE_RATES_HZ` (grid rates only)
     and of the emulation (:func:`workbench.features.rate_sweep.trace_records`)."""
-    def record(f, q=0.0, tau=0.0, reference=False):
-        kw = (dict(dt_p=dt_e, emulation=True) if reference else dict(
-            q=q, tau=tau, dt_p=spec.plant_step, predictor_step=spec.predictor_step))
-        cap = int(TRACE_SECONDS / min(kw["dt_p"], 1.0 / f)) * 3 + 16
-        return run_once(ctx, f, 0, record=(0.0, TRACE_SECONDS, cap), t_cap=TRACE_SECONDS,
-                        **kw)[1][0]
-    return RS.trace_records(spec, TRACE_RATES_HZ, record, ("emulation", 1.0 / dt_e))
+    def record(f, q, tau, step, reference):
+        cap = int(TRACE_SECONDS / min(step, 1.0 / f)) * 3 + 16
+        return run_once(ctx, f, 0, q=q, tau=tau, dt_p=step, emulation=reference,
+                        predictor_step=0.0 if reference else spec.predictor_step,
+                        record=(0.0, TRACE_SECONDS, cap), t_cap=TRACE_SECONDS)[1][0]
+    return RS.trace_records(spec, TRACE_RATES_HZ, record, ("emulation", 1.0 / dt_e, dt_e))
 
 
-def sampled_quantity_names(spec: SampledSpec) -> set[str]:
-    """The ``sampled.*`` quantities a design with ``[sampled]`` has."""
-    return SECTION.quantity_names(spec) | set(RADAU_QUANTITIES)
-
-
-def sampled_quantities(res: SampledResult) -> dict:
-    """Values of :func:`sampled_quantity_names`."""
-    return {**SECTION.quantities(res), **radau_quantities(res.checks, res.lambda_opt)}
+#: The ``sampled.*`` quantities a design with ``[sampled]`` has (of its table) and their
+#: values (of a :class:`SampledResult`).
+sampled_quantity_names, sampled_quantities = SECTION.quantity_names, SECTION.quantities

@@ -36,7 +36,7 @@ Why this loop stays in papers/ (issue 35): it is paper 003's controller
 compiled together with the adhesion plant's event mesh in one numba loop;
 nothing of it serves another system. The general sampled-data machinery
 calls it only through the sweep's ``run`` callback
-(:func:`.antiskid_sampled.runs_of`, :class:`workbench.features.rate_sweep.Runs`)
+(:func:`.antiskid_sampled.model`, :class:`workbench.features.rate_sweep.Runs`)
 and the replay's ``record`` callback (:mod:`.antiskid_sampled_check`,
 :func:`workbench.features.mesh_replay.replay_windows`).
 
