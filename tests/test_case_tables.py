@@ -15,8 +15,8 @@ import pytest
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from workbench.report.case_figures import (Palette, plot_cases, plot_phase_plane,  # noqa: E402
-                                           snapped, time_window)
+from workbench.report.case_figures import (Palette, plot_cases, plot_on_curve,  # noqa: E402
+                                           plot_phase_plane, snapped, time_window)
 from workbench.report.case_tables import (CaseLevels, case_convergence_section,  # noqa: E402
                                           case_convergence_table, case_metric_table, case_rows,
                                           event_cell, fmt_finite)
@@ -157,6 +157,17 @@ def test_case_figure_colours_snapped_data_and_grid_ends():
     assert (start.get_marker(), end.get_marker()) == ("o", "x")
     assert end.get_xydata().tolist() == [[2.0, y["slow"][-1]]]
     assert {ln.get_color() for ln in ax.get_lines()[3:]} == {"tab:green"}
+    plt.close(fig)
+    # where on a saturation y = tanh(x) each toy case operated
+    fig = plt.figure()
+    ax = fig.add_subplot(111)
+    grid = np.linspace(-2.0, 2.0, 41)
+    plot_on_curve(ax, grid, np.tanh, [(n, y[n]) for n in CASES], color_of, "tanh")
+    curve, slow, fast = ax.get_lines()
+    assert curve.get_label() == "tanh" and curve.get_color() == "k"
+    assert np.array_equal(curve.get_ydata(), np.tanh(grid))
+    assert (slow.get_label(), slow.get_marker(), slow.get_color()) == ("slow", ".", "tab:blue")
+    assert np.array_equal(fast.get_xydata(), np.column_stack([y["fast"], np.tanh(y["fast"])]))
     plt.close(fig)
 
 

@@ -75,7 +75,10 @@ def render(design, res) -> Rendered:
     sections.append(_results_section(res))
     sections.append(_switch_section(res, spec))
     sections.append(_convergence_section(res, spec))
-    sections.append(_linear_section(res))
+    sections.append(linear_check_section(
+        res.linear, linearisation="the cruise linearisation",
+        closing=": with this gain the loop decays at delays two orders of magnitude above h_m, "
+        "as its infinite exact margin says."))
     anchors = [(r"cases\[[^\]]+\]\.(diverged|stopped|t_|braking|lam_|evs|omega3|v_)",
                 "What happens"),
                (r"switch\.|basin\.", BASIN_HEADING),
@@ -89,9 +92,9 @@ def render(design, res) -> Rendered:
         anchors.insert(0, (PATTERN, HEADING))
     if res.sampled is not None:
         from .antiskid_sampled_render import (HEADING as SAMPLED_HEADING, PATTERN as SAMPLED,
-                                              sampled_figure, sampled_section, trace_figure)
+                                              sampled_figures, sampled_section)
         sections.append(sampled_section(res.sampled, spec.rail))
-        extra_figs += (sampled_figure(res.sampled), trace_figure(res.sampled))
+        extra_figs += sampled_figures(res.sampled)
         anchors.insert(0, (SAMPLED, SAMPLED_HEADING))
     if res.montecarlo is not None:
         sections.append(_montecarlo_section(design, res.montecarlo, res.halving))
@@ -228,13 +231,6 @@ def _convergence_section(res, spec) -> str:
                          c.converged if c.quarter is None
                          else {k: k not in c.unconverged for k in _LABELS}) for c in res.cases]
     return case_convergence_section(levels, _LABELS, res.dt, spec.conv_rtol, P_MIN)
-
-
-def _linear_section(res) -> str:
-    return linear_check_section(
-        res.linear, linearisation="the cruise linearisation",
-        closing=": with this gain the loop decays at delays two orders of magnitude above h_m, "
-        "as its infinite exact margin says.")
 
 
 def _montecarlo_section(design, mc, halving=None) -> str:
