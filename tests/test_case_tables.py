@@ -172,7 +172,7 @@ def test_case_figure_colours_snapped_data_and_grid_ends():
 
 
 def test_binned_fractions_last_bin_closed_and_empty_bin_dashed():
-    from workbench.report.binned_fractions import binned_fraction_rows
+    from workbench.report.binned_fractions import binned_fraction_rows, binned_fraction_table
     gain = np.array([0.0, 0.1, 0.3, 0.6, 1.0, 1.0])         # a sampled toy gain
     unstable = gain < 0.2                                   # a flag per run
     rows = binned_fraction_rows(gain, 0.0, 1.0, 4, [unstable, ~unstable])
@@ -181,6 +181,9 @@ def test_binned_fractions_last_bin_closed_and_empty_bin_dashed():
     assert rows[0][2:] == ["1", "0"] and rows[3][2:] == ["0", "1"]
     empty = binned_fraction_rows(gain, 0.0, 2.0, 4, [unstable])
     assert empty[3][1:] == [0, "—"] and sum(r[1] for r in empty) == len(gain)
+    table = binned_fraction_table("gain", gain, 0.0, 1.0, 4, {"unstable": unstable}).splitlines()
+    assert table[:2] == ["| gain | runs | fraction unstable |", "| :--- | ---: | ---: |"]
+    assert table[2] == "| [0, 0.25) | 2 | 1 |" and len(table) == 2 + 4
 
 
 def test_event_cell_says_whether_and_when():

@@ -13,6 +13,7 @@ import math
 from functools import partial
 
 from ...features import rate_sweep_render as RR
+from ...report.case_figures import Palette
 from ...report.markdown import Figure, fmt
 from .antiskid_sampled import MESH_ATOL, MESH_CHECK_MAX_HZ, TRACE_SECONDS
 from .antiskid_sampled_check import RTOL, WINDOW_SAMPLES
@@ -24,7 +25,7 @@ HEADING = "Sampled-data controller: rate f_c, zero-order hold"
 PATTERN = r"sampled\."
 #: The emulation row's label.
 EMULATION = "emulation (continuous law, step-dependent)"
-_COLORS = {"zoh": "tab:blue", "zoh_q_tau": "tab:red", "emulation": "k"}
+_color = Palette({"zoh": "tab:blue", "zoh_q_tau": "tab:red", "emulation": "k"})
 #: m/s, the bound of the run designs' creep-speed-tracking claim (drawn for reference).
 EVS_BOUND = 0.01
 
@@ -157,7 +158,7 @@ def plot_sampled(fig, res):
             ("stop_distance", "stop distance (m)", "braking_diverged"))
     # the top left panel shows the excess over 1
     axes = RR.plot_rate_panels(fig, res.variants, keys,
-                               lambda v: _COLORS.get(v.name, "tab:green"), variant_label,
+                               lambda v: _color(v.name), variant_label,
                                res.reference.metrics, EMULATION, {"lam_max_over_opt": 1.0})
     m = res.spec.creep_margin
     RR.mark_requirement(axes[0], m, "requirement λ_opt (1 + margin)", "λ_opt")
@@ -170,7 +171,7 @@ def plot_sampled(fig, res):
 
 def plot_traces(fig, res):
     ax = fig.add_subplot(111)
-    RR.plot_traces(ax, res.traces, "y", lambda tr: _COLORS.get(tr.variant, "tab:green"),
+    RR.plot_traces(ax, res.traces, "y", lambda tr: _color(tr.variant),
                    lambda tr: EMULATION if tr.variant == "emulation" else
                    f"{variant_label(res.variant(tr.variant))}, {fmt(tr.rate)} Hz",
                    {100.0: "-", 1000.0: "--"})
