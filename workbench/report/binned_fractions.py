@@ -3,7 +3,8 @@
 The parameter's range is cut into equal bins, half-open except the last,
 which is closed (it holds the range's upper end); each bin's row gives its
 interval, its number of runs and, per flag, the fraction of its runs
-flagged (:data:`~workbench.report.case_tables.MISSING` for an empty bin).
+flagged (:data:`~workbench.report.case_tables.MISSING` for an empty bin);
+:func:`binned_fraction_table` lays the rows out as a Markdown table.
 
 Used by the ``antiskid-run`` study's Monte Carlo section (paper 003);
 ``tests/test_case_tables.py`` renders a toy.
