@@ -15,8 +15,8 @@ import pytest
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from workbench.report.case_figures import (Palette, plot_cases, plot_phase_plane,  # noqa: E402
-                                           snapped, time_window)
+from workbench.report.case_figures import (Palette, plot_cases, plot_on_curve,  # noqa: E402
+                                           plot_phase_plane, snapped, time_window)
 from workbench.report.case_tables import (CaseLevels, case_convergence_section,  # noqa: E402
                                           case_convergence_table, case_metric_table, case_rows,
                                           event_cell, fmt_finite)
@@ -158,10 +158,21 @@ def test_case_figure_colours_snapped_data_and_grid_ends():
     assert end.get_xydata().tolist() == [[2.0, y["slow"][-1]]]
     assert {ln.get_color() for ln in ax.get_lines()[3:]} == {"tab:green"}
     plt.close(fig)
+    # where on a saturation y = tanh(x) each toy case operated
+    fig = plt.figure()
+    ax = fig.add_subplot(111)
+    grid = np.linspace(-2.0, 2.0, 41)
+    plot_on_curve(ax, grid, np.tanh, [(n, y[n]) for n in CASES], color_of, "tanh")
+    curve, slow, fast = ax.get_lines()
+    assert curve.get_label() == "tanh" and curve.get_color() == "k"
+    assert np.array_equal(curve.get_ydata(), np.tanh(grid))
+    assert (slow.get_label(), slow.get_marker(), slow.get_color()) == ("slow", ".", "tab:blue")
+    assert np.array_equal(fast.get_xydata(), np.column_stack([y["fast"], np.tanh(y["fast"])]))
+    plt.close(fig)
 
 
 def test_binned_fractions_last_bin_closed_and_empty_bin_dashed():
-    from workbench.report.binned_fractions import binned_fraction_rows
+    from workbench.report.binned_fractions import binned_fraction_rows, binned_fraction_table
     gain = np.array([0.0, 0.1, 0.3, 0.6, 1.0, 1.0])         # a sampled toy gain
     unstable = gain < 0.2                                   # a flag per run
     rows = binned_fraction_rows(gain, 0.0, 1.0, 4, [unstable, ~unstable])
@@ -170,6 +181,9 @@ def test_binned_fractions_last_bin_closed_and_empty_bin_dashed():
     assert rows[0][2:] == ["1", "0"] and rows[3][2:] == ["0", "1"]
     empty = binned_fraction_rows(gain, 0.0, 2.0, 4, [unstable])
     assert empty[3][1:] == [0, "—"] and sum(r[1] for r in empty) == len(gain)
+    table = binned_fraction_table("gain", gain, 0.0, 1.0, 4, {"unstable": unstable}).splitlines()
+    assert table[:2] == ["| gain | runs | fraction unstable |", "| :--- | ---: | ---: |"]
+    assert table[2] == "| [0, 0.25) | 2 | 1 |" and len(table) == 2 + 4
 
 
 def test_event_cell_says_whether_and_when():

@@ -215,7 +215,8 @@ def test_comfort_table_and_jerk_text_on_a_toy():
     the stretches above the jerk limit with the events near them."""
     from workbench.features.comfort import comfort_of_speed
     from workbench.features.comfort_render import (comfort_cells, comfort_headers, comfort_table,
-                                                   converged_head, jerk_text)
+                                                   converged_head, jerk_text, limits_text,
+                                                   window_text)
     from workbench.report.markdown import md_table
     t = np.arange(0.0, 20.0 + 1e-9, 0.05)
     ramp = lambda k: comfort_of_speed(t, np.where(t < 5, k * t, 5 * k), SPEC, 0.05)
@@ -233,3 +234,7 @@ def test_comfort_table_and_jerk_text_on_a_toy():
     assert "run → hold at 5 s" in text and text.endswith(").")
     assert jerk_text("flat", ramp(0.0), [], SPEC) == (
         f"`flat`: |jerk| > {SPEC.jerk_max.value:g} m/s³ at no time.")
+    a, j, w = SPEC.a_max, SPEC.jerk_max, SPEC.window
+    assert limits_text(SPEC, "g", "g/s") == (f"|a| <= {a.value:g} g ({a.source}) and |jerk| <= "
+                                             f"{j.value:g} g/s ({j.source})")
+    assert window_text(SPEC) == f"averaged over a {w.value:g} s window ({w.source})"

@@ -33,10 +33,13 @@ def test_freeze_scalar_delayed_loop_margin_and_abscissa():
 def test_frozen_loop_cells_of_toys():
     """The printed cells (features.frozen_loop_render): A on the grid of its
     largest entry (a last-bit-noise entry prints 0), the abscissa, the margin."""
-    from workbench.features.frozen_loop_render import frozen_loop_cells, margin_cell
+    from workbench.features.frozen_loop_render import (FROZEN_ALIGN, FROZEN_HEADS,
+                                                       frozen_loop_cells, margin_cell)
     fl = freeze(lambda x: np.array([-x[0] + 0.1 * x[0] ** 3]), (0.0,), (1e-6,),
                 np.array([[-2.0]]))
-    A, ab, m = frozen_loop_cells(fl.A, fl.abscissa, fl.margin)
+    cells = frozen_loop_cells(fl.A, fl.abscissa, fl.margin)
+    assert len(cells) == len(FROZEN_HEADS) == len(FROZEN_ALIGN)
+    A, ab, m = cells
     assert (A, ab) == ("$\\begin{bmatrix} -1 \\end{bmatrix}$", "-3")
     assert m == f"{math.acos(-0.5) / math.sqrt(3.0):.3g} s"
     assert frozen_loop_cells(np.array([[1.0, 2.6e-7]]), 0.5, fl.margin)[0] == (

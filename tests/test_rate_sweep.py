@@ -207,6 +207,13 @@ def test_the_words_of_a_toy_sweep():
     RR.plot_traces(ax, traces, "y", lambda tr: "k", lambda tr: f"{tr.rate:g} Hz", {20.0: "-"})
     assert [ln.get_label() for ln in ax.lines] == ["20 Hz", "50 Hz"]
     assert [ln.get_linestyle() for ln in ax.lines] == ["-", ":"]
+    RR.mark_requirement(ax, 0.25, "x <= 0.25", "x = 0")
+    base, req = ax.lines[2:]
+    assert (base.get_ydata()[0], base.get_linestyle(), base.get_label()) == (0.0, "-", "x = 0")
+    assert (req.get_ydata()[0], req.get_linestyle(), req.get_label()) == (0.25, ":", "x <= 0.25")
+    # printed digits: NaN is "—", a value near a rounding tie gets one more digit
+    assert RR.printed(math.nan, 3) == "—" and RR.printed(0.123456, 3) == "0.123"
+    assert RR.printed(0.1235000001, 3) == "0.1235"
     fig = Figure()
     axes = RR.plot_rate_panels(fig, (v,), (("x_end", "x at the end", "x_end"),
                                            ("peak", "peak", "peak")), lambda w: "k", label,

@@ -14,9 +14,22 @@ from ..report.markdown import fmt, md_table
 from ..sim.convergence import P_MIN
 from .comfort import COMFORT_RTOL, peaks_converged
 
-__all__ = ["comfort_headers", "comfort_cells", "comfort_table", "converged_head",
+__all__ = ["limits_text", "window_text", "comfort_headers", "comfort_cells", "comfort_table", "converged_head",
            "converged_cell", "converged_text", "jerk_text", "phase_switches", "windows_text",
            "plot_comfort"]
+
+
+def limits_text(limits, accel_unit: str = "m/s²", jerk_unit: str = "m/s³") -> str:
+    """"|a| <= <a_max> m/s² (<source>) and |jerk| <= <jerk_max> m/s³
+    (<source>)": the comfort limits with their sources, in words."""
+    a, j = limits.a_max, limits.jerk_max
+    return (f"|a| <= {fmt(a.value)} {accel_unit} ({a.source}) and |jerk| <= "
+            f"{fmt(j.value)} {jerk_unit} ({j.source})")
+
+
+def window_text(limits) -> str:
+    """"averaged over a <window> s window (<source>)": how a and jerk are smoothed."""
+    return f"averaged over a {fmt(limits.window.value)} s window ({limits.window.source})"
 
 
 def comfort_headers(limits, accel_unit: str = "m/s²", jerk_unit: str = "m/s³") -> list[str]:

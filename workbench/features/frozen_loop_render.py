@@ -8,7 +8,7 @@ import math
 from ..printed_grid import quantised
 from ..report.markdown import fmt, latex_matrix
 
-__all__ = ["A_DIGITS", "frozen_loop_cells", "margin_cell"]
+__all__ = ["A_DIGITS", "FROZEN_ALIGN", "FROZEN_HEADS", "frozen_loop_cells", "margin_cell"]
 
 #: The Jacobian A is printed on the grid of 1e-5 of its largest entry's decade
 #: (:func:`workbench.printed_grid.quantised`): its central differences (step
@@ -17,6 +17,8 @@ __all__ = ["A_DIGITS", "frozen_loop_cells", "margin_cell"]
 #: digit (2.6e-7 as designed, 2.62e-7 with the inputs moved 3 ulp); on the
 #: grid it prints 0.
 A_DIGITS = 6
+#: Column headers of :func:`frozen_loop_cells` and their alignment (``md_table``).
+FROZEN_HEADS, FROZEN_ALIGN = ("A_loc", "abscissa (1/s)", "exact margin"), "lrl"
 
 
 def margin_cell(margin) -> str:

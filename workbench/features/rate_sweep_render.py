@@ -13,8 +13,8 @@ from ..printed_grid import printed_digits
 from ..report.markdown import fmt, md_table
 from ..sim.convergence import P_MAX, P_MIN
 
-__all__ = ["bound", "variant_label", "variant_sources", "summary_lines", "outcome", "missed",
-           "rate_tables",
+__all__ = ["bound", "printed", "variant_label", "variant_sources", "summary_lines", "outcome",
+           "missed", "rate_tables", "mark_requirement",
            "mesh_table", "mesh_text", "three_level_text", "replay_table", "replay_text", "plot_rate_metric",
            "plot_rate_panels", "plot_traces"]
 
@@ -98,10 +98,15 @@ def bound(x: float) -> str:
     return "< " + fmt(10.0 ** (math.floor(math.log10(x)) + 1))
 
 
+def printed(x: float, sig: int) -> str:
+    """``x`` with the digits :func:`~workbench.printed_grid.printed_digits`
+    gives for ``sig`` (one more where ``x`` lies near a rounding tie), "—"
+    for NaN."""
+    return fmt(None if math.isnan(x) else x, printed_digits(x, sig))
+
+
 def _level(x) -> str:
-    if isinstance(x, str):
-        return x
-    return fmt(None if math.isnan(x) else x, printed_digits(x, 5))
+    return x if isinstance(x, str) else printed(x, 5)
 
 
 def _rows(v) -> list:
@@ -239,6 +244,15 @@ def plot_rate_panels(fig, variants, panels, color, label, reference: dict,
     for ax in axes[-cols:]:
         ax.set_xlabel("control rate f_c (Hz)")
     return axes
+
+
+def mark_requirement(ax, requirement: float, label: str | None = None,
+                     base_label: str | None = None) -> None:
+    """A solid grey line at 0 (``base_label``) and a dotted one at
+    ``requirement`` (``label``): a metric drawn as its excess over a base,
+    which it must keep below ``requirement``."""
+    ax.axhline(0.0, color="grey", lw=0.8, label=base_label)
+    ax.axhline(requirement, color="dimgrey", ls=":", lw=1.0, label=label)
 
 
 def plot_traces(ax, traces, y: str, color, label, styles: dict) -> None:

@@ -3,19 +3,20 @@
 The parameter's range is cut into equal bins, half-open except the last,
 which is closed (it holds the range's upper end); each bin's row gives its
 interval, its number of runs and, per flag, the fraction of its runs
-flagged (:data:`~workbench.report.case_tables.MISSING` for an empty bin).
+flagged (:data:`~workbench.report.case_tables.MISSING` for an empty bin);
+:func:`binned_fraction_table` lays the rows out as a Markdown table.
 
 Used by the ``antiskid-run`` study's Monte Carlo section (paper 003);
 ``tests/test_case_tables.py`` renders a toy.
 """
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 
 from .case_tables import MISSING
-from .markdown import fmt
+from .markdown import fmt, md_table
 
 
 def binned_fraction_rows(samples, lo: float, hi: float, bins: int,
@@ -33,3 +34,13 @@ def binned_fraction_rows(samples, lo: float, hi: float, bins: int,
         rows.append([f"[{fmt(a, sig)}, {fmt(b, sig)}" + ("]" if last else ")"), n]
                     + [fmt(f[sel].mean(), frac_sig) if n else MISSING for f in flags])
     return rows
+
+
+def binned_fraction_table(name: str, samples, lo: float, hi: float, bins: int,
+                          flags: Mapping[str, Sequence], sig: int = 3) -> str:
+    """Markdown of :func:`binned_fraction_rows`: columns ``name`` (the
+    sampled parameter's bins), runs, then "fraction <label>" per entry of
+    ``flags`` (label -> one flag per run), in order."""
+    rows = binned_fraction_rows(samples, lo, hi, bins, list(flags.values()), sig)
+    return md_table([name, "runs", *(f"fraction {k}" for k in flags)], rows,
+                    "lr" + "r" * len(flags))

@@ -56,6 +56,16 @@ def plot_phase_plane(ax, traces: Iterable[tuple], color_of, **style) -> None:
         ax.plot(x[-1], y[-1], "x", color=color_of(name), ms=6)
 
 
+def plot_on_curve(ax, grid, f, traces: Iterable[tuple], color_of, label: str) -> None:
+    """A static curve y = ``f(x)`` over ``grid`` in black (legend ``label``),
+    then each trace's (case name, x) points on it, (x, f(x)), as dots in the
+    case's colour labelled with the name: where on a nonlinearity each case
+    operated."""
+    ax.plot(grid, f(grid), color="k", lw=1.0, label=label)
+    for name, x in traces:
+        ax.plot(x, f(x), ".", ms=2, color=color_of(name), label=name)
+
+
 def plot_against_limits(ax, traces: Iterable[tuple], color_of, limits: Iterable[tuple],
                         **style) -> None:
     """One line per trace (case name, t, y) in the case's colour, labelled

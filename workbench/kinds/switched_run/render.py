@@ -9,6 +9,7 @@ from ...features.comfort import TIMES
 from ...features.convergence import claim_table
 from ...features.montecarlo_stats import finite_span
 from ...report.case_tables import fmt_finite
+from ...report.display_math import display_math
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from ...sim.convergence import P_MAX, P_MIN
 from .quantities import scenario_metrics
@@ -22,9 +23,8 @@ def render(design, res) -> Rendered:
     """The report sections and figures of a ``switched-run`` design."""
     from ..delay_feedback.render import model_latex
     spec = design.spec
-    sections = [_problem(spec), "## Model\n\n" + "\n\n".join(
-        f"$$\n{e}\n$$" for e in model_latex(spec)) + "\n\nThe input acts with the delay: "
-        "u = u(t − h) in the equations."]
+    sections = [_problem(spec), "## Model\n\n" + display_math(model_latex(spec))
+                + "\n\nThe input acts with the delay: u = u(t − h) in the equations."]
     sec, figs = _runs(spec, res)
     sections.append(sec)
     if spec.convergence:

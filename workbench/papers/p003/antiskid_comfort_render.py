@@ -12,7 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...controllers.antiskid003_settings import PHASE_NAMES
-from ...features.comfort_render import comfort_table, converged_text, jerk_text, phase_switches
+from ...features.comfort_render import (comfort_table, converged_text, jerk_text, limits_text,
+                                         phase_switches, window_text)
 from ...features.comfort_render import plot_comfort as plot_comfort_traces
 from ...report.case_figures import plot_against_limits
 from ...report.markdown import fmt
@@ -65,11 +66,9 @@ def comfort_section(res, spec) -> str:
                   "(next to its largest |u| / T_adh in the table).")
     return (
         f"## {HEADING}\n\nPaper 003 states no comfort limit; the design's limits are "
-        f"|a| <= {fmt(cf.a_max.value)} m/s² ({cf.a_max.source}) and |jerk| <= "
-        f"{fmt(cf.jerk_max.value)} m/s³ ({cf.jerk_max.source}). a is the train's "
-        f"acceleration v', jerk its rate, each averaged over a {fmt(cf.window.value)} s "
-        f"window ({cf.window.source}) of the run recorded at dt/2; a run that diverged ends "
-        "there. The torque is the controller's commanded u(t) against the peak adhesion "
+        f"{limits_text(cf)}. a is the train's acceleration v', jerk its rate, each "
+        f"{window_text(cf)} of the run recorded at dt/2; a run that diverged ends there. "
+        "The torque is the controller's commanded u(t) against the peak adhesion "
         f"torque T_adh = mu(lambda_opt) m g r = {fmt(u_peak / 1e3, 3)} kN m of the nominal "
         "model, the most the rail transmits in steady state (the paper gives no drive or "
         f"brake limit; the design's only torque bound, `torque_range` = "

@@ -14,7 +14,8 @@ import numpy as np
 
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, CreepSpeedProfile
 from ...printed_grid import axis_end
-from ...report.case_figures import Palette, plot_cases, plot_phase_plane, time_window
+from ...report.case_figures import (Palette, plot_cases, plot_on_curve, plot_phase_plane,
+                                    time_window)
 from ...sim.wheel_slip import ArrayOps, creep_speed, wheel_speed
 
 #: The colour of a case in every figure.
@@ -61,10 +62,8 @@ def plot_adhesion(fig, res, spec):
     mu = NumericAdhesion.from_dict(plant_values(spec, spec.mass_factor)).mu
     lam = np.linspace(-0.6, 0.6, 601)
     ax_mu, ax_pp = fig.subplots(1, 2)
-    ax_mu.plot(lam, mu(lam), color="k", lw=1.0, label="mu(lambda), plant")
-    for c in res.cases:
-        x = np.clip(c.run.x[1], -0.6, 0.6)
-        ax_mu.plot(x, mu(x), ".", ms=2, color=color_of(c.case.name), label=c.case.name)
+    plot_on_curve(ax_mu, lam, mu, [(c.case.name, np.clip(c.run.x[1], -0.6, 0.6))
+                                   for c in res.cases], color_of, "mu(lambda), plant")
     plot_phase_plane(ax_pp, [(c.case.name, c.run.x[0], np.clip(c.run.x[1], -1, 1))
                              for c in res.cases], color_of, lw=0.8)
     for a in (res.lambda_opt, -res.lambda_opt):

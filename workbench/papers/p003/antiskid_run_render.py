@@ -14,9 +14,9 @@ from __future__ import annotations
 import math
 
 from ...controllers.antiskid003_settings import DIVERGED_HOW, PHASE_NAMES, ControllerSettings
-from ...features.frozen_loop_render import frozen_loop_cells
+from ...features.frozen_loop_render import FROZEN_ALIGN, FROZEN_HEADS, frozen_loop_cells
 from ...features.linear_delay_check_render import linear_check_figure, linear_check_section
-from ...report.binned_fractions import binned_fraction_rows
+from ...report.binned_fractions import binned_fraction_table
 from ...report.case_tables import (CaseLevels, case_convergence_section, case_metric_table,
                                    case_rows, event_cell)
 from ...report.markdown import Figure, Rendered, fmt, md_table
@@ -75,7 +75,10 @@ def render(design, res) -> Rendered:
     sections.append(_results_section(res))
     sections.append(_switch_section(res, spec))
     sections.append(_convergence_section(res, spec))
-    sections.append(_linear_section(res))
+    sections.append(linear_check_section(
+        res.linear, linearisation="the cruise linearisation",
+        closing=": with this gain the loop decays at delays two orders of magnitude above h_m, "
+        "as its infinite exact margin says."))
     anchors = [(r"cases\[[^\]]+\]\.(diverged|stopped|t_|braking|lam_|evs|omega3|v_)",
                 "What happens"),
                (r"switch\.|basin\.", BASIN_HEADING),
@@ -89,9 +92,9 @@ def render(design, res) -> Rendered:
         anchors.insert(0, (PATTERN, HEADING))
     if res.sampled is not None:
         from .antiskid_sampled_render import (HEADING as SAMPLED_HEADING, PATTERN as SAMPLED,
-                                              sampled_figure, sampled_section, trace_figure)
+                                              sampled_figures, sampled_section)
         sections.append(sampled_section(res.sampled, spec.rail))
-        extra_figs += (sampled_figure(res.sampled), trace_figure(res.sampled))
+        extra_figs += sampled_figures(res.sampled)
         anchors.insert(0, (SAMPLED, SAMPLED_HEADING))
     if res.montecarlo is not None:
         sections.append(_montecarlo_section(design, res.montecarlo, res.halving))
@@ -179,8 +182,8 @@ def _switch_section(res, spec) -> str:
         "the loop, linearising the traction form with the feed-forward part of (61), "
         "x' = A_loc x + A_d x(t - h), A_d = (y3/den) B K, and give its delay-free spectral "
         "abscissa and exact delay margin (Chen-Gu-Nett).\n\n"
-        + md_table(["case", "v (m/s)", "lambda", "d mu/d lambda", "A_loc", "abscissa (1/s)",
-                    "exact margin"], rows, "lrrrlrl")
+        + md_table(["case", "v (m/s)", "lambda", "d mu/d lambda", *FROZEN_HEADS], rows,
+                   "lrrr" + FROZEN_ALIGN)
         + "\n\n" + _switch_note(res) + "\n\n"
         "**Cruise → braking.** Law (69) is built on the braking form (eq 15, lambda <= 0). "
         "State at t_brake:\n\n"
@@ -230,13 +233,6 @@ def _convergence_section(res, spec) -> str:
     return case_convergence_section(levels, _LABELS, res.dt, spec.conv_rtol, P_MIN)
 
 
-def _linear_section(res) -> str:
-    return linear_check_section(
-        res.linear, linearisation="the cruise linearisation",
-        closing=": with this gain the loop decays at delays two orders of magnitude above h_m, "
-        "as its infinite exact margin says.")
-
-
 def _montecarlo_section(design, mc, halving=None) -> str:
     ms = design.spec.montecarlo
     rng = lambda lo_hi, sig=3: f"[{fmt(lo_hi[0], sig)}, {fmt(lo_hi[1], sig)}]"
@@ -246,8 +242,6 @@ def _montecarlo_section(design, mc, halving=None) -> str:
             ["true input delay h (s)", rng(ms.h, 4) + " (the predictor keeps "
              + fmt(design.spec.scenario["h"], 4) + " s)"],
             ["v(0) (m/s)", rng(ms.v0)]] + _perturbation_rows(ms, rng)
-    brows = binned_fraction_rows(mc.samples["adhesion"], *ms.adhesion, 4,
-                                 [mc.violations["diverged"], mc.violations["above_lambda_opt"]])
     return WORDS.section(
         mc, heading="Monte Carlo robustness (reduced sample)", intro=(
             f"{mc.n} runs of case `{ms.case}` with seed {ms.seed} at dt = "
@@ -273,9 +267,10 @@ def _montecarlo_section(design, mc, halving=None) -> str:
             "`not stopped` row):"),
         notes=("The rates of the table with their intervals (the claims `mc-*-vs-full` and "
                "`mc-perturbations-raise-divergence` compare these intervals with full sweeps).",
-               "By adhesion (s = 0 wet, s = 1 dry):\n\n"
-               + md_table(["adhesion s", "runs", "fraction diverged",
-                           "fraction above lambda_opt"], brows, "lrrr")),
+               "By adhesion (s = 0 wet, s = 1 dry):\n\n" + binned_fraction_table(
+                   "adhesion s", mc.samples["adhesion"], *ms.adhesion, 4,
+                   {"diverged": mc.violations["diverged"],
+                    "above lambda_opt": mc.violations["above_lambda_opt"]})),
         halving=halving, samples=ms.samples)
 
 

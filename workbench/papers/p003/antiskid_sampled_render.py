@@ -13,7 +13,7 @@ import math
 from functools import partial
 
 from ...features import rate_sweep_render as RR
-from ...printed_grid import printed_digits
+from ...report.case_figures import Palette
 from ...report.markdown import Figure, fmt
 from .antiskid_sampled import MESH_ATOL, MESH_CHECK_MAX_HZ, TRACE_SECONDS
 from .antiskid_sampled_check import RTOL, WINDOW_SAMPLES
@@ -25,7 +25,7 @@ HEADING = "Sampled-data controller: rate f_c, zero-order hold"
 PATTERN = r"sampled\."
 #: The emulation row's label.
 EMULATION = "emulation (continuous law, step-dependent)"
-_COLORS = {"zoh": "tab:blue", "zoh_q_tau": "tab:red", "emulation": "k"}
+_color = Palette({"zoh": "tab:blue", "zoh_q_tau": "tab:red", "emulation": "k"})
 #: m/s, the bound of the run designs' creep-speed-tracking claim (drawn for reference).
 EVS_BOUND = 0.01
 
@@ -45,7 +45,7 @@ def _outcome(m: dict, which: str) -> str:
 
 def _row(label: str, m: dict) -> list:
     # a sum of equal sub-steps (time above) lands on rounding ties: one more digit there
-    n = lambda k, sig: fmt(None if math.isnan(m[k]) else m[k], printed_digits(m[k], sig))
+    n = lambda k, sig: RR.printed(m[k], sig)
     return [label, n("lam_max_over_opt", 7), n("time_above", 2), n("t_cruise", 5),
             _outcome(m, "traction"), n("braking_duration", 3), n("stop_distance", 4),
             n("lam_min_brake", 3), n("evs_max_tracking", 2), n("u_max_over_peak", 3),
@@ -142,16 +142,13 @@ def _checks_text(res) -> str:
         "above), tens of minutes for one variant's grid; the compiled mesh takes seconds.")
 
 
-def sampled_figure(res) -> Figure:
-    """``sampled.png``: the metrics against f_c."""
-    return Figure("sampled", "Sampled-data controller: metrics against the control rate.",
-                  lambda fig, res=res: plot_sampled(fig, res), (9.0, 6.5))
-
-
-def trace_figure(res) -> Figure:
-    """``sampled-traction.png``: lambda / lambda_opt - 1 at the start of traction."""
-    return Figure("sampled-traction", "Creep ratio at the start of traction, sampled.",
-                  lambda fig, res=res: plot_traces(fig, res), (7.0, 4.0))
+def sampled_figures(res) -> tuple[Figure, Figure]:
+    """``sampled.png``, the metrics against f_c, and ``sampled-traction.png``,
+    lambda / lambda_opt - 1 at the start of traction."""
+    return (Figure("sampled", "Sampled-data controller: metrics against the control rate.",
+                   lambda fig: plot_sampled(fig, res), (9.0, 6.5)),
+            Figure("sampled-traction", "Creep ratio at the start of traction, sampled.",
+                   lambda fig: plot_traces(fig, res), (7.0, 4.0)))
 
 
 def plot_sampled(fig, res):
@@ -161,11 +158,10 @@ def plot_sampled(fig, res):
             ("stop_distance", "stop distance (m)", "braking_diverged"))
     # the top left panel shows the excess over 1
     axes = RR.plot_rate_panels(fig, res.variants, keys,
-                               lambda v: _COLORS.get(v.name, "tab:green"), variant_label,
+                               lambda v: _color(v.name), variant_label,
                                res.reference.metrics, EMULATION, {"lam_max_over_opt": 1.0})
     m = res.spec.creep_margin
-    axes[0].axhline(0.0, color="grey", lw=0.8, label="λ_opt")
-    axes[0].axhline(m, color="dimgrey", ls=":", lw=1.0, label="requirement λ_opt (1 + margin)")
+    RR.mark_requirement(axes[0], m, "requirement λ_opt (1 + margin)", "λ_opt")
     axes[0].set_yscale("symlog", linthresh=m / 1000)
     axes[0].set_ylim(bottom=-m / 1000)
     axes[1].axhline(EVS_BOUND, color="dimgrey", ls=":", lw=1.0)
@@ -175,12 +171,11 @@ def plot_sampled(fig, res):
 
 def plot_traces(fig, res):
     ax = fig.add_subplot(111)
-    RR.plot_traces(ax, res.traces, "y", lambda tr: _COLORS.get(tr.variant, "tab:green"),
+    RR.plot_traces(ax, res.traces, "y", lambda tr: _color(tr.variant),
                    lambda tr: EMULATION if tr.variant == "emulation" else
                    f"{variant_label(res.variant(tr.variant))}, {fmt(tr.rate)} Hz",
                    {100.0: "-", 1000.0: "--"})
-    ax.axhline(res.spec.creep_margin, color="dimgrey", ls=":", lw=1.0)
-    ax.axhline(0.0, color="grey", lw=0.8)
+    RR.mark_requirement(ax, res.spec.creep_margin)
     ax.set_ylim(-3 * res.spec.creep_margin, 2 * res.spec.creep_margin)
     ax.set_xlabel("t (s)")
     ax.set_ylabel("λ / λ_opt − 1")
