@@ -82,3 +82,21 @@ def test_robust_points_study_on_toy_points():
     with pytest.raises(DesignError, match="compare"):
         load_robust_points(Reader("toy.toml", {"synthesis": TABLE, "compare": [
             {"name": "short", "K": [1.0], "source": "x"}]}), pts)
+
+
+def test_requirements_section_of_toy_points():
+    """robust_points_render.requirements_section on toy points (no paper): the
+    objective, the delay range and the requirements table with the rounded gain."""
+    from types import SimpleNamespace
+
+    from workbench.kinds.delay_feedback.robust_points_render import requirements_section
+    q = SimpleNamespace(objective="decay", delay=(0.0, 0.25), sources={"decay": "toy"})
+    row = SimpleNamespace(name="decay", required=">= 0.1", certified=0.123, exact=0.2,
+                          verdict="met")
+    r = SimpleNamespace(rows=(row,), K=np.array([[-1.5, 0.25]]), reason=None)
+    spec = SimpleNamespace(requirements=q, settings=SimpleNamespace(gain_digits=3))
+    text = requirements_section(SimpleNamespace(requirements=r, spec=spec))
+    assert text.startswith("## Requirements\n\nOne gain for every operating point below")
+    assert "objective **decay**, every constant delay in [0, 0.25] s" in text
+    assert "| decay | >= 0.1 | 0.12 | 0.2 | **met** | toy |" in text
+    assert "K = " in text and "-1.5" in text
