@@ -6,10 +6,22 @@ from __future__ import annotations
 
 from ...features.point_gains import compare_section
 from ...features.robust_gain_render import eps_search_figure, robust_gain_section
-from ...report.markdown import fmt
+from ...report.markdown import Rendered, fmt
 from .requirements_render import requirements_rows
 
-__all__ = ["requirements_section", "robust_points_sections"]
+__all__ = ["requirements_section", "robust_points_report", "robust_points_sections"]
+
+
+def robust_points_report(res, problem: str, own_label: str, note: str = "") -> Rendered:
+    """The report of a :class:`~.robust_points.RobustPointsResult`: the study's
+    ``problem`` section, opened with ``[requirements]`` by :func:`requirements_section`
+    and the study's ``note`` on it (a paragraph, none when empty), then the sections
+    and figures of :func:`robust_points_sections` (``own_label`` as there)."""
+    if res.requirements is not None:
+        problem = (requirements_section(res) + (f"\n\n{note}" if note else "") + "\n\n"
+                   + problem)
+    sections, figs = robust_points_sections(res, own_label)
+    return Rendered((problem, *sections), figs)
 
 
 def requirements_section(res) -> str:

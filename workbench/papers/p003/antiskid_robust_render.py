@@ -1,12 +1,11 @@
 """Markdown and figure of the ``antiskid-robust`` study (pure rendering): paper
-003's problem wording and its comment on the gain designed to requirements. The
-requirements section, the robust gain's section, the compared gains and the eps
-figure are :mod:`workbench.kinds.delay_feedback.robust_points_render`'s."""
+003's problem wording and its note on the gain designed to requirements; the
+rest is :func:`workbench.kinds.delay_feedback.robust_points_render.robust_points_report`
+(requirements, robust gain, compared gains, eps figure)."""
 from __future__ import annotations
 
 from ...features.robust_gain_render import robust_method_text
-from ...kinds.delay_feedback.robust_points_render import (requirements_section,
-                                                           robust_points_sections)
+from ...kinds.delay_feedback.robust_points_render import robust_points_report
 from ...report.markdown import Rendered, fmt, md_table
 
 
@@ -22,9 +21,7 @@ def render(design, res) -> Rendered:
             + md_table(["point", "rail", "v_d (m/s)", "mass factor", "lambda_d"],
                        [[f"`{p.id}`", p.rail, fmt(p.v_d), fmt(p.mass_factor), fmt(p.lambda_d, 4)]
                         for p in pts], "llrrr"))
-    if res.requirements is not None:
-        prob = (requirements_section(res) + "\n\nThe sections below are the earlier *largest "
-                "certified delay* synthesis (maximise h at a decay rate certified at h only), "
-                "kept as a comparison: its gain has almost no creep feedback.\n\n" + prob)
-    sections, figs = robust_points_sections(res, "robust K (this design)")
-    return Rendered((prob, *sections), figs)
+    return robust_points_report(res, prob, "robust K (this design)", (
+        "The sections below are the earlier *largest certified delay* synthesis (maximise h "
+        "at a decay rate certified at h only), kept as a comparison: its gain has almost no "
+        "creep feedback."))
