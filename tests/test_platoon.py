@@ -197,3 +197,18 @@ def test_linear_law_math_with_and_without_symbolic_forms():
                                   "\\ \\mathrm{s^{-1}}\n$$")
     assert "k_e = \\beta(j + k) = 0.2\\ " in linear_law_math(m, "\\beta(j + k) = ", "x = ")
     assert "k_d = x = 0.9\\ " in linear_law_math(m, "\\beta(j + k) = ", "x = ")
+
+
+def test_platoon_hooks_take_a_function_or_a_fixed_text():
+    """A platoon ``[analysis]`` hook (render.HOOKS) is a function of (spec, res)
+    or a fixed text; without one the general text (no paper: toy analyses)."""
+    from types import SimpleNamespace
+
+    from workbench.kinds.platoon.render import _hook
+    general = lambda: "general"  # noqa: E731
+    assert _hook(SimpleNamespace(analysis=None), "bound_note", 3, general) == "general"
+    fixed = SimpleNamespace(analysis=SimpleNamespace(bound_note="fixed"))
+    assert _hook(fixed, "bound_note", 3, general) == "fixed"
+    assert _hook(fixed, "comparison", 3, general) == "general"
+    fn = SimpleNamespace(analysis=SimpleNamespace(bound_note=lambda spec, res: f"res {res}"))
+    assert _hook(fn, "bound_note", 3, general) == "res 3"

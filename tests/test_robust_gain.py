@@ -82,3 +82,31 @@ def test_robust_points_study_on_toy_points():
     with pytest.raises(DesignError, match="compare"):
         load_robust_points(Reader("toy.toml", {"synthesis": TABLE, "compare": [
             {"name": "short", "K": [1.0], "source": "x"}]}), pts)
+
+
+def test_requirements_section_of_toy_points():
+    """robust_points_render.requirements_section on toy points (no paper): the
+    objective, the delay range and the requirements table with the rounded gain."""
+    from types import SimpleNamespace
+
+    from workbench.kinds.delay_feedback.robust_points_render import (requirements_section,
+                                                                     robust_points_report)
+    q = SimpleNamespace(objective="decay", delay=(0.0, 0.25), sources={"decay": "toy"})
+    row = SimpleNamespace(name="decay", required=">= 0.1", certified=0.123, exact=0.2,
+                          verdict="met")
+    r = SimpleNamespace(rows=(row,), K=np.array([[-1.5, 0.25]]), reason=None)
+    spec = SimpleNamespace(requirements=q, settings=SimpleNamespace(gain_digits=3), ids=["p"])
+    text = requirements_section(SimpleNamespace(requirements=r, spec=spec))
+    assert text.startswith("## Requirements\n\nOne gain for every operating point below")
+    assert "objective **decay**, every constant delay in [0, 0.25] s" in text
+    assert "| decay | >= 0.1 | 0.12 | 0.2 | **met** | toy |" in text
+    assert "K = " in text and "-1.5" in text
+    # the report: requirements, the study's note, its problem, then the robust gain
+    syn = SimpleNamespace(K=None, eps=1.0, reason="toy", bracket=SimpleNamespace(h_certified=0.0))
+    res = SimpleNamespace(requirements=r, spec=spec, robust=SimpleNamespace(
+        synthesis=syn, settings=SimpleNamespace(alpha=0.1)))
+    out = robust_points_report(res, "## Problem\n\ntoy", "toy K", "A note.")
+    assert out.sections[0] == text + "\n\nA note.\n\n## Problem\n\ntoy"
+    assert out.sections[1].startswith("## Robust gain\n\n**No gain was certified**")
+    res.requirements = None
+    assert robust_points_report(res, "## Problem", "toy K", "A note.").sections[0] == "## Problem"

@@ -215,3 +215,13 @@ def test_headed_tables_on_a_pid_only_design(synth):
         "its band of the limit: undecided); their reset rates span 20 % … 20 %")
     tun.stops = np.array([1, 1, 1, 1])
     assert T.admissible_text(tun, 0.5) == "None of its 3 reproducible MFAC runs stops within 0.5 m"
+
+
+def test_profile_text_of_a_toy_profile():
+    """render_general.profile_text (the general report and paper 002's profile
+    section) on a toy profile."""
+    from types import SimpleNamespace
+
+    from workbench.kinds.tracking.render_general import profile_text
+    spec = SimpleNamespace(profile={"accel": 0.8, "brake": 0.75, "jerk": 0.5})
+    assert profile_text(spec) == "acceleration 0.8 m/s², braking 0.75 m/s², jerk 0.5 m/s³"

@@ -154,6 +154,21 @@ class Reader:
         sub.finish()
         return Quantity(x, u, src)
 
+    def quantities(self, units: dict[str, str], **kw) -> dict[str, Quantity]:
+        """Every key of ``units`` (name -> unit, in that order) as a :meth:`quantity`
+        with the bounds ``kw``; then :meth:`finish` (this table holds nothing else)."""
+        out = {k: self.quantity(k, u, **kw) for k, u in units.items()}
+        self.finish()
+        return out
+
+    def strings(self, name: str, choices: Iterable[str]) -> tuple[str, ...]:
+        """A non-empty list of strings, each one of ``choices``."""
+        val, choices = self.raw(name), tuple(choices)
+        if not isinstance(val, list) or not val or any(v not in choices for v in val):
+            raise self.fail(name, val, "a non-empty list of strings among "
+                            + ", ".join(repr(c) for c in choices))
+        return tuple(val)
+
     def table(self, name: str, *, default: Any = _MISSING) -> "Reader":
         val = self.raw(name, default)
         if val is default and default is not _MISSING:

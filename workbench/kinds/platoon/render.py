@@ -2,7 +2,8 @@
 
 A paper's ``[analysis]`` module may replace the parts only it can word (its
 law's equations, its comparison, its margin discussion): the hooks of
-:data:`HOOKS`, each ``f(spec, res) -> str``; without one, the general text.
+:data:`HOOKS`, each ``f(spec, res) -> str`` or a fixed ``str``; without one,
+the general text.
 """
 from __future__ import annotations
 
@@ -29,7 +30,7 @@ WORDS = {2: "two", 3: "three", 4: "four", 5: "five", 6: "six"}
 
 def _hook(spec, name: str, res, default):
     f = getattr(spec.analysis, name, None) if spec.analysis is not None else None
-    return default() if f is None else f(spec, res)
+    return default() if f is None else f if isinstance(f, str) else f(spec, res)
 
 DOC = {"m": "mass", "c0": "Davis, constant", "c1": "Davis, linear", "c2": "Davis, quadratic",
        "g": "gravity"}

@@ -326,8 +326,7 @@ def load_spec(root: Reader) -> PlatoonSpec:
     """Read and validate every table of a ``platoon`` design."""
     pl = root.table("plant")
     model = pl.string("model", choices=tuple(TRAIN_MODELS))
-    plant = {k: pl.quantity(k, u, positive=True) for k, u in TRAIN_MODELS[model].items()}
-    pl.finish()
+    plant = pl.quantities(TRAIN_MODELS[model], positive=True)
     un = root.table("uncertainty")
     ms = un.number("mass_spread", nonneg=True, hi=0.5)
     ds = un.number("davis_spread", nonneg=True, hi=0.5)

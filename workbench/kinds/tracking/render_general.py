@@ -13,7 +13,7 @@ from . import figures as F
 from .spec import OBJECTIVE_UNITS, OBJECTIVES
 
 __all__ = ["DOC", "LABEL", "line_figure", "pareto_links", "params_text",
-           "ppd_figure", "render", "scale_rows", "scale_table", "tuning_figures"]
+           "ppd_figure", "profile_text", "render", "scale_rows", "scale_table", "tuning_figures"]
 
 H_TUNE = "Tuning per reading and controller"
 H_MAIN = "Chosen points on the main pair"
@@ -40,9 +40,14 @@ def _problem(spec) -> str:
         "gravity):\n\n" + param_table(spec.train, DOC, 5)
         + f"\n\nCommand limits {fmt(spec.u_limits[0])} … {fmt(spec.u_limits[1])}. Control "
         f"cycle Ts = {fmt(spec.Ts)} s, plant step {fmt(spec.dt)} s. Target profile: "
-        f"acceleration {fmt(spec.profile['accel'])} m/s², braking "
-        f"{fmt(spec.profile['brake'])} m/s², jerk {fmt(spec.profile['jerk'])} m/s³ "
-        "(`workbench/profiles.py`).")
+        f"{profile_text(spec)} (`workbench/profiles.py`).")
+
+
+def profile_text(spec) -> str:
+    """The target profile's limits: "acceleration … m/s², braking … m/s², jerk … m/s³"."""
+    p = spec.profile
+    return (f"acceleration {fmt(p['accel'])} m/s², braking {fmt(p['brake'])} m/s², "
+            f"jerk {fmt(p['jerk'])} m/s³")
 
 
 def params_text(tun, symbol: dict | None = None) -> str:

@@ -106,11 +106,13 @@ class NTSMAnalysis:
             f"{fmt(_c(spec, 'kd_ff'))} 1/s): the NTSM's information without its nonlinear "
             "feedback and switching.")
 
-    def chatter_note(self, spec, res) -> str:
-        return ("The NTSM's spacing error at exact spacing is drawn as its worst |e| per "
-                "follower, not as a trace: sampled at T the sliding mode chatters, and the "
-                "sub-millimetre trace moves by about 1 % when the inputs move by 3 ulp (the "
-                "last-bit perturbation test), so only its maximum is a result.\n\n")
+    #: Fixed texts of three hooks (a hook may be a ``str``).
+    chatter_note = ("The NTSM's spacing error at exact spacing is drawn as its worst |e| per "
+                    "follower, not as a trace: sampled at T the sliding mode chatters, and the "
+                    "sub-millimetre trace moves by about 1 % when the inputs move by 3 ulp (the "
+                    "last-bit perturbation test), so only its maximum is a result.\n\n")
+    bound_note = "eq 6 assumes it stays below G_w + G_d"
+    realism_preface = "Paper 001 has no communication, actuator or emergency. "
 
     def comparison(self, spec, res) -> str:
         q = {k: max(res.metrics[k].max_abs_e) for k in ("ntsm", "pd", "pd_ff")}
@@ -138,12 +140,6 @@ class NTSMAnalysis:
             "chatters in a band of about a centimetre (lower panel of the figure) instead of "
             "staying at 0, yet e follows the sliding law of eq 21 closely enough for eq 22's "
             "time to be met.")
-
-    def bound_note(self, spec, res) -> str:
-        return "eq 6 assumes it stays below G_w + G_d"
-
-    def realism_preface(self, spec, res) -> str:
-        return "Paper 001 has no communication, actuator or emergency. "
 
     def margin_section(self, spec, res) -> str:
         from ...kinds.platoon.realism_render import linear_law_math, margin_body

@@ -110,10 +110,9 @@ def _profile(spec, res) -> str:
     prof = res.profile
     return (
         "## Target profile\n\nJerk-limited accelerate-cruise-brake curve (our construction, "
-        f"`workbench/profiles.py`): acceleration {fmt(spec.profile['accel'])} m/s², braking "
-        f"{fmt(spec.profile['brake'])} m/s², jerk {fmt(spec.profile['jerk'])} m/s³; the cruise "
-        f"speed solves T(v) = T_o: **{fmt(prof.v_cruise * 3.6, 4)} km/h** (end position error "
-        f"of the sampled curve {T.end_error_text(prof)}).")
+        f"`workbench/profiles.py`): {G.profile_text(spec)}; the cruise speed solves T(v) = "
+        f"T_o: **{fmt(prof.v_cruise * 3.6, 4)} km/h** (end position error of the sampled "
+        f"curve {T.end_error_text(prof)}).")
 
 
 def _why(spec, res) -> str:
@@ -239,14 +238,12 @@ def _closing(res) -> str:
             f"realised PPD has the sign of φ(1) on "
             f"{T.pct(s.data_sign_agreement)} of the samples where the command moves; the "
             f"frozen-PPD loop's spectral radius is {fmt(r.frozen_radius, 3)}.")
-    verdicts = {r.verdict for r in res.readings}
-    if any(r.mfac.edges or r.pid.edges for r in res.readings):
-        return (f"## {H_END}\n\n" + "\n".join(items) + "\n\nWhether MFAC beats PID is not "
-                "determined: on a reading whose chosen points lie on their grids' edges the "
-                "tuning has not converged (extend the grids in the parameters named).")
-    tail = ("On neither reading does MFAC beat PID under the stated rule: paper 002's "
+    tail = ("Whether MFAC beats PID is not determined: on a reading whose chosen points lie "
+            "on their grids' edges the tuning has not converged (extend the grids in the "
+            "parameters named)." if any(r.mfac.edges or r.pid.edges for r in res.readings) else
+            "On neither reading does MFAC beat PID under the stated rule: paper 002's "
             "conclusion is not reproduced, whichever way its lost eq 2 is read."
-            if verdicts <= {"PID"} else
+            if {r.verdict for r in res.readings} <= {"PID"} else
             "The verdict depends on the reading of the lost eq 2; see each line above.")
     return f"## {H_END}\n\n" + "\n".join(items) + "\n\n" + tail
 

@@ -104,8 +104,7 @@ class AntiskidCruise(DeclaredQuantities):
         plant = root.table("plant")
         plant.string("model", choices=("adhesion-003",))
         rail = plant.string("rail", choices=("dry", "wet"))
-        params = {k: plant.quantity(k, u, positive=True) for k, u in PARAMETER_UNITS.items()}
-        plant.finish()
+        params = plant.quantities(PARAMETER_UNITS, positive=True)
         op = root.table("operating_point")
         v_d = op.quantity("v_d", "m/s", positive=True, hi=150.0)
         pinned = op.quantity("lambda_d_pinned", "1", positive=True, hi=1.0, default=None)

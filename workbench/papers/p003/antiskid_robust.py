@@ -31,7 +31,7 @@ from ...kinds.delay_feedback.robust_points import (RobustPoints, RobustPointsRes
                                                    load_robust_points, robust_points_quantities,
                                                    run_robust_points)
 from ...plants.units import ADHESION_003 as PARAMETER_UNITS
-from ...reader import Quantity, Reader
+from ...reader import Reader
 
 RAIL_KEYS = ("a", "b", "c")
 
@@ -56,9 +56,7 @@ class Point:
 def _points(path, common, rails, op: Reader) -> tuple[Point, ...]:
     from ...plants.adhesion import NumericAdhesion
     from ...symbolic.linearise import linearise_cruise
-    names = op.raw("rails")
-    if not isinstance(names, list) or not names or any(r not in rails for r in names):
-        raise op.fail("rails", names, "a list of rails among " + ", ".join(sorted(rails)))
+    names = op.strings("rails", sorted(rails))
     speeds = op.numbers("v_d", positive=True, what="cruise speeds (m/s)")
     factors = op.numbers("mass_factor", positive=True, what="mass factors")
     op.finish()
@@ -89,16 +87,10 @@ class AntiskidRobust(DeclaredQuantities):
 
     def load(self, root: Reader) -> RobustPoints:
         plant = root.table("plant")
-        cm = plant.table("common")
-        common = {k: cm.quantity(k, u, positive=True)
-                  for k, u in PARAMETER_UNITS.items() if k not in RAIL_KEYS}
-        cm.finish()
-        rails: dict[str, dict[str, Quantity]] = {}
-        for rail in ("dry", "wet"):
-            if plant.has(rail):
-                rt = plant.table(rail)
-                rails[rail] = {k: rt.quantity(k, "1", positive=True) for k in RAIL_KEYS}
-                rt.finish()
+        common = plant.table("common").quantities(
+            {k: u for k, u in PARAMETER_UNITS.items() if k not in RAIL_KEYS}, positive=True)
+        rails = {rail: plant.table(rail).quantities(dict.fromkeys(RAIL_KEYS, "1"), positive=True)
+                 for rail in ("dry", "wet") if plant.has(rail)}
         plant.finish()
         return load_robust_points(root, _points(root.path, common, rails,
                                                 root.table("operating_points")))
