@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .counter_rng import normal4, uniform
-from .wheel_slip import ArrayOps, wheel_speed
+from .wheel_slip import ArrayOps, model_functions, wheel_speed
 
 
 @dataclass(frozen=True)
@@ -116,6 +116,37 @@ def grade_at(pos, key, lo: float, hi: float, segment: float):
     """Slope at positions ``pos`` (m, arrays) of the runs with gradient keys ``key``."""
     j = np.floor(np.maximum(pos, 0.0) / segment).astype(np.int64)
     return lo + (hi - lo) * uniform(key, j)
+
+
+class PlantOnPath:
+    """The plant's parameters of each step of a batch of runs along their
+    path: on a gradient (``pt.grade``), ``p`` with each run's slope at its
+    position appended (:func:`grade_at`) and the graded model functions; else
+    ``p`` and the level ones. The positions start at 0 and integrate v.
+
+    Parameters
+    ----------
+    pt : Perturbations or None
+    p : tuple
+        The plant's parameters (floats or per-run arrays).
+    """
+
+    def __init__(self, pt: Perturbations | None, p: tuple):
+        self.pt, self.p, self.pos = pt, p, 0.0
+        self.graded = pt is not None and pt.grade is not None
+        self.fns = model_functions("numpy", graded=True) if self.graded else \
+            model_functions("numpy")
+
+    def params(self, v, dt: float) -> tuple:
+        """This step's parameters (at the positions before it), then every
+        position advances by ``dt`` v."""
+        pp = self.p
+        if self.graded:
+            pt = self.pt
+            pp = (*pp, grade_at(self.pos, np.asarray(pt.keys["grade"], np.uint64), *pt.grade,
+                                pt.segment))
+        self.pos = self.pos + dt * v
+        return pp
 
 
 def delay_at(t: float, lo: float, hi: float, period, phase):
