@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .counter_rng import normal4, uniform
+from .history import BatchDelayLine
 from .wheel_slip import ArrayOps, model_functions, wheel_speed
 
 
@@ -202,6 +203,18 @@ class VaryingDelayLine:
         a = self._buf[(n - N) % self._L, self._cols]
         b = self._buf[(n - N - 1) % self._L, self._cols]
         return (1.0 - f) * a + f * b
+
+
+def batch_delay_line(pt: Perturbations | None, h, batch: int | None, dt: float, initial):
+    """The input delay line of a batch of ``batch`` runs: a
+    :class:`VaryingDelayLine` on the varying delay of ``pt``, else a
+    :class:`~workbench.sim.history.BatchDelayLine` of the per-run delays
+    ``h``; None for a single run (``batch`` None: the loop's own line)."""
+    if batch is None:
+        return None
+    if pt is not None and pt.delay is not None:
+        return VaryingDelayLine(*pt.delay, pt.period, pt.phase, dt, initial)
+    return BatchDelayLine(np.broadcast_to(h, (batch,)), dt, initial)
 
 
 #: Entries of the kernel's ``pert`` array (:func:`perturbation_arrays`): what a compiled

@@ -108,8 +108,7 @@ def kernel():
         """One run (module docstring, :func:`kernel`); ``rec`` (n, 4): t, v,
         lambda, applied u at every mesh point in [rec_t0, rec_t1]; ``rec_u``
         (n, 2): t_k, u_k of every sample there; returns how many of each."""
-        for i in range(out.shape[0]):
-            out[i] = math.nan
+        out[:] = math.nan
         eps = 1e-9 * Tc
         Lq = int(math.ceil(tau_m / Tc)) + 3
         mq = np.zeros((Lq, 2))
@@ -117,17 +116,15 @@ def kernel():
         cmd = np.zeros(Lc)
         v, lam, t = v0, lam0, t0
         km, ks, kw = 0, 0, 0
-        while t0 + km * Tc - tau_m <= t0 + eps:      # measurements before t0: the initial state
-            mq[km % Lq, 0], mq[km % Lq, 1] = v0, lam0
-            km += 1
         u_app = u_init
         lam_max, lam_min, above, past, dist = lam, lam, 0.0, 0.0, 0.0
         u_max, evs, steps, n_unres = 0.0, math.nan, 0, 0
         nrec, nrecu = 0, 0
         finished = False
         while not finished:
-            # -- events at t: measurement, then sample (the law), then the wheel
-            if t0 + km * Tc - tau_m <= t + eps:
+            # -- events at t: measurement (at t0 also those before it: the
+            # initial state), then sample (the law), then the wheel
+            while t0 + km * Tc - tau_m <= t + eps:
                 mq[km % Lq, 0], mq[km % Lq, 1] = v, lam
                 km += 1
             if t0 + ks * Tc <= t + eps:

@@ -38,9 +38,8 @@ import numpy as np
 from ...controllers.antiskid003 import Antiskid003, PhaseEvents
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED, ControllerSettings
 from ...sim.delay import SimResult, simulate_closed_loop
-from ...sim.history import BatchDelayLine
 from ...sim.metric_rows import field_names, from_rows, initial_rows
-from ...sim.perturb import Perturbations, PlantOnPath, VaryingDelayLine, noisy_measure
+from ...sim.perturb import Perturbations, PlantOnPath, batch_delay_line, noisy_measure
 from ...sim.rate_mesh import RateMesh as Mesh
 from ...sim.wheel_slip import (PARAM_ORDER, ArrayOps, ScalarOps, creep_rate_coefficient,
                                creep_speed, model_functions, plant_step, wheel_speed)
@@ -299,14 +298,8 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
 
     every = 10**12 if record_dt is None else max(int(round(record_dt / dt)), 1)
     x0 = (run.x0[0] + zero, run.x0[1] + zero)
-    line = None if batch is None else BatchDelayLine(np.broadcast_to(run.h, (batch,)), dt,
-                                                      run.u_init)
-    if pt is not None and pt.delay is not None:
-        line = VaryingDelayLine(*pt.delay, pt.period, pt.phase, dt, run.u_init)
-    level = None
-    if mesh is not None:
-        S = creep_rate_coefficient()(*p)
-        level = lambda x: mesh.level(x[0], S)
+    line = batch_delay_line(pt, run.h, batch, dt, run.u_init)
+    level = None if mesh is None else mesh.of_state(creep_rate_coefficient()(*p))
     with np.errstate(all="ignore"):
         res = simulate_closed_loop(step, ctrl, x0, h=float(np.max(run.h)), dt=dt,
                                    t_end=run.t_end, u_init=run.u_init + zero,
