@@ -284,7 +284,7 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
         i_r = PARAM_ORDER.index("r")
         ctrl.measure = noisy_measure(pt, p[i_r], run.controller.params[i_r],
                                      run.controller.v_floor)
-    path = PlantOnPath(pt, p)
+    path = None if batch is None else PlantOnPath(pt, p)
 
     def step(x, u, t, dt_):
         if batch is None:
