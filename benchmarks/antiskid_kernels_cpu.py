@@ -1,8 +1,8 @@
 """CPU seconds of paper 003's two compiled loops, before and after a change,
 in one run (issue 35, kern48): the batch Monte Carlo kernel (the dry
 design's first ``--samples`` sweep runs, one chunk, compiled path) and the
-sampled loop (a 1 kHz braking run and a 1 kHz traction run of the dry
-design's ``[sampled]`` section, ``zoh``).
+sampled loop (a braking run and a traction run of the dry design's
+``[sampled]`` section, ``zoh``, at each of :data:`SAMPLED_RATES_HZ`).
 
 Each column is a child process importing the package from a tree: with
 ``--before REV`` the tree of git revision REV (exported by ``git archive``)
@@ -14,7 +14,7 @@ Nothing here asserts a time.
 
 Usage::
 
-    python benchmarks/antiskid_kernels_cpu.py --before e73b02e [--samples 64] [--rounds 2]
+    python benchmarks/antiskid_kernels_cpu.py --before e73b02e [--samples 256] [--rounds 2]
 """
 from __future__ import annotations
 
@@ -29,6 +29,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 DRY = ROOT / "designs" / "antiskid-run-dry.toml"
+#: Rates (Hz) of the timed sampled runs (a braking and a traction run each).
+SAMPLED_RATES_HZ = (1000.0, 2000.0, 5000.0)
 
 
 def worker(samples: int) -> None:
@@ -44,15 +46,16 @@ def worker(samples: int) -> None:
     payload = M.chunk_payload(inp, 0, samples, inp["dt"], kernel="compiled")
     M.chunk_worker(M.chunk_payload(inp, 0, 1, inp["dt"], kernel="compiled"))   # compile/load
     ctx = sampled_context(spec, spec.K_table)
-    kw = dict(dt_p=spec.plant_step, predictor_step=spec.predictor_step)
+    kw = dict(dt_p=1e-4, predictor_step=1e-3)          # the dry design's [sampled] steps
     run_once(ctx, 1000.0, 0, t_cap=0.05, **kw)                                 # compile/load
     out = {"tree": str(Path(workbench.__file__).parents[1])}
     c0 = time.process_time()
     M.chunk_worker(payload)
     out["batch"] = time.process_time() - c0
     c0 = time.process_time()
-    run_once(ctx, 1000.0, 1, **kw)
-    run_once(ctx, 1000.0, 0, **kw)
+    for rate in SAMPLED_RATES_HZ:
+        run_once(ctx, rate, 1, **kw)
+        run_once(ctx, rate, 0, **kw)
     out["sampled"] = time.process_time() - c0
     print(json.dumps(out))
 
@@ -60,7 +63,7 @@ def worker(samples: int) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--before", metavar="REV", required=False)
-    ap.add_argument("--samples", type=int, default=64)
+    ap.add_argument("--samples", type=int, default=256)
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args()
