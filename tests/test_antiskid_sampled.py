@@ -15,7 +15,8 @@ from workbench.features import rate_sweep as RS
 from workbench.papers.p003 import antiskid_sampled as S
 from workbench.papers.p003.antiskid_run_spec import sampled_context
 from workbench.features.mesh_replay import replay, window
-from workbench.papers.p003.antiskid_sampled_check import ATOL, RTOL, plant_rhs
+from workbench.papers.p003.antiskid_sampled_check import ATOL, RTOL
+from workbench.sim.wheel_slip import held_torque_rhs as plant_rhs
 
 pytest.importorskip("numba")
 

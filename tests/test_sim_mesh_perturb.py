@@ -11,8 +11,9 @@ import pytest
 
 from workbench.sim.delay import simulate_closed_loop
 from workbench.sim.counter_rng import normal4
-from workbench.sim.perturb import (PERT, Perturbations, measured_state, noisy_measure,
-                                   perturbation_arrays)
+from workbench.sim.history import BatchDelayLine
+from workbench.sim.perturb import (PERT, Perturbations, VaryingDelayLine, batch_delay_line,
+                                   measured_state, noisy_measure, perturbation_arrays)
 from workbench.sim.rate_mesh import RateMesh
 
 
@@ -39,7 +40,7 @@ def test_toy_decay_on_the_rate_mesh_refines_where_the_rate_is_fast():
         return (max(x[0] - S * dt, 0.0),)
     mesh = RateMesh(dt_ref=0.05, courant=2.0, k_max=3)
     r = simulate_closed_loop(step, lambda t, x, line: (0.0, 0), (1.0,), h=0.0, dt=0.05,
-                             t_end=1.0, u_init=0.0, level=lambda x: mesh.level(x[0], S),
+                             t_end=1.0, u_init=0.0, level=mesh.of_state(S),
                              k_max=mesh.k_max, done=lambda t, x, ph: x[0] <= 0.0)
     assert steps[0] == 0.05 and min(steps) == 0.05 / 8
     assert math.isclose(r.t[-1], 1.0 / S, abs_tol=0.05 / 8)
@@ -96,3 +97,16 @@ def test_tuple_readers_read_vectors_and_rows_into_padded_tuples():
     assert row(a, 1) == (4.0, 5.0, 6.0, 7.0)
     assert total(np.array([1.0, 2.0, 3.0]), a, 1) == 3 * (6.0 + 7.0)
     assert tuple_readers(jit, 2)[0](np.array([5.0, 6.0, 7.0])) == (5.0, 6.0)
+
+
+def test_batch_delay_line_is_per_run_or_varying_and_none_for_a_single_run():
+    assert batch_delay_line(None, 0.1, None, 0.01, 5.0) is None
+    line = batch_delay_line(None, np.array([0.02, 0.035]), 2, 0.01, 5.0)
+    assert isinstance(line, BatchDelayLine)
+    for k in range(5):
+        line.push(np.array([k, 10.0 * k]))
+    # the last input (4, 40) was pushed at step 4: the inputs 2 and 3.5 steps back
+    np.testing.assert_allclose(line.delayed(), [4.0 - 2.0, 10.0 * (4.0 - 3.5)])
+    pt = Perturbations(run=(0, 1), keys={}, delay=(0.01, 0.03), period=(1.0, 2.0),
+                       phase=(0.0, 0.5))
+    assert isinstance(batch_delay_line(pt, 0.02, 2, 0.01, 5.0), VaryingDelayLine)

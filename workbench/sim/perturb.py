@@ -29,7 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .counter_rng import normal4, uniform
-from .wheel_slip import ArrayOps, wheel_speed
+from .history import BatchDelayLine
+from .wheel_slip import ArrayOps, model_functions, wheel_speed
 
 
 @dataclass(frozen=True)
@@ -118,6 +119,37 @@ def grade_at(pos, key, lo: float, hi: float, segment: float):
     return lo + (hi - lo) * uniform(key, j)
 
 
+class PlantOnPath:
+    """The plant's parameters of each step of a batch of runs along their
+    path: on a gradient (``pt.grade``), ``p`` with each run's slope at its
+    position appended (:func:`grade_at`) and the graded model functions; else
+    ``p`` and the level ones. The positions start at 0 and integrate v.
+
+    Parameters
+    ----------
+    pt : Perturbations or None
+    p : tuple
+        The plant's parameters (floats or per-run arrays).
+    """
+
+    def __init__(self, pt: Perturbations | None, p: tuple):
+        self.pt, self.p, self.pos = pt, p, 0.0
+        self.graded = pt is not None and pt.grade is not None
+        self.fns = model_functions("numpy", graded=True) if self.graded else \
+            model_functions("numpy")
+
+    def params(self, v, dt: float) -> tuple:
+        """This step's parameters (at the positions before it), then every
+        position advances by ``dt`` v."""
+        pp = self.p
+        if self.graded:
+            pt = self.pt
+            pp = (*pp, grade_at(self.pos, np.asarray(pt.keys["grade"], np.uint64), *pt.grade,
+                                pt.segment))
+        self.pos = self.pos + dt * v
+        return pp
+
+
 def delay_at(t: float, lo: float, hi: float, period, phase):
     """h(t) of each run (s): the clipped triangle wave of the module docstring."""
     x = t / period + phase
@@ -171,6 +203,18 @@ class VaryingDelayLine:
         a = self._buf[(n - N) % self._L, self._cols]
         b = self._buf[(n - N - 1) % self._L, self._cols]
         return (1.0 - f) * a + f * b
+
+
+def batch_delay_line(pt: Perturbations | None, h, batch: int | None, dt: float, initial):
+    """The input delay line of a batch of ``batch`` runs: a
+    :class:`VaryingDelayLine` on the varying delay of ``pt``, else a
+    :class:`~workbench.sim.history.BatchDelayLine` of the per-run delays
+    ``h``; None for a single run (``batch`` None: the loop's own line)."""
+    if batch is None:
+        return None
+    if pt is not None and pt.delay is not None:
+        return VaryingDelayLine(*pt.delay, pt.period, pt.phase, dt, initial)
+    return BatchDelayLine(np.broadcast_to(h, (batch,)), dt, initial)
 
 
 #: Entries of the kernel's ``pert`` array (:func:`perturbation_arrays`): what a compiled

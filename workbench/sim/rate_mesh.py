@@ -44,3 +44,9 @@ class RateMesh:
         rate being ``S / x`` (1/s)."""
         rate = self.dt_ref * S / (self.courant * max(x, self.x_floor))
         return 0 if rate <= 1.0 else min(self.k_max, math.ceil(math.log2(rate)))
+
+    def of_state(self, S: float):
+        """``level(x)`` of a state ``x`` whose first entry is the magnitude,
+        the fastest rate being ``S / x[0]`` (the ``level`` of
+        :func:`workbench.sim.delay.simulate_closed_loop`)."""
+        return lambda x: self.level(x[0], S)

@@ -113,6 +113,28 @@ def plant_forms(v, lam, p, fns, xp):
     return tuple(np.where(pos, a, b) for a, b in zip(tr, br))
 
 
+def held_torque_rhs(p, v_floor: float = 1e-3):
+    """``rhs(u)`` -> ``f(t, (v, lambda))``: the plant's right-hand side with
+    parameters ``p`` under the constant torque u (the form by the sign of
+    lambda, :func:`plant_forms`; the speed floored as :func:`plant_step`
+    floors it), floats, for an ODE solver (e.g. scipy's ``solve_ivp``)."""
+    fns = model_functions("math")
+
+    def rhs(u):
+        def f(t, x):
+            y = plant_forms(max(x[0], v_floor), x[1], p, fns, ScalarOps)
+            return (y[0], y[1] + y[2] * u)
+        return f
+    return rhs
+
+
+def holding_torque(v: float, lam: float, p) -> float:
+    """The torque that holds the creep ratio at ``lam`` at speed ``v``
+    (lambda' = 0 on the traction form, eq 13, lambda >= 0)."""
+    y = model_functions("math")["traction"](v, lam, *p)
+    return -y[1] / y[2]
+
+
 def wheel_speed(v, lam, r, xp):
     """omega (rad/s) from v and lambda, eqs (4)-(5)."""
     return xp.where(lam >= 0, v / (1.0 - xp.minimum(lam, 0.999)), v * (1.0 + lam)) / r

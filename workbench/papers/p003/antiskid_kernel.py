@@ -41,7 +41,8 @@ import numpy as np
 from ...controllers.antiskid003_settings import STOPPED
 from ...sim.history import split_delay
 from ...sim.kernel_path import KERNELS, Kernel, chosen_path, compiled_available, default_kernel
-from ...sim.perturb import perturbation_arrays
+from ...sim.metric_rows import from_rows, initial_rows
+from ...sim.perturb import perturbation_arrays, split_delays
 from .antiskid_scenario import EVS_SETTLE, METRIC_FIELDS, RunMetrics, RunSettings, metric_updates
 
 #: Runs a compiled batch keeps in flight at a time, their predictor rollouts
@@ -210,15 +211,12 @@ def simulate_batch_compiled(run: RunSettings, dt: float) -> RunMetrics:
     """
     from ...controllers.antiskid003_jit import initial_state, settings_array
     B = max(np.size(x) for x in (*run.plant_params, run.h, run.x0[0]))
-    plant = np.ascontiguousarray(np.stack([np.broadcast_to(np.asarray(x, float), (B,))
-                                           for x in run.plant_params], axis=1))
-    parts = [split_delay(float(h), dt) for h in np.broadcast_to(run.h, (B,))]
-    Np = np.array([q[0] for q in parts], np.int64)
-    fp = np.array([q[1] for q in parts], float)
+    plant = np.column_stack([np.broadcast_to(np.asarray(x, float), (B,)) for x in run.plant_params])
+    Np, fp = split_delays(np.broadcast_to(np.asarray(run.h, float), (B,)), dt)
     v0 = np.array(np.broadcast_to(np.asarray(run.x0[0], float), (B,)))
     cs = run.controller
     st0, ub0 = initial_state(cs, dt, run.u_init)
-    m0 = np.array([getattr(RunMetrics(), k) for k in METRIC_FIELDS], float)
+    m0 = initial_rows(RunMetrics, 1)[0]
     out = np.empty((B, len(METRIC_FIELDS)))
     keys, pert, period, phase = perturbation_arrays(run.perturb, B)
     if run.perturb is not None and run.perturb.delay is not None:
@@ -227,7 +225,7 @@ def simulate_batch_compiled(run: RunSettings, dt: float) -> RunMetrics:
                      int(round(run.t_end / dt)), settings_array(cs, dt),
                      np.asarray(cs.params, float), EVS_SETTLE, st0, ub0, m0,
                      keys, pert, period, phase, out)
-    return RunMetrics(**{k: out[:, j].copy() for j, k in enumerate(METRIC_FIELDS)})
+    return from_rows(RunMetrics, out, single=False)
 
 
 def simulate_batch(run: RunSettings, dt: float, kernel: Kernel) -> RunMetrics:

@@ -10,10 +10,10 @@ replay of windows of runs: :func:`workbench.features.mesh_replay.replay_windows`
 placed by :func:`~workbench.features.mesh_replay.sample_windows`, reusing the
 figure's records by :func:`~workbench.features.mesh_replay.reusing`).
 What stays here is paper 003's: where the windows are, the tolerances, the
-kernel's recording and the right-hand side. The right-hand
-side is the lambdified sympy model of :mod:`workbench.sim.wheel_slip` (the
-traction form for lambda >= 0, the braking form otherwise; speed floored as
-the plant step floors it), not a retyped one.
+kernel's recording. The right-hand side is the plant's
+(:func:`workbench.sim.wheel_slip.held_torque_rhs`: the lambdified sympy
+model, the traction form for lambda >= 0, the braking form otherwise), not a
+retyped one.
 
 Windows (:data:`WINDOWS`): the start of traction, from the arrival of the
 first command at t = h (3 m/s: the creep ratio's time constant ~ v/4000 s is
@@ -25,7 +25,7 @@ of the ``zoh`` variant.
 from __future__ import annotations
 
 from ...features.mesh_replay import largest, replay_windows, reusing, sample_windows
-from ...sim.wheel_slip import model_functions
+from ...sim.wheel_slip import held_torque_rhs
 from .antiskid_sampled_kernel import run_once
 
 #: Rates (Hz) of the check (those of the design's grid).
@@ -39,20 +39,6 @@ RTOL, ATOL = 1e-10, (1e-10, 1e-13)
 #: Quantities of the check.
 RADAU_QUANTITIES = ("sampled.radau.max_dlam_over_opt", "sampled.radau.max_dv_rel",
                     "sampled.radau.windows")
-
-
-def plant_rhs(p):
-    """``rhs(u)`` -> ``f(t, (v, lambda))`` of the plant with parameters ``p``
-    under the constant torque u (for :func:`workbench.features.mesh_replay.replay`)."""
-    fns = model_functions("math")
-
-    def rhs(u):
-        def f(t, x):
-            v, lam = x
-            y = fns["traction" if lam >= 0 else "braking"](max(v, 1e-3), lam, *p)
-            return (y[0], y[1] + y[2] * u)
-        return f
-    return rhs
 
 
 def radau_checks(ctx, spec, runs, traction: dict) -> tuple:
@@ -84,7 +70,7 @@ def radau_checks(ctx, spec, runs, traction: dict) -> tuple:
         # the traces' record holds the traction window when it runs on past b + 2 samples
         # (the stretch holding b ends by b + 1 / rate)
         record = reusing({0: traction.get(rate)}, record, 2 / rate)
-        out += [w.check(rate) for w in replay_windows(plant_rhs(ctx.plant), wins, record,
+        out += [w.check(rate) for w in replay_windows(held_torque_rhs(ctx.plant), wins, record,
                                                          RTOL, ATOL)]
     return tuple(out)
 

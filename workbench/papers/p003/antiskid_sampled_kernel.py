@@ -53,7 +53,7 @@ from functools import lru_cache
 import numpy as np
 
 from ...controllers.antiskid003_settings import CRUISE
-from ...sim.wheel_slip import PARAM_ORDER, model_functions
+from ...sim.wheel_slip import PARAM_ORDER, holding_torque
 from .antiskid_scenario import EVS_SETTLE
 
 #: Entries of the result array of the loop (:func:`kernel`; NaN: did not happen).
@@ -71,11 +71,8 @@ BRAKING_LEAD = 5.0
 
 @lru_cache(maxsize=None)
 def kernel():
-    """The compiled loop ``run(p, cfg, pc, v0, lam0, t0, Tc, h, tau_m, q, dt_p,
-    u_init, st, ubuf, ev, scenario, t_cap, tail, lam_thr, lam_peak, v_d,
-    v_stop, lam_div, omega_sw, r, t_brake, settle, rec_t0, rec_t1, rec, rec_u,
-    out)`` (compiled on first use, about 10 s, once per machine: the disk cache of
-    :mod:`workbench.sim.jit_cache`).
+    """The compiled loop ``run`` (below; compiled on first use, about 10 s,
+    once per machine: the disk cache of :mod:`workbench.sim.jit_cache`).
 
     ``p``, ``pc``: plant and controller parameters (PARAM_ORDER); ``cfg``,
     ``st``, ``ubuf``, ``ev``: the compiled controller's settings (step T_c),
@@ -111,8 +108,7 @@ def kernel():
         """One run (module docstring, :func:`kernel`); ``rec`` (n, 4): t, v,
         lambda, applied u at every mesh point in [rec_t0, rec_t1]; ``rec_u``
         (n, 2): t_k, u_k of every sample there; returns how many of each."""
-        for i in range(out.shape[0]):
-            out[i] = math.nan
+        out[:] = math.nan
         eps = 1e-9 * Tc
         Lq = int(math.ceil(tau_m / Tc)) + 3
         mq = np.zeros((Lq, 2))
@@ -120,17 +116,15 @@ def kernel():
         cmd = np.zeros(Lc)
         v, lam, t = v0, lam0, t0
         km, ks, kw = 0, 0, 0
-        while t0 + km * Tc - tau_m <= t0 + eps:      # measurements before t0: the initial state
-            mq[km % Lq, 0], mq[km % Lq, 1] = v0, lam0
-            km += 1
         u_app = u_init
         lam_max, lam_min, above, past, dist = lam, lam, 0.0, 0.0, 0.0
         u_max, evs, steps, n_unres = 0.0, math.nan, 0, 0
         nrec, nrecu = 0, 0
         finished = False
         while not finished:
-            # -- events at t: measurement, then sample (the law), then the wheel
-            if t0 + km * Tc - tau_m <= t + eps:
+            # -- events at t: measurement (at t0 also those before it: the
+            # initial state), then sample (the law), then the wheel
+            while t0 + km * Tc - tau_m <= t + eps:
                 mq[km % Lq, 0], mq[km % Lq, 1] = v, lam
                 km += 1
             if t0 + ks * Tc <= t + eps:
@@ -249,8 +243,7 @@ def run_once(ctx: Context, rate: float, scenario: int, *, q: float = 0.0, tau: f
     ev = np.full(6, np.nan)
     if scenario == BRAKING_SCENARIO:       # the cruise equilibrium, its torque held
         v0, l0 = cs.v_d, cs.lambda_d
-        y = model_functions("math")["traction"](v0, l0, *ctx.plant)
-        u0 = -y[1] / y[2]
+        u0 = holding_torque(v0, l0, ctx.plant)
         st[0], ubuf[:] = CRUISE, u0
         t0, cap = ctx.t_brake - BRAKING_LEAD, ctx.t_end
     else:

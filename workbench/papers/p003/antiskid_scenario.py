@@ -30,7 +30,7 @@ operations stay as they are. Its tables and figures are rendered by the general
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
@@ -38,8 +38,8 @@ import numpy as np
 from ...controllers.antiskid003 import Antiskid003, PhaseEvents
 from ...controllers.antiskid003_settings import BRAKE, BRAKE_IN, STOPPED, ControllerSettings
 from ...sim.delay import SimResult, simulate_closed_loop
-from ...sim.history import BatchDelayLine
-from ...sim.perturb import Perturbations, VaryingDelayLine, grade_at, noisy_measure
+from ...sim.metric_rows import field_names, from_rows, initial_rows
+from ...sim.perturb import Perturbations, PlantOnPath, batch_delay_line, noisy_measure
 from ...sim.rate_mesh import RateMesh as Mesh
 from ...sim.wheel_slip import (PARAM_ORDER, ArrayOps, ScalarOps, creep_rate_coefficient,
                                creep_speed, model_functions, plant_step, wheel_speed)
@@ -69,7 +69,7 @@ class RunMetrics(PhaseEvents):
 
 
 #: Field order of the metrics array (RunMetrics; PhaseEvents first).
-METRIC_FIELDS = tuple(f.name for f in fields(RunMetrics))
+METRIC_FIELDS = field_names(RunMetrics)
 #: The creep-speed error is tracked from t_brake + EVS_SETTLE (s) while omega >
 #: omega_switch (``evs_max_tracking``), in every run of the study.
 EVS_SETTLE = 5.0
@@ -209,7 +209,7 @@ class MetricsRecorder:
         # the metrics read the settings, not the predictor: any predictor's
         # settings are laid out as the compiled controller's
         self.cfg = settings_array(replace(s, predictor="rollout"), dt)
-        self.M = np.tile([getattr(RunMetrics(), k) for k in METRIC_FIELDS], (n, 1))
+        self.M = initial_rows(RunMetrics, n)
         self.RS = np.zeros((n, 5))
         self.RS[:, 0] = x0[0]
         self.r_p = np.broadcast_to(np.asarray(plant_r, float), (n,)).copy()
@@ -227,9 +227,7 @@ class MetricsRecorder:
     @property
     def m(self) -> RunMetrics:
         """The metrics so far: floats for a single run, arrays for a batch."""
-        if self.batch is None:
-            return RunMetrics(**{k: float(x) for k, x in zip(METRIC_FIELDS, self.M[0])})
-        return RunMetrics(**{k: self.M[:, j].copy() for j, k in enumerate(METRIC_FIELDS)})
+        return from_rows(RunMetrics, self.M, self.batch is None)
 
 
 @dataclass(frozen=True)
@@ -286,38 +284,22 @@ def simulate_antiskid(run: RunSettings, dt: float, *, record_dt: float | None = 
         i_r = PARAM_ORDER.index("r")
         ctrl.measure = noisy_measure(pt, p[i_r], run.controller.params[i_r],
                                      run.controller.v_floor)
-    pos, plant_fns = [zero], fns
-    if pt is not None and pt.grade is not None:
-        plant_fns = model_functions("numpy", graded=True)
-
-    def plant_params():
-        """The plant's parameters this step (a slope appended on a gradient)."""
-        if pt is None or pt.grade is None:
-            return p
-        g = grade_at(pos[0], np.asarray(pt.keys["grade"], np.uint64), *pt.grade, pt.segment)
-        return (*p, g)
+    path = None if batch is None else PlantOnPath(pt, p)
 
     def step(x, u, t, dt_):
         if batch is None:
             *nx, ctrl.unresolved = plant_step(x, u, p, dt_, fns, xp, with_flag=True)
             return tuple(nx)
         stop = ctrl.phase >= STOPPED
-        pp = plant_params()
-        pos[0] = pos[0] + dt_ * x[0]
-        *nx, unres = plant_step(x, u, pp, dt_, plant_fns, xp, mask=~stop, with_flag=True)
+        pp = path.params(x[0], dt_)
+        *nx, unres = plant_step(x, u, pp, dt_, path.fns, xp, mask=~stop, with_flag=True)
         ctrl.unresolved = unres & ~stop
         return (np.where(stop, x[0], nx[0]), np.where(stop, x[1], nx[1]))
 
     every = 10**12 if record_dt is None else max(int(round(record_dt / dt)), 1)
     x0 = (run.x0[0] + zero, run.x0[1] + zero)
-    line = None if batch is None else BatchDelayLine(np.broadcast_to(run.h, (batch,)), dt,
-                                                      run.u_init)
-    if pt is not None and pt.delay is not None:
-        line = VaryingDelayLine(*pt.delay, pt.period, pt.phase, dt, run.u_init)
-    level = None
-    if mesh is not None:
-        S = creep_rate_coefficient()(*p)
-        level = lambda x: mesh.level(x[0], S)
+    line = batch_delay_line(pt, run.h, batch, dt, run.u_init)
+    level = None if mesh is None else mesh.of_state(creep_rate_coefficient()(*p))
     with np.errstate(all="ignore"):
         res = simulate_closed_loop(step, ctrl, x0, h=float(np.max(run.h)), dt=dt,
                                    t_end=run.t_end, u_init=run.u_init + zero,
