@@ -19,6 +19,7 @@ import numpy as np
 
 from ...features.montecarlo_halving import Compared, halving_quantities
 from ...features.montecarlo_halving import start_halving as start_batches
+from ...features.quantities import Part
 from ...sim.batch import PendingBatch
 from .antiskid_montecarlo import RUNS, SUMMARY_METRICS, range_worker, sweep_inputs
 from .antiskid_run_spec import SweepSpec
@@ -77,5 +78,5 @@ def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
 
 
 #: The check's quantities (``montecarlo.halving.runs``, ``.agree``, ``.fraction_agree``).
-QUANTITIES = halving_quantities("montecarlo.halving", lambda r: r.halving, lambda spec: (
-    spec.montecarlo is not None and bool(spec.montecarlo.halving)))
+QUANTITIES = (Part(halving_quantities("montecarlo.halving"), lambda spec: (
+    spec.montecarlo is not None and bool(spec.montecarlo.halving)), lambda r: r.halving),)

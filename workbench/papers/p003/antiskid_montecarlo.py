@@ -50,6 +50,7 @@ import numpy as np
 from ...features.montecarlo_arrays import (ArrayRuns, chunk_arrays, inputs_digest,
                                            start_array_sweep)
 from ...features.montecarlo_stats import OK, RunsResult, runs_quantities
+from ...features.quantities import Part
 from ...sim.batch import PendingBatch
 from .antiskid_run_spec import SweepSpec
 
@@ -86,8 +87,8 @@ class SweepResult(RunsResult):
 #: value): ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
 #: ``montecarlo.fraction.<violation>`` and ``montecarlo.wilson.<outcome>.lo``
 #: / ``.hi`` (the Wilson 95 % interval of an outcome's rate).
-QUANTITIES = runs_quantities("montecarlo", SUMMARY_METRICS, VIOLATIONS, OUTCOMES,
-                             lambda r: r.montecarlo, lambda spec: spec.montecarlo is not None)
+QUANTITIES = (Part(runs_quantities("montecarlo", SUMMARY_METRICS, VIOLATIONS, OUTCOMES),
+                   lambda spec: spec.montecarlo is not None, lambda r: r.montecarlo),)
 
 
 def draw_samples(n: int, seed: int, spec: SweepSpec, start: int = 0) -> dict:
