@@ -113,11 +113,9 @@ def chunk_worker(payload: dict) -> dict:
     from ...sim.wheel_slip import PARAM_ORDER
     from .antiskid_kernel import simulate_batch
     from .antiskid_scenario import RunSettings
-    cs_d = dict(payload["controller"])
-    cs_d["profile"] = CreepSpeedProfile(**cs_d["profile"])
-    cs_d["params"] = tuple(cs_d["params"])
-    cs_d["K"] = tuple(cs_d["K"])
-    cs = ControllerSettings(**cs_d)
+    c = payload["controller"]       # asdict of the settings, tuples possibly as lists
+    cs = ControllerSettings(**{**c, "profile": CreepSpeedProfile(**c["profile"]),
+                               "params": tuple(c["params"]), "K": tuple(c["K"])})
     plant = tuple(np.asarray(payload["plant"][k], float) for k in PARAM_ORDER)
     run = RunSettings(plant, cs, np.asarray(payload["h"], float),
                       (np.asarray(payload["v0"], float), payload["lambda0"]),
