@@ -110,6 +110,13 @@ def test_array_runs_make_the_result_in_memory_and_from_the_files(tmp_path):
     assert (back.samples, back.metrics, back.violations) == (mem.samples, mem.metrics,
                                                              mem.violations)
     assert math.isnan(back.seconds) and back.workers == 0
+    # the same sweep started by the runs themselves, in memory and streamed
+    again = runs.start(toy_scaled, payload, N, (1.5,), workers=1, chunk=7).result(False)
+    assert (again.samples, again.metrics, again.violations) == (mem.samples, mem.metrics,
+                                                                mem.violations)
+    streamed = runs.start(toy_scaled, payload, N, (1.5,), workers=1, chunk=7,
+                          out=tmp_path / "again", manifest=man).result(False)
+    assert (streamed.metrics, streamed.violations) == (mem.metrics, mem.violations)
 
 
 def test_array_helpers():

@@ -35,7 +35,7 @@ from workbench.features.montecarlo_render import (DRAWS_TEXT, draw_outcome_scatt
                                                   summary_tables, SweepWords)
 from workbench.features.montecarlo_stats import (OK, STATISTICS, RunsResult, finite_span,
                                                  runs_quantities, summary_row)
-from workbench.features.quantities import names, values
+from workbench.features.quantities import Part, names, values
 
 N, T = 37, 2.0
 SPEC = MonteCarloSpec(N, 11, {
@@ -157,14 +157,17 @@ def test_statistics_of_the_runs():
     assert rates["grew"] == list(wilson_interval(grew, N))
     assert rates[OK] == list(wilson_interval(N - grew, N))
     # the toy's quantities declared once (a result holding the runs as ``.mc``)
-    table = runs_quantities("toy", Decay.SUMMARY, res.violations, Decay.OUTCOMES,
-                            lambda r: r.mc, lambda spec: spec == "with mc")
+    table = (Part(runs_quantities("toy", Decay.SUMMARY, res.violations, Decay.OUTCOMES),
+                  lambda spec: spec == "with mc", lambda r: r.mc),)
     q = values(table, "with mc", SimpleNamespace(mc=res))
     assert set(q) == names(table, "with mc") == {"toy.samples", "toy.fraction.grew"} | {
         f"toy.x_end.{s}" for s in STATISTICS} | {f"toy.wilson.{o}.{b}" for o in ("grew", OK)
                                                  for b in ("lo", "hi")}
     assert q["toy.x_end.max"] == float(np.max(m["x_end"])) and q["toy.samples"] == N
     assert q["toy.fraction.grew"] == grew / N
+    # the sweep did not run: every name not determined; the design has none: no name
+    assert values(table, "with mc", SimpleNamespace(mc=None)) == dict.fromkeys(q)
+    assert names(table, "without") == set() and values(table, "without", None) == {}
 
     class Counted(Decay):                 # the statistics are computed once per result
         calls = 0
@@ -293,7 +296,7 @@ def test_halving_check_of_a_toy_sweep(rtol):
                                   {k: hc.fine[k] for k in ("x_end", "grew")}, rtol,
                                   {"x_end": 0.0}, ("x_end",), ("grew",))
     assert (cv, fv, agree) == (hc.coarse, hc.fine, hc.agree)
-    table = halving_quantities("toy.halving", lambda r: r, lambda spec: True)
+    table = halving_quantities("toy.halving")
     assert values(table, None, hc) == hc.quantities("toy.halving") == {
         "toy.halving.runs": n, "toy.halving.agree": sum(hc.run_agree),
         "toy.halving.fraction_agree": sum(hc.run_agree) / n}

@@ -57,19 +57,34 @@ def test_every_delay_feedback_quantity_has_a_unit():
                                                                         "requirements.")))
 
 
-def test_determined_and_a_group_of_a_part_that_did_not_run():
-    from workbench.features.quantities import DeclaredQuantities, determined
+def test_determined_and_a_part_that_did_not_run():
+    """features.quantities.Part on a toy study: a part the design has but that
+    did not run (None) leaves each of its names not determined (None: the
+    claim INCONCLUSIVE, workbench.claims.check_claim); a part the design does not have
+    declares no name. Declared and Group entries of a part read the same way."""
+    from workbench.claims import Claim, check_claim
+    from workbench.features.quantities import DeclaredQuantities, Part, determined
+    from workbench.outcome import Verdict
     assert determined(float("nan")) is None and determined(None) is None
     assert determined(0.0) == 0.0 and determined("yes") == "yes"
     table = (Declared("gain", "1", lambda r: determined(r.gain)),
-             Group(lambda spec: {"mc.runs"}, lambda mc: {"mc.runs": mc.n},
-                   part=lambda r: r.mc))
+             Part((Declared("mc.mean", "m", lambda mc: mc.mean),
+                   Group(lambda spec: {"mc.runs"}, lambda mc: {"mc.runs": mc.n})),
+                  lambda spec: spec.mc, lambda r: r.mc))
 
     class Toy(DeclaredQuantities):
         TABLE = table
 
-    ran = SimpleNamespace(spec=SPEC, gain=float("nan"), mc=SimpleNamespace(n=7))
-    assert Toy().quantities(ran) == {"gain": None, "mc.runs": 7}
-    assert Toy().quantities(SimpleNamespace(spec=SPEC, gain=1.0, mc=None)) == {"gain": 1.0}
-    assert Toy().quantity_names(SPEC) == {"gain", "mc.runs"}
-    assert Toy().quantity_units(SPEC) == {"gain": "1", "mc.runs": "?"}
+    spec = SimpleNamespace(mc=True)
+    ran = SimpleNamespace(spec=spec, gain=float("nan"), mc=SimpleNamespace(n=7, mean=0.5))
+    assert Toy().quantities(ran) == {"gain": None, "mc.mean": 0.5, "mc.runs": 7}
+    skipped = Toy().quantities(SimpleNamespace(spec=spec, gain=1.0, mc=None))
+    assert skipped == {"gain": 1.0, "mc.mean": None, "mc.runs": None}
+    claim = Claim("c1", "mean", "mc.mean", "<=", 1.0, 0.0, None, "none", "toy", False, "pass", "")
+    assert check_claim(claim, skipped["mc.mean"]).verdict is Verdict.INCONCLUSIVE
+    assert check_claim(claim, 0.5).verdict is Verdict.PASS
+    assert Toy().quantity_names(spec) == {"gain", "mc.mean", "mc.runs"}
+    assert Toy().quantity_units(spec) == {"gain": "1", "mc.mean": "m", "mc.runs": "?"}
+    without = SimpleNamespace(mc=False)
+    assert Toy().quantity_names(without) == {"gain"} == set(Toy().quantity_units(without))
+    assert Toy().quantities(SimpleNamespace(spec=without, gain=1.0, mc=None)) == {"gain": 1.0}

@@ -99,6 +99,14 @@ class ArrayRuns:
         return self.result(draws_of(columns), {k: v.tolist() for k, v in metrics.items()},
                            {k: v.tolist() for k, v in viol.items()}, seconds, workers)
 
+    def start(self, run: Callable, payload: Callable, samples: int, context: tuple = (), **kw):
+        """:func:`start_array_sweep` of ``run`` (``payload``, ``samples`` and
+        the keywords ``kw`` as there) whose result is :meth:`result_of` with
+        ``context``; a streamed sweep reads back the :meth:`select` columns."""
+        return start_array_sweep(run, payload, samples, lambda columns, seconds, workers:
+                                 self.result_of(columns, seconds, workers, *context),
+                                 select=self.select, **kw)
+
     def load(self, out, context: Callable):
         """The result of a streamed sweep read back from its folder ``out``
         (only the :meth:`select` columns); ``context(manifest)``: the

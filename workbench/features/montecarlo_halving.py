@@ -131,20 +131,17 @@ def start_halving(run: Callable, payload_at: Callable, runs_of: Callable, values
     return PendingBatch(run, payloads, collect, len(payloads) if pool else 1, pool)
 
 
-def halving_quantities(prefix: str, part: Callable, present: Callable) -> tuple:
+def halving_quantities(prefix: str) -> tuple:
     """The check's quantities, declared once
-    (:class:`~workbench.features.quantities.Declared`) when ``present(spec)``:
+    (:class:`~workbench.features.quantities.Declared`, reading a
+    :class:`HalvingCheck`; a study puts them in a
+    :class:`~workbench.features.quantities.Part` of its result):
     ``<prefix>.runs`` (runs checked), ``.agree`` (runs whose every metric
     and outcome agrees) and ``.fraction_agree``
-    (:meth:`~workbench.features.convergence.StepComparison.quantities`) of
-    the check ``part(result)`` (None: not run, no value)."""
+    (:meth:`~workbench.features.convergence.StepComparison.quantities`)."""
     from .quantities import Declared
-
-    def read(result, q: str):
-        hc = part(result)
-        return None if hc is None else hc.quantities(prefix)[f"{prefix}.{q}"]
-    return (Declared(prefix + ".{q}", "1", read, over=lambda spec: [
-        {"q": q} for q in ("runs", "agree", "fraction_agree")] if present(spec) else []),)
+    return (Declared(prefix + ".{q}", "1", lambda hc, q: hc.quantities(prefix)[f"{prefix}.{q}"],
+                     over=lambda spec: [{"q": q} for q in ("runs", "agree", "fraction_agree")]),)
 
 
 def sweep_share_levels(finding, at_dt: Callable, check, outcomes: dict, at_quarter: Callable,

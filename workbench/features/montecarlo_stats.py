@@ -118,22 +118,18 @@ class RunsResult:
         return dict(memo)
 
 
-def runs_quantities(prefix: str, summary, flags, outcomes, part, present) -> tuple:
+def runs_quantities(prefix: str, summary, flags, outcomes) -> tuple:
     """A sweep's quantities, declared once
-    (:class:`~workbench.features.quantities.Declared`) when ``present(spec)``:
+    (:class:`~workbench.features.quantities.Declared`, reading a
+    :class:`RunsResult`; a study puts them in a
+    :class:`~workbench.features.quantities.Part` of its result):
     ``<prefix>.samples`` (the runs), ``<prefix>.<metric>.<statistic>`` of each
     ``summary`` metric, ``<prefix>.fraction.<flag>`` of each of ``flags`` and
     ``<prefix>.wilson.<outcome>.lo`` / ``.hi`` of each of ``outcomes``
-    (:meth:`RunsResult.statistics`; None: no finite value) of the runs
-    ``part(result)`` (None: not run, no value)."""
+    (:meth:`RunsResult.statistics`; None: no finite value)."""
     from .quantities import Declared
     keys = ([f"{m}.{s}" for m in summary for s in STATISTICS] + [f"fraction.{k}" for k in flags]
             + [f"wilson.{o}.{b}" for o in outcomes for b in ("lo", "hi")])
-
-    def read(result, key: str | None = None):
-        res = part(result)
-        return None if res is None else res.n if key is None else res.statistics()[key]
-    return (Declared(f"{prefix}.samples", "1", read, over=lambda spec: [{}] if present(spec)
-                     else []),
-            Declared(prefix + ".{key}", "?", read, over=lambda spec: [
-                {"key": k} for k in keys] if present(spec) else []))
+    return (Declared(f"{prefix}.samples", "1", lambda res: res.n),
+            Declared(prefix + ".{key}", "?", lambda res, key: res.statistics()[key],
+                     over=lambda spec: [{"key": k} for k in keys]))

@@ -18,6 +18,14 @@ A reader returns ``None`` for a value that is not determined (the claim is then
 INCONCLUSIVE, as for a name the old ``quantities`` left out; :func:`determined`).
 A study class gets its three quantity methods from its table by deriving from
 :class:`DeclaredQuantities`.
+
+A feature's part of a result that may not have run (a Monte Carlo sweep, a
+basin check: a table of the design, or none) is one :class:`Part`: its
+entries declare names only when the design has the part, and read the
+part's own result, every value undetermined when that is None::
+
+    Part(runs_quantities("montecarlo", ...), lambda spec: spec.montecarlo is not None,
+         lambda r: r.montecarlo)
 """
 from __future__ import annotations
 
@@ -26,7 +34,8 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["Declared", "DeclaredQuantities", "Group", "determined", "names", "units", "values"]
+__all__ = ["Declared", "DeclaredQuantities", "Group", "Part", "determined", "names", "units",
+           "values"]
 
 
 def determined(x):
@@ -71,62 +80,88 @@ class Declared:
 @dataclass(frozen=True)
 class Group:
     """Quantities a feature declares with its own pair of functions (a feature
-    not yet written as :class:`Declared` entries), included when ``present``.
-
-    ``names(spec) -> set``, ``values(result) -> dict``, ``units(spec) -> dict``
-    (default: no unit known, ``"?"``) and ``present(spec) -> bool``. With
-    ``part``, ``values`` reads ``part(result)``, the result of the feature,
-    and the group has no value when that is None (the part did not run).
-    """
+    not yet written as :class:`Declared` entries): ``names(spec) -> set``,
+    ``values(result) -> dict`` and ``units(spec) -> dict`` (default: no unit
+    known, ``"?"``). ``present(spec) -> bool`` is short for the group as the
+    one entry of a :class:`Part` with that ``present``."""
 
     names: Callable[[Any], set]
     values: Callable[[Any], dict]
     present: Callable[[Any], bool] = lambda spec: True
     units: Callable[[Any], dict] | None = None
-    part: Callable[[Any], Any] | None = None
 
-    def values_of(self, result) -> dict:
-        """The group's values in ``result`` (see ``part``)."""
-        if self.part is None:
-            return self.values(result)
-        x = self.part(result)
-        return {} if x is None else self.values(x)
+
+@dataclass(frozen=True)
+class Part:
+    """A feature's part of a study's result, which may not have run.
+
+    Attributes
+    ----------
+    entries : tuple
+        :class:`Declared` and :class:`Group` entries; they read ``part(result)``.
+    present : callable
+        ``present(spec) -> bool``: the design has the part; when not, its
+        entries declare no name.
+    part : callable
+        ``part(result)``: the part's result (default: ``result`` itself);
+        None: the part did not run, every name of its entries is not
+        determined (None, the claim INCONCLUSIVE).
+    """
+
+    entries: tuple
+    present: Callable[[Any], bool] = lambda spec: True
+    part: Callable[[Any], Any] = lambda result: result
+
+
+def _parts(table, spec) -> Iterator[Part]:
+    """The table's parts the design has: each :class:`Part`, a :class:`Group`
+    as a part of its own ``present`` and any other entry as a part of the
+    whole result."""
+    for d in table:
+        if isinstance(d, Group):
+            d = Part((d,), d.present)
+        elif not isinstance(d, Part):
+            d = Part((d,))
+        if d.present(spec):
+            yield d
+
+
+def _names(entry, spec):
+    if isinstance(entry, Group):
+        return entry.names(spec)
+    return [n for n, _ in entry.members(spec)]
 
 
 def names(table, spec) -> set[str]:
     """Every claimable name of a design (known before running)."""
-    out: set[str] = set()
-    for d in table:
-        if isinstance(d, Group):
-            out |= d.names(spec) if d.present(spec) else set()
-        else:
-            out |= {n for n, _ in d.members(spec)}
-    return out
+    return {n for p in _parts(table, spec) for e in p.entries for n in _names(e, spec)}
 
 
 def values(table, spec, result) -> dict:
     """name -> value of every declared quantity (``None``: not determined)."""
     out: dict = {}
-    for d in table:
-        if isinstance(d, Group):
-            if d.present(spec):
-                out.update(d.values_of(result))
-        else:
-            for n, index in d.members(spec):
-                out[n] = d.read(result, **index)
+    for p in _parts(table, spec):
+        x = p.part(result)
+        for e in p.entries:
+            if x is None:
+                out.update(dict.fromkeys(_names(e, spec)))
+            elif isinstance(e, Group):
+                out.update(e.values(x))
+            else:
+                out.update({n: e.read(x, **index) for n, index in e.members(spec)})
     return out
 
 
 def units(table, spec) -> dict[str, str]:
     """name -> unit of every declared quantity (``"?"``: the feature declares none)."""
     out: dict[str, str] = {}
-    for d in table:
-        if isinstance(d, Group):
-            if d.present(spec):
-                u = d.units(spec) if d.units is not None else {}
-                out.update({n: u.get(n, "?") for n in d.names(spec)})
-        else:
-            out.update({n: d.unit.format(**index) for n, index in d.members(spec)})
+    for p in _parts(table, spec):
+        for e in p.entries:
+            if isinstance(e, Group):
+                u = e.units(spec) if e.units is not None else {}
+                out.update({n: u.get(n, "?") for n in e.names(spec)})
+            else:
+                out.update({n: e.unit.format(**index) for n, index in e.members(spec)})
     return out
 
 

@@ -19,9 +19,9 @@ import numpy as np
 
 from ...features.montecarlo_halving import Compared, halving_quantities
 from ...features.montecarlo_halving import start_halving as start_batches
+from ...features.quantities import Part
 from ...sim.batch import PendingBatch
-from .antiskid_montecarlo import RUNS, SUMMARY_METRICS, range_worker, sweep_inputs
-from .antiskid_run_spec import SweepSpec
+from .antiskid_montecarlo import RUNS, SUMMARY_METRICS, draw_samples, range_payload, range_worker
 
 
 def _in_traction(coarse: dict, fine: dict) -> dict:
@@ -61,21 +61,15 @@ def start_halving(design, n: int, *, K: tuple | None = None, pool: bool = True,
     :func:`~workbench.papers.p003.antiskid_montecarlo.start_sweep`; ``kernel``: as
     there (default: compiled when numba is installed).
     """
-    from .antiskid_kernel import default_kernel
-    from .antiskid_run_spec import gain_for
-    kernel = kernel or default_kernel()
-    spec = design.spec
-    ms: SweepSpec = spec.montecarlo
-    K = tuple(gain_for(spec)[0] if K is None else K)
-    inp = sweep_inputs(design, n, ms.seed, K)
-    return start_batches(range_worker, lambda step: {"design": design, "K": K, "seed": ms.seed,
-                                                     "i0": 0, "i1": n, "kernel": kernel,
-                                                     "step": step},
+    spec, ms = design.spec, design.spec.montecarlo
+    payload = range_payload(design, ms.seed, K, kernel)[2]
+    return start_batches(range_worker, lambda step: payload(0, n, step),
                          lambda out: RUNS.runs(out, spec.scenario["t_brake"]), _step_values,
-                         COMPARED, inp["dt"], n, rtol=spec.conv_rtol, atol=spec.conv_atol,
-                         case=ms.case, seed=ms.seed, draws=inp["draws"], coarse=coarse, pool=pool)
+                         COMPARED, ms.dt or spec.dt, n, rtol=spec.conv_rtol,
+                         atol=spec.conv_atol, case=ms.case, seed=ms.seed,
+                         draws=draw_samples(n, ms.seed, ms), coarse=coarse, pool=pool)
 
 
 #: The check's quantities (``montecarlo.halving.runs``, ``.agree``, ``.fraction_agree``).
-QUANTITIES = halving_quantities("montecarlo.halving", lambda r: r.halving, lambda spec: (
-    spec.montecarlo is not None and bool(spec.montecarlo.halving)))
+QUANTITIES = (Part(halving_quantities("montecarlo.halving"), lambda spec: (
+    spec.montecarlo is not None and bool(spec.montecarlo.halving)), lambda r: r.halving),)

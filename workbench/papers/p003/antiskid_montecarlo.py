@@ -47,9 +47,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from ...features.montecarlo_arrays import (ArrayRuns, chunk_arrays, inputs_digest,
-                                           start_array_sweep)
+from ...features.montecarlo_arrays import ArrayRuns, chunk_arrays, inputs_digest
 from ...features.montecarlo_stats import OK, RunsResult, runs_quantities
+from ...features.quantities import Part
 from ...sim.batch import PendingBatch
 from .antiskid_run_spec import SweepSpec
 
@@ -86,8 +86,8 @@ class SweepResult(RunsResult):
 #: value): ``montecarlo.samples``, ``montecarlo.<metric>.<statistic>``,
 #: ``montecarlo.fraction.<violation>`` and ``montecarlo.wilson.<outcome>.lo``
 #: / ``.hi`` (the Wilson 95 % interval of an outcome's rate).
-QUANTITIES = runs_quantities("montecarlo", SUMMARY_METRICS, VIOLATIONS, OUTCOMES,
-                             lambda r: r.montecarlo, lambda spec: spec.montecarlo is not None)
+QUANTITIES = (Part(runs_quantities("montecarlo", SUMMARY_METRICS, VIOLATIONS, OUTCOMES),
+                   lambda spec: spec.montecarlo is not None, lambda r: r.montecarlo),)
 
 
 def draw_samples(n: int, seed: int, spec: SweepSpec, start: int = 0) -> dict:
@@ -113,11 +113,9 @@ def chunk_worker(payload: dict) -> dict:
     from ...sim.wheel_slip import PARAM_ORDER
     from .antiskid_kernel import simulate_batch
     from .antiskid_scenario import RunSettings
-    cs_d = dict(payload["controller"])
-    cs_d["profile"] = CreepSpeedProfile(**cs_d["profile"])
-    cs_d["params"] = tuple(cs_d["params"])
-    cs_d["K"] = tuple(cs_d["K"])
-    cs = ControllerSettings(**cs_d)
+    c = payload["controller"]       # asdict of the settings, tuples possibly as lists
+    cs = ControllerSettings(**{**c, "profile": CreepSpeedProfile(**c["profile"]),
+                               "params": tuple(c["params"]), "K": tuple(c["K"])})
     plant = tuple(np.asarray(payload["plant"][k], float) for k in PARAM_ORDER)
     run = RunSettings(plant, cs, np.asarray(payload["h"], float),
                       (np.asarray(payload["v0"], float), payload["lambda0"]),
@@ -128,19 +126,17 @@ def chunk_worker(payload: dict) -> dict:
                                                    for k, v in vars(m).items()}}
 
 
-def sweep_inputs(design, samples: int, seed: int, K: tuple | None, start: int = 0) -> dict:
-    """Runs ``start <= i < samples`` of the design's sweep with ``seed`` as
-    plain data: ``draws``, per-run ``plant`` parameters, the nominal values
-    ``base``, the ``controller`` (``asdict`` of the case's settings), the
-    ``scenario`` and ``dt``; ``K``: the cruise gain if the caller has it
-    (default: :func:`~workbench.papers.p003.antiskid_run.gain_for`)."""
+def sweep_inputs(design, samples: int, seed: int, K: tuple, start: int = 0) -> dict:
+    """Runs ``start <= i < samples`` of the design's sweep with ``seed`` and
+    the cruise gain ``K`` as plain data: ``draws``, per-run ``plant``
+    parameters, the nominal values ``base``, the ``controller`` (``asdict``
+    of the case's settings), the ``scenario`` and ``dt``."""
     from ...sim.wheel_slip import PARAM_ORDER
-    from .antiskid_run_spec import controller_settings, gain_for, plant_values
+    from .antiskid_run_spec import controller_settings, plant_values
 
     spec = design.spec
     ms: SweepSpec = spec.montecarlo
     case = next(c for c in spec.cases if c.name == ms.case)
-    K = gain_for(spec)[0] if K is None else K
     cs = controller_settings(spec, K, case)
     draws = draw_samples(samples, seed, ms, start)
     base = plant_values(spec)
@@ -234,6 +230,22 @@ def range_worker(payload: dict) -> dict:
                         lambda_opt=lambda_opt_of(inp["plant"]))
 
 
+def range_payload(design, seed: int, K: tuple | None = None, kernel: str | None = None):
+    """(K, kernel, payload) of a design's runs by :func:`range_worker`: the
+    cruise gain (``K``, default
+    :func:`~workbench.papers.p003.antiskid_run_spec.gain_for`), the stepping
+    path (``kernel``, default compiled when numba is installed) and
+    ``payload(i0, i1, step=None)`` of runs ``i0 <= i < i1`` at ``step``
+    (None: the sweep's)."""
+    from .antiskid_kernel import default_kernel
+    from .antiskid_run_spec import gain_for
+    K = tuple(gain_for(design.spec)[0] if K is None else K)
+    kernel = kernel or default_kernel()
+    return K, kernel, lambda i0, i1, step=None: {"design": design, "K": K, "seed": seed,
+                                                 "i0": i0, "i1": i1, "kernel": kernel,
+                                                 "step": step}
+
+
 #: How a sweep's runs are made from its chunk arrays: :func:`per_run` of the
 #: raw metrics it needs and each run's ``lambda_opt``, with the scenario's
 #: ``t_brake`` (``RUNS.runs(arrays, t_brake)``: metrics and violations).
@@ -273,20 +285,13 @@ def start_sweep(design, samples: int, seed: int, *, workers: int | None = None,
     numba is installed); the results agree to rounding
     (``tests/test_compiled_kernel.py``).
     """
-    from .antiskid_kernel import compile_kernel, default_kernel
-    from .antiskid_run_spec import gain_for
-    kernel = kernel or default_kernel()
-    K = tuple(gain_for(design.spec)[0] if K is None else K)
-    t_brake = design.spec.scenario["t_brake"]
-    return start_array_sweep(
-        range_worker, lambda i0, i1: {"design": design, "K": K, "seed": seed, "i0": i0,
-                                      "i1": i1, "kernel": kernel},
-        samples, lambda cols, seconds, n_workers: RUNS.result_of(cols, seconds, n_workers,
-                                                                 t_brake),
-        chunk=chunk, workers=workers, pool=pool, scheduler=scheduler,
-        before_pool=compile_kernel if kernel == "compiled" else None, out=out,
-        manifest=lambda ch: _manifest(design, samples, seed, ch, kernel, K), resume=resume,
-        select=RUNS.select)
+    from .antiskid_kernel import compile_kernel
+    K, kernel, payload = range_payload(design, seed, K, kernel)
+    return RUNS.start(range_worker, payload, samples, (design.spec.scenario["t_brake"],),
+                      chunk=chunk, workers=workers, pool=pool, scheduler=scheduler,
+                      before_pool=compile_kernel if kernel == "compiled" else None, out=out,
+                      manifest=lambda ch: _manifest(design, samples, seed, ch, kernel, K),
+                      resume=resume)
 
 
 def load_sweep(out) -> SweepResult:

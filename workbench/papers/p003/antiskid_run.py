@@ -23,7 +23,7 @@ from ...features.comfort import COMFORT_QUANTITIES, comfort_of, comfort_quantiti
 from ...features.convergence import agree
 from ...features.frozen_loop import FrozenLoop, freeze
 from ...features.linear_delay_check import LinearDelayCheck, linear_delay_check
-from ...features.quantities import Declared, DeclaredQuantities, Group, determined
+from ...features.quantities import Declared, DeclaredQuantities, Group, Part, determined
 from ...jsonable import OMIT, json_method
 from ...margins import DelayMargin
 from ...reader import Reader
@@ -226,10 +226,11 @@ def _switch(r, c, field):
     return None if sw is None else sw.margin.h if field == "margin" else getattr(sw, field)
 
 
-def _comfort_values(r) -> dict:
-    return {k: v for c in r.cases if c.comfort is not None for k, v in comfort_quantities(
-        c.case.name, c.comfort, c.comfort_coarse, None if c.quarter is None else c.quarter[2]
-    ).items()}
+def _comfort(r, c, k):
+    cr = r.case(c)
+    return None if cr.comfort is None else comfort_quantities(
+        c, cr.comfort, cr.comfort_coarse, None if cr.quarter is None else cr.quarter[2]
+    )[f"cases[{c}].{k}"]
 
 
 #: Every claimable quantity of an ``antiskid-run`` design (:mod:`workbench.features.quantities`).
@@ -255,17 +256,17 @@ TABLE = (
              or r.case(c).unconverged else "yes", over=_cases),
     *(Declared(f"cases[{{c}}].switch.{f}", u, lambda r, c, f=f: _switch(r, c, f), over=_cases)
       for f, u in (("abscissa", "1/s"), ("margin", "s"), ("dmu_dlam", "1"))),
-    Group(lambda spec: {f"cases[{c.name}].{k}" for c in spec.cases for k in COMFORT_QUANTITIES},
-          _comfort_values, present=lambda spec: spec.comfort is not None),
+    Part((Declared("cases[{c}].{k}", "?", _comfort, over=lambda spec: [
+        {"c": c.name, "k": k} for c in spec.cases for k in COMFORT_QUANTITIES]),),
+         lambda spec: spec.comfort is not None),
     *MONTECARLO_QUANTITIES,
     *HALVING_QUANTITIES,
-    Group(lambda spec: basin_quantity_names([c.name for c in spec.cases], True),
-          lambda r: basin_quantities(r.basin.basin, r.basin.sweep,
-                                     [c.case.name for c in r.cases], r.basin.brake),
-          present=lambda spec: spec.basin is not None,
-          part=lambda r: None if r.basin is None else r),
-    Group(lambda spec: sampled_quantity_names(spec.sampled), sampled_quantities,
-          present=lambda spec: spec.sampled is not None, part=lambda r: r.sampled),
+    Part((Group(lambda spec: basin_quantity_names([c.name for c in spec.cases], True),
+                lambda r: basin_quantities(r.basin.basin, r.basin.sweep,
+                                           [c.case.name for c in r.cases], r.basin.brake)),),
+         lambda spec: spec.basin is not None, lambda r: None if r.basin is None else r),
+    Part((Group(lambda spec: sampled_quantity_names(spec.sampled), sampled_quantities),),
+         lambda spec: spec.sampled is not None, lambda r: r.sampled),
 )
 
 
