@@ -116,6 +116,6 @@ def basin_quantities(basin, sweep, labels=(), brake=()) -> dict:
         "cruise": basin.judged, "brake": [b.judged for b in brake]}, sweep, "k2")
 
 
-def basin_quantity_names(labels, with_sweep: bool) -> set:
-    """Names of :func:`basin_quantities` (``with_sweep``: the k2 rule's too)."""
-    return switch_basin_quantity_names(labels, ("cruise", "brake"), "k2" if with_sweep else None)
+def basin_quantity_names(labels) -> set:
+    """Names of :func:`basin_quantities`, the k2 rule's included."""
+    return switch_basin_quantity_names(labels, ("cruise", "brake"), "k2")

@@ -261,7 +261,7 @@ TABLE = (
          lambda spec: spec.comfort is not None),
     *MONTECARLO_QUANTITIES,
     *HALVING_QUANTITIES,
-    Part((Group(lambda spec: basin_quantity_names([c.name for c in spec.cases], True),
+    Part((Group(lambda spec: basin_quantity_names([c.name for c in spec.cases]),
                 lambda r: basin_quantities(r.basin.basin, r.basin.sweep,
                                            [c.case.name for c in r.cases], r.basin.brake)),),
          lambda spec: spec.basin is not None, lambda r: None if r.basin is None else r),
