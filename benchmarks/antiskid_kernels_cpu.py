@@ -27,6 +27,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from antiskid_run_times import _tree
+
 ROOT = Path(__file__).resolve().parents[1]
 DRY = ROOT / "designs" / "antiskid-run-dry.toml"
 #: Rates (Hz) of the timed sampled runs (a braking and a traction run each).
@@ -74,12 +76,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         trees = [("after", ROOT)]
         if a.before:
-            before = Path(tmp) / "tree"
-            before.mkdir()
-            arch = subprocess.run(["git", "archive", a.before], cwd=ROOT, check=True,
-                                  capture_output=True)
-            subprocess.run(["tar", "-x", "-C", str(before)], input=arch.stdout, check=True)
-            trees.insert(0, (f"before ({a.before})", before))
+            trees.insert(0, (f"before ({a.before})", _tree(a.before, tmp)))
         got = {label: [] for label, _ in trees}
         for _ in range(a.rounds):
             for label, tree in trees:
