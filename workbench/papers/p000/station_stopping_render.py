@@ -12,6 +12,7 @@ from ...kinds.stop_accuracy.render import quantity_table, ranges_table, sections
 from ...kinds.stop_accuracy.run import controller_index
 from ...kinds.stop_accuracy.trace_figures import plot_tracked_stops
 from ...plants.brake000 import brake_model
+from ...report.display_math import display_math
 from ...report.markdown import Figure, Rendered, fmt, md_table
 from .station_stopping_fair_render import fair_section, figures
 from .station_stopping_spec import CONTROLLERS, VARIANTS, gains, label
@@ -19,6 +20,7 @@ from .station_stopping_spec import CONTROLLERS, VARIANTS, gains, label
 
 #: Stop window of the accuracy table and figure (m): the usual platform-screen-door tolerance.
 STOP_WINDOW_M = 0.3
+
 
 def model_section() -> str:
     """The brake model of paper 000 rendered from the sympy source."""
@@ -38,7 +40,7 @@ def model_section() -> str:
             "slips resolved: eq 3 and eq 7 use V in km/h (the paper writes cm/s); K1/K2 "
             "(Table 1: 85.16) is read as the air-brake deceleration in cm/s² of a full 1 m/s² "
             "demand at standstill, hence the division by 100; only the ratio K1/K2 enters.\n\n"
-            + "\n\n".join(f"$$\n{e}\n$$" for e in eqs))
+            + display_math(eqs))
 
 
 def render(design, res) -> Rendered:
